@@ -1,0 +1,1 @@
+"""Robot kinematics service: forward kinematics and every inverse-kinematics solution."""

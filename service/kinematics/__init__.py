@@ -1,0 +1,1 @@
+"""Pure-numpy kinematics core. Imports numpy and the standard library only."""

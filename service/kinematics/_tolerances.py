@@ -1,0 +1,36 @@
+"""The one place for numerical tolerances used by the core.
+
+Detection of special cases (singularities, parallel or intersecting axes,
+reachability limits) always goes through these tolerances, never through exact
+float equality.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Largest deviation from orthonormality accepted in an input rotation,
+#: measured as max |R^T R - I| and |det R - 1|.
+ORTHONORMAL_TOLERANCE = 1e-6
+
+#: Relative tolerance for geometric tests on unit vectors (parallel axes,
+#: intersecting axes, zero-length projections).
+GEOMETRY_TOLERANCE = 1e-9
+
+#: An IK solution is accepted when its FK position error is below this
+#: fraction of the robot's characteristic length, and its orientation error
+#: (radians) below the same number.
+ACCEPT_RESIDUAL = 1e-6
+
+#: Two solutions closer than this (radians, or fraction of the characteristic
+#: length for prismatic joints) are the same solution.
+DUPLICATE_TOLERANCE = 1e-6
+
+#: A configuration is reported as singular when the relevant quantity (a sine,
+#: a normalised distance) is smaller than this.
+SINGULARITY_TOLERANCE = 1e-7
+
+
+def is_near_zero(value: np.ndarray | float, tolerance: float = GEOMETRY_TOLERANCE) -> np.ndarray | bool:
+    """Whether ``|value| <= tolerance``, elementwise."""
+    return np.abs(value) <= tolerance

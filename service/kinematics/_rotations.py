@@ -1,0 +1,1035 @@
+"""Rotations and rigid transforms: representations, conversions and validation.
+
+Conventions
+-----------
+* Angles are radians. Units other than radians exist only at the API boundary,
+  where :func:`to_radians` and :func:`from_radians` convert them once.
+* A rotation matrix ``a_R_b``, shape (3, 3), maps coordinates in frame b to
+  coordinates in frame a; its columns are the axes of b expressed in a.
+  A homogeneous transform ``a_T_b``, shape (4, 4), is ``[[a_R_b, a_p_b], [0 0 0 1]]``.
+* Quaternions are ``(w, x, y, z)``, scalar first. Conversions return the
+  canonical sign: ``w >= 0``, and when ``w == 0`` the first nonzero of
+  ``(x, y, z)`` is positive.
+* ZYZ Euler angles ``(phi, theta, psi)`` give ``Rz(phi) Ry(theta) Rz(psi)``.
+* Roll, pitch, yaw ``(roll, pitch, yaw)`` give ``Rz(yaw) Ry(pitch) Rx(roll)``:
+  a rotation about the fixed x axis, then the fixed y axis, then the fixed z axis.
+* Returned angles are wrapped to ``(-pi, pi]``.
+
+Validation
+----------
+The ``check_*`` functions validate a value at the boundary of the core and
+return it as a new float64 array. Every conversion *from* a rotation
+representation validates its input the same way, so a matrix that is not a
+rotation can never be converted silently. Failures raise
+:class:`InvalidInputError`. Its ``location`` is relative to the value given:
+``(1, 2)`` is entry (1, 2) of a matrix, ``(4,)`` row 4 of a batch, and ``()``
+the value as a whole. Functions with several array arguments put the
+argument's name first, for example ``("p", 2)`` in :func:`transform_from`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ._errors import InvalidInputError
+from ._tolerances import ORTHONORMAL_TOLERANCE, SINGULARITY_TOLERANCE
+
+__all__ = [
+    "check_rotation",
+    "check_transform",
+    "check_unit_quaternion",
+    "euler_zyz_from_matrix",
+    "from_radians",
+    "invert_transform",
+    "matrices_from_quaternions",
+    "matrix_from_axis_angle",
+    "matrix_from_euler_zyz",
+    "matrix_from_quaternion",
+    "matrix_from_rpy",
+    "quaternion_from_matrix",
+    "quaternions_from_matrices",
+    "rot_x",
+    "rot_y",
+    "rot_z",
+    "rotation_angle_between",
+    "rpy_from_matrix",
+    "to_radians",
+    "transform_from",
+    "wrap_angle",
+]
+
+# Radians per unit, for every angle unit the service accepts.
+_RADIANS_PER_UNIT = {"rad": 1.0, "deg": math.pi / 180.0}
+
+
+# ---------------------------------------------------------------------------
+# Validation helpers (private). They work on stacks of shape (..., m, n) so the
+# single and the batch functions share one implementation; the leading index
+# of the first offending element becomes the error's location.
+# ---------------------------------------------------------------------------
+
+
+def _as_float_array(value: ArrayLike, what: str) -> np.ndarray:
+    """Return ``value`` as a new float64 array, or raise if it holds no real numbers."""
+    try:
+        array = np.asarray(value)
+    except (ValueError, TypeError) as error:  # ragged nested sequences
+        raise InvalidInputError(f"{what} must be an array of numbers ({error})") from None
+    if array.dtype.kind not in "iuf":
+        raise InvalidInputError(f"{what} must contain real numbers, got values of type {array.dtype}")
+    return np.array(array, dtype=np.float64)
+
+
+def _first_true(mask: np.ndarray) -> tuple[int, ...]:
+    """Index of the first true element of ``mask`` (``()`` for a 0-d mask)."""
+    return tuple(int(i) for i in np.unravel_index(int(np.argmax(mask)), mask.shape))
+
+
+def _describe(index: tuple[int, ...]) -> str:
+    return str(index[0]) if len(index) == 1 else str(index)
+
+
+def _check_finite(array: np.ndarray, what: str) -> None:
+    not_finite = ~np.isfinite(array)
+    if not_finite.any():
+        index = _first_true(not_finite)
+        where = f"{what} entry {_describe(index)}" if index else what
+        raise InvalidInputError(f"{where} is {array[index]}; every entry must be a finite number", location=index)
+
+
+def _check_shape(array: np.ndarray, core_shape: tuple[int, ...], batch: bool, what: str) -> None:
+    ndim = len(core_shape) + (1 if batch else 0)
+    if array.ndim != ndim or array.shape[array.ndim - len(core_shape) :] != core_shape:
+        expected = f"(N, {', '.join(map(str, core_shape))})" if batch else str(core_shape)
+        raise InvalidInputError(f"{what} must have shape {expected}, got shape {array.shape}")
+
+
+def _check_rotation_stack(R: np.ndarray, tolerance: float, what: str) -> None:
+    """Raise unless every finite (..., 3, 3) matrix in ``R`` is a rotation within ``tolerance``."""
+    gram_error = np.swapaxes(R, -1, -2) @ R - np.eye(3)
+    worst = np.max(np.abs(gram_error), axis=(-2, -1))
+    not_orthonormal = worst > tolerance
+    if not_orthonormal.any():
+        batch_index = _first_true(not_orthonormal)
+        error = gram_error[batch_index]
+        i, j = np.unravel_index(int(np.argmax(np.abs(error))), (3, 3))
+        if i == j:
+            detail = f"column {i} has length {math.sqrt(1.0 + error[i, j]):.9g}"
+        else:
+            detail = f"columns {min(i, j)} and {max(i, j)} have dot product {error[i, j]:.3g}"
+        raise InvalidInputError(
+            f"{what} is not orthonormal: max |R^T R - I| is {worst[batch_index]:.3g}, "
+            f"more than the tolerance {tolerance:g} ({detail})",
+            location=batch_index,
+        )
+    determinant = np.linalg.det(R)
+    reflection = determinant < 0.0
+    if reflection.any():
+        batch_index = _first_true(reflection)
+        raise InvalidInputError(
+            f"{what} has determinant {determinant[batch_index]:.9g}: it is a reflection, not a rotation",
+            location=batch_index,
+        )
+    off = np.abs(determinant - 1.0) > tolerance
+    if off.any():
+        batch_index = _first_true(off)
+        raise InvalidInputError(
+            f"{what} has determinant {determinant[batch_index]:.9g}, which differs from 1 by "
+            f"{abs(determinant[batch_index] - 1.0):.3g}, more than the tolerance {tolerance:g}",
+            location=batch_index,
+        )
+
+
+def _checked_rotations(R: ArrayLike, tolerance: float, batch: bool) -> np.ndarray:
+    R = _as_float_array(R, "rotation matrix")
+    _check_shape(R, (3, 3), batch, "rotation matrix")
+    _check_finite(R, "rotation matrix")
+    _check_rotation_stack(R, tolerance, "rotation matrix")
+    return R
+
+
+def _checked_transforms(T: ArrayLike, tolerance: float, batch: bool) -> np.ndarray:
+    T = _as_float_array(T, "transform")
+    _check_shape(T, (4, 4), batch, "transform")
+    _check_finite(T, "transform")
+    deviation = np.abs(T[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0]))
+    bad_row = np.max(deviation, axis=-1) > tolerance
+    if bad_row.any():
+        batch_index = _first_true(bad_row)
+        column = int(np.argmax(deviation[batch_index]))
+        raise InvalidInputError(
+            f"the bottom row of a homogeneous transform must be [0, 0, 0, 1], "
+            f"but entry (3, {column}) is {T[(*batch_index, 3, column)]:.9g}",
+            location=(*batch_index, 3, column),
+        )
+    # The rotation block shares its (row, column) indices with the 4x4, so the
+    # locations of these errors are already relative to the transform.
+    _check_rotation_stack(T[..., :3, :3], tolerance, "the rotation block of the transform")
+    return T
+
+
+def _checked_quaternions(wxyz: ArrayLike, tolerance: float, batch: bool) -> np.ndarray:
+    q = _as_float_array(wxyz, "quaternion")
+    _check_shape(q, (4,), batch, "quaternion")
+    _check_finite(q, "quaternion")
+    norm = np.linalg.norm(q, axis=-1)
+    not_unit = np.abs(norm - 1.0) > tolerance
+    if not_unit.any():
+        batch_index = _first_true(not_unit)
+        raise InvalidInputError(
+            f"quaternion (w, x, y, z) must have norm 1, but its norm is {norm[batch_index]:.9g} "
+            f"(off by {abs(norm[batch_index] - 1.0):.3g}, tolerance {tolerance:g})",
+            location=batch_index,
+        )
+    return q
+
+
+def _checked_angles(angle: ArrayLike, what: str, *, scalar: bool = False) -> np.ndarray:
+    """Angles as a float64 array of shape () or (N,) (only () when ``scalar``)."""
+    angle = _as_float_array(angle, what)
+    if angle.ndim > (0 if scalar else 1):
+        shapes = "a scalar" if scalar else "a scalar or shape (N,)"
+        raise InvalidInputError(f"{what} must be {shapes}, got shape {angle.shape}")
+    _check_finite(angle, what)
+    return angle
+
+
+# ---------------------------------------------------------------------------
+# Public validation
+# ---------------------------------------------------------------------------
+
+
+def check_rotation(R: ArrayLike, *, tolerance: float = ORTHONORMAL_TOLERANCE) -> np.ndarray:
+    """Validate a rotation matrix.
+
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation matrix ``a_R_b``.
+    tolerance : float
+        Largest accepted ``max |R^T R - I|`` and ``|det R - 1|``.
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3), float64
+        A new array with the same values (not re-orthonormalised).
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong shape or not numbers (location ``()``); a NaN or infinite entry
+        (location ``(i, j)``); not orthonormal, or a reflection (location ``()``).
+
+    Examples
+    --------
+    >>> check_rotation([[0, -1, 0], [1, 0, 0], [0, 0, 1]]).dtype
+    dtype('float64')
+    >>> check_rotation(np.diag([1.0, 1.0, -1.0]))
+    Traceback (most recent call last):
+    ...
+    service.kinematics._errors.InvalidInputError: rotation matrix has determinant -1: it is a reflection, not a rotation
+    """
+    return _checked_rotations(R, tolerance, batch=False)
+
+
+def check_transform(T: ArrayLike, *, tolerance: float = ORTHONORMAL_TOLERANCE) -> np.ndarray:
+    """Validate a homogeneous transform.
+
+    Parameters
+    ----------
+    T : array_like, shape (4, 4)
+        Transform ``a_T_b = [[a_R_b, a_p_b], [0, 0, 0, 1]]``.
+    tolerance : float
+        Tolerance for the bottom row and for the rotation block (see
+        :func:`check_rotation`).
+
+    Returns
+    -------
+    T : ndarray, shape (4, 4), float64
+        A new array with the same values.
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong shape (location ``()``); a NaN or infinite entry, or a bottom row
+        other than ``[0, 0, 0, 1]`` (location ``(i, j)`` of the 4x4); a rotation
+        block that is not a rotation (location ``()``).
+
+    Examples
+    --------
+    >>> check_transform(np.eye(4)).shape
+    (4, 4)
+    """
+    return _checked_transforms(T, tolerance, batch=False)
+
+
+def check_unit_quaternion(wxyz: ArrayLike, *, tolerance: float = ORTHONORMAL_TOLERANCE) -> np.ndarray:
+    """Validate a unit quaternion.
+
+    Parameters
+    ----------
+    wxyz : array_like, shape (4,)
+        Quaternion ``(w, x, y, z)``.
+    tolerance : float
+        Largest accepted ``| |q| - 1 |``.
+
+    Returns
+    -------
+    wxyz : ndarray, shape (4,), float64
+        A new array with the same values (not re-normalised).
+
+    Raises
+    ------
+    InvalidInputError
+        Wrong shape (location ``()``); a NaN or infinite entry (location
+        ``(i,)``); a norm that is not 1 (location ``()``).
+
+    Examples
+    --------
+    >>> check_unit_quaternion([1, 0, 0, 0]).tolist()
+    [1.0, 0.0, 0.0, 0.0]
+    """
+    return _checked_quaternions(wxyz, tolerance, batch=False)
+
+
+# ---------------------------------------------------------------------------
+# Elementary rotations and axis-angle
+# ---------------------------------------------------------------------------
+
+
+def _elementary(angle: ArrayLike, axis: int, what: str) -> np.ndarray:
+    angle = _checked_angles(angle, what)
+    c, s = np.cos(angle), np.sin(angle)
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    R = np.zeros(angle.shape + (3, 3))
+    R[..., axis, axis] = 1.0
+    R[..., i, i] = c
+    R[..., j, j] = c
+    R[..., i, j] = -s
+    R[..., j, i] = s
+    return R
+
+
+def rot_x(angle: ArrayLike) -> np.ndarray:
+    """Rotation about the x axis by ``angle`` (radians).
+
+    Parameters
+    ----------
+    angle : float or array_like, shape (N,)
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3) or (N, 3, 3)
+        ``[[1, 0, 0], [0, c, -s], [0, s, c]]``.
+
+    Examples
+    --------
+    >>> (rot_x(np.pi / 2) @ [0.0, 1.0, 0.0]).round(12).tolist()
+    [0.0, 0.0, 1.0]
+    """
+    return _elementary(angle, 0, "angle")
+
+
+def rot_y(angle: ArrayLike) -> np.ndarray:
+    """Rotation about the y axis by ``angle`` (radians).
+
+    Parameters
+    ----------
+    angle : float or array_like, shape (N,)
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3) or (N, 3, 3)
+        ``[[c, 0, s], [0, 1, 0], [-s, 0, c]]``.
+
+    Examples
+    --------
+    >>> (rot_y(np.pi / 2) @ [0.0, 0.0, 1.0]).round(12).tolist()
+    [1.0, 0.0, 0.0]
+    """
+    return _elementary(angle, 1, "angle")
+
+
+def rot_z(angle: ArrayLike) -> np.ndarray:
+    """Rotation about the z axis by ``angle`` (radians).
+
+    Parameters
+    ----------
+    angle : float or array_like, shape (N,)
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3) or (N, 3, 3)
+        ``[[c, -s, 0], [s, c, 0], [0, 0, 1]]``.
+
+    Examples
+    --------
+    >>> (rot_z(np.pi / 2) @ [1.0, 0.0, 0.0]).round(12).tolist()
+    [0.0, 1.0, 0.0]
+    >>> rot_z([0.0, 0.5]).shape
+    (2, 3, 3)
+    """
+    return _elementary(angle, 2, "angle")
+
+
+def matrix_from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> np.ndarray:
+    """Rotation by ``angle`` about the unit vector ``axis`` (Rodrigues' formula).
+
+    ``R = cos(angle) I + sin(angle) [axis]x + (1 - cos(angle)) axis axis^T``.
+
+    Parameters
+    ----------
+    axis : array_like, shape (3,)
+        Unit vector (norm within ``ORTHONORMAL_TOLERANCE`` of 1; it is
+        re-normalised).
+    angle : float or array_like, shape (N,)
+        Radians, right-handed about ``axis``.
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3) or (N, 3, 3)
+
+    Raises
+    ------
+    InvalidInputError
+        Locations start with ``"axis"`` or ``"angle"``.
+
+    Examples
+    --------
+    >>> axis = np.array([1.0, 1.0, 1.0]) / np.sqrt(3.0)
+    >>> (matrix_from_axis_angle(axis, 2 * np.pi / 3) @ [1.0, 0.0, 0.0]).round(12).tolist()
+    [0.0, 1.0, 0.0]
+    """
+    try:
+        axis = _as_float_array(axis, "axis")
+        _check_shape(axis, (3,), False, "axis")
+        _check_finite(axis, "axis")
+        norm = float(np.linalg.norm(axis))
+        if abs(norm - 1.0) > ORTHONORMAL_TOLERANCE:
+            raise InvalidInputError(
+                f"axis must be a unit vector, but its norm is {norm:.9g} "
+                f"(off by {abs(norm - 1.0):.3g}, tolerance {ORTHONORMAL_TOLERANCE:g})"
+            )
+    except InvalidInputError as error:
+        raise error.relocated("axis") from None
+    try:
+        angle = _checked_angles(angle, "angle")
+    except InvalidInputError as error:
+        raise error.relocated("angle") from None
+    n = axis / norm
+    cross = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
+    c = np.cos(angle)[..., None, None]
+    s = np.sin(angle)[..., None, None]
+    return c * np.eye(3) + s * cross + (1.0 - c) * np.outer(n, n)
+
+
+# ---------------------------------------------------------------------------
+# Quaternions
+# ---------------------------------------------------------------------------
+
+
+def _matrices_from_quaternions(q: np.ndarray) -> np.ndarray:
+    """(..., 4) quaternions, not necessarily of unit norm, to (..., 3, 3) rotations."""
+    w, x, y, z = np.moveaxis(q, -1, 0)
+    s = 2.0 / np.sum(q * q, axis=-1)
+    R = np.empty(q.shape[:-1] + (3, 3))
+    R[..., 0, 0] = 1.0 - s * (y * y + z * z)
+    R[..., 0, 1] = s * (x * y - w * z)
+    R[..., 0, 2] = s * (x * z + w * y)
+    R[..., 1, 0] = s * (x * y + w * z)
+    R[..., 1, 1] = 1.0 - s * (x * x + z * z)
+    R[..., 1, 2] = s * (y * z - w * x)
+    R[..., 2, 0] = s * (x * z - w * y)
+    R[..., 2, 1] = s * (y * z + w * x)
+    R[..., 2, 2] = 1.0 - s * (x * x + y * y)
+    return R
+
+
+def _canonical_sign(q: np.ndarray) -> np.ndarray:
+    """Flip (..., 4) quaternions so that w >= 0; if w == 0, the first nonzero of x, y, z is > 0."""
+    vector = q[..., 1:]
+    first_nonzero = np.take_along_axis(vector, np.argmax(vector != 0.0, axis=-1)[..., None], axis=-1)[..., 0]
+    w = q[..., 0]
+    flip = (w < 0.0) | ((w == 0.0) & (first_nonzero < 0.0))
+    q = np.where(flip[..., None], -q, q)
+    q[..., 0] = np.abs(q[..., 0])  # turn a -0.0 into 0.0
+    return q
+
+
+def _quaternions_from_matrices(R: np.ndarray) -> np.ndarray:
+    """(..., 3, 3) rotations to canonical (..., 4) unit quaternions (Shepperd's method).
+
+    For a rotation, the symmetric matrix ``K`` below equals ``4 q q^T``. Its
+    largest diagonal entry ``4 q_k^2`` is at least 1 (the diagonal sums to 4), so
+    ``q = K[k] / (2 sqrt(K[k, k]))`` divides by a number no smaller than 2 and
+    stays accurate for every rotation, including those near 180 degrees where
+    ``1 + trace`` vanishes.
+    """
+    r = R
+    trace = r[..., 0, 0] + r[..., 1, 1] + r[..., 2, 2]
+    K = np.empty(R.shape[:-2] + (4, 4))
+    K[..., 0, 0] = 1.0 + trace
+    K[..., 1, 1] = 1.0 + r[..., 0, 0] - r[..., 1, 1] - r[..., 2, 2]
+    K[..., 2, 2] = 1.0 - r[..., 0, 0] + r[..., 1, 1] - r[..., 2, 2]
+    K[..., 3, 3] = 1.0 - r[..., 0, 0] - r[..., 1, 1] + r[..., 2, 2]
+    K[..., 0, 1] = K[..., 1, 0] = r[..., 2, 1] - r[..., 1, 2]
+    K[..., 0, 2] = K[..., 2, 0] = r[..., 0, 2] - r[..., 2, 0]
+    K[..., 0, 3] = K[..., 3, 0] = r[..., 1, 0] - r[..., 0, 1]
+    K[..., 1, 2] = K[..., 2, 1] = r[..., 0, 1] + r[..., 1, 0]
+    K[..., 1, 3] = K[..., 3, 1] = r[..., 0, 2] + r[..., 2, 0]
+    K[..., 2, 3] = K[..., 3, 2] = r[..., 1, 2] + r[..., 2, 1]
+    k = np.argmax(np.diagonal(K, axis1=-2, axis2=-1), axis=-1)
+    row = np.take_along_axis(K, k[..., None, None], axis=-2)[..., 0, :]
+    pivot = np.take_along_axis(row, k[..., None], axis=-1)
+    q = row / (2.0 * np.sqrt(pivot))
+    q /= np.linalg.norm(q, axis=-1, keepdims=True)  # inputs are orthonormal only within a tolerance
+    return _canonical_sign(q)
+
+
+def matrix_from_quaternion(wxyz: ArrayLike) -> np.ndarray:
+    """Rotation matrix of a unit quaternion.
+
+    Parameters
+    ----------
+    wxyz : array_like, shape (4,)
+        Unit quaternion ``(w, x, y, z)``, validated by :func:`check_unit_quaternion`.
+        ``q`` and ``-q`` give the same matrix.
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3)
+        Orthonormal to rounding error (the small allowed norm error is divided out).
+
+    Examples
+    --------
+    >>> h = np.sqrt(0.5)
+    >>> (matrix_from_quaternion([h, 0.0, 0.0, h]) @ [1.0, 0.0, 0.0]).round(12).tolist()
+    [0.0, 1.0, 0.0]
+    """
+    return _matrices_from_quaternions(check_unit_quaternion(wxyz))
+
+
+def matrices_from_quaternions(wxyz: ArrayLike) -> np.ndarray:
+    """Batch version of :func:`matrix_from_quaternion`.
+
+    Parameters
+    ----------
+    wxyz : array_like, shape (N, 4)
+        Unit quaternions ``(w, x, y, z)``, one per row.
+
+    Returns
+    -------
+    R : ndarray, shape (N, 3, 3)
+
+    Raises
+    ------
+    InvalidInputError
+        Location ``(i,)`` for a row whose norm is not 1, ``(i, j)`` for a NaN or
+        infinite entry.
+
+    Examples
+    --------
+    >>> matrices_from_quaternions([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]).round(12).tolist()[1]
+    [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]
+    """
+    return _matrices_from_quaternions(_checked_quaternions(wxyz, ORTHONORMAL_TOLERANCE, batch=True))
+
+
+def quaternion_from_matrix(R: ArrayLike) -> np.ndarray:
+    """Unit quaternion of a rotation matrix, with the canonical sign.
+
+    Uses Shepperd's largest-diagonal method, accurate for every rotation
+    including those near 180 degrees (trace near -1).
+
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation matrix, validated by :func:`check_rotation`.
+
+    Returns
+    -------
+    wxyz : ndarray, shape (4,)
+        ``(w, x, y, z)`` with ``w >= 0``; when ``w == 0`` (a half turn), the first
+        nonzero of ``(x, y, z)`` is positive.
+
+    Examples
+    --------
+    >>> quaternion_from_matrix(rot_z(np.pi / 2)).round(6).tolist()
+    [0.707107, 0.0, 0.0, 0.707107]
+    >>> quaternion_from_matrix(np.diag([-1.0, 1.0, -1.0])).tolist()
+    [0.0, 0.0, 1.0, 0.0]
+    """
+    return _quaternions_from_matrices(check_rotation(R))
+
+
+def quaternions_from_matrices(R: ArrayLike) -> np.ndarray:
+    """Batch version of :func:`quaternion_from_matrix`.
+
+    Parameters
+    ----------
+    R : array_like, shape (N, 3, 3)
+        Rotation matrices.
+
+    Returns
+    -------
+    wxyz : ndarray, shape (N, 4)
+        Canonical unit quaternions ``(w, x, y, z)``, one per matrix.
+
+    Raises
+    ------
+    InvalidInputError
+        Location ``(i,)`` for a matrix that is not a rotation, ``(i, j, k)`` for
+        a NaN or infinite entry.
+
+    Examples
+    --------
+    >>> quaternions_from_matrices(np.stack([np.eye(3), rot_x(np.pi)])).round(12).tolist()
+    [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]
+    """
+    return _quaternions_from_matrices(_checked_rotations(R, ORTHONORMAL_TOLERANCE, batch=True))
+
+
+# ---------------------------------------------------------------------------
+# Euler angles
+# ---------------------------------------------------------------------------
+
+
+def _checked_angle_triple(names: tuple[str, str, str], values: tuple[ArrayLike, ...]) -> list[np.ndarray]:
+    angles = []
+    for name, value in zip(names, values):
+        try:
+            angles.append(_checked_angles(value, name))
+        except InvalidInputError as error:
+            raise error.relocated(name) from None
+    try:
+        np.broadcast_shapes(*(a.shape for a in angles))
+    except ValueError:
+        shapes = ", ".join(f"{n} {a.shape}" for n, a in zip(names, angles))
+        raise InvalidInputError(f"angle arrays must have the same length, got {shapes}") from None
+    return angles
+
+
+def matrix_from_euler_zyz(phi: ArrayLike, theta: ArrayLike, psi: ArrayLike) -> np.ndarray:
+    """Rotation matrix of ZYZ Euler angles: ``Rz(phi) Ry(theta) Rz(psi)``.
+
+    ::
+
+        [ cφcθcψ − sφsψ   −cφcθsψ − sφcψ   cφsθ ]
+        [ sφcθcψ + cφsψ   −sφcθsψ + cφcψ   sφsθ ]
+        [ −sθcψ            sθsψ             cθ   ]
+
+    Parameters
+    ----------
+    phi, theta, psi : float or array_like, shape (N,)
+        Radians. Scalars and arrays of one length N broadcast together.
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3) or (N, 3, 3)
+
+    Examples
+    --------
+    >>> matrix_from_euler_zyz(0.1, 0.2, 0.3)[:, 2].round(6).tolist()
+    [0.197677, 0.019834, 0.980067]
+    """
+    phi, theta, psi = _checked_angle_triple(("phi", "theta", "psi"), (phi, theta, psi))
+    return rot_z(phi) @ rot_y(theta) @ rot_z(psi)
+
+
+def euler_zyz_from_matrix(
+    R: ArrayLike, *, branch: int = 1, free_angle: float = 0.0
+) -> tuple[np.ndarray, bool]:
+    """ZYZ Euler angles ``(phi, theta, psi)`` with ``R = Rz(phi) Ry(theta) Rz(psi)``.
+
+    Regular case, ``sin(theta) = hypot(r13, r23) >= SINGULARITY_TOLERANCE``:
+
+    * ``branch=+1`` (``sin(theta) > 0``): ``theta = atan2(+s, r33)``,
+      ``phi = atan2(r23, r13)``, ``psi = atan2(r32, -r31)``.
+    * ``branch=-1`` (``sin(theta) < 0``): ``theta = atan2(-s, r33)``,
+      ``phi = atan2(-r23, -r13)``, ``psi = atan2(-r32, r31)``; this is
+      ``(phi + pi, -theta, psi + pi)`` of branch +1, wrapped.
+
+    Singular case (``r13 = r23 = 0`` within the tolerance): only one
+    combination is determined, ``phi = wrap_angle(free_angle)``, and both
+    branches give the same answer:
+
+    * ``r33 > 0``: ``theta = 0`` and ``phi + psi = atan2(r21, r11)``.
+    * ``r33 < 0``: ``theta = pi`` and ``phi - psi = atan2(-r12, -r11)``.
+
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation matrix, validated by :func:`check_rotation`.
+    branch : {1, -1}
+        Sign of ``sin(theta)`` (textbook §1.4, the ``±`` root).
+    free_angle : float
+        Value of ``phi`` in the singular case.
+
+    Returns
+    -------
+    angles : ndarray, shape (3,)
+        ``(phi, theta, psi)`` in radians, each in ``(-pi, pi]``.
+    singular : bool
+        Whether the singular case applied.
+
+    Examples
+    --------
+    >>> R = matrix_from_euler_zyz(0.1, 0.2, 0.3)
+    >>> angles, singular = euler_zyz_from_matrix(R)
+    >>> angles.round(6).tolist(), singular
+    ([0.1, 0.2, 0.3], False)
+    >>> euler_zyz_from_matrix(R, branch=-1)[0].round(6).tolist()
+    [-3.041593, -0.2, -2.841593]
+    >>> angles, singular = euler_zyz_from_matrix(matrix_from_euler_zyz(0.3, 0.0, 0.5))
+    >>> angles.round(6).tolist(), singular
+    ([0.0, 0.0, 0.8], True)
+    """
+    R = check_rotation(R)
+    if branch not in (1, -1):
+        raise InvalidInputError(f"branch must be 1 or -1, got {branch!r}", location=("branch",))
+    try:
+        phi = float(_checked_angles(free_angle, "free_angle", scalar=True))
+    except InvalidInputError as error:
+        raise error.relocated("free_angle") from None
+    sin_theta = math.hypot(R[0, 2], R[1, 2])
+    if sin_theta < SINGULARITY_TOLERANCE:
+        if R[2, 2] > 0.0:
+            theta = 0.0
+            psi = math.atan2(R[1, 0], R[0, 0]) - phi
+        else:
+            theta = math.pi
+            psi = phi - math.atan2(-R[0, 1], -R[0, 0])
+        return wrap_angle(np.array([phi, theta, psi])), True
+    if branch == 1:
+        angles = [
+            math.atan2(R[1, 2], R[0, 2]),
+            math.atan2(sin_theta, R[2, 2]),
+            math.atan2(R[2, 1], -R[2, 0]),
+        ]
+    else:
+        angles = [
+            math.atan2(-R[1, 2], -R[0, 2]),
+            math.atan2(-sin_theta, R[2, 2]),
+            math.atan2(-R[2, 1], R[2, 0]),
+        ]
+    return wrap_angle(np.array(angles)), False
+
+
+def matrix_from_rpy(roll: ArrayLike, pitch: ArrayLike, yaw: ArrayLike) -> np.ndarray:
+    """Rotation matrix of roll, pitch, yaw: ``Rz(yaw) Ry(pitch) Rx(roll)``.
+
+    Roll about the fixed x axis first, then pitch about the fixed y axis, then
+    yaw about the fixed z axis (equivalently intrinsic z, y', x'')::
+
+        [ cy·cp   cy·sp·sr − sy·cr   cy·sp·cr + sy·sr ]
+        [ sy·cp   sy·sp·sr + cy·cr   sy·sp·cr − cy·sr ]
+        [ −sp     cp·sr              cp·cr            ]
+
+    Parameters
+    ----------
+    roll, pitch, yaw : float or array_like, shape (N,)
+        Radians. Scalars and arrays of one length N broadcast together.
+
+    Returns
+    -------
+    R : ndarray, shape (3, 3) or (N, 3, 3)
+
+    Examples
+    --------
+    >>> matrix_from_rpy(0.1, 0.2, 0.3)[2].round(6).tolist()
+    [-0.198669, 0.097843, 0.97517]
+    """
+    roll, pitch, yaw = _checked_angle_triple(("roll", "pitch", "yaw"), (roll, pitch, yaw))
+    return rot_z(yaw) @ rot_y(pitch) @ rot_x(roll)
+
+
+def rpy_from_matrix(R: ArrayLike, *, free_angle: float = 0.0) -> tuple[np.ndarray, bool]:
+    """Roll, pitch, yaw with ``R = Rz(yaw) Ry(pitch) Rx(roll)``.
+
+    Regular case, ``cos(pitch) = hypot(r11, r21) >= SINGULARITY_TOLERANCE``:
+    ``pitch = atan2(-r31, cos(pitch))`` in ``(-pi/2, pi/2)``,
+    ``roll = atan2(r32, r33)``, ``yaw = atan2(r21, r11)``. (The other solution,
+    ``(roll + pi, pi - pitch, yaw + pi)``, is not returned.)
+
+    Gimbal lock (``r11 = r21 = 0`` within the tolerance): only one combination
+    is determined, and ``roll = wrap_angle(free_angle)``:
+
+    * ``r31 < 0``: ``pitch = +pi/2`` and ``roll - yaw = atan2(r12, r22)``.
+    * ``r31 > 0``: ``pitch = -pi/2`` and ``roll + yaw = atan2(-r12, r22)``.
+
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation matrix, validated by :func:`check_rotation`.
+    free_angle : float
+        Value of ``roll`` at gimbal lock.
+
+    Returns
+    -------
+    angles : ndarray, shape (3,)
+        ``(roll, pitch, yaw)`` in radians, each in ``(-pi, pi]``.
+    singular : bool
+        Whether the gimbal-lock case applied.
+
+    Examples
+    --------
+    >>> angles, singular = rpy_from_matrix(matrix_from_rpy(0.1, 0.2, 0.3))
+    >>> angles.round(6).tolist(), singular
+    ([0.1, 0.2, 0.3], False)
+    >>> angles, singular = rpy_from_matrix(matrix_from_rpy(0.3, np.pi / 2, 0.5))
+    >>> angles.round(6).tolist(), singular
+    ([0.0, 1.570796, 0.2], True)
+    """
+    R = check_rotation(R)
+    try:
+        roll = float(_checked_angles(free_angle, "free_angle", scalar=True))
+    except InvalidInputError as error:
+        raise error.relocated("free_angle") from None
+    cos_pitch = math.hypot(R[0, 0], R[1, 0])
+    if cos_pitch < SINGULARITY_TOLERANCE:
+        if R[2, 0] < 0.0:
+            pitch = math.pi / 2
+            yaw = roll - math.atan2(R[0, 1], R[1, 1])
+        else:
+            pitch = -math.pi / 2
+            yaw = math.atan2(-R[0, 1], R[1, 1]) - roll
+        return wrap_angle(np.array([roll, pitch, yaw])), True
+    angles = [
+        math.atan2(R[2, 1], R[2, 2]),
+        math.atan2(-R[2, 0], cos_pitch),
+        math.atan2(R[1, 0], R[0, 0]),
+    ]
+    return wrap_angle(np.array(angles)), False
+
+
+# ---------------------------------------------------------------------------
+# Distances, transforms, angles and units
+# ---------------------------------------------------------------------------
+
+
+def rotation_angle_between(R_a: ArrayLike, R_b: ArrayLike) -> float | np.ndarray:
+    """Geodesic angle between two orientations: the rotation angle of ``R_a^T R_b``.
+
+    With ``R_a = w_R_a`` and ``R_b = w_R_b`` this is the angle of ``a_R_b``, in
+    ``[0, pi]``. It is computed as ``2 atan2(|(x, y, z)|, w)`` from the
+    quaternion of ``R_a^T R_b``, which stays accurate near 0 and near pi, where
+    ``arccos((trace - 1) / 2)`` loses half the digits.
+
+    Parameters
+    ----------
+    R_a, R_b : array_like, shape (3, 3) or (N, 3, 3)
+        Rotation matrices; a single matrix broadcasts against a batch.
+
+    Returns
+    -------
+    angle : float, or ndarray of shape (N,)
+        Radians in ``[0, pi]``.
+
+    Raises
+    ------
+    InvalidInputError
+        Locations start with ``"R_a"`` or ``"R_b"``.
+
+    Examples
+    --------
+    >>> round(rotation_angle_between(np.eye(3), rot_x(0.25)), 12)
+    0.25
+    """
+    checked = []
+    for name, R in (("R_a", R_a), ("R_b", R_b)):
+        try:
+            R = _as_float_array(R, name)
+            _check_shape(R, (3, 3), R.ndim == 3, name)
+            _check_finite(R, name)
+            _check_rotation_stack(R, ORTHONORMAL_TOLERANCE, name)
+        except InvalidInputError as error:
+            raise error.relocated(name) from None
+        checked.append(R)
+    R_a, R_b = checked
+    try:
+        np.broadcast_shapes(R_a.shape, R_b.shape)
+    except ValueError:
+        raise InvalidInputError(
+            f"R_a and R_b must hold the same number of matrices, got shapes {R_a.shape} and {R_b.shape}"
+        ) from None
+    q = _quaternions_from_matrices(np.swapaxes(R_a, -1, -2) @ R_b)
+    angle = 2.0 * np.arctan2(np.linalg.norm(q[..., 1:], axis=-1), q[..., 0])
+    return float(angle) if angle.ndim == 0 else angle
+
+
+def transform_from(R: ArrayLike, p: ArrayLike) -> np.ndarray:
+    """Homogeneous transform ``a_T_b`` from rotation ``a_R_b`` and translation ``a_p_b``.
+
+    Parameters
+    ----------
+    R : array_like, shape (3, 3)
+        Rotation, validated by :func:`check_rotation`.
+    p : array_like, shape (3,)
+        Position of b's origin in a (length unit of the robot).
+
+    Returns
+    -------
+    T : ndarray, shape (4, 4)
+        ``[[R, p], [0, 0, 0, 1]]``.
+
+    Raises
+    ------
+    InvalidInputError
+        Locations start with ``"R"`` or ``"p"``.
+
+    Examples
+    --------
+    >>> transform_from(np.eye(3), [1.0, 2.0, 3.0])[:, 3].tolist()
+    [1.0, 2.0, 3.0, 1.0]
+    """
+    try:
+        R = check_rotation(R)
+    except InvalidInputError as error:
+        raise error.relocated("R") from None
+    try:
+        p = _as_float_array(p, "position")
+        _check_shape(p, (3,), False, "position")
+        _check_finite(p, "position")
+    except InvalidInputError as error:
+        raise error.relocated("p") from None
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = p
+    return T
+
+
+def invert_transform(T: ArrayLike) -> np.ndarray:
+    """Inverse of a homogeneous transform: ``b_T_a`` from ``a_T_b``.
+
+    Uses ``[[R^T, -R^T p], [0, 0, 0, 1]]`` rather than a general matrix inverse.
+
+    Parameters
+    ----------
+    T : array_like, shape (4, 4) or (N, 4, 4)
+        Transforms, validated as in :func:`check_transform` (for a batch, the
+        location starts with the row index).
+
+    Returns
+    -------
+    T_inv : ndarray, same shape as ``T``
+
+    Examples
+    --------
+    >>> T = transform_from(rot_z(np.pi / 2), [1.0, 2.0, 3.0])
+    >>> invert_transform(T)[:3, 3].round(12).tolist()
+    [-2.0, 1.0, -3.0]
+    """
+    T = _as_float_array(T, "transform")
+    T = _checked_transforms(T, ORTHONORMAL_TOLERANCE, batch=T.ndim == 3)
+    R_inv = np.swapaxes(T[..., :3, :3], -1, -2)
+    T_inv = np.zeros_like(T)
+    T_inv[..., :3, :3] = R_inv
+    T_inv[..., :3, 3] = -(R_inv @ T[..., :3, 3, None])[..., 0]
+    T_inv[..., 3, 3] = 1.0
+    return T_inv
+
+
+def wrap_angle(x: ArrayLike) -> float | np.ndarray:
+    """Wrap angles to ``(-pi, pi]``.
+
+    Values already in ``(-pi, pi]`` are returned unchanged, bit for bit.
+    ``-pi`` maps to ``pi``. NaN stays NaN; infinities become NaN.
+
+    Parameters
+    ----------
+    x : float or array_like
+        Radians, any shape.
+
+    Returns
+    -------
+    float, or ndarray of the same shape
+
+    Examples
+    --------
+    >>> wrap_angle(3 * np.pi / 2) == -np.pi / 2
+    True
+    >>> wrap_angle([-np.pi, 0.5]).tolist() == [np.pi, 0.5]
+    True
+    """
+    a = np.asarray(x, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        outside = (a <= -np.pi) | (a > np.pi) | np.isinf(a)
+        wrapped = np.where(outside, np.pi - np.mod(np.pi - a, 2.0 * np.pi), a)
+        wrapped = np.where(wrapped <= -np.pi, wrapped + 2.0 * np.pi, wrapped)
+    return float(wrapped) if wrapped.ndim == 0 else wrapped
+
+
+def _radians_per(unit: str) -> float:
+    if not isinstance(unit, str) or unit not in _RADIANS_PER_UNIT:
+        raise InvalidInputError(
+            f"unknown angle unit {unit!r}; use one of {', '.join(map(repr, _RADIANS_PER_UNIT))}",
+            location=("unit",),
+        )
+    return _RADIANS_PER_UNIT[unit]
+
+
+def _angle_values(values: ArrayLike) -> np.ndarray:
+    try:
+        return _as_float_array(values, "angle values")
+    except InvalidInputError as error:
+        raise error.relocated("values") from None
+
+
+def to_radians(values: ArrayLike, unit: str) -> float | np.ndarray:
+    """Convert angles given in ``unit`` to radians.
+
+    The API layer calls this once, at the boundary; the core works in radians.
+
+    Parameters
+    ----------
+    values : float or array_like
+        Angles in ``unit``, any shape. Infinities pass through (an open limit).
+    unit : {"rad", "deg"}
+
+    Returns
+    -------
+    float, or ndarray of the same shape
+
+    Raises
+    ------
+    InvalidInputError
+        An unknown unit (location ``("unit",)``) or non-numeric values
+        (location ``("values",)``).
+
+    Examples
+    --------
+    >>> to_radians(180.0, "deg") == np.pi
+    True
+    >>> to_radians([0.5, 1.0], "rad").tolist()
+    [0.5, 1.0]
+    """
+    scale = _radians_per(unit)
+    converted = _angle_values(values) * scale
+    return float(converted) if converted.ndim == 0 else converted
+
+
+def from_radians(values: ArrayLike, unit: str) -> float | np.ndarray:
+    """Convert angles in radians to ``unit``; the inverse of :func:`to_radians`.
+
+    Parameters
+    ----------
+    values : float or array_like
+        Radians, any shape.
+    unit : {"rad", "deg"}
+
+    Returns
+    -------
+    float, or ndarray of the same shape
+
+    Examples
+    --------
+    >>> from_radians(np.pi / 2, "deg")
+    90.0
+    """
+    scale = _radians_per(unit)
+    converted = _angle_values(values) / scale
+    return float(converted) if converted.ndim == 0 else converted
+

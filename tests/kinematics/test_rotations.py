@@ -1,0 +1,706 @@
+"""Tests for service.kinematics._rotations.
+
+Random rotations come from a QR decomposition of Gaussian matrices, which does
+not use the module under test, so round trips cannot hide a shared mistake.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import doctest
+import math
+
+import numpy as np
+import pytest
+
+from service.kinematics import _rotations
+from service.kinematics._errors import InvalidInputError
+from service.kinematics._rotations import (
+    check_rotation,
+    check_transform,
+    check_unit_quaternion,
+    euler_zyz_from_matrix,
+    from_radians,
+    invert_transform,
+    matrices_from_quaternions,
+    matrix_from_axis_angle,
+    matrix_from_euler_zyz,
+    matrix_from_quaternion,
+    matrix_from_rpy,
+    quaternion_from_matrix,
+    quaternions_from_matrices,
+    rot_x,
+    rot_y,
+    rot_z,
+    rotation_angle_between,
+    rpy_from_matrix,
+    to_radians,
+    transform_from,
+    wrap_angle,
+)
+from service.kinematics._tolerances import SINGULARITY_TOLERANCE
+
+N = 1000
+PI = math.pi
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(0)
+
+
+def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:
+    """(n, 3, 3) rotations from QR of Gaussian matrices (independent of the module)."""
+    Q, upper = np.linalg.qr(rng.standard_normal((n, 3, 3)))
+    Q = Q * np.sign(np.diagonal(upper, axis1=-2, axis2=-1))[:, None, :]
+    Q[np.linalg.det(Q) < 0, :, 0] *= -1.0
+    return Q
+
+
+def random_unit_vectors(rng: np.random.Generator, n: int) -> np.ndarray:
+    v = rng.standard_normal((n, 3))
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+def canonical(q: np.ndarray) -> np.ndarray:
+    """Reference sign convention, written independently: w >= 0."""
+    return q * (1.0 if q[0] >= 0 else -1.0)
+
+
+def assert_is_rotation(R: np.ndarray, atol: float = 1e-12) -> None:
+    np.testing.assert_allclose(np.swapaxes(R, -1, -2) @ R, np.broadcast_to(np.eye(3), R.shape), atol=atol)
+    np.testing.assert_allclose(np.linalg.det(R), 1.0, atol=atol)
+
+
+@contextlib.contextmanager
+def raises_at(location: tuple, match: str):
+    """Expect an InvalidInputError whose message matches ``match`` and whose location is ``location``."""
+    with pytest.raises(InvalidInputError, match=match) as info:
+        yield info
+    assert info.value.location == location
+
+
+# ---------------------------------------------------------------------------
+# Docstring examples
+# ---------------------------------------------------------------------------
+
+
+def test_docstring_examples_hold():
+    result = doctest.testmod(_rotations, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.failed == 0
+    assert result.attempted >= 35
+
+
+def test_docstring_example_values():
+    h = math.sqrt(0.5)
+    np.testing.assert_allclose(quaternion_from_matrix(rot_z(PI / 2)), [h, 0.0, 0.0, h], atol=1e-15)
+    angles, singular = euler_zyz_from_matrix(matrix_from_euler_zyz(0.1, 0.2, 0.3))
+    np.testing.assert_allclose(angles, [0.1, 0.2, 0.3], atol=1e-14)
+    assert singular is False
+    angles, _ = euler_zyz_from_matrix(matrix_from_euler_zyz(0.1, 0.2, 0.3), branch=-1)
+    np.testing.assert_allclose(angles, [0.1 - PI, -0.2, 0.3 - PI], atol=1e-14)
+    np.testing.assert_allclose(
+        matrix_from_euler_zyz(0.1, 0.2, 0.3)[:, 2],
+        [math.cos(0.1) * math.sin(0.2), math.sin(0.1) * math.sin(0.2), math.cos(0.2)],
+        atol=1e-15,
+    )
+    np.testing.assert_allclose(
+        matrix_from_rpy(0.1, 0.2, 0.3)[2],
+        [-math.sin(0.2), math.cos(0.2) * math.sin(0.1), math.cos(0.2) * math.cos(0.1)],
+        atol=1e-15,
+    )
+    axis = np.ones(3) / math.sqrt(3.0)
+    np.testing.assert_allclose(matrix_from_axis_angle(axis, 2 * PI / 3), [[0, 0, 1], [1, 0, 0], [0, 1, 0]], atol=1e-15)
+    T = transform_from(rot_z(PI / 2), [1.0, 2.0, 3.0])
+    np.testing.assert_allclose(invert_transform(T)[:3, 3], [-2.0, 1.0, -3.0], atol=1e-15)
+    assert rotation_angle_between(np.eye(3), rot_x(0.25)) == pytest.approx(0.25, abs=1e-15)
+
+
+# ---------------------------------------------------------------------------
+# Elementary rotations and axis-angle
+# ---------------------------------------------------------------------------
+
+
+def test_elementary_rotations_match_their_closed_forms(rng):
+    for a in rng.uniform(-PI, PI, 20):
+        c, s = math.cos(a), math.sin(a)
+        np.testing.assert_allclose(rot_x(a), [[1, 0, 0], [0, c, -s], [0, s, c]], atol=1e-15)
+        np.testing.assert_allclose(rot_y(a), [[c, 0, s], [0, 1, 0], [-s, 0, c]], atol=1e-15)
+        np.testing.assert_allclose(rot_z(a), [[c, -s, 0], [s, c, 0], [0, 0, 1]], atol=1e-15)
+
+
+def test_elementary_rotations_accept_arrays(rng):
+    angles = rng.uniform(-PI, PI, 7)
+    for rot in (rot_x, rot_y, rot_z):
+        stacked = rot(angles)
+        assert stacked.shape == (7, 3, 3)
+        np.testing.assert_array_equal(stacked, np.stack([rot(a) for a in angles]))
+    assert rot_z(0.3).shape == (3, 3)
+
+
+def test_axis_angle_about_coordinate_axes_matches_elementary_rotations(rng):
+    angles = rng.uniform(-2 * PI, 2 * PI, 50)
+    np.testing.assert_allclose(matrix_from_axis_angle([1, 0, 0], angles), rot_x(angles), atol=1e-15)
+    np.testing.assert_allclose(matrix_from_axis_angle([0, 1, 0], angles), rot_y(angles), atol=1e-15)
+    np.testing.assert_allclose(matrix_from_axis_angle([0, 0, 1], angles), rot_z(angles), atol=1e-15)
+
+
+def test_axis_angle_fixes_its_axis_and_has_its_angle(rng):
+    for axis, angle in zip(random_unit_vectors(rng, 200), rng.uniform(0, PI, 200)):
+        R = matrix_from_axis_angle(axis, angle)
+        assert_is_rotation(R)
+        np.testing.assert_allclose(R @ axis, axis, atol=1e-14)
+        assert np.trace(R) == pytest.approx(1 + 2 * math.cos(angle), abs=1e-14)
+        # right-handed: a vector perpendicular to the axis turns towards axis x vector
+        u = np.cross(axis, [1.0, 0.0, 0.0])
+        u /= np.linalg.norm(u)
+        np.testing.assert_allclose(R @ u, math.cos(angle) * u + math.sin(angle) * np.cross(axis, u), atol=1e-14)
+
+
+# ---------------------------------------------------------------------------
+# Quaternions
+# ---------------------------------------------------------------------------
+
+
+def test_quaternion_round_trip_on_random_quaternions(rng):
+    Q = rng.standard_normal((N, 4))
+    Q /= np.linalg.norm(Q, axis=1, keepdims=True)
+    for q in Q:
+        R = matrix_from_quaternion(q)
+        assert_is_rotation(R)
+        np.testing.assert_allclose(quaternion_from_matrix(R), canonical(q), atol=1e-13)
+
+
+def test_matrix_from_quaternion_agrees_with_axis_angle(rng):
+    for axis, angle in zip(random_unit_vectors(rng, 200), rng.uniform(0, 2 * PI, 200)):
+        q = np.concatenate([[math.cos(angle / 2)], math.sin(angle / 2) * axis])
+        np.testing.assert_allclose(matrix_from_quaternion(q), matrix_from_axis_angle(axis, angle), atol=1e-14)
+
+
+def test_matrix_round_trip_through_quaternion(rng):
+    for R in random_rotations(rng, N):
+        q = quaternion_from_matrix(R)
+        assert q[0] >= 0.0
+        assert np.linalg.norm(q) == pytest.approx(1.0, abs=1e-15)
+        np.testing.assert_allclose(matrix_from_quaternion(q), R, atol=1e-14)
+
+
+def test_quaternion_sign_is_canonical(rng):
+    Q = rng.standard_normal((100, 4))
+    Q /= np.linalg.norm(Q, axis=1, keepdims=True)
+    for q in Q:
+        expected = canonical(q)
+        np.testing.assert_allclose(quaternion_from_matrix(matrix_from_quaternion(q)), expected, atol=1e-13)
+        np.testing.assert_allclose(quaternion_from_matrix(matrix_from_quaternion(-q)), expected, atol=1e-13)
+
+
+@pytest.mark.parametrize(
+    ("half_turn", "expected"),
+    [
+        ([0.0, -0.6, 0.8, 0.0], [0.0, 0.6, -0.8, 0.0]),
+        ([0.0, 0.0, -1.0, 0.0], [0.0, 0.0, 1.0, 0.0]),
+        ([0.0, 0.0, 0.0, -1.0], [0.0, 0.0, 0.0, 1.0]),
+        ([0.0, 0.0, 0.6, -0.8], [0.0, 0.0, 0.6, -0.8]),
+    ],
+)
+def test_half_turn_sign_tie_break(half_turn, expected):
+    q = quaternion_from_matrix(matrix_from_quaternion(half_turn))
+    np.testing.assert_allclose(q, expected, atol=1e-15)
+    assert not np.signbit(q[0])  # w is +0.0, not -0.0
+
+
+@pytest.mark.parametrize("angle", [PI - 1e-6, PI - 1e-9, PI - 1e-12, PI])
+def test_quaternion_of_near_half_turns_is_accurate(rng, angle):
+    for axis in random_unit_vectors(rng, 100):
+        R = matrix_from_axis_angle(axis, angle)
+        assert np.trace(R) == pytest.approx(-1.0, abs=1e-11)
+        expected = canonical(np.concatenate([[math.cos(angle / 2)], math.sin(angle / 2) * axis]))
+        q = quaternion_from_matrix(R)
+        np.testing.assert_allclose(q, expected, atol=1e-13)
+        np.testing.assert_allclose(matrix_from_quaternion(q), R, atol=1e-14)
+
+
+def test_batch_quaternion_functions_equal_single_ones(rng):
+    Q = rng.standard_normal((N, 4))
+    Q /= np.linalg.norm(Q, axis=1, keepdims=True)
+    batch = matrices_from_quaternions(Q)
+    assert batch.shape == (N, 3, 3)
+    np.testing.assert_allclose(batch, np.stack([matrix_from_quaternion(q) for q in Q]), rtol=0, atol=1e-16)
+
+    # Mix every case of Shepperd's method (w, x, y or z largest) in one batch.
+    R = np.concatenate([np.stack([np.eye(3), rot_x(3.0), rot_y(3.0), rot_z(3.0)]), random_rotations(rng, N)])
+    quaternions = quaternions_from_matrices(R)
+    assert quaternions.shape == (N + 4, 4)
+    np.testing.assert_allclose(quaternions, np.stack([quaternion_from_matrix(r) for r in R]), rtol=0, atol=1e-16)
+    np.testing.assert_allclose(quaternions[:4, 0], [1.0, math.cos(1.5), math.cos(1.5), math.cos(1.5)], atol=1e-15)
+    np.testing.assert_allclose(np.abs(quaternions[1:4, 1:]), math.sin(1.5) * np.eye(3), atol=1e-15)
+
+
+def test_batch_functions_accept_empty_batches():
+    assert matrices_from_quaternions(np.zeros((0, 4))).shape == (0, 3, 3)
+    assert quaternions_from_matrices(np.zeros((0, 3, 3))).shape == (0, 4)
+
+
+# ---------------------------------------------------------------------------
+# ZYZ Euler angles
+# ---------------------------------------------------------------------------
+
+
+def test_zyz_matrix_matches_the_textbook_closed_form(rng):
+    for phi, theta, psi in rng.uniform(-PI, PI, (50, 3)):
+        cf, sf, ct, st, cp, sp = (math.cos(phi), math.sin(phi), math.cos(theta), math.sin(theta),
+                                  math.cos(psi), math.sin(psi))
+        expected = [
+            [cf * ct * cp - sf * sp, -cf * ct * sp - sf * cp, cf * st],
+            [sf * ct * cp + cf * sp, -sf * ct * sp + cf * cp, sf * st],
+            [-st * cp, st * sp, ct],
+        ]
+        np.testing.assert_allclose(matrix_from_euler_zyz(phi, theta, psi), expected, atol=1e-15)
+
+
+@pytest.mark.parametrize("branch", [1, -1])
+def test_zyz_round_trip_on_random_rotations(rng, branch):
+    for R in random_rotations(rng, N):
+        angles, singular = euler_zyz_from_matrix(R, branch=branch)
+        assert singular is False
+        assert angles.shape == (3,)
+        assert np.all((angles > -PI) & (angles <= PI))
+        assert branch * math.sin(angles[1]) > 0.0
+        np.testing.assert_allclose(matrix_from_euler_zyz(*angles), R, atol=1e-13)
+
+
+def test_zyz_branches_are_related_by_the_textbook_map(rng):
+    for R in random_rotations(rng, N):
+        phi, theta, psi = euler_zyz_from_matrix(R, branch=1)[0]
+        other = euler_zyz_from_matrix(R, branch=-1)[0]
+        np.testing.assert_allclose(wrap_angle(other - [phi + PI, -theta, psi + PI]), 0.0, atol=1e-12)
+
+
+def test_zyz_angles_round_trip(rng):
+    phi = rng.uniform(-PI, PI, N)
+    theta = rng.uniform(0.01, PI - 0.01, N)
+    psi = rng.uniform(-PI, PI, N)
+    R = matrix_from_euler_zyz(phi, theta, psi)
+    assert R.shape == (N, 3, 3)
+    for i in range(N):
+        angles, singular = euler_zyz_from_matrix(R[i])
+        assert singular is False
+        np.testing.assert_allclose(angles, [phi[i], theta[i], psi[i]], atol=1e-11)
+
+
+@pytest.mark.parametrize("free_angle", [0.0, 1.0, -2.5])
+@pytest.mark.parametrize("branch", [1, -1])
+@pytest.mark.parametrize(("phi", "psi"), [(0.3, 0.5), (-3.0, 1.0), (2.9, 2.8)])
+def test_zyz_singular_theta_zero(free_angle, branch, phi, psi):
+    R = matrix_from_euler_zyz(phi, 0.0, psi)
+    angles, singular = euler_zyz_from_matrix(R, branch=branch, free_angle=free_angle)
+    assert singular is True
+    assert angles[0] == pytest.approx(free_angle, abs=1e-15)
+    assert angles[1] == 0.0
+    assert wrap_angle(angles[0] + angles[2] - (phi + psi)) == pytest.approx(0.0, abs=1e-14)
+    np.testing.assert_allclose(matrix_from_euler_zyz(*angles), R, atol=1e-14)
+
+
+@pytest.mark.parametrize("free_angle", [0.0, 1.0, -2.5])
+@pytest.mark.parametrize("branch", [1, -1])
+@pytest.mark.parametrize(("phi", "psi"), [(0.3, 0.5), (-3.0, 1.0), (2.9, -2.8)])
+def test_zyz_singular_theta_pi(free_angle, branch, phi, psi):
+    R = matrix_from_euler_zyz(phi, PI, psi)
+    angles, singular = euler_zyz_from_matrix(R, branch=branch, free_angle=free_angle)
+    assert singular is True
+    assert angles[0] == pytest.approx(free_angle, abs=1e-15)
+    assert angles[1] == PI
+    assert wrap_angle(angles[0] - angles[2] - (phi - psi)) == pytest.approx(0.0, abs=1e-14)
+    np.testing.assert_allclose(matrix_from_euler_zyz(*angles), R, atol=1e-14)
+
+
+def test_zyz_singular_values_from_the_textbook():
+    angles, singular = euler_zyz_from_matrix(matrix_from_euler_zyz(0.3, 0.0, 0.5))
+    np.testing.assert_allclose(angles, [0.0, 0.0, 0.8], atol=1e-15)
+    angles, singular = euler_zyz_from_matrix(matrix_from_euler_zyz(0.3, PI, 0.5))
+    np.testing.assert_allclose(angles, [0.0, PI, 0.2], atol=1e-15)
+    angles, _ = euler_zyz_from_matrix(matrix_from_euler_zyz(0.3, PI, 0.5), free_angle=1.0)
+    np.testing.assert_allclose(angles, [1.0, PI, 1.2], atol=1e-15)
+
+
+def test_zyz_singularity_uses_the_tolerance_not_exact_equality():
+    near = matrix_from_euler_zyz(0.3, 0.5 * SINGULARITY_TOLERANCE, 0.5)
+    angles, singular = euler_zyz_from_matrix(near)
+    assert singular is True
+    np.testing.assert_allclose(matrix_from_euler_zyz(*angles), near, atol=SINGULARITY_TOLERANCE)
+    near_pi = matrix_from_euler_zyz(0.3, PI - 0.5 * SINGULARITY_TOLERANCE, 0.5)
+    angles, singular = euler_zyz_from_matrix(near_pi)
+    assert singular is True
+    assert angles[1] == PI
+
+    outside = matrix_from_euler_zyz(0.3, 2.0 * SINGULARITY_TOLERANCE, 0.5)
+    angles, singular = euler_zyz_from_matrix(outside)
+    assert singular is False
+    np.testing.assert_allclose(matrix_from_euler_zyz(*angles), outside, atol=1e-12)
+
+
+# ---------------------------------------------------------------------------
+# Roll, pitch, yaw
+# ---------------------------------------------------------------------------
+
+
+def test_rpy_matrix_matches_the_fixed_axis_closed_form(rng):
+    for roll, pitch, yaw in rng.uniform(-PI, PI, (50, 3)):
+        cr, sr, cp, sp, cy, sy = (math.cos(roll), math.sin(roll), math.cos(pitch), math.sin(pitch),
+                                  math.cos(yaw), math.sin(yaw))
+        expected = [
+            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+            [-sp, cp * sr, cp * cr],
+        ]
+        np.testing.assert_allclose(matrix_from_rpy(roll, pitch, yaw), expected, atol=1e-15)
+    np.testing.assert_allclose(matrix_from_rpy(0.4, 0.0, 0.0), rot_x(0.4), atol=1e-16)
+    np.testing.assert_allclose(matrix_from_rpy(0.0, 0.4, 0.0), rot_y(0.4), atol=1e-16)
+    np.testing.assert_allclose(matrix_from_rpy(0.0, 0.0, 0.4), rot_z(0.4), atol=1e-16)
+
+
+def test_rpy_round_trip_on_random_rotations(rng):
+    for R in random_rotations(rng, N):
+        angles, singular = rpy_from_matrix(R)
+        assert singular is False
+        assert np.all((angles > -PI) & (angles <= PI))
+        assert -PI / 2 <= angles[1] <= PI / 2
+        np.testing.assert_allclose(matrix_from_rpy(*angles), R, atol=1e-13)
+
+
+def test_rpy_angles_round_trip(rng):
+    roll = rng.uniform(-PI, PI, N)
+    pitch = rng.uniform(-PI / 2 + 0.01, PI / 2 - 0.01, N)
+    yaw = rng.uniform(-PI, PI, N)
+    R = matrix_from_rpy(roll, pitch, yaw)
+    for i in range(N):
+        angles, singular = rpy_from_matrix(R[i])
+        assert singular is False
+        np.testing.assert_allclose(angles, [roll[i], pitch[i], yaw[i]], atol=1e-11)
+
+
+@pytest.mark.parametrize("free_angle", [0.0, 0.4, -3.0])
+@pytest.mark.parametrize(("roll", "yaw"), [(0.3, 0.5), (-3.0, 2.0), (2.5, -2.9)])
+def test_rpy_gimbal_lock_pitch_up(free_angle, roll, yaw):
+    R = matrix_from_rpy(roll, PI / 2, yaw)
+    angles, singular = rpy_from_matrix(R, free_angle=free_angle)
+    assert singular is True
+    assert angles[0] == pytest.approx(free_angle, abs=1e-15)
+    assert angles[1] == PI / 2
+    assert wrap_angle(angles[0] - angles[2] - (roll - yaw)) == pytest.approx(0.0, abs=1e-14)
+    np.testing.assert_allclose(matrix_from_rpy(*angles), R, atol=1e-14)
+
+
+@pytest.mark.parametrize("free_angle", [0.0, 0.4, -3.0])
+@pytest.mark.parametrize(("roll", "yaw"), [(0.3, 0.5), (-3.0, 2.0), (2.5, 2.9)])
+def test_rpy_gimbal_lock_pitch_down(free_angle, roll, yaw):
+    R = matrix_from_rpy(roll, -PI / 2, yaw)
+    angles, singular = rpy_from_matrix(R, free_angle=free_angle)
+    assert singular is True
+    assert angles[0] == pytest.approx(free_angle, abs=1e-15)
+    assert angles[1] == -PI / 2
+    assert wrap_angle(angles[0] + angles[2] - (roll + yaw)) == pytest.approx(0.0, abs=1e-14)
+    np.testing.assert_allclose(matrix_from_rpy(*angles), R, atol=1e-14)
+
+
+def test_rpy_gimbal_lock_values():
+    np.testing.assert_allclose(rpy_from_matrix(matrix_from_rpy(0.3, PI / 2, 0.5))[0], [0.0, PI / 2, 0.2], atol=1e-15)
+    np.testing.assert_allclose(rpy_from_matrix(matrix_from_rpy(0.3, -PI / 2, 0.5))[0], [0.0, -PI / 2, 0.8], atol=1e-15)
+    near = matrix_from_rpy(0.3, PI / 2 - 0.5 * SINGULARITY_TOLERANCE, 0.5)
+    assert rpy_from_matrix(near)[1] is True
+    assert rpy_from_matrix(matrix_from_rpy(0.3, PI / 2 - 2.0 * SINGULARITY_TOLERANCE, 0.5))[1] is False
+
+
+# ---------------------------------------------------------------------------
+# Geodesic angle
+# ---------------------------------------------------------------------------
+
+
+def test_rotation_angle_between_recovers_the_constructed_angle(rng):
+    R_a = random_rotations(rng, N)
+    axes = random_unit_vectors(rng, N)
+    angles = rng.uniform(0.0, PI, N)
+    angles[:6] = [0.0, 1e-9, 1e-6, PI - 1e-6, PI - 1e-9, PI]
+    steps = np.stack([matrix_from_axis_angle(n, a) for n, a in zip(axes, angles)])
+    R_b = R_a @ steps
+    batch = rotation_angle_between(R_a, R_b)
+    assert batch.shape == (N,)
+    np.testing.assert_allclose(batch, angles, rtol=0, atol=2e-13)
+    for i in range(0, N, 97):
+        single = rotation_angle_between(R_a[i], R_b[i])
+        assert isinstance(single, float)
+        assert single == pytest.approx(angles[i], abs=2e-13)
+        assert rotation_angle_between(R_b[i], R_a[i]) == pytest.approx(angles[i], abs=2e-13)
+
+
+def test_rotation_angle_between_broadcasts_and_folds_past_pi(rng):
+    angles = rng.uniform(0.0, 2 * PI, 50)
+    axis = random_unit_vectors(rng, 1)[0]
+    R_b = matrix_from_axis_angle(axis, angles)
+    result = rotation_angle_between(np.eye(3), R_b)
+    np.testing.assert_allclose(result, np.where(angles > PI, 2 * PI - angles, angles), atol=1e-13)
+    assert np.all((result >= 0.0) & (result <= PI))
+
+
+# ---------------------------------------------------------------------------
+# Transforms
+# ---------------------------------------------------------------------------
+
+
+def test_transform_from_and_invert_transform(rng):
+    R = random_rotations(rng, N)
+    p = rng.uniform(-10, 10, (N, 3))
+    T = np.stack([transform_from(r, v) for r, v in zip(R, p)])
+    np.testing.assert_array_equal(T[:, :3, :3], R)
+    np.testing.assert_array_equal(T[:, :3, 3], p)
+    np.testing.assert_array_equal(T[:, 3], np.broadcast_to([0.0, 0.0, 0.0, 1.0], (N, 4)))
+    T_inv = invert_transform(T)
+    assert T_inv.shape == (N, 4, 4)
+    np.testing.assert_allclose(T_inv @ T, np.broadcast_to(np.eye(4), T.shape), atol=1e-13)
+    np.testing.assert_allclose(T_inv, np.linalg.inv(T), atol=1e-12)
+    np.testing.assert_array_equal(T_inv[:, 3], T[:, 3])
+    np.testing.assert_allclose(T_inv, np.stack([invert_transform(t) for t in T]), rtol=0, atol=1e-16)
+
+
+# ---------------------------------------------------------------------------
+# Angles and units
+# ---------------------------------------------------------------------------
+
+
+def test_wrap_angle_values():
+    assert wrap_angle(3 * PI / 2) == pytest.approx(-PI / 2, abs=1e-15)
+    assert wrap_angle(-PI) == PI
+    assert wrap_angle(PI) == PI
+    assert wrap_angle(-3 * PI) == PI
+    # one ulp above pi: the modulo rounds to exactly -pi, which must still come back as +pi
+    assert wrap_angle(np.nextafter(PI, 4.0)) == PI
+    assert wrap_angle(0.1) == 0.1
+    assert wrap_angle(100.0) == pytest.approx(100.0 - 32 * PI, abs=1e-13)
+    assert isinstance(wrap_angle(1.0), float)
+
+
+def test_wrap_angle_is_vectorized_and_in_range(rng):
+    x = rng.uniform(-50, 50, (10, 100))
+    wrapped = wrap_angle(x)
+    assert wrapped.shape == x.shape
+    assert np.all((wrapped > -PI) & (wrapped <= PI))
+    turns = (x - wrapped) / (2 * PI)
+    np.testing.assert_allclose(turns, np.round(turns), atol=1e-12)
+    inside = rng.uniform(-PI, PI, 100)
+    np.testing.assert_array_equal(wrap_angle(inside), inside)
+
+
+def test_unit_conversion():
+    assert to_radians(180.0, "deg") == PI
+    np.testing.assert_allclose(to_radians([90, -45], "deg"), [PI / 2, -PI / 4], rtol=1e-16)
+    assert to_radians(0.5, "rad") == 0.5
+    assert from_radians(PI, "deg") == 180.0
+    assert from_radians(0.25, "rad") == 0.25
+    degrees = np.array([-170.0, -1e-3, 0.0, 33.3, 360.0])
+    np.testing.assert_allclose(from_radians(to_radians(degrees, "deg"), "deg"), degrees, rtol=1e-15)
+    assert to_radians(-math.inf, "deg") == -math.inf
+
+
+@pytest.mark.parametrize("unit", ["grad", "DEG", "degrees", "", None, 1])
+def test_unknown_units_are_rejected(unit):
+    for convert in (to_radians, from_radians):
+        with raises_at(("unit",), "unknown angle unit"):
+            convert(1.0, unit)
+
+
+def test_non_numeric_angle_values_are_rejected():
+    with raises_at(("values",), "real numbers"):
+        to_radians(["ninety"], "deg")
+
+
+# ---------------------------------------------------------------------------
+# Validation
+# ---------------------------------------------------------------------------
+
+
+def test_check_rotation_returns_a_float64_copy():
+    R = np.array([[0, -1, 0], [1, 0, 0], [0, 0, 1]])
+    checked = check_rotation(R)
+    assert checked.dtype == np.float64
+    np.testing.assert_array_equal(checked, R)
+    checked[0, 0] = 5.0
+    assert R[0, 0] == 0
+
+
+def test_check_rotation_accepts_errors_within_tolerance():
+    R = rot_z(0.3)
+    R[0, 0] += 1e-7
+    np.testing.assert_array_equal(check_rotation(R), R)  # returned as given, not re-orthonormalised
+    R[0, 0] += 1e-5
+    check_rotation(R, tolerance=1e-4)
+
+
+def test_non_orthonormal_by_1e_5_is_rejected_with_the_amount():
+    R = np.eye(3)
+    R[0, 0] += 1e-5
+    with raises_at((), r"not orthonormal: max \|R\^T R - I\| is 2e-05, more than the tolerance 1e-06 "
+                       r"\(column 0 has length 1\.00001\)"):
+        check_rotation(R)
+    R = rot_z(0.3)
+    R[1, 2] = 1e-5
+    with raises_at((), r"not orthonormal.*columns 1 and 2 have dot product"):
+        check_rotation(R)
+
+
+@pytest.mark.parametrize("R", [np.diag([1.0, 1.0, -1.0]), -rot_z(0.3), rot_x(1.0) @ np.diag([1.0, -1.0, 1.0])])
+def test_reflection_is_named(R):
+    with raises_at((), r"determinant -1: it is a reflection, not a rotation"):
+        check_rotation(R)
+
+
+@pytest.mark.parametrize(("bad", "index", "text"), [(np.nan, (1, 2), "nan"), (np.inf, (2, 0), "inf"),
+                                                     (-np.inf, (0, 0), "-inf")])
+def test_non_finite_rotation_entries_are_located(bad, index, text):
+    R = np.eye(3)
+    R[index] = bad
+    with raises_at(index, rf"rotation matrix entry \({index[0]}, {index[1]}\) is {text}; every entry must be"):
+        check_rotation(R)
+
+
+@pytest.mark.parametrize("shape", [(3, 4), (9,), (2, 3, 3), ()])
+def test_rotation_of_wrong_shape_is_rejected(shape):
+    with raises_at((), rf"rotation matrix must have shape \(3, 3\), got shape {re_shape(shape)}"):
+        check_rotation(np.zeros(shape))
+
+
+def re_shape(shape: tuple) -> str:
+    return str(shape).replace("(", r"\(").replace(")", r"\)")
+
+
+def test_rotation_that_is_not_numbers_is_rejected():
+    with raises_at((), "must contain real numbers"):
+        check_rotation([["a", "b", "c"]] * 3)
+    with raises_at((), "must be an array of numbers"):
+        check_rotation([[1, 0, 0], [0, 1], [0, 0, 1]])
+    with raises_at((), "must contain real numbers"):
+        check_rotation(np.eye(3, dtype=complex))
+
+
+def test_check_transform_errors_are_located_in_the_4x4():
+    T = transform_from(rot_z(0.3), [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(check_transform(T), T)
+
+    bad = T.copy()
+    bad[3, 2] = 0.5
+    with raises_at((3, 2), r"bottom row .* must be \[0, 0, 0, 1\], but entry \(3, 2\) is 0\.5"):
+        check_transform(bad)
+    bad = T.copy()
+    bad[3, 3] = 1.0 + 1e-5
+    with raises_at((3, 3), r"entry \(3, 3\) is 1\.00001"):
+        check_transform(bad)
+    bad = T.copy()
+    bad[3, 0] = 1e-7  # within tolerance
+    check_transform(bad)
+
+    bad = T.copy()
+    bad[2, 1] = np.nan
+    with raises_at((2, 1), r"transform entry \(2, 1\) is nan"):
+        check_transform(bad)
+    bad = T.copy()
+    bad[0, 3] = np.inf
+    with raises_at((0, 3), r"transform entry \(0, 3\) is inf"):
+        check_transform(bad)
+    bad = T.copy()
+    bad[:3, :3] = np.diag([1.0, -1.0, 1.0])
+    with raises_at((), "rotation block of the transform has determinant -1: it is a reflection"):
+        check_transform(bad)
+    bad = T.copy()
+    bad[1, 1] += 1e-5
+    with raises_at((), "rotation block of the transform is not orthonormal"):
+        check_transform(bad)
+    with raises_at((), r"transform must have shape \(4, 4\), got shape \(3, 4\)"):
+        check_transform(T[:3])
+
+
+def test_check_unit_quaternion():
+    q = check_unit_quaternion([0.5, 0.5, 0.5, 0.5])
+    assert q.dtype == np.float64
+    check_unit_quaternion([1.0 + 1e-7, 0.0, 0.0, 0.0])
+    with raises_at((), r"norm 1, but its norm is 1\.00001 \(off by 1e-05, tolerance 1e-06\)"):
+        check_unit_quaternion([1.0 + 1e-5, 0.0, 0.0, 0.0])
+    with raises_at((), r"norm is 0 "):
+        matrix_from_quaternion([0.0, 0.0, 0.0, 0.0])
+    with raises_at((2,), r"quaternion entry 2 is nan"):
+        check_unit_quaternion([1.0, 0.0, np.nan, 0.0])
+    with raises_at((0,), r"quaternion entry 0 is inf"):
+        check_unit_quaternion([np.inf, 0.0, 0.0, 0.0])
+    with raises_at((), r"quaternion must have shape \(4,\), got shape \(3,\)"):
+        check_unit_quaternion([1.0, 0.0, 0.0])
+
+
+def test_batch_errors_name_the_row():
+    Q = np.tile([1.0, 0.0, 0.0, 0.0], (6, 1))
+    Q[3, 0] = 1.1
+    with raises_at((3,), "norm is 1.1"):
+        matrices_from_quaternions(Q)
+    Q[3, 0] = 1.0
+    Q[5, 1] = np.nan
+    with raises_at((5, 1), r"quaternion entry \(5, 1\) is nan"):
+        matrices_from_quaternions(Q)
+    with raises_at((), r"quaternion must have shape \(N, 4\), got shape \(4,\)"):
+        matrices_from_quaternions([1.0, 0.0, 0.0, 0.0])
+
+    R = np.tile(np.eye(3), (4, 1, 1))
+    R[2] = np.diag([-1.0, 1.0, 1.0])
+    with raises_at((2,), "reflection, not a rotation"):
+        quaternions_from_matrices(R)
+    R[2] = np.eye(3)
+    R[1, 0, 1] = 1e-5
+    with raises_at((1,), "not orthonormal"):
+        quaternions_from_matrices(R)
+    with raises_at((), r"must have shape \(N, 3, 3\), got shape \(3, 3\)"):
+        quaternions_from_matrices(np.eye(3))
+
+    T = np.tile(np.eye(4), (3, 1, 1))
+    T[1, 3, 0] = 0.2
+    with raises_at((1, 3, 0), "bottom row"):
+        invert_transform(T)
+
+
+def test_errors_of_multi_argument_functions_start_with_the_argument_name():
+    R = np.eye(3)
+    R[0, 1] = np.nan
+    with raises_at(("R", 0, 1), "is nan"):
+        transform_from(R, [0.0, 0.0, 0.0])
+    with raises_at(("p",), r"must have shape \(3,\)"):
+        transform_from(np.eye(3), [0.0, 0.0])
+    with raises_at(("p", 2), "entry 2 is inf"):
+        transform_from(np.eye(3), [0.0, 0.0, np.inf])
+    with raises_at(("R_b", 0, 0), "is nan"):
+        rotation_angle_between(np.eye(3), np.full((3, 3), np.nan))
+    with raises_at(("R_a", 1), "reflection"):
+        rotation_angle_between(np.stack([np.eye(3), -np.eye(3)]), np.eye(3))
+    with raises_at((), "same number of matrices"):
+        rotation_angle_between(np.tile(np.eye(3), (2, 1, 1)), np.tile(np.eye(3), (3, 1, 1)))
+    with raises_at(("axis",), r"unit vector, but its norm is 2"):
+        matrix_from_axis_angle([2.0, 0.0, 0.0], 0.1)
+    with raises_at(("angle", 1), "entry 1 is nan"):
+        matrix_from_axis_angle([1.0, 0.0, 0.0], [0.0, np.nan])
+    with raises_at(("theta",), "theta is nan"):
+        matrix_from_euler_zyz(0.0, np.nan, 0.0)
+    with raises_at((), "same length"):
+        matrix_from_rpy([0.0, 1.0], [0.0, 1.0, 2.0], 0.0)
+
+
+def test_angle_arguments_are_validated():
+    with raises_at((), "angle is nan; every entry must be a finite number"):
+        rot_x(np.nan)
+    with raises_at((1,), "angle entry 1 is inf"):
+        rot_y([0.0, np.inf])
+    with raises_at((), r"angle must be a scalar or shape \(N,\), got shape \(2, 2\)"):
+        rot_z(np.zeros((2, 2)))
+    with raises_at(("branch",), "branch must be 1 or -1, got 0"):
+        euler_zyz_from_matrix(np.eye(3), branch=0)
+    with raises_at(("free_angle",), "is nan"):
+        euler_zyz_from_matrix(np.eye(3), free_angle=np.nan)
+    with raises_at(("free_angle",), "must be a scalar"):
+        rpy_from_matrix(np.eye(3), free_angle=[0.0, 1.0])
+    with raises_at((), "reflection"):
+        euler_zyz_from_matrix(-np.eye(3))
+    with raises_at((0, 0), "is nan"):
+        rpy_from_matrix(np.full((3, 3), np.nan))

@@ -1,1 +1,55 @@
-"""Pure-numpy kinematics core. Imports numpy and the standard library only."""
+"""Pure-numpy kinematics core. Imports numpy and the standard library only.
+
+Angles are radians, lengths are the robot's own unit, and every pose is a 4×4
+homogeneous transform named by the frames it relates (``world_T_tool``).
+"""
+
+from ._conventions import CONVENTIONS, Convention, craig_row_from_khalil, link_transforms
+from ._errors import InvalidInputError, KinematicsError
+from ._forward import (
+    JointScrews,
+    ScrewModel,
+    forward_kinematics,
+    geometric_jacobian,
+    joint_screws,
+    link_frames,
+    screw_model,
+)
+from ._robot import JOINT_KINDS, Joint, JointKind, Robot, check_joint_values
+from ._rotations import (
+    check_rotation,
+    check_transform,
+    check_unit_quaternion,
+    matrix_from_euler_zyz,
+    matrix_from_quaternion,
+    matrix_from_rpy,
+    quaternions_from_matrices,
+)
+
+__all__ = [
+    "CONVENTIONS",
+    "Convention",
+    "InvalidInputError",
+    "JOINT_KINDS",
+    "Joint",
+    "JointKind",
+    "JointScrews",
+    "KinematicsError",
+    "Robot",
+    "ScrewModel",
+    "check_joint_values",
+    "check_rotation",
+    "check_transform",
+    "check_unit_quaternion",
+    "craig_row_from_khalil",
+    "forward_kinematics",
+    "geometric_jacobian",
+    "joint_screws",
+    "link_frames",
+    "link_transforms",
+    "matrix_from_euler_zyz",
+    "matrix_from_quaternion",
+    "matrix_from_rpy",
+    "quaternions_from_matrices",
+    "screw_model",
+]

@@ -1,0 +1,1 @@
+"""The HTTP layer: schemas, routers and error handling around the kinematics core."""

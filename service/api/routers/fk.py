@@ -1,0 +1,54 @@
+"""Forward kinematics."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Depends, Request
+
+from ...kinematics import forward_kinematics, link_frames
+from ..boundary import joints_to_core, located, pose_from_matrix, poses_from_matrices
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
+from ..problems import problem_responses
+from ..schemas.fk import FKBatchRequest, FKBatchResponse, FKInlineRequest, FKRequest, FKResponse
+
+router = APIRouter(prefix="/v1", tags=["forward kinematics"])
+
+
+def _forward(ref: RobotRef, body: FKRequest) -> FKResponse:
+    robot = ref.robot
+    with located("body", "joints"):
+        q = joints_to_core(robot, body.joints, body.angle_unit)
+    frames = None
+    if body.frames:
+        world_T_frames = link_frames(robot, q)
+        world_T_tool = world_T_frames[-1] @ robot.flange_T_tool
+        names = ["base", *robot.joint_names, "tool"]
+        stack = [*world_T_frames, world_T_tool]
+        frames = [{"name": name, **pose} for name, pose in zip(names, poses_from_matrices(stack))]
+    else:
+        world_T_tool = forward_kinematics(robot, q)
+    return FKResponse(robot_id=ref.id, pose=pose_from_matrix(world_T_tool), frames=frames)
+
+
+@router.post("/robots/{robot_id}/fk", operation_id="forward_kinematics", response_model=FKResponse,
+             response_model_exclude_none=True, responses=problem_responses(404, 422))
+def forward_kinematics_catalogue(body: FKRequest, ref: RobotRef = Depends(catalogue_robot)) -> FKResponse:
+    """Pose of the tool (and optionally of every link frame) at the given joint values."""
+    return _forward(ref, body)
+
+
+@router.post("/fk", operation_id="forward_kinematics_inline", response_model=FKResponse,
+             response_model_exclude_none=True, responses=problem_responses(422))
+def forward_kinematics_inline(request: Request, body: FKInlineRequest) -> FKResponse:
+    """Forward kinematics for a robot described in the request body."""
+    return _forward(inline_robot(request, body.robot), body)
+
+
+@router.post("/robots/{robot_id}/fk/batch", operation_id="forward_kinematics_batch", response_model=FKBatchResponse,
+             responses=problem_responses(404, 413, 422))
+def forward_kinematics_batch(request: Request, body: FKBatchRequest,
+                             ref: RobotRef = Depends(catalogue_robot)) -> FKBatchResponse:
+    """One tool pose per row of joint values, computed as one vectorised batch."""
+    check_batch_size(request, len(body.joints), "joints")
+    with located("body", "joints"):
+        q = joints_to_core(ref.robot, body.joints, body.angle_unit, batch=True)
+    return FKBatchResponse(robot_id=ref.id, poses=poses_from_matrices(forward_kinematics(ref.robot, q)))

@@ -1,0 +1,30 @@
+"""Liveness and readiness probes (never behind the API key)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Request
+
+from ..problems import ProblemError, problem_responses
+from ..schemas.common import ApiModel
+
+router = APIRouter(tags=["health"])
+
+
+class Health(ApiModel):
+    status: str
+    robots: int | None = None
+
+
+@router.get("/healthz", operation_id="liveness", response_model=Health)
+def liveness() -> Health:
+    """Answer 200 while the process runs."""
+    return Health(status="ok")
+
+
+@router.get("/readyz", operation_id="readiness", response_model=Health, responses=problem_responses(503))
+def readiness(request: Request) -> Health:
+    """Answer 200 once the robot catalogue is loaded, 503 before."""
+    catalogue = request.app.state.catalogue
+    if catalogue is None:
+        raise ProblemError(503, "not-ready", "Not ready", "The robot catalogue is not loaded yet.")
+    return Health(status="ready", robots=len(catalogue))

@@ -1,0 +1,38 @@
+"""Shared fixtures: an in-process client for the ASGI app, with the lifespan run."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from fastapi.testclient import TestClient
+
+from service.api.app import create_app
+from service.config import Settings
+
+DATA = Path(__file__).parent / "data"
+
+
+@pytest.fixture(scope="session")
+def client() -> TestClient:
+    with TestClient(create_app(Settings())) as test_client:
+        yield test_client
+
+
+@pytest.fixture(scope="session")
+def textbook_fk_vectors() -> dict:
+    return json.loads((DATA / "textbook_fk_vectors.json").read_text())
+
+
+def assert_problem(response, status: int, *, loc: list | None = None, match: str | None = None) -> dict:
+    """Check that ``response`` is a problem document with the given status, field location and wording."""
+    assert response.status_code == status, response.text
+    assert response.headers["content-type"].startswith("application/problem+json")
+    body = response.json()
+    assert body["status"] == status and body["title"] and body["type"].startswith("https://")
+    if loc is not None:
+        assert any(error["loc"][: len(loc)] == loc for error in body["errors"]), body["errors"]
+    if match is not None:
+        assert match in body["detail"], body["detail"]
+    return body

@@ -1,0 +1,182 @@
+"""Core forward kinematics: conventions, batch, frames, screws and the Jacobian."""
+
+import numpy as np
+import pytest
+
+from service.kinematics import (
+    InvalidInputError,
+    Joint,
+    Robot,
+    check_joint_values,
+    forward_kinematics,
+    geometric_jacobian,
+    joint_screws,
+    link_frames,
+    link_transforms,
+    screw_model,
+)
+
+
+def _rot(axis: str, angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    T = np.eye(4)
+    i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]
+    T[i, i], T[i, j], T[j, i], T[j, j] = c, -s, s, c
+    return T
+
+
+def _trans(axis: str, distance: float) -> np.ndarray:
+    T = np.eye(4)
+    T["xyz".index(axis), 3] = distance
+    return T
+
+
+def _random_robot(rng: np.random.Generator, convention: str, kinds: str) -> Robot:
+    joints = [
+        Joint(f"q{i + 1}", "revolute" if k == "R" else "prismatic", *rng.uniform(-1, 1, 2), *rng.uniform(-1, 1, 2))
+        for i, k in enumerate(kinds)
+    ]
+    return Robot(joints, convention=convention)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified", "khalil"])
+def test_link_transform_is_the_product_of_elementary_motions(convention):
+    rng = np.random.default_rng(0)
+    for a, alpha, d, theta in rng.uniform(-3, 3, (50, 4)):
+        if convention == "standard":
+            expected = _rot("z", theta) @ _trans("z", d) @ _trans("x", a) @ _rot("x", alpha)
+        else:  # Craig; a Khalil row arrives already renamed to Craig's columns
+            expected = _rot("x", alpha) @ _trans("x", a) @ _rot("z", theta) @ _trans("z", d)
+        np.testing.assert_allclose(link_transforms(convention, [a], [alpha], [d], [theta])[0], expected, atol=1e-14)
+
+
+def test_link_transforms_reject_an_unknown_convention():
+    with pytest.raises(ValueError, match="unknown convention"):
+        link_transforms("paul", [0], [0], [0], [0])
+
+
+def test_planar_rr_matches_spong_eq_3_25():
+    """Spong Example 3.1: o = (a1 c1 + a2 c12, a1 s1 + a2 s12)."""
+    arm = Robot([Joint("q1", "revolute", 1.0, 0, 0, 0), Joint("q2", "revolute", 0.5, 0, 0, 0)])
+    q1, q2 = 0.5, -0.7
+    T = forward_kinematics(arm, [q1, q2])
+    np.testing.assert_allclose(T[:2, 3], [np.cos(q1) + 0.5 * np.cos(q1 + q2), np.sin(q1) + 0.5 * np.sin(q1 + q2)])
+    np.testing.assert_allclose(T[:2, :2], [[np.cos(q1 + q2), -np.sin(q1 + q2)], [np.sin(q1 + q2), np.cos(q1 + q2)]])
+
+
+def test_offsets_are_added_to_the_joint_variable():
+    with_offset = Robot([Joint("q1", "revolute", 1.0, 0.3, 0.2, 0.4), Joint("q2", "prismatic", 0.1, 0, 0.5, 0)])
+    without = Robot([Joint("q1", "revolute", 1.0, 0.3, 0.2, 0.0), Joint("q2", "prismatic", 0.1, 0, 0.0, 0)])
+    np.testing.assert_allclose(forward_kinematics(with_offset, [0.1, 0.2]), forward_kinematics(without, [0.5, 0.7]))
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_batch_equals_single_calls_and_base_and_tool_apply(convention):
+    rng = np.random.default_rng(1)
+    base = _rot("z", 0.3) @ _trans("x", 0.5) @ _rot("x", 1.1)
+    tool = _trans("z", 0.2) @ _rot("y", -0.4)
+    plain = _random_robot(rng, convention, "RRPRRR")
+    robot = Robot(plain.joints, convention=convention, world_T_base=base, flange_T_tool=tool)
+    q = rng.uniform(-np.pi, np.pi, (20, 6))
+    batch = forward_kinematics(robot, q)
+    assert batch.shape == (20, 4, 4)
+    for row, T in zip(q, batch):
+        np.testing.assert_allclose(T, forward_kinematics(robot, row), atol=1e-14)
+        np.testing.assert_allclose(T, base @ forward_kinematics(plain, row) @ tool, atol=1e-12)
+
+
+def test_link_frames_start_at_the_base_and_end_at_the_flange():
+    rng = np.random.default_rng(2)
+    robot = Robot(_random_robot(rng, "standard", "RPR").joints, flange_T_tool=_trans("z", 0.3))
+    q = rng.uniform(-1, 1, 3)
+    frames = link_frames(robot, q)
+    assert frames.shape == (4, 4, 4)
+    np.testing.assert_allclose(frames[0], np.eye(4))
+    np.testing.assert_allclose(frames[-1] @ _trans("z", 0.3), forward_kinematics(robot, q), atol=1e-14)
+
+
+def _exp_twist(direction, point, revolute, q):
+    """exp([S] q) for a unit screw, written independently of the core (Rodrigues)."""
+    T = np.eye(4)
+    if revolute:
+        k = np.array([[0, -direction[2], direction[1]], [direction[2], 0, -direction[0]],
+                      [-direction[1], direction[0], 0]])
+        R = np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * k @ k
+        T[:3, :3] = R
+        T[:3, 3] = (np.eye(3) - R) @ point
+    else:
+        T[:3, 3] = direction * q
+    return T
+
+
+@pytest.mark.parametrize("convention,kinds", [("standard", "RRPRRR"), ("modified", "PRRRPR"), ("khalil", "RRRRRR")])
+def test_product_of_exponentials_reproduces_dh_forward_kinematics(convention, kinds):
+    rng = np.random.default_rng(3)
+    plain = _random_robot(rng, convention, kinds)
+    robot = Robot(plain.joints, convention=convention, world_T_base=_rot("y", 0.7) @ _trans("z", 1.0),
+                  flange_T_tool=_trans("x", 0.25))
+    model = screw_model(robot)
+    np.testing.assert_allclose(np.linalg.norm(model.directions, axis=1), 1.0)
+    for q in rng.uniform(-np.pi, np.pi, (30, robot.dof)):
+        T = np.eye(4)
+        for direction, point, revolute, value in zip(model.directions, model.points, model.is_revolute, q):
+            T = T @ _exp_twist(direction, point, revolute, value)
+        np.testing.assert_allclose(T @ model.home, forward_kinematics(robot, q), atol=1e-12)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_jacobian_matches_finite_differences_of_fk(convention):
+    rng = np.random.default_rng(4)
+    robot = Robot(_random_robot(rng, convention, "RRPRRP").joints, convention=convention,
+                  world_T_base=_rot("x", 0.4), flange_T_tool=_trans("y", 0.3))
+    step = 1e-6
+    for q in rng.uniform(-np.pi, np.pi, (10, robot.dof)):
+        J = geometric_jacobian(robot, q)
+        T = forward_kinematics(robot, q)
+        for i in range(robot.dof):
+            dq = np.zeros(robot.dof)
+            dq[i] = step
+            T_plus, T_minus = forward_kinematics(robot, q + dq), forward_kinematics(robot, q - dq)
+            linear = (T_plus[:3, 3] - T_minus[:3, 3]) / (2 * step)
+            dR = (T_plus[:3, :3] - T_minus[:3, :3]) / (2 * step) @ T[:3, :3].T  # = [ω]×
+            angular = np.array([dR[2, 1], dR[0, 2], dR[1, 0]])
+            np.testing.assert_allclose(J[:3, i], linear, atol=1e-8)
+            np.testing.assert_allclose(J[3:, i], angular, atol=1e-8)
+    batch = geometric_jacobian(robot, rng.uniform(-1, 1, (5, robot.dof)))
+    assert batch.shape == (5, 6, robot.dof)
+
+
+def test_joint_screws_follow_the_convention_axis():
+    """Standard DH: joint 1 turns about z0 of the base; Craig: about z1, which coincides with z0 at alpha_0 = 0."""
+    spong = Robot([Joint("q1", "revolute", 0, np.pi / 2, 0.5, 0), Joint("q2", "revolute", 1, 0, 0, 0)])
+    directions, points, _ = joint_screws(spong, np.array([0.3, 0.2]))
+    np.testing.assert_allclose(directions[0], [0, 0, 1], atol=1e-15)
+    np.testing.assert_allclose(directions[1], [np.sin(0.3), -np.cos(0.3), 0], atol=1e-15)  # z1 = (s1, -c1, 0)
+    np.testing.assert_allclose(points[1], [0, 0, 0.5], atol=1e-15)
+
+
+def test_robot_validation_names_the_joint():
+    with pytest.raises(InvalidInputError, match="lower limit 2 is greater than upper limit 1") as error:
+        Robot([Joint("q1", "revolute", 0, 0, 0, 0), Joint("q2", "revolute", 0, 0, 0, 0, 2.0, 1.0)])
+    assert error.value.location == ("joints", 1, "limits")
+    with pytest.raises(InvalidInputError, match="at least one joint"):
+        Robot([])
+    with pytest.raises(InvalidInputError, match="finite") as error:
+        Robot([Joint("q1", "revolute", float("nan"), 0, 0, 0)])
+    assert error.value.location == ("joints", 0, "a")
+
+
+def test_joint_values_are_checked_for_shape_and_finiteness():
+    robot = Robot([Joint("q1", "revolute", 1, 0, 0, 0), Joint("q2", "prismatic", 0, 0, 0, 0)])
+    with pytest.raises(InvalidInputError, match=r"shape \(2,\).*got shape \(3,\)"):
+        check_joint_values(robot, [1, 2, 3])
+    with pytest.raises(InvalidInputError, match="finite") as error:
+        check_joint_values(robot, [[0, 1], [np.inf, 0]], batch=True)
+    assert error.value.location == (1, 0)
+
+
+def test_ragged_batch_rows_are_named():
+    robot = Robot([Joint("q1", "revolute", 1, 0, 0, 0), Joint("q2", "prismatic", 0, 0, 0, 0)])
+    with pytest.raises(InvalidInputError, match="row 1 has 3") as error:
+        check_joint_values(robot, [[0, 1], [1, 2, 3]], batch=True)
+    assert error.value.location == (1,)

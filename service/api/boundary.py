@@ -18,6 +18,8 @@ import numpy as np
 
 from ..kinematics import (
     InvalidInputError,
+    Limits,
+    Violation,
     Joint,
     KinematicsError,
     Robot,
@@ -68,7 +70,7 @@ def robot_from_description(description: DHRobot | KhalilRobot, *, max_joints: in
         else:
             a, alpha, d, theta = row.a, row.alpha, row.d, row.theta
         scale = angle if row.type == "revolute" else 1.0
-        lower, upper = (-math.inf, math.inf) if row.limits is None else (row.limits.lower * scale, row.limits.upper * scale)
+        lower, upper = _bounds(row.limits, scale)
         joints.append(Joint(row.name or f"q{index + 1}", row.type, a, alpha * angle, d, theta * angle, lower, upper))
     with located():
         return Robot(
@@ -78,6 +80,15 @@ def robot_from_description(description: DHRobot | KhalilRobot, *, max_joints: in
             flange_T_tool=None if description.tool is None else np.asarray(description.tool, dtype=float),
             name=description.name or description.id,
         )
+
+
+def _bounds(limits, scale: float) -> tuple[float, float]:
+    """(lower, upper) in core units from a wire limits object; open sides become ∓inf."""
+    if limits is None:
+        return -math.inf, math.inf
+    lower = -math.inf if limits.lower is None else limits.lower * scale
+    upper = math.inf if limits.upper is None else limits.upper * scale
+    return lower, upper
 
 
 def _unit_scale(robot: Robot, unit: AngleUnit) -> np.ndarray:
@@ -138,3 +149,19 @@ def poses_from_matrices(matrices: np.ndarray) -> list[dict]:
 def pose_from_matrix(matrix: np.ndarray) -> dict:
     """The wire pose of one transform, shape (4, 4)."""
     return poses_from_matrices(np.asarray(matrix)[None])[0]
+
+
+def limits_to_core(robot: Robot, overrides: Sequence | None, unit: AngleUnit) -> Limits:
+    """The limits a request works with: the robot's, or the request's overrides converted to radians."""
+    if overrides is None:
+        return Limits.of(robot)
+    if len(overrides) != robot.dof:
+        raise InvalidInputError(f"expected limits for {robot.dof} joints, got {len(overrides)}")
+    bounds = [_bounds(o, factor) for o, factor in zip(overrides, _unit_scale(robot, unit))]
+    return Limits.checked(robot, np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds]))
+
+
+def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:
+    scale = float(_unit_scale(robot, unit)[violation.joint])
+    return {"joint": violation.joint, "value": violation.value / scale,
+            "lower": violation.lower / scale, "upper": violation.upper / scale}

@@ -15,6 +15,7 @@ from ._forward import (
     link_frames,
     screw_model,
 )
+from ._limits import LIMIT_TOLERANCE, Limits, Violation, fitting_equivalents, violations, within
 from ._robot import JOINT_KINDS, Joint, JointKind, Robot, check_joint_values
 from ._rotations import (
     check_rotation,
@@ -34,6 +35,12 @@ __all__ = [
     "Joint",
     "JointKind",
     "JointScrews",
+    "LIMIT_TOLERANCE",
+    "Limits",
+    "Violation",
+    "fitting_equivalents",
+    "violations",
+    "within",
     "KinematicsError",
     "Robot",
     "ScrewModel",

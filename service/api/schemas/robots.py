@@ -17,14 +17,16 @@ JointType = Literal["revolute", "prismatic"]
 
 
 class JointLimits(ApiModel):
-    """Bounds on the joint variable q: the robot's angle unit for revolute joints, its length unit for prismatic ones."""
+    """Inclusive bounds on the joint variable q: the robot's angle unit for revolute joints, its length unit for
+    prismatic ones. A null bound is open on that side (a slide that only has to stay positive: lower 0, upper null).
+    """
 
-    lower: Number
-    upper: Number
+    lower: Number | None
+    upper: Number | None
 
     @model_validator(mode="after")
     def _ordered(self) -> "JointLimits":
-        if self.lower > self.upper:
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
             raise ValueError(f"lower limit {self.lower:g} is greater than upper limit {self.upper:g}")
         return self
 

@@ -1,0 +1,1 @@
+"""Analytic inverse kinematics: geometric subproblems and the solvers built on them."""

@@ -1,0 +1,819 @@
+"""Geometric subproblems of analytic inverse kinematics, vectorised over a batch.
+
+The solvers for each kinematic family reduce a pose to a few of these
+subproblems (Paden-Kahan 1-3, IK-Geo 4, and their prismatic analogues). Each
+one returns every candidate, and each candidate carries its own flags. No
+solver here decides acceptance, so a solver can still use a least-squares
+candidate when the target is just outside the workspace.
+
+Conventions
+-----------
+* ``R(k, theta) p`` rotates ``p`` by ``theta`` radians about the unit axis
+  ``k`` through the origin, right-handed (Rodrigues)::
+
+      R(k, theta) p = (k.p) k + cos(theta) (p - (k.p) k) + sin(theta) (k x p)
+
+  Callers translate points first so that the axis passes through the origin.
+  ``p_perp = p - (k.p) k`` is the part of ``p`` that the rotation moves.
+* Axes and fixed directions (``k``, ``k1``, ``k2``, ``h``, ``v``) are constant
+  unit vectors of shape (3,). They are validated (shape, unit norm to
+  ``ORTHONORMAL_TOLERANCE``) and renormalised.
+* Data (points of shape (..., 3), distances and heights of shape (...)) broadcast
+  against each other. Their broadcast shape, the *batch shape*, leads every
+  result. Data are not checked for finiteness: these functions run inside the
+  solvers, after the API boundary. A non-finite row gives NaN candidates with
+  false flags.
+* Returned angles are wrapped to ``(-pi, pi]``. A candidate slot that does not
+  exist (``valid`` false) holds NaN.
+* Tolerances come from :mod:`service.kinematics._tolerances` and scale with each
+  problem. Every docstring names the scale it uses.
+
+  - ``GEOMETRY_TOLERANCE`` decides whether a least-squares miss or a
+    rotation radius is zero. It is relative to the scale.
+  - ``DUPLICATE_TOLERANCE`` decides when two roots are one root. Two roots
+    are reported once, as the tangent root midway between them with ``merged``
+    set, when that midpoint satisfies the equation to
+    ``DUPLICATE_TOLERANCE**2`` of the scale. Near a double root the residual
+    grows with the square of the distance from it. So this merges roots
+    closer than about ``DUPLICATE_TOLERANCE`` (radians, or a fraction of the
+    scale for prismatic joints), the project's test for "the same solution".
+    It also merges a double root that rounding has split.
+
+Results
+-------
+Every function returns a record with the same flags. ``m`` is the number of
+candidate slots, which is fixed for each function (1 or 2):
+
+* ``valid`` (..., m) bool: the candidate exists. The first slot is always
+  valid, because every problem has an exact, least-squares or representative
+  answer.
+* ``exact`` (..., m) bool: the candidate satisfies the equation within
+  tolerance. False means it is the least-squares answer.
+* ``degenerate`` (...,) bool: infinitely many candidates are equally good,
+  because the equation or its least-squares residual does not depend on a
+  joint. The candidate given is a representative, with the free value 0.
+* ``merged`` (...,) bool: the two roots coincide. This is the tangent or
+  workspace-boundary case, and a singular configuration for the solver. Only
+  the first slot is valid. Functions with one slot always report False.
+
+The records are :class:`AngleSolutions` (``theta``), :class:`AnglePairSolutions`
+(``theta1``, ``theta2``) and :class:`DisplacementSolutions` (``s``).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._errors import InvalidInputError
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
+
+__all__ = [
+    "AnglePairSolutions",
+    "AngleSolutions",
+    "DisplacementSolutions",
+    "planar_two_link_elbow",
+    "prismatic_to_distance",
+    "prismatic_to_plane",
+    "subproblem_1",
+    "subproblem_2",
+    "subproblem_2_chain",
+    "subproblem_3",
+    "subproblem_4",
+]
+
+
+class AngleSolutions(NamedTuple):
+    """Candidates for one joint angle. See the module docstring for the flags."""
+
+    theta: np.ndarray  #: (..., m) float, radians in (-pi, pi]; NaN where not valid
+    valid: np.ndarray  #: (..., m) bool
+    exact: np.ndarray  #: (..., m) bool
+    degenerate: np.ndarray  #: (...,) bool
+    merged: np.ndarray  #: (...,) bool
+
+
+class AnglePairSolutions(NamedTuple):
+    """Candidates for two joint angles. Slot ``j`` of ``theta1`` and ``theta2`` is one candidate."""
+
+    theta1: np.ndarray  #: (..., 2) float, radians in (-pi, pi]; NaN where not valid
+    theta2: np.ndarray  #: (..., 2) float, radians in (-pi, pi]; NaN where not valid
+    valid: np.ndarray  #: (..., 2) bool
+    exact: np.ndarray  #: (..., 2) bool
+    degenerate: np.ndarray  #: (...,) bool
+    merged: np.ndarray  #: (...,) bool
+
+
+class DisplacementSolutions(NamedTuple):
+    """Candidates for one prismatic displacement. See the module docstring for the flags."""
+
+    s: np.ndarray  #: (..., m) float, length unit of the inputs; NaN where not valid
+    valid: np.ndarray  #: (..., m) bool
+    exact: np.ndarray  #: (..., m) bool
+    degenerate: np.ndarray  #: (...,) bool
+    merged: np.ndarray  #: (...,) bool
+
+
+# Largest relative residual of the midpoint for which two roots count as one.
+_MERGE_RESIDUAL = DUPLICATE_TOLERANCE**2
+_TWO_PI = 2.0 * math.pi
+
+
+# ---------------------------------------------------------------------------
+# Private helpers
+# ---------------------------------------------------------------------------
+
+
+def _unit(k: ArrayLike, name: str) -> np.ndarray:
+    """Return the constant unit vector ``k`` (shape (3,)) renormalised, or raise."""
+    k = np.asarray(k, dtype=float)
+    if k.shape != (3,):
+        raise InvalidInputError(f"{name} must be a unit vector of shape (3,), got shape {k.shape}", location=(name,))
+    norm = math.sqrt(float(k @ k))
+    if not abs(norm - 1.0) <= ORTHONORMAL_TOLERANCE:  # also rejects NaN
+        raise InvalidInputError(f"{name} must be a unit vector, its norm is {norm:.9g}", location=(name,))
+    return k / norm
+
+
+def _points(p: ArrayLike, name: str) -> np.ndarray:
+    p = np.asarray(p, dtype=float)
+    if p.ndim == 0 or p.shape[-1] != 3:
+        raise InvalidInputError(f"{name} must have shape (..., 3), got shape {p.shape}", location=(name,))
+    return p
+
+
+def _distances(d: ArrayLike, name: str) -> np.ndarray:
+    d = np.asarray(d, dtype=float)
+    if (d < 0.0).any():
+        raise InvalidInputError(f"{name} is a distance and must not be negative", location=(name,))
+    return d
+
+
+def _frame(k: np.ndarray) -> np.ndarray:
+    """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``.
+
+    ``p @ _frame(k)`` gives the coordinates ``(x, y, z)`` of ``p``, where ``z = k.p``
+    is the height along the axis. A rotation about ``k`` turns ``(x, y)`` like a
+    plane rotation: ``R(k, theta) p`` has ``(x cos - y sin, x sin + y cos, z)``.
+    """
+    kx, ky, kz = k.tolist()
+    # e1 = k x (the coordinate axis least aligned with k), normalised.
+    if abs(kx) <= abs(ky) and abs(kx) <= abs(kz):
+        e1 = (0.0, kz, -ky)
+    elif abs(ky) <= abs(kz):
+        e1 = (-kz, 0.0, kx)
+    else:
+        e1 = (ky, -kx, 0.0)
+    n = math.sqrt(e1[0] ** 2 + e1[1] ** 2 + e1[2] ** 2)
+    ax, ay, az = e1[0] / n, e1[1] / n, e1[2] / n
+    e2 = (ky * az - kz * ay, kz * ax - kx * az, kx * ay - ky * ax)  # k x e1
+    return np.array([[ax, e2[0], kx], [ay, e2[1], ky], [az, e2[2], kz]])
+
+
+def _coords(p: np.ndarray, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    c = p @ frame
+    return c[..., 0], c[..., 1], c[..., 2]
+
+
+def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of two vectors of shape (3,) (cheaper than ``np.cross`` for one pair)."""
+    (ax, ay, az), (bx, by, bz) = a.tolist(), b.tolist()
+    return np.array([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx])
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot product over the last axis, broadcasting the batch axes."""
+    if a.ndim == 1 and b.ndim == 1:  # single row: ``@`` has less overhead than einsum
+        return a @ b
+    return np.einsum("...i,...i->...", a, b)
+
+
+def _hypot(x: ArrayLike, y: ArrayLike) -> np.ndarray:
+    """``sqrt(x**2 + y**2)``, several times faster than ``np.hypot``.
+
+    Accurate for any length far from float overflow or underflow (1e+-154).
+    """
+    return np.sqrt(x * x + y * y)
+
+
+def _norm(a: np.ndarray) -> np.ndarray:
+    return np.sqrt(_dot(a, a))
+
+
+def _wrap(theta: np.ndarray) -> np.ndarray:
+    """Wrap angles in (-3 pi, 3 pi] to (-pi, pi], leaving angles already there untouched. NaN stays NaN."""
+    return theta - _TWO_PI * (theta > np.pi) + _TWO_PI * (theta <= -np.pi)
+
+
+def _pair(shape: tuple[int, ...], first: ArrayLike, second: ArrayLike, dtype: type) -> np.ndarray:
+    """Candidates of shape ``shape + (2,)`` from the two slots (cheaper than ``np.stack`` for one row)."""
+    out = np.empty(shape + (2,), dtype=dtype)
+    out[..., 0] = first
+    out[..., 1] = second
+    return out
+
+
+def _rotate_onto(
+    frame: np.ndarray, p: np.ndarray, q: np.ndarray, scale: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Subproblem 1 core: ``(theta, exact, degenerate)`` for ``R(k, theta) p = q``.
+
+    ``frame`` is ``_frame(k)``. ``scale`` defaults to ``max(||p||, ||q||)``.
+    """
+    px, py, pz = _coords(p, frame)
+    qx, qy, qz = _coords(q, frame)
+    # q.R p = pz qz + cos(theta) (px qx + py qy) + sin(theta) (px qy - py qx), largest at:
+    theta = np.arctan2(px * qy - py * qx, px * qx + py * qy)
+    radius_p = _hypot(px, py)
+    radius_q = _hypot(qx, qy)
+    if scale is None:
+        scale = np.maximum(_hypot(radius_p, pz), _hypot(radius_q, qz))
+    tol = GEOMETRY_TOLERANCE * scale
+    exact = (np.abs(radius_p - radius_q) <= tol) & (np.abs(pz - qz) <= tol)
+    degenerate = (radius_p <= tol) | (radius_q <= tol)
+    return np.where(degenerate, 0.0, _wrap(theta)), exact, degenerate
+
+
+def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> AngleSolutions:
+    """Solve ``a cos(theta) + b sin(theta) = c`` elementwise.
+
+    Subproblems 3 and 4 and the two-link elbow all reduce to this equation.
+    ``scale`` (same unit as ``a``, ``b``, ``c``) sets the tolerance. With
+    ``rho = hypot(a, b)`` and ``phi = atan2(b, a)`` the equation reads
+    ``rho cos(theta - phi) = c``. The roots are ``phi + half`` and
+    ``phi - half``, in that order, where ``half = atan2(sqrt(rho**2 - c**2), c)``.
+    When ``|c| > rho``, ``theta = phi`` (``c > 0``) or ``phi + pi`` (``c < 0``)
+    minimises ``|a cos + b sin - c|``. When ``rho`` is about 0 the equation is
+    degenerate. The midpoint ``phi`` (or ``phi + pi``) of two roots misses by
+    ``rho - |c|``, which is what decides ``merged``.
+    """
+    tol = GEOMETRY_TOLERANCE * scale
+    rho = _hypot(a, b)
+    abs_c = np.abs(c)
+    excess = abs_c - rho  # > 0: c is outside the range [-rho, rho] of the left side
+    exact = np.asarray(excess <= tol)
+    shape = exact.shape  # the broadcast batch shape
+    degenerate = rho <= tol
+    if np.shape(degenerate) != shape:
+        degenerate = np.broadcast_to(degenerate, shape)
+    regular = exact & ~degenerate
+    merged = regular & (-excess <= _MERGE_RESIDUAL * scale)
+    two = regular & ~merged
+    root = np.sqrt(np.maximum(-excess, 0.0) * (rho + abs_c))  # sqrt(rho**2 - c**2) without cancellation
+    half = np.arctan2(root * two, c)  # 0 or pi unless there are two roots
+    phi = np.arctan2(b, a)
+    first = np.where(degenerate, 0.0, _wrap(phi + half))
+    second = np.where(two, _wrap(phi - half), np.nan)
+    exact_first = regular | (degenerate & (np.abs(a - c) <= tol))
+    return AngleSolutions(
+        theta=_pair(shape, first, second, float),
+        valid=_pair(shape, True, two, bool),
+        exact=_pair(shape, exact_first, two, bool),
+        degenerate=np.array(degenerate),
+        merged=np.asarray(merged),
+    )
+
+
+# ---------------------------------------------------------------------------
+# Revolute subproblems
+# ---------------------------------------------------------------------------
+
+
+def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike) -> AngleSolutions:
+    """Paden-Kahan 1: solve ``R(k, theta) p = q``; else minimise ``||R(k, theta) p - q||``.
+
+    An exact solution needs ``||p_perp|| = ||q_perp||`` and ``k.p = k.q``. The
+    solution and the least-squares minimiser are the same formula:
+    ``theta = atan2(k.(p x q), p_perp.q_perp)``, which turns ``p_perp`` onto
+    the direction of ``q_perp``.
+
+    Parameters
+    ----------
+    k : array_like, shape (3,)
+        Unit rotation axis through the origin.
+    p, q : array_like, shape (..., 3)
+        Points before and after the rotation.
+
+    Returns
+    -------
+    AngleSolutions
+        ``theta`` has shape (..., 1). ``merged`` is always False.
+
+    Notes
+    -----
+    Scale: ``L = max(||p||, ||q||)``. The solution is exact when
+    ``| ||p_perp|| - ||q_perp|| |`` and ``|k.p - k.q|`` are both at most
+    ``GEOMETRY_TOLERANCE * L``. It is degenerate, with representative
+    ``theta = 0``, when ``p`` lies on the axis (``||p_perp|| <= tol``): every
+    angle solves it. It is also degenerate when only ``q`` lies on the axis,
+    because every angle is then an equally good least-squares answer.
+
+    Examples
+    --------
+    >>> sol = subproblem_1([0, 0, 1], [1, 0, 0.5], [0, 1, 0.5])
+    >>> np.degrees(sol.theta).round(9).tolist(), sol.exact.tolist()
+    ([90.0], [True])
+    """
+    k = _unit(k, "k")
+    p = _points(p, "p")
+    q = _points(q, "q")
+    theta, exact, degenerate = _rotate_onto(_frame(k), p, q)  # all of the batch shape
+    return AngleSolutions(
+        theta=theta[..., None],
+        valid=np.ones(theta.shape + (1,), dtype=bool),
+        exact=exact[..., None],
+        degenerate=np.asarray(degenerate),
+        merged=np.zeros(theta.shape, dtype=bool),
+    )
+
+
+def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> AnglePairSolutions:
+    """Paden-Kahan 2, IK-Geo form: solve ``R(k1, theta1) p = R(k2, theta2) q``; else least squares.
+
+    The common point ``x`` lies on the circle that ``p`` sweeps about ``k1`` and
+    on the circle that ``q`` sweeps about ``k2``. On the unit sphere, write
+    ``x = alpha k1 + beta k2 + gamma (k1 x k2)``. The conditions
+    ``k1.x = k1.p/||p||`` and ``k2.x = k2.q/||q||`` fix ``alpha`` and ``beta``.
+    The condition ``||x|| = 1`` gives ``gamma = +/- sqrt(g) / ||k1 x k2||`` with
+    ``g = 1 - ||alpha k1 + beta k2||**2``. Each ``x`` gives both angles through
+    subproblem 1. The code evaluates it in the coordinates of ``p`` and ``q``
+    along ``k1``, ``k2`` and ``k1 x k2``, so it forms no batch of 3-vectors.
+    When ``g < 0`` the two cones do not meet. With ``gamma = 0``, the angles
+    then turn ``p`` and ``q`` to the closest pair of directions on the two
+    cones. Because ``||R1 p - R2 q||**2 = ||p||**2 + ||q||**2 - 2 R1 p . R2 q``,
+    this pair also minimises ``||R(k1, theta1) p - R(k2, theta2) q||``, and it
+    does so whatever ``||p||`` and ``||q||`` are.
+
+    Paden-Kahan's own form ``R(k1, a) R(k2, b) p = q`` is the same problem as
+    ``R(k1, -a) q = R(k2, b) p``. Call ``subproblem_2(k1, k2, q, p)`` and take
+    ``a = -theta1``, ``b = theta2``, or call :func:`subproblem_2_chain`.
+
+    Parameters
+    ----------
+    k1, k2 : array_like, shape (3,)
+        Unit axes through the origin, not parallel.
+    p, q : array_like, shape (..., 3)
+        ``p`` is rotated about ``k1``, ``q`` about ``k2``.
+
+    Returns
+    -------
+    AnglePairSolutions
+        Two slots. There are 2 valid candidates when the cones cross, and 1
+        when they touch (``merged``), miss (least squares) or when a joint is
+        free (``degenerate``). The candidate with ``+gamma`` comes first.
+        Candidates are not exact when ``||p|| != ||q||``. They are still the
+        least-squares minimisers.
+
+    Raises
+    ------
+    InvalidInputError
+        When ``k1`` and ``k2`` are parallel (``||k1 x k2|| <= GEOMETRY_TOLERANCE``).
+
+    Notes
+    -----
+    Scale: ``L = max(||p||, ||q||)``. Exactness needs
+    ``| ||p|| - ||q|| | <= tol L``. When the cones miss, it also needs the gap
+    between the closest directions to be at most ``GEOMETRY_TOLERANCE`` (on the
+    unit sphere). A gap that small means the cones touch, and the candidate is
+    then ``merged``. ``theta1`` is free (degenerate, representative 0) when
+    ``p`` lies on ``k1``, or ``p = 0``. ``theta2`` is then the subproblem 1
+    answer for ``R(k2, theta2) q = p``. The case ``q`` on ``k2`` is the mirror
+    image.
+
+    Examples
+    --------
+    Two crossings, at ``(0, 1, 0)`` and ``(0, -1, 0)``:
+
+    >>> sol = subproblem_2([0, 0, 1], [1, 0, 0], [1, 0, 0], [0, 1, 0])
+    >>> np.degrees(sol.theta1).round(9).tolist(), np.degrees(sol.theta2).round(9).tolist()
+    ([90.0, -90.0], [0.0, 180.0])
+
+    Two cones of half-angle 45 degrees about perpendicular axes touch at ``(1, 0, 1)``:
+
+    >>> sol = subproblem_2([0, 0, 1], [1, 0, 0], [1, 0, 1], [1, 1, 0])
+    >>> np.degrees(sol.theta1).round(9).tolist(), np.degrees(sol.theta2).round(9).tolist()
+    ([0.0, nan], [90.0, nan])
+    >>> sol.merged.tolist(), sol.exact.tolist()
+    (True, [True, False])
+    """
+    k1 = _unit(k1, "k1")
+    k2 = _unit(k2, "k2")
+    normal = _cross3(k1, k2)
+    sin2 = float(normal @ normal)
+    if sin2 <= GEOMETRY_TOLERANCE**2:
+        raise InvalidInputError(
+            "k1 and k2 are parallel; subproblem 2 needs two intersecting, non-parallel axes", location=("k2",)
+        )
+    cos = float(k1 @ k2)
+    sin = math.sqrt(sin2)
+    p = _points(p, "p")
+    q = _points(q, "q")
+
+    # Everything follows from the coordinates of p and q along k1, k2 and n = k1 x k2.
+    basis = np.array([k1, k2, normal]).T
+    pk = p @ basis
+    qk = q @ basis
+    p1, p2, pn = pk[..., 0], pk[..., 1], pk[..., 2]
+    q1, q2, qn = qk[..., 0], qk[..., 1], qk[..., 2]
+    d1 = p2 - cos * p1  # p.(k2 - cos k1): with pn, the part of p that k1 moves
+    e2 = q1 - cos * q2  # q.(k1 - cos k2): with qn, the part of q that k2 moves
+    radius_p = _hypot(pn, d1) / sin  # ||k1 x p||
+    radius_q = _hypot(qn, e2) / sin  # ||k2 x q||
+    norm_p = _hypot(p1, radius_p)
+    norm_q = _hypot(q2, radius_q)
+    scale = np.maximum(norm_p, norm_q)
+    tol = GEOMETRY_TOLERANCE * scale
+    free1 = radius_p <= tol  # p on k1 (or p = 0): theta1 free
+    free2 = radius_q <= tol  # q on k2 (or q = 0): theta2 free
+    degenerate = free1 | free2
+    norms_match = np.abs(norm_p - norm_q) <= tol
+
+    # Directions on the unit sphere (zero vectors are degenerate rows).
+    inv_p = 1.0 / np.where(norm_p > 0.0, norm_p, 1.0)
+    inv_q = 1.0 / np.where(norm_q > 0.0, norm_q, 1.0)
+    h1 = p1 * inv_p
+    h2 = q2 * inv_q
+    rho1 = radius_p * inv_p
+    rho2 = radius_q * inv_q
+    alpha = (h1 - cos * h2) / sin2
+    beta = (h2 - cos * h1) / sin2
+    g = 1.0 - alpha * h1 - beta * h2  # 1 - ||x0||**2 for x0 = alpha k1 + beta k2 (k1.x0 = h1, k2.x0 = h2)
+    meet = g >= 0.0
+    # With gamma = 0 each angle turns its vector to the arc midpoint between the
+    # two crossings, a sagitta of at most g / rho from x0: the residual is at most g (1/rho1 + 1/rho2).
+    close = g * (rho1 + rho2) <= _MERGE_RESIDUAL * rho1 * rho2
+    two = meet & ~close & ~degenerate
+    gamma = np.sqrt(np.maximum(g, 0.0)) * two / sin
+
+    # Subproblem 1 towards x = x0 + sign gamma n, written in the coordinates:
+    #   (k1 x p).x = -beta pn + sign gamma d1,   (k1 x p).(k1 x x) = beta d1 + sign gamma pn,
+    #   (k2 x q).x = alpha qn - sign gamma e2,   (k2 x q).(k2 x x) = alpha e2 + sign gamma qn.
+    s1, c1, t1, u1 = -beta * pn, beta * d1, gamma * d1, gamma * pn
+    s2, c2, t2, u2 = alpha * qn, alpha * e2, gamma * e2, gamma * qn
+    first1 = _wrap(np.arctan2(s1 + t1, c1 + u1))
+    first2 = _wrap(np.arctan2(s2 - t2, c2 + u2))
+    second1 = np.where(two, _wrap(np.arctan2(s1 - t1, c1 - u1)), np.nan)
+    second2 = np.where(two, _wrap(np.arctan2(s2 + t2, c2 - u2)), np.nan)
+
+    touch = meet & close
+    if not meet.all():
+        # The cones miss. In the orthonormal frame (k1, (k2 - cos k1) / sin) of
+        # their common plane, the closest directions are u = (h1, +/-rho1) on
+        # the side of beta and v = h2 (cos, sin) +/- rho2 (sin, -cos) on the
+        # side of alpha. They touch if u and v meet within tolerance.
+        side1 = np.sign(beta) * rho1
+        side2 = np.sign(alpha) * rho2
+        gap = _hypot(h1 - cos * h2 - sin * side2, side1 - sin * h2 + cos * side2)
+        touch = touch | (~meet & (gap <= GEOMETRY_TOLERANCE))
+    merged = touch & ~degenerate
+    exact_first = norms_match & (meet | touch)
+
+    if degenerate.any():
+        scale_b = np.broadcast_to(scale, degenerate.shape)
+        # theta1 free: R(k2, theta2) q = p.  theta2 free: R(k1, theta1) p = q.
+        free_t2, exact2, _ = _rotate_onto(_frame(k2), q, p, scale_b)
+        free_t1, exact1, _ = _rotate_onto(_frame(k1), p, q, scale_b)
+        first1 = np.where(free1, 0.0, np.where(free2, free_t1, first1))
+        first2 = np.where(free1, free_t2, np.where(free2, 0.0, first2))
+        exact_first = np.where(free1, exact2, np.where(free2, exact1, exact_first))
+
+    shape = two.shape
+    return AnglePairSolutions(
+        theta1=_pair(shape, first1, second1, float),
+        theta2=_pair(shape, first2, second2, float),
+        valid=_pair(shape, True, two, bool),
+        exact=_pair(shape, exact_first, two & norms_match, bool),
+        degenerate=np.asarray(degenerate),
+        merged=np.asarray(merged),
+    )
+
+
+def subproblem_2_chain(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> AnglePairSolutions:
+    """Paden-Kahan 2, chain form: solve ``R(k1, theta1) R(k2, theta2) p = q``; else least squares.
+
+    This is :func:`subproblem_2` applied to ``R(k1, -theta1) q = R(k2, theta2) p``.
+    It minimises the same residual, because rotations preserve length. Flags,
+    slots and tolerances are as in :func:`subproblem_2`. In this form
+    ``theta2`` is free when ``p`` lies on ``k2``, and ``theta1`` is free when
+    ``q`` lies on ``k1``.
+
+    Parameters
+    ----------
+    k1, k2 : array_like, shape (3,)
+        Unit axes through the origin, not parallel. ``k2`` acts first.
+    p, q : array_like, shape (..., 3)
+        Point before and after both rotations.
+
+    Examples
+    --------
+    Turn ``z`` onto ``y``: first about ``y`` to ``+x`` or ``-x``, then about ``z``:
+
+    >>> sol = subproblem_2_chain([0, 0, 1], [0, 1, 0], [0, 0, 1], [0, 1, 0])
+    >>> np.degrees(sol.theta1).round(9).tolist(), np.degrees(sol.theta2).round(9).tolist()
+    ([-90.0, 90.0], [-90.0, 90.0])
+    """
+    sol = subproblem_2(k1, k2, q, p)
+    return sol._replace(theta1=_wrap(-sol.theta1))
+
+
+def subproblem_3(k: ArrayLike, p: ArrayLike, q: ArrayLike, delta: ArrayLike) -> AngleSolutions:
+    """Paden-Kahan 3: solve ``||R(k, theta) p - q|| = delta``; else minimise ``| ||R(k, theta) p - q|| - delta |``.
+
+    Expanding the square gives ``a cos(theta) + b sin(theta) = c``, where
+    ``a = p_perp.q_perp``, ``b = k.(p x q)`` and
+    ``c = (||p_perp||**2 + ||q_perp||**2 + (k.p - k.q)**2 - delta**2) / 2``.
+    The distance varies between the two ends of a range. When ``delta`` is
+    outside that range, the least-squares answer is the end nearer
+    ``delta``.
+
+    Parameters
+    ----------
+    k : array_like, shape (3,)
+        Unit rotation axis through the origin.
+    p, q : array_like, shape (..., 3)
+        Rotated point and fixed point.
+    delta : array_like, shape (...)
+        Wanted distance, ``>= 0``.
+
+    Returns
+    -------
+    AngleSolutions
+        ``theta`` has shape (..., 2). The roots are ``phi + half`` and then
+        ``phi - half``, where ``phi = atan2(b, a)``.
+
+    Raises
+    ------
+    InvalidInputError
+        When a ``delta`` is negative.
+
+    Notes
+    -----
+    Scale: ``S = ||p||**2 + ||q||**2 + delta**2``. The answer is exact when
+    ``(d**2 - delta**2) / 2`` is at most ``GEOMETRY_TOLERANCE * S``, with ``d``
+    the distance reached. The problem is degenerate (representative
+    ``theta = 0``) when ``||p_perp|| ||q_perp|| <= tol S``, that is when ``p``
+    or ``q`` lies on the axis. The distance then does not depend on ``theta``,
+    and the answer is exact only if that distance is ``delta``. At either end
+    of the range the two roots merge.
+
+    Examples
+    --------
+    >>> sol = subproblem_3([0, 0, 1], [1, 0, 0], [0, 0, 0], 1.0)  # p on a circle about q
+    >>> sol.degenerate.tolist(), sol.exact.tolist()
+    (True, [True, False])
+    >>> sol = subproblem_3([0, 0, 1], [1, 0, 0], [1, 0, 0], np.sqrt(2))
+    >>> np.degrees(sol.theta).round(9).tolist()
+    [90.0, -90.0]
+    """
+    k = _unit(k, "k")
+    p = _points(p, "p")
+    q = _points(q, "q")
+    delta = _distances(delta, "delta")
+    frame = _frame(k)
+    px, py, pz = _coords(p, frame)
+    qx, qy, qz = _coords(q, frame)
+    rp2 = px * px + py * py
+    rq2 = qx * qx + qy * qy
+    delta2 = delta * delta
+    c = 0.5 * (rp2 + rq2 + (pz - qz) ** 2 - delta2)
+    scale = rp2 + rq2 + pz * pz + qz * qz + delta2
+    return _harmonic(px * qx + py * qy, px * qy - py * qx, c, scale)
+
+
+def subproblem_4(h: ArrayLike, k: ArrayLike, p: ArrayLike, delta: ArrayLike) -> AngleSolutions:
+    """IK-Geo 4: solve ``h.R(k, theta) p = delta``; else minimise ``|h.R(k, theta) p - delta|``.
+
+    With ``h_perp = h - (h.k) k`` the equation is
+    ``a cos(theta) + b sin(theta) = c``, where ``a = h_perp.p``,
+    ``b = (h x k).p`` and ``c = delta - (h.k)(k.p)``. The height ``h.R p``
+    varies in ``(h.k)(k.p) +/- ||h_perp|| ||p_perp||``. When ``delta`` is
+    outside that interval, the least-squares answer is the end nearer
+    ``delta``.
+
+    Parameters
+    ----------
+    h : array_like, shape (3,)
+        Unit normal of the planes ``h.x = delta``.
+    k : array_like, shape (3,)
+        Unit rotation axis through the origin.
+    p : array_like, shape (..., 3)
+        Rotated point.
+    delta : array_like, shape (...)
+        Wanted height along ``h``, signed.
+
+    Returns
+    -------
+    AngleSolutions
+        ``theta`` has shape (..., 2). The roots are ``phi + half`` and then
+        ``phi - half``, where ``phi = atan2(b, a)``.
+
+    Notes
+    -----
+    Scale: ``S = ||p|| + |delta|``. The answer is exact when the height error
+    is at most ``GEOMETRY_TOLERANCE * S``. The problem is degenerate
+    (representative ``theta = 0``) when ``||h_perp|| ||p_perp|| <= tol S``, that
+    is when ``h`` is parallel to ``k`` or ``p`` lies on the axis. The height
+    then does not depend on ``theta``. At either end of the interval the two
+    roots merge.
+
+    Examples
+    --------
+    >>> sol = subproblem_4([0, 1, 0], [0, 0, 1], [1, 0, 0], 0.5)  # sin(theta) = 0.5
+    >>> np.degrees(sol.theta).round(9).tolist()
+    [150.0, 30.0]
+    """
+    h = _unit(h, "h")
+    k = _unit(k, "k")
+    p = _points(p, "p")
+    delta = np.asarray(delta, dtype=float)
+    hk = float(h @ k)
+    # One product gives h_perp.p, (h x k).p and k.p for the whole batch.
+    coords = p @ np.stack([h - hk * k, _cross3(h, k), k], axis=1)
+    a = coords[..., 0]
+    b = coords[..., 1]
+    c = delta - hk * coords[..., 2]
+    scale = _norm(p) + np.abs(delta)
+    return _harmonic(a, b, c, scale)
+
+
+def planar_two_link_elbow(l1: float, l2: float, r: ArrayLike) -> AngleSolutions:
+    """Elbow angle of a planar two-link arm: solve ``||l1 e(0) + l2 e(q2)|| = r`` for ``q2``.
+
+    ``e(t)`` is the unit vector at angle ``t``, and ``q2`` is the angle of the
+    second link relative to the first (0 when stretched out). By the law of
+    cosines ``cos(q2) = D = (r**2 - l1**2 - l2**2) / (2 l1 l2)``. The branches
+    are ``q2 = +acos(D)`` and then ``-acos(D)``. When ``|D| > 1`` the target is
+    unreachable. The least-squares answer is then ``q2 = 0`` (stretched, when
+    ``D > 1``) or ``pi`` (folded, when ``D < -1``).
+
+    This is subproblem 3 with ``k = z``, ``p = (l2, 0, 0)``, ``q = (-l1, 0, 0)``
+    and ``delta = r``. The equation ``l1 l2 cos(q2) = (r**2 - l1**2 - l2**2) / 2``
+    goes straight to the same solver core, and the flags mean the same.
+    ``merged`` marks the singular boundary ``|D| = 1``, where the branches
+    meet: ``r = l1 + l2`` (``q2 = 0``) or ``r = |l1 - l2|`` (``q2 = pi``).
+    ``exact`` false marks an unreachable ``r``.
+
+    Parameters
+    ----------
+    l1, l2 : float
+        Link lengths, ``>= 0``.
+    r : array_like, shape (...)
+        Distance from the first joint to the target, ``>= 0``.
+
+    Returns
+    -------
+    AngleSolutions
+        ``theta`` has shape (..., 2). The problem is degenerate
+        (representative 0) when ``l1 l2`` is about 0.
+
+    Notes
+    -----
+    Scale: ``S = l1**2 + l2**2 + r**2``. Tolerances as in :func:`subproblem_3`.
+
+    Examples
+    --------
+    >>> sol = planar_two_link_elbow(1.0, 1.0, np.sqrt(2))
+    >>> np.degrees(sol.theta).round(9).tolist()
+    [90.0, -90.0]
+    >>> planar_two_link_elbow(1.0, 1.0, [2.0, 2.5]).merged.tolist()
+    [True, False]
+    """
+    lengths = []
+    for name, value in (("l1", l1), ("l2", l2)):
+        value = float(value)
+        if not (math.isfinite(value) and value >= 0.0):
+            raise InvalidInputError(f"{name} must be a finite length >= 0, got {value}", location=(name,))
+        lengths.append(value)
+    l1, l2 = lengths
+    r = _distances(r, "r")
+    r2 = r * r
+    return _harmonic(l1 * l2, 0.0, 0.5 * (r2 - l1 * l1 - l2 * l2), l1 * l1 + l2 * l2 + r2)
+
+
+# ---------------------------------------------------------------------------
+# Prismatic analogues
+# ---------------------------------------------------------------------------
+
+
+def prismatic_to_distance(p: ArrayLike, v: ArrayLike, q: ArrayLike, delta: ArrayLike) -> DisplacementSolutions:
+    """Slide to a distance: solve ``||p + s v - q|| = delta``; else minimise ``| ||p + s v - q|| - delta |``.
+
+    With ``w = p - q``, ``b = v.w`` and ``e = ||w - b v||``, the distance from
+    ``q`` to the line, the equation is ``(s + b)**2 = delta**2 - e**2``. The
+    roots are ``s = -b + sqrt(...)`` and then ``-b - sqrt(...)``. When
+    ``delta < e`` no point of the line is that close to ``q``. The
+    least-squares answer is then the closest point, ``s = -b``.
+
+    Parameters
+    ----------
+    p : array_like, shape (..., 3)
+        Point at ``s = 0``.
+    v : array_like, shape (3,)
+        Unit sliding direction.
+    q : array_like, shape (..., 3)
+        Fixed point.
+    delta : array_like, shape (...)
+        Wanted distance, ``>= 0``.
+
+    Returns
+    -------
+    DisplacementSolutions
+        ``s`` has shape (..., 2). ``degenerate`` is always False, because the
+        distance always grows along the line.
+
+    Notes
+    -----
+    Scale: ``L = ||p - q|| + delta``. The answer is exact when
+    ``e - delta <= GEOMETRY_TOLERANCE * L``. The roots merge (``merged``,
+    the sphere of radius ``delta`` tangent to the line) when the midpoint
+    ``s = -b`` meets the equation within ``DUPLICATE_TOLERANCE**2 * L``.
+
+    Examples
+    --------
+    >>> sol = prismatic_to_distance([0, 0, 0], [1, 0, 0], [0, 3, 0], 5.0)
+    >>> sol.s.round(9).tolist()
+    [4.0, -4.0]
+    """
+    p = _points(p, "p")
+    v = _unit(v, "v")
+    q = _points(q, "q")
+    delta = _distances(delta, "delta")
+    wx, wy, b = _coords(p - q, _frame(v))  # b = v.(p - q)
+    e = _hypot(wx, wy)
+    scale = _hypot(e, b) + delta
+    tol = GEOMETRY_TOLERANCE * scale
+    excess = e - delta
+    exact = np.asarray(excess <= tol)
+    shape = exact.shape  # the broadcast batch shape
+    root = np.sqrt(np.maximum(-excess, 0.0) * (delta + e))  # sqrt(delta**2 - e**2) without cancellation
+    merged = exact & (-excess <= _MERGE_RESIDUAL * scale)  # the midpoint s = -b misses by -excess
+    two = exact & ~merged
+    return DisplacementSolutions(
+        s=_pair(shape, root * two - b, np.where(two, -b - root, np.nan), float),
+        valid=_pair(shape, True, two, bool),
+        exact=_pair(shape, exact, two, bool),
+        degenerate=np.zeros(shape, dtype=bool),
+        merged=np.asarray(merged),
+    )
+
+
+def prismatic_to_plane(h: ArrayLike, p: ArrayLike, v: ArrayLike, delta: ArrayLike) -> DisplacementSolutions:
+    """Slide to a plane: solve ``h.(p + s v) = delta``; else minimise ``|h.(p + s v) - delta|``.
+
+    The equation is linear: ``s = (delta - h.p) / (h.v)``. It is degenerate
+    when ``|h.v| <= GEOMETRY_TOLERANCE``, that is when the slide runs parallel
+    to the plane. The height then does not depend on ``s``. The representative
+    is ``s = 0``, and it is exact only if ``p`` already lies in the plane.
+    Otherwise there is always one exact solution.
+
+    Parameters
+    ----------
+    h : array_like, shape (3,)
+        Unit normal of the planes ``h.x = delta``.
+    p : array_like, shape (..., 3)
+        Point at ``s = 0``.
+    v : array_like, shape (3,)
+        Unit sliding direction.
+    delta : array_like, shape (...)
+        Wanted height along ``h``, signed.
+
+    Returns
+    -------
+    DisplacementSolutions
+        ``s`` has shape (..., 1). ``merged`` is always False.
+
+    Notes
+    -----
+    Scale: ``L = ||p|| + |delta|``. In the degenerate case the answer is exact
+    when ``|h.p - delta| <= GEOMETRY_TOLERANCE * L``.
+
+    Examples
+    --------
+    >>> prismatic_to_plane([0, 0, 1], [1, 2, 3], [0, 0, 1], 5.0).s.tolist()
+    [2.0]
+    """
+    h = _unit(h, "h")
+    p = _points(p, "p")
+    v = _unit(v, "v")
+    delta = np.asarray(delta, dtype=float)
+    hv = float(h @ v)
+    miss = delta - p @ h
+    if abs(hv) <= GEOMETRY_TOLERANCE:
+        scale = _norm(p) + np.abs(delta)
+        s = np.zeros_like(miss)
+        exact = np.abs(miss) <= GEOMETRY_TOLERANCE * scale
+        degenerate = np.ones(miss.shape, dtype=bool)
+    else:
+        s = miss / hv
+        exact = np.ones(miss.shape, dtype=bool)
+        degenerate = np.zeros(miss.shape, dtype=bool)
+    return DisplacementSolutions(
+        s=s[..., None],
+        valid=np.ones(miss.shape + (1,), dtype=bool),
+        exact=exact[..., None],
+        degenerate=degenerate,
+        merged=np.zeros(miss.shape, dtype=bool),
+    )

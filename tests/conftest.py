@@ -36,3 +36,8 @@ def assert_problem(response, status: int, *, loc: list | None = None, match: str
     if match is not None:
         assert match in body["detail"], body["detail"]
     return body
+
+
+def catalogue_robot(client, robot_id: str):
+    """The core Robot the service built from a catalogue entry (to compare in the core's units)."""
+    return client.app.state.catalogue.get(robot_id).robot

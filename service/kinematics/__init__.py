@@ -15,7 +15,15 @@ from ._forward import (
     link_frames,
     screw_model,
 )
-from ._limits import LIMIT_TOLERANCE, Limits, Violation, fitting_equivalents, violations, within
+from ._limits import (
+    LIMIT_TOLERANCE,
+    Limits,
+    Violation,
+    fitting_equivalents,
+    nearest_fitting_equivalent,
+    violations,
+    within,
+)
 from ._robot import JOINT_KINDS, Joint, JointKind, Robot, check_joint_values
 from ._rotations import (
     check_rotation,
@@ -54,6 +62,7 @@ __all__ = [
     "joint_screws",
     "link_frames",
     "link_transforms",
+    "nearest_fitting_equivalent",
     "matrix_from_euler_zyz",
     "matrix_from_quaternion",
     "matrix_from_rpy",

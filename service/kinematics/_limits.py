@@ -115,3 +115,12 @@ def fitting_equivalents(robot: Robot, limits: Limits, q: np.ndarray, cap: int) -
         return np.zeros((0, robot.dof)), False
     combos = itertools.islice(itertools.product(*options), cap)
     return np.array(list(combos), dtype=float), total > cap
+
+
+def nearest_fitting_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray | None:
+    """The 2π-equivalent of q (shape (n,)) that fits the limits and moves each joint least; None if none fits."""
+    options = turn_offsets(robot, limits, q)
+    if any(len(o) == 0 for o in options):
+        return None
+    nearest = np.array([o[np.argmin(np.abs(o - value))] for o, value in zip(options, q)])
+    return nearest if within(robot, limits, nearest) else None

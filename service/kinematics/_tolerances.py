@@ -20,7 +20,12 @@ GEOMETRY_TOLERANCE = 1e-9
 #: An IK solution is accepted when its FK position error is below this
 #: fraction of the robot's characteristic length, and its orientation error
 #: (radians) below the same number.
-ACCEPT_RESIDUAL = 1e-6
+ACCEPT_RESIDUAL = 1e-9
+
+#: Candidates whose residual is below this (same units) but above
+#: ACCEPT_RESIDUAL get a few Gauss–Newton steps before the FK check: near a
+#: singularity a closed form loses digits that one Newton step restores.
+POLISH_RESIDUAL = 1e-4
 
 #: Two solutions closer than this (radians, or fraction of the characteristic
 #: length for prismatic joints) are the same solution.

@@ -1,1 +1,28 @@
-"""Analytic inverse kinematics: geometric subproblems and the solvers built on them."""
+"""Inverse kinematics: every solution, found from the arm's geometry.
+
+The solver reads the joint axes off the robot's product-of-exponentials
+model, detects the structure (intersecting and parallel axes, wrists,
+prismatic joints), and decomposes the problem into geometric subproblems
+(Paden–Kahan 1–4 and their prismatic analogues). Arms no family covers fall
+back to a bounded numeric search that says it may be incomplete.
+"""
+
+from ._numeric import NumericOptions
+from ._plan import plan_for
+from ._solve import IKOptions, solve_ik, solve_ik_batch
+from ._types import IKResult, Singularity, Solution
+from ._verify import distance_to_reference, joint_difference, wrap_revolute
+
+__all__ = [
+    "IKOptions",
+    "IKResult",
+    "NumericOptions",
+    "Singularity",
+    "Solution",
+    "distance_to_reference",
+    "joint_difference",
+    "plan_for",
+    "solve_ik",
+    "solve_ik_batch",
+    "wrap_revolute",
+]

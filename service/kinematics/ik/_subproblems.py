@@ -119,6 +119,9 @@ class DisplacementSolutions(NamedTuple):
 
 # Largest relative residual of the midpoint for which two roots count as one.
 _MERGE_RESIDUAL = DUPLICATE_TOLERANCE**2
+# Two roots phi ± half of rho cos(theta - phi) = c are one when half < DUPLICATE_TOLERANCE / 2, that is when
+# rho - |c| < rho (1 - cos(DUPLICATE_TOLERANCE / 2)): an angle criterion, independent of the problem's scale.
+_MERGE_COS_GAP = 1.0 - math.cos(DUPLICATE_TOLERANCE / 2.0)
 _TWO_PI = 2.0 * math.pi
 
 
@@ -247,8 +250,8 @@ def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> Ang
     ``phi - half``, in that order, where ``half = atan2(sqrt(rho**2 - c**2), c)``.
     When ``|c| > rho``, ``theta = phi`` (``c > 0``) or ``phi + pi`` (``c < 0``)
     minimises ``|a cos + b sin - c|``. When ``rho`` is about 0 the equation is
-    degenerate. The midpoint ``phi`` (or ``phi + pi``) of two roots misses by
-    ``rho - |c|``, which is what decides ``merged``.
+    degenerate. The two roots are one (``merged``) when they are closer than
+    ``DUPLICATE_TOLERANCE`` in angle, i.e. ``rho - |c| < rho (1 - cos(tol / 2))``.
     """
     tol = GEOMETRY_TOLERANCE * scale
     rho = _hypot(a, b)
@@ -260,7 +263,7 @@ def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> Ang
     if np.shape(degenerate) != shape:
         degenerate = np.broadcast_to(degenerate, shape)
     regular = exact & ~degenerate
-    merged = regular & (-excess <= _MERGE_RESIDUAL * scale)
+    merged = regular & (-excess <= rho * _MERGE_COS_GAP)
     two = regular & ~merged
     root = np.sqrt(np.maximum(-excess, 0.0) * (rho + abs_c))  # sqrt(rho**2 - c**2) without cancellation
     half = np.arctan2(root * two, c)  # 0 or pi unless there are two roots

@@ -1,0 +1,126 @@
+"""Inverse kinematics: every solution, verified by forward kinematics."""
+
+from __future__ import annotations
+
+import numpy as np
+from fastapi import APIRouter, Depends, Request
+
+from ...kinematics import Robot
+from ...kinematics.ik import IKOptions, IKResult, NumericOptions, solve_ik_batch
+from ...kinematics.ik._select import Ordering, Selected, Selection, select
+from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, target_matrix, violation_to_wire
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
+from ..problems import problem_responses
+from ..schemas.ik import IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest, IKResponse
+
+router = APIRouter(prefix="/v1", tags=["inverse kinematics"])
+
+
+def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
+    robot = ref.robot
+    matrices, orientation_flags = [], []
+    for index, target in enumerate(targets):
+        with located("body", "target" if isinstance(body, IKRequest) else "targets", *(() if isinstance(body, IKRequest) else (index,))):
+            matrix, constrained = target_matrix(target, body.angle_unit)
+        matrices.append(matrix)
+        orientation_flags.append(constrained)
+    reference = None
+    if body.reference is not None:
+        with located("body", "reference"):
+            reference = joints_to_core(robot, body.reference, body.angle_unit)
+    with located("body", "limits"):
+        limits = limits_to_core(robot, body.limits, body.angle_unit)
+    ordering = _ordering(robot, body, reference)
+    options = IKOptions(NumericOptions(starts=body.numeric.starts,
+                                       time_budget_seconds=body.numeric.time_budget_ms / 1000.0))
+    results: list[IKResult | None] = [None] * len(targets)
+    for constrained in (True, False):
+        rows = [i for i, flag in enumerate(orientation_flags) if flag is constrained]
+        if rows:
+            solved = solve_ik_batch(robot, np.array([matrices[i] for i in rows]), constrain_orientation=constrained,
+                                    reference=reference, options=options)
+            for i, result in zip(rows, solved):
+                results[i] = result
+    return [
+        _to_wire(ref.id, robot, result, select(robot, result, limits, filter_limits=body.filter_limits,
+                                               reference=reference, ordering=ordering,
+                                               max_equivalents=body.max_equivalents),
+                 body.angle_unit, orientation_flags[i])
+        for i, result in enumerate(results)
+    ]
+
+
+def _ordering(robot: Robot, body: IKRequest | IKBatchRequest, reference: np.ndarray | None) -> Ordering:
+    weights = None
+    if body.ordering.weights is not None:
+        if len(body.ordering.weights) != robot.dof:
+            from ...kinematics import InvalidInputError
+            raise InvalidInputError(f"expected {robot.dof} weights, got {len(body.ordering.weights)}",
+                                    location=("body", "ordering", "weights"))
+        weights = np.array(body.ordering.weights)
+    max_move = body.max_joint_move
+    if max_move is not None:
+        if reference is None:
+            from ...kinematics import InvalidInputError
+            raise InvalidInputError("max_joint_move needs a reference", location=("body", "max_joint_move"))
+        if body.angle_unit == "deg":
+            max_move = np.radians(max_move) if robot.is_revolute.all() else max_move
+    return Ordering(body.ordering.norm, weights, body.max_solutions, max_move)
+
+
+def _solution_to_wire(robot: Robot, entry: Selected, unit: str, constrained: bool) -> dict:
+    solution = entry.solution
+    return {
+        "joints": joints_from_core(robot, solution.joints, unit).tolist(),
+        "branch": solution.branch,
+        "within_limits": entry.within_limits,
+        "violations": [violation_to_wire(robot, v, unit) for v in entry.violations],
+        "residual": {"position": solution.position_residual,
+                     "orientation": solution.orientation_residual if constrained else None},
+    }
+
+
+def _to_wire(robot_id: str, robot: Robot, result: IKResult, selection: Selection, unit: str,
+             constrained: bool) -> dict:
+    detail = result.detail or None
+    if selection.status == "no_solution_within_limits":
+        detail = f"All {len(selection.rejected)} solutions violate a joint limit; they are listed in 'rejected'."
+    if selection.notes:
+        detail = "; ".join(filter(None, [detail, *selection.notes]))
+    return {
+        "robot_id": robot_id,
+        "status": selection.status,
+        "detail": detail,
+        "solutions": [_solution_to_wire(robot, e, unit, constrained) for e in selection.solutions],
+        "rejected": [_solution_to_wire(robot, e, unit, constrained) for e in selection.rejected],
+        "solver": {"method": result.method, "structure": result.structure, "complete": result.complete,
+                   "time_budget_exhausted": result.search_exhausted_budget},
+        "singularities": [{"kind": s.kind, "joints": list(s.joints), "relation": s.relation, "detail": s.detail}
+                          for s in result.singularities],
+        "free_joints": result.free_joints,
+        "truncated": selection.expansion_truncated,
+        "trimmed": selection.trimmed,
+    }
+
+
+@router.post("/robots/{robot_id}/ik", operation_id="inverse_kinematics", response_model=IKResponse,
+             responses=problem_responses(404, 422))
+def inverse_kinematics(body: IKRequest, ref: RobotRef = Depends(catalogue_robot)) -> dict:
+    """Every joint vector that reaches the target pose, each checked by forward kinematics."""
+    return _solve(ref, body, [body.target])[0]
+
+
+@router.post("/ik", operation_id="inverse_kinematics_inline", response_model=IKResponse,
+             responses=problem_responses(422))
+def inverse_kinematics_inline(request: Request, body: IKInlineRequest) -> dict:
+    """Inverse kinematics for a robot described in the request body."""
+    return _solve(inline_robot(request, body.robot), body, [body.target])[0]
+
+
+@router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch", response_model=IKBatchResponse,
+             responses=problem_responses(404, 413, 422))
+def inverse_kinematics_batch(request: Request, body: IKBatchRequest,
+                             ref: RobotRef = Depends(catalogue_robot)) -> dict:
+    """Every solution for each target; the analytic solvers run vectorised over the targets."""
+    check_batch_size(request, len(body.targets), "targets")
+    return {"robot_id": ref.id, "results": _solve(ref, body, body.targets)}

@@ -1,0 +1,48 @@
+"""Joint-limit checks with reasons, and the 2π-equivalent that fits."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter, Depends, Request
+
+from ...kinematics import LIMIT_TOLERANCE, nearest_fitting_equivalent, violations
+from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, violation_to_wire
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
+from ..problems import problem_responses
+from ..schemas.limits import LimitsInlineRequest, LimitsRequest, LimitsResponse
+
+router = APIRouter(prefix="/v1", tags=["joint limits"])
+
+
+def _check(request: Request, ref: RobotRef, body: LimitsRequest) -> dict:
+    check_batch_size(request, len(body.joints), "joints")
+    robot = ref.robot
+    with located("body", "joints"):
+        rows = joints_to_core(robot, body.joints, body.angle_unit, batch=True)
+    with located("body", "limits"):
+        limits = limits_to_core(robot, body.limits, body.angle_unit)
+    results = []
+    for q in rows:
+        broken = violations(robot, limits, q)
+        equivalent = None
+        if broken:
+            nearest = nearest_fitting_equivalent(robot, limits, q)
+            if nearest is not None:
+                equivalent = joints_from_core(robot, nearest, body.angle_unit).tolist()
+        results.append({"within_limits": not broken,
+                        "violations": [violation_to_wire(robot, v, body.angle_unit) for v in broken],
+                        "equivalent": equivalent})
+    return {"robot_id": ref.id, "tolerance": LIMIT_TOLERANCE, "results": results}
+
+
+@router.post("/robots/{robot_id}/limits", operation_id="check_joint_limits", response_model=LimitsResponse,
+             responses=problem_responses(404, 413, 422))
+def check_joint_limits(request: Request, body: LimitsRequest, ref: RobotRef = Depends(catalogue_robot)) -> dict:
+    """For each joint vector: within limits or not, each violation, and the 2π-equivalent that fits, if one does."""
+    return _check(request, ref, body)
+
+
+@router.post("/limits", operation_id="check_joint_limits_inline", response_model=LimitsResponse,
+             responses=problem_responses(413, 422))
+def check_joint_limits_inline(request: Request, body: LimitsInlineRequest) -> dict:
+    """Joint-limit checks for a robot described in the request body."""
+    return _check(request, inline_robot(request, body.robot), body)

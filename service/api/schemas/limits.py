@@ -1,0 +1,45 @@
+"""Joint-limit checks."""
+
+from __future__ import annotations
+
+from pydantic import Field
+
+from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number
+from .robots import JointLimits, RobotDescription
+
+
+class JointLimitsOverride(JointLimits):
+    """Bounds for one joint in a request, in the request's angle unit (revolute) or length unit (prismatic)."""
+
+
+class LimitViolation(ApiModel):
+    joint: int = Field(description="0-based joint index")
+    value: float
+    lower: float
+    upper: float
+
+
+class LimitsRequest(ApiModel):
+    joints: list[list[Number]] = Field(min_length=1, description="joint vectors to check")
+    angle_unit: AngleUnit = ANGLE_UNIT_FIELD
+    limits: list[JointLimitsOverride | None] | None = Field(
+        None, description="replace the robot's limits: one entry per joint, null for an unlimited joint")
+
+
+class LimitsInlineRequest(LimitsRequest):
+    robot: RobotDescription
+
+
+class LimitsResult(ApiModel):
+    within_limits: bool
+    violations: list[LimitViolation]
+    equivalent: list[float] | None = Field(
+        description="when the vector is out of range only by whole turns of revolute joints: the 2π-equivalent "
+                    "that fits (nearest to the given values); null otherwise or when already within limits")
+
+
+class LimitsResponse(ApiModel):
+    robot_id: str
+    tolerance: float = Field(description="inclusive-bound tolerance: radians (revolute), fraction of the robot's "
+                                         "size (prismatic)")
+    results: list[LimitsResult]

@@ -1,0 +1,86 @@
+"""Choosing a solver from the arm's geometry.
+
+The plan depends on the joint axes only (read off the screw model), never on
+the robot's name or its DH table, so two descriptions of the same arm get the
+same plan. Adding a structure class is adding one family module and one line
+here.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol
+
+import numpy as np
+
+from .._forward import screw_model
+from .._robot import Robot
+from ._decoupled import DecoupledPlan
+from ._positioning import find_positioner
+from ._screws import apply, chain_motion
+from ._structure import Geometry
+from ._three_parallel import ThreeParallelPlan
+from ._types import Branch, Candidates
+from ._wrist import Roll, SphericalWrist
+
+
+class Plan(Protocol):
+    structure: str
+    generic_count: int
+    free_joints: list[int]
+
+    def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates: ...
+
+    def labels(self, joints: np.ndarray) -> list[Branch]: ...
+
+
+def geometry_of(robot: Robot) -> Geometry:
+    return Geometry(screw_model(robot), robot.characteristic_length)
+
+
+def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
+    """The analytic plan for this robot and kind of target, or None when no family applies."""
+    geometry = geometry_of(robot)
+    n = geometry.dof
+    if constrain_orientation:
+        return _pose_plan(geometry, n)
+    return _position_plan(geometry, n, reference)
+
+
+def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
+    model = geometry.model
+    for k in (n - 3, n - 1, n):
+        if k < 0:
+            continue
+        wrist_joints = tuple(range(k, n))
+        if len(wrist_joints) == 3:
+            point = geometry.common_point(wrist_joints)
+            if point is None:
+                continue
+            wrist = SphericalWrist(geometry, wrist_joints)
+        elif len(wrist_joints) == 1:
+            if not model.is_revolute[k]:
+                continue
+            point, wrist = geometry.point(k), Roll(geometry, k)
+        elif not wrist_joints:
+            point, wrist = model.home[:3, 3], None
+        else:
+            continue
+        positioner = find_positioner(geometry, tuple(range(k)), point) if k else None
+        if k and positioner is None:
+            continue
+        return DecoupledPlan(positioner, wrist, point, model.home, n)
+    return ThreeParallelPlan.match(geometry)
+
+
+def _position_plan(geometry: Geometry, n: int, reference: np.ndarray | None) -> Plan | None:
+    model = geometry.model
+    k = min(n, 3)
+    free = {i: (0.0 if reference is None else float(reference[i])) for i in range(k, n)}
+    q_free = np.array([free[i] for i in range(k, n)])
+    tail = chain_motion(model.directions[k:], model.points[k:], model.is_revolute[k:], q_free) if free else np.eye(4)
+    # the tool point with the free joints held, expressed at q = 0 of the first k joints
+    point = apply(tail @ model.home, np.zeros(3))
+    positioner = find_positioner(geometry, tuple(range(k)), point)
+    if positioner is None:
+        return None
+    return DecoupledPlan(positioner, None, point, None, n, fixed=free)

@@ -1,0 +1,439 @@
+"""Positioning arms: the first joints of a chain placing one point.
+
+Each positioner solves ``x = exp([S_1] q_1) ⋯ exp([S_k] q_k) · w`` for the
+joint values that carry a point ``w`` (given at q = 0, world frame) to
+targets ``x`` (N, 3), by reducing it to geometric subproblems. Each class is
+named after the family it solves and states its equations. Results are
+vectorised over the N targets: candidate slots of shape (N, m, k) with a
+validity mask, plus per-target singular flags.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._tolerances import SINGULARITY_TOLERANCE
+from ._screws import chain_motion, rotate_about
+from ._structure import Geometry
+from ._subproblems import (
+    prismatic_to_distance,
+    prismatic_to_plane,
+    subproblem_1,
+    subproblem_2_chain,
+    subproblem_3,
+)
+from ._types import Branch, Singularity
+
+
+@dataclass
+class PositionerResult:
+    """Candidate joint values for the positioning joints.
+
+    ``joints`` (N, m, k); ``valid`` (N, m); ``singularities`` a list of N lists.
+    """
+
+    joints: np.ndarray
+    valid: np.ndarray
+    singularities: list[list[Singularity]] = field(default_factory=list)
+
+
+def _up_direction(direction: np.ndarray) -> np.ndarray:
+    """``direction`` or its opposite, whichever points up (non-negative world z)."""
+    return -direction if direction[2] < -1e-12 else direction
+
+
+def _unit(v: np.ndarray) -> np.ndarray | None:
+    norm = np.linalg.norm(v)
+    return v / norm if norm > 1e-9 else None
+
+
+def _flag_rows(flags: np.ndarray, template: Singularity, rows: list[list[Singularity]]) -> None:
+    for row in np.flatnonzero(flags):
+        rows[row].append(template)
+
+
+class Positioner:
+    """Base class: the joints it moves, its generic solution count and its labels."""
+
+    name: str = ""
+    generic_count: int = 0
+
+    def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> None:
+        self.geometry = geometry
+        self.joints = joints
+        self.point = np.asarray(point, dtype=float)
+        self.model = geometry.model
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        raise NotImplementedError
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        """Branch labels of full joint vectors (M, n), one dict per row."""
+        return [{} for _ in range(len(joints))]
+
+    def _motion(self, q: np.ndarray, upto: int) -> np.ndarray:
+        """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) for joint values (..., n)."""
+        m = self.model
+        return chain_motion(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], q[..., :upto])
+
+
+class IntersectingShoulder(Positioner):
+    """Revolute joints 1 and 2 with intersecting axes, then a revolute or prismatic joint 3.
+
+    The elbow arm (with or without shoulder offset), the Stanford and polar
+    arms, and the PUMA's first three joints. With c the intersection point,
+    joint 2 turns about an axis through c, so ``‖x − c‖ = ‖exp([S_3] q_3) w − c‖``
+    depends on q_3 alone: subproblem 3 (revolute) or a quadratic (prismatic),
+    up to 2 roots. Then ``R(ω1, q1) R(ω2, q2) (w_3 − c) = x − c`` is
+    subproblem 2, up to 2 roots: 4 in all.
+
+    Labels: ``shoulder`` left/right is the sign of the arm's reach along the
+    forward direction of link 1 (the textbook's left/right arm; "front" is left);
+    ``elbow`` up/down (revolute joint 3) is the side of the shoulder–point line
+    the elbow lies on, seen along the up-pointing axis 1.
+    """
+
+    name = "intersecting_shoulder"
+    generic_count = 4
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "IntersectingShoulder | None":
+        if len(joints) != 3 or geometry.kinds(joints)[:2] != "RR":
+            return None
+        i, j, _ = joints
+        centre = geometry.intersection(i, j)
+        if centre is None:
+            return None
+        solver = cls(geometry, joints, point)
+        solver.centre = centre
+        return solver
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        g, (i, j, k) = self.geometry, self.joints
+        c, w = self.centre, self.point
+        n_targets = len(targets)
+        reach = np.linalg.norm(targets - c, axis=-1)
+        if g.model.is_revolute[k]:
+            third = subproblem_3(g.direction(k), w - g.point(k), c - g.point(k), reach)
+            q3 = third.theta
+            w3 = g.point(k) + rotate_about(g.direction(k), q3, w - g.point(k))
+        else:
+            third = prismatic_to_distance(w, g.direction(k), c, reach)
+            q3 = third.s
+            w3 = w + g.direction(k) * q3[..., None]
+        pair = subproblem_2_chain(g.direction(i), g.direction(j), w3 - c, (targets - c)[:, None, :])
+        q1, q2 = pair.theta1, pair.theta2  # (N, 2 third roots, 2 pair roots)
+        free_shoulder = pair.degenerate  # (N, 2): target on axis 1
+        if free_shoulder.any():
+            start = 0.0 if reference is None else reference[i]
+            back = rotate_about(g.direction(i), -start, (targets - c)[:, None, :])
+            q2_free = subproblem_1(g.direction(j), w3 - c, back).theta[..., 0]
+            q1 = np.where(free_shoulder[..., None], start, q1)
+            q2 = np.where(free_shoulder[..., None], q2_free[..., None], q2)
+        joints = np.zeros((n_targets, 2, 2, 3))
+        joints[..., 0], joints[..., 1] = q1, q2
+        joints[..., 2] = q3[:, :, None]
+        valid = third.valid[:, :, None] & pair.valid & third.exact[:, :, None] & pair.exact
+        valid[:, :, 1] &= ~free_shoulder  # one representative when the shoulder is free
+        singular: list[list[Singularity]] = [[] for _ in range(n_targets)]
+        _flag_rows(free_shoulder.any(axis=1),
+                   Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "
+                               "joint 1 is set to the reference value (or 0)"), singular)
+        if g.model.is_revolute[k]:
+            stretched = self._stretched(q3[:, 0], w, c)
+            _flag_rows(third.merged & stretched, Singularity("elbow", (k,), "stretched",
+                                                             "the arm is fully stretched"), singular)
+            _flag_rows(third.merged & ~stretched, Singularity("elbow", (k,), "folded",
+                                                              "the arm is fully folded"), singular)
+        else:
+            _flag_rows(third.merged, Singularity("reach", (k,), "boundary",
+                                                 "the point is at the nearest reach of the prismatic joint"), singular)
+        return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
+
+    def _stretched(self, q3: np.ndarray, w: np.ndarray, c: np.ndarray) -> np.ndarray:
+        g, k = self.geometry, self.joints[2]
+        at = g.point(k) + rotate_about(g.direction(k), q3, w - g.point(k))
+        opposite = g.point(k) + rotate_about(g.direction(k), q3 + np.pi, w - g.point(k))
+        return np.linalg.norm(at - c, axis=-1) >= np.linalg.norm(opposite - c, axis=-1)
+
+    def _forward_direction(self) -> np.ndarray:
+        """Link 1's forward direction at q = 0: the arm's reach, perpendicular to axes 1 and 2."""
+        g, (i, j, _) = self.geometry, self.joints
+        normal = _unit(np.cross(g.direction(i), g.direction(j)))
+        reach = self.point - self.centre
+        if normal is not None:
+            along = float(reach @ normal)
+            if abs(along) > 1e-9 * g.length_scale:
+                return normal * np.sign(along)
+            return -normal
+        return reach
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        g, (i, j, k) = self.geometry, self.joints
+        forward = rotate_about(g.direction(i), joints[:, i], self._forward_direction())
+        G3 = self._motion(joints, k + 1)
+        point = np.einsum("mij,j->mi", G3[:, :3, :3], self.point) + G3[:, :3, 3]
+        reach = point - self.centre
+        shoulder = np.where(np.einsum("mi,mi->m", reach, forward) >= 0, "left", "right")
+        labels: list[Branch] = [{"shoulder": str(s)} for s in shoulder]
+        if g.model.is_revolute[k]:
+            G2 = self._motion(joints, k)
+            elbow = np.einsum("mij,j->mi", G2[:, :3, :3], g.point(k)) + G2[:, :3, 3] - self.centre
+            up = _up_direction(g.direction(i))
+            line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
+            rejection = elbow - np.einsum("mi,mi->m", elbow, line)[:, None] * line
+            side = rejection @ up
+            for label, s in zip(labels, side):
+                label["elbow"] = "up" if s > 0 else "down"
+        return labels
+
+
+class ParallelShoulder(Positioner):
+    """Revolute joints 1 and 2 with parallel axes, then a prismatic joint 3 along them: the SCARA arm.
+
+    The height along the common axis u fixes the slide: ``u·(w + s v₃) = u·x``
+    (linear). In the plane normal to u it is the RRR (Assur) group: the
+    distance from axis 1 to the point fixes q₂ by subproblem 3 (two assembly
+    modes), and q₁ follows by subproblem 1.
+
+    Labels: ``assembly_mode`` 1 when the elbow lies counter-clockwise of the
+    line from axis 1 to the point, seen from the up-pointing axis (the paper's
+    φ = θ + β), 2 otherwise.
+    """
+
+    name = "parallel_shoulder"
+    generic_count = 2
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "ParallelShoulder | None":
+        if len(joints) != 3 or geometry.kinds(joints) != "RRP":
+            return None
+        i, j, k = joints
+        if not (geometry.parallel(i, j) and geometry.parallel(i, k)):
+            return None
+        return cls(geometry, joints, point)
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        g, (i, j, k) = self.geometry, self.joints
+        u = g.direction(i)
+        n_targets = len(targets)
+        slide = prismatic_to_plane(u, self.point, g.direction(k), targets @ u)  # (N, 1)
+        w3 = self.point + g.direction(k) * slide.s[..., None]  # (N, 1, 3)
+        radial = targets - g.point(i)
+        radial = radial - np.outer(radial @ u, u)
+        reach = np.linalg.norm(radial, axis=-1)
+        in_plane = np.eye(3) - np.outer(u, u)
+        elbow = subproblem_3(g.direction(j), (w3[:, 0] - g.point(j)) @ in_plane, in_plane @ (g.point(i) - g.point(j)),
+                             reach)
+        q2 = elbow.theta  # (N, 2)
+        w2 = g.point(j) + rotate_about(g.direction(j), q2, (w3 - g.point(j)))  # (N, 2, 3)
+        first = subproblem_1(u, w2 - g.point(i), (targets - g.point(i))[:, None, :])
+        q1 = first.theta[..., 0]
+        free = first.degenerate
+        if free.any():
+            q1 = np.where(free, 0.0 if reference is None else reference[i], q1)
+        joints = np.stack([q1, q2, np.broadcast_to(slide.s, q2.shape)], axis=-1)
+        valid = elbow.valid & elbow.exact & first.exact[..., 0] & slide.exact
+        valid[:, 1] &= ~free[:, 1]
+        singular: list[list[Singularity]] = [[] for _ in range(n_targets)]
+        coincident = elbow.degenerate
+        _flag_rows(coincident, Singularity("assur_group", (i, j), "coincident",
+                                           "the point is on the first axis with equal link lengths: "
+                                           "joint 1 is free (increased mobility)"), singular)
+        _flag_rows(elbow.merged & ~coincident, Singularity("assur_group", (j,), "aligned",
+                                                           "the links are aligned (stretched or folded): "
+                                                           "the two assembly modes meet"), singular)
+        return PositionerResult(joints, valid, singular)
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        g, (i, j, k) = self.geometry, self.joints
+        up = _up_direction(g.direction(i))
+        G1 = self._motion(joints, i + 1)
+        elbow = np.einsum("mij,j->mi", G1[:, :3, :3], g.point(j)) + G1[:, :3, 3] - g.point(i)
+        G3 = self._motion(joints, k + 1)
+        point = np.einsum("mij,j->mi", G3[:, :3, :3], self.point) + G3[:, :3, 3] - g.point(i)
+        side = np.einsum("mi,i->m", np.cross(point, elbow), up)
+        return [{"assembly_mode": 1 if s > 0 else 2} for s in side]
+
+
+class PlanarTwoLink(Positioner):
+    """Two revolute joints with parallel axes placing a point in their plane (Spong Example 3.1).
+
+    The distance from axis 1 fixes q₂ (subproblem 3, elbow up/down), then q₁ by
+    subproblem 1. The point's height along the axes cannot change: a target
+    off that plane is unreachable.
+    """
+
+    name = "planar_two_link"
+    generic_count = 2
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "PlanarTwoLink | None":
+        if len(joints) != 2 or geometry.kinds(joints) != "RR" or not geometry.parallel(*joints):
+            return None
+        return cls(geometry, joints, point)
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        g, (i, j) = self.geometry, self.joints
+        u = g.direction(i)
+        radial = targets - g.point(i)
+        reach = np.linalg.norm(radial - np.outer(radial @ u, u), axis=-1)
+        in_plane = np.abs((targets - self.point) @ u) <= 1e-9 * g.length_scale
+        in_plane_projector = np.eye(3) - np.outer(u, u)
+        elbow = subproblem_3(g.direction(j), in_plane_projector @ (self.point - g.point(j)),
+                             in_plane_projector @ (g.point(i) - g.point(j)), reach)
+        w2 = g.point(j) + rotate_about(g.direction(j), elbow.theta, self.point - g.point(j))
+        first = subproblem_1(u, w2 - g.point(i), (targets - g.point(i))[:, None, :])
+        q1 = first.theta[..., 0]
+        free = first.degenerate
+        if free.any():
+            q1 = np.where(free, 0.0 if reference is None else reference[i], q1)
+        joints = np.stack([q1, elbow.theta], axis=-1)
+        valid = elbow.valid & elbow.exact & first.exact[..., 0] & in_plane[:, None]
+        valid[:, 1] &= ~free[:, 1]
+        singular: list[list[Singularity]] = [[] for _ in range(len(targets))]
+        _flag_rows(elbow.merged, Singularity("elbow", (j,), "stretched_or_folded",
+                                             "the arm is fully stretched or folded"), singular)
+        _flag_rows(free.any(axis=1), Singularity("shoulder", (i,), "free",
+                                                 "the point is on the first axis; joint 1 is free"), singular)
+        return PositionerResult(joints, valid, singular)
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        g, (i, j) = self.geometry, self.joints
+        up = _up_direction(g.direction(i))
+        G1 = self._motion(joints, i + 1)
+        elbow = np.einsum("mij,j->mi", G1[:, :3, :3], g.point(j)) + G1[:, :3, 3] - g.point(i)
+        G2 = self._motion(joints, j + 1)
+        point = np.einsum("mij,j->mi", G2[:, :3, :3], self.point) + G2[:, :3, 3] - g.point(i)
+        side = np.einsum("mi,i->m", np.cross(point, elbow), up)
+        return [{"elbow": "up" if s > 0 else "down"} for s in side]
+
+
+class OneRevoluteTwoPrismatic(Positioner):
+    """One revolute and two prismatic joints in any order (cylindrical RPP, PRP).
+
+    With the slides s before the revolute joint collected in V_pre and those after it in
+    V_post, ``x − p − V_pre s = R(ω, θ)(w − p + V_post s)``. The rotation keeps the
+    component along ω (a linear equation in s) and the distance from the axis (a
+    quadratic): together up to 2 roots. θ follows by subproblem 1.
+    """
+
+    name = "one_revolute_two_prismatic"
+    generic_count = 2
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "OneRevoluteTwoPrismatic | None":
+        kinds = geometry.kinds(joints)
+        if len(joints) != 3 or kinds.count("R") != 1:
+            return None
+        solver = cls(geometry, joints, point)
+        solver.revolute = joints[kinds.index("R")]
+        solver.slides = tuple(joint for joint in joints if joint != solver.revolute)
+        omega = geometry.direction(solver.revolute)
+        axial = np.array([omega @ geometry.direction(s) for s in solver.slides])
+        if np.abs(axial).max() <= 1e-9:
+            return None  # no slide along the axis: the height equation does not fix them
+        return solver
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        g, r = self.geometry, self.revolute
+        omega, p = g.direction(r), g.point(r)
+        V = np.stack([g.direction(s) for s in self.slides], axis=1)  # (3, 2)
+        before = np.array([s < r for s in self.slides])
+        V_pre, V_post = V * before, V * ~before
+        perp = np.eye(3) - np.outer(omega, omega)
+        # linear: a·s = b   with a = ω·(V_pre + V_post), b = ω·(x − w)
+        a = omega @ (V_pre + V_post)
+        b = (targets - self.point) @ omega
+        s0 = np.outer(b, a) / (a @ a)  # (N, 2)
+        nullspace = np.array([-a[1], a[0]]) / np.linalg.norm(a)
+        alpha = (targets - p) @ perp  # (N, 3)
+        beta = (self.point - p) @ perp
+        P, Q = perp @ V_pre, perp @ V_post  # (3, 2)
+        lhs = alpha - s0 @ P.T
+        rhs = beta + s0 @ Q.T
+        Pn, Qn = P @ nullspace, Q @ nullspace
+        A = Pn @ Pn - Qn @ Qn
+        B = -2 * (lhs @ Pn) - 2 * (rhs @ Qn)
+        C = np.einsum("ni,ni->n", lhs, lhs) - np.einsum("ni,ni->n", rhs, rhs)
+        t, t_valid, merged = _quadratic_roots(A, B, C, g.length_scale)
+        slides = s0[:, None, :] + t[..., None] * nullspace  # (N, 2, 2)
+        body = self.point - p + slides @ V_post.T
+        world = targets[:, None, :] - p - slides @ V_pre.T
+        turn = subproblem_1(omega, body, world)
+        theta = turn.theta[..., 0]
+        free = turn.degenerate
+        if free.any():
+            theta = np.where(free, 0.0 if reference is None else reference[r], theta)
+        joints = np.zeros(slides.shape[:2] + (3,))
+        order = list(self.joints)
+        joints[..., order.index(r)] = theta
+        for column, s in enumerate(self.slides):
+            joints[..., order.index(s)] = slides[..., column]
+        valid = t_valid & turn.exact[..., 0]
+        singular: list[list[Singularity]] = [[] for _ in range(len(targets))]
+        _flag_rows(free.any(axis=1), Singularity("shoulder", (r,), "free",
+                                                 "the point is on the revolute axis; that joint is free"), singular)
+        _flag_rows(merged, Singularity("reach", self.slides, "boundary",
+                                       "the two slide solutions meet"), singular)
+        return PositionerResult(joints, valid, singular)
+
+
+class Cartesian(Positioner):
+    """Three prismatic joints with independent directions: one linear solve."""
+
+    name = "cartesian"
+    generic_count = 1
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "Cartesian | None":
+        if len(joints) != 3 or geometry.kinds(joints) != "PPP":
+            return None
+        V = np.stack([geometry.direction(j) for j in joints], axis=1)
+        if abs(np.linalg.det(V)) < 1e-9:
+            return None
+        solver = cls(geometry, joints, point)
+        solver.inverse = np.linalg.inv(V)
+        return solver
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        joints = (targets - self.point) @ self.inverse.T
+        return PositionerResult(joints[:, None, :], np.ones((len(targets), 1), dtype=bool),
+                                [[] for _ in range(len(targets))])
+
+
+def _quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale: float):
+    """Real roots of A t² + B t + C = 0 per row: (N, 2) roots, validity, and merged flags."""
+    A = np.broadcast_to(np.asarray(A, dtype=float), B.shape)
+    roots = np.full(B.shape + (2,), np.nan)
+    valid = np.zeros(B.shape + (2,), dtype=bool)
+    merged = np.zeros(B.shape, dtype=bool)
+    linear = np.abs(A) <= 1e-12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        roots[linear, 0] = -C[linear] / B[linear]
+        valid[linear, 0] = np.abs(B[linear]) > 1e-12
+        quad = ~linear
+        discriminant = B[quad] ** 2 - 4 * A[quad] * C[quad]
+        tolerance = SINGULARITY_TOLERANCE * (B[quad] ** 2 + np.abs(4 * A[quad] * C[quad]) + scale ** 2 * 1e-12)
+        touching = np.abs(discriminant) <= tolerance
+        root = np.sqrt(np.maximum(discriminant, 0.0))
+        roots[quad, 0] = (-B[quad] + root) / (2 * A[quad])
+        roots[quad, 1] = (-B[quad] - root) / (2 * A[quad])
+        valid[quad, 0] = discriminant >= -tolerance
+        valid[quad, 1] = (discriminant >= -tolerance) & ~touching
+        merged[quad] = touching
+    return roots, valid, merged
+
+
+POSITIONERS = (IntersectingShoulder, ParallelShoulder, OneRevoluteTwoPrismatic, Cartesian, PlanarTwoLink)
+
+
+def find_positioner(geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> Positioner | None:
+    """The first positioning family that matches these joints, or None."""
+    for family in POSITIONERS:
+        solver = family.match(geometry, joints, point)
+        if solver is not None:
+            return solver
+    return None

@@ -1,0 +1,147 @@
+"""6R arms whose joints 2, 3 and 4 have parallel axes, and whose axes 5 and 6 meet (UR5 type).
+
+With ω_p the common direction of axes 2–4, A = world_T_target · home⁻¹ =
+G_1 ⋯ G_6, and c the point where axes 5 and 6 meet:
+
+1. Turning about axes parallel to ω_p keeps the component along ω_p, and
+   G_5, G_6 leave c fixed, so ``ω_p·R(ω_1, −q_1)(A c − p_1) = ω_p·(c − p_1)``:
+   subproblem 4, two shoulder roots.
+2. For the rotations, ``ω_pᵀ R_1ᵀ R_A ω_6 = ω_pᵀ R(ω_5, q_5) ω_6``: subproblem 4,
+   two wrist roots.
+3. ``R(ω_6, −q_6) R(ω_5, −q_5) ω_p = (R_1ᵀ R_A)ᵀ ω_p``: subproblem 1.
+4. What is left, R_234, is a turn about ω_p by the (signed) sum q_2 + q_3 + q_4:
+   subproblem 1.
+5. The point p_4 on axis 4 reaches ``G_1⁻¹ A G_6⁻¹ G_5⁻¹ p_4`` through joints 2
+   and 3: subproblem 3 for q_3 (two elbow roots), subproblem 1 for q_2, and
+   q_4 from the sum.
+
+2 × 2 × 2 = 8 solutions in general.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._positioning import _flag_rows, _up_direction, _unit
+from ._screws import apply, chain_motion, invert, joint_motion, rotate_about
+from ._structure import Geometry
+from ._subproblems import subproblem_1, subproblem_3, subproblem_4
+from ._types import Branch, Candidates, Singularity
+from ._wrist import _perpendicular_unit
+
+
+class ThreeParallelPlan:
+    """The UR5-type family: axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersecting."""
+
+    method = "analytic"
+    structure = "three_parallel"
+    generic_count = 8
+    free_joints: list[int] = []
+
+    @classmethod
+    def match(cls, geometry: Geometry) -> "ThreeParallelPlan | None":
+        if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
+            return None
+        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.parallel(0, 1):
+            return None
+        if geometry.parallel(1, 4):
+            return None
+        centre = geometry.intersection(4, 5)
+        if centre is None:
+            return None
+        return cls(geometry, centre)
+
+    def __init__(self, geometry: Geometry, centre: np.ndarray) -> None:
+        self.geometry = geometry
+        self.model = geometry.model
+        self.centre = centre
+        self.home_inverse = invert(self.model.home)
+        self.omega_p = geometry.direction(1)
+        self.signs = np.array([np.sign(geometry.direction(j) @ self.omega_p) for j in (1, 2, 3)])
+        self.normal_p = _perpendicular_unit(self.omega_p)
+        forward = _unit(np.cross(geometry.direction(0), self.omega_p))
+        reach = geometry.point(3) - geometry.point(0)
+        self.forward = forward if forward @ reach >= 0 else -forward
+
+    def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
+        g, w_p = self.geometry, self.omega_p
+        n = len(world_T_targets)
+        A = world_T_targets @ self.home_inverse  # (N, 4, 4)
+        R_A = A[:, :3, :3]
+        c_world = apply(A, self.centre)
+        # 1. shoulder: two roots for q1
+        shoulder = subproblem_4(w_p, g.direction(0), c_world - g.point(0), w_p @ (self.centre - g.point(0)))
+        q1 = -shoulder.theta  # (N, 2)
+        R1 = joint_motion(g.direction(0), g.point(0), True, q1)  # (N, 2, 4, 4)
+        R_rest = np.swapaxes(R1[..., :3, :3], -1, -2) @ R_A[:, None]  # (N, 2, 3, 3)
+        # 2. wrist: two roots for q5
+        target_height = np.einsum("i,...ij,j->...", w_p, R_rest, g.direction(5))
+        wrist = subproblem_4(w_p, g.direction(4), g.direction(5), target_height)
+        q5 = wrist.theta  # (N, 2, 2)
+        # 3. q6
+        p = rotate_about(g.direction(4), -q5, w_p)  # (N, 2, 2, 3)
+        q = np.einsum("...ji,j->...i", R_rest, w_p)[:, :, None, :]
+        sixth = subproblem_1(g.direction(5), p, q)
+        q6 = -sixth.theta[..., 0]
+        free_six = sixth.degenerate
+        if free_six.any():
+            q6 = np.where(free_six, 0.0 if reference is None else reference[5], q6)
+        # 4. R_234 about ω_p: the signed sum
+        R5 = joint_motion(g.direction(4), g.point(4), True, q5)[..., :3, :3]
+        R6 = joint_motion(g.direction(5), g.point(5), True, q6)[..., :3, :3]
+        R234 = R_rest[:, :, None] @ np.swapaxes(R6, -1, -2) @ np.swapaxes(R5, -1, -2)
+        angle_sum = subproblem_1(w_p, self.normal_p, R234 @ self.normal_p).theta[..., 0]  # (N, 2, 2)
+        # 5. point on axis 4 through joints 2 and 3
+        # G_1 G_2 G_3 p_4 = A G_6⁻¹ G_5⁻¹ p_4 (G_4 leaves p_4 where it is)
+        y = apply(invert(joint_motion(g.direction(4), g.point(4), True, q5)), g.point(3))
+        y = apply(invert(joint_motion(g.direction(5), g.point(5), True, q6)), y)
+        p4_world = apply(A[:, None, None], y)
+        z = apply(invert(R1)[:, :, None], p4_world)  # (N, 2, 2, 3)
+        elbow = subproblem_3(g.direction(2), g.point(3) - g.point(2), g.point(1) - g.point(2),
+                             np.linalg.norm(z - g.point(1), axis=-1))
+        q3 = elbow.theta  # (N, 2, 2, 2)
+        moved = g.point(2) + rotate_about(g.direction(2), q3, g.point(3) - g.point(2))
+        second = subproblem_1(g.direction(1), moved - g.point(1), (z - g.point(1))[..., None, :])
+        q2 = second.theta[..., 0]
+        s2, s3, s4 = self.signs
+        q4 = s4 * (angle_sum[..., None] - s2 * q2 - s3 * q3)
+        shape = (n, 2, 2, 2)
+        joints = np.stack([np.broadcast_to(q1[:, :, None, None], shape), q2, q3, q4,
+                           np.broadcast_to(q5[..., None], shape), np.broadcast_to(q6[..., None], shape)], axis=-1)
+        valid = (shoulder.valid[:, :, None, None] & wrist.valid[..., None] & elbow.valid)
+        valid[:, :, :, 1] &= ~elbow.merged
+        singular: list[list[Singularity]] = [[] for _ in range(n)]
+        _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
+                                                    "the wrist point is on the first axis; joint 1 is free"), singular)
+        _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",
+                                                "the two shoulder solutions meet"), singular)
+        relation = "sum" if np.all(self.signs > 0) else "signed_sum"
+        _flag_rows((free_six & shoulder.valid[..., None]).any(axis=(1, 2)),
+                   Singularity("wrist", (1, 2, 3, 5), relation,
+                               "axis 6 is parallel to axes 2–4: only q2 + q3 + q4 and q6 together are "
+                               "determined; q6 is set to the reference value (or 0)"), singular)
+        merged_rows = (elbow.merged & valid[..., 0]).any(axis=(1, 2))
+        for row in np.flatnonzero(merged_rows):
+            index = np.argwhere(elbow.merged[row] & valid[row, :, :, 0])[0]
+            kind = "stretched" if np.cos(q3[row, index[0], index[1], 0]) > 0 else "folded"
+            singular[row].append(Singularity("elbow", (2,), kind, f"the arm is fully {kind}"))
+        return Candidates(joints.reshape(n, 8, 6), valid.reshape(n, 8), [], singular)
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        g, m = self.geometry, self.model
+        G1 = chain_motion(m.directions[:1], m.points[:1], m.is_revolute[:1], joints[:, :1])
+        G2 = chain_motion(m.directions[:2], m.points[:2], m.is_revolute[:2], joints[:, :2])
+        G3 = chain_motion(m.directions[:3], m.points[:3], m.is_revolute[:3], joints[:, :3])
+        forward = np.einsum("mij,j->mi", G1[:, :3, :3], self.forward)
+        wrist_point = apply(G3, g.point(3))
+        shoulder = np.einsum("mi,mi->m", wrist_point - g.point(0), forward)
+        shoulder_point = apply(G1, g.point(1))
+        elbow_point = apply(G2, g.point(2)) - shoulder_point
+        reach = wrist_point - shoulder_point
+        line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
+        rejection = elbow_point - np.einsum("mi,mi->m", elbow_point, line)[:, None] * line
+        side = rejection @ _up_direction(g.direction(0))
+        middle = np.pi - np.mod(np.pi - joints[:, 4], 2 * np.pi)
+        return [{"shoulder": "left" if s >= 0 else "right", "elbow": "up" if e > 0 else "down",
+                 "wrist": "no_flip" if 0 <= w < np.pi else "flip"}
+                for s, e, w in zip(shoulder, side, middle)]

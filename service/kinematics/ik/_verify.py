@@ -1,0 +1,105 @@
+"""Verification of candidate solutions by forward kinematics, merging and ordering.
+
+No solution leaves the core unless FK of it reproduces the target within a
+tolerance relative to the robot's size.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._forward import forward_kinematics
+from .._robot import Robot
+from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE
+
+
+def wrap_revolute(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Revolute joint values wrapped to (−π, π]; prismatic values unchanged. Shape (..., n)."""
+    wrapped = np.pi - np.mod(np.pi - q, 2 * np.pi)
+    return np.where(robot.is_revolute, wrapped, q)
+
+
+def joint_difference(robot: Robot, q: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """q − reference with revolute differences taken across the 2π wrap, in (−π, π]. Shape (..., n)."""
+    return wrap_revolute(robot, np.asarray(q) - reference)
+
+
+def residuals(robot: Robot, q: np.ndarray, world_T_target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Position error (length units) and orientation error (radians) of FK(q) against the target.
+
+    Parameters
+    ----------
+    q : ndarray, shape (k, n)
+    world_T_target : ndarray, shape (4, 4) or (k, 4, 4)
+
+    Returns
+    -------
+    position, orientation : ndarrays, shape (k,)
+    """
+    world_T_tool = forward_kinematics(robot, q)
+    position = np.linalg.norm(world_T_tool[..., :3, 3] - world_T_target[..., :3, 3], axis=-1)
+    relative = np.swapaxes(world_T_target[..., :3, :3], -1, -2) @ world_T_tool[..., :3, :3]
+    skew = relative - np.swapaxes(relative, -1, -2)
+    sine = 0.5 * np.linalg.norm(np.stack([skew[..., 2, 1], skew[..., 0, 2], skew[..., 1, 0]], axis=-1), axis=-1)
+    cosine = 0.5 * (np.trace(relative, axis1=-2, axis2=-1) - 1.0)
+    orientation = np.arctan2(sine, cosine)
+    return position, orientation
+
+
+def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool) -> np.ndarray:
+    """Which residuals pass the FK check."""
+    ok = position <= ACCEPT_RESIDUAL * robot.characteristic_length
+    if constrain_orientation:
+        ok &= orientation <= ACCEPT_RESIDUAL
+    return ok
+
+
+def distinct(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """Indices of the first occurrence of each distinct joint vector, revolute joints compared modulo 2π."""
+    tolerance = np.where(robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length)
+    keep: list[int] = []
+    for i in range(len(q)):
+        if not any(np.all(np.abs(joint_difference(robot, q[i], q[j])) <= tolerance) for j in keep):
+            keep.append(i)
+    return np.array(keep, dtype=int)
+
+
+def distance_to_reference(robot: Robot, q: np.ndarray, reference: np.ndarray, *, norm: str = "linf",
+                          weights: np.ndarray | None = None) -> np.ndarray:
+    """Wrap-aware distance of each row of q from the reference, shape (k,).
+
+    ``norm`` is ``"linf"`` (the largest single joint move, the default) or ``"l2"``;
+    ``weights`` scale each joint's difference.
+    """
+    difference = np.abs(joint_difference(robot, q, reference))
+    if weights is not None:
+        difference = difference * weights
+    return difference.max(axis=-1) if norm == "linf" else np.linalg.norm(difference, axis=-1)
+
+
+def polish(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray, constrain_orientation: bool,
+           steps: int = 3) -> np.ndarray:
+    """A few damped Gauss–Newton steps towards the target, for candidates that are close but not exact.
+
+    q : (k, n); world_T_targets : (k, 4, 4). Returns the refined (k, n). Rows
+    already within :data:`ACCEPT_RESIDUAL` * 1e-3 are left as they are.
+    """
+    from .._forward import geometric_jacobian
+    from ._numeric import pose_error
+
+    scale = robot.characteristic_length
+    rows = slice(0, 6) if constrain_orientation else slice(0, 3)
+    q = q.copy()
+    for _ in range(steps):
+        error = pose_error(forward_kinematics(robot, q), world_T_targets, scale)[:, rows]
+        size = np.abs(error).max(axis=1)
+        active = size > ACCEPT_RESIDUAL * 1e-3
+        if not active.any():
+            break
+        J = geometric_jacobian(robot, q[active])
+        J[:, :3, :] /= scale
+        J = J[:, rows, :]
+        JJt = J @ np.swapaxes(J, -1, -2) + 1e-12 * np.eye(J.shape[1])
+        step = np.einsum("kji,kj->ki", J, np.linalg.solve(JJt, error[active][..., None])[..., 0])
+        q[active] += step
+    return q

@@ -1,0 +1,112 @@
+"""Wrists: revolute joints whose axes meet at one point, solving orientation alone.
+
+Given ``R_w``, the rotation the wrist joints must produce (the positioning
+joints' motion already removed), these solve
+``R(ω_a, q_a) R(ω_b, q_b) R(ω_c, q_c) = R_w`` (spherical wrist) or
+``R(ω, q) = R_w`` (a final roll). Axes are the home axes of the screw model.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._tolerances import SINGULARITY_TOLERANCE
+from ._screws import rotate_about
+from ._structure import Geometry
+from ._subproblems import subproblem_1, subproblem_2_chain
+from ._types import Branch, Singularity
+
+
+@dataclass
+class WristResult:
+    """``joints`` (N, m, k) for the wrist joints, ``valid`` (N, m), singular flags per target."""
+
+    joints: np.ndarray
+    valid: np.ndarray
+    singularities: list[list[Singularity]]
+
+
+def _perpendicular_unit(axis: np.ndarray) -> np.ndarray:
+    trial = np.eye(3)[np.argmin(np.abs(axis))]
+    u = np.cross(axis, trial)
+    return u / np.linalg.norm(u)
+
+
+class SphericalWrist:
+    """Three revolute joints meeting at the wrist centre (Spong §4.2–4.4, done with subproblems).
+
+    Subproblem 2 turns ω_c's home direction onto ``R_w ω_c`` with joints a and
+    b (two roots: the wrist flip), then subproblem 1 finds q_c from a vector
+    normal to ω_c. When ``R_w ω_c`` lies on ω_a (the middle joint aligns the
+    outer axes), only q_a ± q_c is determined: q_a takes the reference value
+    (or 0) and the singularity is reported.
+
+    Labels: ``wrist`` is ``no_flip`` when the middle joint's angle (wrapped)
+    lies in [0, π), ``flip`` otherwise.
+    """
+
+    name = "spherical_wrist"
+    generic_count = 2
+
+    def __init__(self, geometry: Geometry, joints: tuple[int, int, int]) -> None:
+        self.geometry = geometry
+        self.joints = joints
+        self.axes = [geometry.direction(j) for j in joints]
+        self.normal = _perpendicular_unit(self.axes[2])
+
+    def solve(self, R_w: np.ndarray, reference: np.ndarray | None) -> WristResult:
+        a, b, c = self.axes
+        target_axis = R_w @ c  # (..., 3)
+        pair = subproblem_2_chain(a, b, c, target_axis[..., None, :])
+        qa, qb = pair.theta1[..., 0, :], pair.theta2[..., 0, :]  # (..., 2)
+        free = pair.degenerate[..., 0]
+        if free.any():
+            start = 0.0 if reference is None else reference[self.joints[0]]
+            back = rotate_about(a, -start, target_axis)
+            qb_free = subproblem_1(b, c, back).theta[..., 0]
+            qa = np.where(free[..., None], start, qa)
+            qb = np.where(free[..., None], qb_free[..., None], qb)
+        valid = pair.valid[..., 0, :].copy()
+        valid[..., 1] &= ~free
+        # q_c: R(c, q_c) u = (R_a R_b)^T R_w u
+        wanted = np.einsum("...ij,j->...i", R_w, self.normal)[..., None, :]  # (..., 1, 3)
+        unwound = rotate_about(b, -qb, rotate_about(a, -qa, wanted))
+        qc = subproblem_1(c, self.normal, unwound).theta[..., 0]
+        joints = np.stack([qa, qb, qc], axis=-1)
+        singular: list[list[Singularity]] = [[] for _ in range(len(R_w))]
+        for row in np.flatnonzero(free):
+            aligned = rotate_about(b, qb[row, 0], c) @ a
+            relation = "sum" if aligned > 0 else "difference"
+            singular[row].append(Singularity(
+                "wrist", (self.joints[0], self.joints[2]), relation,
+                f"the first and last wrist axes are aligned: only q{self.joints[0] + 1} "
+                f"{'+' if relation == 'sum' else '−'} q{self.joints[2] + 1} is determined; "
+                f"q{self.joints[0] + 1} is set to the reference value (or 0)"))
+        return WristResult(joints, valid, singular)
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        middle = np.pi - np.mod(np.pi - joints[:, self.joints[1]], 2 * np.pi)
+        return [{"wrist": "no_flip" if 0 <= value < np.pi - SINGULARITY_TOLERANCE else "flip"} for value in middle]
+
+
+class Roll:
+    """One revolute joint turning the tool about its own axis: subproblem 1 on a vector normal to it."""
+
+    name = "roll"
+    generic_count = 1
+
+    def __init__(self, geometry: Geometry, joint: int) -> None:
+        self.geometry = geometry
+        self.joints = (joint,)
+        self.axis = geometry.direction(joint)
+        self.normal = _perpendicular_unit(self.axis)
+
+    def solve(self, R_w: np.ndarray, reference: np.ndarray | None) -> WristResult:
+        wanted = np.einsum("...ij,j->...i", R_w, self.normal)
+        q = subproblem_1(self.axis, self.normal, wanted).theta  # (..., 1)
+        return WristResult(q[..., None], np.ones(q.shape, dtype=bool), [[] for _ in range(len(R_w))])
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        return [{} for _ in range(len(joints))]

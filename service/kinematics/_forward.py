@@ -10,11 +10,13 @@ vectorises over N: there is no Python loop over configurations.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
 
 from ._conventions import link_transforms
+from ._cache import memo
 from ._robot import Robot
 
 
@@ -69,12 +71,136 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> np.ndarray:
     [1.36762, 0.38009]
     """
     q = np.asarray(q, dtype=float)
-    theta, d = _dh_variables(robot, q)
-    prev_T_link = link_transforms(robot.convention, robot.a, robot.alpha, d, theta)
-    world_T_flange = np.broadcast_to(robot.world_T_base, q.shape[:-1] + (4, 4))
+    if q.ndim == 1:
+        return _tool_matrix(robot, q.tolist())
+    x, y, z, p = tool_columns(robot, q.reshape(-1, q.shape[-1]))
+    world_T_tool = np.empty((x.shape[1], 4, 4))
+    for column, values in enumerate((x, y, z, p)):
+        world_T_tool[:, :3, column] = values.T
+    world_T_tool[:, 3, :3] = 0.0
+    world_T_tool[:, 3, 3] = 1.0
+    return world_T_tool.reshape(q.shape[:-1] + (4, 4))
+
+
+class _Step(NamedTuple):
+    """One link of the chain, as the column operations it needs (zero terms left out)."""
+
+    revolute: bool
+    theta: float  # constant part of the joint angle
+    d: float  # constant part of the offset along z
+    a: float
+    cos_alpha: float
+    sin_alpha: float
+    twisted: bool  # alpha is not 0
+
+
+def _chain_steps(robot: Robot) -> tuple[_Step, ...]:
+    steps = []
     for i in range(robot.dof):
-        world_T_flange = world_T_flange @ prev_T_link[..., i, :, :]
-    return world_T_flange @ robot.flange_T_tool
+        alpha = float(robot.alpha[i])
+        cos_alpha, sin_alpha = math.cos(alpha), math.sin(alpha)
+        # an alpha of ±90° gives cos 6e-17, not 0: treat it as the exact 0 it stands for
+        cos_alpha = 0.0 if abs(cos_alpha) < 1e-15 else cos_alpha
+        sin_alpha = 0.0 if abs(sin_alpha) < 1e-15 else sin_alpha
+        steps.append(_Step(bool(robot.is_revolute[i]), float(robot.theta[i]), float(robot.d[i]), float(robot.a[i]),
+                           cos_alpha, sin_alpha, alpha != 0.0))
+    return tuple(steps)
+
+
+def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``world_T_tool`` for a batch of joint vectors, as its four columns.
+
+    The chain is multiplied out column by column: post-multiplying by Rz(θ)
+    mixes the x and y columns, by Rx(α) the y and z columns, and a
+    translation adds a multiple of one column to the position. Each step is
+    a few elementwise operations over the whole batch, and terms that are
+    zero for this robot (a = 0, d = 0, α = 0) are skipped.
+
+    Parameters
+    ----------
+    q : ndarray, shape (N, n)
+
+    Returns
+    -------
+    x, y, z, p : ndarrays, shape (3, N)
+        The rotation's columns and the position of the tool, in the world frame.
+    """
+    steps = memo(robot, "chain_steps", lambda: _chain_steps(robot))
+    qt = np.asarray(q, dtype=float).T  # (n, N)
+    angles = np.array([s.theta for s in steps])[:, None] + np.where(robot.is_revolute[:, None], qt, 0.0)
+    cos, sin = np.cos(angles), np.sin(angles)
+    base = robot.world_T_base
+    count = qt.shape[1]
+    x, y, z = (np.repeat(base[:3, k:k + 1], count, axis=1) for k in range(3))
+    p = np.repeat(base[:3, 3:4], count, axis=1)
+    standard = robot.convention == "standard"
+    for i, step in enumerate(steps):
+        c, s = cos[i], sin[i]
+        if standard:  # A = Rz(θ) Tz(d) Tx(a) Rx(α)
+            d = step.d if step.revolute else step.d + qt[i]
+            if step.revolute and d != 0.0 or not step.revolute:
+                p = p + z * d
+            x, y = x * c + y * s, y * c - x * s
+            if step.a != 0.0:
+                p = p + x * step.a
+            if step.twisted:
+                y, z = y * step.cos_alpha + z * step.sin_alpha, z * step.cos_alpha - y * step.sin_alpha
+        else:  # T = Rx(α) Tx(a) Rz(θ) Tz(d)
+            if step.a != 0.0:
+                p = p + x * step.a
+            if step.twisted:
+                y, z = y * step.cos_alpha + z * step.sin_alpha, z * step.cos_alpha - y * step.sin_alpha
+            x, y = x * c + y * s, y * c - x * s
+            d = step.d if step.revolute else step.d + qt[i]
+            if step.revolute and d != 0.0 or not step.revolute:
+                p = p + z * d
+    tool = robot.flange_T_tool
+    if not np.array_equal(tool, _IDENTITY):
+        R, t = tool[:3, :3], tool[:3, 3]
+        p = p + x * t[0] + y * t[1] + z * t[2]
+        x, y, z = (x * R[0, k] + y * R[1, k] + z * R[2, k] for k in range(3))
+    return x, y, z, p
+
+
+_IDENTITY = np.eye(4)
+
+
+def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:
+    """``world_T_tool`` for one joint vector: :func:`tool_columns` in scalar arithmetic (no array overhead)."""
+    steps = memo(robot, "chain_steps", lambda: _chain_steps(robot))
+    start = memo(robot, "base_columns", lambda: robot.world_T_base[:3].T.tolist())
+    (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = start
+    standard = robot.convention == "standard"
+    cos, sin = math.cos, math.sin
+    for step, value in zip(steps, q):
+        if step.revolute:
+            angle, d = step.theta + value, step.d
+        else:
+            angle, d = step.theta, step.d + value
+        c, s = cos(angle), sin(angle)
+        if not standard:
+            if step.a:
+                p0, p1, p2 = p0 + x0 * step.a, p1 + x1 * step.a, p2 + x2 * step.a
+            if step.twisted:
+                ca, sa = step.cos_alpha, step.sin_alpha
+                y0, y1, y2, z0, z1, z2 = (y0 * ca + z0 * sa, y1 * ca + z1 * sa, y2 * ca + z2 * sa,
+                                          z0 * ca - y0 * sa, z1 * ca - y1 * sa, z2 * ca - y2 * sa)
+        elif d:
+            p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
+        x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
+                                  y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
+        if standard:
+            if step.a:
+                p0, p1, p2 = p0 + x0 * step.a, p1 + x1 * step.a, p2 + x2 * step.a
+            if step.twisted:
+                ca, sa = step.cos_alpha, step.sin_alpha
+                y0, y1, y2, z0, z1, z2 = (y0 * ca + z0 * sa, y1 * ca + z1 * sa, y2 * ca + z2 * sa,
+                                          z0 * ca - y0 * sa, z1 * ca - y1 * sa, z2 * ca - y2 * sa)
+        elif d:
+            p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
+    flange_T = np.array([[x0, y0, z0, p0], [x1, y1, z1, p1], [x2, y2, z2, p2], [0.0, 0.0, 0.0, 1.0]])
+    tool = robot.flange_T_tool
+    return flange_T if np.array_equal(tool, _IDENTITY) else flange_T @ tool
 
 
 class JointScrews(NamedTuple):

@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 
 from ._positioning import Positioner
-from ._screws import apply, chain_motion, invert
-from ._types import Branch, Candidates
+from ._screws import apply, chain_rotation, invert
+from ._types import Branch, Candidates, LabelCodes, SingularFlags, branches_from_codes
 from ._wrist import Roll, SphericalWrist
 
 
@@ -54,7 +54,7 @@ class DecoupledPlan:
         else:
             arm_joints = np.zeros((n_targets, 1, 0))
             arm_valid = np.ones((n_targets, 1), dtype=bool)
-            singular = [[] for _ in range(n_targets)]
+            singular = SingularFlags(n_targets)
         m_arm = arm_joints.shape[1]
         joints = np.zeros((n_targets, m_arm, self.dof))
         joints[..., :k] = arm_joints
@@ -63,32 +63,32 @@ class DecoupledPlan:
         if self.wrist is None:
             return Candidates(joints, arm_valid, [], singular)
         model = self.positioner.model if self.positioner else None
+        # the wrist's rotation: H = G⁻¹ · world_T_target · home⁻¹, of which only the rotation is needed
+        R_target = world_T_targets[:, :3, :3] @ self.home_inverse[:3, :3]
         if self.positioner is not None:
-            G = chain_motion(model.directions[:k], model.points[:k], model.is_revolute[:k],
-                             np.nan_to_num(arm_joints))
+            R_G = chain_rotation(model.directions[:k], model.is_revolute[:k], np.nan_to_num(arm_joints))
+            R_H = np.swapaxes(R_G, -1, -2) @ R_target[:, None]
         else:
-            G = np.broadcast_to(np.eye(4), (n_targets, 1, 4, 4))
-        H = invert(G) @ (world_T_targets @ self.home_inverse)[:, None]
-        wrist = self.wrist.solve(H[..., :3, :3].reshape(-1, 3, 3), reference)
+            R_H = R_target[:, None]
+        wrist = self.wrist.solve(R_H.reshape(-1, 3, 3), reference)
         m_wrist = wrist.joints.shape[1]
         wrist_joints = wrist.joints.reshape(n_targets, m_arm, m_wrist, -1)
         wrist_valid = wrist.valid.reshape(n_targets, m_arm, m_wrist)
         full = np.repeat(joints[:, :, None, :], m_wrist, axis=2)
         full[..., list(self.wrist.joints)] = wrist_joints
         valid = arm_valid[:, :, None] & wrist_valid
-        for flat, flags in enumerate(wrist.singularities):
-            row, slot = divmod(flat, m_arm)
-            if arm_valid[row, slot]:
-                for flag in flags:
-                    if flag not in singular[row]:
-                        singular[row].append(flag)
+        for mask, flag in wrist.singularities.entries:
+            singular.add((mask.reshape(n_targets, m_arm) & arm_valid).any(axis=1), flag)
         return Candidates(full.reshape(n_targets, m_arm * m_wrist, self.dof), valid.reshape(n_targets, -1), [],
                           singular)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
-        labels: list[Branch] = [{} for _ in range(len(joints))]
+        return branches_from_codes(self.label_codes(joints), len(joints))
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        """Branch labels of full joint vectors (M, n) as arrays: the positioner's, then the wrist's."""
+        codes: LabelCodes = {}
         for part in (self.positioner, self.wrist):
             if part is not None:
-                for label, extra in zip(labels, part.labels(joints)):
-                    label.update(extra)
-        return labels
+                codes.update(part.label_codes(joints))
+        return codes

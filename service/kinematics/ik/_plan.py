@@ -19,7 +19,7 @@ from ._positioning import find_positioner
 from ._screws import apply, chain_motion
 from ._structure import Geometry
 from ._three_parallel import ThreeParallelPlan
-from ._types import Branch, Candidates
+from ._types import Branch, Candidates, LabelCodes
 from ._wrist import Roll, SphericalWrist
 
 
@@ -31,6 +31,8 @@ class Plan(Protocol):
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates: ...
 
     def labels(self, joints: np.ndarray) -> list[Branch]: ...
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes: ...
 
 
 def geometry_of(robot: Robot) -> Geometry:

@@ -24,7 +24,7 @@ from ._subproblems import (
     subproblem_2_chain,
     subproblem_3,
 )
-from ._types import Branch, Singularity
+from ._types import Branch, LabelCodes, SingularFlags, Singularity, branches_from_codes
 
 
 @dataclass
@@ -36,7 +36,7 @@ class PositionerResult:
 
     joints: np.ndarray
     valid: np.ndarray
-    singularities: list[list[Singularity]] = field(default_factory=list)
+    singularities: SingularFlags = field(default_factory=lambda: SingularFlags(0))
 
 
 def _up_direction(direction: np.ndarray) -> np.ndarray:
@@ -49,9 +49,8 @@ def _unit(v: np.ndarray) -> np.ndarray | None:
     return v / norm if norm > 1e-9 else None
 
 
-def _flag_rows(flags: np.ndarray, template: Singularity, rows: list[list[Singularity]]) -> None:
-    for row in np.flatnonzero(flags):
-        rows[row].append(template)
+def _flag_rows(flags: np.ndarray, template: Singularity, rows: SingularFlags) -> None:
+    rows.add(flags, template)
 
 
 class Positioner:
@@ -71,7 +70,11 @@ class Positioner:
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
         """Branch labels of full joint vectors (M, n), one dict per row."""
-        return [{} for _ in range(len(joints))]
+        return branches_from_codes(self.label_codes(joints), len(joints))
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        """The same labels as arrays: name → (values, codes (M,))."""
+        return {}
 
     def _motion(self, q: np.ndarray, upto: int) -> np.ndarray:
         """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) for joint values (..., n)."""
@@ -137,7 +140,7 @@ class IntersectingShoulder(Positioner):
         joints[..., 2] = q3[:, :, None]
         valid = third.valid[:, :, None] & pair.valid & third.exact[:, :, None] & pair.exact
         valid[:, :, 1] &= ~free_shoulder  # one representative when the shoulder is free
-        singular: list[list[Singularity]] = [[] for _ in range(n_targets)]
+        singular = SingularFlags(n_targets)
         _flag_rows(free_shoulder.any(axis=1),
                    Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "
                                "joint 1 is set to the reference value (or 0)"), singular)
@@ -170,14 +173,13 @@ class IntersectingShoulder(Positioner):
             return -normal
         return reach
 
-    def labels(self, joints: np.ndarray) -> list[Branch]:
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, (i, j, k) = self.geometry, self.joints
         forward = rotate_about(g.direction(i), joints[:, i], self._forward_direction())
         G3 = self._motion(joints, k + 1)
         point = np.einsum("mij,j->mi", G3[:, :3, :3], self.point) + G3[:, :3, 3]
         reach = point - self.centre
-        shoulder = np.where(np.einsum("mi,mi->m", reach, forward) >= 0, "left", "right")
-        labels: list[Branch] = [{"shoulder": str(s)} for s in shoulder]
+        codes: LabelCodes = {"shoulder": (("left", "right"), (~(np.einsum("mi,mi->m", reach, forward) >= 0)).view(np.int8))}
         if g.model.is_revolute[k]:
             G2 = self._motion(joints, k)
             elbow = np.einsum("mij,j->mi", G2[:, :3, :3], g.point(k)) + G2[:, :3, 3] - self.centre
@@ -185,9 +187,8 @@ class IntersectingShoulder(Positioner):
             line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
             rejection = elbow - np.einsum("mi,mi->m", elbow, line)[:, None] * line
             side = rejection @ up
-            for label, s in zip(labels, side):
-                label["elbow"] = "up" if s > 0 else "down"
-        return labels
+            codes["elbow"] = (("up", "down"), (~(side > 0)).view(np.int8))
+        return codes
 
 
 class ParallelShoulder(Positioner):
@@ -237,7 +238,7 @@ class ParallelShoulder(Positioner):
         joints = np.stack([q1, q2, np.broadcast_to(slide.s, q2.shape)], axis=-1)
         valid = elbow.valid & elbow.exact & first.exact[..., 0] & slide.exact
         valid[:, 1] &= ~free[:, 1]
-        singular: list[list[Singularity]] = [[] for _ in range(n_targets)]
+        singular = SingularFlags(n_targets)
         coincident = elbow.degenerate
         _flag_rows(coincident, Singularity("assur_group", (i, j), "coincident",
                                            "the point is on the first axis with equal link lengths: "
@@ -247,7 +248,7 @@ class ParallelShoulder(Positioner):
                                                            "the two assembly modes meet"), singular)
         return PositionerResult(joints, valid, singular)
 
-    def labels(self, joints: np.ndarray) -> list[Branch]:
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, (i, j, k) = self.geometry, self.joints
         up = _up_direction(g.direction(i))
         G1 = self._motion(joints, i + 1)
@@ -255,7 +256,7 @@ class ParallelShoulder(Positioner):
         G3 = self._motion(joints, k + 1)
         point = np.einsum("mij,j->mi", G3[:, :3, :3], self.point) + G3[:, :3, 3] - g.point(i)
         side = np.einsum("mi,i->m", np.cross(point, elbow), up)
-        return [{"assembly_mode": 1 if s > 0 else 2} for s in side]
+        return {"assembly_mode": ((1, 2), (~(side > 0)).view(np.int8))}
 
 
 class PlanarTwoLink(Positioner):
@@ -293,14 +294,14 @@ class PlanarTwoLink(Positioner):
         joints = np.stack([q1, elbow.theta], axis=-1)
         valid = elbow.valid & elbow.exact & first.exact[..., 0] & in_plane[:, None]
         valid[:, 1] &= ~free[:, 1]
-        singular: list[list[Singularity]] = [[] for _ in range(len(targets))]
+        singular = SingularFlags(len(targets))
         _flag_rows(elbow.merged, Singularity("elbow", (j,), "stretched_or_folded",
                                              "the arm is fully stretched or folded"), singular)
         _flag_rows(free.any(axis=1), Singularity("shoulder", (i,), "free",
                                                  "the point is on the first axis; joint 1 is free"), singular)
         return PositionerResult(joints, valid, singular)
 
-    def labels(self, joints: np.ndarray) -> list[Branch]:
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, (i, j) = self.geometry, self.joints
         up = _up_direction(g.direction(i))
         G1 = self._motion(joints, i + 1)
@@ -308,7 +309,7 @@ class PlanarTwoLink(Positioner):
         G2 = self._motion(joints, j + 1)
         point = np.einsum("mij,j->mi", G2[:, :3, :3], self.point) + G2[:, :3, 3] - g.point(i)
         side = np.einsum("mi,i->m", np.cross(point, elbow), up)
-        return [{"elbow": "up" if s > 0 else "down"} for s in side]
+        return {"elbow": (("up", "down"), (~(side > 0)).view(np.int8))}
 
 
 class OneRevoluteTwoPrismatic(Positioner):
@@ -373,7 +374,7 @@ class OneRevoluteTwoPrismatic(Positioner):
         for column, s in enumerate(self.slides):
             joints[..., order.index(s)] = slides[..., column]
         valid = t_valid & turn.exact[..., 0]
-        singular: list[list[Singularity]] = [[] for _ in range(len(targets))]
+        singular = SingularFlags(len(targets))
         _flag_rows(free.any(axis=1), Singularity("shoulder", (r,), "free",
                                                  "the point is on the revolute axis; that joint is free"), singular)
         _flag_rows(merged, Singularity("reach", self.slides, "boundary",
@@ -401,7 +402,7 @@ class Cartesian(Positioner):
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         joints = (targets - self.point) @ self.inverse.T
         return PositionerResult(joints[:, None, :], np.ones((len(targets), 1), dtype=bool),
-                                [[] for _ in range(len(targets))])
+                                SingularFlags(len(targets)))
 
 
 def _quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale: float):

@@ -51,6 +51,17 @@ def chain_motion(directions: np.ndarray, points: np.ndarray, revolute: np.ndarra
     return T
 
 
+def chain_rotation(directions: np.ndarray, revolute: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """The rotation part of :func:`chain_motion`, shape (..., 3, 3): prismatic joints do not turn."""
+    q = np.asarray(q, dtype=float)
+    R = None
+    for i in range(q.shape[-1]):
+        if revolute[i]:
+            turn = rotation_about(directions[i], q[..., i])
+            R = turn if R is None else R @ turn
+    return np.broadcast_to(np.eye(3), q.shape[:-1] + (3, 3)) if R is None else R
+
+
 def apply(T: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Transform points: T (..., 4, 4) applied to x (..., 3)."""
     return np.einsum("...ij,...j->...i", T[..., :3, :3], x) + T[..., :3, 3]

@@ -8,9 +8,9 @@ import numpy as np
 
 from .._robot import Robot
 from ._numeric import NumericOptions, solve_numeric
-from ._plan import geometry_of, plan_for
+from ._arrays import IKArrays, solve_ik_arrays
+from ._plan import geometry_of
 from ._types import IKResult, Solution
-from .._tolerances import ACCEPT_RESIDUAL, POLISH_RESIDUAL
 from ._verify import accepted, distance_to_reference, distinct, polish, residuals, wrap_revolute
 
 
@@ -47,62 +47,59 @@ def solve_ik(robot: Robot, world_T_target: np.ndarray, *, constrain_orientation:
 
 def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,
                    reference: np.ndarray | None = None, options: IKOptions | None = None) -> list[IKResult]:
-    """:func:`solve_ik` for targets of shape (N, 4, 4); the analytic families run vectorised over N."""
+    """:func:`solve_ik` for targets of shape (N, 4, 4); the analytic families run vectorised over N.
+
+    The work is :func:`solve_ik_arrays`; this only turns its rows into records.
+    """
     options = options or IKOptions()
     targets = np.asarray(world_T_targets, dtype=float)
-    plan = plan_for(robot, constrain_orientation=constrain_orientation, reference=reference)
-    if plan is None:
+    arrays = solve_ik_arrays(robot, targets, constrain_orientation=constrain_orientation, reference=reference)
+    if arrays is None:
         return [_numeric(robot, target, constrain_orientation, reference, options) for target in targets]
-    candidates = plan.solve(targets, reference)
-    n_targets, m, n = candidates.joints.shape
-    joints = wrap_revolute(robot, np.nan_to_num(candidates.joints.reshape(-1, n)))
-    repeated_targets = np.repeat(targets, m, axis=0)
-    position, orientation = residuals(robot, joints, repeated_targets)
-    joints, position, orientation = _polished(robot, joints, repeated_targets, position, orientation,
-                                              candidates.valid.reshape(-1), constrain_orientation)
-    position, orientation = position.reshape(n_targets, m), orientation.reshape(n_targets, m)
-    ok = candidates.valid & accepted(robot, position, orientation, constrain_orientation)
-    joints = joints.reshape(n_targets, m, n)
+    return results_from_arrays(robot, arrays, targets, constrain_orientation, reference)
+
+
+def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
+                        reference: np.ndarray | None) -> list[IKResult]:
+    """One :class:`IKResult` per row of :func:`solve_ik_arrays`' answer."""
+    counts = arrays.count.tolist()
+    details = _unreachable_details(robot, arrays, targets, constrain_orientation, reference)
+    joints, position, orientation = arrays.joints, arrays.position.tolist(), arrays.orientation.tolist()
+    labels = [(name, values, codes.tolist()) for name, (values, codes) in arrays.labels.items()]
+    free_joints = arrays.free_joints
     results = []
-    for row in range(n_targets):
-        slots = np.flatnonzero(ok[row])
-        kept = slots[distinct(robot, joints[row, slots])] if len(slots) else slots
-        labels = plan.labels(joints[row, kept]) if len(kept) else []
-        solutions = [Solution(joints[row, s], label, float(position[row, s]), float(orientation[row, s]))
-                     for s, label in zip(kept, labels)]
-        detail = "" if solutions else _unreachable_detail(robot, targets[row], constrain_orientation, reference)
-        results.append(IKResult(
-            status="ok" if solutions else "unreachable",
-            solutions=_ordered(robot, solutions, reference),
-            method="analytic", structure=plan.structure, complete=True,
-            singularities=candidates.singularities[row] if solutions else [],
-            free_joints=list(plan.free_joints), detail=detail))
+    for row, count in enumerate(counts):
+        if count:
+            solutions = [Solution(joints[row, s], {name: values[codes[row][s]] for name, values, codes in labels},
+                                  position[row][s], orientation[row][s]) for s in range(count)]
+            results.append(IKResult(status="ok", solutions=solutions, method="analytic",
+                                    structure=arrays.structure, complete=True,
+                                    singularities=arrays.singularities[row], free_joints=list(free_joints)))
+        else:
+            results.append(IKResult(status="unreachable", solutions=[], method="analytic",
+                                    structure=arrays.structure, complete=True, singularities=[],
+                                    free_joints=list(free_joints), detail=details[row]))
     return results
 
 
-def _polished(robot: Robot, joints: np.ndarray, targets: np.ndarray, position: np.ndarray, orientation: np.ndarray,
-              valid: np.ndarray, constrain_orientation: bool):
-    """Refine the candidates that are close to the target but not within the acceptance tolerance."""
-    scale = robot.characteristic_length
-    size = np.maximum(position / scale, orientation if constrain_orientation else 0.0)
-    near = valid & (size > ACCEPT_RESIDUAL * 1e-3) & (size <= POLISH_RESIDUAL)
-    if near.any():
-        joints = joints.copy()
-        joints[near] = wrap_revolute(robot, polish(robot, joints[near], targets[near], constrain_orientation))
-        position, orientation = position.copy(), orientation.copy()
-        position[near], orientation[near] = residuals(robot, joints[near], targets[near])
-    return joints, position, orientation
-
-
-def _unreachable_detail(robot: Robot, target: np.ndarray, constrain_orientation: bool,
-                        reference: np.ndarray | None) -> str:
-    """Say whether the position or only the orientation is out of reach."""
-    if constrain_orientation:
-        position_only = solve_ik_batch(robot, target[None], constrain_orientation=False, reference=reference)[0]
-        if position_only.solutions:
-            return ("The position is reachable but the orientation is not: " + _orientation_freedom(robot) +
-                    " No joint vector gives the requested orientation at that position.")
-    return "The target position is outside the workspace."
+def _unreachable_details(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
+                         reference: np.ndarray | None) -> dict[int, str]:
+    """For each unreachable target: whether the position or only the orientation is out of reach."""
+    rows = np.flatnonzero(arrays.count == 0)
+    details = {int(row): "The target position is outside the workspace." for row in rows}
+    if constrain_orientation and len(rows):
+        position_only = solve_ik_arrays(robot, targets[rows], constrain_orientation=False, reference=reference)
+        if position_only is not None:
+            reachable = position_only.count > 0
+        else:  # no analytic family for the position alone: the numeric search decides, as for any target
+            reachable = np.array([bool(result.solutions) for result in solve_ik_batch(
+                robot, targets[rows], constrain_orientation=False, reference=reference)])
+        if reachable.any():
+            for row in rows[reachable]:
+                details[int(row)] = ("The position is reachable but the orientation is not: " +
+                                     _orientation_freedom(robot) +
+                                     " No joint vector gives the requested orientation at that position.")
+    return details
 
 
 def _orientation_freedom(robot: Robot) -> str:

@@ -26,7 +26,7 @@ from ._positioning import _flag_rows, _up_direction, _unit
 from ._screws import apply, chain_motion, invert, joint_motion, rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_4
-from ._types import Branch, Candidates, Singularity
+from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
 from ._wrist import _perpendicular_unit
 
 
@@ -110,7 +110,7 @@ class ThreeParallelPlan:
                            np.broadcast_to(q5[..., None], shape), np.broadcast_to(q6[..., None], shape)], axis=-1)
         valid = (shoulder.valid[:, :, None, None] & wrist.valid[..., None] & elbow.valid)
         valid[:, :, :, 1] &= ~elbow.merged
-        singular: list[list[Singularity]] = [[] for _ in range(n)]
+        singular = SingularFlags(n)
         _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
                                                     "the wrist point is on the first axis; joint 1 is free"), singular)
         _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",
@@ -120,14 +120,19 @@ class ThreeParallelPlan:
                    Singularity("wrist", (1, 2, 3, 5), relation,
                                "axis 6 is parallel to axes 2–4: only q2 + q3 + q4 and q6 together are "
                                "determined; q6 is set to the reference value (or 0)"), singular)
-        merged_rows = (elbow.merged & valid[..., 0]).any(axis=(1, 2))
-        for row in np.flatnonzero(merged_rows):
-            index = np.argwhere(elbow.merged[row] & valid[row, :, :, 0])[0]
-            kind = "stretched" if np.cos(q3[row, index[0], index[1], 0]) > 0 else "folded"
-            singular[row].append(Singularity("elbow", (2,), kind, f"the arm is fully {kind}"))
+        merged = (elbow.merged & valid[..., 0]).reshape(n, 4)
+        merged_rows = merged.any(axis=1)
+        if merged_rows.any():
+            first = np.argmax(merged, axis=1)  # the first merged slot of each row, as argwhere found it
+            stretched = np.cos(q3[..., 0].reshape(n, 4)[np.arange(n), first]) > 0
+            for kind, mask in (("stretched", merged_rows & stretched), ("folded", merged_rows & ~stretched)):
+                singular.add(mask, Singularity("elbow", (2,), kind, f"the arm is fully {kind}"))
         return Candidates(joints.reshape(n, 8, 6), valid.reshape(n, 8), [], singular)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
+        return branches_from_codes(self.label_codes(joints), len(joints))
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, m = self.geometry, self.model
         G1 = chain_motion(m.directions[:1], m.points[:1], m.is_revolute[:1], joints[:, :1])
         G2 = chain_motion(m.directions[:2], m.points[:2], m.is_revolute[:2], joints[:, :2])
@@ -142,6 +147,6 @@ class ThreeParallelPlan:
         rejection = elbow_point - np.einsum("mi,mi->m", elbow_point, line)[:, None] * line
         side = rejection @ _up_direction(g.direction(0))
         middle = np.pi - np.mod(np.pi - joints[:, 4], 2 * np.pi)
-        return [{"shoulder": "left" if s >= 0 else "right", "elbow": "up" if e > 0 else "down",
-                 "wrist": "no_flip" if 0 <= w < np.pi else "flip"}
-                for s, e, w in zip(shoulder, side, middle)]
+        return {"shoulder": (("left", "right"), (~(shoulder >= 0)).view(np.int8)),
+                "elbow": (("up", "down"), (~(side > 0)).view(np.int8)),
+                "wrist": (("no_flip", "flip"), (~((0 <= middle) & (middle < np.pi))).view(np.int8))}

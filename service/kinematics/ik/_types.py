@@ -10,6 +10,18 @@ import numpy as np
 Branch = dict[str, str | int]
 Status = Literal["ok", "unreachable"]
 
+#: Branch labels as arrays: label name → (its values, codes of shape (M,) indexing them).
+LabelCodes = dict[str, tuple[tuple[str | int, ...], np.ndarray]]
+
+
+def branches_from_codes(codes: LabelCodes, count: int) -> list[Branch]:
+    """One label dict per row from :data:`LabelCodes` (the object form of the same labels)."""
+    branches: list[Branch] = [{} for _ in range(count)]
+    for name, (values, index) in codes.items():
+        for branch, code in zip(branches, index.tolist()):
+            branch[name] = values[code]
+    return branches
+
 
 @dataclass(frozen=True)
 class Singularity:
@@ -28,6 +40,50 @@ class Singularity:
     detail: str = ""
 
 
+class SingularFlags:
+    """The singular conditions met by a batch of N targets, one boolean mask (N,) per condition.
+
+    Reads like a list of N lists: ``flags[row]`` is the list of distinct
+    :class:`Singularity` records met by target ``row``, in the order they
+    were added. Solvers add whole masks, so no Python loop runs over targets.
+    """
+
+    def __init__(self, count: int) -> None:
+        self.count = count
+        self.entries: list[tuple[np.ndarray, Singularity]] = []
+
+    def add(self, mask: np.ndarray, singularity: Singularity) -> None:
+        """Flag ``singularity`` on every target where ``mask`` (N,) is true."""
+        mask = np.asarray(mask, dtype=bool)
+        if mask.any():
+            self.entries.append((mask, singularity))
+
+    def extend(self, other: "SingularFlags", rows: np.ndarray | None = None) -> None:
+        """Add every condition of ``other``; ``rows`` (N,) maps its rows onto these when it has fewer."""
+        for mask, singularity in other.entries:
+            self.add(mask if rows is None else mask[rows], singularity)
+
+    def any(self) -> np.ndarray:
+        """Which targets meet at least one condition, shape (N,)."""
+        flagged = np.zeros(self.count, dtype=bool)
+        for mask, _ in self.entries:
+            flagged |= mask
+        return flagged
+
+    def __len__(self) -> int:
+        return self.count
+
+    def __getitem__(self, row: int) -> list[Singularity]:
+        met: list[Singularity] = []
+        for mask, singularity in self.entries:
+            if mask[row] and singularity not in met:
+                met.append(singularity)
+        return met
+
+    def __iter__(self):
+        return (self[row] for row in range(self.count))
+
+
 @dataclass
 class Candidates:
     """Joint vectors proposed by a solver for a batch of targets.
@@ -35,14 +91,14 @@ class Candidates:
     ``joints`` has shape (N, m, n): m candidate slots for each of N targets;
     ``valid`` (N, m) says which slots hold a candidate. ``branches`` gives
     the labels of each slot, per target: a list of N lists of m dicts (built
-    lazily by the family's labeller). ``singularities`` lists, per target, the
+    lazily by the family's labeller). ``singularities`` gives, per target, the
     singular conditions met.
     """
 
     joints: np.ndarray
     valid: np.ndarray
     branches: list[list[Branch]]
-    singularities: list[list[Singularity]]
+    singularities: SingularFlags
 
 
 @dataclass(frozen=True)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._forward import forward_kinematics
+from .._forward import forward_kinematics, tool_columns
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE
 
@@ -44,6 +44,38 @@ def residuals(robot: Robot, q: np.ndarray, world_T_target: np.ndarray) -> tuple[
     cosine = 0.5 * (np.trace(relative, axis1=-2, axis2=-1) - 1.0)
     orientation = np.arctan2(sine, cosine)
     return position, orientation
+
+
+def residual_arrays(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`residuals` for m candidates per target, without repeating the targets.
+
+    Parameters
+    ----------
+    q : ndarray, shape (N, m, n)
+    world_T_targets : ndarray, shape (N, 4, 4)
+
+    Returns
+    -------
+    position, orientation : ndarrays, shape (N, m)
+        Length units and radians, as :func:`residuals`.
+    """
+    n_targets, m, n = q.shape
+    x, y, z, p = (c.reshape(3, n_targets, m) for c in tool_columns(robot, q.reshape(-1, n)))
+    target = np.moveaxis(world_T_targets[:, :3, :], 0, -1)[..., None]  # (3, 4, N, 1)
+    tx, ty, tz, tp = target[:, 0], target[:, 1], target[:, 2], target[:, 3]
+    delta = p - tp
+    position = np.sqrt(_dot(delta, delta))
+    # relative = target_R^T · R: entry (i, j) is target column i · column j
+    dot = _dot
+    cosine = 0.5 * (dot(tx, x) + dot(ty, y) + dot(tz, z) - 1.0)
+    sine = 0.5 * np.sqrt((dot(tz, y) - dot(ty, z)) ** 2 + (dot(tx, z) - dot(tz, x)) ** 2
+                         + (dot(ty, x) - dot(tx, y)) ** 2)
+    return position, np.arctan2(sine, cosine)
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Dot products along the leading axis of length 3, broadcasting the rest."""
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
 def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool) -> np.ndarray:

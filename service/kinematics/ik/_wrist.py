@@ -16,7 +16,7 @@ from .._tolerances import SINGULARITY_TOLERANCE
 from ._screws import rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_2_chain
-from ._types import Branch, Singularity
+from ._types import Branch, LabelCodes, SingularFlags, Singularity, branches_from_codes
 
 
 @dataclass
@@ -25,7 +25,7 @@ class WristResult:
 
     joints: np.ndarray
     valid: np.ndarray
-    singularities: list[list[Singularity]]
+    singularities: SingularFlags
 
 
 def _perpendicular_unit(axis: np.ndarray) -> np.ndarray:
@@ -75,20 +75,24 @@ class SphericalWrist:
         unwound = rotate_about(b, -qb, rotate_about(a, -qa, wanted))
         qc = subproblem_1(c, self.normal, unwound).theta[..., 0]
         joints = np.stack([qa, qb, qc], axis=-1)
-        singular: list[list[Singularity]] = [[] for _ in range(len(R_w))]
-        for row in np.flatnonzero(free):
-            aligned = rotate_about(b, qb[row, 0], c) @ a
-            relation = "sum" if aligned > 0 else "difference"
-            singular[row].append(Singularity(
-                "wrist", (self.joints[0], self.joints[2]), relation,
-                f"the first and last wrist axes are aligned: only q{self.joints[0] + 1} "
-                f"{'+' if relation == 'sum' else '−'} q{self.joints[2] + 1} is determined; "
-                f"q{self.joints[0] + 1} is set to the reference value (or 0)"))
+        singular = SingularFlags(len(R_w))
+        if free.any():
+            aligned = rotate_about(b, qb[..., 0], c) @ a
+            for relation, mask in (("sum", free & (aligned > 0)), ("difference", free & ~(aligned > 0))):
+                singular.add(mask, Singularity(
+                    "wrist", (self.joints[0], self.joints[2]), relation,
+                    f"the first and last wrist axes are aligned: only q{self.joints[0] + 1} "
+                    f"{'+' if relation == 'sum' else '−'} q{self.joints[2] + 1} is determined; "
+                    f"q{self.joints[0] + 1} is set to the reference value (or 0)"))
         return WristResult(joints, valid, singular)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
+        return branches_from_codes(self.label_codes(joints), len(joints))
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
         middle = np.pi - np.mod(np.pi - joints[:, self.joints[1]], 2 * np.pi)
-        return [{"wrist": "no_flip" if 0 <= value < np.pi - SINGULARITY_TOLERANCE else "flip"} for value in middle]
+        no_flip = (0 <= middle) & (middle < np.pi - SINGULARITY_TOLERANCE)
+        return {"wrist": (("no_flip", "flip"), (~no_flip).view(np.int8))}
 
 
 class Roll:
@@ -106,7 +110,10 @@ class Roll:
     def solve(self, R_w: np.ndarray, reference: np.ndarray | None) -> WristResult:
         wanted = np.einsum("...ij,j->...i", R_w, self.normal)
         q = subproblem_1(self.axis, self.normal, wanted).theta  # (..., 1)
-        return WristResult(q[..., None], np.ones(q.shape, dtype=bool), [[] for _ in range(len(R_w))])
+        return WristResult(q[..., None], np.ones(q.shape, dtype=bool), SingularFlags(len(R_w)))
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
         return [{} for _ in range(len(joints))]
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        return {}

@@ -1,0 +1,169 @@
+"""Closed-form IK end to end as arrays: candidates, FK check, merging, labels and order, with no loop over targets.
+
+:func:`solve_ik_arrays` is the core of every analytic solve. The object API
+(:func:`~service.kinematics.ik.solve_ik_batch`, :func:`~service.kinematics.ik.solve_ik`)
+is a thin wrapper that turns its rows into :class:`Solution` records.
+
+Layout: N targets, m candidate slots per target (the family's generic count,
+e.g. 8 for the PUMA and the UR5), n joints. After merging and ordering the
+solutions of target i are ``joints[i, :count[i]]``, in output order (nearest
+to the reference first when one is given, else the family's slot order);
+slots past ``count[i]`` hold no solution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .._cache import memo
+from .._robot import Robot
+from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
+from ._plan import Plan, plan_for
+from ._types import LabelCodes, SingularFlags
+from ._verify import distance_to_reference, polish, residual_arrays, wrap_revolute
+
+
+@dataclass(frozen=True)
+class IKArrays:
+    """Every verified, distinct solution of a batch of targets, as arrays.
+
+    Attributes
+    ----------
+    joints : ndarray, shape (N, m, n)
+        Radians (revolute joints wrapped to (−π, π]) and length units. Row i
+        holds target i's solutions in its first ``count[i]`` slots.
+    valid : ndarray of bool, shape (N, m)
+        ``valid[i, s]`` is ``s < count[i]``.
+    count : ndarray of int, shape (N,)
+        Solutions per target; 0 means unreachable.
+    position, orientation : ndarrays, shape (N, m)
+        FK residuals of each solution: length units and radians.
+    labels : dict
+        Branch labels: name → (values, codes of shape (N, m)), ``values[code]``
+        being the label of a slot (e.g. ``"shoulder" → (("left", "right"), codes)``).
+    singularities : SingularFlags
+        The singular conditions each target meets (N rows).
+    structure : str
+        The kinematic family that solved it.
+    free_joints : list of int
+        Joints the target does not determine, set to the reference value (or 0).
+    """
+
+    joints: np.ndarray
+    valid: np.ndarray
+    count: np.ndarray
+    position: np.ndarray
+    orientation: np.ndarray
+    labels: LabelCodes
+    singularities: SingularFlags
+    structure: str
+    free_joints: list[int]
+
+
+def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
+    """:func:`plan_for`, built once per robot and kind of target (and values of the free joints).
+
+    A position-only target on an arm with more than three joints holds the
+    others at the reference values: those plans depend on the values and are
+    built each time rather than kept.
+    """
+    if constrain_orientation:
+        return memo(robot, ("ik_plan", "pose"),
+                    lambda: plan_for(robot, constrain_orientation=True, reference=None))
+    if robot.dof <= 3 or reference is None:
+        return memo(robot, ("ik_plan", "position"),
+                    lambda: plan_for(robot, constrain_orientation=False, reference=None))
+    return plan_for(robot, constrain_orientation=False, reference=reference)
+
+
+def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,
+                    reference: np.ndarray | None = None, plan: Plan | None = None) -> IKArrays | None:
+    """Every solution for each of N targets, vectorised over the targets.
+
+    Parameters
+    ----------
+    world_T_targets : ndarray, shape (N, 4, 4)
+        Targets in the world frame; with ``constrain_orientation`` false only
+        their positions count.
+    reference : ndarray, shape (n,), optional
+        Orders each target's solutions nearest first (wrap-aware, largest
+        single joint move) and sets joints that are free at a singularity.
+    plan : optional
+        The analytic plan to use (default: the cached one for this robot).
+
+    Returns
+    -------
+    IKArrays, or None when no analytic family covers this robot (the object
+    API then runs the numeric fallback).
+
+    Every candidate is checked by FK: it is kept when its position error is
+    within ``ACCEPT_RESIDUAL`` times the robot's size and its orientation error
+    within ``ACCEPT_RESIDUAL`` radians; candidates close to that get a few
+    Gauss–Newton steps first. Candidates equal to an earlier kept one modulo
+    2π (within ``DUPLICATE_TOLERANCE``) are merged into it.
+    """
+    if plan is None:
+        plan = cached_plan(robot, constrain_orientation=constrain_orientation, reference=reference)
+        if plan is None:
+            return None
+    targets = np.asarray(world_T_targets, dtype=float)
+    candidates = plan.solve(targets, reference)
+    n_targets, m, n = candidates.joints.shape
+    joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
+    position, orientation = residual_arrays(robot, joints, targets)
+    _polish_near(robot, joints, targets, position, orientation, candidates.valid, constrain_orientation)
+    ok = candidates.valid & (position <= ACCEPT_RESIDUAL * robot.characteristic_length)
+    if constrain_orientation:
+        ok &= orientation <= ACCEPT_RESIDUAL
+    kept = _first_of_each(robot, joints, ok)
+    labels = plan.label_codes(joints.reshape(-1, n))
+    # output order: kept slots first, nearest to the reference first, else in slot order (stable)
+    if reference is not None:
+        key = np.where(kept, distance_to_reference(robot, joints, reference), np.inf)
+        order = np.argsort(key, axis=1, kind="stable")
+    else:
+        order = np.argsort(~kept, axis=1, kind="stable")
+    count = kept.sum(axis=1)
+    take = (np.arange(n_targets)[:, None], order)
+    return IKArrays(
+        joints=joints[take], valid=kept[take], count=count,
+        position=position[take], orientation=orientation[take],
+        labels={name: (values, codes.reshape(n_targets, m)[take]) for name, (values, codes) in labels.items()},
+        singularities=candidates.singularities, structure=plan.structure, free_joints=list(plan.free_joints))
+
+
+def _polish_near(robot: Robot, joints: np.ndarray, targets: np.ndarray, position: np.ndarray,
+                 orientation: np.ndarray, valid: np.ndarray, constrain_orientation: bool) -> None:
+    """Refine, in place, candidates close to their target but outside the acceptance tolerance."""
+    size = np.maximum(position / robot.characteristic_length, orientation if constrain_orientation else 0.0)
+    near = valid & (size > ACCEPT_RESIDUAL * 1e-3) & (size <= POLISH_RESIDUAL)
+    if not near.any():
+        return
+    rows, slots = np.nonzero(near)
+    refined = wrap_revolute(robot, polish(robot, joints[rows, slots], targets[rows], constrain_orientation))
+    joints[rows, slots] = refined
+    p, o = residual_arrays(robot, refined[:, None, :], targets[rows])
+    position[rows, slots], orientation[rows, slots] = p[:, 0], o[:, 0]
+
+
+def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """Which slots (N, m) hold the first occurrence of a distinct solution among the ``ok`` ones.
+
+    Revolute joints are compared modulo 2π. A slot is dropped when it equals
+    a slot kept before it, exactly as a sequential scan would: the loop runs
+    over the m slots, each step vectorised over the targets.
+    """
+    m = joints.shape[1]
+    if m == 1:
+        return ok.copy()
+    tolerance = memo(robot, "duplicate_tolerance", lambda: np.where(
+        robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length))
+    difference = wrap_revolute(robot, joints[:, :, None, :] - joints[:, None, :, :])  # (N, m, m, n)
+    same = np.all(np.abs(difference) <= tolerance, axis=-1)  # (N, m, m)
+    kept = np.zeros_like(ok)
+    kept[:, 0] = ok[:, 0]
+    for slot in range(1, m):
+        kept[:, slot] = ok[:, slot] & ~np.any(same[:, slot, :slot] & kept[:, :slot], axis=1)
+    return kept

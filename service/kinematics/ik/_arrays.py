@@ -158,12 +158,19 @@ def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarr
     m = joints.shape[1]
     if m == 1:
         return ok.copy()
+    revolute = robot.is_revolute
+    all_revolute = bool(revolute.all())
     tolerance = memo(robot, "duplicate_tolerance", lambda: np.where(
-        robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length))
-    difference = wrap_revolute(robot, joints[:, :, None, :] - joints[:, None, :, :])  # (N, m, m, n)
-    same = np.all(np.abs(difference) <= tolerance, axis=-1)  # (N, m, m)
+        revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length))
+    # joints are wrapped to (−π, π], so a revolute difference d lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
     kept = np.zeros_like(ok)
     kept[:, 0] = ok[:, 0]
     for slot in range(1, m):
-        kept[:, slot] = ok[:, slot] & ~np.any(same[:, slot, :slot] & kept[:, :slot], axis=1)
+        gap = np.abs(joints[:, slot, None, :] - joints[:, :slot, :])  # (N, slot, n)
+        if all_revolute:
+            np.minimum(gap, 2 * np.pi - gap, out=gap)
+        elif revolute.any():
+            gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
+        same = (gap <= tolerance).all(axis=-1)  # (N, slot)
+        kept[:, slot] = ok[:, slot] & ~np.any(same & kept[:, :slot], axis=1)
     return kept

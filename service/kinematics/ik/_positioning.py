@@ -15,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._tolerances import SINGULARITY_TOLERANCE
-from ._screws import chain_motion, rotate_about
+from ._screws import chain_motion, move_point, rotate_about
 from ._structure import Geometry
 from ._subproblems import (
     prismatic_to_distance,
@@ -75,6 +75,11 @@ class Positioner:
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """The same labels as arrays: name → (values, codes (M,))."""
         return {}
+
+    def _moved(self, q: np.ndarray, upto: int, x: np.ndarray) -> np.ndarray:
+        """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) applied to the point x (3,), for joint values (..., n)."""
+        m = self.model
+        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], q[..., :upto], x)
 
     def _motion(self, q: np.ndarray, upto: int) -> np.ndarray:
         """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) for joint values (..., n)."""
@@ -176,13 +181,12 @@ class IntersectingShoulder(Positioner):
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, (i, j, k) = self.geometry, self.joints
         forward = rotate_about(g.direction(i), joints[:, i], self._forward_direction())
-        G3 = self._motion(joints, k + 1)
-        point = np.einsum("mij,j->mi", G3[:, :3, :3], self.point) + G3[:, :3, 3]
+        point = self._moved(joints, k + 1, self.point)
         reach = point - self.centre
-        codes: LabelCodes = {"shoulder": (("left", "right"), (~(np.einsum("mi,mi->m", reach, forward) >= 0)).view(np.int8))}
+        left = np.einsum("mi,mi->m", reach, forward) >= 0
+        codes: LabelCodes = {"shoulder": (("left", "right"), (~left).view(np.int8))}
         if g.model.is_revolute[k]:
-            G2 = self._motion(joints, k)
-            elbow = np.einsum("mij,j->mi", G2[:, :3, :3], g.point(k)) + G2[:, :3, 3] - self.centre
+            elbow = self._moved(joints, k, g.point(k)) - self.centre
             up = _up_direction(g.direction(i))
             line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
             rejection = elbow - np.einsum("mi,mi->m", elbow, line)[:, None] * line
@@ -251,10 +255,8 @@ class ParallelShoulder(Positioner):
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, (i, j, k) = self.geometry, self.joints
         up = _up_direction(g.direction(i))
-        G1 = self._motion(joints, i + 1)
-        elbow = np.einsum("mij,j->mi", G1[:, :3, :3], g.point(j)) + G1[:, :3, 3] - g.point(i)
-        G3 = self._motion(joints, k + 1)
-        point = np.einsum("mij,j->mi", G3[:, :3, :3], self.point) + G3[:, :3, 3] - g.point(i)
+        elbow = self._moved(joints, i + 1, g.point(j)) - g.point(i)
+        point = self._moved(joints, k + 1, self.point) - g.point(i)
         side = np.einsum("mi,i->m", np.cross(point, elbow), up)
         return {"assembly_mode": ((1, 2), (~(side > 0)).view(np.int8))}
 
@@ -304,10 +306,8 @@ class PlanarTwoLink(Positioner):
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, (i, j) = self.geometry, self.joints
         up = _up_direction(g.direction(i))
-        G1 = self._motion(joints, i + 1)
-        elbow = np.einsum("mij,j->mi", G1[:, :3, :3], g.point(j)) + G1[:, :3, 3] - g.point(i)
-        G2 = self._motion(joints, j + 1)
-        point = np.einsum("mij,j->mi", G2[:, :3, :3], self.point) + G2[:, :3, 3] - g.point(i)
+        elbow = self._moved(joints, i + 1, g.point(j)) - g.point(i)
+        point = self._moved(joints, j + 1, self.point) - g.point(i)
         side = np.einsum("mi,i->m", np.cross(point, elbow), up)
         return {"elbow": (("up", "down"), (~(side > 0)).view(np.int8))}
 

@@ -9,10 +9,41 @@ def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
     """R(k, θ)·v by Rodrigues' formula.
 
     k : (3,) unit axis; theta : (...,); v : (..., 3), broadcast together.
+    In a frame (e1, e2, k) around the axis the turn is a plane rotation of the
+    (e1, e2) coordinates, so the work is two small matrix products and four
+    elementwise products (cheaper than the cross-product form).
     """
-    theta = np.asarray(theta, dtype=float)[..., None]
+    theta = np.asarray(theta, dtype=float)
+    v = np.asarray(v, dtype=float)
+    shape = np.broadcast_shapes(v.shape, theta.shape + (3,))
+    frame = _frame_about(k)  # columns e1, e2, k
+    # (3, 3) @ (3, M) products run as one BLAS call; (M, 3) @ (3, 3) would not
+    local = frame.T @ np.broadcast_to(v, shape).reshape(-1, 3).T  # (3, M): coordinates along e1, e2, k
+    theta = np.broadcast_to(theta, shape[:-1]).reshape(-1)
     cos, sin = np.cos(theta), np.sin(theta)
-    return v * cos + np.cross(k, v) * sin + k * (v @ k)[..., None] * (1.0 - cos)
+    a, b = local[0], local[1]
+    turned = np.empty_like(local)
+    np.subtract(a * cos, b * sin, out=turned[0])
+    np.add(a * sin, b * cos, out=turned[1])
+    turned[2] = local[2]
+    return (frame @ turned).T.reshape(shape)
+
+
+def _frame_about(k: np.ndarray) -> np.ndarray:
+    """A right-handed orthonormal frame [e1, e2, k] (columns) around the unit vector k, memoised by value."""
+    key = tuple(np.asarray(k, dtype=float).tolist())
+    frame = _FRAMES.get(key)
+    if frame is None:
+        k = np.asarray(key)
+        trial = np.eye(3)[np.argmin(np.abs(k))]
+        e1 = np.cross(k, trial)
+        e1 /= np.linalg.norm(e1)
+        frame = _FRAMES[key] = np.stack([e1, np.cross(k, e1), k], axis=1)
+        frame.setflags(write=False)
+    return frame
+
+
+_FRAMES: dict[tuple[float, ...], np.ndarray] = {}
 
 
 def rotation_about(k: np.ndarray, theta: np.ndarray) -> np.ndarray:
@@ -49,6 +80,20 @@ def chain_motion(directions: np.ndarray, points: np.ndarray, revolute: np.ndarra
     for i in range(q.shape[-1]):
         T = T @ joint_motion(directions[i], points[i], bool(revolute[i]), q[..., i])
     return T
+
+
+def move_point(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, q: np.ndarray,
+               x: np.ndarray) -> np.ndarray:
+    """:func:`chain_motion` applied to the point x (3,): shape (..., 3), turning the point joint by joint
+    from the last to the first (vector operations only, no 4×4 products)."""
+    q = np.asarray(q, dtype=float)
+    x = np.broadcast_to(np.asarray(x, dtype=float), q.shape[:-1] + (3,))
+    for i in reversed(range(q.shape[-1])):
+        if revolute[i]:
+            x = points[i] + rotate_about(directions[i], q[..., i], x - points[i])
+        else:
+            x = x + directions[i] * q[..., i, None]
+    return x
 
 
 def chain_rotation(directions: np.ndarray, revolute: np.ndarray, q: np.ndarray) -> np.ndarray:

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._positioning import _flag_rows, _up_direction, _unit
-from ._screws import apply, chain_motion, invert, joint_motion, rotate_about
+from ._screws import apply, invert, joint_motion, move_point, rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_4
 from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
@@ -134,14 +134,14 @@ class ThreeParallelPlan:
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, m = self.geometry, self.model
-        G1 = chain_motion(m.directions[:1], m.points[:1], m.is_revolute[:1], joints[:, :1])
-        G2 = chain_motion(m.directions[:2], m.points[:2], m.is_revolute[:2], joints[:, :2])
-        G3 = chain_motion(m.directions[:3], m.points[:3], m.is_revolute[:3], joints[:, :3])
-        forward = np.einsum("mij,j->mi", G1[:, :3, :3], self.forward)
-        wrist_point = apply(G3, g.point(3))
+        def moved(upto: int, x: np.ndarray) -> np.ndarray:
+            return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x)
+
+        forward = rotate_about(g.direction(0), joints[:, 0], self.forward)
+        wrist_point = moved(3, g.point(3))
         shoulder = np.einsum("mi,mi->m", wrist_point - g.point(0), forward)
-        shoulder_point = apply(G1, g.point(1))
-        elbow_point = apply(G2, g.point(2)) - shoulder_point
+        shoulder_point = moved(1, g.point(1))
+        elbow_point = moved(2, g.point(2)) - shoulder_point
         reach = wrist_point - shoulder_point
         line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
         rejection = elbow_point - np.einsum("mi,mi->m", elbow_point, line)[:, None] * line

@@ -33,6 +33,8 @@ from ..kinematics import (
     matrix_from_rpy,
     quaternions_from_matrices,
 )
+from ..kinematics._rotations import _checked_transforms
+from ..kinematics._tolerances import ORTHONORMAL_TOLERANCE
 from .schemas.common import AngleUnit
 from .schemas.poses import (
     EulerZYZOrientation,
@@ -136,13 +138,34 @@ def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool
     return T, True
 
 
+def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str | int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`target_matrix` for many targets: (N, 4, 4) matrices and which constrain orientation (N,).
+
+    Matrix targets are stacked and checked in one vectorised pass; on any
+    error, and for other target forms, each target is converted on its own so
+    that the problem names the offending target exactly as before.
+    """
+    if all(target.matrix is not None for target in targets):
+        stacked = np.array([target.matrix for target in targets], dtype=float)
+        try:
+            return _checked_transforms(stacked, ORTHONORMAL_TOLERANCE, batch=True), np.ones(len(targets), dtype=bool)
+        except KinematicsError:
+            pass  # the per-target pass below reports it with its full location
+    matrices = np.empty((len(targets), 4, 4))
+    constrained = np.empty(len(targets), dtype=bool)
+    for index, target in enumerate(targets):
+        with located(*prefix, index):
+            matrices[index], constrained[index] = target_matrix(target, unit)
+    return matrices, constrained
+
+
 def poses_from_matrices(matrices: np.ndarray) -> list[dict]:
     """Wire poses for a stack of transforms, shape (N, 4, 4)."""
     matrices = np.asarray(matrices, dtype=float)
-    quaternions = quaternions_from_matrices(matrices[:, :3, :3])
+    quaternions = quaternions_from_matrices(matrices[:, :3, :3]).tolist()
     return [
-        {"matrix": T.tolist(), "position": T[:3, 3].tolist(), "quaternion_wxyz": quaternion.tolist()}
-        for T, quaternion in zip(matrices, quaternions)
+        {"matrix": T, "position": [T[0][3], T[1][3], T[2][3]], "quaternion_wxyz": quaternion}
+        for T, quaternion in zip(matrices.tolist(), quaternions)
     ]
 
 

@@ -8,9 +8,10 @@ from ...kinematics import forward_kinematics, link_frames
 from ..boundary import joints_to_core, located, pose_from_matrix, poses_from_matrices
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
 from ..problems import problem_responses
+from ..routing import FastJSONRoute
 from ..schemas.fk import FKBatchRequest, FKBatchResponse, FKInlineRequest, FKRequest, FKResponse
 
-router = APIRouter(prefix="/v1", tags=["forward kinematics"])
+router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["forward kinematics"])
 
 
 def _forward(ref: RobotRef, body: FKRequest) -> FKResponse:

@@ -7,23 +7,24 @@ from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import Robot
 from ...kinematics.ik import IKOptions, IKResult, NumericOptions, solve_ik_batch
+from ...kinematics.ik._arrays import solve_ik_arrays
 from ...kinematics.ik._select import Ordering, Selected, Selection, select
-from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, target_matrix, violation_to_wire
+from ...kinematics.ik._select_arrays import SolutionTable, select_arrays
+from ...kinematics.ik._solve import _unreachable_details
+from ..boundary import (joints_from_core, joints_to_core, limits_to_core, located, target_matrices, target_matrix,
+                        violation_to_wire)
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
 from ..problems import problem_responses
-from ..schemas.ik import IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest, IKResponse
+from ..routing import FastJSONRoute
+from ..responses import FastJSONResponse
+from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest,
+                          IKResponse)
 
-router = APIRouter(prefix="/v1", tags=["inverse kinematics"])
+router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinematics"])
 
 
-def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
-    robot = ref.robot
-    matrices, orientation_flags = [], []
-    for index, target in enumerate(targets):
-        with located("body", "target" if isinstance(body, IKRequest) else "targets", *(() if isinstance(body, IKRequest) else (index,))):
-            matrix, constrained = target_matrix(target, body.angle_unit)
-        matrices.append(matrix)
-        orientation_flags.append(constrained)
+def _settings(robot: Robot, body: IKRequest | IKBatchRequest):
+    """Reference, limits, ordering and numeric options of a request, in core units."""
     reference = None
     if body.reference is not None:
         with located("body", "reference"):
@@ -33,13 +34,26 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
     ordering = _ordering(robot, body, reference)
     options = IKOptions(NumericOptions(starts=body.numeric.starts,
                                        time_budget_seconds=body.numeric.time_budget_ms / 1000.0))
+    return reference, limits, ordering, options
+
+
+def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
+    robot = ref.robot
+    if isinstance(body, IKRequest):
+        with located("body", "target"):
+            matrix, constrained = target_matrix(targets[0], body.angle_unit)
+        matrices, flags = matrix[None], np.array([constrained])
+    else:
+        matrices, flags = target_matrices(targets, body.angle_unit, "body", "targets")
+    orientation_flags = flags.tolist()
+    reference, limits, ordering, options = _settings(robot, body)
     results: list[IKResult | None] = [None] * len(targets)
     for constrained in (True, False):
-        rows = [i for i, flag in enumerate(orientation_flags) if flag is constrained]
-        if rows:
-            solved = solve_ik_batch(robot, np.array([matrices[i] for i in rows]), constrain_orientation=constrained,
+        rows = np.flatnonzero(flags == constrained)
+        if len(rows):
+            solved = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained,
                                     reference=reference, options=options)
-            for i, result in zip(rows, solved):
+            for i, result in zip(rows.tolist(), solved):
                 results[i] = result
     return [
         _to_wire(ref.id, robot, result, select(robot, result, limits, filter_limits=body.filter_limits,
@@ -48,6 +62,133 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
                  body.angle_unit, orientation_flags[i])
         for i, result in enumerate(results)
     ]
+
+
+def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
+    """The batch answer as columns: solve, select and encode with array operations, no loop over targets."""
+    robot = ref.robot
+    matrices, flags = target_matrices(body.targets, body.angle_unit, "body", "targets")
+    reference, limits, ordering, options = _settings(robot, body)
+    n_targets = len(matrices)
+    status = np.empty(n_targets, dtype=object)
+    detail: list[str | None] = [None] * n_targets
+    solver = np.zeros(n_targets, dtype=int)
+    singular: list[list[int]] = [[] for _ in range(n_targets)]
+    truncated, trimmed = np.zeros(n_targets, dtype=bool), np.zeros(n_targets, dtype=int)
+    solvers: list[dict] = []
+    reports: list[dict] = []
+    report_index: dict = {}
+    kept_tables, rejected_tables = [], []
+    scale = np.where(robot.is_revolute, np.pi / 180.0 if body.angle_unit == "deg" else 1.0, 1.0)
+    for constrained in (True, False):
+        rows = np.flatnonzero(flags == constrained)
+        if not len(rows):
+            continue
+        arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
+        if arrays is None:  # no analytic family: the numeric search, one target at a time
+            for row, result in zip(rows.tolist(), solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained,
+                                                                 reference=reference, options=options)):
+                wire = _to_wire(ref.id, robot, result, select(robot, result, limits, filter_limits=body.filter_limits,
+                                                              reference=reference, ordering=ordering,
+                                                              max_equivalents=body.max_equivalents),
+                                body.angle_unit, constrained)
+                status[row], detail[row], truncated[row], trimmed[row] = (wire["status"], wire["detail"],
+                                                                          wire["truncated"], wire["trimmed"])
+                solver[row] = _index(solvers, {**wire["solver"], "free_joints": wire["free_joints"]})
+                singular[row] = [_index(reports, s) for s in wire["singularities"]]
+                kept_tables.append(_table_from_wire(row, wire["solutions"], robot.dof))
+                rejected_tables.append(_table_from_wire(row, wire["rejected"], robot.dof))
+            continue
+        chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
+                               ordering=ordering, max_equivalents=body.max_equivalents)
+        status[rows], truncated[rows], trimmed[rows] = chosen.status, chosen.truncated, chosen.trimmed
+        solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
+                                        "time_budget_exhausted": False, "free_joints": arrays.free_joints})
+        for local, text in _unreachable_details(robot, arrays, matrices[rows], constrained, reference).items():
+            detail[rows[local]] = text
+        rejected_count = np.bincount(chosen.rejected.target, minlength=len(rows))
+        for local in np.flatnonzero(chosen.status == "no_solution_within_limits").tolist():
+            detail[rows[local]] = (f"All {rejected_count[local]} solutions violate a joint limit; "
+                                   f"they are listed in 'rejected'.")
+        for local, notes in chosen.notes.items():
+            detail[rows[local]] = "; ".join(filter(None, [detail[rows[local]], *notes]))
+        solved = arrays.count > 0
+        for mask, flag in arrays.singularities.entries:
+            index = _index(reports, {"kind": flag.kind, "joints": list(flag.joints), "relation": flag.relation,
+                                     "detail": flag.detail})
+            for local in np.flatnonzero(mask & solved).tolist():
+                if index not in singular[rows[local]]:
+                    singular[rows[local]].append(index)
+        for table, into in ((chosen.solutions, kept_tables), (chosen.rejected, rejected_tables)):
+            table.target = rows[table.target]
+            table.joints = table.joints / scale
+            if not constrained:
+                table.orientation = np.full(len(table.target), np.nan)
+            into.append(table)
+    kept, rejected = (_merged(tables, robot.dof) for tables in (kept_tables, rejected_tables))
+    # number solvers and singularity reports by first appearance in target order, as a reader meets them
+    present, first = np.unique(solver, return_index=True)
+    renumber = np.zeros(max(len(solvers), 1), dtype=int)
+    renumber[present[np.argsort(first)]] = np.arange(len(present))
+    solvers, solver = [solvers[i] for i in present[np.argsort(first)]], renumber[solver]
+    order: dict[int, int] = {}
+    for flags in singular:
+        for index in flags:
+            order.setdefault(index, len(order))
+    reports = [reports[i] for i in sorted(order, key=order.get)]
+    singular = [[order[i] for i in flags] for flags in singular] if order else singular
+    return FastJSONResponse({
+        "robot_id": ref.id,
+        "format": "arrays",
+        "solvers": solvers,
+        "singularity_reports": reports,
+        "targets": {"status": status.tolist(), "detail": detail, "solver": solver, "singularities": singular,
+                    "truncated": truncated, "trimmed": trimmed,
+                    "solution_count": np.bincount(kept.target, minlength=n_targets),
+                    "rejected_count": np.bincount(rejected.target, minlength=n_targets)},
+        "solutions": _columns(kept),
+        "rejected": _columns(rejected),
+    })
+
+
+def _index(items: list[dict], item: dict) -> int:
+    """Position of ``item`` in ``items``, appending it when new."""
+    try:
+        return items.index(item)
+    except ValueError:
+        items.append(item)
+        return len(items) - 1
+
+
+def _table_from_wire(row: int, solutions: list[dict], dof: int) -> SolutionTable:
+    names = sorted({name for s in solutions for name in s["branch"]})
+    labels = {}
+    for name in names:
+        values = tuple(sorted({s["branch"][name] for s in solutions if name in s["branch"]}, key=str))
+        labels[name] = (values, np.array([values.index(s["branch"][name]) if name in s["branch"] else -1
+                                          for s in solutions], dtype=np.int8))
+    return SolutionTable(np.full(len(solutions), row), np.array([s["joints"] for s in solutions]).reshape(-1, dof),
+                         np.array([s["within_limits"] for s in solutions], dtype=bool),
+                         np.array([s["residual"]["position"] for s in solutions], dtype=float),
+                         np.array([np.nan if s["residual"]["orientation"] is None else s["residual"]["orientation"]
+                                   for s in solutions], dtype=float), labels)
+
+
+def _merged(tables: list[SolutionTable], dof: int) -> SolutionTable:
+    table = SolutionTable.concatenate(tables, dof)
+    return table.take(np.argsort(table.target, kind="stable")) if len(tables) > 1 else table
+
+
+def _columns(table: SolutionTable) -> dict:
+    orientation = table.orientation
+    if np.isnan(orientation).any():
+        orientation = [None if np.isnan(value) else value for value in orientation.tolist()]
+    branch = {}
+    for name, (values, codes) in table.labels.items():
+        vocabulary = np.array([*values, None], dtype=object)
+        branch[name] = vocabulary[codes].tolist()
+    return {"target": table.target, "joints": table.joints, "within_limits": table.within_limits,
+            "residual_position": table.position, "residual_orientation": orientation, "branch": branch}
 
 
 def _ordering(robot: Robot, body: IKRequest | IKBatchRequest, reference: np.ndarray | None) -> Ordering:
@@ -117,10 +258,12 @@ def inverse_kinematics_inline(request: Request, body: IKInlineRequest) -> dict:
     return _solve(inline_robot(request, body.robot), body, [body.target])[0]
 
 
-@router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch", response_model=IKBatchResponse,
-             responses=problem_responses(404, 413, 422))
+@router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch",
+             response_model=IKBatchResponse | IKBatchArraysResponse, responses=problem_responses(404, 413, 422))
 def inverse_kinematics_batch(request: Request, body: IKBatchRequest,
-                             ref: RobotRef = Depends(catalogue_robot)) -> dict:
+                             ref: RobotRef = Depends(catalogue_robot)):
     """Every solution for each target; the analytic solvers run vectorised over the targets."""
     check_batch_size(request, len(body.targets), "targets")
+    if body.format == "arrays":
+        return _solve_arrays(ref, body)
     return {"robot_id": ref.id, "results": _solve(ref, body, body.targets)}

@@ -50,6 +50,9 @@ class IKInlineRequest(IKRequest):
 
 class IKBatchRequest(ApiModel):
     targets: list[PoseTarget] = Field(min_length=1)
+    format: Literal["objects", "arrays"] = Field(
+        "objects", description="objects: one IKResponse per target (default); arrays: the same answer as columns "
+                               "(IKBatchArraysResponse), much smaller and faster for large batches")
     filter_limits: bool = True
     reference: list[Number] | None = None
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
@@ -120,3 +123,48 @@ class IKResponse(ApiModel):
 class IKBatchResponse(ApiModel):
     robot_id: RobotId
     results: list[IKResponse]
+
+
+class SolverEntry(SolverInfo):
+    free_joints: list[int] = Field(default_factory=list)
+
+
+class TargetColumns(ApiModel):
+    """Per-target fields of the arrays form, one entry per target in request order."""
+
+    status: list[Literal["ok", "unreachable", "no_solution_within_limits"]]
+    detail: list[str | None]
+    solver: list[int] = Field(description="index into `solvers`")
+    singularities: list[list[int]] = Field(description="indices into `singularity_reports`")
+    truncated: list[bool]
+    trimmed: list[int]
+    solution_count: list[int] = Field(description="rows of `solutions` for this target")
+    rejected_count: list[int] = Field(description="rows of `rejected` for this target")
+
+
+class SolutionColumns(ApiModel):
+    """Solutions as columns, one row each, grouped by target in request order (`target` is non-decreasing).
+
+    Rows of one target appear in the order the objects form lists them. Violations are not listed: a row with
+    `within_limits` false breaks the bounds of the limits in force.
+    """
+
+    target: list[int] = Field(description="index of the target this row solves")
+    joints: list[list[float]]
+    within_limits: list[bool]
+    residual_position: list[float]
+    residual_orientation: list[float | None]
+    branch: dict[str, list[str | int | None]] = Field(
+        description="one column per branch label that applies; null where a row has no such label")
+
+
+class IKBatchArraysResponse(ApiModel):
+    """The batch answer in columns (``"format": "arrays"``): the same content as the objects form."""
+
+    robot_id: RobotId
+    format: Literal["arrays"]
+    solvers: list[SolverEntry]
+    singularity_reports: list[SingularityReport]
+    targets: TargetColumns
+    solutions: SolutionColumns
+    rejected: SolutionColumns

@@ -1,0 +1,120 @@
+"""The arrays form of the IK batch holds exactly the objects form's answer, in columns.
+
+Both forms are requested for the same seeded targets under different options (limits that expand into
+2π-equivalents, filtering, a reference with trimming, degrees, position-only and unreachable targets, a cap that
+cuts the list), and the objects form is turned into columns here to compare.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.conftest import catalogue_robot
+
+
+def _targets(client, robot_id: str, count: int, seed: int, *, position_only: bool = False) -> list[dict]:
+    robot = catalogue_robot(client, robot_id)
+    q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (count, robot.dof))
+    q[:, ~robot.is_revolute] = 0.3
+    poses = client.post(f"/v1/robots/{robot_id}/fk/batch", json={"joints": q.tolist()}).json()["poses"]
+    targets = [{"position": p["position"]} if position_only else {"matrix": p["matrix"]} for p in poses]
+    far = [[1, 0, 0, 50.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]
+    return targets + [{"matrix": far}]
+
+
+def _columns_of_objects(results: list[dict]) -> dict:
+    """The objects form rearranged the way the arrays form lays it out."""
+    solvers, reports = [], []
+
+    def index(items, item):
+        if item not in items:
+            items.append(item)
+        return items.index(item)
+
+    targets = {key: [] for key in ("status", "detail", "solver", "singularities", "truncated", "trimmed",
+                                   "solution_count", "rejected_count")}
+    tables = {"solutions": [], "rejected": []}
+    for row, result in enumerate(results):
+        targets["status"].append(result["status"])
+        targets["detail"].append(result["detail"])
+        targets["solver"].append(index(solvers, {**result["solver"], "free_joints": result["free_joints"]}))
+        targets["singularities"].append([index(reports, s) for s in result["singularities"]])
+        targets["truncated"].append(result["truncated"])
+        targets["trimmed"].append(result["trimmed"])
+        targets["solution_count"].append(len(result["solutions"]))
+        targets["rejected_count"].append(len(result["rejected"]))
+        for name in tables:
+            tables[name] += [(row, s) for s in result[name]]
+    columns = {}
+    for name, rows in tables.items():
+        labels = sorted({label for _, s in rows for label in s["branch"]})
+        columns[name] = {
+            "target": [row for row, _ in rows],
+            "joints": [s["joints"] for _, s in rows],
+            "within_limits": [s["within_limits"] for _, s in rows],
+            "residual_position": [s["residual"]["position"] for _, s in rows],
+            "residual_orientation": [s["residual"]["orientation"] for _, s in rows],
+            "branch": {label: [s["branch"].get(label) for _, s in rows] for label in labels},
+        }
+    return {"solvers": solvers, "singularity_reports": reports, "targets": targets, **columns}
+
+
+def _assert_same(arrays: dict, objects: dict) -> None:
+    assert arrays["format"] == "arrays"
+    assert arrays["solvers"] == objects["solvers"]
+    assert arrays["singularity_reports"] == objects["singularity_reports"]
+    assert arrays["targets"] == objects["targets"]
+    for name in ("solutions", "rejected"):
+        got, want = arrays[name], objects[name]
+        assert got["target"] == want["target"]
+        assert got["within_limits"] == want["within_limits"]
+        assert {k: v for k, v in got["branch"].items() if any(x is not None for x in v)} == want["branch"]
+        np.testing.assert_allclose(np.array(got["joints"]).reshape(-1, 1), np.array(want["joints"]).reshape(-1, 1),
+                                   rtol=0, atol=1e-12)
+        np.testing.assert_allclose(got["residual_position"], want["residual_position"], rtol=0, atol=1e-15)
+        assert [x is None for x in got["residual_orientation"]] == [x is None for x in want["residual_orientation"]]
+
+
+CASES = {
+    "puma, its own limits (2π-equivalents of joints 4 and 6)": ("puma560_modified", {}, False),
+    "puma, limits filtered out, reference, trimmed": (
+        "puma560_modified", {"reference": [0.1, -0.5, 0.3, 0, 0.4, 0], "max_solutions": 3}, False),
+    "puma, not filtered, degrees, l2 ordering with weights": (
+        "puma560_modified", {"filter_limits": False, "angle_unit": "deg", "reference": [10, -20, 30, 0, 40, 0],
+                             "ordering": {"norm": "l2", "weights": [2, 1, 1, 1, 1, 1]}, "max_joint_move": 150}, False),
+    "ur5, ±360° limits expand every joint": ("ur5", {}, False),
+    "ur5, a cap that cuts the list": ("ur5", {"max_equivalents": 100, "reference": [0, 0, 0, 0, 0, 0]}, False),
+    "ur5, no limits": ("ur5", {"limits": [None] * 6}, False),
+    "stanford (prismatic joint), position and pose": ("spong_ex3_5_stanford", {}, False),
+    "polar arm, position-only targets": ("ex004_2_polar_rrp", {}, True),
+}
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_arrays_form_equals_objects_form(client, case):
+    robot_id, options, position_only = CASES[case]
+    targets = _targets(client, robot_id, 40, seed=sorted(CASES).index(case), position_only=position_only)
+    objects = client.post(f"/v1/robots/{robot_id}/ik/batch", json={"targets": targets, **options})
+    arrays = client.post(f"/v1/robots/{robot_id}/ik/batch", json={"targets": targets, "format": "arrays", **options})
+    assert objects.status_code == arrays.status_code == 200, arrays.text
+    _assert_same(arrays.json(), _columns_of_objects(objects.json()["results"]))
+
+
+def test_arrays_form_mixes_target_kinds_in_request_order(client):
+    targets = _targets(client, "spong_ex3_5_stanford", 6, seed=7)
+    mixed = [t if i % 2 else {"position": t["matrix"][0][3:] + t["matrix"][1][3:] + t["matrix"][2][3:]}
+             for i, t in enumerate(targets)]
+    objects = client.post("/v1/robots/spong_ex3_5_stanford/ik/batch", json={"targets": mixed})
+    arrays = client.post("/v1/robots/spong_ex3_5_stanford/ik/batch", json={"targets": mixed, "format": "arrays"})
+    assert objects.status_code == arrays.status_code == 200, arrays.text
+    _assert_same(arrays.json(), _columns_of_objects(objects.json()["results"]))
+
+
+def test_arrays_form_reports_a_bad_target_like_the_objects_form(client):
+    targets = _targets(client, "puma560_modified", 3, seed=1)
+    targets[2]["matrix"][0][0] = 2.0  # not a rotation
+    for form in ("objects", "arrays"):
+        response = client.post("/v1/robots/puma560_modified/ik/batch", json={"targets": targets, "format": form})
+        assert response.status_code == 422
+        assert any(e["loc"][:4] == ["body", "targets", 2, "matrix"] for e in response.json()["errors"])

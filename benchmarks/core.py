@@ -1,0 +1,271 @@
+"""The core against EAIK, ik-geo and roboticstoolbox-python, side by side in one process and one run.
+
+    python -m benchmarks.core                # the full run (a few minutes)
+    python -m benchmarks.core --quick        # tiny sizes: a smoke run
+
+For each robot (PUMA 560, UR5, Stanford) it draws seeded joint vectors, makes
+their poses with the core's FK, and gives the same poses to every library that
+supports the robot. Rows: single-pose IK (one call per pose), batch IK (one
+call for N poses), single FK and batch FK. Beside each time: solutions per pose
+and recall (the fraction of poses whose generating joint vector is among the
+returned solutions, revolute joints modulo 2π). Repeats are interleaved across
+libraries and the best repeat is kept, so that the load of a shared machine
+falls on all of them alike; ratios are taken within the run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import platform
+import sys
+import time
+import tracemalloc
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+
+from service.catalogue import load_catalogue
+from service.config import Settings
+from service.kinematics import Robot, forward_kinematics
+from service.kinematics.ik import solve_ik, solve_ik_batch
+from service.kinematics.ik._arrays import solve_ik_arrays
+
+from . import anchors
+
+ROBOTS = {"PUMA 560": "puma560_standard", "UR5": "ur5", "Stanford": "spong_ex3_5_stanford"}
+RECALL_TOLERANCE = 1e-6  # radians (length units × robot size for prismatic joints)
+
+
+@dataclass
+class Row:
+    robot: str
+    task: str
+    library: str
+    seconds_per_item: float | None = None
+    solutions_per_pose: float | None = None
+    recall: float | None = None
+    note: str = ""
+
+
+@dataclass
+class Report:
+    rows: list[Row] = field(default_factory=list)
+    skipped: list[str] = field(default_factory=list)
+    memory: str = ""
+
+    def find(self, robot: str, task: str, library: str) -> Row | None:
+        return next((r for r in self.rows if (r.robot, r.task, r.library) == (robot, task, library)), None)
+
+
+def sample_configurations(robot: Robot, count: int, seed: int) -> np.ndarray:
+    """Revolute joints uniform in ±π; prismatic joints uniform within their limits (or 0.1–1 robot sizes)."""
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(-np.pi, np.pi, (count, robot.dof))
+    for i in np.flatnonzero(~robot.is_revolute):
+        lower, upper = robot.lower[i], robot.upper[i]
+        if not (np.isfinite(lower) and np.isfinite(upper)):
+            lower, upper = 0.1 * robot.characteristic_length, robot.characteristic_length
+        q[:, i] = rng.uniform(lower, upper, count)
+    return q
+
+
+def recall(robot: Robot, truth: np.ndarray, solutions: list[np.ndarray]) -> tuple[float, float]:
+    """(mean solutions per pose, fraction of poses whose generating vector is among the solutions)."""
+    tolerance = np.where(robot.is_revolute, RECALL_TOLERANCE, RECALL_TOLERANCE * robot.characteristic_length)
+    found = 0
+    for q, sols in zip(truth, solutions):
+        sols = np.asarray(sols, dtype=float).reshape(-1, robot.dof)
+        if len(sols):
+            gap = np.abs(sols - q)
+            gap = np.where(robot.is_revolute, np.minimum(gap % (2 * np.pi), 2 * np.pi - gap % (2 * np.pi)), gap)
+            found += bool(np.any(np.all(gap <= tolerance, axis=1)))
+    return float(np.mean([len(np.asarray(s).reshape(-1, robot.dof)) for s in solutions])), found / len(truth)
+
+
+def best_of(tasks: dict[str, Callable[[], object]], repeats: int) -> dict[str, float]:
+    """Best wall time of each task over ``repeats`` rounds, the tasks interleaved within each round."""
+    best = {name: float("inf") for name in tasks}
+    for _ in range(repeats):
+        for name, task in tasks.items():
+            start = time.perf_counter()
+            task()
+            best[name] = min(best[name], time.perf_counter() - start)
+    return best
+
+
+def _core_batch_solutions(robot: Robot, Ts: np.ndarray) -> list[np.ndarray]:
+    arrays = solve_ik_arrays(robot, Ts)
+    return [arrays.joints[i, :c] for i, c in enumerate(arrays.count.tolist())]
+
+
+def bench_robot(report: Report, label: str, robot: Robot, args: argparse.Namespace) -> None:
+    q_single = sample_configurations(robot, args.single, seed=1)
+    q_batch = sample_configurations(robot, args.batch, seed=2)
+    T_single, T_batch = forward_kinematics(robot, q_single), forward_kinematics(robot, q_batch)
+
+    libraries: dict[str, anchors.Anchor] = {}
+    for name, build in anchors.BUILDERS.items():
+        if not anchors.installed(name):
+            continue
+        built = build(robot)
+        if isinstance(built, str):
+            report.skipped.append(f"{name} on {label}: {built}")
+        else:
+            libraries[name] = built
+            for note in built.notes:
+                report.skipped.append(f"{name} on {label}: {note}")
+
+    # --- single-pose IK: one call per pose
+    single: dict[str, Callable[[], list]] = {"core": lambda: [solve_ik(robot, T) for T in T_single]}
+    for name, lib in libraries.items():
+        if lib.ik_single is not None:
+            single[name] = (lambda f: lambda: [f(T) for T in T_single])(lib.ik_single)
+    _timed_ik(report, label, "IK, single pose", robot, single, q_single, args.repeats,
+              lambda name, out: [np.array([s.joints for s in r.solutions]) for r in out] if name == "core" else out)
+
+    # --- batch IK: one call for N poses
+    batch: dict[str, Callable[[], list]] = {
+        "core": lambda: _core_batch_solutions(robot, T_batch),
+        "core (IKResult objects)": lambda: solve_ik_batch(robot, T_batch),
+    }
+    for name, lib in libraries.items():
+        if lib.ik_batch is not None:
+            batch[name] = (lambda f: lambda: f(T_batch))(lib.ik_batch)
+    _timed_ik(report, label, f"IK, batch of {args.batch:,}", robot, batch, q_batch, args.repeats,
+              lambda name, out: [np.array([s.joints for s in r.solutions]) for r in out]
+              if name == "core (IKResult objects)" else out)
+
+    # --- FK
+    fk_single = {"core": lambda: [forward_kinematics(robot, q) for q in q_single]}
+    fk_batch = {"core": lambda: forward_kinematics(robot, q_batch)}
+    for name, lib in libraries.items():
+        if lib.fk_single is not None:
+            fk_single[name] = (lambda f: lambda: [f(q) for q in q_single])(lib.fk_single)
+        if lib.fk_batch is not None:
+            fk_batch[name] = (lambda f: lambda: f(q_batch))(lib.fk_batch)
+    for task, tasks, count in ((f"FK, single configuration", fk_single, len(q_single)),
+                               (f"FK, batch of {args.batch:,}", fk_batch, len(q_batch))):
+        for name, seconds in best_of(tasks, args.repeats).items():
+            report.rows.append(Row(label, task, name, seconds / count))
+
+
+def _timed_ik(report: Report, label: str, task: str, robot: Robot, tasks: dict[str, Callable[[], list]],
+              truth: np.ndarray, repeats: int, to_solutions: Callable[[str, list], list[np.ndarray]]) -> None:
+    counts = {}
+    for name, run in tasks.items():  # one untimed call each: warm-up and the solutions for recall
+        counts[name] = recall(robot, truth, to_solutions(name, run()))
+    for name, seconds in best_of(tasks, repeats).items():
+        per_pose, found = counts[name]
+        report.rows.append(Row(label, task, name, seconds / len(truth), per_pose, found))
+
+
+def peak_memory(robot: Robot, poses: int) -> str:
+    """Peak traced allocation while solving a batch of ``poses`` targets with the array API."""
+    T = forward_kinematics(robot, sample_configurations(robot, poses, seed=3))
+    solve_ik_arrays(robot, T[:10])  # plan built outside the measurement
+    tracemalloc.start()
+    tracemalloc.reset_peak()
+    start = time.perf_counter()
+    arrays = solve_ik_arrays(robot, T)
+    elapsed = time.perf_counter() - start
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    result_bytes = sum(a.nbytes for a in (arrays.joints, arrays.valid, arrays.count, arrays.position,
+                                          arrays.orientation))
+    return (f"peak traced memory for a {poses:,}-pose batch (PUMA 560, solve_ik_arrays): {peak / 2**20:.0f} MiB "
+            f"({peak / poses:.0f} bytes per pose; the result itself is {result_bytes / 2**20:.0f} MiB); "
+            f"{elapsed:.2f} s with tracing on")
+
+
+def format_report(report: Report) -> str:
+    lines = ["| robot | task | library | µs per item | × core | solutions per pose | recall |",
+             "|---|---|---|---:|---:|---:|---:|"]
+    for row in report.rows:
+        core = report.find(row.robot, row.task, "core")
+        ratio = row.seconds_per_item / core.seconds_per_item if core and core.seconds_per_item else None
+        lines.append("| " + " | ".join([
+            row.robot, row.task, row.library, f"{row.seconds_per_item * 1e6:.2f}",
+            "" if ratio is None or row.library == "core" else f"{ratio:.2f}",
+            "" if row.solutions_per_pose is None else f"{row.solutions_per_pose:.2f}",
+            "" if row.recall is None else f"{row.recall:.3f}"]) + " |")
+    return "\n".join(lines)
+
+
+def targets(report: Report, batch: int) -> list[str]:
+    """The issue's targets, each a ratio from this run."""
+    out = []
+
+    def ratio(robot: str, task: str, a: str, b: str) -> float | None:
+        x, y = report.find(robot, task, a), report.find(robot, task, b)
+        return None if x is None or y is None else x.seconds_per_item / y.seconds_per_item
+
+    checks = []
+    for robot in ("PUMA 560", "UR5"):
+        checks += [
+            (f"batch IK per pose, core / EAIK IK_batched ({robot})", ratio(robot, f"IK, batch of {batch:,}", "core", "EAIK"), "<=", 1.0),
+            (f"single-pose IK, core / EAIK IK ({robot})", ratio(robot, "IK, single pose", "core", "EAIK"), "<=", 5.0),
+            (f"single-pose IK, roboticstoolbox analytic / core ({robot})",
+             ratio(robot, "IK, single pose", "roboticstoolbox", "core"), ">=", 10.0),
+            (f"batch FK per configuration, core / roboticstoolbox ETS.eval ({robot})",
+             ratio(robot, f"FK, batch of {batch:,}", "core", "roboticstoolbox"), "<=", 1.0),
+        ]
+    for name, value, sense, bound in checks:
+        if value is None:
+            out.append(f"- {name}: not measured (library not installed or arm not supported)")
+        else:
+            met = value <= bound if sense == "<=" else value >= bound
+            out.append(f"- {name}: {value:.2f} (target {sense} {bound:g}: {'met' if met else 'NOT met'})")
+    return out
+
+
+def machine() -> str:
+    cpu = "unknown CPU"
+    try:
+        cpu = next(line.split(":", 1)[1].strip() for line in Path("/proc/cpuinfo").read_text().splitlines()
+                   if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    import os
+    return (f"{cpu}, {os.cpu_count()} logical CPUs, Python {platform.python_version()}, "
+            f"numpy {np.__version__}, {platform.system()} {platform.release()}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.core", description=__doc__.splitlines()[0])
+    parser.add_argument("--batch", type=int, default=10_000, help="poses in a batch (default 10,000)")
+    parser.add_argument("--single", type=int, default=500, help="poses timed one call at a time (default 500)")
+    parser.add_argument("--repeats", type=int, default=5, help="interleaved rounds, best kept (default 5)")
+    parser.add_argument("--memory-poses", type=int, default=100_000, help="poses in the memory run (0: skip)")
+    parser.add_argument("--robots", nargs="*", default=list(ROBOTS), choices=list(ROBOTS))
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, for a smoke run")
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.batch, args.single, args.repeats, args.memory_poses = 20, 5, 1, 200
+
+    catalogue = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+    report = Report()
+    missing = [name for name in anchors.LIBRARIES if not anchors.installed(name)]
+    for name in missing:
+        report.skipped.append(f"{name}: not installed (pip install -e '.[bench]'), skipped")
+    for label in args.robots:
+        bench_robot(report, label, catalogue.get(ROBOTS[label]).robot, args)
+    if args.memory_poses:
+        report.memory = peak_memory(catalogue.get(ROBOTS["PUMA 560"]).robot, args.memory_poses)
+
+    print(f"machine: {machine()}")
+    print(f"sizes: batch {args.batch:,}, single {args.single:,} poses, best of {args.repeats} interleaved rounds\n")
+    print(format_report(report))
+    print("\ntargets (ratios from this run):")
+    print("\n".join(targets(report, args.batch)))
+    if report.memory:
+        print(f"\nmemory: {report.memory}")
+    if report.skipped:
+        print("\nnotes:")
+        print("\n".join(f"- {line}" for line in report.skipped))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

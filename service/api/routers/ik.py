@@ -6,9 +6,16 @@ import numpy as np
 from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import Robot
-from ...kinematics.ik import IKOptions, IKResult, NumericOptions, solve_ik_batch
-from ...kinematics.ik._select import Ordering, Selected, Selection, select
-from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, target_matrix, violation_to_wire
+from ...kinematics.ik import IKOptions, IKResult, NumericOptions, Selected, Selection, select, solve_ik_batch
+from ..boundary import (
+    joints_from_core,
+    joints_to_core,
+    limits_to_core,
+    located,
+    ordering_to_core,
+    target_matrix,
+    violation_to_wire,
+)
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
 from ..problems import problem_responses
 from ..schemas.ik import IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest, IKResponse
@@ -18,9 +25,10 @@ router = APIRouter(prefix="/v1", tags=["inverse kinematics"])
 
 def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
     robot = ref.robot
+    single = isinstance(body, IKRequest)
     matrices, orientation_flags = [], []
     for index, target in enumerate(targets):
-        with located("body", "target" if isinstance(body, IKRequest) else "targets", *(() if isinstance(body, IKRequest) else (index,))):
+        with located("body", *(("target",) if single else ("targets", index))):
             matrix, constrained = target_matrix(target, body.angle_unit)
         matrices.append(matrix)
         orientation_flags.append(constrained)
@@ -30,7 +38,9 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
             reference = joints_to_core(robot, body.reference, body.angle_unit)
     with located("body", "limits"):
         limits = limits_to_core(robot, body.limits, body.angle_unit)
-    ordering = _ordering(robot, body, reference)
+    with located("body"):
+        ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
+                                    body.angle_unit)
     options = IKOptions(NumericOptions(starts=body.numeric.starts,
                                        time_budget_seconds=body.numeric.time_budget_ms / 1000.0))
     results: list[IKResult | None] = [None] * len(targets)
@@ -50,24 +60,6 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
     ]
 
 
-def _ordering(robot: Robot, body: IKRequest | IKBatchRequest, reference: np.ndarray | None) -> Ordering:
-    weights = None
-    if body.ordering.weights is not None:
-        if len(body.ordering.weights) != robot.dof:
-            from ...kinematics import InvalidInputError
-            raise InvalidInputError(f"expected {robot.dof} weights, got {len(body.ordering.weights)}",
-                                    location=("body", "ordering", "weights"))
-        weights = np.array(body.ordering.weights)
-    max_move = body.max_joint_move
-    if max_move is not None:
-        if reference is None:
-            from ...kinematics import InvalidInputError
-            raise InvalidInputError("max_joint_move needs a reference", location=("body", "max_joint_move"))
-        if body.angle_unit == "deg":
-            max_move = np.radians(max_move) if robot.is_revolute.all() else max_move
-    return Ordering(body.ordering.norm, weights, body.max_solutions, max_move)
-
-
 def _solution_to_wire(robot: Robot, entry: Selected, unit: str, constrained: bool) -> dict:
     solution = entry.solution
     return {
@@ -82,11 +74,7 @@ def _solution_to_wire(robot: Robot, entry: Selected, unit: str, constrained: boo
 
 def _to_wire(robot_id: str, robot: Robot, result: IKResult, selection: Selection, unit: str,
              constrained: bool) -> dict:
-    detail = result.detail or None
-    if selection.status == "no_solution_within_limits":
-        detail = f"All {len(selection.rejected)} solutions violate a joint limit; they are listed in 'rejected'."
-    if selection.notes:
-        detail = "; ".join(filter(None, [detail, *selection.notes]))
+    detail = " ".join(filter(None, [result.detail, *selection.notes])) or None
     return {
         "robot_id": robot_id,
         "status": selection.status,
@@ -100,6 +88,7 @@ def _to_wire(robot_id: str, robot: Robot, result: IKResult, selection: Selection
         "free_joints": result.free_joints,
         "truncated": selection.expansion_truncated,
         "trimmed": selection.trimmed,
+        "available": selection.available,
     }
 
 

@@ -16,6 +16,7 @@ import yaml
 from pydantic import TypeAdapter, ValidationError
 
 from .api.boundary import robot_from_description
+from .api.problems import field_location
 from .api.schemas.robots import DHRobot, KhalilRobot, RobotDescription
 from .kinematics import KinematicsError, Robot
 
@@ -64,7 +65,8 @@ def load_robot_file(path: Path, *, max_joints: int) -> CatalogueEntry:
         description = _description_adapter.validate_python(data)
     except ValidationError as error:
         problems = "; ".join(
-            f"{'.'.join(str(p) for p in e['loc']) or '(top level)'}: {e['msg']}" for e in error.errors()
+            f"{'.'.join(str(p) for p in field_location(e['loc'])) or '(top level)'}: {e['msg']}"
+            for e in error.errors()
         )
         raise CatalogueError(f"{path}: {problems}") from None
     if description.id != path.stem:

@@ -35,7 +35,9 @@ from ..kinematics import (
 )
 from ..kinematics._rotations import _checked_transforms
 from ..kinematics._tolerances import ORTHONORMAL_TOLERANCE
+from ..kinematics.ik import Ordering, check_ordering
 from .schemas.common import AngleUnit
+from .schemas.ik import Ordering as OrderingOptions
 from .schemas.poses import (
     EulerZYZOrientation,
     MatrixOrientation,
@@ -175,16 +177,61 @@ def pose_from_matrix(matrix: np.ndarray) -> dict:
 
 
 def limits_to_core(robot: Robot, overrides: Sequence | None, unit: AngleUnit) -> Limits:
-    """The limits a request works with: the robot's, or the request's overrides converted to radians."""
+    """The limits a request works with: the robot's, or the request's overrides converted to radians.
+
+    Errors are located at the joint index and name the joint; bounds are quoted in the request's units.
+    """
     if overrides is None:
         return Limits.of(robot)
     if len(overrides) != robot.dof:
-        raise InvalidInputError(f"expected limits for {robot.dof} joints, got {len(overrides)}")
+        raise InvalidInputError(f"expected limits for {robot.dof} joints, one entry (or null) per joint, "
+                                f"got {len(overrides)}")
+    for index, (override, name) in enumerate(zip(overrides, robot.joint_names)):
+        if override is not None and override.lower is not None and override.upper is not None \
+                and override.lower > override.upper:
+            raise InvalidInputError(f"joint {index} ({name}): lower limit {override.lower:g} is greater than "
+                                    f"upper limit {override.upper:g}", location=(index,))
     bounds = [_bounds(o, factor) for o, factor in zip(overrides, _unit_scale(robot, unit))]
-    return Limits.checked(robot, np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds]))
+    return Limits.checked(robot, [b[0] for b in bounds], [b[1] for b in bounds])
+
+
+def ordering_to_core(robot: Robot, ordering: OrderingOptions, max_solutions: int | None,
+                     max_joint_move: float | Sequence[float | None] | None, reference: np.ndarray | None,
+                     unit: AngleUnit) -> Ordering:
+    """The core's :class:`Ordering` from an IK request's options, validated.
+
+    ``max_joint_move`` is in the request's units: one number bounds every joint in its own unit (angle unit for
+    revolute joints, length unit for prismatic ones); a list bounds each joint, null meaning unbounded. Weights
+    multiply moves in radians / length units and need no conversion. Error locations are relative to the request
+    body: ``ordering.weights``, ``max_solutions``, ``max_joint_move``.
+    """
+    if reference is None and ordering.model_fields_set:
+        name = sorted(ordering.model_fields_set)[0]
+        raise InvalidInputError(f"ordering.{name} needs a reference: distances are measured from it",
+                                location=("ordering", name))
+    move = None
+    if max_joint_move is not None:
+        if isinstance(max_joint_move, (int, float)):
+            move = np.full(robot.dof, float(max_joint_move))
+        elif len(max_joint_move) != robot.dof:
+            raise InvalidInputError(f"expected {robot.dof} values of max_joint_move, one per joint (or one number "
+                                    f"for every joint), got {len(max_joint_move)}", location=("max_joint_move",))
+        else:
+            move = np.array([math.inf if v is None else v for v in max_joint_move], dtype=float)
+        move = move * _unit_scale(robot, unit)
+    weights = None if ordering.weights is None else np.array(ordering.weights, dtype=float)
+    core = Ordering(ordering.norm, weights, max_solutions, move)
+    try:
+        check_ordering(robot, core, reference)
+    except KinematicsError as error:
+        nested = error.location[:1] in (("weights",), ("norm",))
+        raise error.relocated(*(("ordering",) if nested else ())) from None
+    return core
 
 
 def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:
+    """A violation in the request's units; an open side of the range is null."""
     scale = float(_unit_scale(robot, unit)[violation.joint])
-    return {"joint": violation.joint, "value": violation.value / scale,
-            "lower": violation.lower / scale, "upper": violation.upper / scale}
+    lower = None if math.isinf(violation.lower) else violation.lower / scale
+    upper = None if math.isinf(violation.upper) else violation.upper / scale
+    return {"joint": violation.joint, "value": violation.value / scale, "lower": lower, "upper": upper}

@@ -69,9 +69,24 @@ def _describe(errors: list[dict]) -> str:
     return f"{where}: {first['msg']}{more}"
 
 
+#: Tags pydantic inserts into locations inside tagged unions: robot conventions and orientation types.
+_UNION_TAGS = {"standard", "modified", "khalil", "matrix", "quaternion", "euler_zyz", "rpy"}
+_UNION_FIELDS = {"robot", "orientation"}
+
+
+def field_location(loc: tuple | list) -> list[str | int]:
+    """A validation location as a client reads it: the union tags pydantic inserts are left out.
+
+    ``("body", "robot", "standard", "joints", 0)`` becomes ``["body", "robot", "joints", 0]``.
+    """
+    parts = [part if isinstance(part, (str, int)) else str(part) for part in loc]
+    return [part for i, part in enumerate(parts)
+            if not (part in _UNION_TAGS and (i == 0 or parts[i - 1] in _UNION_FIELDS))]
+
+
 def _jsonable_errors(raw: list[dict]) -> list[dict]:
     return [
-        {"loc": [part if isinstance(part, (str, int)) else str(part) for part in e.get("loc", ())],
+        {"loc": field_location(e.get("loc", ())),
          "msg": str(e.get("msg", "")),
          "type": str(e.get("type", "value_error"))}
         for e in raw

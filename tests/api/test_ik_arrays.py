@@ -33,7 +33,7 @@ def _columns_of_objects(results: list[dict]) -> dict:
         return items.index(item)
 
     targets = {key: [] for key in ("status", "detail", "solver", "singularities", "truncated", "trimmed",
-                                   "solution_count", "rejected_count")}
+                                   "available", "solution_count", "rejected_count")}
     tables = {"solutions": [], "rejected": []}
     for row, result in enumerate(results):
         targets["status"].append(result["status"])
@@ -42,6 +42,7 @@ def _columns_of_objects(results: list[dict]) -> dict:
         targets["singularities"].append([index(reports, s) for s in result["singularities"]])
         targets["truncated"].append(result["truncated"])
         targets["trimmed"].append(result["trimmed"])
+        targets["available"].append(result["available"])
         targets["solution_count"].append(len(result["solutions"]))
         targets["rejected_count"].append(len(result["rejected"]))
         for name in tables:
@@ -83,6 +84,14 @@ CASES = {
     "puma, not filtered, degrees, l2 ordering with weights": (
         "puma560_modified", {"filter_limits": False, "angle_unit": "deg", "reference": [10, -20, 30, 0, 40, 0],
                              "ordering": {"norm": "l2", "weights": [2, 1, 1, 1, 1, 1]}, "max_joint_move": 150}, False),
+    "puma, no limits, reference, weights, per-joint max_joint_move, max_solutions (the array path)": (
+        "puma560_modified", {"limits": [None] * 6, "reference": [0.1, -0.5, 0.3, 0, 0.4, 0],
+                             "ordering": {"weights": [2, 1, 1, 0.5, 1, 1]},
+                             "max_joint_move": [2.5, 2.5, None, 3, 3, 3], "max_solutions": 5}, False),
+    "puma, one-sided and narrow limits (one value per joint)": (
+        "puma560_modified", {"limits": [{"lower": -3.2, "upper": 3.2}, None, {"lower": -1.0, "upper": None},
+                                        None, {"lower": None, "upper": 2.0}, None],
+                             "reference": [0, 0, 0, 0, 0, 0], "max_equivalents": 3}, False),
     "ur5, ±360° limits expand every joint": ("ur5", {}, False),
     "ur5, a cap that cuts the list": ("ur5", {"max_equivalents": 100, "reference": [0, 0, 0, 0, 0, 0]}, False),
     "ur5, no limits": ("ur5", {"limits": [None] * 6}, False),

@@ -15,7 +15,7 @@ class Health(ApiModel):
     robots: int | None = None
 
 
-@router.get("/healthz", operation_id="liveness", response_model=Health)
+@router.get("/healthz", operation_id="liveness", response_model=Health, response_model_exclude_none=True)
 def liveness() -> Health:
     """Answer 200 while the process runs."""
     return Health(status="ok")

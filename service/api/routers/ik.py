@@ -6,17 +6,24 @@ import numpy as np
 from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import Robot
-from ...kinematics.ik import IKOptions, IKResult, NumericOptions, solve_ik_batch
+from ...kinematics.ik import IKOptions, IKResult, NumericOptions, Selected, Selection, select, solve_ik_batch
 from ...kinematics.ik._arrays import solve_ik_arrays
-from ...kinematics.ik._select import Ordering, Selected, Selection, select
 from ...kinematics.ik._select_arrays import SolutionTable, select_arrays
 from ...kinematics.ik._solve import _unreachable_details
-from ..boundary import (joints_from_core, joints_to_core, limits_to_core, located, target_matrices, target_matrix,
-                        violation_to_wire)
+from ..boundary import (
+    joints_from_core,
+    joints_to_core,
+    limits_to_core,
+    located,
+    ordering_to_core,
+    target_matrices,
+    target_matrix,
+    violation_to_wire,
+)
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
 from ..problems import problem_responses
-from ..routing import FastJSONRoute
 from ..responses import FastJSONResponse
+from ..routing import FastJSONRoute
 from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest,
                           IKResponse)
 
@@ -31,7 +38,9 @@ def _settings(robot: Robot, body: IKRequest | IKBatchRequest):
             reference = joints_to_core(robot, body.reference, body.angle_unit)
     with located("body", "limits"):
         limits = limits_to_core(robot, body.limits, body.angle_unit)
-    ordering = _ordering(robot, body, reference)
+    with located("body"):
+        ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
+                                    body.angle_unit)
     options = IKOptions(NumericOptions(starts=body.numeric.starts,
                                        time_budget_seconds=body.numeric.time_budget_ms / 1000.0))
     return reference, limits, ordering, options
@@ -75,9 +84,9 @@ def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
     solver = np.zeros(n_targets, dtype=int)
     singular: list[list[int]] = [[] for _ in range(n_targets)]
     truncated, trimmed = np.zeros(n_targets, dtype=bool), np.zeros(n_targets, dtype=int)
+    available = np.zeros(n_targets, dtype=int)
     solvers: list[dict] = []
     reports: list[dict] = []
-    report_index: dict = {}
     kept_tables, rejected_tables = [], []
     scale = np.where(robot.is_revolute, np.pi / 180.0 if body.angle_unit == "deg" else 1.0, 1.0)
     for constrained in (True, False):
@@ -92,8 +101,8 @@ def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
                                                               reference=reference, ordering=ordering,
                                                               max_equivalents=body.max_equivalents),
                                 body.angle_unit, constrained)
-                status[row], detail[row], truncated[row], trimmed[row] = (wire["status"], wire["detail"],
-                                                                          wire["truncated"], wire["trimmed"])
+                status[row], detail[row], truncated[row], trimmed[row], available[row] = (
+                    wire["status"], wire["detail"], wire["truncated"], wire["trimmed"], wire["available"])
                 solver[row] = _index(solvers, {**wire["solver"], "free_joints": wire["free_joints"]})
                 singular[row] = [_index(reports, s) for s in wire["singularities"]]
                 kept_tables.append(_table_from_wire(row, wire["solutions"], robot.dof))
@@ -101,17 +110,13 @@ def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
             continue
         chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
                                ordering=ordering, max_equivalents=body.max_equivalents)
-        status[rows], truncated[rows], trimmed[rows] = chosen.status, chosen.truncated, chosen.trimmed
+        status[rows], truncated[rows] = chosen.status, chosen.truncated
+        trimmed[rows], available[rows] = chosen.trimmed, chosen.available
         solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
                                         "time_budget_exhausted": False, "free_joints": arrays.free_joints})
-        for local, text in _unreachable_details(robot, arrays, matrices[rows], constrained, reference).items():
-            detail[rows[local]] = text
-        rejected_count = np.bincount(chosen.rejected.target, minlength=len(rows))
-        for local in np.flatnonzero(chosen.status == "no_solution_within_limits").tolist():
-            detail[rows[local]] = (f"All {rejected_count[local]} solutions violate a joint limit; "
-                                   f"they are listed in 'rejected'.")
-        for local, notes in chosen.notes.items():
-            detail[rows[local]] = "; ".join(filter(None, [detail[rows[local]], *notes]))
+        unreachable = _unreachable_details(robot, arrays, matrices[rows], constrained, reference)
+        for local in set(unreachable) | set(chosen.notes):
+            detail[rows[local]] = " ".join(filter(None, [unreachable.get(local), *chosen.notes.get(local, [])])) or None
         solved = arrays.count > 0
         for mask, flag in arrays.singularities.entries:
             index = _index(reports, {"kind": flag.kind, "joints": list(flag.joints), "relation": flag.relation,
@@ -143,7 +148,7 @@ def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
         "solvers": solvers,
         "singularity_reports": reports,
         "targets": {"status": status.tolist(), "detail": detail, "solver": solver, "singularities": singular,
-                    "truncated": truncated, "trimmed": trimmed,
+                    "truncated": truncated, "trimmed": trimmed, "available": available,
                     "solution_count": np.bincount(kept.target, minlength=n_targets),
                     "rejected_count": np.bincount(rejected.target, minlength=n_targets)},
         "solutions": _columns(kept),
@@ -191,24 +196,6 @@ def _columns(table: SolutionTable) -> dict:
             "residual_position": table.position, "residual_orientation": orientation, "branch": branch}
 
 
-def _ordering(robot: Robot, body: IKRequest | IKBatchRequest, reference: np.ndarray | None) -> Ordering:
-    weights = None
-    if body.ordering.weights is not None:
-        if len(body.ordering.weights) != robot.dof:
-            from ...kinematics import InvalidInputError
-            raise InvalidInputError(f"expected {robot.dof} weights, got {len(body.ordering.weights)}",
-                                    location=("body", "ordering", "weights"))
-        weights = np.array(body.ordering.weights)
-    max_move = body.max_joint_move
-    if max_move is not None:
-        if reference is None:
-            from ...kinematics import InvalidInputError
-            raise InvalidInputError("max_joint_move needs a reference", location=("body", "max_joint_move"))
-        if body.angle_unit == "deg":
-            max_move = np.radians(max_move) if robot.is_revolute.all() else max_move
-    return Ordering(body.ordering.norm, weights, body.max_solutions, max_move)
-
-
 def _solution_to_wire(robot: Robot, entry: Selected, unit: str, constrained: bool) -> dict:
     solution = entry.solution
     return {
@@ -223,11 +210,7 @@ def _solution_to_wire(robot: Robot, entry: Selected, unit: str, constrained: boo
 
 def _to_wire(robot_id: str, robot: Robot, result: IKResult, selection: Selection, unit: str,
              constrained: bool) -> dict:
-    detail = result.detail or None
-    if selection.status == "no_solution_within_limits":
-        detail = f"All {len(selection.rejected)} solutions violate a joint limit; they are listed in 'rejected'."
-    if selection.notes:
-        detail = "; ".join(filter(None, [detail, *selection.notes]))
+    detail = " ".join(filter(None, [result.detail, *selection.notes])) or None
     return {
         "robot_id": robot_id,
         "status": selection.status,
@@ -241,6 +224,7 @@ def _to_wire(robot_id: str, robot: Robot, result: IKResult, selection: Selection
         "free_joints": result.free_joints,
         "truncated": selection.expansion_truncated,
         "trimmed": selection.trimmed,
+        "available": selection.available,
     }
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends, Request
 
-from ...kinematics import LIMIT_TOLERANCE, nearest_fitting_equivalent, violations
+from ...kinematics import LIMIT_TOLERANCE, nearest_fitting_equivalent, violations, within
 from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, violation_to_wire
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
 from ..problems import problem_responses
@@ -21,14 +21,11 @@ def _check(request: Request, ref: RobotRef, body: LimitsRequest) -> dict:
     with located("body", "limits"):
         limits = limits_to_core(robot, body.limits, body.angle_unit)
     results = []
-    for q in rows:
-        broken = violations(robot, limits, q)
-        equivalent = None
-        if broken:
-            nearest = nearest_fitting_equivalent(robot, limits, q)
-            if nearest is not None:
-                equivalent = joints_from_core(robot, nearest, body.angle_unit).tolist()
-        results.append({"within_limits": not broken,
+    for q, inside in zip(rows, within(robot, limits, rows)):
+        broken = [] if inside else violations(robot, limits, q)
+        nearest = None if inside else nearest_fitting_equivalent(robot, limits, q)
+        equivalent = None if nearest is None else joints_from_core(robot, nearest, body.angle_unit).tolist()
+        results.append({"within_limits": bool(inside),
                         "violations": [violation_to_wire(robot, v, body.angle_unit) for v in broken],
                         "equivalent": equivalent})
     return {"robot_id": ref.id, "tolerance": LIMIT_TOLERANCE, "results": results}

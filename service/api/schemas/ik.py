@@ -2,21 +2,29 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, model_serializer
 
+from ...kinematics.ik import MAX_EQUIVALENTS
 from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RobotId
 from .limits import JointLimitsOverride, LimitViolation
 from .poses import PoseTarget
 from .robots import RobotDescription
 
 
-class Ordering(ApiModel):
-    """How solutions are ranked against ``reference``."""
+NonNegative = Annotated[Number, Field(ge=0)]
 
-    norm: Literal["linf", "l2"] = Field("linf", description="linf: the largest single joint move (default); l2")
-    weights: list[Number] | None = Field(None, description="per-joint factors applied to the differences")
+
+class Ordering(ApiModel):
+    """How solutions are ranked against ``reference`` (needs ``reference``)."""
+
+    norm: Literal["linf", "l2"] = Field(
+        "linf", description="linf: the largest single joint move (default); l2: the Euclidean norm of the moves")
+    weights: list[NonNegative] | None = Field(
+        None, description="one factor ≥ 0 per joint, multiplying that joint's move before the norm; moves are "
+                          "measured in radians and the robot's length unit whatever angle_unit says, so the order "
+                          "does not depend on the unit")
 
 
 class NumericSearch(ApiModel):
@@ -26,42 +34,58 @@ class NumericSearch(ApiModel):
     time_budget_ms: int = Field(500, ge=1, le=10_000)
 
 
-class IKRequest(ApiModel):
+class _Target(ApiModel):
     target: PoseTarget
-    filter_limits: bool = Field(True, description="move solutions that violate a joint limit to `rejected`")
+
+
+class _Targets(ApiModel):
+    targets: list[PoseTarget] = Field(min_length=1)
+
+
+class IKRequestOptions(ApiModel):
+    """What every IK request may say besides its target(s)."""
+
+    filter_limits: bool = Field(
+        True, description="move solutions that violate a joint limit, whatever whole turns their revolute joints "
+                          "make, to `rejected`; when false they stay in `solutions` with within_limits false")
     reference: list[Number] | None = Field(
-        None, description="current joint values: orders solutions nearest first, and sets free joints")
+        None, description="current joint values: orders solutions nearest first (a continuous joint's move is "
+                          "taken across the 2π wrap, any other joint's is its actual travel), and sets free joints")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
     limits: list[JointLimitsOverride | None] | None = Field(
         None, description="replace the robot's limits for this request: one entry per joint, null for an "
                           "unlimited (continuous) joint; in this request's angle unit / the robot's length unit")
-    ordering: Ordering = Field(default_factory=Ordering)
-    max_solutions: int | None = Field(None, ge=0, description="with reference: keep only the nearest k")
-    max_joint_move: Number | None = Field(
-        None, ge=0, description="with reference: keep only solutions within this distance (ordering norm)")
-    max_equivalents: int = Field(1024, ge=1, le=100_000,
-                                 description="cap on solutions after expanding multi-turn joints by 2π")
+    ordering: Ordering = Field(default_factory=Ordering, description="needs reference")
+    max_solutions: int | None = Field(None, ge=0, description="needs reference: keep only the nearest k")
+    max_joint_move: NonNegative | list[NonNegative | None] | None = Field(
+        None, description="needs reference: keep only the solutions in which every joint moves at most this far "
+                          "from the reference (an empty list is then a valid answer). One number bounds every "
+                          "joint in its own unit: angle_unit for revolute joints, the robot's length unit for "
+                          "prismatic ones. A list gives one bound per joint (null: unbounded), e.g. "
+                          "[30, 30, 0.05, 90, 90, 90] in degrees for an arm with a slide as joint 3. Neither the "
+                          "norm nor the weights apply to it.")
+    max_equivalents: int = Field(
+        MAX_EQUIVALENTS, ge=1, le=100_000,
+        description="cap on the solutions returned after expanding multi-turn joints into their 2π-equivalents; "
+                    "the nearest (with reference) or the least-turned are kept, and `truncated` says when the cap "
+                    "left some out")
     numeric: NumericSearch = Field(default_factory=NumericSearch)
+
+
+class IKRequest(IKRequestOptions, _Target):
+    """Every solution for one target."""
 
 
 class IKInlineRequest(IKRequest):
     robot: RobotDescription
 
 
-class IKBatchRequest(ApiModel):
-    targets: list[PoseTarget] = Field(min_length=1)
+class IKBatchRequest(IKRequestOptions, _Targets):
+    """Every solution for each of many targets; the options apply to every target."""
+
     format: Literal["objects", "arrays"] = Field(
         "objects", description="objects: one IKResponse per target (default); arrays: the same answer as columns "
                                "(IKBatchArraysResponse), much smaller and faster for large batches")
-    filter_limits: bool = True
-    reference: list[Number] | None = None
-    angle_unit: AngleUnit = ANGLE_UNIT_FIELD
-    limits: list[JointLimitsOverride | None] | None = None
-    ordering: Ordering = Field(default_factory=Ordering)
-    max_solutions: int | None = Field(None, ge=0)
-    max_joint_move: Number | None = Field(None, ge=0)
-    max_equivalents: int = Field(1024, ge=1, le=100_000)
-    numeric: NumericSearch = Field(default_factory=NumericSearch)
 
 
 class Branch(ApiModel):
@@ -116,8 +140,10 @@ class IKResponse(ApiModel):
     singularities: list[SingularityReport]
     free_joints: list[int] = Field(default_factory=list,
                                    description="joints the target does not determine, set to reference or 0")
-    truncated: bool = Field(False, description="max_equivalents cut the list")
+    truncated: bool = Field(False, description="max_equivalents left out some of the solutions that fit")
     trimmed: int = Field(0, description="solutions left out by max_solutions or max_joint_move")
+    available: int = Field(0, description="solutions after 2π expansion and max_joint_move, before "
+                                          "max_equivalents and max_solutions")
 
 
 class IKBatchResponse(ApiModel):
@@ -138,6 +164,7 @@ class TargetColumns(ApiModel):
     singularities: list[list[int]] = Field(description="indices into `singularity_reports`")
     truncated: list[bool]
     trimmed: list[int]
+    available: list[int]
     solution_count: list[int] = Field(description="rows of `solutions` for this target")
     rejected_count: list[int] = Field(description="rows of `rejected` for this target")
 

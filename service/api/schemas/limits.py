@@ -5,18 +5,26 @@ from __future__ import annotations
 from pydantic import Field
 
 from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number
-from .robots import JointLimits, RobotDescription
+from .robots import RobotDescription
 
 
-class JointLimitsOverride(JointLimits):
-    """Bounds for one joint in a request, in the request's angle unit (revolute) or length unit (prismatic)."""
+class JointLimitsOverride(ApiModel):
+    """Bounds for one joint in a request: the request's angle unit (revolute), the robot's length unit (prismatic).
+
+    Inclusive; a null side is open. lower > upper is a 422 that names the joint (checked against the robot).
+    """
+
+    lower: Number | None
+    upper: Number | None
 
 
 class LimitViolation(ApiModel):
+    """One joint outside its inclusive bounds, in the request's angle unit / the robot's length unit."""
+
     joint: int = Field(description="0-based joint index")
     value: float
-    lower: float
-    upper: float
+    lower: float | None = Field(description="null when the range is open below")
+    upper: float | None = Field(description="null when the range is open above")
 
 
 class LimitsRequest(ApiModel):

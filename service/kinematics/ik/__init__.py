@@ -9,20 +9,29 @@ back to a bounded numeric search that says it may be incomplete.
 
 from ._numeric import NumericOptions
 from ._plan import plan_for
+from ._select import MAX_EQUIVALENTS, Ordering, Selected, Selection, check_ordering, joint_travel, select, travel
 from ._solve import IKOptions, solve_ik, solve_ik_batch
 from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
 
 __all__ = [
+    "MAX_EQUIVALENTS",
     "IKOptions",
     "IKResult",
     "NumericOptions",
+    "Ordering",
+    "Selected",
+    "Selection",
     "Singularity",
     "Solution",
+    "check_ordering",
     "distance_to_reference",
     "joint_difference",
+    "joint_travel",
     "plan_for",
+    "select",
     "solve_ik",
     "solve_ik_batch",
+    "travel",
     "wrap_revolute",
 ]

@@ -1,11 +1,14 @@
 """:func:`~service.kinematics.ik._select.select` for a whole batch at once, as arrays.
 
-Same rules as the per-result version (limits, 2π-equivalents in
-``itertools.product`` order, ``filter_limits``, reference order, trimming),
-computed for every target together. A target where the ``max_equivalents``
-cap would cut the list takes the per-result path, so the cut falls exactly
-where :func:`select` puts it; that needs more than ``max_equivalents``
-solutions for one target and is rare.
+The common case is computed for all targets together: every solution of the
+target has exactly one usable value per joint (no joint with two or more
+2π-equivalents within its limits, none outside its limits), and the order,
+if any, is the default ``linf`` one. Then each solution is one answer row,
+ordered by distance to the reference (ties by solution order, as the lazy
+merge of :func:`select` gives) or kept in solution order, filtered by
+``max_joint_move`` and cut by ``max_solutions`` / ``max_equivalents``. Every
+other target goes through :func:`select` itself, so the answer is always
+the per-result one.
 """
 
 from __future__ import annotations
@@ -17,10 +20,11 @@ import numpy as np
 from .._limits import Limits
 from .._robot import Robot
 from ._arrays import IKArrays
-from ._select import Ordering, Selection, select, travel
+from ._select import MAX_EQUIVALENTS, Ordering, Selected, Selection, _notes, check_ordering, joint_travel, select
 from ._types import IKResult, Solution
 
 _TWO_PI = 2.0 * np.pi
+_FITS = Selected(None, True, [])  # stands for a kept row when counting for the notes
 
 
 @dataclass
@@ -72,108 +76,92 @@ class BatchSelection:
     status: np.ndarray  # (N,) object: "ok", "unreachable", "no_solution_within_limits"
     truncated: np.ndarray  # (N,) bool
     trimmed: np.ndarray  # (N,) int
+    available: np.ndarray  # (N,) int
     notes: dict[int, list[str]]
     solutions: SolutionTable
     rejected: SolutionTable
+    vectorised: int  # how many targets took the array path
 
 
 def select_arrays(robot: Robot, arrays: IKArrays, limits: Limits, *, filter_limits: bool = True,
                   reference: np.ndarray | None = None, ordering: Ordering = Ordering(),
-                  max_equivalents: int = 1024) -> BatchSelection:
-    """Apply limits, expand 2π-equivalents, order and trim every target's solutions, vectorised over targets."""
+                  max_equivalents: int = MAX_EQUIVALENTS) -> BatchSelection:
+    """Apply limits, expand 2π-equivalents, order and trim every target's solutions (see the module docstring)."""
+    check_ordering(robot, ordering, reference)
     n_targets, _, n = arrays.joints.shape
     rows = SolutionTable(
         target=np.repeat(np.arange(n_targets), arrays.count),
         joints=arrays.joints[arrays.valid], within_limits=np.ones(int(arrays.count.sum()), dtype=bool),
         position=arrays.position[arrays.valid], orientation=arrays.orientation[arrays.valid],
         labels={name: (values, codes[arrays.valid]) for name, (values, codes) in arrays.labels.items()})
-    # each joint's 2π-equivalents that fit: first turn and how many (revolute joints with both bounds finite)
+    values, single = _single_values(robot, limits, rows.joints)
+    per_target_single = np.bincount(rows.target, weights=~single, minlength=n_targets) == 0
+    simple = per_target_single & (arrays.count <= max_equivalents)
+    if reference is not None and ordering.norm != "linf":
+        simple &= arrays.count == 0  # the l2 cost is summed with math.fsum there: leave its order to select()
+    fast = simple[rows.target]
+    kept = rows.take(np.flatnonzero(fast))
+    kept.joints = values[fast]
+    with_all_moves = np.bincount(kept.target, minlength=n_targets)
+    if reference is not None:
+        travel_ = joint_travel(robot, limits, kept.joints, reference)
+        if ordering.max_joint_move is not None:
+            near = np.all(travel_ <= ordering.max_joint_move + limits.tolerance(robot), axis=1)
+            kept, travel_ = kept.take(np.flatnonzero(near)), travel_[near]
+        cost = (travel_ * ordering.weights if ordering.weights is not None else travel_).max(axis=1)
+        order = np.lexsort((cost, kept.target))
+        kept = kept.take(order)
+    available = np.bincount(kept.target, minlength=n_targets)
+    limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
+    starts = np.searchsorted(kept.target, np.arange(n_targets))
+    rank = np.arange(len(kept.target)) - starts[kept.target]
+    kept = kept.take(np.flatnonzero(rank < limit))
+    count = np.bincount(kept.target, minlength=n_targets)
+    capped = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
+    truncated = (available > count) & (not capped)
+    trimmed = with_all_moves - available + ((available - count) if capped else 0)
+    status = np.where(arrays.count == 0, "unreachable", "ok").astype(object)
+    notes: dict[int, list[str]] = {}
+    for row in np.flatnonzero(simple & (arrays.count > 0) & (truncated | (count == 0))).tolist():
+        notes[row] = _notes(Selection(status[row], [_FITS] * int(count[row]), [], bool(truncated[row]),
+                                      int(trimmed[row]), int(available[row])),
+                            int(with_all_moves[row]), max_equivalents, reference is not None)
+    kept_parts, rejected_parts = [kept], []
+    for row in np.flatnonzero(~simple).tolist():
+        selection = select(robot, _result(arrays, row), limits, filter_limits=filter_limits, reference=reference,
+                           ordering=ordering, max_equivalents=max_equivalents)
+        status[row], truncated[row], trimmed[row], available[row] = (
+            selection.status, selection.expansion_truncated, selection.trimmed, selection.available)
+        if selection.notes:
+            notes[row] = selection.notes
+        kept_parts.append(_table(row, selection.solutions, rows.labels, n))
+        rejected_parts.append(_table(row, selection.rejected, rows.labels, n))
+    solutions = _by_target(SolutionTable.concatenate(kept_parts, n)) if len(kept_parts) > 1 else kept
+    rejected = _by_target(SolutionTable.concatenate(rejected_parts, n)) if rejected_parts else rows.take(
+        np.zeros(0, dtype=int))
+    return BatchSelection(status, truncated, trimmed, available, notes, solutions, rejected, int(simple.sum()))
+
+
+def _single_values(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's joint values moved into the limits, and whether every joint of it has exactly one usable value.
+
+    The rules of :func:`.._limits.turn_offsets`: a joint with both bounds finite takes q + 2kπ inside them, a
+    joint bounded on one side the one q + 2kπ inside nearest q, any other joint q itself if it is inside.
+    """
     tolerance = limits.tolerance(robot)
     lower, upper = limits.lower - tolerance, limits.upper + tolerance
-    expands = robot.is_revolute & np.isfinite(lower) & np.isfinite(upper)
-    q = rows.joints
+    both = robot.is_revolute & np.isfinite(lower) & np.isfinite(upper)
+    one_sided = robot.is_revolute & ~both & (np.isfinite(lower) | np.isfinite(upper))
     with np.errstate(invalid="ignore"):
-        first = np.where(expands, np.ceil((lower - q) / _TWO_PI), 0.0)
-        last = np.where(expands, np.floor((upper - q) / _TWO_PI), 0.0)
-    options = np.maximum(last - first + 1, 0).astype(np.int64)  # (S, n)
-    total = np.prod(options, axis=1)
-    fits = total > 0
-    kept_count = np.where(fits, total, 0 if filter_limits else 1)
-    # targets where the cap cuts the list go through the per-result path
-    per_target = np.bincount(rows.target, weights=kept_count, minlength=n_targets)
-    last_row = np.cumsum(arrays.count) - 1
-    last_kept = kept_count[np.maximum(last_row, 0)] if len(kept_count) else np.zeros(n_targets)
-    before_last = per_target - np.where(arrays.count > 0, last_kept, 0)
-    exact = (per_target <= max_equivalents) & (before_last < max_equivalents)
-    simple_rows = exact[rows.target]
-
-    # kept: every fitting equivalent, in product order; a solution with none stays as it is unless filtered
-    source = np.flatnonzero(simple_rows)
-    repeats = kept_count[source]
-    expanded = np.repeat(source, repeats)
-    local = np.arange(len(expanded)) - np.repeat(np.cumsum(repeats) - repeats, repeats)
-    joints = q[expanded].copy()
-    fitting = fits[expanded]
-    for j in reversed(range(n)):
-        if not expands[j]:
-            continue
-        count = np.where(fitting, options[expanded, j], 1)
-        turn = np.where(fitting, first[expanded, j] + local % count, 0.0)
-        local = local // count
-        joints[:, j] += _TWO_PI * turn
-    kept = rows.take(expanded)
-    kept.joints = joints
-    kept.within_limits = fitting
-    rejected = rows.take(np.flatnonzero(simple_rows & ~fits)) if filter_limits else rows.take(np.zeros(0, int))
-    rejected.within_limits = np.zeros(len(rejected.target), dtype=bool)
-
-    status = np.where(arrays.count == 0, "unreachable",
-                      np.where(np.bincount(kept.target, minlength=n_targets) > 0, "ok",
-                               "no_solution_within_limits")).astype(object)
-    trimmed = np.zeros(n_targets, dtype=int)
-    if reference is not None:
-        kept, trimmed = _order(robot, limits, kept, reference, ordering, n_targets, trim=True)
-        rejected, _ = _order(robot, limits, rejected, reference, ordering, n_targets, trim=False)
-    truncated = np.zeros(n_targets, dtype=bool)
-    notes: dict[int, list[str]] = {}
-
-    hard = np.flatnonzero(~exact & (arrays.count > 0))
-    if len(hard):
-        kept_parts, rejected_parts = [kept], [rejected]
-        for row in hard.tolist():
-            selection = select(robot, _result(arrays, row), limits, filter_limits=filter_limits,
-                               reference=reference, ordering=ordering, max_equivalents=max_equivalents)
-            status[row], truncated[row], trimmed[row] = (selection.status, selection.expansion_truncated,
-                                                         selection.trimmed)
-            if selection.notes:
-                notes[row] = selection.notes
-            kept_parts.append(_table(row, selection.solutions, rows.labels, n))
-            rejected_parts.append(_table(row, selection.rejected, rows.labels, n))
-        kept, rejected = (_by_target(SolutionTable.concatenate(parts, n)) for parts in (kept_parts, rejected_parts))
-    return BatchSelection(status, truncated, trimmed, notes, kept, rejected)
-
-
-def _order(robot: Robot, limits: Limits, table: SolutionTable, reference: np.ndarray, ordering: Ordering,
-           n_targets: int, *, trim: bool) -> tuple[SolutionTable, np.ndarray]:
-    """Nearest first within each target (stable), then max_joint_move and max_solutions."""
-    trimmed = np.zeros(n_targets, dtype=int)
-    if not len(table.target):
-        return table, trimmed
-    distance = travel(robot, limits, table.joints, reference, ordering)
-    order = np.lexsort((distance, table.target))
-    table, distance = table.take(order), distance[order]
-    if not trim:
-        return table, trimmed
-    keep = np.ones(len(table.target), dtype=bool)
-    if ordering.max_joint_move is not None:
-        keep &= distance <= ordering.max_joint_move
-    if ordering.max_solutions is not None:
-        starts = np.searchsorted(table.target[keep], np.arange(n_targets))
-        rank = np.zeros(len(table.target), dtype=int)
-        rank[keep] = np.arange(keep.sum()) - starts[table.target[keep]]
-        keep &= rank < ordering.max_solutions
-    trimmed = np.bincount(table.target, minlength=n_targets) - np.bincount(table.target[keep], minlength=n_targets)
-    return table.take(np.flatnonzero(keep)), trimmed
+        first = np.ceil((lower - q) / _TWO_PI)
+        last = np.floor((upper - q) / _TWO_PI)
+        up = q + _TWO_PI * np.ceil((lower - q) / _TWO_PI)
+        down = q - _TWO_PI * np.ceil((q - upper) / _TWO_PI)
+    values = np.where(both, q + _TWO_PI * first, q)
+    values = np.where(one_sided & (q < lower), up, np.where(one_sided & (q > upper), down, values))
+    inside = (values >= lower) & (values <= upper)
+    single = inside & np.where(both, last == first, True)
+    return values, single.all(axis=1)
 
 
 def _result(arrays: IKArrays, row: int) -> IKResult:

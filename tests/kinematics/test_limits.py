@@ -1,0 +1,248 @@
+"""Joint limits in the core: bounds, 2π-equivalents, the cheapest-first enumeration, and selection of IK answers."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+
+from service.kinematics import (
+    LIMIT_TOLERANCE,
+    InvalidInputError,
+    Joint,
+    Limits,
+    Robot,
+    closest_equivalent,
+    combinations_by_cost,
+    fitting_equivalents,
+    nearest_fitting_equivalent,
+    turn_offsets,
+    violations,
+    within,
+)
+from service.kinematics.ik import IKResult, Ordering, Solution, select
+
+DEG = math.pi / 180
+
+
+def arm(*limits: tuple[str, float, float]) -> Robot:
+    """A chain of joints with the given (kind, lower, upper); links of 0.5 so the robot has a size."""
+    return Robot([Joint(f"q{i + 1}", kind, 0.5, 0.0, 0.0, 0.0, lower, upper)
+                  for i, (kind, lower, upper) in enumerate(limits)], name="test arm")
+
+
+# A ±270° joint, a slide, a continuous joint, a joint bounded below only, a ±100° joint.
+MIXED = arm(("revolute", -270 * DEG, 270 * DEG), ("prismatic", 0.1, 1.0), ("revolute", -math.inf, math.inf),
+            ("revolute", 0.0, math.inf), ("revolute", -100 * DEG, 100 * DEG))
+
+
+def test_turn_offsets_per_kind_of_joint():
+    q = np.array([100 * DEG, 0.5, 3.0, -10 * DEG, 120 * DEG])
+    options = turn_offsets(MIXED, Limits.of(MIXED), q)
+    np.testing.assert_allclose(options[0], [-260 * DEG, 100 * DEG])  # both equivalents within ±270°
+    np.testing.assert_array_equal(options[1], [0.5])                   # a slide keeps its value
+    np.testing.assert_array_equal(options[2], [3.0])                   # continuous: never expanded
+    np.testing.assert_allclose(options[3], [350 * DEG])                # one side only: the nearest that fits
+    assert len(options[4]) == 0                                        # 120° has no equivalent in ±100°
+
+
+def test_a_prismatic_joint_is_never_wrapped():
+    """d = 1.0 + 2π is out of [0.1, 1.0]; its value minus 2π would fit, but a slide has no turns."""
+    q = np.array([0.0, 0.5 + 2 * np.pi, 0.0, 0.0, 0.0])
+    assert len(turn_offsets(MIXED, Limits.of(MIXED), q)[1]) == 0
+    assert nearest_fitting_equivalent(MIXED, Limits.of(MIXED), q) is None
+    np.testing.assert_array_equal(closest_equivalent(MIXED, Limits.of(MIXED), q)[1], q[1])
+
+
+def test_closest_equivalent_fixes_what_turns_can_fix_and_nothing_else():
+    limits = Limits.of(MIXED)
+    q = np.array([300 * DEG, 0.5, 3.0, -10 * DEG, 250 * DEG])
+    closest = closest_equivalent(MIXED, limits, q)
+    # 300° → −60° (the only equivalent in ±270°); 250° has none in ±100°: −110° is the smallest violation.
+    np.testing.assert_allclose(closest, [-60 * DEG, 0.5, 3.0, 350 * DEG, -110 * DEG])
+    assert [v.joint for v in violations(MIXED, limits, closest)] == [4]
+    assert [v.joint for v in violations(MIXED, limits, q)] == [0, 3, 4]
+    # 120° against ±100°: 120° (20° over) beats −240° (140° under).
+    assert closest_equivalent(MIXED, limits, np.array([0, 0.5, 0, 0, 120 * DEG]))[4] == pytest.approx(120 * DEG)
+
+
+def test_nearest_fitting_equivalent_picks_the_nearest_of_several():
+    ur5 = arm(*[("revolute", -2 * np.pi, 2 * np.pi)] * 6)
+    q = np.array([7.0, -7.0, 0.0, 1.0, 2 * np.pi, -3.0])
+    nearest = nearest_fitting_equivalent(ur5, Limits.of(ur5), q)
+    # 7 − 2π = 0.717 and 7 − 4π = −5.566 both fit; the nearest to 7 is 0.717.
+    np.testing.assert_allclose(nearest, [7.0 - 2 * np.pi, -7.0 + 2 * np.pi, 0.0, 1.0, 2 * np.pi, -3.0])
+
+
+def test_bounds_are_inclusive_with_the_documented_tolerance():
+    limits = Limits.of(MIXED)
+    size = MIXED.characteristic_length
+    inside = np.array([270 * DEG + 0.5 * LIMIT_TOLERANCE, 1.0 + 0.5 * LIMIT_TOLERANCE * size, 0, 0, -100 * DEG])
+    outside = np.array([270 * DEG + 2 * LIMIT_TOLERANCE, 1.0 + 2 * LIMIT_TOLERANCE * size, 0, 0, -100 * DEG])
+    assert within(MIXED, limits, inside) and not violations(MIXED, limits, inside)
+    assert not within(MIXED, limits, outside)
+    broken = violations(MIXED, limits, outside)
+    assert [(v.joint, v.value, v.lower, v.upper) for v in broken] == [
+        (0, outside[0], -270 * DEG, 270 * DEG), (1, outside[1], 0.1, 1.0)]
+
+
+def test_checked_limits_name_the_joint():
+    with pytest.raises(InvalidInputError, match=r"joint 1 \(q2\): lower limit 2 is greater than upper limit 1") as e:
+        Limits.checked(MIXED, [-1, 2, -1, -1, -1], [1, 1, 1, 1, 1])
+    assert e.value.location == (1,)
+    with pytest.raises(InvalidInputError, match=r"joint 3 \(q4\): limits must be numbers, not NaN"):
+        Limits.checked(MIXED, [-1, 0, -1, np.nan, -1], [1, 1, 1, 1, 1])
+    with pytest.raises(InvalidInputError, match="expected limits for 5 joints"):
+        Limits.checked(MIXED, [-1, 0], [1, 1])
+    locked = Limits.checked(MIXED, [0.5] * 5, [0.5] * 5)  # lower == upper: a locked joint is allowed
+    assert within(MIXED, locked, np.full(5, 0.5))
+
+
+def test_fitting_equivalents_fewest_turns_first_and_capped():
+    two = arm(("revolute", -2 * np.pi, 2 * np.pi), ("revolute", -2 * np.pi, 2 * np.pi))
+    equivalents, truncated = fitting_equivalents(two, Limits.of(two), np.array([1.0, -2.0]), cap=10)
+    np.testing.assert_allclose(equivalents, [[1.0, -2.0], [1.0, -2.0 + 2 * np.pi], [1.0 - 2 * np.pi, -2.0],
+                                             [1.0 - 2 * np.pi, -2.0 + 2 * np.pi]])
+    assert not truncated
+    capped, truncated = fitting_equivalents(two, Limits.of(two), np.array([1.0, -2.0]), cap=3)
+    np.testing.assert_allclose(capped, equivalents[:3])
+    assert truncated
+
+
+@pytest.mark.parametrize("combine", [max, math.fsum, lambda c: math.sqrt(math.fsum(x * x for x in c))])
+def test_combinations_by_cost_is_the_sorted_product(combine):
+    """Lazily generated, cheapest first: the same sequence as sorting the whole product, ties by indices."""
+    rng = np.random.default_rng(3)
+    for trial in range(40):
+        sizes = rng.integers(1, 5, rng.integers(1, 5))
+        # integer costs make ties common; sorted per joint as the function requires
+        costs = [np.sort(rng.integers(0, 4, size).astype(float)) for size in sizes]
+        everything = sorted((combine([costs[j][k] for j, k in enumerate(indices)]), indices)
+                            for indices in itertools.product(*[range(s) for s in sizes]))
+        assert list(combinations_by_cost(costs, combine)) == everything, trial
+
+
+def test_combinations_by_cost_stops_early_on_a_huge_product():
+    costs = [np.arange(1000, dtype=float)] * 8  # 10^24 combinations
+    first = list(itertools.islice(combinations_by_cost(costs, max), 5))
+    assert first[0] == (0.0, (0,) * 8)
+    assert [cost for cost, _ in first] == [0.0, 1.0, 1.0, 1.0, 1.0]
+
+
+# --- selection of IK answers -------------------------------------------------------------------------------
+
+def result_of(*joint_vectors) -> IKResult:
+    solutions = [Solution(np.array(q, dtype=float), {"branch": i}, 0.0, 0.0) for i, q in enumerate(joint_vectors)]
+    return IKResult("ok", solutions, "analytic", "test", True)
+
+
+TWO_TURN = arm(("revolute", -2 * np.pi, 2 * np.pi), ("revolute", -2 * np.pi, 2 * np.pi))
+
+
+def test_select_expands_every_solution_and_rejects_what_no_turn_fixes():
+    wrist = arm(("revolute", -2 * np.pi, 2 * np.pi), ("revolute", -100 * DEG, 100 * DEG))
+    selection = select(wrist, result_of([1.0, 0.5], [1.0, 120 * DEG], [-1.0, 250 * DEG]), Limits.of(wrist))
+    assert selection.status == "ok"
+    np.testing.assert_allclose([s.solution.joints for s in selection.solutions],
+                               [[1.0, 0.5], [1.0 - 2 * np.pi, 0.5]])
+    assert [(r.solution.branch, r.within_limits) for r in selection.rejected] == [({"branch": 1}, False),
+                                                                                  ({"branch": 2}, False)]
+    # the third is shown turned to −110°, its smallest violation; joint 0 still reads −1 (it fits as it is)
+    np.testing.assert_allclose(selection.rejected[1].solution.joints, [-1.0, -110 * DEG])
+    assert [v.joint for v in selection.rejected[1].violations] == [1]
+    assert selection.available == 2 and not selection.expansion_truncated and selection.trimmed == 0
+
+
+def test_select_all_rejected_and_unfiltered():
+    narrow = arm(("revolute", -0.1, 0.1))
+    result = result_of([0.5], [-0.5])
+    selection = select(narrow, result, Limits.of(narrow))
+    assert selection.status == "no_solution_within_limits" and not selection.solutions
+    assert len(selection.rejected) == 2 and "All 2 solutions violate" in selection.notes[0]
+    unfiltered = select(narrow, result, Limits.of(narrow), filter_limits=False)
+    assert unfiltered.status == "ok" and not unfiltered.rejected
+    assert [(s.within_limits, [v.joint for v in s.violations]) for s in unfiltered.solutions] == [
+        (False, [0]), (False, [0])]
+
+
+def test_cap_keeps_the_nearest_with_a_reference():
+    result = result_of([1.0, -2.0], [-1.5, 2.5], [3.0, 0.2])
+    reference = np.array([-5.0, 4.0])
+    full = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=reference)
+    assert len(full.solutions) == 12 and not full.expansion_truncated
+    distances = [np.abs(s.solution.joints - reference).max() for s in full.solutions]
+    assert distances == sorted(distances)
+    capped = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=reference, max_equivalents=5)
+    assert capped.expansion_truncated and capped.available == 12 and capped.trimmed == 0
+    np.testing.assert_array_equal([s.solution.joints for s in capped.solutions],
+                                  [s.solution.joints for s in full.solutions[:5]])
+    assert "12 solutions fit; max_equivalents = 5 kept the nearest 5" in capped.notes[0]
+
+
+def test_cap_without_reference_keeps_every_branch_before_any_second_turn():
+    result = result_of([1.0, -2.0], [-1.5, 2.5], [3.0, 0.2])
+    capped = select(TWO_TURN, result, Limits.of(TWO_TURN), max_equivalents=4)
+    np.testing.assert_array_equal([s.solution.joints for s in capped.solutions[:3]], [[1.0, -2.0], [-1.5, 2.5],
+                                                                                      [3.0, 0.2]])
+    assert capped.solutions[3].solution.branch == {"branch": 0} and capped.expansion_truncated
+
+
+def test_max_solutions_and_max_joint_move_are_counted_as_trimmed():
+    result = result_of([1.0, -2.0], [-1.5, 2.5], [3.0, 0.2])
+    reference = np.array([0.0, 0.0])
+    full = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=reference)
+    nearest = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=reference, ordering=Ordering(max_solutions=2))
+    assert [s.solution.branch for s in nearest.solutions] == [s.solution.branch for s in full.solutions[:2]]
+    assert nearest.trimmed == 10 and not nearest.expansion_truncated
+    move = Ordering(max_joint_move=np.array([2.0, 2.6]))
+    bounded = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=reference, ordering=move)
+    # within |Δ0| ≤ 2 and |Δ1| ≤ 2.6: (1, −2) and (−1.5, 2.5) only
+    np.testing.assert_array_equal([s.solution.joints for s in bounded.solutions], [[1.0, -2.0], [-1.5, 2.5]])
+    assert bounded.trimmed == 10 and bounded.available == 2
+    nothing = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=reference,
+                     ordering=Ordering(max_joint_move=np.zeros(2)))
+    assert nothing.status == "ok" and nothing.solutions == [] and nothing.trimmed == 12
+    assert "none is within max_joint_move" in nothing.notes[0]
+
+
+def test_continuous_joints_are_measured_across_the_wrap():
+    spinning = arm(("revolute", -math.inf, math.inf), ("revolute", -math.inf, math.inf))
+    result = result_of([np.pi - 0.1, 0.5], [-np.pi + 0.4, -0.5])
+    selection = select(spinning, result, Limits.of(spinning), reference=np.array([-np.pi + 0.05, 0.5]))
+    assert len(selection.solutions) == 2  # never expanded
+    assert [s.solution.branch for s in selection.solutions] == [{"branch": 0}, {"branch": 1}]
+    # the same joint with ±360° limits is a different thing: π − 0.1 − 2π is the nearer equivalent
+    nearest = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=np.array([-np.pi + 0.05, 0.5]))
+    np.testing.assert_allclose(nearest.solutions[0].solution.joints, [-np.pi - 0.1, 0.5])
+
+
+@pytest.mark.parametrize("ordering, reference, location, message", [
+    (Ordering(max_solutions=1), None, ("max_solutions",), "needs a reference"),
+    (Ordering(max_joint_move=np.ones(2)), None, ("max_joint_move",), "needs a reference"),
+    (Ordering(weights=np.ones(2)), None, ("weights",), "needs a reference"),
+    (Ordering(weights=np.ones(3)), np.zeros(2), ("weights",), "expected 2 values of weights"),
+    (Ordering(weights=np.array([1.0, -1.0])), np.zeros(2), ("weights", 1), "≥ 0"),
+    (Ordering(weights=np.array([1.0, np.inf])), np.zeros(2), ("weights", 1), "finite"),
+    (Ordering(max_joint_move=np.array([np.nan, 1.0])), np.zeros(2), ("max_joint_move", 0), "≥ 0"),
+    (Ordering(max_solutions=-1), np.zeros(2), ("max_solutions",), "≥ 0"),
+])
+def test_select_refuses_bad_orderings(ordering, reference, location, message):
+    with pytest.raises(InvalidInputError, match=message) as error:
+        select(TWO_TURN, result_of([0.0, 0.0]), Limits.of(TWO_TURN), reference=reference, ordering=ordering)
+    assert error.value.location == location
+
+
+@pytest.mark.parametrize("max_solutions, cap, kept, truncated, trimmed", [
+    (3, 5, 3, False, 9),    # max_solutions is the tighter: its cut is counted as trimmed
+    (5, 5, 5, False, 7),    # equal: the user asked for k, so nothing was lost to the cap
+    (8, 5, 5, True, 0),     # the cap is the tighter: truncated, and nothing counts as trimmed
+    (20, 50, 12, False, 0),
+])
+def test_cap_and_max_solutions_say_which_one_cut(max_solutions, cap, kept, truncated, trimmed):
+    result = result_of([1.0, -2.0], [-1.5, 2.5], [3.0, 0.2])
+    selection = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=np.zeros(2),
+                       ordering=Ordering(max_solutions=max_solutions), max_equivalents=cap)
+    assert (len(selection.solutions), selection.expansion_truncated, selection.trimmed) == (kept, truncated, trimmed)
+    assert selection.available == 12

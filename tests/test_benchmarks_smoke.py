@@ -1,0 +1,38 @@
+"""The benchmark scripts run end to end with tiny sizes, so that they cannot rot.
+
+No timing is asserted: only that each script runs and prints its table. The anchor libraries (the ``bench``
+extra) are usually not installed here, and the scripts must then say they skipped them; wrk may be missing too.
+"""
+
+from __future__ import annotations
+
+import shutil
+
+import pytest
+
+from benchmarks import anchors, core, http
+
+
+def test_core_benchmark_runs_with_tiny_sizes(capsys):
+    assert core.main(["--quick", "--robots", "PUMA 560", "Stanford"]) == 0
+    out = capsys.readouterr().out
+    assert "| PUMA 560 | IK, single pose | core |" in out
+    assert "| Stanford | FK, batch of 20 | core |" in out
+    assert "peak traced memory for a 200-pose batch" in out
+    for name in anchors.LIBRARIES:
+        if not anchors.installed(name):
+            assert f"{name}: not installed" in out
+
+
+@pytest.mark.skipif(shutil.which("wrk") is None, reason="wrk (Debian package) is not installed")
+def test_http_benchmark_runs_with_tiny_sizes(capsys):
+    assert http.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "| GET /healthz (framework ceiling) |" in out
+    assert "single-IK throughput / trivial endpoint" in out
+
+
+def test_http_benchmark_says_when_wrk_is_missing(capsys, monkeypatch):
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    assert http.main(["--quick"]) == 0
+    assert "wrk is not installed" in capsys.readouterr().out

@@ -13,6 +13,8 @@ slots past ``count[i]`` hold no solution.
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -78,8 +80,14 @@ def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndar
     return plan_for(robot, constrain_orientation=False, reference=reference)
 
 
+#: Targets solved together: large enough that per-operation overhead is small, small enough that the
+#: (chunk × m × n) temporaries stay in cache and memory is bounded whatever the batch size.
+CHUNK = 4096
+
+
 def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,
-                    reference: np.ndarray | None = None, plan: Plan | None = None) -> IKArrays | None:
+                    reference: np.ndarray | None = None, plan: Plan | None = None,
+                    threads: int | None = None) -> IKArrays | None:
     """Every solution for each of N targets, vectorised over the targets.
 
     Parameters
@@ -103,12 +111,54 @@ def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orie
     within ``ACCEPT_RESIDUAL`` radians; candidates close to that get a few
     Gauss–Newton steps first. Candidates equal to an earlier kept one modulo
     2π (within ``DUPLICATE_TOLERANCE``) are merged into it.
+
+    A batch larger than :data:`CHUNK` is solved in chunks, on up to
+    ``threads`` threads (default: one per CPU); numpy releases the GIL inside
+    its array operations, so the chunks run in parallel.
     """
     if plan is None:
         plan = cached_plan(robot, constrain_orientation=constrain_orientation, reference=reference)
         if plan is None:
             return None
     targets = np.asarray(world_T_targets, dtype=float)
+    if len(targets) > CHUNK:
+        chunks = [targets[start:start + CHUNK] for start in range(0, len(targets), CHUNK)]
+        workers = min(threads or os.cpu_count() or 1, len(chunks))
+
+        def solve(chunk: np.ndarray) -> IKArrays:
+            return _solve_chunk(robot, chunk, constrain_orientation, reference, plan)
+
+        if workers > 1:
+            with ThreadPoolExecutor(workers) as pool:
+                parts = list(pool.map(solve, chunks))
+        else:
+            parts = [solve(chunk) for chunk in chunks]
+        return _concatenated(parts)
+    return _solve_chunk(robot, targets, constrain_orientation, reference, plan)
+
+
+def _concatenated(parts: list[IKArrays]) -> IKArrays:
+    """One IKArrays from the answers for consecutive chunks of targets."""
+    singularities = SingularFlags(sum(len(p.count) for p in parts))
+    offset = 0
+    for part in parts:
+        for mask, flag in part.singularities.entries:
+            full = np.zeros(singularities.count, dtype=bool)
+            full[offset:offset + len(mask)] = mask
+            singularities.add(full, flag)
+        offset += len(part.count)
+    first = parts[0]
+    return IKArrays(
+        joints=np.concatenate([p.joints for p in parts]), valid=np.concatenate([p.valid for p in parts]),
+        count=np.concatenate([p.count for p in parts]), position=np.concatenate([p.position for p in parts]),
+        orientation=np.concatenate([p.orientation for p in parts]),
+        labels={name: (values, np.concatenate([p.labels[name][1] for p in parts]))
+                for name, (values, _) in first.labels.items()},
+        singularities=singularities, structure=first.structure, free_joints=first.free_joints)
+
+
+def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
+                 plan: Plan) -> IKArrays:
     candidates = plan.solve(targets, reference)
     n_targets, m, n = candidates.joints.shape
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))

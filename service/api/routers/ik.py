@@ -9,8 +9,9 @@ from ...kinematics import Robot
 from ...kinematics.ik import IKOptions, IKResult, NumericOptions, Selected, Selection, select, solve_ik_batch
 from ...kinematics.ik._arrays import solve_ik_arrays
 from ...kinematics.ik._select_arrays import SolutionTable, select_arrays
-from ...kinematics.ik._solve import _unreachable_details
+from ...kinematics.ik._solve import _unreachable_details, results_from_arrays
 from ..boundary import (
+    _unit_scale,
     joints_from_core,
     joints_to_core,
     limits_to_core,
@@ -54,23 +55,42 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
         matrices, flags = matrix[None], np.array([constrained])
     else:
         matrices, flags = target_matrices(targets, body.angle_unit, "body", "targets")
-    orientation_flags = flags.tolist()
     reference, limits, ordering, options = _settings(robot, body)
-    results: list[IKResult | None] = [None] * len(targets)
+    answers: list[dict | None] = [None] * len(targets)
     for constrained in (True, False):
         rows = np.flatnonzero(flags == constrained)
-        if len(rows):
-            solved = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained,
-                                    reference=reference, options=options)
-            for i, result in zip(rows.tolist(), solved):
-                results[i] = result
-    return [
-        _to_wire(ref.id, robot, result, select(robot, result, limits, filter_limits=body.filter_limits,
-                                               reference=reference, ordering=ordering,
-                                               max_equivalents=body.max_equivalents),
-                 body.angle_unit, orientation_flags[i])
-        for i, result in enumerate(results)
-    ]
+        if not len(rows):
+            continue
+        arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
+        if arrays is None:  # no analytic family: the numeric search, one target at a time
+            for row, result in zip(rows.tolist(), solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained,
+                                                                 reference=reference, options=options)):
+                answers[row] = _to_wire(ref.id, robot, result, select(
+                    robot, result, limits, filter_limits=body.filter_limits, reference=reference, ordering=ordering,
+                    max_equivalents=body.max_equivalents), body.angle_unit, constrained)
+            continue
+        results = results_from_arrays(robot, arrays, matrices[rows], constrained, reference)
+        chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
+                               ordering=ordering, max_equivalents=body.max_equivalents)
+        kept = chosen.solutions
+        joints = (kept.joints / _unit_scale(robot, body.angle_unit)).tolist()
+        position = kept.position.tolist()
+        orientation = kept.orientation.tolist() if constrained else [None] * len(position)
+        branch = [(name, np.array(values, dtype=object)[codes].tolist()) for name, (values, codes) in kept.labels.items()]
+        starts = np.searchsorted(kept.target, np.arange(len(rows) + 1)).tolist()
+        for local, (row, result) in enumerate(zip(rows.tolist(), results)):
+            selection = chosen.selections.get(local)
+            if selection is not None:
+                answers[row] = _to_wire(ref.id, robot, result, selection, body.angle_unit, constrained)
+                continue
+            solutions = [{"joints": joints[k], "branch": {name: column[k] for name, column in branch},
+                          "within_limits": True, "violations": [],
+                          "residual": {"position": position[k], "orientation": orientation[k]}}
+                         for k in range(starts[local], starts[local + 1])]
+            answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
+                                 chosen.notes.get(local, []), bool(chosen.truncated[local]),
+                                 int(chosen.trimmed[local]), int(chosen.available[local]))
+    return answers
 
 
 def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
@@ -88,7 +108,7 @@ def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
     solvers: list[dict] = []
     reports: list[dict] = []
     kept_tables, rejected_tables = [], []
-    scale = np.where(robot.is_revolute, np.pi / 180.0 if body.angle_unit == "deg" else 1.0, 1.0)
+    scale = _unit_scale(robot, body.angle_unit)
     for constrained in (True, False):
         rows = np.flatnonzero(flags == constrained)
         if not len(rows):
@@ -210,21 +230,28 @@ def _solution_to_wire(robot: Robot, entry: Selected, unit: str, constrained: boo
 
 def _to_wire(robot_id: str, robot: Robot, result: IKResult, selection: Selection, unit: str,
              constrained: bool) -> dict:
-    detail = " ".join(filter(None, [result.detail, *selection.notes])) or None
+    return _wire(robot_id, result, selection.status,
+                 [_solution_to_wire(robot, e, unit, constrained) for e in selection.solutions],
+                 [_solution_to_wire(robot, e, unit, constrained) for e in selection.rejected],
+                 selection.notes, selection.expansion_truncated, selection.trimmed, selection.available)
+
+
+def _wire(robot_id: str, result: IKResult, status: str, solutions: list[dict], rejected: list[dict],
+          notes: list[str], truncated: bool, trimmed: int, available: int) -> dict:
     return {
         "robot_id": robot_id,
-        "status": selection.status,
-        "detail": detail,
-        "solutions": [_solution_to_wire(robot, e, unit, constrained) for e in selection.solutions],
-        "rejected": [_solution_to_wire(robot, e, unit, constrained) for e in selection.rejected],
+        "status": status,
+        "detail": " ".join(filter(None, [result.detail, *notes])) or None,
+        "solutions": solutions,
+        "rejected": rejected,
         "solver": {"method": result.method, "structure": result.structure, "complete": result.complete,
                    "time_budget_exhausted": result.search_exhausted_budget},
         "singularities": [{"kind": s.kind, "joints": list(s.joints), "relation": s.relation, "detail": s.detail}
                           for s in result.singularities],
         "free_joints": result.free_joints,
-        "truncated": selection.expansion_truncated,
-        "trimmed": selection.trimmed,
-        "available": selection.available,
+        "truncated": truncated,
+        "trimmed": trimmed,
+        "available": available,
     }
 
 

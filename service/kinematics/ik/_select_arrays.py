@@ -81,6 +81,7 @@ class BatchSelection:
     solutions: SolutionTable
     rejected: SolutionTable
     vectorised: int  # how many targets took the array path
+    selections: dict[int, Selection]  # the per-result answer of every target that did not
 
 
 def select_arrays(robot: Robot, arrays: IKArrays, limits: Limits, *, filter_limits: bool = True,
@@ -96,7 +97,7 @@ def select_arrays(robot: Robot, arrays: IKArrays, limits: Limits, *, filter_limi
         labels={name: (values, codes[arrays.valid]) for name, (values, codes) in arrays.labels.items()})
     values, single = _single_values(robot, limits, rows.joints)
     per_target_single = np.bincount(rows.target, weights=~single, minlength=n_targets) == 0
-    simple = per_target_single & (arrays.count <= max_equivalents)
+    simple = per_target_single
     if reference is not None and ordering.norm != "linf":
         simple &= arrays.count == 0  # the l2 cost is summed with math.fsum there: leave its order to select()
     fast = simple[rows.target]
@@ -127,8 +128,9 @@ def select_arrays(robot: Robot, arrays: IKArrays, limits: Limits, *, filter_limi
                                       int(trimmed[row]), int(available[row])),
                             int(with_all_moves[row]), max_equivalents, reference is not None)
     kept_parts, rejected_parts = [kept], []
+    selections: dict[int, Selection] = {}
     for row in np.flatnonzero(~simple).tolist():
-        selection = select(robot, _result(arrays, row), limits, filter_limits=filter_limits, reference=reference,
+        selection = selections[row] = select(robot, _result(arrays, row), limits, filter_limits=filter_limits, reference=reference,
                            ordering=ordering, max_equivalents=max_equivalents)
         status[row], truncated[row], trimmed[row], available[row] = (
             selection.status, selection.expansion_truncated, selection.trimmed, selection.available)
@@ -139,7 +141,8 @@ def select_arrays(robot: Robot, arrays: IKArrays, limits: Limits, *, filter_limi
     solutions = _by_target(SolutionTable.concatenate(kept_parts, n)) if len(kept_parts) > 1 else kept
     rejected = _by_target(SolutionTable.concatenate(rejected_parts, n)) if rejected_parts else rows.take(
         np.zeros(0, dtype=int))
-    return BatchSelection(status, truncated, trimmed, available, notes, solutions, rejected, int(simple.sum()))
+    return BatchSelection(status, truncated, trimmed, available, notes, solutions, rejected, int(simple.sum()),
+                          selections)
 
 
 def _single_values(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -127,3 +127,17 @@ def test_arrays_form_reports_a_bad_target_like_the_objects_form(client):
         response = client.post("/v1/robots/puma560_modified/ik/batch", json={"targets": targets, "format": form})
         assert response.status_code == 422
         assert any(e["loc"][:4] == ["body", "targets", 2, "matrix"] for e in response.json()["errors"])
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_objects_form_is_what_its_model_says(client, case):
+    """The batch objects form is encoded without passing through the response model: it must already be it."""
+    from service.api.schemas.ik import IKBatchResponse
+
+    robot_id, options, position_only = CASES[case]
+    targets = _targets(client, robot_id, 15, seed=sorted(CASES).index(case), position_only=position_only)
+    response = client.post(f"/v1/robots/{robot_id}/ik/batch",
+                           json={"targets": targets, **{**options, "filter_limits": False}})
+    assert response.status_code == 200
+    body = response.json()
+    assert IKBatchResponse.model_validate(body).model_dump(mode="json") == body

@@ -24,6 +24,7 @@ from ._limits import (
     violations,
     within,
 )
+from ._rates import JointRates, TaskSpace, jacobian_derivative, joint_rates, task_space
 from ._robot import JOINT_KINDS, Joint, JointKind, Robot, check_joint_values
 from ._rotations import (
     check_rotation,
@@ -42,6 +43,7 @@ __all__ = [
     "JOINT_KINDS",
     "Joint",
     "JointKind",
+    "JointRates",
     "JointScrews",
     "LIMIT_TOLERANCE",
     "Limits",
@@ -51,6 +53,7 @@ __all__ = [
     "within",
     "KinematicsError",
     "Robot",
+    "TaskSpace",
     "ScrewModel",
     "check_joint_values",
     "check_rotation",
@@ -59,6 +62,8 @@ __all__ = [
     "craig_row_from_khalil",
     "forward_kinematics",
     "geometric_jacobian",
+    "jacobian_derivative",
+    "joint_rates",
     "joint_screws",
     "link_frames",
     "link_transforms",
@@ -68,4 +73,5 @@ __all__ = [
     "matrix_from_rpy",
     "quaternions_from_matrices",
     "screw_model",
+    "task_space",
 ]

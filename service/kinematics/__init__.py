@@ -35,6 +35,7 @@ from ._rotations import (
     matrix_from_rpy,
     quaternions_from_matrices,
 )
+from ._trajectory import TrajectoryOptions, TrajectoryResult, follow_trajectory
 
 __all__ = [
     "CONVENTIONS",
@@ -54,12 +55,15 @@ __all__ = [
     "KinematicsError",
     "Robot",
     "TaskSpace",
+    "TrajectoryOptions",
+    "TrajectoryResult",
     "ScrewModel",
     "check_joint_values",
     "check_rotation",
     "check_transform",
     "check_unit_quaternion",
     "craig_row_from_khalil",
+    "follow_trajectory",
     "forward_kinematics",
     "geometric_jacobian",
     "jacobian_derivative",

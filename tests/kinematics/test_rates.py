@@ -227,3 +227,58 @@ def test_damped_least_squares_only_when_asked_and_only_at_singular_samples():
 
 def test_docstring_examples():
     assert doctest.testmod(_rates, raise_on_error=False).failed == 0
+
+
+# ---------------------------------------------------------------------------
+# Along smooth paths: rates against central differences of the position IK
+# ---------------------------------------------------------------------------
+
+#: robot id → (start configuration, rotation axes k1, k2 of the path's orientation (k2 None: about k1 only)).
+SMOOTH_PATHS = {
+    "puma560_modified": ([0.3, -0.6, 0.4, 0.5, 0.8, -0.3], [0, 0, 1], [1, 0, 0]),
+    "ur5": ([0.3, -1.0, 1.2, -0.6, 1.1, 0.4], [0, 0, 1], [1, 0, 0]),
+    "spong_ex3_5_stanford": ([0.3, 0.9, 0.8, 0.5, 0.8, -0.3], [0, 0, 1], [1, 0, 0]),
+    "spong_ex3_6_scara_rrpr": ([0.4, -0.9, 0.3, 0.5], [0, 0, 1], None),  # a SCARA turns about z only
+}
+
+#: Worst disagreement measured (25 points of t in [0, 6] s, h = 1e-3 s, five-point stencils; rad/s, rad/s²,
+#: m/s, m/s²): velocities ≤ 1.0e-12, accelerations ≤ 3.6e-9 (rounding of the second difference, ~eps·|q|/h²).
+#:   puma560_modified        q̇ 6.0e-13   q̈ 2.1e-9
+#:   ur5                     q̇ 1.0e-12   q̈ 3.6e-9
+#:   spong_ex3_5_stanford    q̇ 6.3e-13   q̈ 1.9e-9
+#:   spong_ex3_6_scara_rrpr  q̇ 9.0e-13   q̈ 2.4e-9
+FD_STEP = 1e-3
+
+
+@pytest.mark.parametrize("robot_id", sorted(SMOOTH_PATHS))
+def test_rates_along_a_smooth_path_match_differences_of_the_position_ik(robot_id):
+    """The path has an exact twist and acceleration (tests/oracles/paths.py); positions come from the IK alone.
+
+    Each of 25 points t is surrounded by t ± h, t ± 2h in one trajectory, so the branch is the same for all
+    five; q̇ and q̈ at t are compared with the five-point differences of the joint positions.
+    """
+    from service.kinematics._trajectory import TrajectoryOptions, follow_trajectory
+    from tests.oracles.paths import wobble
+
+    arm = robot(robot_id)
+    q0, k1, k2 = SMOOTH_PATHS[robot_id]
+    centres = np.linspace(0.0, 6.0, 25)
+    times = (centres[:, None] + FD_STEP * np.arange(-2, 3)).ravel()
+    poses, twists, accelerations = wobble(times, forward_kinematics(arm, np.array(q0)),
+                                          0.04 * arm.characteristic_length, k1, k2)
+    result = follow_trajectory(arm, times, poses, twists=twists, accelerations=accelerations,
+                               options=TrajectoryOptions(reference=np.array(q0)))
+    assert result.rates == "jacobian" and result.task.solve == "exact"
+    assert not result.summary.singular_samples and not result.summary.branch_changes
+    q = np.array([s.joints for s in result.samples]).reshape(25, 5, arm.dof)
+    centre = [s for k, s in enumerate(result.samples) if k % 5 == 2]
+    qd = np.array([s.velocities for s in centre])
+    qdd = np.array([s.accelerations for s in centre])
+    h = FD_STEP
+    first = (-q[:, 4] + 8 * q[:, 3] - 8 * q[:, 1] + q[:, 0]) / (12 * h)
+    second = (-q[:, 4] + 16 * q[:, 3] - 30 * q[:, 2] + 16 * q[:, 1] - q[:, 0]) / (12 * h * h)
+    assert np.abs(qd).max() > 0.1 and np.abs(qdd).max() > 0.1  # the path really moves every sample
+    assert np.abs(first - qd).max() < 1e-11
+    assert np.abs(second - qdd).max() < 2e-8
+    assert max(s.velocity_residual for s in centre) < 1e-14
+    assert max(s.acceleration_residual for s in centre) < 1e-14

@@ -35,6 +35,7 @@ from ._rotations import (
     matrix_from_rpy,
     quaternions_from_matrices,
 )
+from ._tolerances import RATE_SINGULARITY_TOLERANCE
 from ._trajectory import TrajectoryOptions, TrajectoryResult, follow_trajectory
 
 __all__ = [
@@ -53,6 +54,7 @@ __all__ = [
     "violations",
     "within",
     "KinematicsError",
+    "RATE_SINGULARITY_TOLERANCE",
     "Robot",
     "TaskSpace",
     "TrajectoryOptions",

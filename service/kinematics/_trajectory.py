@@ -59,8 +59,15 @@ from ._limits import Limits, Violation, nearest_fitting_equivalent, violations, 
 from ._rates import TaskSpace, joint_rates, rate_residuals, task_space
 from ._robot import Robot, check_joint_values
 from ._tolerances import RATE_SINGULARITY_TOLERANCE
-from .ik import IKOptions, IKResult, Singularity, solve_ik, solve_ik_batch
-from .ik._verify import distance_to_reference, joint_difference
+from .ik import (
+    IKOptions,
+    IKResult,
+    Singularity,
+    distance_to_reference,
+    joint_difference,
+    solve_ik,
+    solve_ik_batch,
+)
 
 __all__ = [
     "PaperJoints",

@@ -6,6 +6,7 @@ from typing import Literal
 
 from pydantic import Field, model_validator
 
+from ...kinematics import RATE_SINGULARITY_TOLERANCE
 from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RobotId, Vector3
 from .ik import Branch, SingularityReport
 from .limits import LimitViolation
@@ -60,7 +61,7 @@ class TrajectoryRequest(ApiModel):
                           "(among those on `branch`, when given); each later sample continues from the previous")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
     singularity_tolerance: Number = Field(
-        1e-3, ge=0, description="a sample is singular when its distance to a singularity (the smallest singular "
+        RATE_SINGULARITY_TOLERANCE, ge=0, description="a sample is singular when its distance to a singularity (the smallest singular "
                                 "value of the scaled task Jacobian) is below this")
     damping: Number | None = Field(
         None, gt=0, description="λ for damped least-squares rates at singular samples; without it their "

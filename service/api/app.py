@@ -14,7 +14,7 @@ from ..catalogue import load_catalogue
 from ..config import Settings
 from .limits import BodySizeLimit
 from .problems import install_problem_handlers
-from .routers import fk, health, ik, limits, robots
+from .routers import fk, health, ik, limits, robots, trajectory
 
 logger = logging.getLogger("service")
 
@@ -59,6 +59,6 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.catalogue = None
     install_problem_handlers(app)
     app.add_middleware(BodySizeLimit, max_body_bytes=settings.max_body_bytes)
-    for module in (health, robots, fk, ik, limits):
+    for module in (health, robots, fk, ik, limits, trajectory):
         app.include_router(module.router)
     return app

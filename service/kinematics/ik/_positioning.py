@@ -238,7 +238,9 @@ class ParallelShoulder(Positioner):
         valid = elbow.valid & elbow.exact & first.exact[..., 0] & slide.exact
         valid[:, 1] &= ~free[:, 1]
         singular: list[list[Singularity]] = [[] for _ in range(n_targets)]
-        coincident = elbow.degenerate
+        # The point on the first axis leaves joint 1 free (subproblem 1 is degenerate); it is reachable there
+        # only with equal link lengths, the group's coincident case (textbook.md §4.2 item 6).
+        coincident = elbow.degenerate | free.any(axis=1)
         _flag_rows(coincident, Singularity("assur_group", (i, j), "coincident",
                                            "the point is on the first axis with equal link lengths: "
                                            "joint 1 is free (increased mobility)"), singular)

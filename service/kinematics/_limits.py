@@ -78,15 +78,25 @@ def within(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray:
 def turn_offsets(robot: Robot, limits: Limits, q: np.ndarray) -> list[np.ndarray]:
     """For each joint, the values q_i + 2kπ that fit its bounds (revolute joints with finite bounds).
 
-    A prismatic joint, or a continuous revolute joint (no bounds), keeps its
-    own value only: there is nothing to expand into.
+    A prismatic joint keeps its own value only, if it is within its bounds
+    (an empty array otherwise): there is nothing to expand into. A revolute
+    joint bounded on one side only keeps its value if it fits, or else takes
+    the first equivalent past that bound; a continuous one keeps its value.
     """
     tolerance = limits.tolerance(robot)
     options = []
     for i in range(robot.dof):
         lower, upper = limits.lower[i] - tolerance[i], limits.upper[i] + tolerance[i]
-        if not robot.is_revolute[i] or not (np.isfinite(lower) and np.isfinite(upper)):
-            options.append(np.array([q[i]]))
+        if not robot.is_revolute[i]:
+            options.append(np.array([q[i]]) if lower <= q[i] <= upper else np.array([]))
+            continue
+        if not (np.isfinite(lower) and np.isfinite(upper)):
+            value = q[i]
+            if value < lower:
+                value += _TWO_PI * np.ceil((lower - value) / _TWO_PI)
+            elif value > upper:
+                value -= _TWO_PI * np.ceil((value - upper) / _TWO_PI)
+            options.append(np.array([value]))
             continue
         first = np.ceil((lower - q[i]) / _TWO_PI)
         last = np.floor((upper - q[i]) / _TWO_PI)

@@ -39,11 +39,6 @@ class PositionerResult:
     singularities: list[list[Singularity]] = field(default_factory=list)
 
 
-def _up_direction(direction: np.ndarray) -> np.ndarray:
-    """``direction`` or its opposite, whichever points up (non-negative world z)."""
-    return -direction if direction[2] < -1e-12 else direction
-
-
 def _unit(v: np.ndarray) -> np.ndarray | None:
     norm = np.linalg.norm(v)
     return v / norm if norm > 1e-9 else None
@@ -92,7 +87,7 @@ class IntersectingShoulder(Positioner):
     Labels: ``shoulder`` left/right is the sign of the arm's reach along the
     forward direction of link 1 (the textbook's left/right arm; "front" is left);
     ``elbow`` up/down (revolute joint 3) is the side of the shoulder–point line
-    the elbow lies on, seen along the up-pointing axis 1.
+    the elbow lies on, seen along the up-pointing axis 1. See :meth:`labels`.
     """
 
     name = "intersecting_shoulder"
@@ -158,19 +153,54 @@ class IntersectingShoulder(Positioner):
         opposite = g.point(k) + rotate_about(g.direction(k), q3 + np.pi, w - g.point(k))
         return np.linalg.norm(at - c, axis=-1) >= np.linalg.norm(opposite - c, axis=-1)
 
+    def _offset(self) -> np.ndarray | None:
+        """The shoulder offset at q = 0, shape (3,): the point's displacement from the centre along axis 2.
+
+        Joint 2 keeps that component, and so does joint 3 when it turns about an
+        axis parallel to axis 2 or slides perpendicular to it (the elbow, PUMA,
+        Stanford and polar arms). None when it is zero or not constant.
+        """
+        g, (_, j, k) = self.geometry, self.joints
+        axis = g.direction(j)
+        constant = g.parallel(j, k) if g.model.is_revolute[k] else abs(float(g.direction(k) @ axis)) <= 1e-9
+        along = float((self.point - self.centre) @ axis)
+        if not constant or abs(along) <= 1e-9 * g.length_scale:
+            return None
+        return along * axis
+
     def _forward_direction(self) -> np.ndarray:
-        """Link 1's forward direction at q = 0: the arm's reach, perpendicular to axes 1 and 2."""
+        """Link 1's forward direction at q = 0, perpendicular to axis 1: it decides left (front) from right (back).
+
+        * With a shoulder offset (the PUMA, the Stanford arm, textbook §3.3),
+          forward is ``offset × up``: the left arm is the one whose offset lies to
+          the left of its reach, seen from above. This is a property of the
+          arm, the same in every description of it (textbook §3.3: left arm
+          θ1 = φ − atan2(d, u0), reach u = +u0 along x1, offset +d along y1).
+        * Without an offset the arm is mirror-symmetric and the textbook's
+          "front" is a convention of its frames: θ1 = atan2(yc, xc) puts the
+          wrist centre along x1 (§3.2, §3.4). Forward is then the x axis of link
+          frame 1 at q = 0.
+        """
         g, (i, j, _) = self.geometry, self.joints
-        normal = _unit(np.cross(g.direction(i), g.direction(j)))
-        reach = self.point - self.centre
-        if normal is not None:
-            along = float(reach @ normal)
-            if abs(along) > 1e-9 * g.length_scale:
-                return normal * np.sign(along)
-            return -normal
-        return reach
+        axis = g.direction(i)
+        offset = self._offset()
+        if offset is not None:
+            forward = _unit(np.cross(offset, g.upward(axis)))
+            if forward is not None:
+                return forward
+        if g.link_x is not None:
+            forward = _unit(g.link_x[i] - (g.link_x[i] @ axis) * axis)
+            if forward is not None:
+                return forward
+        normal = _unit(np.cross(axis, g.direction(j)))
+        return normal if normal is not None else self.point - self.centre
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
+        """Shoulder left/right: the sign of the reach along link 1's forward direction (see
+        :meth:`_forward_direction`). Elbow up/down (revolute joint 3): the side of the shoulder–point
+        line the elbow lies on, along the robot's up direction, measured in the arm's plane (normal to
+        axis 2) when axes 2 and 3 are parallel, so that the choice of point on axis 3 does not matter.
+        """
         g, (i, j, k) = self.geometry, self.joints
         forward = rotate_about(g.direction(i), joints[:, i], self._forward_direction())
         G3 = self._motion(joints, k + 1)
@@ -181,7 +211,11 @@ class IntersectingShoulder(Positioner):
         if g.model.is_revolute[k]:
             G2 = self._motion(joints, k)
             elbow = np.einsum("mij,j->mi", G2[:, :3, :3], g.point(k)) + G2[:, :3, 3] - self.centre
-            up = _up_direction(g.direction(i))
+            if g.parallel(j, k):  # work in the arm's plane, normal to axis 2
+                normal = np.einsum("mij,j->mi", self._motion(joints, j)[:, :3, :3], g.direction(j))
+                elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
+                reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
+            up = g.upward(g.direction(i))
             line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
             rejection = elbow - np.einsum("mi,mi->m", elbow, line)[:, None] * line
             side = rejection @ up
@@ -249,7 +283,7 @@ class ParallelShoulder(Positioner):
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
         g, (i, j, k) = self.geometry, self.joints
-        up = _up_direction(g.direction(i))
+        up = g.upward(g.direction(i))
         G1 = self._motion(joints, i + 1)
         elbow = np.einsum("mij,j->mi", G1[:, :3, :3], g.point(j)) + G1[:, :3, 3] - g.point(i)
         G3 = self._motion(joints, k + 1)
@@ -302,7 +336,7 @@ class PlanarTwoLink(Positioner):
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
         g, (i, j) = self.geometry, self.joints
-        up = _up_direction(g.direction(i))
+        up = g.upward(g.direction(i))
         G1 = self._motion(joints, i + 1)
         elbow = np.einsum("mij,j->mi", G1[:, :3, :3], g.point(j)) + G1[:, :3, 3] - g.point(i)
         G2 = self._motion(joints, j + 1)

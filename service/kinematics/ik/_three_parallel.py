@@ -22,12 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._positioning import _flag_rows, _up_direction, _unit
+from ._positioning import _flag_rows, _unit
 from ._screws import apply, chain_motion, invert, joint_motion, rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_4
 from ._types import Branch, Candidates, Singularity
-from ._wrist import _perpendicular_unit
+from ._wrist import _perpendicular_unit, wrist_labels
 
 
 class ThreeParallelPlan:
@@ -140,8 +140,6 @@ class ThreeParallelPlan:
         reach = wrist_point - shoulder_point
         line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
         rejection = elbow_point - np.einsum("mi,mi->m", elbow_point, line)[:, None] * line
-        side = rejection @ _up_direction(g.direction(0))
-        middle = np.pi - np.mod(np.pi - joints[:, 4], 2 * np.pi)
-        return [{"shoulder": "left" if s >= 0 else "right", "elbow": "up" if e > 0 else "down",
-                 "wrist": "no_flip" if 0 <= w < np.pi else "flip"}
-                for s, e, w in zip(shoulder, side, middle)]
+        side = rejection @ g.upward(g.direction(0))
+        return [{"shoulder": "left" if s >= 0 else "right", "elbow": "up" if e > 0 else "down", **w}
+                for s, e, w in zip(shoulder, side, wrist_labels(joints[:, 4]))]

@@ -128,6 +128,10 @@ class ThreeParallelPlan:
         return Candidates(joints.reshape(n, 8, 6), valid.reshape(n, 8), [], singular)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
+        """Shoulder left/right: the sign of the reach to axis 4 along link 1's forward direction. Elbow up/down:
+        the side of the line from axis 2 to axis 4 that axis 3 lies on, along the robot's up direction, measured
+        in the plane normal to the parallel axes (so the points the description puts on them do not matter).
+        Wrist: the sign of sin q5 (:func:`wrist_labels`)."""
         g, m = self.geometry, self.model
         G1 = chain_motion(m.directions[:1], m.points[:1], m.is_revolute[:1], joints[:, :1])
         G2 = chain_motion(m.directions[:2], m.points[:2], m.is_revolute[:2], joints[:, :2])
@@ -138,6 +142,9 @@ class ThreeParallelPlan:
         shoulder_point = apply(G1, g.point(1))
         elbow_point = apply(G2, g.point(2)) - shoulder_point
         reach = wrist_point - shoulder_point
+        normal = np.einsum("mij,j->mi", G1[:, :3, :3], self.omega_p)  # the parallel axes, after joint 1
+        elbow_point = elbow_point - np.einsum("mi,mi->m", elbow_point, normal)[:, None] * normal
+        reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
         line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
         rejection = elbow_point - np.einsum("mi,mi->m", elbow_point, line)[:, None] * line
         side = rejection @ g.upward(g.direction(0))

@@ -14,6 +14,29 @@ from tests.conftest import catalogue_robot
 from tests.ik_helpers import find, joints_of, unlimited
 from tests.oracles.closed_forms import CLOSED_FORMS
 
+#: UR5, Universal Robots' published standard-DH table (robots/ur5.yaml); the FK below is written here, as a plain
+#: product of link transforms, independent of the service (the textbook prints no closed form for the UR5).
+UR5_D = np.array([0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823])
+UR5_A = np.array([0.0, -0.425, -0.39225, 0.0, 0.0, 0.0])
+UR5_ALPHA = np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0])
+UR5_STRETCHED = [0.4, -0.5, 0.0, 0.3, 0.9, -0.2]
+
+
+def ur5_fk(q: np.ndarray) -> np.ndarray:
+    """base_T_tool of the UR5 for joint vectors q, shape (..., 6) -> (..., 4, 4): A_i = Rz(θ) Tz(d) Tx(a) Rx(α)."""
+    q = np.asarray(q, dtype=float)
+    T = np.broadcast_to(np.eye(4), q.shape[:-1] + (4, 4)).copy()
+    for i in range(6):
+        ct, st = np.cos(q[..., i]), np.sin(q[..., i])
+        ca, sa = np.cos(UR5_ALPHA[i]), np.sin(UR5_ALPHA[i])
+        A = np.zeros(q.shape[:-1] + (4, 4))
+        A[..., 0, :] = np.stack([ct, -st * ca, st * sa, UR5_A[i] * ct], axis=-1)
+        A[..., 1, :] = np.stack([st, ct * ca, -ct * sa, UR5_A[i] * st], axis=-1)
+        A[..., 2, :] = [0.0, sa, ca, UR5_D[i]]
+        A[..., 3, 3] = 1.0
+        T = T @ A
+    return T
+
 
 # --------------------------------------------------------------------------
 # Joint limits on prismatic joints (the textbook keeps slides >= 0)
@@ -39,3 +62,258 @@ def test_a_slide_below_its_lower_limit_is_rejected(client, robot_id, q):
     assert limited["rejected"] and all(s["within_limits"] is False for s in limited["rejected"])
     assert all(any(v["joint"] == slide and v["value"] < 0 and v["lower"] == 0 for v in s["violations"])
                for s in limited["rejected"])
+
+
+def _pose_ik(client, robot_id: str, T: np.ndarray, **options) -> dict:
+    robot = catalogue_robot(client, robot_id)
+    response = client.post(f"/v1/robots/{robot_id}/ik",
+                           json={"target": {"matrix": np.asarray(T).tolist()}, "limits": unlimited(robot), **options})
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def _position_ik(client, robot_id: str, position, **options) -> dict:
+    robot = catalogue_robot(client, robot_id)
+    response = client.post(f"/v1/robots/{robot_id}/ik",
+                           json={"target": {"position": list(map(float, position))}, "limits": unlimited(robot),
+                                 **options})
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+def assert_fk_reaches(robot_id: str, result: dict, T: np.ndarray, *, position_only: bool = False) -> None:
+    """Every solution reproduces the target under the independent closed-form FK, and reports a tiny residual."""
+    scale = max(1.0, np.abs(T[:3, 3]).max())
+    assert result["solutions"]
+    for solution in result["solutions"]:
+        reached = CLOSED_FORMS[robot_id](solution["joints"])
+        if position_only:
+            assert np.abs(reached[:3, 3] - T[:3, 3]).max() < 1e-9 * scale
+            assert solution["residual"]["orientation"] is None
+        else:
+            assert np.abs(reached - T).max() < 1e-9 * scale
+            assert solution["residual"]["orientation"] < 1e-9
+        assert solution["residual"]["position"] < 1e-9 * scale
+
+
+def _kinds(result: dict) -> list[tuple]:
+    return [(s["kind"], s["joints"], s["relation"]) for s in result["singularities"]]
+
+
+# --------------------------------------------------------------------------
+# Singular targets
+# --------------------------------------------------------------------------
+
+PUMA = "puma560_modified"
+
+
+@pytest.mark.parametrize("theta5, relation, combined", [(0.0, "sum", lambda q4, q6: q4 + q6),
+                                                         (np.pi, "difference", lambda q4, q6: q4 - q6)])
+def test_puma_wrist_singularity(client, theta5, relation, combined):
+    """θ5 = 0 (axes 4 and 6 aligned, same sense in Craig's frames): only θ4 + θ6 is determined; θ5 = π: θ4 − θ6.
+    One representative with θ4 = the reference value, or 0; the other three arm branches keep both wrists."""
+    robot = catalogue_robot(client, PUMA)
+    q = np.array([0.3, -0.6, 0.4, 0.8, theta5, -0.5])
+    T = CLOSED_FORMS[PUMA](q)
+    for reference, q4 in ((None, 0.0), ([0.0, 0.0, 0.0, 1.1, 0.0, 0.0], 1.1), ([0.3, -0.6, 0.4, -2.9, 0, 0], -2.9)):
+        result = _pose_ik(client, PUMA, T, **({} if reference is None else {"reference": reference}))
+        assert ("wrist", [3, 5], relation) in _kinds(result)
+        assert_fk_reaches(PUMA, result, T)
+        solutions = joints_of(result)
+        assert len(solutions) == 7
+        arm = np.abs(np.angle(np.exp(1j * (solutions[:, :3] - q[:3])))).max(axis=1)
+        family = np.flatnonzero(arm < 1e-7)
+        assert len(family) == 1  # the singular arm branch: one representative
+        representative = solutions[family[0]]
+        assert np.sin(representative[4]) == pytest.approx(0.0, abs=1e-9)
+        assert representative[3] == pytest.approx(q4, abs=1e-9)  # the free joint: reference value, or 0
+        difference = combined(representative[3], representative[5]) - combined(q[3], q[5])
+        assert np.cos(difference) == pytest.approx(1.0, abs=1e-12)  # the determined combination
+        assert "wrist" not in result["solutions"][family[0]]["branch"]  # flip and no flip are one family here
+
+
+ELBOW = "spong_ex4_3_elbow_with_wrist"
+A2, A3 = 1.0, 0.8
+
+
+def test_wrist_centre_on_the_first_axis(client):
+    """Spong Fig. 4.4: xc = yc = 0, θ1 is arbitrary. Reported, and θ1 = the reference value, or 0."""
+    robot = catalogue_robot(client, ELBOW)
+    q2 = 1.2
+    q3 = np.arccos(-A2 * np.cos(q2) / A3) - q2  # a2 c2 + a3 c23 = 0: the wrist centre above the base
+    q = np.array([0.4, q2, q3, 0.3, 0.9, -0.2])
+    T = CLOSED_FORMS[ELBOW](q)
+    assert np.hypot(*(T[:2, 3] - 0.2 * T[:2, 2])) < 1e-12
+    for reference, q1 in ((None, 0.0), ([0.7, 0, 0, 0, 0, 0], 0.7), ([0.4, 0, 0, 0, 0, 0], 0.4)):
+        result = _pose_ik(client, ELBOW, T, **({} if reference is None else {"reference": reference}))
+        assert _kinds(result) == [("shoulder", [0], "free")]
+        assert_fk_reaches(ELBOW, result, T)
+        solutions = joints_of(result)
+        assert len(solutions) == 4  # front and back are one family: 2 elbows x 2 wrists
+        assert np.allclose(solutions[:, 0], q1, atol=1e-12)
+        assert all("shoulder" not in s["branch"] for s in result["solutions"])
+        assert sorted(s["branch"]["elbow"] for s in result["solutions"]) == ["down", "down", "up", "up"]
+    assert find(robot, solutions, q) is not None  # with reference θ1 = 0.4 the generating vector is a solution
+
+
+@pytest.mark.parametrize("q3, kind", [(0.0, "stretched"), (np.pi, "folded")])
+def test_stretched_and_folded_elbow(client, q3, kind):
+    """D = ±1 (eq. 4.29): the two elbow branches meet; one solution per shoulder and wrist, no elbow label."""
+    robot = catalogue_robot(client, ELBOW)
+    q = np.array([0.4, 0.5, q3, 0.3, 0.9, -0.2])
+    T = CLOSED_FORMS[ELBOW](q)
+    result = _pose_ik(client, ELBOW, T)
+    assert ("elbow", [2], kind) in _kinds(result)
+    assert_fk_reaches(ELBOW, result, T)
+    solutions = joints_of(result)
+    assert len(solutions) == 4 and find(robot, solutions, q) is not None
+    assert np.allclose(np.cos(solutions[:, 2]), np.cos(q3), atol=1e-9)
+    assert all("elbow" not in s["branch"] for s in result["solutions"])
+
+
+def test_ur5_with_a_stretched_elbow(client):
+    """UR5, θ3 = 0: the elbow is stretched, reported, and the generating vector is among the (FK-checked)
+    solutions; test_ur5_counts_are_the_real_solution_counts shows no solution is missing at this pose."""
+    robot = catalogue_robot(client, "ur5")
+    q = np.array(UR5_STRETCHED)
+    T = ur5_fk(q)
+    result = _pose_ik(client, "ur5", T)
+    assert ("elbow", [2], "stretched") in _kinds(result)
+    solutions = joints_of(result)
+    assert find(robot, solutions, q) is not None
+    assert len(solutions) < 8
+    for s in solutions:
+        assert np.abs(ur5_fk(s) - T).max() < 1e-9
+    assert "elbow" not in result["solutions"][find(robot, solutions, q)]["branch"]
+
+
+@pytest.mark.parametrize("robot_id, q, kind", [
+    ("assur001_scara_rrp", [0.3, 0.0, 40.0], "position"),  # stretched: |AC| = l_AB + l_BC
+    ("assur001_scara_rrp", [0.3, np.pi, 40.0], "position"),  # folded: |AC| = l_AB - l_BC
+    ("spong_ex3_6_scara_rrpr", [0.3, 0.0, 0.4, 0.5], "pose"),
+])
+def test_scara_aligned_links(client, robot_id, q, kind):
+    """The RRR (Assur) group with A, B and C aligned (P/Q = ±1): the two assembly modes meet."""
+    robot = catalogue_robot(client, robot_id)
+    T = CLOSED_FORMS[robot_id](q)
+    result = _pose_ik(client, robot_id, T) if kind == "pose" else _position_ik(client, robot_id, T[:3, 3])
+    assert _kinds(result) == [("assur_group", [1], "aligned")]
+    assert_fk_reaches(robot_id, result, T, position_only=kind == "position")
+    solutions = joints_of(result)
+    assert len(solutions) == 1 and find(robot, solutions, q) is not None
+    assert "assembly_mode" not in result["solutions"][0]["branch"]
+
+
+def test_scara_with_equal_links_and_the_point_on_the_first_axis(client):
+    """File 001 §2: A ≡ B with l_AC = l_BC: the group assembles but C is undefined (increased mobility). Joint 1 is
+    free: the reference value, or 0; the links fold onto each other (q2 = π)."""
+    robot = {"convention": "standard", "joints": [{"a": 0.5}, {"a": 0.5, "alpha": np.pi}, {"type": "prismatic"}]}
+    for reference, q1 in ((None, 0.0), ([0.4, 0.0, 0.0], 0.4)):
+        body = {"robot": robot, "target": {"position": [0.0, 0.0, -0.3]}}
+        if reference is not None:
+            body["reference"] = reference
+        result = client.post("/v1/ik", json=body).json()
+        assert _kinds(result) == [("assur_group", [0, 1], "coincident")]
+        [solution] = result["solutions"]
+        assert solution["joints"] == pytest.approx([q1, np.pi, 0.3], abs=1e-12)
+        assert solution["residual"]["position"] < 1e-12
+
+
+# --------------------------------------------------------------------------
+# Unreachable targets
+# --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("robot_id, target", [
+    (PUMA, {"position": [2.0, 0.0, 0.0], "orientation": {"type": "rpy", "angles": [3.0, 0.1, 0.2]}}),
+    (ELBOW, {"position": [0.0, 0.0, 3.0], "orientation": {"type": "quaternion", "wxyz": [1, 0, 0, 0]}}),
+    ("ur5", {"position": [1.2, 0.0, 0.1], "orientation": {"type": "quaternion", "wxyz": [0, 1, 0, 0]}}),
+    ("assur001_scara_rrp", {"position": [200.0, 0.0, 50.0]}),  # |AC| > l_AB + l_BC
+    ("assur001_scara_rrp", {"position": [10.0, 0.0, 50.0]}),  # |AC| < l_AB - l_BC
+    ("ex004_4_polar_offset_rrp", {"position": [0.1, 0.1, 1.0]}),  # rho^2 + h^2 < l2^2
+    ("spong_ex3_1_planar_rr", {"position": [0.3, 0.4, 0.2]}),  # off the arm's plane
+])
+def test_outside_the_workspace(client, robot_id, target):
+    result = client.post(f"/v1/robots/{robot_id}/ik", json={"target": target}).json()
+    assert result["status"] == "unreachable"
+    assert result["solutions"] == [] and result["rejected"] == []
+    assert "position" in result["detail"] and "outside the workspace" in result["detail"]
+    assert result["solver"]["method"] == "analytic" and result["solver"]["complete"] is True
+
+
+def test_scara_with_a_tilted_orientation_is_unreachable(client):
+    """Spong eq. 4.56: a SCARA can only reach R = [[cα, sα, 0], [sα, −cα, 0], [0, 0, −1]]. A reachable position with
+    that orientation is solved; tilted by 0.1 rad it is unreachable, and the detail says the orientation is."""
+    position = CLOSED_FORMS["spong_ex3_6_scara_rrpr"]([0.3, 0.7, 0.4, -0.2])[:3, 3].tolist()
+    alpha = 0.4
+    upright = [[np.cos(alpha), np.sin(alpha), 0], [np.sin(alpha), -np.cos(alpha), 0], [0, 0, -1]]
+    tilt = np.array([[1, 0, 0], [0, np.cos(0.1), -np.sin(0.1)], [0, np.sin(0.1), np.cos(0.1)]])
+    ok = client.post("/v1/robots/spong_ex3_6_scara_rrpr/ik",
+                     json={"target": {"position": position, "orientation": {"type": "matrix", "matrix": upright}}})
+    assert ok.json()["status"] == "ok" and len(ok.json()["solutions"]) == 2
+    tilted = client.post("/v1/robots/spong_ex3_6_scara_rrpr/ik", json={"target": {
+        "position": position, "orientation": {"type": "matrix", "matrix": (tilt @ upright).tolist()}}}).json()
+    assert tilted["status"] == "unreachable" and tilted["solutions"] == []
+    assert "orientation" in tilted["detail"] and "4.56" in tilted["detail"]
+    assert "position is reachable" in tilted["detail"]
+
+
+# --------------------------------------------------------------------------
+# Under-determined targets: position only, more joints than the target fixes
+# --------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("robot_id, q, free, count", [
+    (PUMA, [0.3, -0.6, 0.4, 0.8, 0.3, -0.5], [3, 4, 5], 4),
+    (ELBOW, [0.3, -0.6, 0.4, 0.8, 0.3, -0.5], [3, 4, 5], 4),
+    ("spong_ex3_6_scara_rrpr", [0.3, -0.6, 0.4, 0.8], [3], 2),
+    ("ex004_3_spherical_rrpr", [0.3, 0.6, 0.4, 0.8], [3], 4),  # 2 with q3 >= 0, 2 more with q3 < 0
+    # the wrist's tool point lies on axis 3: q3 never moves it (subproblem 3 is degenerate for every target)
+    ("spong_ex3_3_spherical_wrist_rrr", [0.5, -0.7, 1.1], [2], 2),
+])
+def test_a_position_only_target_names_the_free_joints(client, robot_id, q, free, count):
+    """The target fixes 3 coordinates; the other joints are named in ``free_joints`` and held at the reference
+    value, or 0. Targets are made with the free joints at those values, so the generating vector is a solution."""
+    robot = catalogue_robot(client, robot_id)
+    rng = np.random.default_rng(3)
+    for reference in (None, rng.uniform(-1, 1, robot.dof)):
+        held = np.zeros(len(free)) if reference is None else reference[free]
+        q = np.array(q, dtype=float)
+        q[free] = held
+        T = CLOSED_FORMS[robot_id](q)
+        options = {} if reference is None else {"reference": reference.tolist()}
+        result = _position_ik(client, robot_id, T[:3, 3], **options)
+        assert result["status"] == "ok" and result["free_joints"] == free
+        assert result["solver"]["complete"] is True
+        solutions = joints_of(result)
+        assert len(solutions) == count
+        assert np.abs(solutions[:, free] - held).max() < 1e-12  # the free joints: reference value, or 0
+        assert_fk_reaches(robot_id, result, T, position_only=True)
+        assert find(robot, solutions, q) is not None
+
+
+def test_held_free_joints_that_move_the_point_are_named_when_it_is_out_of_reach(client):
+    """The elbow arm's tool point is d6 from the wrist centre: with the wrist held at 0 some reachable points are
+    out of reach. The answer must not claim the point is outside the workspace; it names the held joints."""
+    q = np.array([0.3, -0.6, 0.4, 0.8, 1.3, -0.5])
+    T = CLOSED_FORMS[ELBOW](q)
+    held = _position_ik(client, ELBOW, T[:3, 3])
+    if held["status"] == "ok":  # this target happens to be reachable with the wrist at 0 as well
+        pytest.fail("choose a target that the held wrist cannot reach")
+    assert held["status"] == "unreachable" and held["free_joints"] == [3, 4, 5]
+    assert "outside the workspace" not in held["detail"]
+    assert "q4, q5, q6" in held["detail"]
+    reached = _position_ik(client, ELBOW, T[:3, 3], reference=q.tolist())  # held at the generating values
+    assert reached["status"] == "ok"
+    assert find(catalogue_robot(client, ELBOW), joints_of(reached), q) is not None
+
+
+def test_the_spherical_wrist_places_its_tool_point_with_two_solutions(client):
+    """Position only, the wrist's tool point is d6 (c4 s5, s4 s5, c5): θ4 = atan2(y, x), θ5 = acos(z / d6), or the
+    flip (θ4 + π, −θ5); θ6 is free (0 here)."""
+    robot = catalogue_robot(client, "spong_ex3_3_spherical_wrist_rrr")
+    x, y, z = CLOSED_FORMS["spong_ex3_3_spherical_wrist_rrr"]([0.5, -0.7, 1.1])[:3, 3]
+    solutions = joints_of(_position_ik(client, "spong_ex3_3_spherical_wrist_rrr", [x, y, z]))
+    theta4, theta5 = np.arctan2(y, x), np.arccos(z / 0.2)
+    assert find(robot, solutions, [theta4, theta5, 0.0]) is not None
+    assert find(robot, solutions, [theta4 + np.pi, -theta5, 0.0]) is not None

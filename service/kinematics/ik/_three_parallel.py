@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._positioning import _flag_rows, _unit
+from ._positioning import _flag_rows, _unit, side_labels
 from ._screws import apply, chain_motion, invert, joint_motion, rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_4
@@ -148,5 +148,6 @@ class ThreeParallelPlan:
         line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
         rejection = elbow_point - np.einsum("mi,mi->m", elbow_point, line)[:, None] * line
         side = rejection @ g.upward(g.direction(0))
-        return [{"shoulder": "left" if s >= 0 else "right", "elbow": "up" if e > 0 else "down", **w}
-                for s, e, w in zip(shoulder, side, wrist_labels(joints[:, 4]))]
+        labels = side_labels("shoulder", shoulder, np.linalg.norm(wrist_point - g.point(0), axis=-1), "left", "right")
+        elbows = side_labels("elbow", side, np.linalg.norm(elbow_point, axis=-1), "up", "down")
+        return [{**s, **e, **w} for s, e, w in zip(labels, elbows, wrist_labels(joints[:, 4]))]

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._tolerances import SINGULARITY_TOLERANCE
+from .._tolerances import GEOMETRY_TOLERANCE
 from ._screws import rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_2_chain
@@ -38,11 +38,12 @@ def wrist_labels(middle: np.ndarray) -> list[Branch]:
     """Wrist labels from the middle wrist joint's angles (M,): ``no_flip`` when its sine is positive.
 
     The flip is (q_a + π, −q_b, q_c + π) (textbook §2.3, §3.2). When the sine is
-    zero (within :data:`SINGULARITY_TOLERANCE`) the outer axes are aligned, the two
-    branches are one family and no wrist label applies.
+    zero (within the tolerance at which subproblem 2 finds the first joint free)
+    the outer axes are aligned, the two branches are one family and no wrist
+    label applies.
     """
     sine = np.sin(middle)
-    return [{} if abs(s) <= SINGULARITY_TOLERANCE else {"wrist": "no_flip" if s > 0 else "flip"} for s in sine]
+    return [{} if abs(s) <= 10 * GEOMETRY_TOLERANCE else {"wrist": "no_flip" if s > 0 else "flip"} for s in sine]
 
 
 class SphericalWrist:

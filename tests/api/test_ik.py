@@ -14,28 +14,36 @@ from tests.conftest import catalogue_robot
 from tests.ik_helpers import find, joints_of, unlimited
 from tests.oracles.closed_forms import CLOSED_FORMS
 
-#: UR5, Universal Robots' published standard-DH table (robots/ur5.yaml); the FK below is written here, as a plain
-#: product of link transforms, independent of the service (the textbook prints no closed form for the UR5).
-UR5_D = np.array([0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823])
-UR5_A = np.array([0.0, -0.425, -0.39225, 0.0, 0.0, 0.0])
-UR5_ALPHA = np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0])
-UR5_STRETCHED = [0.4, -0.5, 0.0, 0.3, 0.9, -0.2]
+def dh_fk(a, alpha, d, q) -> np.ndarray:
+    """base_T_flange of a revolute standard-DH chain, written here independently of the service.
 
-
-def ur5_fk(q: np.ndarray) -> np.ndarray:
-    """base_T_tool of the UR5 for joint vectors q, shape (..., 6) -> (..., 4, 4): A_i = Rz(θ) Tz(d) Tx(a) Rx(α)."""
+    a, alpha, d: shape (n,); q: shape (..., n) (θ offsets 0). Returns (..., 4, 4), the product of
+    A_i = Rz(θ_i) Tz(d_i) Tx(a_i) Rx(α_i) (textbook.md §1.1, eq. 3.10).
+    """
     q = np.asarray(q, dtype=float)
     T = np.broadcast_to(np.eye(4), q.shape[:-1] + (4, 4)).copy()
-    for i in range(6):
+    for i in range(q.shape[-1]):
         ct, st = np.cos(q[..., i]), np.sin(q[..., i])
-        ca, sa = np.cos(UR5_ALPHA[i]), np.sin(UR5_ALPHA[i])
+        ca, sa = np.cos(alpha[i]), np.sin(alpha[i])
         A = np.zeros(q.shape[:-1] + (4, 4))
-        A[..., 0, :] = np.stack([ct, -st * ca, st * sa, UR5_A[i] * ct], axis=-1)
-        A[..., 1, :] = np.stack([st, ct * ca, -ct * sa, UR5_A[i] * st], axis=-1)
-        A[..., 2, :] = [0.0, sa, ca, UR5_D[i]]
+        A[..., 0, :] = np.stack([ct, -st * ca, st * sa, a[i] * ct], axis=-1)
+        A[..., 1, :] = np.stack([st, ct * ca, -ct * sa, a[i] * st], axis=-1)
+        A[..., 2, :] = [0.0, sa, ca, d[i]]
         A[..., 3, 3] = 1.0
         T = T @ A
     return T
+
+
+#: UR5, Universal Robots' published standard-DH table (robots/ur5.yaml): the textbook prints no closed form.
+UR5_TABLE = dict(a=np.array([0.0, -0.425, -0.39225, 0.0, 0.0, 0.0]),
+                 alpha=np.array([np.pi / 2, 0.0, 0.0, np.pi / 2, -np.pi / 2, 0.0]),
+                 d=np.array([0.089159, 0.0, 0.0, 0.10915, 0.09465, 0.0823]))
+UR5_STRETCHED = [0.4, -0.5, 0.0, 0.3, 0.9, -0.2]
+
+
+def ur5_fk(q) -> np.ndarray:
+    """UR5 base_T_tool for q of shape (..., 6)."""
+    return dh_fk(UR5_TABLE["a"], UR5_TABLE["alpha"], UR5_TABLE["d"], q)
 
 
 # --------------------------------------------------------------------------
@@ -317,3 +325,238 @@ def test_the_spherical_wrist_places_its_tool_point_with_two_solutions(client):
     theta4, theta5 = np.arctan2(y, x), np.arccos(z / 0.2)
     assert find(robot, solutions, [theta4, theta5, 0.0]) is not None
     assert find(robot, solutions, [theta4 + np.pi, -theta5, 0.0]) is not None
+
+
+# --------------------------------------------------------------------------
+# The numeric fallback
+# --------------------------------------------------------------------------
+
+#: a 6R arm with skew axes (no two axes parallel or intersecting): no analytic family applies
+SKEW = dict(a=np.array([0.1, 0.5, 0.2, 0.05, 0.1, 0.03]), alpha=np.array([0.5, -0.9, 1.1, 0.7, -1.3, 0.4]),
+            d=np.array([0.2, 0.1, -0.15, 0.3, 0.05, 0.1]))
+SKEW_ROBOT = {"convention": "standard", "angle_unit": "rad",
+              "joints": [{"a": float(a), "alpha": float(al), "d": float(d)}
+                         for a, al, d in zip(SKEW["a"], SKEW["alpha"], SKEW["d"])]}
+SKEW_SCALE = float(np.abs(SKEW["a"]).sum() + np.abs(SKEW["d"]).sum())
+
+
+def _inline_ik(client, robot: dict, target: dict, **options):
+    response = client.post("/v1/ik", json={"robot": robot, "target": target, **options})
+    assert response.status_code == 200, response.text
+    return response.json()
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_numeric_fallback_for_an_arm_no_family_covers(client, seed):
+    q = np.random.default_rng(seed).uniform(-np.pi, np.pi, 6)
+    T = dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], q)
+    result = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()})
+    assert result["status"] == "ok"
+    assert result["solver"] == {"method": "numeric", "structure": "general", "complete": False,
+                                "time_budget_exhausted": False}
+    solutions = joints_of(result)
+    for solution in result["solutions"]:  # every solution passes an FK check independent of the service
+        assert np.abs(dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], solution["joints"]) - T).max() < 1e-9 * SKEW_SCALE
+        assert solution["residual"]["position"] <= 1e-9 * SKEW_SCALE
+        assert solution["residual"]["orientation"] <= 1e-9
+        assert solution["branch"] == {}
+    robot = type("Revolute6", (), {"is_revolute": np.ones(6, dtype=bool)})
+    assert find(robot, solutions, q) is not None  # the generating vector was found
+    for i in range(len(solutions)):  # merged: no two the same
+        others = np.delete(solutions, i, axis=0)
+        assert find(robot, others, solutions[i], tolerance=1e-6) is None
+
+
+def test_numeric_time_budget_is_respected_and_reported(client):
+    import time
+
+    T = dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], [0.3, -1.2, 0.8, 2.0, -0.4, 1.1])
+    start = time.perf_counter()
+    cut = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()}, numeric={"starts": 2000, "time_budget_ms": 5})
+    elapsed = time.perf_counter() - start
+    assert cut["solver"]["method"] == "numeric" and cut["solver"]["complete"] is False
+    assert cut["solver"]["time_budget_exhausted"] is True
+    assert "time budget" in cut["detail"]
+    assert elapsed < 2.0  # 5 ms of search plus one iteration, polishing and HTTP; not the whole 2,000-start search
+    for solution in cut["solutions"]:  # what was found before the cut is still verified
+        assert np.abs(dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], solution["joints"]) - T).max() < 1e-9 * SKEW_SCALE
+    full = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
+    assert full["solver"]["time_budget_exhausted"] is False and full["status"] == "ok"
+
+
+def _revolute(a, alpha, d, kind="revolute"):
+    return {"type": kind, "a": a, "alpha": alpha, "d": d}
+
+
+SKEW_7R = {"convention": "standard", "joints": [_revolute(0.1 * i, 0.3 + 0.2 * i, 0.05 * (i % 3)) for i in range(7)]}
+SKEW_PRISMATIC = {"convention": "standard", "joints": [
+    _revolute(0.1, 0.4, 0.2), _revolute(0.2, -0.7, 0.0, "prismatic"), _revolute(0.3, 1.0, 0.1),
+    _revolute(0.05, 0.6, 0.0, "prismatic"), _revolute(0.1, -1.1, 0.2), _revolute(0.0, 0.3, 0.1)]}
+NO_LENGTHS = {"convention": "standard", "joints": [_revolute(0, al, 0) for al in (0.9, -1.2, 0.5, 0.8, -0.6, 1.3)]}
+SKEW_2R = {"convention": "standard", "joints": [_revolute(0.3, 0.7, 0.1), _revolute(0.2, 0.0, 0.4)]}
+ONE_JOINT = {"convention": "modified", "joints": [_revolute(0.3, 0.7, 0.1)]}
+
+#: (robot, joint vector whose FK is the target, target kind): every one reachable
+REACHABLE = [
+    (SKEW_7R, [0.3, -0.2, 0.9, 1.4, -0.7, 0.2, 0.5], "pose"),  # redundant: infinitely many, some returned
+    (SKEW_PRISMATIC, [0.4, 0.3, -1.1, 0.2, 2.0, -0.6], "pose"),
+    (SKEW_PRISMATIC, [0.4, 0.3, -1.1, 0.2, 2.0, -0.6], "position"),  # 3 joints more than the target fixes
+    (SKEW_2R, [1.0, -0.5], "position"),
+    (ONE_JOINT, [0.7], "position"),
+]
+
+#: (robot, target): out of reach (or only an orientation the arm cannot give)
+UNREACHABLE = [
+    (SKEW_7R, {"position": [1e6, -1e6, 3.0], "orientation": {"type": "euler_zyz", "angles": [1, 2, 3]}}),
+    (SKEW_PRISMATIC, {"position": [50.0, 0.0, 0.0], "orientation": {"type": "rpy", "angles": [0, 0, 0]}}),
+    (NO_LENGTHS, {"position": [1.0, 0.0, 0.0], "orientation": {"type": "rpy", "angles": [0, 0, 0]}}),
+    (SKEW_2R, {"position": [0.1, 0.2, 0.3]}),
+    (ONE_JOINT, {"position": [0.3, 0.5, 0.1]}),
+]
+
+
+def _scale(robot: dict) -> float:
+    return sum(abs(j.get("a", 0)) + abs(j.get("d", 0)) for j in robot["joints"]) or 1.0
+
+
+def _fk_pose(client, robot: dict, q) -> np.ndarray:
+    return np.array(client.post("/v1/fk", json={"robot": robot, "joints": list(q)}).json()["pose"]["matrix"])
+
+
+@pytest.mark.parametrize("robot, q, kind", REACHABLE)
+@pytest.mark.parametrize("numeric", [None, {"starts": 1, "time_budget_ms": 1}])
+def test_the_numeric_fallback_never_fails_and_never_returns_a_wrong_solution(client, robot, q, kind, numeric):
+    """Reachable targets: with the default search at least one solution, every one FK-correct; with a 1-start,
+    1 ms search the answer may be empty, but is still a 200 and still correct."""
+    T = _fk_pose(client, robot, q)
+    target = {"matrix": T.tolist()} if kind == "pose" else {"position": T[:3, 3].tolist()}
+    result = _inline_ik(client, robot, target, **({} if numeric is None else {"numeric": numeric}))
+    assert result["solver"]["method"] == "numeric" and result["solver"]["complete"] is False
+    if numeric is None:
+        assert result["status"] == "ok" and result["solutions"]
+    else:
+        assert result["status"] in ("ok", "unreachable")
+    for solution in result["solutions"]:
+        reached = _fk_pose(client, robot, solution["joints"])
+        error = np.abs(reached - T).max() if kind == "pose" else np.abs(reached[:3, 3] - T[:3, 3]).max()
+        assert error < 1e-9 * _scale(robot)
+        assert solution["residual"]["position"] < 1e-9 * _scale(robot)
+
+
+@pytest.mark.parametrize("robot, target", UNREACHABLE)
+def test_unreachable_targets_of_any_arm_are_a_plain_answer(client, robot, target):
+    result = _inline_ik(client, robot, target)
+    assert result["status"] == "unreachable" and result["solutions"] == [] and result["detail"]
+    if result["solver"]["method"] == "numeric":  # it cannot prove the target is out of reach, and says so
+        assert "may be outside the workspace" in result["detail"]
+
+
+# --------------------------------------------------------------------------
+# Ordering by a reference
+# --------------------------------------------------------------------------
+
+
+def _wrapped(q):
+    return np.pi - np.mod(np.pi - np.asarray(q), 2 * np.pi)
+
+
+@pytest.mark.parametrize("norm", ["linf", "l2"])
+def test_reference_orders_nearest_first_across_the_wrap(client, norm):
+    """Continuous joints (no limits): distances are measured across the 2π wrap. The reference is one solution
+    moved by whole turns on three joints plus a small step: that solution comes first, and the order is the
+    independent wrap-aware distance's."""
+    robot = catalogue_robot(client, ELBOW)
+    q = np.array([2.9, -0.6, 0.4, -3.0, 0.3, 3.1])
+    T = CLOSED_FORMS[ELBOW](q)
+    plain = joints_of(_pose_ik(client, ELBOW, T))
+    assert len(plain) == 8
+    rng = np.random.default_rng(11)
+    for chosen in range(8):
+        reference = plain[chosen] + np.array([2 * np.pi, 0, -2 * np.pi, 0, 4 * np.pi, 0]) + rng.uniform(-0.05, 0.05, 6)
+        ordered = _pose_ik(client, ELBOW, T, reference=reference.tolist(), ordering={"norm": norm})
+        solutions = joints_of(ordered)
+        assert find(robot, solutions[:1], plain[chosen]) == 0
+        difference = np.abs(_wrapped(solutions - reference))
+        distance = difference.max(axis=1) if norm == "linf" else np.linalg.norm(difference, axis=1)
+        assert np.all(np.diff(distance) >= 0)
+        assert distance[0] <= (0.05 if norm == "linf" else 0.05 * np.sqrt(6)) + 1e-12
+        nearest = _pose_ik(client, ELBOW, T, reference=reference.tolist(), ordering={"norm": norm}, max_solutions=3)
+        assert np.allclose(joints_of(nearest), solutions[:3]) and nearest["trimmed"] == 5
+
+
+def test_reference_with_multi_turn_joints_measures_the_actual_travel(client):
+    """UR5 joints span ±360°: each solution has 2π-equivalents within the limits, different physical positions of
+    the cable-limited joint. Nearest first then means the equivalent with the least actual travel."""
+    q = np.array([0.4, -1.1, 1.3, -0.6, 1.2, -2.5])
+    T = ur5_fk(q)
+    reference = q + np.array([-2 * np.pi, 0, 0, 2 * np.pi, 0, 2 * np.pi]) + 0.01  # all within ±2π
+    result = client.post("/v1/robots/ur5/ik", json={"target": {"matrix": T.tolist()}, "reference": reference.tolist()})
+    solutions = joints_of(result.json())
+    assert np.abs(solutions[0] - (reference - 0.01)).max() < 1e-9  # the equivalent itself, not its wrapped twin
+    travel = np.abs(solutions - reference).max(axis=1)
+    assert np.all(np.diff(travel) >= 0)
+    assert np.all(np.abs(solutions) <= 2 * np.pi + 1e-9)
+
+
+# --------------------------------------------------------------------------
+# UR5: poses with fewer than 8 solutions really have fewer
+# --------------------------------------------------------------------------
+
+
+def _dense_search(target: np.ndarray, starts: int = 600, iterations: int = 60, seed: int = 0) -> np.ndarray:
+    """Every UR5 solution a Levenberg–Marquardt search from ``starts`` random starts converges to, shape (k, 6).
+
+    Independent of the service: its own FK (:func:`ur5_fk`), finite-difference Jacobian of the 12 entries of the
+    top three rows of the pose, per-start damping; converged (error < 1e-10) vectors wrapped and merged at 1e-4.
+    """
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(-np.pi, np.pi, (starts, 6))
+    damping = np.full(starts, 1e-3)
+
+    def error(joints):
+        return (target[:3, :] - ur5_fk(joints)[:, :3, :]).reshape(len(joints), 12)
+
+    e = error(q)
+    cost = np.einsum("si,si->s", e, e)
+    step_size = 1e-7
+    for _ in range(iterations):
+        J = np.empty((starts, 12, 6))
+        for i in range(6):
+            dq = np.zeros(6)
+            dq[i] = step_size
+            J[:, :, i] = (ur5_fk(q + dq) - ur5_fk(q - dq))[:, :3, :].reshape(starts, 12) / (2 * step_size)
+        Jt = np.swapaxes(J, 1, 2)
+        step = np.linalg.solve(Jt @ J + damping[:, None, None] * np.eye(6), (Jt @ e[..., None]))[..., 0]
+        trial = q + step
+        trial_error = error(trial)
+        trial_cost = np.einsum("si,si->s", trial_error, trial_error)
+        better = trial_cost < cost
+        q[better], e[better], cost[better] = trial[better], trial_error[better], trial_cost[better]
+        damping = np.where(better, np.maximum(damping * 0.3, 1e-12), damping * 10)
+    found: list[np.ndarray] = []
+    for candidate in _wrapped(q[np.sqrt(cost) < 1e-10]):
+        if not any(np.abs(_wrapped(candidate - other)).max() < 1e-4 for other in found):
+            found.append(candidate)
+    return np.array(found)
+
+
+def test_ur5_counts_are_the_real_solution_counts(client):
+    """For poses where the service returns 8, 6, 4 and 2 solutions (and the stretched-elbow pose), a dense
+    multi-start numeric search finds exactly the same set: no solution is missing, none is extra. The 8-solution
+    pose shows the search is dense enough to find them all."""
+    robot = catalogue_robot(client, "ur5")
+    q = np.random.default_rng(5).uniform(-np.pi, np.pi, (300, 6))
+    poses = ur5_fk(q)
+    results = client.post("/v1/robots/ur5/ik/batch", json={
+        "targets": [{"matrix": T.tolist()} for T in poses], "limits": unlimited(robot)}).json()["results"]
+    counts = [len(r["solutions"]) for r in results]
+    chosen = [counts.index(count) for count in (8, 6, 4, 2)]
+    cases = [(poses[i], results[i]) for i in chosen]
+    stretched = ur5_fk(np.array(UR5_STRETCHED))
+    cases.append((stretched, _pose_ik(client, "ur5", stretched)))
+    assert [len(result["solutions"]) for _, result in cases] == [8, 6, 4, 2, 5]
+    for T, result in cases:
+        service = joints_of(result)
+        searched = _dense_search(T)
+        assert len(searched) == len(service), (searched, service)
+        assert all(find(robot, service, s, tolerance=1e-4) is not None for s in searched)

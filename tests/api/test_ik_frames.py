@@ -20,11 +20,11 @@ import numpy as np
 import pytest
 
 from tests.conftest import catalogue_robot
-from tests.ik_helpers import find, fk_inline, joints_of, random_configurations
+from tests.ik_helpers import find, fk_inline, fk_matrix, joints_of, random_configurations
 
 DATA = Path(__file__).resolve().parents[1] / "data"
 ALIGNMENT = {(r["from"], r["to"]): r for r in json.loads((DATA / "puma_frame_alignment.json").read_text())["relations"]}
-TARGETS = 25
+TARGETS = 16
 
 
 def _ik(client, target: np.ndarray, *, robot_id: str | None = None, robot: dict | None = None,
@@ -80,7 +80,7 @@ def test_puma_tables_give_the_same_solutions_and_labels(client, other):
     q = random_configurations(craig, TARGETS, seed=31)
     compared = 0
     for row in q:
-        T = np.array(client.post("/v1/robots/puma560_modified/fk", json={"joints": row.tolist()}).json()["pose"]["matrix"])
+        T = fk_matrix(client, "puma560_modified", row)
         first = _ik(client, T, robot_id="puma560_modified")
         second = _ik(client, base @ T @ tool, robot_id=other)
         compared += assert_same_solutions(craig, first, second, mapping=lambda q_other: q_other - offset)
@@ -137,7 +137,7 @@ def test_a_base_and_a_tool_transform_keep_the_solutions_and_labels(client, robot
         moved["tool"] = tool.tolist()
     q = random_configurations(robot, TARGETS, seed=41)
     for row in q:
-        T = np.array(client.post(f"/v1/robots/{robot_id}/fk", json={"joints": row.tolist()}).json()["pose"]["matrix"])
+        T = fk_matrix(client, robot_id, row)
         moved_T = base @ T @ tool
         assert np.abs(fk_inline(client, moved, row) - moved_T).max() < 1e-9 * max(1.0, np.abs(moved_T).max())
         first = _ik(client, T, robot_id=robot_id, kind=kind)
@@ -194,7 +194,7 @@ def test_a_reversed_axis_negates_that_joint_and_keeps_the_labels(client, robot_i
     sign = np.ones(robot.dof)
     sign[joint] = -1.0
     for row in random_configurations(robot, TARGETS, seed=51):
-        T = np.array(client.post(f"/v1/robots/{robot_id}/fk", json={"joints": row.tolist()}).json()["pose"]["matrix"])
+        T = fk_matrix(client, robot_id, row)
         assert np.abs(fk_inline(client, flipped, sign * row) - T).max() < 1e-9 * max(1.0, np.abs(T).max())
         first = _ik(client, T, robot_id=robot_id, kind=kind)
         second = _ik(client, T, robot=flipped, kind=kind)
@@ -209,7 +209,7 @@ def test_reversing_the_middle_wrist_axis_swaps_flip_and_no_flip(client):
     flipped = reversed_axis(description(client, robot_id), 4)
     swap = {"flip": "no_flip", "no_flip": "flip"}
     for row in random_configurations(robot, 10, seed=61):
-        T = np.array(client.post(f"/v1/robots/{robot_id}/fk", json={"joints": row.tolist()}).json()["pose"]["matrix"])
+        T = fk_matrix(client, robot_id, row)
         first, second = _ik(client, T, robot_id=robot_id), _ik(client, T, robot=flipped)
         a = joints_of(first)
         assert len(a) == len(joints_of(second)) == 8
@@ -239,6 +239,6 @@ def test_an_offset_moved_along_parallel_axes_changes_nothing(client, robot_id, m
         moved["joints"][source]["d"] -= amount
         moved["joints"][destination]["d"] += amount
     for row in random_configurations(robot, TARGETS, seed=71):
-        T = np.array(client.post(f"/v1/robots/{robot_id}/fk", json={"joints": row.tolist()}).json()["pose"]["matrix"])
+        T = fk_matrix(client, robot_id, row)
         assert np.abs(fk_inline(client, moved, row) - T).max() < 1e-12
         assert_same_solutions(robot, _ik(client, T, robot_id=robot_id), _ik(client, T, robot=moved))

@@ -225,3 +225,40 @@ def test_assur_scara_table_positions_both_assembly_modes(client, mode):
         index = find(robot, solutions, [row[1], -row[4], row[7]], tolerance=5e-6 * max(1.0, row[7]))
         assert index is not None, (row, solutions)
         assert result["solutions"][index]["branch"] == {"assembly_mode": mode}
+
+
+# --------------------------------------------------------------------------
+# Errata (textbook.md §10): the misprinted formulas give no solution; the corrected ones are the service's
+# --------------------------------------------------------------------------
+
+
+def test_scara_eq_4_62_as_printed_is_not_a_solution(client):
+    """Erratum 3: d3 = oz + d4 (printed) vs d3 = −oz − d4. For every target the printed d3 misses, the service's
+    d3 is the corrected one."""
+    robot = catalogue_robot(client, "spong_ex3_6_scara_rrpr")
+    q = random_configurations(robot, 30, seed=9)
+    _, targets = _targets("spong_ex3_6_scara_rrpr", q, "pose")
+    results = client.post("/v1/robots/spong_ex3_6_scara_rrpr/ik/batch", json={"targets": targets}).json()["results"]
+    for target, result in zip(targets, results):
+        oz = target["matrix"][2][3]
+        d3 = joints_of(result)[:, 2]
+        assert np.allclose(d3, -oz - 0.2, atol=1e-12)
+        assert np.abs(d3 - (oz + 0.2)).min() > 1e-3
+
+
+def test_elbow_formulas_without_d1_are_not_solutions(client):
+    """Erratum 4: with Table 4.1's d1 = 0.5, the source's literal zc (the corrected formulas with d1 = 0) gives
+    joint vectors that are not solutions; the service returns the corrected ones (compared above)."""
+    robot = catalogue_robot(client, "spong_ex4_3_elbow_with_wrist")
+    q = random_configurations(robot, 20, seed=10)
+    checked = 0
+    for row in q:
+        T = CLOSED_FORMS["spong_ex4_3_elbow_with_wrist"](row)
+        literal = textbook_ik.elbow_with_wrist(T, d1=0.0, a2=1.0, a3=0.8, d6=0.2)
+        result = client.post("/v1/robots/spong_ex4_3_elbow_with_wrist/ik",
+                             json={"target": {"matrix": T.tolist()}}).json()
+        for branch in literal:
+            assert find(robot, joints_of(result), branch.joints, tolerance=1e-6) is None
+            assert np.abs(CLOSED_FORMS["spong_ex4_3_elbow_with_wrist"](branch.joints) - T).max() > 1e-3
+            checked += 1
+    assert checked >= 40

@@ -369,7 +369,10 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
             fitting = nearest_fitting_equivalent(robot, limits, q)
             q = q if fitting is None else fitting
         branch = dict(pool[choice].branch)
-        for key in ambiguous & branch.keys():
+        # Where two branches meet, IK leaves their label out (or the singularity makes it ambiguous): the
+        # trajectory carries the held label, or the previous sample's, through that sample.
+        undefined = (ambiguous & branch.keys()) | ({*held, *(previous_branch or {})} - branch.keys())
+        for key in undefined:
             if key in held:
                 branch[key] = held[key]
             elif previous_branch is not None and key in previous_branch:

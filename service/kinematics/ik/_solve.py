@@ -70,7 +70,8 @@ def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orien
         labels = plan.labels(joints[row, kept]) if len(kept) else []
         solutions = [Solution(joints[row, s], label, float(position[row, s]), float(orientation[row, s]))
                      for s, label in zip(kept, labels)]
-        detail = "" if solutions else _unreachable_detail(robot, targets[row], constrain_orientation, reference)
+        detail = "" if solutions else _unreachable_detail(robot, targets[row], constrain_orientation, reference,
+                                                          plan.free_joints)
         results.append(IKResult(
             status="ok" if solutions else "unreachable",
             solutions=_ordered(robot, solutions, reference),
@@ -95,8 +96,12 @@ def _polished(robot: Robot, joints: np.ndarray, targets: np.ndarray, position: n
 
 
 def _unreachable_detail(robot: Robot, target: np.ndarray, constrain_orientation: bool,
-                        reference: np.ndarray | None) -> str:
-    """Say whether the position or only the orientation is out of reach."""
+                        reference: np.ndarray | None, free_joints: list[int] = ()) -> str:
+    """Say whether the position or only the orientation is out of reach (or only with the free joints held)."""
+    if free_joints and not constrain_orientation:
+        names = ", ".join(f"q{i + 1}" for i in free_joints)
+        return (f"The target position is out of reach with the free joints {names} held at the reference values "
+                f"(or 0); other values of those joints may reach it.")
     if constrain_orientation:
         position_only = solve_ik_batch(robot, target[None], constrain_orientation=False, reference=reference)[0]
         if position_only.solutions:

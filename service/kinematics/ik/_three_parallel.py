@@ -22,12 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._positioning import _flag_rows, _up_direction, _unit
+from ._positioning import _flag_rows, _unit, side_labels
 from ._screws import apply, chain_motion, invert, joint_motion, rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_4
 from ._types import Branch, Candidates, Singularity
-from ._wrist import _perpendicular_unit
+from ._wrist import _perpendicular_unit, wrist_labels
 
 
 class ThreeParallelPlan:
@@ -128,6 +128,10 @@ class ThreeParallelPlan:
         return Candidates(joints.reshape(n, 8, 6), valid.reshape(n, 8), [], singular)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
+        """Shoulder left/right: the sign of the reach to axis 4 along link 1's forward direction. Elbow up/down:
+        the side of the line from axis 2 to axis 4 that axis 3 lies on, along the robot's up direction, measured
+        in the plane normal to the parallel axes (so the points the description puts on them do not matter).
+        Wrist: the sign of sin q5 (:func:`wrist_labels`)."""
         g, m = self.geometry, self.model
         G1 = chain_motion(m.directions[:1], m.points[:1], m.is_revolute[:1], joints[:, :1])
         G2 = chain_motion(m.directions[:2], m.points[:2], m.is_revolute[:2], joints[:, :2])
@@ -138,10 +142,12 @@ class ThreeParallelPlan:
         shoulder_point = apply(G1, g.point(1))
         elbow_point = apply(G2, g.point(2)) - shoulder_point
         reach = wrist_point - shoulder_point
+        normal = np.einsum("mij,j->mi", G1[:, :3, :3], self.omega_p)  # the parallel axes, after joint 1
+        elbow_point = elbow_point - np.einsum("mi,mi->m", elbow_point, normal)[:, None] * normal
+        reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
         line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
         rejection = elbow_point - np.einsum("mi,mi->m", elbow_point, line)[:, None] * line
-        side = rejection @ _up_direction(g.direction(0))
-        middle = np.pi - np.mod(np.pi - joints[:, 4], 2 * np.pi)
-        return [{"shoulder": "left" if s >= 0 else "right", "elbow": "up" if e > 0 else "down",
-                 "wrist": "no_flip" if 0 <= w < np.pi else "flip"}
-                for s, e, w in zip(shoulder, side, middle)]
+        side = rejection @ g.upward(g.direction(0))
+        labels = side_labels("shoulder", shoulder, np.linalg.norm(wrist_point - g.point(0), axis=-1), "left", "right")
+        elbows = side_labels("elbow", side, np.linalg.norm(elbow_point, axis=-1), "up", "down")
+        return [{**s, **e, **w} for s, e, w in zip(labels, elbows, wrist_labels(joints[:, 4]))]

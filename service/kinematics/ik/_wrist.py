@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._tolerances import SINGULARITY_TOLERANCE
+from .._tolerances import GEOMETRY_TOLERANCE
 from ._screws import rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_2_chain
@@ -34,6 +34,18 @@ def _perpendicular_unit(axis: np.ndarray) -> np.ndarray:
     return u / np.linalg.norm(u)
 
 
+def wrist_labels(middle: np.ndarray) -> list[Branch]:
+    """Wrist labels from the middle wrist joint's angles (M,): ``no_flip`` when its sine is positive.
+
+    The flip is (q_a + π, −q_b, q_c + π) (textbook §2.3, §3.2). When the sine is
+    zero (within the tolerance at which subproblem 2 finds the first joint free)
+    the outer axes are aligned, the two branches are one family and no wrist
+    label applies.
+    """
+    sine = np.sin(middle)
+    return [{} if abs(s) <= 10 * GEOMETRY_TOLERANCE else {"wrist": "no_flip" if s > 0 else "flip"} for s in sine]
+
+
 class SphericalWrist:
     """Three revolute joints meeting at the wrist centre (Spong §4.2–4.4, done with subproblems).
 
@@ -43,8 +55,7 @@ class SphericalWrist:
     outer axes), only q_a ± q_c is determined: q_a takes the reference value
     (or 0) and the singularity is reported.
 
-    Labels: ``wrist`` is ``no_flip`` when the middle joint's angle (wrapped)
-    lies in [0, π), ``flip`` otherwise.
+    Labels: see :func:`wrist_labels`.
     """
 
     name = "spherical_wrist"
@@ -87,8 +98,7 @@ class SphericalWrist:
         return WristResult(joints, valid, singular)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
-        middle = np.pi - np.mod(np.pi - joints[:, self.joints[1]], 2 * np.pi)
-        return [{"wrist": "no_flip" if 0 <= value < np.pi - SINGULARITY_TOLERANCE else "flip"} for value in middle]
+        return wrist_labels(joints[:, self.joints[1]])
 
 
 class Roll:

@@ -163,5 +163,10 @@ def limits_to_core(robot: Robot, overrides: Sequence | None, unit: AngleUnit) ->
 
 def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:
     scale = float(_unit_scale(robot, unit)[violation.joint])
+
+    def bound(value: float) -> float | None:
+        # An open side is ±inf in the core and null on the wire (JSON has no infinity).
+        return value / scale if math.isfinite(value) else None
+
     return {"joint": violation.joint, "value": violation.value / scale,
-            "lower": violation.lower / scale, "upper": violation.upper / scale}
+            "lower": bound(violation.lower), "upper": bound(violation.upper)}

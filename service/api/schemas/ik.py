@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from enum import Enum, IntEnum
 
 from pydantic import Field, model_serializer
 
@@ -12,10 +12,52 @@ from .poses import PoseTarget
 from .robots import RobotDescription
 
 
+class OrderingNorm(str, Enum):
+    """Distance between joint vectors: the largest single joint move, or the Euclidean norm."""
+
+    linf = "linf"
+    l2 = "l2"
+
+
+class Shoulder(str, Enum):
+    left = "left"
+    right = "right"
+
+
+class Elbow(str, Enum):
+    up = "up"
+    down = "down"
+
+
+class Wrist(str, Enum):
+    flip = "flip"
+    no_flip = "no_flip"
+
+
+class AssemblyMode(IntEnum):
+    """Assembly mode of a closed (Assur) group: 1 or 2."""
+
+    mode_1 = 1
+    mode_2 = 2
+
+
+class SolverMethod(str, Enum):
+    analytic = "analytic"
+    numeric = "numeric"
+
+
+class IKStatus(str, Enum):
+    """ok: at least one solution; unreachable: none exists; no_solution_within_limits: all are in `rejected`."""
+
+    ok = "ok"
+    unreachable = "unreachable"
+    no_solution_within_limits = "no_solution_within_limits"
+
+
 class Ordering(ApiModel):
     """How solutions are ranked against ``reference``."""
 
-    norm: Literal["linf", "l2"] = Field("linf", description="linf: the largest single joint move (default); l2")
+    norm: OrderingNorm = Field("linf", description="linf: the largest single joint move (default); l2")
     weights: list[Number] | None = Field(None, description="per-joint factors applied to the differences")
 
 
@@ -36,7 +78,7 @@ class IKRequest(ApiModel):
         None, description="replace the robot's limits for this request: one entry per joint, null for an "
                           "unlimited (continuous) joint; in this request's angle unit / the robot's length unit")
     ordering: Ordering = Field(default_factory=Ordering)
-    max_solutions: int | None = Field(None, ge=0, description="with reference: keep only the nearest k")
+    max_solutions: int | None = Field(None, ge=0, le=100_000, description="with reference: keep only the nearest k")
     max_joint_move: Number | None = Field(
         None, ge=0, description="with reference: keep only solutions within this distance (ordering norm)")
     max_equivalents: int = Field(1024, ge=1, le=100_000,
@@ -55,7 +97,7 @@ class IKBatchRequest(ApiModel):
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
     limits: list[JointLimitsOverride | None] | None = None
     ordering: Ordering = Field(default_factory=Ordering)
-    max_solutions: int | None = Field(None, ge=0)
+    max_solutions: int | None = Field(None, ge=0, le=100_000)
     max_joint_move: Number | None = Field(None, ge=0)
     max_equivalents: int = Field(1024, ge=1, le=100_000)
     numeric: NumericSearch = Field(default_factory=NumericSearch)
@@ -64,10 +106,10 @@ class IKBatchRequest(ApiModel):
 class Branch(ApiModel):
     """Branch labels; only the ones that apply to the arm's structure are present."""
 
-    shoulder: Literal["left", "right"] | None = None
-    elbow: Literal["up", "down"] | None = None
-    wrist: Literal["flip", "no_flip"] | None = None
-    assembly_mode: Literal[1, 2] | None = None
+    shoulder: Shoulder | None = None
+    elbow: Elbow | None = None
+    wrist: Wrist | None = None
+    assembly_mode: AssemblyMode | None = None
 
     @model_serializer(mode="wrap")
     def _present_only(self, handler):
@@ -88,7 +130,7 @@ class IKSolution(ApiModel):
 
 
 class SolverInfo(ApiModel):
-    method: Literal["analytic", "numeric"]
+    method: SolverMethod
     structure: str = Field(description="the kinematic family the solver recognised, e.g. "
                                        "'intersecting_shoulder+spherical_wrist'")
     complete: bool = Field(description="true when the method guarantees every solution was found")
@@ -105,7 +147,7 @@ class SingularityReport(ApiModel):
 
 class IKResponse(ApiModel):
     robot_id: RobotId
-    status: Literal["ok", "unreachable", "no_solution_within_limits"]
+    status: IKStatus
     detail: str | None = None
     solutions: list[IKSolution]
     rejected: list[IKSolution]

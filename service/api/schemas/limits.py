@@ -15,8 +15,8 @@ class JointLimitsOverride(JointLimits):
 class LimitViolation(ApiModel):
     joint: int = Field(description="0-based joint index")
     value: float
-    lower: float
-    upper: float
+    lower: float | None = Field(description="null when the joint has no lower bound")
+    upper: float | None = Field(description="null when the joint has no upper bound")
 
 
 class LimitsRequest(ApiModel):

@@ -54,6 +54,14 @@ def initial_guesses(robot: Robot, count: int, rng: np.random.Generator, referenc
     default_upper = np.where(robot.is_revolute, np.pi, scale)
     lower = np.where(np.isfinite(robot.lower), np.maximum(robot.lower, default_lower - 2 * np.pi), default_lower)
     upper = np.where(np.isfinite(robot.upper), np.minimum(robot.upper, default_upper + 2 * np.pi), default_upper)
+    # A joint whose whole range lies outside that window (e.g. limits [10, 10] rad) gets one window's width of
+    # its own range instead; without this, upper < lower and the draw fails.
+    empty = upper < lower
+    if empty.any():
+        width = default_upper - default_lower
+        own_lower = np.where(np.isfinite(robot.lower), robot.lower, robot.upper - width)
+        lower = np.where(empty, own_lower, lower)
+        upper = np.where(empty, np.minimum(own_lower + width, robot.upper), upper)
     starts = rng.uniform(lower, upper, (count, robot.dof))
     starts[0] = np.clip(0.0, lower, upper)
     if reference is not None and count > 1:

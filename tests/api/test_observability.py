@@ -5,14 +5,8 @@ from __future__ import annotations
 import io
 import json
 import logging
-import os
 import re
-import socket
-import subprocess
-import sys
 import time
-import urllib.error
-import urllib.request
 from pathlib import Path
 
 import pytest
@@ -22,8 +16,7 @@ from service.api.app import create_app
 from service.api.observability import JsonFormatter
 from service.config import BUILTIN_ROBOTS_DIR, Settings
 from tests.conftest import assert_problem
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.live import get, serve
 
 
 # --------------------------------------------------------------------------- request ids
@@ -169,52 +162,20 @@ def test_a_bad_robot_file_keeps_the_service_from_becoming_ready(tmp_path):
 # --------------------------------------------------------------------------- several workers, live
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def _get(url: str) -> tuple[int, str, dict]:
-    try:
-        with urllib.request.urlopen(url, timeout=5) as response:
-            return response.status, response.read().decode(), dict(response.headers)
-    except urllib.error.HTTPError as error:
-        return error.code, error.read().decode(), dict(error.headers)
-
-
-def test_several_workers_serve_and_metrics_add_up_across_them():
-    """KIN_WORKERS=2: both workers answer, and /metrics (from whichever worker) counts every request once."""
-    port = _free_port()
-    env = {**os.environ, "PORT": str(port), "HOST": "127.0.0.1", "KIN_WORKERS": "2", "KIN_LOG_LEVEL": "warning"}
-    env.pop("PROMETHEUS_MULTIPROC_DIR", None)
-    server = subprocess.Popen([sys.executable, "-m", "service"], cwd=ROOT, env=env,
-                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    try:
-        deadline = time.monotonic() + 60
-        while True:
-            try:
-                if _get(f"http://127.0.0.1:{port}/readyz")[0] == 200:
-                    break
-            except OSError:
-                pass
-            assert server.poll() is None, server.stderr.read().decode()
-            assert time.monotonic() < deadline, "the server did not become ready"
-            time.sleep(0.2)
+def test_several_workers_serve_and_metrics_add_up_across_them(tmp_path):
+    """KIN_WORKERS=2: two worker processes, each writing its samples to the multiprocess directory, and
+    /metrics (answered by whichever worker) counts every request exactly once."""
+    with serve(KIN_WORKERS="2", PROMETHEUS_MULTIPROC_DIR=str(tmp_path)) as base_url:
         time.sleep(1.0)  # let the second worker finish its start-up too
+        children = Path(f"/proc/{serve.pid}/task/{serve.pid}/children").read_text().split()
+        assert len(children) >= 2  # the workers (uvicorn may add a helper process)
+        assert {p.stem.rsplit("_", 1)[1] for p in tmp_path.glob("histogram_*.db")} <= set(children)
         for _ in range(40):
-            assert _get(f"http://127.0.0.1:{port}/v1/robots")[0] == 200
+            assert get(f"{base_url}/v1/robots")[0] == 200
         counts = set()
         for _ in range(6):
-            status, text, headers = _get(f"http://127.0.0.1:{port}/metrics")
+            status, text, _ = get(f"{base_url}/metrics")
             assert status == 200
             counts.add(_sample(text, "kin_http_requests_total", method="GET", route="/v1/robots", status="200"))
         assert counts == {40.0}
-    finally:
-        server.terminate()
-        try:
-            server.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            server.kill()
-            server.wait()
-    assert server.returncode == 0
+        assert len(list(tmp_path.glob("counter_*.db"))) >= 1

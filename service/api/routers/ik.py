@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 from fastapi import APIRouter, Depends, Request
 
@@ -16,14 +18,23 @@ from ..boundary import (
     target_matrix,
     violation_to_wire,
 )
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of
+from ..observability import observe_ik
 from ..problems import problem_responses
 from ..schemas.ik import IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest, IKResponse
 
 router = APIRouter(prefix="/v1", tags=["inverse kinematics"])
 
 
-def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
+def _budget_seconds(request: Request, body: IKRequest | IKBatchRequest, targets: int) -> tuple[float, bool]:
+    """The numeric search's time per target: the request's, within the server's cap (KIN_MAX_IK_TIME_MS) per
+    request, which a batch shares across its targets. Also whether the cap lowered the request's budget."""
+    cap_ms = settings_of(request).max_ik_time_ms / targets
+    requested_ms = body.numeric.time_budget_ms
+    return min(requested_ms, cap_ms) / 1000.0, cap_ms < requested_ms
+
+
+def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
     robot = ref.robot
     single = isinstance(body, IKRequest)
     matrices, orientation_flags = [], []
@@ -41,23 +52,33 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
     with located("body"):
         ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
                                     body.angle_unit)
-    options = IKOptions(NumericOptions(starts=body.numeric.starts,
-                                       time_budget_seconds=body.numeric.time_budget_ms / 1000.0))
+    budget, capped = _budget_seconds(request, body, len(targets))
+    options = IKOptions(NumericOptions(starts=body.numeric.starts, time_budget_seconds=budget))
     results: list[IKResult | None] = [None] * len(targets)
     for constrained in (True, False):
         rows = [i for i, flag in enumerate(orientation_flags) if flag is constrained]
         if rows:
+            started = time.perf_counter()
             solved = solve_ik_batch(robot, np.array([matrices[i] for i in rows]), constrain_orientation=constrained,
                                     reference=reference, options=options)
+            observe_ik(solved[0].method, solved[0].structure, time.perf_counter() - started,
+                       [len(result.solutions) for result in solved])
             for i, result in zip(rows, solved):
                 results[i] = result
-    return [
+    wire = [
         _to_wire(ref.id, robot, result, select(robot, result, limits, filter_limits=body.filter_limits,
                                                reference=reference, ordering=ordering,
                                                max_equivalents=body.max_equivalents),
                  body.angle_unit, orientation_flags[i])
         for i, result in enumerate(results)
     ]
+    if capped:
+        note = (f"The server capped the numeric search at {budget * 1000.0:g} ms per target "
+                f"(KIN_MAX_IK_TIME_MS per request), below the requested {body.numeric.time_budget_ms} ms.")
+        for entry in wire:
+            if entry["solver"]["time_budget_exhausted"]:
+                entry["detail"] = f"{entry['detail']} {note}" if entry["detail"] else note
+    return wire
 
 
 def _solution_to_wire(robot: Robot, entry: Selected, unit: str, constrained: bool) -> dict:
@@ -94,16 +115,16 @@ def _to_wire(robot_id: str, robot: Robot, result: IKResult, selection: Selection
 
 @router.post("/robots/{robot_id}/ik", operation_id="inverse_kinematics", response_model=IKResponse,
              responses=problem_responses(404, 422))
-def inverse_kinematics(body: IKRequest, ref: RobotRef = Depends(catalogue_robot)) -> dict:
+def inverse_kinematics(request: Request, body: IKRequest, ref: RobotRef = Depends(catalogue_robot)) -> dict:
     """Every joint vector that reaches the target pose, each checked by forward kinematics."""
-    return _solve(ref, body, [body.target])[0]
+    return _solve(request, ref, body, [body.target])[0]
 
 
 @router.post("/ik", operation_id="inverse_kinematics_inline", response_model=IKResponse,
              responses=problem_responses(422))
 def inverse_kinematics_inline(request: Request, body: IKInlineRequest) -> dict:
     """Inverse kinematics for a robot described in the request body."""
-    return _solve(inline_robot(request, body.robot), body, [body.target])[0]
+    return _solve(request, inline_robot(request, body.robot), body, [body.target])[0]
 
 
 @router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch", response_model=IKBatchResponse,
@@ -112,4 +133,4 @@ def inverse_kinematics_batch(request: Request, body: IKBatchRequest,
                              ref: RobotRef = Depends(catalogue_robot)) -> dict:
     """Every solution for each target; the analytic solvers run vectorised over the targets."""
     check_batch_size(request, len(body.targets), "targets")
-    return {"robot_id": ref.id, "results": _solve(ref, body, body.targets)}
+    return {"robot_id": ref.id, "results": _solve(request, ref, body, body.targets)}

@@ -10,7 +10,10 @@
 #     -v ./my-robots:/robots.d:ro -e KIN_ROBOTS_DIR=/robots.d kinematics-service
 #
 # Other settings are read from the environment: KIN_WORKERS, KIN_LOG_LEVEL,
-# KIN_API_KEY, KIN_MAX_BATCH, KIN_MAX_BODY_BYTES, KIN_MAX_JOINTS (see the API doc).
+# KIN_API_KEY, KIN_CORS_ORIGINS, KIN_MAX_BATCH, KIN_MAX_BODY_BYTES, KIN_MAX_JOINTS,
+# KIN_MAX_IK_TIME_MS (see the README). With KIN_WORKERS > 1 the service keeps its
+# Prometheus samples in a fresh directory under /tmp (multiprocess mode): /tmp must
+# be writable (a tmpfs or emptyDir when the root filesystem is read-only).
 
 ARG PYTHON_VERSION=3.11
 
@@ -26,16 +29,17 @@ ENV PIP_NO_CACHE_DIR=1 \
 RUN python -m venv /opt/venv
 ENV PATH=/opt/venv/bin:$PATH
 
-# Only pyproject.toml is copied first, so the (slow) dependency layer is rebuilt
-# when the dependencies change, not on every source edit. The package itself is
-# not installed into the venv: the service finds its catalogue as the `robots`
-# directory next to the `service` package, so both live side by side in /app.
-# pip and setuptools are then removed from the venv; the runtime needs neither.
+# Only requirements.lock is copied first, so the (slow) dependency layer is rebuilt
+# when the pinned dependencies change, not on every source edit. The image installs
+# exactly the versions CI audits (.ci/audit), with --no-deps: the lock is the whole
+# closure, so nothing unpinned can slip in. The package itself is not installed into
+# the venv: the service finds its catalogue as the `robots` directory next to the
+# `service` package, so both live side by side in /app. pip and setuptools are then
+# removed from the venv; the runtime needs neither.
 WORKDIR /src
-COPY pyproject.toml ./
-RUN python -c "import tomllib; print('\n'.join(tomllib.load(open('pyproject.toml', 'rb'))['project']['dependencies']))" \
-        > requirements.txt \
- && pip install --no-cache-dir -r requirements.txt \
+COPY requirements.lock ./
+RUN pip install --no-cache-dir --no-deps -r requirements.lock \
+ && pip check \
  && pip uninstall --yes pip setuptools \
  && find /opt/venv -depth -type d -name '__pycache__' -exec rm -rf {} +
 

@@ -7,10 +7,10 @@ other setting carries the ``KIN_`` prefix (see ``../shared/api.md``).
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Literal
+from typing import Annotated, Literal
 
-from pydantic import AliasChoices, Field, SecretStr
-from pydantic_settings import BaseSettings, SettingsConfigDict
+from pydantic import AliasChoices, Field, SecretStr, field_validator
+from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 #: The built-in catalogue: the ``robots`` directory beside the package.
 BUILTIN_ROBOTS_DIR = Path(__file__).resolve().parent.parent / "robots"
@@ -28,6 +28,25 @@ class Settings(BaseSettings):
     robots_dir: Path | None = Field(None, description="extra directory of robot files added to the built-in catalogue")
     builtin_robots_dir: Path = BUILTIN_ROBOTS_DIR
     api_key: SecretStr | None = Field(None, description="when set, /v1 requires the X-API-Key header")
-    max_batch: int = Field(10_000, ge=1, description="most rows in one batch request")
+    cors_origins: Annotated[list[str], NoDecode] = Field(
+        default_factory=list,
+        description="comma-separated origins allowed by CORS ('*' for any); CORS is off when empty")
+    max_batch: int = Field(10_000, ge=1, le=1_000_000, description="most rows in one batch request")
     max_body_bytes: int = Field(32 * 1024 * 1024, ge=1024, description="largest request body accepted")
-    max_joints: int = Field(32, ge=1, description="most joints a robot may have")
+    max_joints: int = Field(32, ge=1, le=1000, description="most joints a robot may have")
+    max_ik_time_ms: int = Field(
+        2000, ge=1, le=600_000,
+        description="server-side cap on the numeric IK search per request (a batch shares it across its targets)")
+
+    @field_validator("cors_origins", mode="before")
+    @classmethod
+    def _split_origins(cls, value: object) -> object:
+        if isinstance(value, str):
+            return [origin.strip() for origin in value.split(",") if origin.strip()]
+        return value
+
+    @field_validator("api_key", mode="after")
+    @classmethod
+    def _empty_key_is_unset(cls, value: SecretStr | None) -> SecretStr | None:
+        # KIN_API_KEY= (set but empty) must not turn on a key that every client trivially matches.
+        return value if value is not None and value.get_secret_value() else None

@@ -15,6 +15,8 @@ CONTRACT_OPERATIONS = {
     ("post", "/v1/robots/{robot_id}/ik/batch"): "inverse_kinematics_batch",
     ("post", "/v1/robots/{robot_id}/limits"): "check_joint_limits",
     ("post", "/v1/limits"): "check_joint_limits_inline",
+    ("post", "/v1/robots/{robot_id}/ik/trajectory"): "inverse_kinematics_trajectory",
+    ("post", "/v1/ik/trajectory"): "inverse_kinematics_trajectory_inline",
     ("get", "/healthz"): "liveness",
     ("get", "/readyz"): "readiness",
 }
@@ -44,3 +46,15 @@ def test_orientation_variants_are_named_and_tagged():
     for name, tag in [("MatrixOrientation", "matrix"), ("QuaternionOrientation", "quaternion"),
                       ("EulerZYZOrientation", "euler_zyz"), ("RPYOrientation", "rpy")]:
         assert schemas[name]["properties"]["type"]["const"] == tag
+
+
+def test_trajectory_field_names_of_the_contract():
+    """api.md, Trajectory IK: the request and per-sample response fields clients depend on."""
+    schemas = current_spec()["components"]["schemas"]
+    assert {"samples", "branch", "reference"} <= set(schemas["TrajectoryRequest"]["properties"])
+    assert {"time", "pose", "twist", "acceleration"} <= set(schemas["TrajectorySample"]["properties"])
+    assert set(schemas["Twist"]["properties"]) == {"linear", "angular"}
+    assert set(schemas["Acceleration"]["properties"]) == {"linear", "angular"}
+    assert {"time", "joints", "velocities", "accelerations", "branch", "branch_changed", "singularities"} <= set(
+        schemas["TrajectorySampleResult"]["properties"])
+    assert {"samples", "summary"} <= set(schemas["TrajectoryResponse"]["properties"])

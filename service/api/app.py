@@ -6,15 +6,20 @@ import logging
 from contextlib import asynccontextmanager
 from typing import AsyncIterator
 
+from typing import Any
+
 from fastapi import FastAPI
+from fastapi.middleware.cors import CORSMiddleware
 from fastapi.routing import APIRoute
 
 from .. import __version__
 from ..catalogue import load_catalogue
 from ..config import Settings
 from .limits import BodySizeLimit
-from .problems import install_problem_handlers
-from .routers import fk, health, ik, limits, robots
+from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
+from .problems import PROBLEM_MEDIA_TYPE, Problem, install_problem_handlers
+from .routers import fk, health, ik, limits, robots, trajectory
+from .security import API_KEY_HEADER, API_KEY_SCHEME, ApiKeyMiddleware, is_protected
 
 logger = logging.getLogger("service")
 
@@ -25,7 +30,13 @@ Forward kinematics and **every** inverse-kinematics solution of serial robots, w
 * Standard DH (Spong), modified DH (Craig) and Khalil–Kleinfinger tables are accepted.
 * All angles are radians unless the request says `"angle_unit": "deg"`; lengths are in the robot's length unit.
 * Every error is `application/problem+json` (RFC 9457) with field-level `errors`.
+* Every number in a request must be finite and within ±1e6 (see the README's "Limits of input").
+* When the service runs with `KIN_API_KEY`, every `/v1` operation needs the `X-API-Key` header.
 """
+
+_PROBLEM_DESCRIPTIONS = {401: "Missing or wrong API key (only when the service runs with KIN_API_KEY)",
+                         404: "Unknown robot", 413: "Body or batch too large", 422: "Invalid request",
+                         503: "Not ready: the catalogue is not loaded"}
 
 
 def _operation_id(route: APIRoute) -> str:
@@ -57,8 +68,71 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     app.state.catalogue = None
+    configure_logging(settings.log_level)
     install_problem_handlers(app)
+    # add_middleware wraps what is already there: the last added runs first. Order of a request:
+    # request id + access log + metrics → CORS (answers preflights itself) → API key → body size → routes.
     app.add_middleware(BodySizeLimit, max_body_bytes=settings.max_body_bytes)
-    for module in (health, robots, fk, ik, limits):
+    if settings.api_key is not None:
+        app.add_middleware(ApiKeyMiddleware, api_key=settings.api_key.get_secret_value())
+    if settings.cors_origins:
+        app.add_middleware(CORSMiddleware, allow_origins=settings.cors_origins, allow_methods=["GET", "POST"],
+                           allow_headers=["Content-Type", API_KEY_HEADER, REQUEST_ID_HEADER],
+                           expose_headers=[REQUEST_ID_HEADER], max_age=600)
+    app.add_middleware(RequestContextMiddleware)
+    for module in (health, robots, fk, ik, limits, trajectory):
         app.include_router(module.router)
+    app.include_router(metrics_router)
+
+    def openapi() -> dict[str, Any]:
+        if app.openapi_schema is None:
+            _document_problems_and_security(FastAPI.openapi(app))
+        return app.openapi_schema
+
+    app.openapi = openapi  # type: ignore[method-assign]
     return app
+
+
+def _problem(status: int) -> dict[str, Any]:
+    return {"description": _PROBLEM_DESCRIPTIONS.get(status, "Problem"),
+            "content": {PROBLEM_MEDIA_TYPE: {"schema": {"$ref": "#/components/schemas/Problem"}}}}
+
+
+def _document_problems_and_security(spec: dict[str, Any]) -> None:
+    """Declare every error an operation can answer, as problem+json only, and the API-key scheme.
+
+    Done on the finished document so that it covers every router, including ones added later:
+    401 on every ``/v1`` operation, 413 and 422 wherever there is a body, 422 wherever there are
+    parameters, 404 wherever a robot id is in the path, and 503 on the catalogue's operations.
+    """
+    components = spec.setdefault("components", {})
+    schemas = components.setdefault("schemas", {})
+    if "Problem" not in schemas:
+        problem_schema = Problem.model_json_schema(ref_template="#/components/schemas/{model}")
+        schemas.update(problem_schema.pop("$defs", {}))
+        schemas["Problem"] = problem_schema
+    components["securitySchemes"] = {API_KEY_SCHEME: {
+        "type": "apiKey", "in": "header", "name": API_KEY_HEADER,
+        "description": "Required on /v1 only when the service runs with KIN_API_KEY; compared in constant time."}}
+    for path, operations in spec.get("paths", {}).items():
+        for operation in operations.values():
+            statuses: set[int] = set()
+            if is_protected(path):
+                statuses.add(401)
+                operation["security"] = [{API_KEY_SCHEME: []}]
+            if "requestBody" in operation:
+                statuses |= {413, 422}
+            if operation.get("parameters"):
+                statuses.add(422)
+            if "{robot_id}" in path:
+                statuses.add(404)
+            if path.startswith("/v1/robots"):
+                statuses.add(503)
+            responses = operation.setdefault("responses", {})
+            for status in statuses:
+                responses.setdefault(str(status), _problem(status))
+            for status, response in responses.items():
+                if status[0] in "45":
+                    # Errors are application/problem+json only (FastAPI also lists application/json for a model).
+                    response["content"] = _problem(int(status))["content"]
+            operation["responses"] = dict(sorted(responses.items()))

@@ -18,6 +18,7 @@ from pydantic import Field
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from ..kinematics import KinematicsError
+from .observability import REQUEST_ID_HEADER, REQUEST_ID_SCOPE_KEY
 from .schemas.common import ApiModel
 
 logger = logging.getLogger("service.errors")
@@ -52,14 +53,15 @@ class ProblemError(Exception):
 
 
 def problem_response(
-    status: int, slug: str, title: str, detail: str, *, instance: str | None = None, errors: list[dict] | None = None
+    status: int, slug: str, title: str, detail: str, *, instance: str | None = None, errors: list[dict] | None = None,
+    headers: dict[str, str] | None = None,
 ) -> JSONResponse:
     body: dict[str, Any] = {"type": PROBLEM_TYPE_BASE + slug, "title": title, "status": status, "detail": detail}
     if instance:
         body["instance"] = instance
     if errors is not None:
         body["errors"] = errors
-    return JSONResponse(body, status_code=status, media_type=PROBLEM_MEDIA_TYPE)
+    return JSONResponse(body, status_code=status, media_type=PROBLEM_MEDIA_TYPE, headers=headers)
 
 
 def _describe(errors: list[dict]) -> str:
@@ -114,15 +116,29 @@ _HTTP_TITLES = {404: ("not-found", "Not found"), 405: ("method-not-allowed", "Me
 
 
 async def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResponse:
+    if exc.status_code == 400:
+        # FastAPI answers 400 when it cannot decode the body at all (e.g. bytes that are not UTF-8); the contract
+        # says a malformed body is 422, with the body as the offending field.
+        errors = [{"loc": ["body"], "msg": "the body is not valid JSON text", "type": "json_invalid"}]
+        return problem_response(422, "validation-error", "Request is not valid", _describe(errors),
+                                instance=request.url.path, errors=errors)
     slug, title = _HTTP_TITLES.get(exc.status_code, ("http-error", "HTTP error"))
-    return problem_response(exc.status_code, slug, title, str(exc.detail), instance=request.url.path)
+    # Keep the exception's headers: a 405 must carry ``Allow`` (RFC 9110 §15.5.6).
+    return problem_response(exc.status_code, slug, title, str(exc.detail), instance=request.url.path,
+                            headers=getattr(exc, "headers", None))
 
 
 async def _unexpected_error(request: Request, exc: Exception) -> JSONResponse:
-    logger.exception("unhandled error on %s %s", request.method, request.url.path)
+    # Runs in Starlette's outermost middleware, after the request-id middleware has unwound: take the id from
+    # the scope, so that the log line and the response still carry it.
+    request_id = request.scope.get(REQUEST_ID_SCOPE_KEY)
+    logger.error("unhandled error on %s %s", request.method, request.url.path, exc_info=exc,
+                 extra={"request_id": request_id})
     return problem_response(500, "internal-error", "Internal server error",
-                            "The service failed to handle this request. This is a bug; please report it.",
-                            instance=request.url.path)
+                            "The service failed to handle this request. This is a bug; please report it"
+                            + (f" with the request id {request_id}." if request_id else "."),
+                            instance=request.url.path,
+                            headers={REQUEST_ID_HEADER: request_id} if request_id else None)
 
 
 def install_problem_handlers(app: FastAPI) -> None:

@@ -28,6 +28,7 @@ from ._limits import (
     violations,
     within,
 )
+from ._rates import JointRates, TaskSpace, jacobian_derivative, joint_rates, task_space
 from ._robot import JOINT_KINDS, Joint, JointKind, Robot, check_joint_values
 from ._rotations import (
     check_rotation,
@@ -38,6 +39,8 @@ from ._rotations import (
     matrix_from_rpy,
     quaternions_from_matrices,
 )
+from ._tolerances import RATE_SINGULARITY_TOLERANCE
+from ._trajectory import TrajectoryOptions, TrajectoryResult, follow_trajectory
 
 __all__ = [
     "CONVENTIONS",
@@ -46,6 +49,7 @@ __all__ = [
     "JOINT_KINDS",
     "Joint",
     "JointKind",
+    "JointRates",
     "JointScrews",
     "LIMIT_TOLERANCE",
     "Limits",
@@ -58,15 +62,22 @@ __all__ = [
     "violations",
     "within",
     "KinematicsError",
+    "RATE_SINGULARITY_TOLERANCE",
     "Robot",
+    "TaskSpace",
+    "TrajectoryOptions",
+    "TrajectoryResult",
     "ScrewModel",
     "check_joint_values",
     "check_rotation",
     "check_transform",
     "check_unit_quaternion",
     "craig_row_from_khalil",
+    "follow_trajectory",
     "forward_kinematics",
     "geometric_jacobian",
+    "jacobian_derivative",
+    "joint_rates",
     "joint_screws",
     "link_frames",
     "link_transforms",
@@ -76,4 +87,5 @@ __all__ = [
     "matrix_from_rpy",
     "quaternions_from_matrices",
     "screw_model",
+    "task_space",
 ]

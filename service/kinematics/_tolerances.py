@@ -35,6 +35,12 @@ DUPLICATE_TOLERANCE = 1e-6
 #: a normalised distance) is smaller than this.
 SINGULARITY_TOLERANCE = 1e-7
 
+#: Joint rates are reported as singular (NaN, or damped least squares on
+#: request) where the smallest singular value of the scaled task Jacobian is
+#: below this (see :mod:`._rates`): the joint rates would be more than about a
+#: thousand times the task rate, in units of the robot's size.
+RATE_SINGULARITY_TOLERANCE = 1e-3
+
 
 def is_near_zero(value: np.ndarray | float, tolerance: float = GEOMETRY_TOLERANCE) -> np.ndarray | bool:
     """Whether ``|value| <= tolerance``, elementwise."""

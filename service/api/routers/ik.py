@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 from fastapi import APIRouter, Depends, Request
 
@@ -21,7 +23,8 @@ from ..boundary import (
     target_matrix,
     violation_to_wire,
 )
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of
+from ..observability import observe_ik
 from ..problems import problem_responses
 from ..responses import FastJSONResponse
 from ..routing import FastJSONRoute
@@ -31,8 +34,16 @@ from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinematics"])
 
 
-def _settings(robot: Robot, body: IKRequest | IKBatchRequest):
-    """Reference, limits, ordering and numeric options of a request, in core units."""
+def _budget_seconds(request: Request, body: IKRequest | IKBatchRequest, targets: int) -> tuple[float, bool]:
+    """The numeric search's time per target: the request's, within the server's cap (KIN_MAX_IK_TIME_MS) per
+    request, which a batch shares across its targets. Also whether the cap lowered the request's budget."""
+    cap_ms = settings_of(request).max_ik_time_ms / targets
+    requested_ms = body.numeric.time_budget_ms
+    return min(requested_ms, cap_ms) / 1000.0, cap_ms < requested_ms
+
+
+def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, targets: int):
+    """Reference, limits, ordering and numeric options of a request, in core units, and the numeric cap note."""
     reference = None
     if body.reference is not None:
         with located("body", "reference"):
@@ -42,12 +53,16 @@ def _settings(robot: Robot, body: IKRequest | IKBatchRequest):
     with located("body"):
         ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
                                     body.angle_unit)
-    options = IKOptions(NumericOptions(starts=body.numeric.starts,
-                                       time_budget_seconds=body.numeric.time_budget_ms / 1000.0))
-    return reference, limits, ordering, options
+    budget, capped = _budget_seconds(request, body, targets)
+    options = IKOptions(NumericOptions(starts=body.numeric.starts, time_budget_seconds=budget))
+    note = None
+    if capped:
+        note = (f"The server capped the numeric search at {budget * 1000.0:g} ms per target "
+                f"(KIN_MAX_IK_TIME_MS per request), below the requested {body.numeric.time_budget_ms} ms.")
+    return reference, limits, ordering, options, note
 
 
-def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
+def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
     robot = ref.robot
     if isinstance(body, IKRequest):
         with located("body", "target"):
@@ -55,20 +70,25 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
         matrices, flags = matrix[None], np.array([constrained])
     else:
         matrices, flags = target_matrices(targets, body.angle_unit, "body", "targets")
-    reference, limits, ordering, options = _settings(robot, body)
+    reference, limits, ordering, options, note = _settings(request, robot, body, len(targets))
     answers: list[dict | None] = [None] * len(targets)
     for constrained in (True, False):
         rows = np.flatnonzero(flags == constrained)
         if not len(rows):
             continue
+        started = time.perf_counter()
         arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
         if arrays is None:  # no analytic family: the numeric search, one target at a time
-            for row, result in zip(rows.tolist(), solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained,
-                                                                 reference=reference, options=options)):
-                answers[row] = _to_wire(ref.id, robot, result, select(
+            solved = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
+                                    options=options)
+            observe_ik(solved[0].method, solved[0].structure, time.perf_counter() - started,
+                       [len(result.solutions) for result in solved])
+            for row, result in zip(rows.tolist(), solved):
+                answers[row] = _capped(_to_wire(ref.id, robot, result, select(
                     robot, result, limits, filter_limits=body.filter_limits, reference=reference, ordering=ordering,
-                    max_equivalents=body.max_equivalents), body.angle_unit, constrained)
+                    max_equivalents=body.max_equivalents), body.angle_unit, constrained), note)
             continue
+        observe_ik("analytic", arrays.structure, time.perf_counter() - started, arrays.count.tolist())
         results = results_from_arrays(robot, arrays, matrices[rows], constrained, reference)
         chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
                                ordering=ordering, max_equivalents=body.max_equivalents)
@@ -76,14 +96,16 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
         joints = (kept.joints / _unit_scale(robot, body.angle_unit)).tolist()
         position = kept.position.tolist()
         orientation = kept.orientation.tolist() if constrained else [None] * len(position)
-        branch = [(name, np.array(values, dtype=object)[codes].tolist()) for name, (values, codes) in kept.labels.items()]
+        branch = [(name, np.array([*values, None], dtype=object)[codes].tolist())
+                  for name, (values, codes) in kept.labels.items()]
         starts = np.searchsorted(kept.target, np.arange(len(rows) + 1)).tolist()
         for local, (row, result) in enumerate(zip(rows.tolist(), results)):
             selection = chosen.selections.get(local)
             if selection is not None:
                 answers[row] = _to_wire(ref.id, robot, result, selection, body.angle_unit, constrained)
                 continue
-            solutions = [{"joints": joints[k], "branch": {name: column[k] for name, column in branch},
+            solutions = [{"joints": joints[k], "branch": {name: column[k] for name, column in branch
+                                                          if column[k] is not None},
                           "within_limits": True, "violations": [],
                           "residual": {"position": position[k], "orientation": orientation[k]}}
                          for k in range(starts[local], starts[local + 1])]
@@ -93,11 +115,11 @@ def _solve(ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> li
     return answers
 
 
-def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
+def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
     """The batch answer as columns: solve, select and encode with array operations, no loop over targets."""
     robot = ref.robot
     matrices, flags = target_matrices(body.targets, body.angle_unit, "body", "targets")
-    reference, limits, ordering, options = _settings(robot, body)
+    reference, limits, ordering, options, note = _settings(request, robot, body, len(matrices))
     n_targets = len(matrices)
     status = np.empty(n_targets, dtype=object)
     detail: list[str | None] = [None] * n_targets
@@ -113,14 +135,17 @@ def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
         rows = np.flatnonzero(flags == constrained)
         if not len(rows):
             continue
+        started = time.perf_counter()
         arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
         if arrays is None:  # no analytic family: the numeric search, one target at a time
-            for row, result in zip(rows.tolist(), solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained,
-                                                                 reference=reference, options=options)):
-                wire = _to_wire(ref.id, robot, result, select(robot, result, limits, filter_limits=body.filter_limits,
-                                                              reference=reference, ordering=ordering,
-                                                              max_equivalents=body.max_equivalents),
-                                body.angle_unit, constrained)
+            solved = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
+                                    options=options)
+            observe_ik(solved[0].method, solved[0].structure, time.perf_counter() - started,
+                       [len(result.solutions) for result in solved])
+            for row, result in zip(rows.tolist(), solved):
+                wire = _capped(_to_wire(ref.id, robot, result, select(
+                    robot, result, limits, filter_limits=body.filter_limits, reference=reference, ordering=ordering,
+                    max_equivalents=body.max_equivalents), body.angle_unit, constrained), note)
                 status[row], detail[row], truncated[row], trimmed[row], available[row] = (
                     wire["status"], wire["detail"], wire["truncated"], wire["trimmed"], wire["available"])
                 solver[row] = _index(solvers, {**wire["solver"], "free_joints": wire["free_joints"]})
@@ -128,6 +153,7 @@ def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
                 kept_tables.append(_table_from_wire(row, wire["solutions"], robot.dof))
                 rejected_tables.append(_table_from_wire(row, wire["rejected"], robot.dof))
             continue
+        observe_ik("analytic", arrays.structure, time.perf_counter() - started, arrays.count.tolist())
         chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
                                ordering=ordering, max_equivalents=body.max_equivalents)
         status[rows], truncated[rows] = chosen.status, chosen.truncated
@@ -174,6 +200,13 @@ def _solve_arrays(ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
         "solutions": _columns(kept),
         "rejected": _columns(rejected),
     })
+
+
+def _capped(wire: dict, note: str | None) -> dict:
+    """Add the server's note on a capped numeric budget to an answer whose search ran out of time."""
+    if note and wire["solver"]["time_budget_exhausted"]:
+        wire["detail"] = f"{wire['detail']} {note}" if wire["detail"] else note
+    return wire
 
 
 def _index(items: list[dict], item: dict) -> int:
@@ -257,16 +290,16 @@ def _wire(robot_id: str, result: IKResult, status: str, solutions: list[dict], r
 
 @router.post("/robots/{robot_id}/ik", operation_id="inverse_kinematics", response_model=IKResponse,
              responses=problem_responses(404, 422))
-def inverse_kinematics(body: IKRequest, ref: RobotRef = Depends(catalogue_robot)) -> dict:
+def inverse_kinematics(request: Request, body: IKRequest, ref: RobotRef = Depends(catalogue_robot)) -> dict:
     """Every joint vector that reaches the target pose, each checked by forward kinematics."""
-    return _solve(ref, body, [body.target])[0]
+    return _solve(request, ref, body, [body.target])[0]
 
 
 @router.post("/ik", operation_id="inverse_kinematics_inline", response_model=IKResponse,
              responses=problem_responses(422))
 def inverse_kinematics_inline(request: Request, body: IKInlineRequest) -> dict:
     """Inverse kinematics for a robot described in the request body."""
-    return _solve(inline_robot(request, body.robot), body, [body.target])[0]
+    return _solve(request, inline_robot(request, body.robot), body, [body.target])[0]
 
 
 @router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch",
@@ -276,7 +309,7 @@ def inverse_kinematics_batch(request: Request, body: IKBatchRequest,
     """Every solution for each target; the analytic solvers run vectorised over the targets."""
     check_batch_size(request, len(body.targets), "targets")
     if body.format == "arrays":
-        return _solve_arrays(ref, body)
+        return _solve_arrays(request, ref, body)
     # built field by field to IKBatchResponse (a test validates it against the model), so it is encoded as it
     # stands: validating tens of thousands of solution objects again would cost more than solving them
-    return FastJSONResponse({"robot_id": ref.id, "results": _solve(ref, body, body.targets)})
+    return FastJSONResponse({"robot_id": ref.id, "results": _solve(request, ref, body, body.targets)})

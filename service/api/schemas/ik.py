@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from enum import Enum, IntEnum
 from typing import Annotated, Literal
 
 from pydantic import Field, model_serializer
@@ -16,10 +17,52 @@ from .robots import RobotDescription
 NonNegative = Annotated[Number, Field(ge=0)]
 
 
+class OrderingNorm(str, Enum):
+    """Distance between joint vectors: the largest single joint move, or the Euclidean norm."""
+
+    linf = "linf"
+    l2 = "l2"
+
+
+class Shoulder(str, Enum):
+    left = "left"
+    right = "right"
+
+
+class Elbow(str, Enum):
+    up = "up"
+    down = "down"
+
+
+class Wrist(str, Enum):
+    flip = "flip"
+    no_flip = "no_flip"
+
+
+class AssemblyMode(IntEnum):
+    """Assembly mode of a closed (Assur) group: 1 or 2."""
+
+    mode_1 = 1
+    mode_2 = 2
+
+
+class SolverMethod(str, Enum):
+    analytic = "analytic"
+    numeric = "numeric"
+
+
+class IKStatus(str, Enum):
+    """ok: at least one solution; unreachable: none exists; no_solution_within_limits: all are in `rejected`."""
+
+    ok = "ok"
+    unreachable = "unreachable"
+    no_solution_within_limits = "no_solution_within_limits"
+
+
 class Ordering(ApiModel):
     """How solutions are ranked against ``reference`` (needs ``reference``)."""
 
-    norm: Literal["linf", "l2"] = Field(
+    norm: OrderingNorm = Field(
         "linf", description="linf: the largest single joint move (default); l2: the Euclidean norm of the moves")
     weights: list[NonNegative] | None = Field(
         None, description="one factor ≥ 0 per joint, multiplying that joint's move before the norm; moves are "
@@ -56,7 +99,7 @@ class IKRequestOptions(ApiModel):
         None, description="replace the robot's limits for this request: one entry per joint, null for an "
                           "unlimited (continuous) joint; in this request's angle unit / the robot's length unit")
     ordering: Ordering = Field(default_factory=Ordering, description="needs reference")
-    max_solutions: int | None = Field(None, ge=0, description="needs reference: keep only the nearest k")
+    max_solutions: int | None = Field(None, ge=0, le=100_000, description="needs reference: keep only the nearest k")
     max_joint_move: NonNegative | list[NonNegative | None] | None = Field(
         None, description="needs reference: keep only the solutions in which every joint moves at most this far "
                           "from the reference (an empty list is then a valid answer). One number bounds every "
@@ -91,10 +134,10 @@ class IKBatchRequest(IKRequestOptions, _Targets):
 class Branch(ApiModel):
     """Branch labels; only the ones that apply to the arm's structure are present."""
 
-    shoulder: Literal["left", "right"] | None = None
-    elbow: Literal["up", "down"] | None = None
-    wrist: Literal["flip", "no_flip"] | None = None
-    assembly_mode: Literal[1, 2] | None = None
+    shoulder: Shoulder | None = None
+    elbow: Elbow | None = None
+    wrist: Wrist | None = None
+    assembly_mode: AssemblyMode | None = None
 
     @model_serializer(mode="wrap")
     def _present_only(self, handler):
@@ -115,7 +158,7 @@ class IKSolution(ApiModel):
 
 
 class SolverInfo(ApiModel):
-    method: Literal["analytic", "numeric"]
+    method: SolverMethod
     structure: str = Field(description="the kinematic family the solver recognised, e.g. "
                                        "'intersecting_shoulder+spherical_wrist'")
     complete: bool = Field(description="true when the method guarantees every solution was found")
@@ -132,7 +175,7 @@ class SingularityReport(ApiModel):
 
 class IKResponse(ApiModel):
     robot_id: RobotId
-    status: Literal["ok", "unreachable", "no_solution_within_limits"]
+    status: IKStatus
     detail: str | None = None
     solutions: list[IKSolution]
     rejected: list[IKSolution]
@@ -158,7 +201,7 @@ class SolverEntry(SolverInfo):
 class TargetColumns(ApiModel):
     """Per-target fields of the arrays form, one entry per target in request order."""
 
-    status: list[Literal["ok", "unreachable", "no_solution_within_limits"]]
+    status: list[IKStatus]
     detail: list[str | None]
     solver: list[int] = Field(description="index into `solvers`")
     singularities: list[list[int]] = Field(description="indices into `singularity_reports`")

@@ -6,7 +6,7 @@ from typing import Annotated, Literal, Union
 
 from pydantic import Field, model_validator
 
-from .common import Matrix3, Matrix4, Number, ApiModel, Vector3, Vector4
+from .common import ApiModel, Matrix3, Matrix4, Number, RealMatrix4, RealVector3, RealVector4, Vector3, Vector4
 
 
 class MatrixOrientation(ApiModel):
@@ -66,9 +66,9 @@ class PoseTarget(ApiModel):
 class Pose(ApiModel):
     """A pose in the world frame, in three forms so that no client has to convert."""
 
-    matrix: Matrix4
-    position: Vector3
-    quaternion_wxyz: Vector4 = Field(description="unit quaternion (w, x, y, z) with w ≥ 0")
+    matrix: RealMatrix4
+    position: RealVector3
+    quaternion_wxyz: RealVector4 = Field(description="unit quaternion (w, x, y, z) with w ≥ 0")
 
 
 class NamedPose(Pose):

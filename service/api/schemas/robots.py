@@ -7,13 +7,28 @@ incoming dict to a local named ``d`` and break otherwise (see api.md).
 
 from __future__ import annotations
 
+from enum import Enum
 from typing import Annotated, Literal, Union
 
-from pydantic import Field, model_validator
+from pydantic import Field, RootModel, model_validator
 
 from .common import AngleUnit, Matrix4, Number, RobotId, ApiModel
 
-JointType = Literal["revolute", "prismatic"]
+class JointType(str, Enum):
+    revolute = "revolute"
+    prismatic = "prismatic"
+
+
+class Convention(str, Enum):
+    """standard: DH (Spong/Paul); modified: Craig; khalil: Khalil–Kleinfinger."""
+
+    standard = "standard"
+    modified = "modified"
+    khalil = "khalil"
+
+
+class RobotParameters(RootModel[dict[str, Number]]):
+    """Values given to the source's symbolic lengths, by symbol (informational)."""
 
 
 class JointLimits(ApiModel):
@@ -69,7 +84,7 @@ class _RobotFields(ApiModel):
     source: str = Field("", max_length=2000, description="where the parameters come from")
     angle_unit: AngleUnit = Field("rad", description="unit of alpha, theta and revolute limits in this description")
     length_unit: str = Field("m", max_length=16)
-    parameters: dict[str, Number] | None = Field(
+    parameters: RobotParameters | None = Field(
         None, description="values given to the source's symbolic lengths (informational)"
     )
     limits_source: str | None = Field(None, max_length=2000, description="where the joint limits come from")
@@ -99,7 +114,7 @@ class RobotSummary(ApiModel):
     id: RobotId
     name: str
     dof: int
-    convention: Literal["standard", "modified", "khalil"]
+    convention: Convention
     joint_types: list[JointType]
     source: str
 

@@ -38,7 +38,10 @@ class DecoupledPlan:
 
     @property
     def free_joints(self) -> list[int]:
-        return sorted(self.fixed)
+        """Joints the target does not determine: those held for a position-only target, and any the
+        positioner finds structurally free (each set to the reference value or 0)."""
+        positioner = self.positioner.free_joints if self.positioner is not None else ()
+        return sorted(set(self.fixed) | set(positioner))
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         """Candidates (N, m, n) for targets (N, 4, 4)."""

@@ -54,6 +54,14 @@ def initial_guesses(robot: Robot, count: int, rng: np.random.Generator, referenc
     default_upper = np.where(robot.is_revolute, np.pi, scale)
     lower = np.where(np.isfinite(robot.lower), np.maximum(robot.lower, default_lower - 2 * np.pi), default_lower)
     upper = np.where(np.isfinite(robot.upper), np.minimum(robot.upper, default_upper + 2 * np.pi), default_upper)
+    # A joint whose whole range lies outside that window (e.g. limits [10, 10] rad) gets one window's width of
+    # its own range instead; without this, upper < lower and the draw fails.
+    empty = upper < lower
+    if empty.any():
+        width = default_upper - default_lower
+        own_lower = np.where(np.isfinite(robot.lower), robot.lower, robot.upper - width)
+        lower = np.where(empty, own_lower, lower)
+        upper = np.where(empty, np.minimum(own_lower + width, robot.upper), upper)
     starts = rng.uniform(lower, upper, (count, robot.dof))
     starts[0] = np.clip(0.0, lower, upper)
     if reference is not None and count > 1:
@@ -105,13 +113,15 @@ def solve_numeric(
         J = J[:, rows, :]
         JtJ = np.einsum("sij,sik->sjk", J, J)
         gradient = np.einsum("sij,si->sj", J, error[active])
-        regulariser = damping[active, None, None] * np.eye(robot.dof)
-        step = np.linalg.solve(JtJ + regulariser * np.maximum(1.0, np.trace(JtJ, axis1=1, axis2=2))[:, None, None],
-                               gradient[..., None])[..., 0]
-        trial = q[active] + step
-        trial_error = residual(trial)
-        trial_cost = np.einsum("si,si->s", trial_error, trial_error)
-        improved = trial_cost < cost[active]
+        # Levenberg–Marquardt: damp the diagonal, scaled by the size of JᵀJ.
+        diagonal = np.arange(robot.dof)
+        JtJ[:, diagonal, diagonal] += (damping[active] * np.maximum(1.0, np.trace(JtJ, axis1=1, axis2=2)))[:, None]
+        with np.errstate(over="ignore", invalid="ignore"):
+            step = np.linalg.solve(JtJ, gradient[..., None])[..., 0]
+            trial = q[active] + step
+            trial_error = residual(trial)
+            trial_cost = np.einsum("si,si->s", trial_error, trial_error)
+        improved = np.isfinite(trial_cost) & (trial_cost < cost[active])  # an overflowing step is a failed step
         indices = np.flatnonzero(active)
         better = indices[improved]
         q[better] = trial[improved]

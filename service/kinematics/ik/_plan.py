@@ -12,7 +12,7 @@ from typing import Protocol
 
 import numpy as np
 
-from .._forward import screw_model
+from .._forward import link_frames, screw_model
 from .._robot import Robot
 from ._decoupled import DecoupledPlan
 from ._positioning import find_positioner
@@ -36,7 +36,10 @@ class Plan(Protocol):
 
 
 def geometry_of(robot: Robot) -> Geometry:
-    return Geometry(screw_model(robot), robot.characteristic_length)
+    """The robot's screw model, size, up direction (base z) and link x axes at q = 0, in the world frame."""
+    frames = link_frames(robot, np.zeros(robot.dof))
+    return Geometry(screw_model(robot), robot.characteristic_length, up=robot.world_T_base[:3, 2].copy(),
+                    link_x=frames[1:, :3, 0].copy())
 
 
 def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:

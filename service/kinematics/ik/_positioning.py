@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._tolerances import SINGULARITY_TOLERANCE
-from ._screws import chain_motion, move_point, rotate_about
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, SINGULARITY_TOLERANCE
+from ._screws import chain_motion, chain_rotation, move_point, rotate_about
 from ._structure import Geometry
 from ._subproblems import (
     prismatic_to_distance,
@@ -39,14 +39,26 @@ class PositionerResult:
     singularities: SingularFlags = field(default_factory=lambda: SingularFlags(0))
 
 
-def _up_direction(direction: np.ndarray) -> np.ndarray:
-    """``direction`` or its opposite, whichever points up (non-negative world z)."""
-    return -direction if direction[2] < -1e-12 else direction
-
-
 def _unit(v: np.ndarray) -> np.ndarray | None:
     norm = np.linalg.norm(v)
     return v / norm if norm > 1e-9 else None
+
+
+def side_labels(key: str, side: np.ndarray, size: np.ndarray, positive, negative) -> list[Branch]:
+    """One label per row from the sign of ``side`` (M,): ``positive`` when above 0, else ``negative``.
+
+    Where ``|side| <= DUPLICATE_TOLERANCE * size`` the row sits where its two
+    branches meet (a stretched or folded elbow, aligned Assur links, a wrist
+    point at the shoulder's boundary): the label does not apply and is left out.
+    """
+    return branches_from_codes({key: ((positive, negative), side_codes(side, size))}, len(side))
+
+
+def side_codes(side: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """:func:`side_labels` as codes (M,): 0 for ``positive``, 1 for ``negative``, −1 where the label is left out."""
+    codes = np.where(side > 0, 0, 1).astype(np.int8)
+    codes[np.abs(side) <= DUPLICATE_TOLERANCE * size] = -1
+    return codes
 
 
 def _flag_rows(flags: np.ndarray, template: Singularity, rows: SingularFlags) -> None:
@@ -58,6 +70,8 @@ class Positioner:
 
     name: str = ""
     generic_count: int = 0
+    #: joints the target never determines (structurally free): set to the reference value or 0
+    free_joints: tuple[int, ...] = ()
 
     def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> None:
         self.geometry = geometry
@@ -73,7 +87,7 @@ class Positioner:
         return branches_from_codes(self.label_codes(joints), len(joints))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        """The same labels as arrays: name → (values, codes (M,))."""
+        """The same labels as arrays: name → (values, codes (M,), −1 where the label is left out)."""
         return {}
 
     def _moved(self, q: np.ndarray, upto: int, x: np.ndarray) -> np.ndarray:
@@ -97,10 +111,15 @@ class IntersectingShoulder(Positioner):
     up to 2 roots. Then ``R(ω1, q1) R(ω2, q2) (w_3 − c) = x − c`` is
     subproblem 2, up to 2 roots: 4 in all.
 
+    When joint 3 turns about an axis through the point or through c (the
+    spherical wrist placing its tool point), subproblem 3 is degenerate for
+    every target: q_3 does not change ‖w_3 − c‖, the target does not determine
+    it, and it is a free joint (reference value or 0); 2 solutions remain.
+
     Labels: ``shoulder`` left/right is the sign of the arm's reach along the
     forward direction of link 1 (the textbook's left/right arm; "front" is left);
     ``elbow`` up/down (revolute joint 3) is the side of the shoulder–point line
-    the elbow lies on, seen along the up-pointing axis 1.
+    the elbow lies on, seen along the up-pointing axis 1. See :meth:`labels`.
     """
 
     name = "intersecting_shoulder"
@@ -116,6 +135,10 @@ class IntersectingShoulder(Positioner):
             return None
         solver = cls(geometry, joints, point)
         solver.centre = centre
+        k = joints[2]
+        if geometry.model.is_revolute[k] and (geometry.on_axis(k, solver.point) or geometry.on_axis(k, centre)):
+            solver.free_joints = (k,)  # subproblem 3 is degenerate for every target
+            solver.generic_count = 2
         return solver
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
@@ -126,6 +149,8 @@ class IntersectingShoulder(Positioner):
         if g.model.is_revolute[k]:
             third = subproblem_3(g.direction(k), w - g.point(k), c - g.point(k), reach)
             q3 = third.theta
+            if self.free_joints:  # degenerate: the representative is the reference value (or 0), not SP3's 0
+                q3 = np.where(third.valid, 0.0 if reference is None else reference[k], q3)
             w3 = g.point(k) + rotate_about(g.direction(k), q3, w - g.point(k))
         else:
             third = prismatic_to_distance(w, g.direction(k), c, reach)
@@ -166,32 +191,82 @@ class IntersectingShoulder(Positioner):
         opposite = g.point(k) + rotate_about(g.direction(k), q3 + np.pi, w - g.point(k))
         return np.linalg.norm(at - c, axis=-1) >= np.linalg.norm(opposite - c, axis=-1)
 
+    def _offset(self) -> np.ndarray | None:
+        """The shoulder offset at q = 0, shape (3,): the point's displacement from the centre along axis 2.
+
+        Joint 2 keeps that component, and so does joint 3 when it turns about an
+        axis parallel to axis 2 or slides perpendicular to it (the elbow, PUMA,
+        Stanford and polar arms). None when it is zero or not constant.
+        """
+        g, (_, j, k) = self.geometry, self.joints
+        axis = g.direction(j)
+        constant = g.parallel(j, k) if g.model.is_revolute[k] else abs(float(g.direction(k) @ axis)) <= 1e-9
+        along = float((self.point - self.centre) @ axis)
+        if not constant or abs(along) <= 1e-9 * g.length_scale:
+            return None
+        return along * axis
+
     def _forward_direction(self) -> np.ndarray:
-        """Link 1's forward direction at q = 0: the arm's reach, perpendicular to axes 1 and 2."""
+        """Link 1's forward direction at q = 0, perpendicular to axis 1: it decides left (front) from right (back).
+
+        * With a shoulder offset (the PUMA, the Stanford arm, textbook §3.3),
+          forward is ``offset × up``: the left arm is the one whose offset lies to
+          the left of its reach, seen from above. This is a property of the
+          arm, the same in every description of it (textbook §3.3: left arm
+          θ1 = φ − atan2(d, u0), reach u = +u0 along x1, offset +d along y1).
+        * Without an offset the arm is mirror-symmetric and the textbook's
+          "front" is a convention of its frames: θ1 = atan2(yc, xc) puts the
+          wrist centre along x1 (§3.2, §3.4). Forward is then the x axis of link
+          frame 1 at q = 0.
+        """
         g, (i, j, _) = self.geometry, self.joints
-        normal = _unit(np.cross(g.direction(i), g.direction(j)))
-        reach = self.point - self.centre
-        if normal is not None:
-            along = float(reach @ normal)
-            if abs(along) > 1e-9 * g.length_scale:
-                return normal * np.sign(along)
-            return -normal
-        return reach
+        axis = g.direction(i)
+        offset = self._offset()
+        if offset is not None:
+            forward = _unit(np.cross(offset, g.upward(axis)))
+            if forward is not None:
+                return forward
+        if g.link_x is not None:
+            forward = _unit(g.link_x[i] - (g.link_x[i] @ axis) * axis)
+            if forward is not None:
+                return forward
+        normal = _unit(np.cross(axis, g.direction(j)))
+        return normal if normal is not None else self.point - self.centre
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        """Shoulder left/right: the sign of the reach along link 1's forward direction (see
+        :meth:`_forward_direction`); none when the point is on axis 1. Elbow up/down (revolute joint 3,
+        unless it is free): the side of the shoulder–point line the elbow lies on, along the robot's up
+        direction, measured in the arm's plane (normal to axis 2) when axes 2 and 3 are parallel, so that
+        the choice of point on axis 3 does not matter. With the point on axis 1 the line is vertical and
+        the front configuration's limit is used (textbook §3.2: front, θ3 < 0 is up: the elbow behind).
+        """
         g, (i, j, k) = self.geometry, self.joints
         forward = rotate_about(g.direction(i), joints[:, i], self._forward_direction())
         point = self._moved(joints, k + 1, self.point)
         reach = point - self.centre
-        left = np.einsum("mi,mi->m", reach, forward) >= 0
-        codes: LabelCodes = {"shoulder": (("left", "right"), (~left).view(np.int8))}
-        if g.model.is_revolute[k]:
+        axis = g.direction(i)
+        sideways = reach - np.outer(reach @ axis, axis)
+        on_axis = np.linalg.norm(sideways, axis=-1) <= GEOMETRY_TOLERANCE * 10 * g.length_scale
+        along = np.einsum("mi,mi->m", reach, forward)
+        # on axis 1 (the shoulder singularity) front and back are one family, and at the boundary
+        # (the point as near axis 1 as the offset allows) left and right meet: no shoulder label
+        codes: LabelCodes = {"shoulder": (("left", "right"), side_codes(along, np.linalg.norm(reach, axis=-1)))}
+        if g.model.is_revolute[k] and not self.free_joints:
             elbow = self._moved(joints, k, g.point(k)) - self.centre
-            up = _up_direction(g.direction(i))
+            if g.parallel(j, k):  # work in the arm's plane, normal to axis 2
+                m = self.model
+                normal = np.einsum("mij,j->mi", chain_rotation(m.directions[:j], m.is_revolute[:j], joints[:, :j]),
+                                   g.direction(j))
+                elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
+                reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
+            up = g.upward(axis)
             line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
             rejection = elbow - np.einsum("mi,mi->m", elbow, line)[:, None] * line
             side = rejection @ up
-            codes["elbow"] = (("up", "down"), (~(side > 0)).view(np.int8))
+            # line along axis 1: "above" is undefined; take the limit from the front (the elbow behind is up)
+            side = np.where(on_axis, -(line @ up) * np.einsum("mi,mi->m", elbow, forward), side)
+            codes["elbow"] = (("up", "down"), side_codes(side, np.linalg.norm(elbow, axis=-1)))
         return codes
 
 
@@ -241,9 +316,11 @@ class ParallelShoulder(Positioner):
             q1 = np.where(free, 0.0 if reference is None else reference[i], q1)
         joints = np.stack([q1, q2, np.broadcast_to(slide.s, q2.shape)], axis=-1)
         valid = elbow.valid & elbow.exact & first.exact[..., 0] & slide.exact
+        # The point on the first axis leaves joint 1 free (subproblem 1 is degenerate); it is reachable there
+        # only with equal link lengths, the group's coincident case (textbook.md §4.2 item 6).
+        coincident = elbow.degenerate | (free & valid).any(axis=1)
         valid[:, 1] &= ~free[:, 1]
         singular = SingularFlags(n_targets)
-        coincident = elbow.degenerate
         _flag_rows(coincident, Singularity("assur_group", (i, j), "coincident",
                                            "the point is on the first axis with equal link lengths: "
                                            "joint 1 is free (increased mobility)"), singular)
@@ -254,11 +331,12 @@ class ParallelShoulder(Positioner):
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, (i, j, k) = self.geometry, self.joints
-        up = _up_direction(g.direction(i))
+        up = g.upward(g.direction(i))
         elbow = self._moved(joints, i + 1, g.point(j)) - g.point(i)
         point = self._moved(joints, k + 1, self.point) - g.point(i)
         side = np.einsum("mi,i->m", np.cross(point, elbow), up)
-        return {"assembly_mode": ((1, 2), (~(side > 0)).view(np.int8))}
+        size = np.linalg.norm(point, axis=-1) * np.linalg.norm(elbow, axis=-1)
+        return {"assembly_mode": ((1, 2), side_codes(side, size))}
 
 
 class PlanarTwoLink(Positioner):
@@ -305,11 +383,11 @@ class PlanarTwoLink(Positioner):
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         g, (i, j) = self.geometry, self.joints
-        up = _up_direction(g.direction(i))
+        up = g.upward(g.direction(i))
         elbow = self._moved(joints, i + 1, g.point(j)) - g.point(i)
         point = self._moved(joints, j + 1, self.point) - g.point(i)
         side = np.einsum("mi,i->m", np.cross(point, elbow), up)
-        return {"elbow": (("up", "down"), (~(side > 0)).view(np.int8))}
+        return {"elbow": (("up", "down"), side_codes(side, np.linalg.norm(point, axis=-1) * np.linalg.norm(elbow, axis=-1)))}
 
 
 class OneRevoluteTwoPrismatic(Positioner):

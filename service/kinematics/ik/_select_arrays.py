@@ -171,7 +171,8 @@ def _result(arrays: IKArrays, row: int) -> IKResult:
     """Target ``row`` of the arrays as an IKResult (the per-result selection's input)."""
     count = int(arrays.count[row])
     solutions = [Solution(arrays.joints[row, s], {name: values[codes[row, s]]
-                                                  for name, (values, codes) in arrays.labels.items()},
+                                                  for name, (values, codes) in arrays.labels.items()
+                                                  if codes[row, s] >= 0},
                           float(arrays.position[row, s]), float(arrays.orientation[row, s])) for s in range(count)]
     return IKResult("ok" if count else "unreachable", solutions, "analytic", arrays.structure, True)
 

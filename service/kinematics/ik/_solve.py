@@ -70,7 +70,8 @@ def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
     results = []
     for row, count in enumerate(counts):
         if count:
-            solutions = [Solution(joints[row, s], {name: values[codes[row][s]] for name, values, codes in labels},
+            solutions = [Solution(joints[row, s], {name: values[codes[row][s]] for name, values, codes in labels
+                                                   if codes[row][s] >= 0},
                                   position[row][s], orientation[row][s]) for s in range(count)]
             results.append(IKResult(status="ok", solutions=solutions, method="analytic",
                                     structure=arrays.structure, complete=True,
@@ -84,9 +85,14 @@ def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
 
 def _unreachable_details(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
                          reference: np.ndarray | None) -> dict[int, str]:
-    """For each unreachable target: whether the position or only the orientation is out of reach."""
+    """For each unreachable target: whether the position or only the orientation is out of reach (or only with
+    the free joints held)."""
     rows = np.flatnonzero(arrays.count == 0)
     details = {int(row): "The target position is outside the workspace." for row in rows}
+    if arrays.free_joints and not constrain_orientation:
+        names = ", ".join(f"q{i + 1}" for i in arrays.free_joints)
+        return {int(row): (f"The target position is out of reach with the free joints {names} held at the reference "
+                           f"values (or 0); other values of those joints may reach it.") for row in rows}
     if constrain_orientation and len(rows):
         position_only = solve_ik_arrays(robot, targets[rows], constrain_orientation=False, reference=reference)
         if position_only is not None:

@@ -8,7 +8,7 @@ relative to the robot's size, never exact equality.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -18,10 +18,21 @@ from .._tolerances import GEOMETRY_TOLERANCE
 
 @dataclass(frozen=True)
 class Geometry:
-    """A screw model plus the length scale used for relative tolerances."""
+    """A screw model plus the length scale used for relative tolerances.
+
+    ``up`` (3,) is the robot's up direction in the world frame: the z axis of
+    its base frame, so that a base transform (a tilted or ceiling mount) does
+    not change which side of an arm is "up". ``link_x`` (n, 3), when known, holds
+    the x axis of each link frame 1…n at q = 0, in the world frame: along the
+    common normal of joint axes i and i+1 in every DH convention, with the
+    sense the robot's designer chose. The textbook's "front" is defined by it
+    (θ1 = atan2(yc, xc) puts the wrist centre along x1).
+    """
 
     model: ScrewModel
     length_scale: float
+    up: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    link_x: np.ndarray | None = None
 
     @property
     def dof(self) -> int:
@@ -57,6 +68,10 @@ class Geometry:
         if all(self.parallel(indices[0], i) for i in indices[1:]):
             return None
         return _closest_common_point([self.point(i) for i in indices], directions, self.length_scale)
+
+    def upward(self, direction: np.ndarray) -> np.ndarray:
+        """``direction`` or its opposite, whichever has a non-negative component along :attr:`up`."""
+        return -direction if float(direction @ self.up) < -1e-12 else direction
 
     def on_axis(self, i: int, point: np.ndarray) -> bool:
         """Whether ``point`` lies on the axis of revolute joint i."""

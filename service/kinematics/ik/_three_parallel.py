@@ -22,12 +22,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._positioning import _flag_rows, _up_direction, _unit
+from ._positioning import _flag_rows, _unit, side_codes
 from ._screws import apply, invert, joint_motion, move_point, rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_4
 from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
-from ._wrist import _perpendicular_unit
+from ._wrist import _perpendicular_unit, wrist_codes
 
 
 class ThreeParallelPlan:
@@ -133,6 +133,10 @@ class ThreeParallelPlan:
         return branches_from_codes(self.label_codes(joints), len(joints))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        """Shoulder left/right: the sign of the reach to axis 4 along link 1's forward direction. Elbow up/down:
+        the side of the line from axis 2 to axis 4 that axis 3 lies on, along the robot's up direction, measured
+        in the plane normal to the parallel axes (so the points the description puts on them do not matter).
+        Wrist: the sign of sin q5 (:func:`wrist_labels`)."""
         g, m = self.geometry, self.model
         def moved(upto: int, x: np.ndarray) -> np.ndarray:
             return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x)
@@ -143,10 +147,12 @@ class ThreeParallelPlan:
         shoulder_point = moved(1, g.point(1))
         elbow_point = moved(2, g.point(2)) - shoulder_point
         reach = wrist_point - shoulder_point
+        normal = rotate_about(g.direction(0), joints[:, 0], self.omega_p)  # the parallel axes, after joint 1
+        elbow_point = elbow_point - np.einsum("mi,mi->m", elbow_point, normal)[:, None] * normal
+        reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
         line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
         rejection = elbow_point - np.einsum("mi,mi->m", elbow_point, line)[:, None] * line
-        side = rejection @ _up_direction(g.direction(0))
-        middle = np.pi - np.mod(np.pi - joints[:, 4], 2 * np.pi)
-        return {"shoulder": (("left", "right"), (~(shoulder >= 0)).view(np.int8)),
-                "elbow": (("up", "down"), (~(side > 0)).view(np.int8)),
-                "wrist": (("no_flip", "flip"), (~((0 <= middle) & (middle < np.pi))).view(np.int8))}
+        side = rejection @ g.upward(g.direction(0))
+        return {"shoulder": (("left", "right"), side_codes(shoulder, np.linalg.norm(wrist_point - g.point(0), axis=-1))),
+                "elbow": (("up", "down"), side_codes(side, np.linalg.norm(elbow_point, axis=-1))),
+                **wrist_codes(joints[:, 4])}

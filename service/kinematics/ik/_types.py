@@ -10,7 +10,8 @@ import numpy as np
 Branch = dict[str, str | int]
 Status = Literal["ok", "unreachable"]
 
-#: Branch labels as arrays: label name → (its values, codes of shape (M,) indexing them).
+#: Branch labels as arrays: label name → (its values, codes of shape (M,) indexing them; −1 where the label
+#: does not apply to a row, e.g. where its two branches meet).
 LabelCodes = dict[str, tuple[tuple[str | int, ...], np.ndarray]]
 
 
@@ -19,7 +20,8 @@ def branches_from_codes(codes: LabelCodes, count: int) -> list[Branch]:
     branches: list[Branch] = [{} for _ in range(count)]
     for name, (values, index) in codes.items():
         for branch, code in zip(branches, index.tolist()):
-            branch[name] = values[code]
+            if code >= 0:  # −1: the label does not apply to this row
+                branch[name] = values[code]
     return branches
 
 

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._tolerances import SINGULARITY_TOLERANCE
+from .._tolerances import GEOMETRY_TOLERANCE
 from ._screws import rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_2_chain
@@ -34,6 +34,25 @@ def _perpendicular_unit(axis: np.ndarray) -> np.ndarray:
     return u / np.linalg.norm(u)
 
 
+def wrist_labels(middle: np.ndarray) -> list[Branch]:
+    """Wrist labels from the middle wrist joint's angles (M,): ``no_flip`` when its sine is positive.
+
+    The flip is (q_a + π, −q_b, q_c + π) (textbook §2.3, §3.2). When the sine is
+    zero (within the tolerance at which subproblem 2 finds the first joint free)
+    the outer axes are aligned, the two branches are one family and no wrist
+    label applies.
+    """
+    return branches_from_codes(wrist_codes(middle), len(middle))
+
+
+def wrist_codes(middle: np.ndarray) -> LabelCodes:
+    """:func:`wrist_labels` as codes: 0 ``no_flip``, 1 ``flip``, −1 where no wrist label applies."""
+    sine = np.sin(middle)
+    codes = np.where(sine > 0, 0, 1).astype(np.int8)
+    codes[np.abs(sine) <= 10 * GEOMETRY_TOLERANCE] = -1
+    return {"wrist": (("no_flip", "flip"), codes)}
+
+
 class SphericalWrist:
     """Three revolute joints meeting at the wrist centre (Spong §4.2–4.4, done with subproblems).
 
@@ -43,8 +62,7 @@ class SphericalWrist:
     outer axes), only q_a ± q_c is determined: q_a takes the reference value
     (or 0) and the singularity is reported.
 
-    Labels: ``wrist`` is ``no_flip`` when the middle joint's angle (wrapped)
-    lies in [0, π), ``flip`` otherwise.
+    Labels: see :func:`wrist_labels`.
     """
 
     name = "spherical_wrist"
@@ -87,12 +105,10 @@ class SphericalWrist:
         return WristResult(joints, valid, singular)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
-        return branches_from_codes(self.label_codes(joints), len(joints))
+        return wrist_labels(joints[:, self.joints[1]])
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        middle = np.pi - np.mod(np.pi - joints[:, self.joints[1]], 2 * np.pi)
-        no_flip = (0 <= middle) & (middle < np.pi - SINGULARITY_TOLERANCE)
-        return {"wrist": (("no_flip", "flip"), (~no_flip).view(np.int8))}
+        return wrist_codes(joints[:, self.joints[1]])
 
 
 class Roll:

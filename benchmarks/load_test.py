@@ -1,0 +1,239 @@
+"""Load test: mixed FK, IK and limits traffic against a live server on 127.0.0.1, driven by locust.
+
+    python benchmarks/load_test.py                 # 60 s, 16 users, one server worker
+    python benchmarks/load_test.py --workers 2     # the same against KIN_WORKERS=2
+    python benchmarks/load_test.py --smoke         # 5 s, 4 users: a quick check CI can run
+    python benchmarks/load_test.py --url http://127.0.0.1:8000   # against a server already running
+
+Starts ``python -m service`` on a free loopback port (unless --url is given), warms it up, records the
+server's resident memory (RSS, all of its processes), runs the locust users for the given duration with no
+think time, records RSS again, and prints one JSON report: requests, errors, requests/s, latency percentiles
+(overall and per request kind), RSS before/after. Exits non-zero when any request failed or, for a full run,
+when RSS grew by more than --max-rss-growth-mb. Traffic goes only to 127.0.0.1 and the run stops by itself.
+
+Needs the ``load`` extra (locust): ``pip install -e '.[load]'``.
+"""
+
+from __future__ import annotations
+
+# locust monkey-patches the standard library with gevent; it must come first.
+from locust import FastHttpUser, constant, events, task  # noqa: I001
+from locust.env import Environment
+
+import argparse
+import json
+import os
+import random
+import signal
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import gevent
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from service.catalogue import load_catalogue  # noqa: E402
+from service.config import BUILTIN_ROBOTS_DIR  # noqa: E402
+from service.kinematics import forward_kinematics, quaternions_from_matrices  # noqa: E402
+
+IK_ROBOTS = ("puma560_modified", "ur5", "spong_ex3_5_stanford", "spong_ex4_3_elbow_with_wrist")
+FK_ROBOTS = ("puma560_modified", "ur5", "spong_ex3_1_planar_rr", "spong_ex3_6_scara_rrpr", "puma560_khalil")
+
+
+def _workload(seed: int = 0, count: int = 200) -> dict[str, list]:
+    """Requests precomputed once: joint vectors within limits, and IK targets that FK of such vectors reaches."""
+    catalogue = load_catalogue([BUILTIN_ROBOTS_DIR], max_joints=32)
+    rng = np.random.default_rng(seed)
+
+    def joints(robot) -> np.ndarray:
+        lower = np.where(np.isfinite(robot.lower), robot.lower, np.where(robot.is_revolute, -np.pi, -0.5))
+        upper = np.where(np.isfinite(robot.upper), robot.upper, np.where(robot.is_revolute, np.pi, 0.5))
+        return rng.uniform(lower, np.maximum(lower, upper))
+
+    fk, batch, ik, limits = [], [], [], []
+    for i in range(count):
+        robot_id = FK_ROBOTS[i % len(FK_ROBOTS)]
+        robot = catalogue.get(robot_id).robot
+        fk.append((robot_id, {"joints": joints(robot).tolist(), "frames": i % 4 == 0}))
+        batch.append((robot_id, {"joints": [joints(robot).tolist() for _ in range(50)]}))
+        limits.append((robot_id, {"joints": [(joints(robot) + rng.choice([0, 2 * np.pi])).tolist()
+                                             for _ in range(10)]}))
+        robot_id = IK_ROBOTS[i % len(IK_ROBOTS)]
+        robot = catalogue.get(robot_id).robot
+        q = joints(robot)
+        T = forward_kinematics(robot, q)
+        if i % 2:
+            target = {"matrix": T.tolist()}
+        else:
+            target = {"position": T[:3, 3].tolist(),
+                      "orientation": {"type": "quaternion", "wxyz": quaternions_from_matrices(T[None, :3, :3])[0].tolist()}}
+        ik.append((robot_id, {"target": target, "reference": q.tolist()}))
+    return {"fk": fk, "fk_batch": batch, "ik": ik, "limits": limits}
+
+
+WORKLOAD: dict[str, list] = {}
+
+
+class KinematicsUser(FastHttpUser):
+    """One client: FK 40 %, IK 35 %, limits 15 %, FK batch of 50 rows 10 %; no think time."""
+
+    wait_time = constant(0)
+
+    def _post(self, kind: str, path: str, body: dict) -> None:
+        with self.client.post(path, json=body, name=kind, catch_response=True) as response:
+            if response.status_code != 200:
+                response.failure(f"{response.status_code}: {response.text[:200]}")
+            elif kind == "ik" and response.json()["status"] != "ok":
+                response.failure(f"reachable target answered {response.json()['status']}")
+
+    @task(40)
+    def fk(self) -> None:
+        robot_id, body = random.choice(WORKLOAD["fk"])
+        self._post("fk", f"/v1/robots/{robot_id}/fk", body)
+
+    @task(35)
+    def ik(self) -> None:
+        robot_id, body = random.choice(WORKLOAD["ik"])
+        self._post("ik", f"/v1/robots/{robot_id}/ik", body)
+
+    @task(15)
+    def limits(self) -> None:
+        robot_id, body = random.choice(WORKLOAD["limits"])
+        self._post("limits", f"/v1/robots/{robot_id}/limits", body)
+
+    @task(10)
+    def fk_batch(self) -> None:
+        robot_id, body = random.choice(WORKLOAD["fk_batch"])
+        self._post("fk_batch", f"/v1/robots/{robot_id}/fk/batch", body)
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return probe.getsockname()[1]
+
+
+def _process_tree(pid: int) -> list[int]:
+    pids, frontier = [pid], [pid]
+    while frontier:
+        parent = frontier.pop()
+        try:
+            children = Path(f"/proc/{parent}/task/{parent}/children").read_text().split()
+        except OSError:
+            continue
+        pids += [int(c) for c in children]
+        frontier += [int(c) for c in children]
+    return pids
+
+
+def _rss_mb(pid: int) -> float:
+    """Resident memory of the server and all its processes (uvicorn workers), in MiB."""
+    total_kb = 0
+    for process in _process_tree(pid):
+        try:
+            for line in Path(f"/proc/{process}/status").read_text().splitlines():
+                if line.startswith("VmRSS:"):
+                    total_kb += int(line.split()[1])
+        except OSError:
+            pass
+    return total_kb / 1024.0
+
+
+def _wait_ready(base_url: str, server: subprocess.Popen | None, timeout: float = 60.0) -> None:
+    deadline = time.monotonic() + timeout
+    while True:
+        try:
+            with urllib.request.urlopen(f"{base_url}/readyz", timeout=2) as response:
+                if response.status == 200:
+                    return
+        except OSError:
+            pass
+        if server is not None and server.poll() is not None:
+            raise SystemExit(f"the server exited with {server.returncode}")
+        if time.monotonic() > deadline:
+            raise SystemExit("the server did not become ready")
+        time.sleep(0.2)
+
+
+def _run_locust(base_url: str, users: int, seconds: float) -> Environment:
+    environment = Environment(user_classes=[KinematicsUser], host=base_url, events=events)
+    runner = environment.create_local_runner()
+    runner.start(users, spawn_rate=users)
+    gevent.spawn_later(seconds, runner.quit)
+    runner.greenlet.join()
+    return environment
+
+
+def _percentiles(entry) -> dict[str, float]:
+    return {f"p{int(q * 100)}_ms": round(entry.get_response_time_percentile(q), 1) for q in (0.5, 0.9, 0.99)} | {
+        "max_ms": round(entry.max_response_time or 0.0, 1)}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--duration", type=float, default=60.0, help="seconds of load (default 60)")
+    parser.add_argument("--users", type=int, default=16, help="concurrent locust users (default 16)")
+    parser.add_argument("--workers", type=int, default=1, help="KIN_WORKERS of the server started (default 1)")
+    parser.add_argument("--url", help="use a server already running at this URL (memory is then not measured)")
+    parser.add_argument("--max-rss-growth-mb", type=float, default=20.0,
+                        help="fail a full run when the server's RSS grows by more than this (default 20 MiB)")
+    parser.add_argument("--smoke", action="store_true", help="5 s with 4 users; memory is reported, not judged")
+    args = parser.parse_args(argv)
+    if args.smoke:
+        args.duration, args.users = 5.0, 4
+
+    WORKLOAD.update(_workload())
+    server = None
+    base_url = args.url
+    if base_url is None:
+        port = _free_port()
+        env = {**os.environ, "HOST": "127.0.0.1", "PORT": str(port), "KIN_WORKERS": str(args.workers),
+               "KIN_LOG_LEVEL": "warning"}
+        server = subprocess.Popen([sys.executable, "-m", "service"], cwd=ROOT, env=env,
+                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        base_url = f"http://127.0.0.1:{port}"
+    try:
+        _wait_ready(base_url, server)
+        # Warm-up (imports, first allocations, numpy caches), not counted.
+        _run_locust(base_url, users=args.users, seconds=min(5.0, args.duration / 4))
+        rss_before = _rss_mb(server.pid) if server else None
+        environment = _run_locust(base_url, users=args.users, seconds=args.duration)
+        rss_after = _rss_mb(server.pid) if server else None
+    finally:
+        if server is not None:
+            server.send_signal(signal.SIGTERM)
+            try:
+                server.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                server.kill()
+
+    total = environment.stats.total
+    report = {
+        "duration_s": args.duration, "users": args.users, "server_workers": args.workers if server else None,
+        "requests": total.num_requests, "errors": total.num_failures,
+        "requests_per_s": round(total.num_requests / args.duration, 1),
+        **_percentiles(total),
+        "by_kind": {name: {"requests": entry.num_requests, "errors": entry.num_failures, **_percentiles(entry)}
+                    for (name, _), entry in sorted(environment.stats.entries.items())},
+        "rss_mb_before": None if rss_before is None else round(rss_before, 1),
+        "rss_mb_after": None if rss_after is None else round(rss_after, 1),
+    }
+    failures = [f"{error.name}: {error.error} x{error.occurrences}" for error in environment.stats.errors.values()]
+    if failures:
+        report["failures"] = failures
+    print(json.dumps(report, indent=2))
+    ok = total.num_failures == 0 and total.num_requests > 0
+    if ok and rss_before is not None and not args.smoke and rss_after - rss_before > args.max_rss_growth_mb:
+        print(f"RSS grew by {rss_after - rss_before:.1f} MiB (> {args.max_rss_growth_mb} MiB)", file=sys.stderr)
+        ok = False
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

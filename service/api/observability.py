@@ -1,0 +1,184 @@
+"""Request ids, structured JSON logs and Prometheus metrics.
+
+* Every request gets an id: the client's ``X-Request-ID`` when it is sane
+  (1–128 characters of ``[A-Za-z0-9._:-]``), otherwise a fresh UUID. It is
+  echoed in the ``X-Request-ID`` response header and carried by every log line
+  written while the request is handled.
+* One JSON access-log line per request on the ``service.access`` logger:
+  method, path, route template, status, duration, request id.
+* Metrics at ``/metrics`` (prometheus-client): request counts and latency by
+  route template, IK solve time by solver method and structure, solutions per
+  IK target.
+
+Several uvicorn workers: each worker is a process with its own counters. When
+``PROMETHEUS_MULTIPROC_DIR`` is set (``python -m service`` sets it to a fresh
+temporary directory whenever ``KIN_WORKERS`` > 1), prometheus-client's
+multiprocess mode is used: every worker writes its samples to that directory,
+and ``/metrics``, whichever worker answers, aggregates all of them. Only
+counters and histograms are used, which aggregate correctly across processes.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import os
+import re
+import sys
+import time
+import uuid
+from contextvars import ContextVar
+from datetime import datetime, timezone
+
+from fastapi import APIRouter
+from fastapi.responses import Response
+from prometheus_client import CONTENT_TYPE_LATEST, REGISTRY, CollectorRegistry, Counter, Histogram, generate_latest
+from prometheus_client import multiprocess
+from starlette.datastructures import MutableHeaders
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+REQUEST_ID_HEADER = "X-Request-ID"
+#: Where the request id is kept in the ASGI scope, for handlers that run outside the middleware (the 500 handler).
+REQUEST_ID_SCOPE_KEY = "kin.request_id"
+_SANE_REQUEST_ID = re.compile(r"^[A-Za-z0-9._:-]{1,128}$")
+UNMATCHED_ROUTE = "unmatched"
+
+request_id_var: ContextVar[str | None] = ContextVar("request_id", default=None)
+
+access_logger = logging.getLogger("service.access")
+
+# --------------------------------------------------------------------------- metrics
+
+_LATENCY_BUCKETS = (0.001, 0.0025, 0.005, 0.01, 0.025, 0.05, 0.1, 0.25, 0.5, 1.0, 2.5, 5.0, 10.0)
+
+HTTP_REQUESTS = Counter("kin_http_requests", "HTTP requests by method, route template and status code",
+                        ["method", "route", "status"])
+HTTP_LATENCY = Histogram("kin_http_request_duration_seconds", "HTTP request latency by method and route template",
+                         ["method", "route"], buckets=_LATENCY_BUCKETS)
+IK_SOLVE_SECONDS = Histogram("kin_ik_solve_seconds",
+                             "Time of one IK solver call (all targets of a request) by method and structure",
+                             ["method", "structure"], buckets=_LATENCY_BUCKETS)
+IK_SOLUTIONS = Histogram("kin_ik_solutions", "Solutions returned per IK target, by solver structure",
+                         ["structure"], buckets=(0, 1, 2, 4, 8, 16, 32, 64, 128, 512, 1024))
+
+
+def observe_ik(method: str, structure: str, seconds: float, solutions_per_target: list[int]) -> None:
+    """Record one solver call: its duration, and how many solutions each of its targets got."""
+    IK_SOLVE_SECONDS.labels(method, structure).observe(seconds)
+    histogram = IK_SOLUTIONS.labels(structure)
+    for count in solutions_per_target:
+        histogram.observe(count)
+
+
+def metrics_registry() -> CollectorRegistry:
+    """The registry to expose: every worker's samples in multiprocess mode, else this process's."""
+    if os.environ.get("PROMETHEUS_MULTIPROC_DIR"):
+        registry = CollectorRegistry()
+        multiprocess.MultiProcessCollector(registry)
+        return registry
+    return REGISTRY
+
+
+metrics_router = APIRouter()
+
+
+@metrics_router.get("/metrics", include_in_schema=False)
+def metrics() -> Response:
+    """Prometheus text exposition (never behind the API key)."""
+    return Response(generate_latest(metrics_registry()), media_type=CONTENT_TYPE_LATEST)
+
+
+# --------------------------------------------------------------------------- logs
+
+
+class JsonFormatter(logging.Formatter):
+    """One JSON object per line: ts, level, logger, msg, request_id (when in a request), and ``fields``."""
+
+    def format(self, record: logging.LogRecord) -> str:
+        entry: dict[str, object] = {
+            "ts": datetime.fromtimestamp(record.created, timezone.utc).isoformat(timespec="milliseconds"),
+            "level": record.levelname.lower(),
+            "logger": record.name,
+            "msg": record.getMessage(),
+        }
+        request_id = getattr(record, "request_id", None) or request_id_var.get()
+        if request_id:
+            entry["request_id"] = request_id
+        fields = getattr(record, "fields", None)
+        if isinstance(fields, dict):
+            entry.update(fields)
+        if record.exc_info:
+            entry["exc"] = self.formatException(record.exc_info)
+        return json.dumps(entry, default=str, ensure_ascii=False)
+
+
+class _StdoutHandler(logging.StreamHandler):
+    """Writes to the current ``sys.stdout`` (resolved per record, so redirected or captured output still works)."""
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.stream = sys.stdout
+        super().emit(record)
+
+
+def configure_logging(level: str) -> None:
+    """Send the ``service`` loggers to stdout as JSON lines, once per process."""
+    logger = logging.getLogger("service")
+    if not any(isinstance(handler, _StdoutHandler) for handler in logger.handlers):
+        handler = _StdoutHandler()
+        handler.setFormatter(JsonFormatter())
+        logger.addHandler(handler)
+    logger.setLevel(logging.DEBUG if level == "trace" else level.upper())
+    logger.propagate = False
+
+
+# --------------------------------------------------------------------------- middleware
+
+
+def sane_request_id(value: str | None) -> str | None:
+    return value if value is not None and _SANE_REQUEST_ID.match(value) else None
+
+
+class RequestContextMiddleware:
+    """Request id, access log and HTTP metrics for every request; the outermost of the service's middleware."""
+
+    def __init__(self, app: ASGIApp) -> None:
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.app(scope, receive, send)
+            return
+        incoming = None
+        for name, value in scope.get("headers", ()):
+            if name == b"x-request-id":
+                incoming = value.decode("latin-1")
+                break
+        request_id = sane_request_id(incoming) or uuid.uuid4().hex
+        scope[REQUEST_ID_SCOPE_KEY] = request_id
+        token = request_id_var.set(request_id)
+        status = 500  # unless a response starts: an exception escaped and the server error handler answers
+        started = time.perf_counter()
+
+        async def send_with_id(message: Message) -> None:
+            nonlocal status
+            if message["type"] == "http.response.start":
+                status = message["status"]
+                MutableHeaders(scope=message).append(REQUEST_ID_HEADER, request_id)
+            await send(message)
+
+        try:
+            await self.app(scope, receive, send_with_id)
+        finally:
+            duration = time.perf_counter() - started
+            route = getattr(scope.get("route"), "path", None) or UNMATCHED_ROUTE
+            method = scope.get("method", "")
+            HTTP_REQUESTS.labels(method, route, str(status)).inc()
+            HTTP_LATENCY.labels(method, route).observe(duration)
+            client = scope.get("client")
+            access_logger.info(
+                "%s %s %d", method, scope.get("path", ""), status,
+                extra={"fields": {"method": method, "path": scope.get("path", ""), "route": route,
+                                  "status": status, "duration_ms": round(duration * 1000.0, 3),
+                                  "client": client[0] if client else None}},
+            )
+            request_id_var.reset(token)

@@ -1,0 +1,520 @@
+"""Branch-consistent trajectories: joint positions, rates and accelerations along a sequence of poses.
+
+:func:`follow_trajectory` takes samples (time, target pose, optional twist and
+acceleration of the tool) and returns, per sample, one joint solution on a
+consistent branch with its joint velocities and accelerations. It works in
+three passes:
+
+1. **Positions**, batch-solved for every sample at once with
+   :func:`~.ik.solve_ik_batch` (vectorised over the samples for the analytic
+   families). A sample where the IK reports a free joint (a wrist, shoulder or
+   coincident-group singularity) is solved again with the previous sample's
+   joints as reference, so the free joint keeps its value instead of jumping
+   to 0.
+2. **Branch choice**, sample by sample (:func:`_follow`):
+
+   * with ``branch`` (labels to hold, e.g. ``{"assembly_mode": 1}``), the
+     solutions whose labels match; where the IK reports a singularity of the
+     kind a label names (shoulder, elbow, wrist, the Assur group for
+     ``assembly_mode``), the branches meet, so every solution there matches
+     that label and the sample reports the held value. When no solution
+     matches, the sample continues on the nearest one and says so
+     (``status = "branch_unavailable"``);
+   * among the candidates, the one nearest to the previous sample (or to
+     ``reference`` at the first sample; the first solution in IK order when
+     there is neither), wrap-aware, by the largest single joint move with
+     prismatic moves measured in units of the robot's size;
+   * revolute joints are unwrapped so that each sample continues from the
+     previous one (the first from ``reference``; without one, from its
+     (−π, π] value, or the 2π-equivalent that fits the limits);
+   * ``branch`` reports the solution's labels, except that a label the
+     sample is singular in keeps the held value or the previous sample's;
+     ``branch_changed`` is true when the labels differ from the previous
+     reached sample's.
+3. **Rates**, vectorised over all reached samples (:mod:`._rates`):
+   ``q̇ = J⁻¹ v``, ``q̈ = J⁻¹ (a − J̇ q̇)`` on the task rows the arm controls.
+   For the paper's SCARA (:func:`~._assur_arm.assur_scara_of`) positions,
+   velocities and accelerations come from the RRR Assur group instead, as in
+   the paper (two vectorised calls, one per assembly mode); the Jacobian then
+   only measures the distance to a singularity and supplies the damped answer.
+
+**Singularities.** A sample is flagged when the IK reports a singular
+condition, when the Assur group is not regular, or when its distance to a
+singularity (smallest singular value of the scaled task Jacobian, see
+:mod:`._rates`) is below ``singularity_tolerance``. A flagged sample has NaN
+rates unless ``damping`` is given, in which case they are damped least squares.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Literal, Mapping
+
+import numpy as np
+
+from ._assur import RRRCase
+from ._assur_arm import AssurScara, assur_scara_of
+from ._errors import InvalidInputError
+from ._limits import Limits, Violation, nearest_fitting_equivalent, violations, within
+from ._rates import TaskSpace, joint_rates, rate_residuals, task_space
+from ._robot import Robot, check_joint_values
+from ._tolerances import RATE_SINGULARITY_TOLERANCE
+from .ik import (
+    IKOptions,
+    IKResult,
+    Singularity,
+    distance_to_reference,
+    joint_difference,
+    plan_for,
+    solve_ik,
+    solve_ik_batch,
+)
+
+__all__ = [
+    "PaperJoints",
+    "SampleResult",
+    "TrajectoryOptions",
+    "TrajectoryResult",
+    "TrajectorySummary",
+    "follow_trajectory",
+]
+
+#: The branch labels that a singularity of each kind makes ambiguous (their two values meet there). With the
+#: point on the first axis (shoulder "free") the line from the shoulder to the point is that axis, so the
+#: elbow's side of it is undefined as well.
+LABEL_OF_SINGULARITY = {"shoulder": ("shoulder",), "elbow": ("elbow",), "wrist": ("wrist",),
+                        "assur_group": ("assembly_mode",)}
+_FREE_SHOULDER_LABELS = ("shoulder", "elbow")
+
+
+def ambiguous_labels(singularities: list[Singularity]) -> set[str]:
+    """The branch labels that do not tell the branches apart at a sample with these singular conditions."""
+    labels: set[str] = set()
+    for s in singularities:
+        labels.update(_FREE_SHOULDER_LABELS if (s.kind, s.relation) == ("shoulder", "free")
+                      else LABEL_OF_SINGULARITY.get(s.kind, ()))
+    return labels
+
+#: Singularity relations under which the IK sets a free joint (to the reference, here the previous sample).
+_FREE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum", "coincident"})
+
+
+@dataclass(frozen=True)
+class TrajectoryOptions:
+    """How to follow a trajectory.
+
+    Attributes
+    ----------
+    branch : mapping, optional
+        Branch labels to hold, as the IK names them (``{"shoulder": "left"}``,
+        ``{"assembly_mode": 1}``).
+    reference : ndarray, shape (n,), optional
+        Joint values the first sample continues from (radians, length units).
+    limits : Limits, optional
+        Limits to check (default: the robot's).
+    singularity_tolerance : float
+        Smallest singular value of the scaled task Jacobian below which a
+        sample is singular.
+    damping : float, optional
+        λ for damped least-squares rates at singular samples; None leaves
+        their rates NaN.
+    ik : IKOptions
+        Passed to the position IK.
+    """
+
+    branch: Mapping[str, str | int] | None = None
+    reference: np.ndarray | None = None
+    limits: Limits | None = None
+    singularity_tolerance: float = RATE_SINGULARITY_TOLERANCE
+    damping: float | None = None
+    ik: IKOptions = field(default_factory=IKOptions)
+
+
+@dataclass(frozen=True)
+class PaperJoints:
+    """The paper's SCARA joints (θ1, θ2 = θ1 − θ_BC, l3), rates and accelerations, and the group's case."""
+
+    joints: np.ndarray
+    velocities: np.ndarray
+    accelerations: np.ndarray
+    case: str
+
+
+@dataclass
+class SampleResult:
+    """One sample of the trajectory. Arrays have shape (n,); rates are NaN where not computed."""
+
+    time: float
+    status: Literal["ok", "unreachable", "branch_unavailable"]
+    joints: np.ndarray | None = None
+    velocities: np.ndarray | None = None
+    accelerations: np.ndarray | None = None
+    branch: dict = field(default_factory=dict)
+    branch_changed: bool = False
+    singularities: list[Singularity] = field(default_factory=list)
+    distance_to_singularity: float | None = None
+    damped: bool = False
+    violations: list[Violation] = field(default_factory=list)
+    velocity_residual: float | None = None
+    acceleration_residual: float | None = None
+    paper: PaperJoints | None = None
+
+    @property
+    def reached(self) -> bool:
+        return self.joints is not None
+
+
+@dataclass
+class TrajectorySummary:
+    """Over the whole trajectory.
+
+    ``largest_joint_step`` (n,) is the largest |q_i(k) − q_i(k−1)| over
+    consecutive samples that were both reached (NaN if there are none), and
+    ``largest_joint_step_at`` the sample k where it happens. The smallest
+    distance to a singularity is over the reached samples.
+    """
+
+    largest_joint_step: np.ndarray
+    largest_joint_step_at: list[int | None]
+    smallest_distance_to_singularity: float | None
+    smallest_distance_at: int | None
+    limit_violations: list[tuple[int, Violation]]
+    singular_samples: list[int]
+    branch_changes: list[int]
+    unreachable_samples: list[int]
+
+
+@dataclass
+class TrajectoryResult:
+    samples: list[SampleResult]
+    summary: TrajectorySummary
+    method: str
+    structure: str
+    complete: bool
+    rates: Literal["jacobian", "assur_group"]
+    task: TaskSpace
+    assur: AssurScara | None
+
+
+# --------------------------------------------------------------------------
+# Validation
+# --------------------------------------------------------------------------
+
+
+def _check_times(times) -> np.ndarray:
+    t = np.asarray(times, dtype=float)
+    if t.ndim != 1 or len(t) == 0:
+        raise InvalidInputError(f"times must be a non-empty list, got shape {t.shape}", location=("samples",))
+    bad = np.flatnonzero(~np.isfinite(t))
+    if len(bad):
+        raise InvalidInputError("time must be finite", location=("samples", int(bad[0]), "time"))
+    back = np.flatnonzero(np.diff(t) <= 0.0)
+    if len(back):
+        k = int(back[0]) + 1
+        raise InvalidInputError(f"sample times must increase strictly: sample {k} has time {t[k]:g}, "
+                                f"sample {k - 1} has {t[k - 1]:g}", location=("samples", k, "time"))
+    return t
+
+
+def _check_cartesian(values, name: str, count: int, task: TaskSpace) -> tuple[np.ndarray | None, np.ndarray]:
+    """(N, 6) with NaN for parts not given; and which samples gave one. Parts the task needs must be given."""
+    if values is None:
+        return None, np.zeros(count, dtype=bool)
+    array = np.array(values, dtype=float)
+    if array.shape != (count, 6):
+        raise InvalidInputError(f"{name} must have shape ({count}, 6), got {array.shape}", location=(name,))
+    given = ~np.isnan(array).all(axis=1)
+    if np.isinf(array).any():
+        row = int(np.argwhere(np.isinf(array))[0][0])
+        raise InvalidInputError(f"{name} must be finite", location=("samples", row, name))
+    needs = [("linear", slice(0, 3), task.uses_linear), ("angular", slice(3, 6), task.uses_angular)]
+    for part, columns, needed in needs:
+        missing = given & np.isnan(array[:, columns]).any(axis=1)
+        if needed and missing.any():
+            row = int(np.flatnonzero(missing)[0])
+            raise InvalidInputError(
+                f"this arm's rates are solved on the task rows {', '.join(task.names)}, which need the "
+                f"{part} part of the {name}", location=("samples", row, name, part))
+    return array, given
+
+
+def _check_branch(branch: Mapping | None, results: list[IKResult]) -> dict:
+    if not branch:
+        return {}
+    available = {key for result in results for solution in result.solutions for key in solution.branch}
+    if any(result.solutions for result in results):
+        for key in branch:
+            if key not in available:
+                names = ", ".join(sorted(available)) or "none"
+                raise InvalidInputError(
+                    f"this arm's solutions carry the branch labels: {names} (structure {results[0].structure}); "
+                    f"{key!r} is not one of them", location=("branch", key))
+    return dict(branch)
+
+
+# --------------------------------------------------------------------------
+# Following
+# --------------------------------------------------------------------------
+
+
+def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orientation: bool = True,
+                      twists=None, accelerations=None,
+                      options: TrajectoryOptions | None = None) -> TrajectoryResult:
+    """Joint positions, velocities and accelerations on one branch along a sampled tool trajectory.
+
+    Parameters
+    ----------
+    times : array-like, shape (N,)
+        Strictly increasing sample times [s].
+    world_T_targets : array-like, shape (N, 4, 4)
+        Target poses; only their positions count when ``constrain_orientation`` is false.
+    twists : array-like, shape (N, 6), optional
+        ``[ṗ; ω]`` of the tool origin in the world frame (length/s, rad/s). A
+        row of NaN means no twist for that sample (its rates are NaN); a NaN
+        part that the arm's task rows need is an error.
+    accelerations : array-like, shape (N, 6), optional
+        ``[p̈; ω̇]`` (length/s², rad/s²), the same way. A sample with an
+        acceleration needs a twist.
+    options : TrajectoryOptions
+
+    Returns
+    -------
+    TrajectoryResult
+
+    Raises
+    ------
+    InvalidInputError
+        Non-increasing or non-finite times, a twist or acceleration of the
+        wrong shape or lacking a part the arm needs, an acceleration without a
+        twist, a branch label the arm's solutions do not carry, a reference of
+        the wrong length; the location names the sample and field.
+    """
+    options = options or TrajectoryOptions()
+    times = _check_times(times)
+    targets = np.asarray(world_T_targets, dtype=float)
+    count = len(times)
+    if targets.shape != (count, 4, 4):
+        raise InvalidInputError(f"expected {count} target poses of shape (4, 4), got shape {targets.shape}",
+                                location=("samples",))
+    reference = None
+    if options.reference is not None:
+        try:
+            reference = check_joint_values(robot, options.reference)
+        except InvalidInputError as error:
+            raise error.relocated("reference") from None
+    if not np.isfinite(options.singularity_tolerance) or options.singularity_tolerance < 0:
+        raise InvalidInputError("singularity_tolerance must be a non-negative number",
+                                location=("singularity_tolerance",))
+    if options.damping is not None and not (np.isfinite(options.damping) and options.damping > 0):
+        raise InvalidInputError("damping must be a positive number", location=("damping",))
+    limits = options.limits or Limits.of(robot)
+
+    plan = plan_for(robot, constrain_orientation=constrain_orientation, reference=reference)
+    task = task_space(robot, constrain_orientation=constrain_orientation,
+                      free_joints=plan.free_joints if plan is not None else ())
+    twist, has_twist = _check_cartesian(twists, "twist", count, task)
+    acceleration, has_acceleration = _check_cartesian(accelerations, "acceleration", count, task)
+    orphan = np.flatnonzero(has_acceleration & ~has_twist)
+    if len(orphan):
+        raise InvalidInputError("an acceleration needs the sample's twist (q̈ = J⁻¹(a − J̇q̇) needs q̇)",
+                                location=("samples", int(orphan[0]), "acceleration"))
+    results = solve_ik_batch(robot, targets, constrain_orientation=constrain_orientation, reference=reference,
+                             options=options.ik)
+    held = _check_branch(options.branch, results)
+
+    samples = _follow(robot, times, targets, results, held, reference, limits, constrain_orientation, options.ik)
+    assur = assur_scara_of(robot)
+    reached = np.array([k for k, s in enumerate(samples) if s.reached], dtype=int)
+    if len(reached):
+        _rates_of(robot, samples, reached, targets, twist, acceleration, task, assur, options)
+    for sample in samples:
+        if sample.reached:
+            sample.violations = violations(robot, limits, sample.joints)
+    first = results[0]
+    return TrajectoryResult(samples, _summary(robot, samples), first.method, first.structure,
+                            all(r.complete for r in results), "assur_group" if assur else "jacobian", task, assur)
+
+
+def _has_free_joint(result: IKResult) -> bool:
+    return any(s.relation in _FREE_RELATIONS for s in result.singularities)
+
+
+def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[IKResult], held: dict,
+            reference: np.ndarray | None, limits: Limits, constrain_orientation: bool,
+            ik_options: IKOptions) -> list[SampleResult]:
+    """Choose one solution per sample (the branch rules of the module docstring)."""
+    weights = np.where(robot.is_revolute, 1.0, 1.0 / robot.characteristic_length)
+    previous_q = reference
+    previous_branch: dict | None = None
+    samples: list[SampleResult] = []
+    for k, result in enumerate(results):
+        if previous_q is not None and _has_free_joint(result):
+            result = solve_ik(robot, targets[k], constrain_orientation=constrain_orientation, reference=previous_q,
+                              options=ik_options)
+        if not result.solutions:
+            samples.append(SampleResult(float(times[k]), "unreachable"))
+            continue
+        ambiguous = ambiguous_labels(result.singularities)
+        matching = [s for s in result.solutions
+                    if all(s.branch.get(key) == value or key in ambiguous for key, value in held.items())]
+        pool = matching or result.solutions
+        joints = np.array([s.joints for s in pool])
+        choice = 0
+        if previous_q is not None:
+            choice = int(np.argmin(distance_to_reference(robot, joints, previous_q, weights=weights)))
+        q = joints[choice]
+        if previous_q is not None:
+            q = _continued(robot, limits, q, previous_q)
+        elif not within(robot, limits, q):
+            fitting = nearest_fitting_equivalent(robot, limits, q)
+            q = q if fitting is None else fitting
+        branch = dict(pool[choice].branch)
+        # Where two branches meet, IK leaves their label out (or the singularity makes it ambiguous): the
+        # trajectory carries the held label, or the previous sample's, through that sample.
+        undefined = (ambiguous & branch.keys()) | ({*held, *(previous_branch or {})} - branch.keys())
+        for key in undefined:
+            if key in held:
+                branch[key] = held[key]
+            elif previous_branch is not None and key in previous_branch:
+                branch[key] = previous_branch[key]
+        samples.append(SampleResult(
+            float(times[k]), "ok" if matching or not held else "branch_unavailable", q, branch=branch,
+            branch_changed=previous_branch is not None and branch != previous_branch,
+            singularities=list(result.singularities)))
+        previous_q, previous_branch = q, branch
+    return samples
+
+
+def _continued(robot: Robot, limits: Limits, q: np.ndarray, previous: np.ndarray) -> np.ndarray:
+    """q with each revolute joint moved by whole turns to the value nearest to ``previous``.
+
+    A joint half a turn away has two nearest values; then the one within its
+    limits is taken, or else the one nearer to 0.
+    """
+    difference = joint_difference(robot, q, previous)
+    near = previous + difference
+    half_turn = robot.is_revolute & (np.abs(np.abs(difference) - np.pi) <= 1e-9)
+    if half_turn.any():
+        other = near - 2.0 * np.pi * np.sign(difference)
+        tolerance = limits.tolerance(robot)
+        inside = (near >= limits.lower - tolerance) & (near <= limits.upper + tolerance)
+        other_inside = (other >= limits.lower - tolerance) & (other <= limits.upper + tolerance)
+        prefer_other = (other_inside & ~inside) | ((other_inside == inside) & (np.abs(other) < np.abs(near)))
+        near = np.where(half_turn & prefer_other, other, near)
+    return near
+
+
+def _rates_of(robot: Robot, samples: list[SampleResult], reached: np.ndarray, targets: np.ndarray,
+              twist: np.ndarray | None, acceleration: np.ndarray | None, task: TaskSpace,
+              assur: AssurScara | None, options: TrajectoryOptions) -> None:
+    """Rates of every reached sample at once; fills the samples in place."""
+    q = np.array([samples[k].joints for k in reached])
+    tw = None if twist is None else twist[reached]
+    acc = None if acceleration is None else acceleration[reached]
+    group = None
+    if assur is not None:
+        group = _assur_group(robot, assur, q, np.array([samples[k].branch.get("assembly_mode", 1) for k in reached]),
+                             targets[reached], tw, acc)
+        q = group["joints"]
+    rates = joint_rates(robot, q, tw, acc, task, tolerance=options.singularity_tolerance, damping=options.damping)
+    velocities, accelerations = rates.velocities, rates.accelerations
+    if group is not None:
+        # The group's rates where it is regular and the Jacobian is not near singular; elsewhere the
+        # Jacobian's (damped where singular) only when damping was asked for.
+        regular = ((group["case"] == RRRCase.REGULAR) & ~rates.singular)[:, None]
+        keep = options.damping is not None
+        velocities = np.where(regular, group["velocities"], velocities if keep else np.nan)
+        accelerations = np.where(regular, group["accelerations"], accelerations if keep else np.nan)
+        no_twist = np.ones(len(q), dtype=bool) if tw is None else np.isnan(tw).all(axis=1)
+        no_acceleration = np.ones(len(q), dtype=bool) if acc is None else np.isnan(acc).all(axis=1)
+        velocities[no_twist] = np.nan
+        accelerations[no_twist | no_acceleration] = np.nan
+    velocity_residual, acceleration_residual = rate_residuals(robot, q, velocities, accelerations, tw, acc, task)
+    tolerance = options.singularity_tolerance
+    for row, k in enumerate(reached):
+        sample = samples[k]
+        sample.joints = q[row]
+        sample.velocities, sample.accelerations = velocities[row], accelerations[row]
+        sample.distance_to_singularity = float(rates.distance[row])
+        sample.damped = bool(rates.damped[row]) and not bool(np.isnan(velocities[row]).all())
+        sample.velocity_residual = _finite(velocity_residual[row])
+        sample.acceleration_residual = _finite(acceleration_residual[row])
+        if group is not None:
+            # The group classifies its own singular cases, as in the paper.
+            case = RRRCase(int(group["case"][row]))
+            sample.singularities = [s for s in sample.singularities if s.kind != "assur_group"]
+            if case != RRRCase.REGULAR:
+                sample.singularities.append(_group_singularity(assur, case, float(group["reach"][row])))
+            theta, thetad, thetadd = assur.paper_from_joints(q[row], velocities[row], accelerations[row])
+            sample.paper = PaperJoints(theta, thetad, thetadd, case.name.lower())
+        if rates.singular[row]:
+            sample.singularities.append(Singularity(
+                "jacobian", tuple(int(c) for c in task.columns), "near_singular",
+                f"the smallest singular value of the scaled task Jacobian, {rates.distance[row]:.3g}, is below "
+                f"{tolerance:g}: joint rates " + ("are damped least squares" if options.damping is not None
+                                                  else "are not returned (ask for damping to get them)")))
+
+
+def _assur_group(robot: Robot, assur: AssurScara, q: np.ndarray, modes: np.ndarray, targets: np.ndarray,
+                 twist: np.ndarray | None, acceleration: np.ndarray | None) -> dict:
+    """The paper's §3 for every reached sample, both assembly modes at once, picked per sample."""
+    points = targets[:, :3, 3]
+    zero = np.zeros_like(points)
+    velocity = zero if twist is None else np.nan_to_num(twist[:, :3])
+    accel = zero if acceleration is None else np.nan_to_num(acceleration[:, :3])
+    one, two = (assur.inverse(points, velocity, accel, mode) for mode in (1, 2))
+    pick = (modes == 1)[:, None]
+    joints = np.where(pick, one.joints, two.joints)
+    case = np.where(modes == 1, one.case, two.case)
+    assembled = (case == RRRCase.REGULAR) | (case == RRRCase.ALIGNED)
+    # The group's θ1 is not wrapped; keep the continuity of the chosen joints (they differ by 2π at most).
+    joints = np.where(assembled[:, None], q + joint_difference(robot, np.nan_to_num(joints), q), q)
+    reach = np.linalg.norm(assur.to_paper_points(points)[:, :2], axis=-1)
+    return {"joints": joints, "case": case, "reach": reach,
+            "velocities": np.where(pick, one.velocities, two.velocities),
+            "accelerations": np.where(pick, one.accelerations, two.accelerations)}
+
+
+def _group_singularity(assur: AssurScara, case: RRRCase, reach: float) -> Singularity:
+    """The paper's singular cases of the RRR group (``textbook.md`` §4.2 item 6, §4.3), as a report."""
+    if case == RRRCase.ALIGNED:
+        stretched = reach > 0.5 * (assur.l_AB + assur.l_BC + abs(assur.l_AB - assur.l_BC))
+        shape = (f"stretched, |AC| = l_AB + l_BC = {assur.l_AB + assur.l_BC:g}" if stretched
+                 else f"folded, |AC| = |l_AB - l_BC| = {abs(assur.l_AB - assur.l_BC):g}")
+        return Singularity("assur_group", (1,), "aligned",
+                           f"the RRR group is aligned ({shape}): the two assembly modes meet, and beta', beta'' "
+                           "(so the joint velocities and accelerations) do not exist")
+    if case == RRRCase.COINCIDENT:
+        return Singularity("assur_group", (0, 1), "coincident",
+                           "the tool point is on the shoulder axis with l_AB = l_BC: the group's point C is "
+                           "undefined (increased mobility), joint 1 is free and keeps the previous sample's value")
+    return Singularity("assur_group", (0, 1), "unreachable", "the RRR group cannot be assembled within its tolerance")
+
+
+def _finite(value: float) -> float | None:
+    return None if np.isnan(value) else float(value)
+
+
+def _summary(robot: Robot, samples: list[SampleResult]) -> TrajectorySummary:
+    n = robot.dof
+    largest = np.full(n, np.nan)
+    at: list[int | None] = [None] * n
+    for k in range(1, len(samples)):
+        if samples[k].reached and samples[k - 1].reached:
+            step = np.abs(samples[k].joints - samples[k - 1].joints)
+            better = np.isnan(largest) | (step > largest)
+            largest = np.where(better, step, largest)
+            at = [k if b else a for a, b in zip(at, better)]
+    distances = [(s.distance_to_singularity, k) for k, s in enumerate(samples)
+                 if s.distance_to_singularity is not None]
+    smallest = min(distances) if distances else (None, None)
+    return TrajectorySummary(
+        largest_joint_step=largest,
+        largest_joint_step_at=at,
+        smallest_distance_to_singularity=smallest[0],
+        smallest_distance_at=smallest[1],
+        limit_violations=[(k, v) for k, s in enumerate(samples) for v in s.violations],
+        singular_samples=[k for k, s in enumerate(samples) if s.singularities],
+        branch_changes=[k for k, s in enumerate(samples) if s.branch_changed],
+        unreachable_samples=[k for k, s in enumerate(samples) if not s.reached],
+    )

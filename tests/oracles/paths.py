@@ -1,0 +1,85 @@
+"""Tool paths with exact derivatives, and a Jacobian by differences of FK: references for the trajectory tests.
+
+Nothing here uses the code under test except forward kinematics (tested against the textbook on its own).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from service.kinematics import forward_kinematics
+
+
+def spiral(t):
+    """The paper's path (eq. 16, textbook.md §4.4) and its exact derivatives, each of shape (N, 3) [mm, s]."""
+    t = np.asarray(t, dtype=float)
+    w = np.pi / 2.0
+    s, c, one = np.sin(w * t), np.cos(w * t), np.ones_like(t)
+    D = np.stack((100.0 + 20.0 * s, -20.0 * c, 50.0 + 10.0 * t), axis=-1)
+    Dd = np.stack((10.0 * np.pi * c, 10.0 * np.pi * s, 10.0 * one), axis=-1)
+    Ddd = np.stack((-5.0 * np.pi**2 * s, 5.0 * np.pi**2 * c, 0.0 * one), axis=-1)
+    return D, Dd, Ddd
+
+
+def rotation(axis, angle: float) -> np.ndarray:
+    """R(k, θ) by Rodrigues' formula, k a unit vector."""
+    k = np.asarray(axis, dtype=float)
+    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * K @ K
+
+
+def wobble(t, world_T_start: np.ndarray, radius: float, k1, k2):
+    """A smooth pose path from ``world_T_start`` with its exact twist and acceleration (world frame).
+
+    Position: ``p0 + ρ (sin t, 1 − cos t, ½ sin 2t)``. Orientation:
+    ``R(k1, α(t)) R(k2, β(t)) R0`` with α = 0.2 sin t and β = 0.15 sin(1.3t + 0.4) (β = 0 when k2 is None), so
+    ``ω = k1 α' + R(k1, α) k2 β'`` and ``ω' = k1 α'' + R(k1, α) k2 β'' + (k1 α') × (R(k1, α) k2 β')``.
+
+    Returns (N, 4, 4) poses, (N, 6) twists [ṗ; ω] and (N, 6) accelerations [p̈; ω'].
+    """
+    t = np.asarray(t, dtype=float)
+    p = world_T_start[:3, 3] + radius * np.stack([np.sin(t), 1 - np.cos(t), 0.5 * np.sin(2 * t)], axis=-1)
+    pd = radius * np.stack([np.cos(t), np.sin(t), np.cos(2 * t)], axis=-1)
+    pdd = radius * np.stack([-np.sin(t), np.cos(t), -2 * np.sin(2 * t)], axis=-1)
+    a, ad, add = 0.2 * np.sin(t), 0.2 * np.cos(t), -0.2 * np.sin(t)
+    phase = 1.3 * t + 0.4
+    b, bd, bdd = 0.15 * np.sin(phase), 0.195 * np.cos(phase), -0.2535 * np.sin(phase)
+    k1 = np.asarray(k1, dtype=float)
+    k2 = np.zeros(3) if k2 is None else np.asarray(k2, dtype=float)
+    poses = np.tile(np.eye(4), (len(t), 1, 1))
+    omega, omegad = np.zeros((len(t), 3)), np.zeros((len(t), 3))
+    for i in range(len(t)):
+        Ra = rotation(k1, a[i])
+        Rb = rotation(k2, b[i]) if k2.any() else np.eye(3)
+        poses[i, :3, :3] = Ra @ Rb @ world_T_start[:3, :3]
+        poses[i, :3, 3] = p[i]
+        second = Ra @ k2 * bd[i]
+        omega[i] = k1 * ad[i] + second
+        omegad[i] = k1 * add[i] + Ra @ k2 * bdd[i] + np.cross(k1 * ad[i], second)
+    return poses, np.concatenate([pd, omega], axis=1), np.concatenate([pdd, omegad], axis=1)
+
+
+def difference_jacobian(robot, q: np.ndarray, h: float = 1e-6) -> np.ndarray:
+    """The geometric Jacobian (6, n) by central differences of forward kinematics.
+
+    Column i: the tool origin's velocity and the angular velocity (from ``Ṙ Rᵀ``) for q̇ = e_i.
+    """
+    q = np.asarray(q, dtype=float)
+    J = np.zeros((6, len(q)))
+    R = forward_kinematics(robot, q)[:3, :3]
+    for i in range(len(q)):
+        step = np.zeros(len(q))
+        step[i] = h
+        plus, minus = forward_kinematics(robot, q + step), forward_kinematics(robot, q - step)
+        J[:3, i] = (plus[:3, 3] - minus[:3, 3]) / (2 * h)
+        W = (plus[:3, :3] - minus[:3, :3]) / (2 * h) @ R.T
+        J[3:, i] = 0.5 * np.array([W[2, 1] - W[1, 2], W[0, 2] - W[2, 0], W[1, 0] - W[0, 1]])
+    return J
+
+
+def scaled_sigma_min(robot, J: np.ndarray, rows: list[int]) -> float:
+    """Smallest singular value of J's given rows, linear rows divided by the robot's size, slides multiplied."""
+    L = robot.characteristic_length
+    Js = J[rows] * np.array([1 / L if r < 3 else 1.0 for r in rows])[:, None]
+    Js = Js * np.where(robot.is_revolute, 1.0, L)
+    return float(np.linalg.svd(Js, compute_uv=False)[-1])

@@ -14,6 +14,7 @@ import pytest
 
 from service.kinematics.ik import joint_difference
 from tests.conftest import catalogue_robot
+from tests.ik_helpers import random_configurations
 
 SAMPLES = 1000
 
@@ -43,15 +44,6 @@ GENERIC = {
 
 def test_every_catalogue_robot_has_an_analytic_class(client):
     assert {robot["id"] for robot in client.get("/v1/robots").json()["robots"]} == set(GENERIC)
-
-
-def random_configurations(robot, count: int, seed: int) -> np.ndarray:
-    """Revolute joints uniform in ±π; prismatic joints uniform in (0.1, 1) robot sizes."""
-    rng = np.random.default_rng(seed)
-    q = rng.uniform(-np.pi, np.pi, (count, robot.dof))
-    slides = ~robot.is_revolute
-    q[:, slides] = rng.uniform(0.1, 1.0, (count, slides.sum())) * robot.characteristic_length / 2
-    return q
 
 
 def targets_for(client, robot_id: str, q: np.ndarray, kind: str) -> list[dict]:

@@ -62,6 +62,20 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
     return reference, limits, ordering, options, note
 
 
+def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: np.ndarray, rows: np.ndarray,
+                     constrained: bool, reference, limits, ordering, options, note, started: float):
+    """Wire answers (row, dict) from the numeric search, for structures no analytic family covers."""
+    robot = ref.robot
+    solved = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
+                            options=options)
+    observe_ik(solved[0].method, solved[0].structure, time.perf_counter() - started,
+               [len(result.solutions) for result in solved])
+    for row, result in zip(rows.tolist(), solved):
+        selection = select(robot, result, limits, filter_limits=body.filter_limits, reference=reference,
+                           ordering=ordering, max_equivalents=body.max_equivalents)
+        yield row, _capped(_to_wire(ref.id, robot, result, selection, body.angle_unit, constrained), note)
+
+
 def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
     robot = ref.robot
     if isinstance(body, IKRequest):
@@ -79,14 +93,9 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
         started = time.perf_counter()
         arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
         if arrays is None:  # no analytic family: the numeric search, one target at a time
-            solved = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
-                                    options=options)
-            observe_ik(solved[0].method, solved[0].structure, time.perf_counter() - started,
-                       [len(result.solutions) for result in solved])
-            for row, result in zip(rows.tolist(), solved):
-                answers[row] = _capped(_to_wire(ref.id, robot, result, select(
-                    robot, result, limits, filter_limits=body.filter_limits, reference=reference, ordering=ordering,
-                    max_equivalents=body.max_equivalents), body.angle_unit, constrained), note)
+            for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
+                                              options, note, started):
+                answers[row] = wire
             continue
         observe_ik("analytic", arrays.structure, time.perf_counter() - started, arrays.count.tolist())
         results = results_from_arrays(robot, arrays, matrices[rows], constrained, reference)
@@ -138,14 +147,8 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
         started = time.perf_counter()
         arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
         if arrays is None:  # no analytic family: the numeric search, one target at a time
-            solved = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
-                                    options=options)
-            observe_ik(solved[0].method, solved[0].structure, time.perf_counter() - started,
-                       [len(result.solutions) for result in solved])
-            for row, result in zip(rows.tolist(), solved):
-                wire = _capped(_to_wire(ref.id, robot, result, select(
-                    robot, result, limits, filter_limits=body.filter_limits, reference=reference, ordering=ordering,
-                    max_equivalents=body.max_equivalents), body.angle_unit, constrained), note)
+            for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
+                                              options, note, started):
                 status[row], detail[row], truncated[row], trimmed[row], available[row] = (
                     wire["status"], wire["detail"], wire["truncated"], wire["trimmed"], wire["available"])
                 solver[row] = _index(solvers, {**wire["solver"], "free_joints": wire["free_joints"]})

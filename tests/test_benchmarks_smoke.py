@@ -10,7 +10,7 @@ import shutil
 
 import pytest
 
-from benchmarks import anchors, core, http
+from benchmarks import anchors, core, http_throughput
 
 
 def test_core_benchmark_runs_with_tiny_sizes(capsys):
@@ -26,7 +26,7 @@ def test_core_benchmark_runs_with_tiny_sizes(capsys):
 
 @pytest.mark.skipif(shutil.which("wrk") is None, reason="wrk (Debian package) is not installed")
 def test_http_benchmark_runs_with_tiny_sizes(capsys):
-    assert http.main(["--quick"]) == 0
+    assert http_throughput.main(["--quick"]) == 0
     out = capsys.readouterr().out
     assert "| GET /healthz (framework ceiling) |" in out
     assert "single-IK throughput / trivial endpoint" in out
@@ -34,5 +34,5 @@ def test_http_benchmark_runs_with_tiny_sizes(capsys):
 
 def test_http_benchmark_says_when_wrk_is_missing(capsys, monkeypatch):
     monkeypatch.setattr(shutil, "which", lambda name: None)
-    assert http.main(["--quick"]) == 0
+    assert http_throughput.main(["--quick"]) == 0
     assert "wrk is not installed" in capsys.readouterr().out

@@ -1,7 +1,7 @@
 """The service under load: wrk against a real uvicorn on 127.0.0.1, all in one run.
 
-    python -m benchmarks.http                # the full run (about a minute)
-    python -m benchmarks.http --quick        # tiny sizes: a smoke run
+    python -m benchmarks.http_throughput                # the full run (about a minute)
+    python -m benchmarks.http_throughput --quick        # tiny sizes: a smoke run
 
 It starts the service (one uvicorn worker, as ``python -m service`` does) on a
 free loopback port, and drives it with wrk (Debian package ``wrk``; the POST
@@ -125,7 +125,7 @@ def run_wrk(name: str, url: str, script: Path, *, seconds: float, connections: i
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.http", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.http_throughput", description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10, help="length of each wrk run (default 10)")
     parser.add_argument("--connections", type=int, default=8, help="open connections for the single calls")
     parser.add_argument("--batch", type=int, default=10_000, help="targets in the batch request (default 10,000)")

@@ -198,6 +198,18 @@ def _polish_near(robot: Robot, joints: np.ndarray, targets: np.ndarray, position
     position[rows, slots], orientation[rows, slots] = p[:, 0], o[:, 0]
 
 
+def _slot_pairs(m: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair of slots (earlier, later), grouped by the later slot: (0, 1), (0, 2), (1, 2), (0, 3), …"""
+    pairs = _PAIRS.get(m)
+    if pairs is None:
+        later, earlier = np.tril_indices(m, -1)
+        pairs = _PAIRS[m] = (earlier, later)
+    return pairs
+
+
+_PAIRS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
 def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """Which slots (N, m) hold the first occurrence of a distinct solution among the ``ok`` ones.
 
@@ -212,15 +224,19 @@ def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarr
     all_revolute = bool(revolute.all())
     tolerance = memo(robot, "duplicate_tolerance", lambda: np.where(
         revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length))
-    # joints are wrapped to (−π, π], so a revolute difference d lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
-    kept = np.zeros_like(ok)
-    kept[:, 0] = ok[:, 0]
+    # every pair (earlier slot, later slot) at once; joints are wrapped to (−π, π], so a revolute difference d
+    # lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
+    earlier, later = _slot_pairs(m)
+    gap = np.abs(joints[:, later, :] - joints[:, earlier, :])  # (N, pairs, n)
+    if all_revolute:
+        np.minimum(gap, 2 * np.pi - gap, out=gap)
+    elif revolute.any():
+        gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
+    same = (gap <= tolerance).all(axis=-1)  # (N, pairs)
+    # then the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
+    kept = ok.copy()
+    start = 0
     for slot in range(1, m):
-        gap = np.abs(joints[:, slot, None, :] - joints[:, :slot, :])  # (N, slot, n)
-        if all_revolute:
-            np.minimum(gap, 2 * np.pi - gap, out=gap)
-        elif revolute.any():
-            gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
-        same = (gap <= tolerance).all(axis=-1)  # (N, slot)
-        kept[:, slot] = ok[:, slot] & ~np.any(same & kept[:, :slot], axis=1)
+        kept[:, slot] &= ~np.any(same[:, start:start + slot] & kept[:, :slot], axis=1)
+        start += slot
     return kept

@@ -15,11 +15,15 @@ def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
     """
     theta = np.asarray(theta, dtype=float)
     v = np.asarray(v, dtype=float)
-    shape = np.broadcast_shapes(v.shape, theta.shape + (3,))
+    shape = v.shape if v.shape[:-1] == theta.shape else np.broadcast_shapes(v.shape, theta.shape + (3,))
     frame = _frame_about(k)  # columns e1, e2, k
+    if v.shape != shape:
+        v = np.broadcast_to(v, shape)
+    if theta.shape != shape[:-1]:
+        theta = np.broadcast_to(theta, shape[:-1])
     # (3, 3) @ (3, M) products run as one BLAS call; (M, 3) @ (3, 3) would not
-    local = frame.T @ np.broadcast_to(v, shape).reshape(-1, 3).T  # (3, M): coordinates along e1, e2, k
-    theta = np.broadcast_to(theta, shape[:-1]).reshape(-1)
+    local = frame.T @ v.reshape(-1, 3).T  # (3, M): coordinates along e1, e2, k
+    theta = theta.reshape(-1)
     cos, sin = np.cos(theta), np.sin(theta)
     a, b = local[0], local[1]
     turned = np.empty_like(local)

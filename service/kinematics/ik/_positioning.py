@@ -175,13 +175,13 @@ class IntersectingShoulder(Positioner):
         _flag_rows(free_shoulder.any(axis=1),
                    Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "
                                "joint 1 is set to the reference value (or 0)"), singular)
-        if g.model.is_revolute[k]:
+        if g.model.is_revolute[k] and third.merged.any():  # (no elbow flag to set otherwise)
             stretched = self._stretched(q3[:, 0], w, c)
             _flag_rows(third.merged & stretched, Singularity("elbow", (k,), "stretched",
                                                              "the arm is fully stretched"), singular)
             _flag_rows(third.merged & ~stretched, Singularity("elbow", (k,), "folded",
                                                               "the arm is fully folded"), singular)
-        else:
+        elif not g.model.is_revolute[k]:
             _flag_rows(third.merged, Singularity("reach", (k,), "boundary",
                                                  "the point is at the nearest reach of the prismatic joint"), singular)
         return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)

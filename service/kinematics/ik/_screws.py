@@ -53,9 +53,28 @@ _FRAMES: dict[tuple[float, ...], np.ndarray] = {}
 def rotation_about(k: np.ndarray, theta: np.ndarray) -> np.ndarray:
     """R(k, θ) as matrices, shape (..., 3, 3)."""
     theta = np.asarray(theta, dtype=float)
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    K, KK = _cross_matrices(k)
     sin, cos = np.sin(theta)[..., None, None], np.cos(theta)[..., None, None]
-    return np.eye(3) + sin * K + (1.0 - cos) * (K @ K)
+    return _EYE3 + sin * K + (1.0 - cos) * KK
+
+
+def _cross_matrices(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """[k]× and [k]×², memoised by value (the joint axes are a few constants)."""
+    key = tuple(np.asarray(k, dtype=float).tolist())
+    pair = _CROSS.get(key)
+    if pair is None:
+        K = np.array([[0.0, -key[2], key[1]], [key[2], 0.0, -key[0]], [-key[1], key[0], 0.0]])
+        pair = (K, K @ K)
+        for matrix in pair:
+            matrix.setflags(write=False)
+        if len(_CROSS) < 4096:
+            _CROSS[key] = pair
+    return pair
+
+
+_CROSS: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray]] = {}
+_EYE3 = np.eye(3)
+_EYE3.setflags(write=False)
 
 
 def joint_motion(direction: np.ndarray, point: np.ndarray, revolute: bool, q: np.ndarray) -> np.ndarray:

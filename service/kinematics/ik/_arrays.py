@@ -22,6 +22,7 @@ import numpy as np
 from .._cache import memo
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
+from ._lean import lean_candidates
 from ._plan import Plan, plan_for
 from ._types import LabelCodes, SingularFlags
 from ._verify import distance_to_reference, polish, residual_arrays, wrap_revolute
@@ -159,7 +160,10 @@ def _concatenated(parts: list[IKArrays]) -> IKArrays:
 
 def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
                  plan: Plan) -> IKArrays:
-    candidates = plan.solve(targets, reference)
+    # one pose: the scalar candidates when the pose is clearly generic (see _lean), else the array solver's
+    candidates = lean_candidates(plan, targets[0], reference) if len(targets) == 1 else None
+    if candidates is None:
+        candidates = plan.solve(targets, reference)
     n_targets, m, n = candidates.joints.shape
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
     position, orientation = residual_arrays(robot, joints, targets)

@@ -125,13 +125,15 @@ def _mtv(R: Matrix, v: Vector) -> Vector:
 
 
 def _mm(A: Matrix, B: Matrix) -> Matrix:
-    columns = tuple(zip(*B))
-    return tuple(tuple(_dot(row, column) for column in columns) for row in A)
+    (b00, b01, b02), (b10, b11, b12), (b20, b21, b22) = B
+    return tuple((a0 * b00 + a1 * b10 + a2 * b20, a0 * b01 + a1 * b11 + a2 * b21, a0 * b02 + a1 * b12 + a2 * b22)
+                 for a0, a1, a2 in A)
 
 
 def _mtm(A: Matrix, B: Matrix) -> Matrix:
     """Aᵀ B."""
-    return _mm(tuple(zip(*A)), B)
+    (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = A
+    return _mm(((a00, a10, a20), (a01, a11, a21), (a02, a12, a22)), B)
 
 
 def _rotation(k: Vector, theta: float) -> Matrix:
@@ -146,8 +148,10 @@ def _rotation(k: Vector, theta: float) -> Matrix:
 def _rotate(k: Vector, theta: float, v: Vector) -> Vector:
     """R(k, θ) v by Rodrigues' formula."""
     s, c = math.sin(theta), math.cos(theta)
-    kv, kxv = _dot(k, v), _cross(k, v)
-    return tuple(v[i] * c + kxv[i] * s + k[i] * kv * (1.0 - c) for i in range(3))
+    (kx, ky, kz), (vx, vy, vz) = k, v
+    along = (kx * vx + ky * vy + kz * vz) * (1.0 - c)
+    return (vx * c + (ky * vz - kz * vy) * s + kx * along, vy * c + (kz * vx - kx * vz) * s + ky * along,
+            vz * c + (kx * vy - ky * vx) * s + kz * along)
 
 
 def _wrap(theta: float) -> float:

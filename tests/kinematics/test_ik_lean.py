@@ -41,7 +41,7 @@ def test_the_two_hot_families_are_covered():
 
 @pytest.mark.parametrize("robot_id", LEAN_ROBOTS)
 def test_scalar_candidates_are_the_array_candidates(robot_id):
-    """Same slots, same joints, every slot valid and no singularity, wherever the scalar path answers."""
+    """Same slots, same valid slots and joints, and no singularity, wherever the scalar path answers."""
     robot = _CATALOGUE.get(robot_id).robot
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     answered = 0
@@ -51,10 +51,12 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
             continue
         answered += 1
         array = plan.solve(T[None], None)
-        assert array.valid.all() and lean.valid.all()
+        assert (lean.valid == array.valid).all()
         assert not array.singularities.entries
-        assert np.abs(joint_difference(robot, lean.joints, array.joints)).max() <= 1e-9
-    assert answered >= 250  # generic poses are the common case
+        valid = array.valid[0]
+        assert np.abs(joint_difference(robot, lean.joints[0, valid], array.joints[0, valid])).max() <= 1e-9
+        assert np.isnan(lean.joints[0, ~valid]).any(axis=-1).all()
+    assert answered >= 450  # generic poses are the common case (of 400 random, 100 snapped, 40 far)
 
 
 @pytest.mark.parametrize("robot_id", LEAN_ROBOTS)

@@ -10,8 +10,10 @@ ordering in :mod:`._arrays`.
 
 It covers the generic case only: every subproblem has two distinct, exact,
 non-degenerate roots, each clearly (by :data:`MARGIN` times the tolerance)
-away from the threshold where the array solver would decide otherwise. Then
-every slot is valid and no singularity is met. Anything else (an unreachable
+away from the threshold where the array solver would decide otherwise (the
+one exception: the UR5 type's elbow may be clearly out of reach for some
+shoulder and wrist roots, which gives a least-squares slot and an empty one,
+as in the array solver). Then no singularity is met. Anything else (an unreachable
 target, a singular or nearly singular pose, another family) returns None and
 the pose takes the array path, which is the reference: a test holds these
 candidates to it over many random poses.
@@ -62,8 +64,8 @@ def lean_candidates(plan: object, world_T_target: np.ndarray, reference: np.ndar
         joints = solver(world_T_target)
     except _NotGeneric:
         return None
-    m, n = len(joints), len(joints[0])
-    return Candidates(np.array(joints).reshape(1, m, n), np.ones((1, m), dtype=bool), [], SingularFlags(1))
+    joints = np.array(joints)[None]  # (1, m, n)
+    return Candidates(joints, ~np.isnan(joints).any(axis=-1), [], SingularFlags(1))
 
 
 def _solver_for(plan: object):
@@ -179,15 +181,21 @@ def _frame(k: Vector) -> tuple[Vector, Vector]:
     return e1, _cross(k, e1)
 
 
-def _harmonic(a: float, b: float, c: float, scale: float) -> tuple[float, float]:
-    """The two roots of a cos θ + b sin θ = c, φ + half first; _NotGeneric unless clearly two."""
+def _harmonic(a: float, b: float, c: float, scale: float, out_of_reach: bool = False) -> tuple[float, float]:
+    """The two roots of a cos θ + b sin θ = c, φ + half first; _NotGeneric unless clearly two.
+
+    With ``out_of_reach``, a clearly unreachable c gives the least-squares root and NaN (one valid slot),
+    as the array solver does.
+    """
     tol = GEOMETRY_TOLERANCE * scale
     rho = math.sqrt(a * a + b * b)
     excess = abs(c) - rho
+    phi = math.atan2(b, a)
+    if out_of_reach and rho > MARGIN * tol and excess > MARGIN * tol:
+        return _wrap(phi + math.atan2(0.0, c)), math.nan
     if not (rho > MARGIN * tol and -excess > MARGIN * (rho * _MERGE_COS_GAP + tol)):
         raise _NotGeneric
     half = math.atan2(math.sqrt(-excess * (rho + abs(c))), c)
-    phi = math.atan2(b, a)
     return _wrap(phi + half), _wrap(phi - half)
 
 
@@ -203,13 +211,14 @@ def _subproblem_1(k: Vector, frame: tuple[Vector, Vector], p: Vector, q: Vector)
     return _wrap(math.atan2(px * qy - py * qx, px * qx + py * qy))
 
 
-def _subproblem_3(k: Vector, frame: tuple[Vector, Vector], p: Vector, q: Vector, delta: float) -> tuple[float, float]:
+def _subproblem_3(k: Vector, frame: tuple[Vector, Vector], p: Vector, q: Vector, delta: float,
+                  out_of_reach: bool = False) -> tuple[float, float]:
     e1, e2 = frame
     px, py, pz = _dot(p, e1), _dot(p, e2), _dot(p, k)
     qx, qy, qz = _dot(q, e1), _dot(q, e2), _dot(q, k)
     rp2, rq2, delta2 = px * px + py * py, qx * qx + qy * qy, delta * delta
     c = 0.5 * (rp2 + rq2 + (pz - qz) ** 2 - delta2)
-    return _harmonic(px * qx + py * qy, px * qy - py * qx, c, rp2 + rq2 + pz * pz + qz * qz + delta2)
+    return _harmonic(px * qx + py * qy, px * qy - py * qx, c, rp2 + rq2 + pz * pz + qz * qz + delta2, out_of_reach)
 
 
 def _subproblem_4(h: Vector, k: Vector, p: Vector, delta: float) -> tuple[float, float]:
@@ -338,8 +347,14 @@ class _ThreeParallel:
                 p4_world = _add(_mv(R_A, y), t_A)
                 z = _add(p[0], _mtv(R1, _sub(p4_world, p[0])))
                 z1 = _sub(z, p[1])
-                elbow = _subproblem_3(d[2], self.frames[2], _sub(p[3], p[2]), _sub(p[1], p[2]), _norm(z1))
+                # this shoulder and wrist may leave the point out of the elbow's reach: a least-squares root
+                # (then rejected by the FK check) and an empty slot, as in the array solver
+                elbow = _subproblem_3(d[2], self.frames[2], _sub(p[3], p[2]), _sub(p[1], p[2]), _norm(z1),
+                                      out_of_reach=True)
                 for q3 in elbow:
+                    if math.isnan(q3):
+                        joints.append([q1, math.nan, math.nan, math.nan, q5, q6])
+                        continue
                     moved = _add(p[2], _rotate(d[2], q3, _sub(p[3], p[2])))
                     q2 = _subproblem_1(d[1], self.frames[1], _sub(moved, p[1]), z1)
                     q4 = s4 * (angle_sum - s2 * q2 - s3 * q3)

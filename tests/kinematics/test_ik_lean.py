@@ -8,7 +8,8 @@ from service.config import Settings
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import _arrays, joint_difference, solve_ik
 from service.kinematics.ik._arrays import cached_plan
-from service.kinematics.ik._lean import lean_candidates
+from service.kinematics.ik._lean import lean_candidates, lean_label_codes
+from service.kinematics.ik._verify import accepted, residual_arrays, wrap_revolute
 
 from tests.ik_helpers import random_configurations
 
@@ -41,10 +42,11 @@ def test_the_two_hot_families_are_covered():
 
 @pytest.mark.parametrize("robot_id", LEAN_ROBOTS)
 def test_scalar_candidates_are_the_array_candidates(robot_id):
-    """Same slots, same valid slots and joints, and no singularity, wherever the scalar path answers."""
+    """Same slots, same valid slots and joints, and no singularity, wherever the scalar path answers; the
+    same branch labels wherever its labeller answers."""
     robot = _CATALOGUE.get(robot_id).robot
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
-    answered = 0
+    answered = labelled = 0
     for T in _poses(robot, 400, seed=11):
         lean = lean_candidates(plan, T, None)
         if lean is None:
@@ -56,7 +58,20 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
         valid = array.valid[0]
         assert np.abs(joint_difference(robot, lean.joints[0, valid], array.joints[0, valid])).max() <= 1e-9
         assert np.isnan(lean.joints[0, ~valid]).any(axis=-1).all()
+        joints = wrap_revolute(robot, np.nan_to_num(lean.joints))
+        # as solve_ik: label the slots the FK check keeps (not the least-squares ones it rejects)
+        position, orientation = residual_arrays(robot, joints, T[None])
+        valid = lean.valid[0] & accepted(robot, position[0], orientation[0], True)
+        labels = lean_label_codes(plan, joints, valid[None])
+        if labels is not None:
+            labelled += 1
+            expected = plan.label_codes(joints[0])
+            assert list(labels) == list(expected)
+            for name, (values, codes) in labels.items():
+                assert values == expected[name][0]
+                assert (codes[valid] == expected[name][1][valid]).all()
     assert answered >= 450  # generic poses are the common case (of 400 random, 100 snapped, 40 far)
+    assert labelled >= 0.9 * answered
 
 
 @pytest.mark.parametrize("robot_id", LEAN_ROBOTS)

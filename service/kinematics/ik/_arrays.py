@@ -22,7 +22,7 @@ import numpy as np
 from .._cache import memo
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
-from ._lean import lean_candidates
+from ._lean import lean_candidates, lean_label_codes
 from ._plan import Plan, plan_for
 from ._types import LabelCodes, SingularFlags
 from ._verify import distance_to_reference, polish, residual_arrays, wrap_revolute
@@ -162,7 +162,8 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
                  plan: Plan) -> IKArrays:
     # one pose: the scalar candidates when the pose is clearly generic (see _lean), else the array solver's
     candidates = lean_candidates(plan, targets[0], reference) if len(targets) == 1 else None
-    if candidates is None:
+    lean = candidates is not None
+    if not lean:
         candidates = plan.solve(targets, reference)
     n_targets, m, n = candidates.joints.shape
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
@@ -172,7 +173,9 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     if constrain_orientation:
         ok &= orientation <= ACCEPT_RESIDUAL
     kept = _first_of_each(robot, joints, ok)
-    labels = plan.label_codes(joints.reshape(-1, n))
+    labels = lean_label_codes(plan, joints, kept) if lean else None
+    if labels is None:
+        labels = plan.label_codes(joints.reshape(-1, n))
     # output order: kept slots first, nearest to the reference first, else in slot order (stable)
     if reference is not None:
         key = np.where(kept, distance_to_reference(robot, joints, reference), np.inf)

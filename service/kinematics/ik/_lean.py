@@ -33,7 +33,7 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._decoupled import DecoupledPlan
 from ._positioning import IntersectingShoulder
 from ._three_parallel import ThreeParallelPlan
-from ._types import Candidates, SingularFlags
+from ._types import Candidates, LabelCodes, SingularFlags
 from ._wrist import SphericalWrist
 
 #: How far (as a multiple of each tolerance) a quantity must be from the array solver's threshold for the
@@ -66,6 +66,62 @@ def lean_candidates(plan: object, world_T_target: np.ndarray, reference: np.ndar
         return None
     joints = np.array(joints)[None]  # (1, m, n)
     return Candidates(joints, ~np.isnan(joints).any(axis=-1), [], SingularFlags(1))
+
+
+def lean_label_codes(plan: object, joints: np.ndarray, valid: np.ndarray) -> LabelCodes | None:
+    """``plan.label_codes`` of one pose's slots (1, m, n), for the valid ones (the others get −1), or None.
+
+    None when the plan is not covered or a slot's label quantity is within :data:`MARGIN` times the
+    tolerance of the value where the label flips or is left out: the array labeller then decides.
+    """
+    labeller = _labeller_for(plan)
+    if labeller is None:
+        return None
+    codes = {name: [-1] * len(valid[0]) for name in labeller.names}
+    try:
+        for slot, (q, ok) in enumerate(zip(joints[0].tolist(), valid[0].tolist())):
+            if ok:
+                for name, code in zip(labeller.names, labeller.codes(q)):
+                    codes[name][slot] = code
+    except _NotGeneric:
+        return None
+    return {name: (values, np.array(codes[name], dtype=np.int8))
+            for name, values in zip(labeller.names, labeller.values)}
+
+
+def _side_code(side: float, size: float) -> int:
+    """:func:`._positioning.side_codes` for one value, clear of its thresholds."""
+    if abs(side) <= MARGIN * DUPLICATE_TOLERANCE * size:
+        raise _NotGeneric
+    return 0 if side > 0 else 1
+
+
+def _wrist_code(middle: float) -> int:
+    """:func:`._wrist.wrist_codes` for one value, clear of its thresholds."""
+    sine = math.sin(middle)
+    if abs(sine) <= MARGIN * 10 * GEOMETRY_TOLERANCE:
+        raise _NotGeneric
+    return 0 if sine > 0 else 1
+
+
+def _moved(directions: list[Vector], points: list[Vector], q: list[float], upto: int, x: Vector) -> Vector:
+    """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) x for revolute joints (as :func:`._screws.move_point`)."""
+    for i in reversed(range(upto)):
+        x = _add(points[i], _rotate(directions[i], q[i], _sub(x, points[i])))
+    return x
+
+
+def _reject(v: Vector, unit: Vector) -> Vector:
+    along = _dot(v, unit)
+    return (v[0] - along * unit[0], v[1] - along * unit[1], v[2] - along * unit[2])
+
+
+def _labeller_for(plan: object):
+    labeller = plan.__dict__.get("_lean_labels")
+    if labeller is None:
+        solver = _solver_for(plan)
+        labeller = plan.__dict__["_lean_labels"] = solver.__self__ if solver is not None else False
+    return labeller or None
 
 
 def _solver_for(plan: object):
@@ -127,9 +183,11 @@ def _mtv(R: Matrix, v: Vector) -> Vector:
 
 
 def _mm(A: Matrix, B: Matrix) -> Matrix:
+    (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = A
     (b00, b01, b02), (b10, b11, b12), (b20, b21, b22) = B
-    return tuple((a0 * b00 + a1 * b10 + a2 * b20, a0 * b01 + a1 * b11 + a2 * b21, a0 * b02 + a1 * b12 + a2 * b22)
-                 for a0, a1, a2 in A)
+    return ((a00 * b00 + a01 * b10 + a02 * b20, a00 * b01 + a01 * b11 + a02 * b21, a00 * b02 + a01 * b12 + a02 * b22),
+            (a10 * b00 + a11 * b10 + a12 * b20, a10 * b01 + a11 * b11 + a12 * b21, a10 * b02 + a11 * b12 + a12 * b22),
+            (a20 * b00 + a21 * b10 + a22 * b20, a20 * b01 + a21 * b11 + a22 * b21, a20 * b02 + a21 * b12 + a22 * b22))
 
 
 def _mtm(A: Matrix, B: Matrix) -> Matrix:
@@ -271,6 +329,29 @@ class _ShoulderWrist:
         self.axes = [_v(a) for a in wrist.axes]
         self.normal = _v(wrist.normal)
         self.frame_c = _frame(self.axes[2])
+        forward, in_plane, up = positioner._label_constants
+        self.forward, self.in_plane, self.up = _v(forward), in_plane, _v(up)
+        self.on_axis = GEOMETRY_TOLERANCE * 10 * positioner.geometry.length_scale
+
+    names = ("shoulder", "elbow", "wrist")
+    values = (("left", "right"), ("up", "down"), ("no_flip", "flip"))
+
+    def codes(self, q: list[float]) -> tuple[int, int, int]:
+        """:meth:`IntersectingShoulder.label_codes` and :func:`wrist_codes` for one joint vector."""
+        d, p, c = self.directions, self.points, self.centre
+        forward = _rotate(d[0], q[0], self.forward)
+        reach = _sub(_moved(d, p, q, 3, self.point), c)
+        if _norm(_reject(reach, d[0])) <= MARGIN * self.on_axis:  # the point near axis 1
+            raise _NotGeneric
+        shoulder = _side_code(_dot(reach, forward), _norm(reach))
+        elbow = _sub(_moved(d, p, q, 2, p[2]), c)
+        if self.in_plane:  # in the arm's plane, normal to axis 2
+            normal = _rotate(d[0], q[0], d[1])
+            elbow, reach = _reject(elbow, normal), _reject(reach, normal)
+        length = _norm(reach)
+        line = (reach[0] / length, reach[1] / length, reach[2] / length)
+        side = _dot(_reject(elbow, line), self.up)
+        return shoulder, _side_code(side, _norm(elbow)), _wrist_code(q[4])
 
     def solve(self, T: np.ndarray) -> list[list[float]]:
         (R_T0, R_T1, R_T2, t_T) = T[:3].T.tolist()  # the target's columns
@@ -318,6 +399,29 @@ class _ThreeParallel:
         self.frame_p = _frame(self.omega_p)
         self.signs = [float(s) for s in plan.signs]
         self.height = _dot(self.omega_p, _sub(self.centre, self.points[0]))
+        self.forward = _v(plan.forward)
+        self.up = _v(plan.geometry.upward(plan.geometry.direction(0)))
+
+    names = ("shoulder", "elbow", "wrist")
+    values = (("left", "right"), ("up", "down"), ("no_flip", "flip"))
+
+    def codes(self, q: list[float]) -> tuple[int, int, int]:
+        """:meth:`ThreeParallelPlan.label_codes` for one joint vector."""
+        d, p = self.directions, self.points
+        forward = _rotate(d[0], q[0], self.forward)
+        wrist_point = _moved(d, p, q, 3, p[3])
+        to_wrist = _sub(wrist_point, p[0])
+        shoulder = _side_code(_dot(to_wrist, forward), _norm(to_wrist))
+        shoulder_point = _moved(d, p, q, 1, p[1])
+        normal = _rotate(d[0], q[0], self.omega_p)  # the parallel axes, after joint 1
+        elbow = _reject(_sub(_moved(d, p, q, 2, p[2]), shoulder_point), normal)
+        reach = _reject(_sub(wrist_point, shoulder_point), normal)
+        length = _norm(reach)
+        if length <= 1e-300:
+            raise _NotGeneric
+        line = (reach[0] / length, reach[1] / length, reach[2] / length)
+        side = _dot(_reject(elbow, line), self.up)
+        return shoulder, _side_code(side, _norm(elbow)), _wrist_code(q[4])
 
     def solve(self, T: np.ndarray) -> list[list[float]]:
         (R_T0, R_T1, R_T2, t_T) = T[:3].T.tolist()

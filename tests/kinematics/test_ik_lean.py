@@ -106,3 +106,19 @@ def test_single_pose_answers_do_not_depend_on_the_path(robot_id, monkeypatch):
                 return np.abs(joint_difference(robot, np.array([s.joints for s in result.solutions]),
                                                reference)).max(axis=1)
             np.testing.assert_allclose(distances(fast), distances(slow), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("robot_id", ["puma560_standard", "spong_ex3_5_stanford"])
+def test_scalar_duplicate_scan_is_the_array_scan(robot_id):
+    """One pose's slots are merged by a plain scan; it must keep the slots the array scan keeps."""
+    robot = _CATALOGUE.get(robot_id).robot
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        q = random_configurations(robot, 8, seed=int(rng.integers(1 << 30)))[None]
+        copies = rng.integers(0, 8, 4)
+        q[0, copies[:2]] = q[0, copies[2:]] + rng.choice([0.0, 1e-7, 1e-5], (2, 1)) * robot.is_revolute
+        q[0, :, robot.is_revolute] = wrap_revolute(robot, q[0])[:, robot.is_revolute].T
+        ok = rng.random((1, 8)) < 0.8
+        tolerance = np.where(robot.is_revolute, 1e-6, 1e-6 * robot.characteristic_length)
+        scalar = _arrays._first_of_each_scalar(q, ok, robot.is_revolute.tolist(), tolerance.tolist())
+        assert (scalar == _arrays._first_of_each(robot, np.repeat(q, 3, axis=0), np.repeat(ok, 3, axis=0))[0]).all()

@@ -217,6 +217,31 @@ def _slot_pairs(m: int) -> tuple[np.ndarray, np.ndarray]:
 _PAIRS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
 
+def _first_of_each_scalar(joints: np.ndarray, ok: np.ndarray, revolute: list[bool],
+                          tolerance: list[float]) -> np.ndarray:
+    """:func:`_first_of_each` by a plain scan (the same rule), for a few slots."""
+    kept = np.zeros_like(ok)
+    two_pi = 2 * np.pi
+    for row, (slots, usable) in enumerate(zip(joints.tolist(), ok.tolist())):
+        first: list[list[float]] = []
+        for slot, (q, good) in enumerate(zip(slots, usable)):
+            if not good:
+                continue
+            for other in first:
+                for a, b, turn, tol in zip(q, other, revolute, tolerance):
+                    gap = abs(a - b)
+                    if turn and two_pi - gap < gap:
+                        gap = two_pi - gap
+                    if not gap <= tol:
+                        break
+                else:  # every joint within tolerance: the same solution
+                    break
+            else:
+                first.append(q)
+                kept[row, slot] = True
+    return kept
+
+
 def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """Which slots (N, m) hold the first occurrence of a distinct solution among the ``ok`` ones.
 
@@ -231,6 +256,8 @@ def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarr
     all_revolute = bool(revolute.all())
     tolerance = memo(robot, "duplicate_tolerance", lambda: np.where(
         revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length))
+    if joints.size <= 16 * len(revolute):  # one pose's slots: a scan in Python is cheaper than the array ops
+        return _first_of_each_scalar(joints, ok, revolute.tolist(), tolerance.tolist())
     # every pair (earlier slot, later slot) at once; joints are wrapped to (−π, π], so a revolute difference d
     # lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
     earlier, later = _slot_pairs(m)

@@ -167,6 +167,13 @@ _IDENTITY = np.eye(4)
 
 def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:
     """``world_T_tool`` for one joint vector: :func:`tool_columns` in scalar arithmetic (no array overhead)."""
+    (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = tool_columns_scalar(robot, q)
+    return np.array([[x0, y0, z0, p0], [x1, y1, z1, p1], [x2, y2, z2, p2], [0.0, 0.0, 0.0, 1.0]])
+
+
+def tool_columns_scalar(robot: Robot, q: list[float]) -> tuple[tuple[float, float, float], ...]:
+    """:func:`tool_columns` for one joint vector (a list of floats), in scalar arithmetic: the columns x, y, z, p
+    of ``world_T_tool`` as tuples of three floats."""
     steps = memo(robot, "chain_steps", lambda: _chain_steps(robot))
     start = memo(robot, "base_columns", lambda: robot.world_T_base[:3].T.tolist())
     (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = start
@@ -198,9 +205,16 @@ def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:
                                           z0 * ca - y0 * sa, z1 * ca - y1 * sa, z2 * ca - y2 * sa)
         elif d:
             p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
-    flange_T = np.array([[x0, y0, z0, p0], [x1, y1, z1, p1], [x2, y2, z2, p2], [0.0, 0.0, 0.0, 1.0]])
-    tool = robot.flange_T_tool
-    return flange_T if np.array_equal(tool, _IDENTITY) else flange_T @ tool
+    x, y, z, p = (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)
+    tool = memo(robot, "tool_scalar", lambda: None if np.array_equal(robot.flange_T_tool, _IDENTITY)
+                else robot.flange_T_tool[:3].T.tolist())
+    if tool is None:
+        return x, y, z, p
+    # as in tool_columns: p += R_flange t, then each column of R_flange · R_tool
+    (r0, r1, r2, t) = tool
+    p = tuple(p[a] + x[a] * t[0] + y[a] * t[1] + z[a] * t[2] for a in range(3))
+    x, y, z = (tuple(x[a] * r[0] + y[a] * r[1] + z[a] * r[2] for a in range(3)) for r in (r0, r1, r2))
+    return x, y, z, p
 
 
 class JointScrews(NamedTuple):

@@ -13,6 +13,7 @@ from typing import Literal, Sequence
 
 import numpy as np
 
+from ._cache import memo
 from ._conventions import CONVENTIONS, Convention
 from ._errors import InvalidInputError
 
@@ -120,8 +121,11 @@ class Robot:
         """A length that sets the scale of this robot, for relative tolerances.
 
         The sum of the constant link lengths and offsets, plus the tool
-        offset; 1 for a robot with no lengths at all (a pure wrist).
+        offset; 1 for a robot with no lengths at all (a pure wrist). Computed once: the robot does not change.
         """
+        return memo(self, "characteristic_length", self._characteristic_length)
+
+    def _characteristic_length(self) -> float:
         total = float(np.sum(np.abs(self.a)) + np.sum(np.abs(self.d)))
         total += float(np.linalg.norm(self.flange_T_tool[:3, 3]))
         return total if total > 0.0 else 1.0

@@ -180,3 +180,21 @@ def test_ragged_batch_rows_are_named():
     with pytest.raises(InvalidInputError, match="row 1 has 3") as error:
         check_joint_values(robot, [[0, 1], [1, 2, 3]], batch=True)
     assert error.value.location == (1,)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_scalar_residuals_of_a_few_candidates_equal_the_array_ones(convention, monkeypatch):
+    """One pose's candidates are verified by the scalar FK; it must give the array path's residuals."""
+    from service.kinematics.ik import _verify
+
+    rng = np.random.default_rng(3)
+    tool = _trans("z", 0.2) @ _rot("y", -0.4)
+    robot = Robot(_random_robot(rng, convention, "RRPRRR").joints, convention=convention,
+                  world_T_base=_rot("z", 0.3) @ _trans("x", 0.5), flange_T_tool=tool)
+    q = rng.uniform(-np.pi, np.pi, (2, 8, 6))
+    targets = forward_kinematics(robot, q[:, 0] + rng.normal(0, 1e-3, (2, 6)))
+    scalar = _verify.residual_arrays(robot, q, targets)
+    monkeypatch.setattr(_verify, "SCALAR_CANDIDATES", 0)
+    arrays = _verify.residual_arrays(robot, q, targets)
+    for a, b in zip(scalar, arrays):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-13)

@@ -22,6 +22,7 @@ import numpy as np
 from .._cache import memo
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
+from ._lean import lean_candidates, lean_label_codes
 from ._plan import Plan, plan_for
 from ._types import LabelCodes, SingularFlags
 from ._verify import distance_to_reference, polish, residual_arrays, wrap_revolute
@@ -159,7 +160,11 @@ def _concatenated(parts: list[IKArrays]) -> IKArrays:
 
 def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
                  plan: Plan) -> IKArrays:
-    candidates = plan.solve(targets, reference)
+    # one pose: the scalar candidates when the pose is clearly generic (see _lean), else the array solver's
+    candidates = lean_candidates(plan, targets[0], reference) if len(targets) == 1 else None
+    lean = candidates is not None
+    if not lean:
+        candidates = plan.solve(targets, reference)
     n_targets, m, n = candidates.joints.shape
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
     position, orientation = residual_arrays(robot, joints, targets)
@@ -168,7 +173,9 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     if constrain_orientation:
         ok &= orientation <= ACCEPT_RESIDUAL
     kept = _first_of_each(robot, joints, ok)
-    labels = plan.label_codes(joints.reshape(-1, n))
+    labels = lean_label_codes(plan, joints, kept) if lean else None
+    if labels is None:
+        labels = plan.label_codes(joints.reshape(-1, n))
     # output order: kept slots first, nearest to the reference first, else in slot order (stable)
     if reference is not None:
         key = np.where(kept, distance_to_reference(robot, joints, reference), np.inf)
@@ -198,6 +205,43 @@ def _polish_near(robot: Robot, joints: np.ndarray, targets: np.ndarray, position
     position[rows, slots], orientation[rows, slots] = p[:, 0], o[:, 0]
 
 
+def _slot_pairs(m: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair of slots (earlier, later), grouped by the later slot: (0, 1), (0, 2), (1, 2), (0, 3), …"""
+    pairs = _PAIRS.get(m)
+    if pairs is None:
+        later, earlier = np.tril_indices(m, -1)
+        pairs = _PAIRS[m] = (earlier, later)
+    return pairs
+
+
+_PAIRS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+
+def _first_of_each_scalar(joints: np.ndarray, ok: np.ndarray, revolute: list[bool],
+                          tolerance: list[float]) -> np.ndarray:
+    """:func:`_first_of_each` by a plain scan (the same rule), for a few slots."""
+    kept = np.zeros_like(ok)
+    two_pi = 2 * np.pi
+    for row, (slots, usable) in enumerate(zip(joints.tolist(), ok.tolist())):
+        first: list[list[float]] = []
+        for slot, (q, good) in enumerate(zip(slots, usable)):
+            if not good:
+                continue
+            for other in first:
+                for a, b, turn, tol in zip(q, other, revolute, tolerance):
+                    gap = abs(a - b)
+                    if turn and two_pi - gap < gap:
+                        gap = two_pi - gap
+                    if not gap <= tol:
+                        break
+                else:  # every joint within tolerance: the same solution
+                    break
+            else:
+                first.append(q)
+                kept[row, slot] = True
+    return kept
+
+
 def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """Which slots (N, m) hold the first occurrence of a distinct solution among the ``ok`` ones.
 
@@ -212,15 +256,21 @@ def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarr
     all_revolute = bool(revolute.all())
     tolerance = memo(robot, "duplicate_tolerance", lambda: np.where(
         revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length))
-    # joints are wrapped to (−π, π], so a revolute difference d lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
-    kept = np.zeros_like(ok)
-    kept[:, 0] = ok[:, 0]
+    if joints.size <= 16 * len(revolute):  # one pose's slots: a scan in Python is cheaper than the array ops
+        return _first_of_each_scalar(joints, ok, revolute.tolist(), tolerance.tolist())
+    # every pair (earlier slot, later slot) at once; joints are wrapped to (−π, π], so a revolute difference d
+    # lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
+    earlier, later = _slot_pairs(m)
+    gap = np.abs(joints[:, later, :] - joints[:, earlier, :])  # (N, pairs, n)
+    if all_revolute:
+        np.minimum(gap, 2 * np.pi - gap, out=gap)
+    elif revolute.any():
+        gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
+    same = (gap <= tolerance).all(axis=-1)  # (N, pairs)
+    # then the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
+    kept = ok.copy()
+    start = 0
     for slot in range(1, m):
-        gap = np.abs(joints[:, slot, None, :] - joints[:, :slot, :])  # (N, slot, n)
-        if all_revolute:
-            np.minimum(gap, 2 * np.pi - gap, out=gap)
-        elif revolute.any():
-            gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
-        same = (gap <= tolerance).all(axis=-1)  # (N, slot)
-        kept[:, slot] = ok[:, slot] & ~np.any(same & kept[:, :slot], axis=1)
+        kept[:, slot] &= ~np.any(same[:, start:start + slot] & kept[:, :slot], axis=1)
+        start += slot
     return kept

@@ -11,6 +11,7 @@ validity mask, plus per-target singular flags.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -174,13 +175,13 @@ class IntersectingShoulder(Positioner):
         _flag_rows(free_shoulder.any(axis=1),
                    Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "
                                "joint 1 is set to the reference value (or 0)"), singular)
-        if g.model.is_revolute[k]:
+        if g.model.is_revolute[k] and third.merged.any():  # (no elbow flag to set otherwise)
             stretched = self._stretched(q3[:, 0], w, c)
             _flag_rows(third.merged & stretched, Singularity("elbow", (k,), "stretched",
                                                              "the arm is fully stretched"), singular)
             _flag_rows(third.merged & ~stretched, Singularity("elbow", (k,), "folded",
                                                               "the arm is fully folded"), singular)
-        else:
+        elif not g.model.is_revolute[k]:
             _flag_rows(third.merged, Singularity("reach", (k,), "boundary",
                                                  "the point is at the nearest reach of the prismatic joint"), singular)
         return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
@@ -233,6 +234,13 @@ class IntersectingShoulder(Positioner):
         normal = _unit(np.cross(axis, g.direction(j)))
         return normal if normal is not None else self.point - self.centre
 
+    @cached_property
+    def _label_constants(self) -> tuple[np.ndarray, bool, np.ndarray]:
+        """What :meth:`label_codes` needs of the geometry alone, computed once per plan: link 1's forward
+        direction at q = 0, whether axes 2 and 3 are parallel, and the up-pointing axis 1."""
+        g, (i, j, k) = self.geometry, self.joints
+        return self._forward_direction(), bool(g.parallel(j, k)), g.upward(g.direction(i))
+
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """Shoulder left/right: the sign of the reach along link 1's forward direction (see
         :meth:`_forward_direction`); none when the point is on axis 1. Elbow up/down (revolute joint 3,
@@ -242,7 +250,8 @@ class IntersectingShoulder(Positioner):
         the front configuration's limit is used (textbook §3.2: front, θ3 < 0 is up: the elbow behind).
         """
         g, (i, j, k) = self.geometry, self.joints
-        forward = rotate_about(g.direction(i), joints[:, i], self._forward_direction())
+        forward_home, in_plane, up = self._label_constants
+        forward = rotate_about(g.direction(i), joints[:, i], forward_home)
         point = self._moved(joints, k + 1, self.point)
         reach = point - self.centre
         axis = g.direction(i)
@@ -254,13 +263,12 @@ class IntersectingShoulder(Positioner):
         codes: LabelCodes = {"shoulder": (("left", "right"), side_codes(along, np.linalg.norm(reach, axis=-1)))}
         if g.model.is_revolute[k] and not self.free_joints:
             elbow = self._moved(joints, k, g.point(k)) - self.centre
-            if g.parallel(j, k):  # work in the arm's plane, normal to axis 2
+            if in_plane:  # work in the arm's plane, normal to axis 2
                 m = self.model
                 normal = np.einsum("mij,j->mi", chain_rotation(m.directions[:j], m.is_revolute[:j], joints[:, :j]),
                                    g.direction(j))
                 elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
                 reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
-            up = g.upward(axis)
             line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
             rejection = elbow - np.einsum("mi,mi->m", elbow, line)[:, None] * line
             side = rejection @ up

@@ -15,11 +15,15 @@ def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
     """
     theta = np.asarray(theta, dtype=float)
     v = np.asarray(v, dtype=float)
-    shape = np.broadcast_shapes(v.shape, theta.shape + (3,))
+    shape = v.shape if v.shape[:-1] == theta.shape else np.broadcast_shapes(v.shape, theta.shape + (3,))
     frame = _frame_about(k)  # columns e1, e2, k
+    if v.shape != shape:
+        v = np.broadcast_to(v, shape)
+    if theta.shape != shape[:-1]:
+        theta = np.broadcast_to(theta, shape[:-1])
     # (3, 3) @ (3, M) products run as one BLAS call; (M, 3) @ (3, 3) would not
-    local = frame.T @ np.broadcast_to(v, shape).reshape(-1, 3).T  # (3, M): coordinates along e1, e2, k
-    theta = np.broadcast_to(theta, shape[:-1]).reshape(-1)
+    local = frame.T @ v.reshape(-1, 3).T  # (3, M): coordinates along e1, e2, k
+    theta = theta.reshape(-1)
     cos, sin = np.cos(theta), np.sin(theta)
     a, b = local[0], local[1]
     turned = np.empty_like(local)
@@ -49,9 +53,28 @@ _FRAMES: dict[tuple[float, ...], np.ndarray] = {}
 def rotation_about(k: np.ndarray, theta: np.ndarray) -> np.ndarray:
     """R(k, θ) as matrices, shape (..., 3, 3)."""
     theta = np.asarray(theta, dtype=float)
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    K, KK = _cross_matrices(k)
     sin, cos = np.sin(theta)[..., None, None], np.cos(theta)[..., None, None]
-    return np.eye(3) + sin * K + (1.0 - cos) * (K @ K)
+    return _EYE3 + sin * K + (1.0 - cos) * KK
+
+
+def _cross_matrices(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """[k]× and [k]×², memoised by value (the joint axes are a few constants)."""
+    key = tuple(np.asarray(k, dtype=float).tolist())
+    pair = _CROSS.get(key)
+    if pair is None:
+        K = np.array([[0.0, -key[2], key[1]], [key[2], 0.0, -key[0]], [-key[1], key[0], 0.0]])
+        pair = (K, K @ K)
+        for matrix in pair:
+            matrix.setflags(write=False)
+        if len(_CROSS) < 4096:
+            _CROSS[key] = pair
+    return pair
+
+
+_CROSS: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray]] = {}
+_EYE3 = np.eye(3)
+_EYE3.setflags(write=False)
 
 
 def joint_motion(direction: np.ndarray, point: np.ndarray, revolute: bool, q: np.ndarray) -> np.ndarray:

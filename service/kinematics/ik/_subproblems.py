@@ -131,7 +131,30 @@ _TWO_PI = 2.0 * math.pi
 
 
 def _unit(k: ArrayLike, name: str) -> np.ndarray:
-    """Return the constant unit vector ``k`` (shape (3,)) renormalised, or raise."""
+    """Return the constant unit vector ``k`` (shape (3,)) renormalised, or raise.
+
+    The solvers pass the same few joint axes on every call, so a vector that passed is remembered by value
+    (read-only) and the next call with it skips the checks.
+    """
+    try:
+        key = tuple(k.tolist()) if isinstance(k, np.ndarray) else tuple(k)
+        known = _UNITS.get(key)
+    except TypeError:  # not a flat sequence of numbers: let the checks below say what is wrong
+        key, known = None, None
+    if known is not None:
+        return known
+    unit = _checked_unit(k, name)
+    if key is not None and len(_UNITS) < _UNITS_KEPT:
+        unit.setflags(write=False)
+        _UNITS[key] = unit
+    return unit
+
+
+_UNITS: dict[tuple, np.ndarray] = {}
+_UNITS_KEPT = 4096  # bounded: a caller sweeping over many axes keeps no more than this
+
+
+def _checked_unit(k: ArrayLike, name: str) -> np.ndarray:
     k = np.asarray(k, dtype=float)
     if k.shape != (3,):
         raise InvalidInputError(f"{name} must be a unit vector of shape (3,), got shape {k.shape}", location=(name,))
@@ -156,6 +179,22 @@ def _distances(d: ArrayLike, name: str) -> np.ndarray:
 
 
 def _frame(k: np.ndarray) -> np.ndarray:
+    """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``, remembered by value
+    (read-only) as :func:`_unit` remembers the axes."""
+    key = tuple(k.tolist())
+    frame = _FRAMES.get(key)
+    if frame is None:
+        frame = _build_frame(k)
+        if len(_FRAMES) < _UNITS_KEPT:
+            frame.setflags(write=False)
+            _FRAMES[key] = frame
+    return frame
+
+
+_FRAMES: dict[tuple, np.ndarray] = {}
+
+
+def _build_frame(k: np.ndarray) -> np.ndarray:
     """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``.
 
     ``p @ _frame(k)`` gives the coordinates ``(x, y, z)`` of ``p``, where ``z = k.p``

@@ -87,14 +87,15 @@ class ThreeParallelPlan:
         if free_six.any():
             q6 = np.where(free_six, 0.0 if reference is None else reference[5], q6)
         # 4. R_234 about ω_p: the signed sum
-        R5 = joint_motion(g.direction(4), g.point(4), True, q5)[..., :3, :3]
-        R6 = joint_motion(g.direction(5), g.point(5), True, q6)[..., :3, :3]
+        G5 = joint_motion(g.direction(4), g.point(4), True, q5)
+        G6 = joint_motion(g.direction(5), g.point(5), True, q6)
+        R5, R6 = G5[..., :3, :3], G6[..., :3, :3]
         R234 = R_rest[:, :, None] @ np.swapaxes(R6, -1, -2) @ np.swapaxes(R5, -1, -2)
         angle_sum = subproblem_1(w_p, self.normal_p, R234 @ self.normal_p).theta[..., 0]  # (N, 2, 2)
         # 5. point on axis 4 through joints 2 and 3
         # G_1 G_2 G_3 p_4 = A G_6⁻¹ G_5⁻¹ p_4 (G_4 leaves p_4 where it is)
-        y = apply(invert(joint_motion(g.direction(4), g.point(4), True, q5)), g.point(3))
-        y = apply(invert(joint_motion(g.direction(5), g.point(5), True, q6)), y)
+        y = apply(invert(G5), g.point(3))
+        y = apply(invert(G6), y)
         p4_world = apply(A[:, None, None], y)
         z = apply(invert(R1)[:, :, None], p4_world)  # (N, 2, 2, 3)
         elbow = subproblem_3(g.direction(2), g.point(3) - g.point(2), g.point(1) - g.point(2),

@@ -6,9 +6,11 @@ tolerance relative to the robot's size.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
-from .._forward import forward_kinematics, tool_columns
+from .._forward import forward_kinematics, tool_columns, tool_columns_scalar
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE
 
@@ -60,6 +62,8 @@ def residual_arrays(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) ->
         Length units and radians, as :func:`residuals`.
     """
     n_targets, m, n = q.shape
+    if n_targets * m <= SCALAR_CANDIDATES:
+        return _residuals_scalar(robot, q, world_T_targets)
     x, y, z, p = (c.reshape(3, n_targets, m) for c in tool_columns(robot, q.reshape(-1, n)))
     target = np.moveaxis(world_T_targets[:, :3, :], 0, -1)[..., None]  # (3, 4, N, 1)
     tx, ty, tz, tp = target[:, 0], target[:, 1], target[:, 2], target[:, 3]
@@ -71,6 +75,30 @@ def residual_arrays(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) ->
     sine = 0.5 * np.sqrt((dot(tz, y) - dot(ty, z)) ** 2 + (dot(tx, z) - dot(tz, x)) ** 2
                          + (dot(ty, x) - dot(tx, y)) ** 2)
     return position, np.arctan2(sine, cosine)
+
+
+#: Up to this many candidates in all (one pose's), :func:`residual_arrays` runs the scalar FK on each: cheaper
+#: than the array operations, whose fixed cost dominates at that size.
+SCALAR_CANDIDATES = 16
+
+
+def _residuals_scalar(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`residual_arrays` by the scalar FK, candidate by candidate (the same formulas)."""
+    n_targets, m, _ = q.shape
+    position, orientation = np.empty((n_targets, m)), np.empty((n_targets, m))
+    for row, (candidates, target) in enumerate(zip(q.tolist(), world_T_targets[:, :3, :].tolist())):
+        (tx0, ty0, tz0, tp0), (tx1, ty1, tz1, tp1), (tx2, ty2, tz2, tp2) = target
+        for slot, joints in enumerate(candidates):
+            (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = tool_columns_scalar(robot, joints)
+            d0, d1, d2 = p0 - tp0, p1 - tp1, p2 - tp2
+            position[row, slot] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            cosine = 0.5 * ((tx0 * x0 + tx1 * x1 + tx2 * x2) + (ty0 * y0 + ty1 * y1 + ty2 * y2)
+                            + (tz0 * z0 + tz1 * z1 + tz2 * z2) - 1.0)
+            sine = 0.5 * math.sqrt(((tz0 * y0 + tz1 * y1 + tz2 * y2) - (ty0 * z0 + ty1 * z1 + ty2 * z2)) ** 2
+                                   + ((tx0 * z0 + tx1 * z1 + tx2 * z2) - (tz0 * x0 + tz1 * x1 + tz2 * x2)) ** 2
+                                   + ((ty0 * x0 + ty1 * x1 + ty2 * x2) - (tx0 * y0 + tx1 * y1 + tx2 * y2)) ** 2)
+            orientation[row, slot] = math.atan2(sine, cosine)
+    return position, orientation
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -1,0 +1,124 @@
+"""The scalar single-pose candidates (ik/_lean.py) against the array solvers they stand in for."""
+
+import numpy as np
+import pytest
+
+from service.catalogue import load_catalogue
+from service.config import Settings
+from service.kinematics import forward_kinematics
+from service.kinematics.ik import _arrays, joint_difference, solve_ik
+from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik._lean import lean_candidates, lean_label_codes
+from service.kinematics.ik._verify import accepted, residual_arrays, wrap_revolute
+
+from tests.ik_helpers import random_configurations
+
+_CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+LEAN_ROBOTS = sorted(entry.description.id for entry in _CATALOGUE.entries()
+                     if lean_candidates(cached_plan(entry.robot, constrain_orientation=True, reference=None),
+                                        forward_kinematics(entry.robot, np.full(entry.robot.dof, 0.3)), None)
+                     is not None)
+
+
+def _poses(robot, count: int, seed: int) -> np.ndarray:
+    """Random reachable poses, poses at singular configurations (joints snapped to 0 or ±π/2) and poses
+    moved out of reach."""
+    rng = np.random.default_rng(seed)
+    q = random_configurations(robot, count, seed)
+    snapped = q[: count // 4].copy()
+    snap = rng.random(snapped.shape) < 0.3
+    snapped[snap] = rng.choice([0.0, np.pi / 2, -np.pi / 2, np.pi], snap.sum())
+    T = forward_kinematics(robot, np.concatenate([q, snapped]))
+    far = T[: count // 10].copy()
+    far[:, :3, 3] *= rng.uniform(1.5, 3.0, (len(far), 1))
+    return np.concatenate([T, far])
+
+
+def test_the_two_hot_families_are_covered():
+    structures = {cached_plan(_CATALOGUE.get(rid).robot, constrain_orientation=True, reference=None).structure
+                  for rid in LEAN_ROBOTS}
+    assert structures == {"intersecting_shoulder+spherical_wrist", "three_parallel"}
+
+
+@pytest.mark.parametrize("robot_id", LEAN_ROBOTS)
+def test_scalar_candidates_are_the_array_candidates(robot_id):
+    """Same slots, same valid slots and joints, and no singularity, wherever the scalar path answers; the
+    same branch labels wherever its labeller answers."""
+    robot = _CATALOGUE.get(robot_id).robot
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    answered = labelled = 0
+    for T in _poses(robot, 400, seed=11):
+        lean = lean_candidates(plan, T, None)
+        if lean is None:
+            continue
+        answered += 1
+        array = plan.solve(T[None], None)
+        assert (lean.valid == array.valid).all()
+        assert not array.singularities.entries
+        valid = array.valid[0]
+        assert np.abs(joint_difference(robot, lean.joints[0, valid], array.joints[0, valid])).max() <= 1e-9
+        assert np.isnan(lean.joints[0, ~valid]).any(axis=-1).all()
+        joints = wrap_revolute(robot, np.nan_to_num(lean.joints))
+        # as solve_ik: label the slots the FK check keeps (not the least-squares ones it rejects)
+        position, orientation = residual_arrays(robot, joints, T[None])
+        valid = lean.valid[0] & accepted(robot, position[0], orientation[0], True)
+        labels = lean_label_codes(plan, joints, valid[None])
+        if labels is not None:
+            labelled += 1
+            expected = plan.label_codes(joints[0])
+            assert list(labels) == list(expected)
+            for name, (values, codes) in labels.items():
+                assert values == expected[name][0]
+                assert (codes[valid] == expected[name][1][valid]).all()
+    assert answered >= 450  # generic poses are the common case (of 400 random, 100 snapped, 40 far)
+    assert labelled >= 0.9 * answered
+
+
+@pytest.mark.parametrize("robot_id", LEAN_ROBOTS)
+def test_single_pose_answers_do_not_depend_on_the_path(robot_id, monkeypatch):
+    """solve_ik with and without the scalar candidates: the same solutions with the same labels, residuals and
+    singularities, for random, singular and unreachable poses; in the same order without a reference, and
+    nearest first with one (two solutions at the same distance, e.g. sharing the joint that moves most, may
+    swap: the paths' last bits differ)."""
+    robot = _CATALOGUE.get(robot_id).robot
+    poses = _poses(robot, 200, seed=12)
+    references = [None, random_configurations(robot, 1, seed=13)[0]]
+    lean = [solve_ik(robot, T, reference=references[i % 2]) for i, T in enumerate(poses)]
+    monkeypatch.setattr(_arrays, "lean_candidates", lambda *args: None)
+    for i, (T, fast) in enumerate(zip(poses, lean)):
+        reference = references[i % 2]
+        slow = solve_ik(robot, T, reference=reference)
+        assert (fast.status, fast.structure, fast.singularities, fast.free_joints, fast.detail) == \
+               (slow.status, slow.structure, slow.singularities, slow.free_joints, slow.detail)
+        assert len(fast.solutions) == len(slow.solutions)
+        slow_joints = np.array([s.joints for s in slow.solutions]).reshape(-1, robot.dof)
+        for index, a in enumerate(fast.solutions):
+            gaps = np.abs(joint_difference(robot, slow_joints, a.joints)).max(axis=1)
+            b = slow.solutions[int(np.argmin(gaps))]
+            assert gaps.min() <= 1e-9
+            assert a.branch == b.branch
+            assert abs(a.position_residual - b.position_residual) <= 1e-12 * robot.characteristic_length
+            assert abs(a.orientation_residual - b.orientation_residual) <= 1e-12
+            if reference is None:
+                assert b is slow.solutions[index]
+        if reference is not None and fast.solutions:
+            def distances(result):
+                return np.abs(joint_difference(robot, np.array([s.joints for s in result.solutions]),
+                                               reference)).max(axis=1)
+            np.testing.assert_allclose(distances(fast), distances(slow), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("robot_id", ["puma560_standard", "spong_ex3_5_stanford"])
+def test_scalar_duplicate_scan_is_the_array_scan(robot_id):
+    """One pose's slots are merged by a plain scan; it must keep the slots the array scan keeps."""
+    robot = _CATALOGUE.get(robot_id).robot
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        q = random_configurations(robot, 8, seed=int(rng.integers(1 << 30)))[None]
+        copies = rng.integers(0, 8, 4)
+        q[0, copies[:2]] = q[0, copies[2:]] + rng.choice([0.0, 1e-7, 1e-5], (2, 1)) * robot.is_revolute
+        q[0, :, robot.is_revolute] = wrap_revolute(robot, q[0])[:, robot.is_revolute].T
+        ok = rng.random((1, 8)) < 0.8
+        tolerance = np.where(robot.is_revolute, 1e-6, 1e-6 * robot.characteristic_length)
+        scalar = _arrays._first_of_each_scalar(q, ok, robot.is_revolute.tolist(), tolerance.tolist())
+        assert (scalar == _arrays._first_of_each(robot, np.repeat(q, 3, axis=0), np.repeat(ok, 3, axis=0))[0]).all()

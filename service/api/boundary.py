@@ -26,6 +26,7 @@ from ..kinematics import (
     check_joint_values,
     check_rotation,
     check_transform,
+    check_transforms,
     check_unit_quaternion,
     craig_row_from_khalil,
     matrix_from_euler_zyz,
@@ -33,8 +34,6 @@ from ..kinematics import (
     matrix_from_rpy,
     quaternions_from_matrices,
 )
-from ..kinematics._rotations import _checked_transforms
-from ..kinematics._tolerances import ORTHONORMAL_TOLERANCE
 from ..kinematics.ik import Ordering, check_ordering
 from .schemas.common import AngleUnit
 from .schemas.ik import Ordering as OrderingOptions
@@ -150,7 +149,7 @@ def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str
     if all(target.matrix is not None for target in targets):
         stacked = np.array([target.matrix for target in targets], dtype=float)
         try:
-            return _checked_transforms(stacked, ORTHONORMAL_TOLERANCE, batch=True), np.ones(len(targets), dtype=bool)
+            return check_transforms(stacked), np.ones(len(targets), dtype=bool)
         except KinematicsError:
             pass  # the per-target pass below reports it with its full location
     matrices = np.empty((len(targets), 4, 4))

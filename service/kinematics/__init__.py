@@ -33,6 +33,7 @@ from ._robot import JOINT_KINDS, Joint, JointKind, Robot, check_joint_values
 from ._rotations import (
     check_rotation,
     check_transform,
+    check_transforms,
     check_unit_quaternion,
     matrix_from_euler_zyz,
     matrix_from_quaternion,
@@ -71,6 +72,7 @@ __all__ = [
     "check_joint_values",
     "check_rotation",
     "check_transform",
+    "check_transforms",
     "check_unit_quaternion",
     "craig_row_from_khalil",
     "follow_trajectory",

@@ -40,6 +40,7 @@ from ._tolerances import ORTHONORMAL_TOLERANCE, SINGULARITY_TOLERANCE
 __all__ = [
     "check_rotation",
     "check_transform",
+    "check_transforms",
     "check_unit_quaternion",
     "euler_zyz_from_matrix",
     "from_radians",
@@ -264,6 +265,11 @@ def check_transform(T: ArrayLike, *, tolerance: float = ORTHONORMAL_TOLERANCE) -
     (4, 4)
     """
     return _checked_transforms(T, tolerance, batch=False)
+
+
+def check_transforms(T: ArrayLike, *, tolerance: float = ORTHONORMAL_TOLERANCE) -> np.ndarray:
+    """Validate a stack of homogeneous transforms, shape (N, 4, 4); as :func:`check_transform`, row index first."""
+    return _checked_transforms(T, tolerance, batch=True)
 
 
 def check_unit_quaternion(wxyz: ArrayLike, *, tolerance: float = ORTHONORMAL_TOLERANCE) -> np.ndarray:

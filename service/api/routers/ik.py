@@ -8,10 +8,20 @@ import numpy as np
 from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import Robot
-from ...kinematics.ik import IKOptions, IKResult, NumericOptions, Selected, Selection, select, solve_ik_batch
-from ...kinematics.ik._arrays import solve_ik_arrays
-from ...kinematics.ik._select_arrays import SolutionTable, select_arrays
-from ...kinematics.ik._solve import _unreachable_details, results_from_arrays
+from ...kinematics.ik import (
+    IKOptions,
+    IKResult,
+    NumericOptions,
+    Selected,
+    Selection,
+    SolutionTable,
+    results_from_arrays,
+    select,
+    select_arrays,
+    solve_ik_arrays,
+    solve_ik_batch,
+    unreachable_details,
+)
 from ..boundary import (
     _unit_scale,
     joints_from_core,
@@ -62,6 +72,19 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
     return reference, limits, ordering, options, note
 
 
+def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference):
+    """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
+
+    ``arrays`` is None when no analytic family covers the robot (the caller then runs the numeric search).
+    """
+    for constrained in (True, False):
+        rows = np.flatnonzero(flags == constrained)
+        if len(rows):
+            started = time.perf_counter()
+            yield constrained, rows, solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained,
+                                                     reference=reference), started
+
+
 def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: np.ndarray, rows: np.ndarray,
                      constrained: bool, reference, limits, ordering, options, note, started: float):
     """Wire answers (row, dict) from the numeric search, for structures no analytic family covers."""
@@ -86,12 +109,7 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
         matrices, flags = target_matrices(targets, body.angle_unit, "body", "targets")
     reference, limits, ordering, options, note = _settings(request, robot, body, len(targets))
     answers: list[dict | None] = [None] * len(targets)
-    for constrained in (True, False):
-        rows = np.flatnonzero(flags == constrained)
-        if not len(rows):
-            continue
-        started = time.perf_counter()
-        arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, note, started):
@@ -140,12 +158,7 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     reports: list[dict] = []
     kept_tables, rejected_tables = [], []
     scale = _unit_scale(robot, body.angle_unit)
-    for constrained in (True, False):
-        rows = np.flatnonzero(flags == constrained)
-        if not len(rows):
-            continue
-        started = time.perf_counter()
-        arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, note, started):
@@ -163,7 +176,7 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
         trimmed[rows], available[rows] = chosen.trimmed, chosen.available
         solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
                                         "time_budget_exhausted": False, "free_joints": arrays.free_joints})
-        unreachable = _unreachable_details(robot, arrays, matrices[rows], constrained, reference)
+        unreachable = unreachable_details(robot, arrays, matrices[rows], constrained, reference)
         for local in set(unreachable) | set(chosen.notes):
             detail[rows[local]] = " ".join(filter(None, [unreachable.get(local), *chosen.notes.get(local, [])])) or None
         solved = arrays.count > 0

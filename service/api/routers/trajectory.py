@@ -8,7 +8,7 @@ import numpy as np
 from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import InvalidInputError, Robot
-from ...kinematics._trajectory import TrajectoryOptions, TrajectoryResult, follow_trajectory
+from ...kinematics import TrajectoryOptions, TrajectoryResult, follow_trajectory
 from ..boundary import joints_from_core, joints_to_core, located, target_matrix, violation_to_wire
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
 from ..problems import problem_responses

@@ -7,14 +7,17 @@ prismatic joints), and decomposes the problem into geometric subproblems
 back to a bounded numeric search that says it may be incomplete.
 """
 
+from ._arrays import IKArrays, solve_ik_arrays
 from ._numeric import NumericOptions
 from ._plan import plan_for
 from ._select import MAX_EQUIVALENTS, Ordering, Selected, Selection, check_ordering, joint_travel, select, travel
-from ._solve import IKOptions, solve_ik, solve_ik_batch
+from ._select_arrays import SolutionTable, select_arrays
+from ._solve import IKOptions, results_from_arrays, solve_ik, solve_ik_batch, unreachable_details
 from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
 
 __all__ = [
+    "IKArrays",
     "MAX_EQUIVALENTS",
     "IKOptions",
     "IKResult",
@@ -24,14 +27,19 @@ __all__ = [
     "Selection",
     "Singularity",
     "Solution",
+    "SolutionTable",
     "check_ordering",
     "distance_to_reference",
     "joint_difference",
     "joint_travel",
     "plan_for",
+    "results_from_arrays",
     "select",
+    "select_arrays",
     "solve_ik",
+    "solve_ik_arrays",
     "solve_ik_batch",
     "travel",
+    "unreachable_details",
     "wrap_revolute",
 ]

@@ -63,7 +63,7 @@ def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
                         reference: np.ndarray | None) -> list[IKResult]:
     """One :class:`IKResult` per row of :func:`solve_ik_arrays`' answer."""
     counts = arrays.count.tolist()
-    details = _unreachable_details(robot, arrays, targets, constrain_orientation, reference)
+    details = unreachable_details(robot, arrays, targets, constrain_orientation, reference)
     joints, position, orientation = arrays.joints, arrays.position.tolist(), arrays.orientation.tolist()
     labels = [(name, values, codes.tolist()) for name, (values, codes) in arrays.labels.items()]
     free_joints = arrays.free_joints
@@ -83,7 +83,7 @@ def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
     return results
 
 
-def _unreachable_details(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
+def unreachable_details(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
                          reference: np.ndarray | None) -> dict[int, str]:
     """For each unreachable target: whether the position or only the orientation is out of reach (or only with
     the free joints held)."""

@@ -171,40 +171,46 @@ def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:
     return np.array([[x0, y0, z0, p0], [x1, y1, z1, p1], [x2, y2, z2, p2], [0.0, 0.0, 0.0, 1.0]])
 
 
+def _screw_z(frame: tuple, c: float, s: float, d: float) -> tuple:
+    """A frame (x, y, z, p columns, flattened) moved by Rot_z(theta)·Trans_z(d), given c, s of theta (they commute)."""
+    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frame
+    if d:
+        p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
+    return (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s, y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s,
+            z0, z1, z2, p0, p1, p2)
+
+
+def _screw_x(frame: tuple, step) -> tuple:
+    """A frame moved by Trans_x(a)·Rot_x(alpha) of a chain step (they commute); zero terms are skipped."""
+    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frame
+    if step.a:
+        p0, p1, p2 = p0 + x0 * step.a, p1 + x1 * step.a, p2 + x2 * step.a
+    if step.twisted:
+        ca, sa = step.cos_alpha, step.sin_alpha
+        y0, y1, y2, z0, z1, z2 = (y0 * ca + z0 * sa, y1 * ca + z1 * sa, y2 * ca + z2 * sa,
+                                  z0 * ca - y0 * sa, z1 * ca - y1 * sa, z2 * ca - y2 * sa)
+    return x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2
+
+
 def tool_columns_scalar(robot: Robot, q: list[float]) -> tuple[tuple[float, float, float], ...]:
     """:func:`tool_columns` for one joint vector (a list of floats), in scalar arithmetic: the columns x, y, z, p
     of ``world_T_tool`` as tuples of three floats."""
     steps = memo(robot, "chain_steps", lambda: _chain_steps(robot))
     start = memo(robot, "base_columns", lambda: robot.world_T_base[:3].T.tolist())
     (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = start
+    frame = (x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2)
     standard = robot.convention == "standard"
-    cos, sin = math.cos, math.sin
     for step, value in zip(steps, q):
         if step.revolute:
             angle, d = step.theta + value, step.d
         else:
             angle, d = step.theta, step.d + value
-        c, s = cos(angle), sin(angle)
-        if not standard:
-            if step.a:
-                p0, p1, p2 = p0 + x0 * step.a, p1 + x1 * step.a, p2 + x2 * step.a
-            if step.twisted:
-                ca, sa = step.cos_alpha, step.sin_alpha
-                y0, y1, y2, z0, z1, z2 = (y0 * ca + z0 * sa, y1 * ca + z1 * sa, y2 * ca + z2 * sa,
-                                          z0 * ca - y0 * sa, z1 * ca - y1 * sa, z2 * ca - y2 * sa)
-        elif d:
-            p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
-        x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
-                                  y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
+        # Standard DH is a screw about z (theta, d) then about x (a, alpha); Craig and Khalil the other way round.
         if standard:
-            if step.a:
-                p0, p1, p2 = p0 + x0 * step.a, p1 + x1 * step.a, p2 + x2 * step.a
-            if step.twisted:
-                ca, sa = step.cos_alpha, step.sin_alpha
-                y0, y1, y2, z0, z1, z2 = (y0 * ca + z0 * sa, y1 * ca + z1 * sa, y2 * ca + z2 * sa,
-                                          z0 * ca - y0 * sa, z1 * ca - y1 * sa, z2 * ca - y2 * sa)
-        elif d:
-            p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
+            frame = _screw_x(_screw_z(frame, math.cos(angle), math.sin(angle), d), step)
+        else:
+            frame = _screw_z(_screw_x(frame, step), math.cos(angle), math.sin(angle), d)
+    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frame
     x, y, z, p = (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)
     tool = memo(robot, "tool_scalar", lambda: None if np.array_equal(robot.flange_T_tool, _IDENTITY)
                 else robot.flange_T_tool[:3].T.tolist())

@@ -32,6 +32,7 @@ from .._cache import memo
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._decoupled import DecoupledPlan
 from ._positioning import IntersectingShoulder
+from ._subproblems import _frame as _subproblems_frame
 from ._three_parallel import ThreeParallelPlan
 from ._types import Candidates, LabelCodes, SingularFlags
 from ._wrist import SphericalWrist
@@ -226,17 +227,9 @@ def _wrap(theta: float) -> float:
 # --- the subproblems, generic case only ------------------------------------------------------------------
 
 def _frame(k: Vector) -> tuple[Vector, Vector]:
-    """e1, e2 of :func:`._subproblems._frame` (k completes the right-handed frame)."""
-    kx, ky, kz = k
-    if abs(kx) <= abs(ky) and abs(kx) <= abs(kz):
-        e1 = (0.0, kz, -ky)
-    elif abs(ky) <= abs(kz):
-        e1 = (-kz, 0.0, kx)
-    else:
-        e1 = (ky, -kx, 0.0)
-    n = _norm(e1)
-    e1 = (e1[0] / n, e1[1] / n, e1[2] / n)
-    return e1, _cross(k, e1)
+    """e1, e2 of :func:`._subproblems._frame` (k completes the right-handed frame); built once per plan."""
+    frame = _subproblems_frame(np.asarray(k, dtype=float))
+    return tuple(frame[:, 0].tolist()), tuple(frame[:, 1].tolist())
 
 
 def _harmonic(a: float, b: float, c: float, scale: float, out_of_reach: bool = False) -> tuple[float, float]:

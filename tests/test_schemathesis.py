@@ -24,7 +24,7 @@ from hypothesis import strategies as st
 from schemathesis.specs.openapi.checks import positive_data_acceptance
 
 from service.api.app import create_app
-from service.catalogue import ROBOT_FILE_SUFFIXES
+from service.robots.catalogue import ROBOT_FILE_SUFFIXES
 from service.config import BUILTIN_ROBOTS_DIR, Settings
 from service.openapi import SPEC_PATH
 
@@ -76,7 +76,7 @@ def test_api_conforms_to_its_spec(case):
 import numpy as np  # noqa: E402
 from hypothesis import given  # noqa: E402
 
-from service.catalogue import load_catalogue  # noqa: E402
+from service.robots.catalogue import load_catalogue  # noqa: E402
 from service.kinematics import forward_kinematics, quaternions_from_matrices  # noqa: E402
 from service.kinematics._rotations import euler_zyz_from_matrix, rpy_from_matrix  # noqa: E402
 

@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import BUILTIN_ROBOTS_DIR
 from service.kinematics import forward_kinematics
 from service.openapi import SPEC_PATH

@@ -29,7 +29,7 @@ from ._limits import (
     within,
 )
 from ._rates import JointRates, TaskSpace, jacobian_derivative, joint_rates, task_space
-from ._robot import JOINT_KINDS, Joint, JointKind, Robot, check_joint_values
+from ._robot import JOINT_KINDS, Joint, JointKind, Robot, ScrewJoint, check_joint_values
 from ._rotations import (
     check_rotation,
     check_transform,
@@ -65,6 +65,7 @@ __all__ = [
     "KinematicsError",
     "RATE_SINGULARITY_TOLERANCE",
     "Robot",
+    "ScrewJoint",
     "TaskSpace",
     "TrajectoryOptions",
     "TrajectoryResult",

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import _arrays, joint_difference, solve_ik

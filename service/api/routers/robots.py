@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends, Request
 
-from ...catalogue import Catalogue
+from ...robots.catalogue import Catalogue
 from ..deps import catalogue_of, catalogue_robot, RobotRef
 from ..problems import problem_responses
-from ..schemas.robots import DHRobot, KhalilRobot, RobotDescription, RobotList, RobotSummary
+from ...robots.schemas import AnyRobotDescription, RobotDescription, RobotList, RobotSummary
 
 router = APIRouter(prefix="/v1/robots", tags=["robots"])
 
@@ -16,15 +16,17 @@ router = APIRouter(prefix="/v1/robots", tags=["robots"])
 def list_robots(catalogue: Catalogue = Depends(catalogue_of)) -> RobotList:
     """List the catalogue: id, name, degrees of freedom, convention and joint types of every robot."""
     return RobotList(robots=[
-        RobotSummary(id=e.description.id, name=e.description.name, dof=e.robot.dof,
-                     convention=e.description.convention, joint_types=[j.type for j in e.description.joints],
-                     source=e.description.source)
+        RobotSummary(id=e.description.id, name=e.description.name or e.robot.name, dof=e.robot.dof, format=e.description.format,
+                     convention=getattr(e.description, "convention", None),
+                     joint_types=["revolute" if r else "prismatic" for r in e.robot.is_revolute.tolist()],
+                     joint_names=e.robot.joint_names, source=e.description.source,
+                     licence=getattr(e.description, "licence", None))
         for e in catalogue.entries()
     ])
 
 
 @router.get("/{robot_id}", operation_id="get_robot", response_model=RobotDescription,
             responses=problem_responses(404, 422))
-def get_robot(request: Request, ref: RobotRef = Depends(catalogue_robot)) -> DHRobot | KhalilRobot:
+def get_robot(request: Request, ref: RobotRef = Depends(catalogue_robot)) -> AnyRobotDescription:
     """Return one robot's full description, exactly as its catalogue file states it (units included)."""
     return catalogue_of(request).get(ref.id).description

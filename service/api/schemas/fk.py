@@ -6,7 +6,7 @@ from pydantic import Field
 
 from .common import ANGLE_UNIT_FIELD, AngleUnit, Number, RobotId, ApiModel
 from .poses import NamedPose, Pose
-from .robots import RobotDescription
+from ...robots.schemas import RobotDescription
 
 
 class FKRequest(ApiModel):

@@ -11,7 +11,7 @@ from ...kinematics.ik import MAX_EQUIVALENTS
 from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RobotId
 from .limits import JointLimitsOverride, LimitViolation
 from .poses import PoseTarget
-from .robots import RobotDescription
+from ...robots.schemas import RobotDescription
 
 
 NonNegative = Annotated[Number, Field(ge=0)]

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pydantic import Field
 
 from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number
-from .robots import RobotDescription
+from ...robots.schemas import RobotDescription
 
 
 class JointLimitsOverride(ApiModel):

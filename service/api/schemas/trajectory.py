@@ -11,7 +11,7 @@ from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RobotId, Vect
 from .ik import Branch, SingularityReport
 from .limits import LimitViolation
 from .poses import PoseTarget
-from .robots import RobotDescription
+from ...robots.schemas import RobotDescription
 
 
 class _Rates(ApiModel):

@@ -39,6 +39,7 @@ from ._rotations import (
     matrix_from_quaternion,
     matrix_from_rpy,
     quaternions_from_matrices,
+    rpy_from_matrix,
 )
 from ._tolerances import RATE_SINGULARITY_TOLERANCE
 from ._trajectory import TrajectoryOptions, TrajectoryResult, follow_trajectory
@@ -89,6 +90,7 @@ __all__ = [
     "matrix_from_quaternion",
     "matrix_from_rpy",
     "quaternions_from_matrices",
+    "rpy_from_matrix",
     "screw_model",
     "task_space",
 ]

@@ -107,7 +107,7 @@ def _urdf_entry(path: Path, urdf: str) -> dict:
             raise CatalogueError(f"{sidecar}: {required}: a catalogue URDF must state its {required}")
     if "urdf" in meta or meta.get("format", "urdf") != "urdf":
         raise CatalogueError(f"{sidecar}: the URDF text comes from {path.name}; the sidecar sets the other fields")
-    return {**meta, "format": "urdf", "urdf": urdf}
+    return {"id": path.stem, **meta, "format": "urdf", "urdf": urdf}
 
 
 def load_catalogue(directories: Iterable[Path], *, max_joints: int) -> Catalogue:

@@ -89,6 +89,7 @@ class _RobotFields(ApiModel):
     id: RobotId = "inline"
     name: str = Field("", max_length=200)
     source: str = Field("", max_length=2000, description="where the parameters come from")
+    licence: str | None = Field(None, max_length=200, description="licence of the source")
     angle_unit: AngleUnit = Field("rad", description="unit of alpha, theta and revolute limits in this description")
     length_unit: str = Field("m", max_length=16)
     parameters: RobotParameters | None = Field(

@@ -33,7 +33,7 @@ from ..boundary import (
     target_matrix,
     violation_to_wire,
 )
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of, with_request_frames
 from ..observability import observe_ik
 from ..problems import problem_responses
 from ..responses import FastJSONResponse
@@ -100,6 +100,7 @@ def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: 
 
 
 def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     if isinstance(body, IKRequest):
         with located("body", "target"):
@@ -139,11 +140,14 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
             answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
                                  chosen.notes.get(local, []), bool(chosen.truncated[local]),
                                  int(chosen.trimmed[local]), int(chosen.available[local]))
+    for answer in answers:
+        answer["joint_names"] = robot.joint_names
     return answers
 
 
 def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
     """The batch answer as columns: solve, select and encode with array operations, no loop over targets."""
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     matrices, flags = target_matrices(body.targets, body.angle_unit, "body", "targets")
     reference, limits, ordering, options, note = _settings(request, robot, body, len(matrices))
@@ -206,6 +210,7 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     singular = [[order[i] for i in flags] for flags in singular] if order else singular
     return FastJSONResponse({
         "robot_id": ref.id,
+        "joint_names": robot.joint_names,
         "format": "arrays",
         "solvers": solvers,
         "singularity_reports": reports,

@@ -30,6 +30,18 @@ RealMatrix4 = Annotated[
 ]
 
 
+class RequestFrames(ApiModel):
+    """Per-request base and tool: they replace the robot's own for this request only."""
+
+    base: Matrix4 | None = Field(None, description="world_T_base for this request, replacing the robot's own; "
+                                                   "validated as a rigid transform")
+    tool: Matrix4 | None = Field(None, description="flange_T_tool for this request, replacing the robot's own; "
+                                                   "validated as a rigid transform")
+
+
+JOINT_NAMES_FIELD = Field(description="the robot's joint names, in the order of every joint vector in this answer")
+
+
 ANGLE_UNIT_FIELD = Field(
     "rad",
     description="Unit of every revolute joint value and every angle in this request and its response. "

@@ -68,7 +68,10 @@ def parse_urdf(text: str, *, base_link: str | None = None, tip_link: str | None 
         raise _error(f"not well-formed XML: {error}") from None
     except ValueError as error:  # e.g. an encoding declaration on a str
         raise _error(f"not a readable XML document: {error}") from None
-    if _XACRO_NAMESPACE in text or any(element.tag.startswith(f"{{{_XACRO_NAMESPACE}}}") for element in root.iter()):
+    # An expanded file may still declare the xacro namespace; only xacro elements (macros, properties...) mean
+    # that it was never expanded.
+    if any(isinstance(element.tag, str) and element.tag.startswith(f"{{{_XACRO_NAMESPACE}}}")
+           for element in root.iter()):
         raise _error("this is a xacro file; xacro is out of scope: expand it first (xacro robot.urdf.xacro > "
                      "robot.urdf) and send the resulting URDF")
     if root.tag != "robot":

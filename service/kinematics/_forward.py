@@ -222,23 +222,29 @@ def _screw_chain_columns(robot: Robot, q: np.ndarray):
 
 
 def _screw_chain_scalar(robot: Robot, q: list[float]):
-    """:func:`_screw_chain_columns` for one joint vector, in scalar arithmetic."""
+    """:func:`_screw_chain_columns` for one joint vector, in scalar arithmetic (unrolled, no array overhead)."""
     def build():
         fixed = [robot.world_T_base @ robot.chain_transforms[0], *robot.chain_transforms[1:-1],
                  robot.chain_transforms[-1] @ robot.flange_T_tool]
-        return [(T[:3, :3].T.tolist(), T[:3, 3].tolist()) for T in fixed]
+        return [tuple(T[:3, :].T.ravel().tolist()) for T in fixed]  # x, y, z, p columns, flattened
 
     fixed = memo(robot, "screw_chain_scalar", build)
-    (x, y, z), p = fixed[0]
-    for revolute, value, (R, t) in zip(robot.is_revolute.tolist(), q, fixed[1:]):
+    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = fixed[0]
+    for revolute, value, F in zip(robot.is_revolute.tolist(), q, fixed[1:]):
         if revolute:
             c, s = math.cos(value), math.sin(value)
-            x, y = [x[a] * c + y[a] * s for a in range(3)], [y[a] * c - x[a] * s for a in range(3)]
+            x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
+                                      y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
         else:
-            p = [p[a] + z[a] * value for a in range(3)]
-        p = [p[a] + x[a] * t[0] + y[a] * t[1] + z[a] * t[2] for a in range(3)]
-        x, y, z = ([x[a] * r[0] + y[a] * r[1] + z[a] * r[2] for a in range(3)] for r in R)
-    return tuple(x), tuple(y), tuple(z), tuple(p)
+            p0, p1, p2 = p0 + z0 * value, p1 + z1 * value, p2 + z2 * value
+        a0, a1, a2, b0, b1, b2, c0, c1, c2, t0, t1, t2 = F
+        p0, p1, p2 = (p0 + x0 * t0 + y0 * t1 + z0 * t2, p1 + x1 * t0 + y1 * t1 + z1 * t2,
+                      p2 + x2 * t0 + y2 * t1 + z2 * t2)
+        x0, x1, x2, y0, y1, y2, z0, z1, z2 = (
+            x0 * a0 + y0 * a1 + z0 * a2, x1 * a0 + y1 * a1 + z1 * a2, x2 * a0 + y2 * a1 + z2 * a2,
+            x0 * b0 + y0 * b1 + z0 * b2, x1 * b0 + y1 * b1 + z1 * b2, x2 * b0 + y2 * b1 + z2 * b2,
+            x0 * c0 + y0 * c1 + z0 * c2, x1 * c0 + y1 * c1 + z1 * c2, x2 * c0 + y2 * c1 + z2 * c2)
+    return (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)
 
 
 def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:

@@ -177,6 +177,9 @@ class IntersectingShoulder(Positioner):
         _flag_rows(free_shoulder.any(axis=1),
                    Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "
                                "joint 1 is set to the reference value (or 0)"), singular)
+        _flag_rows((pair.merged & ~free_shoulder & third.valid & third.exact).any(axis=1),
+                   Singularity("shoulder", (i, j), "boundary", "the two shoulder solutions meet: the point is as "
+                               "near axis 1 as the shoulder allows"), singular)
         if g.model.is_revolute[k] and third.merged.any():  # (no elbow flag to set otherwise)
             stretched = self._stretched(q3[:, 0], w, c)
             _flag_rows(third.merged & stretched, Singularity("elbow", (k,), "stretched",
@@ -507,6 +510,8 @@ class OffsetShoulderIntersectingElbow(Positioner):
         _flag_rows((free & first_ok).any(axis=1), Singularity("elbow", (j,), "free", "the point is on axis 2; "
                                                               "joint 2 is set to the reference value (or 0)"),
                    singular)
+        _flag_rows((pair.merged & first_ok).any(axis=1), Singularity("elbow", (j, k), "boundary", "the two "
+                                                                     "solutions of joints 2 and 3 meet"), singular)
         return PositionerResult(joints, valid.reshape(n_targets, 4), singular)
 
 

@@ -334,33 +334,26 @@ def _positioner_singular_configurations(robot: Robot, plan, count: int, seed: in
 
         def centre(q):
             return (forward_kinematics(robot, q) @ home_inverse @ np.append(plan.point, 1.0))[:, :3]
-    grid = np.linspace(-np.pi, np.pi, 721)
-    found = []
-    for q in configurations(robot, 4 * count, seed):
-        trial = np.repeat(q[None], len(grid), axis=0)
-        trial[:, search] = grid if robot.is_revolute[search] else grid / np.pi
-        det = _positioner_determinant(robot, trial, joints, centre)
-        change = np.flatnonzero(np.sign(det[:-1]) != np.sign(det[1:]))
-        if not len(change):
-            continue
-        low, high = trial[change[0], search], trial[change[0] + 1, search]
-        f_low = det[change[0]]
-        for _ in range(60):
-            mid = 0.5 * (low + high)
-            probe = q.copy()
-            probe[search] = mid
-            f_mid = _positioner_determinant(robot, probe[None], joints, centre)[0]
-            if np.sign(f_mid) == np.sign(f_low):
-                low, f_low = mid, f_mid
-            else:
-                high = mid
-        q = q.copy()
-        q[search] = 0.5 * (low + high)
-        found.append(q)
-        if len(found) == count:
-            break
+    grid = np.linspace(-np.pi, np.pi, 721) * (1.0 if robot.is_revolute[search] else 1 / np.pi)
+    q = configurations(robot, 2 * count, seed)
+    trial = np.repeat(q[:, None], len(grid), axis=1)
+    trial[..., search] = grid
+    det = _positioner_determinant(robot, trial.reshape(-1, robot.dof), joints, centre).reshape(len(q), -1)
+    change = np.sign(det[:, :-1]) != np.sign(det[:, 1:])
+    rows = np.flatnonzero(change.any(axis=1))[:count]
+    first = change[rows].argmax(axis=1)
+    low, high, f_low = grid[first], grid[first + 1], det[rows, first]
+    q = q[rows]
+    for _ in range(60):  # bisection on every row at once
+        q[:, search] = 0.5 * (low + high)
+        f_mid = _positioner_determinant(robot, q, joints, centre)
+        same = np.sign(f_mid) == np.sign(f_low)
+        low, f_low, high = np.where(same, q[:, search], low), np.where(same, f_mid, f_low), \
+            np.where(same, high, q[:, search])
+    q[:, search] = 0.5 * (low + high)
+    found = q
     assert len(found) == count
-    return np.array(found)
+    return found
 
 
 def robot_home(robot: Robot) -> np.ndarray:

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from service.kinematics import Joint, Robot
-from service.kinematics._forward import forward_kinematics, joint_screws, link_frames
+from service.kinematics._forward import forward_kinematics, joint_screws, link_frames, screw_model
 from service.kinematics.ik import _numeric, joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik._arrays import cached_plan
 from service.kinematics.ik._subproblems import subproblem_1
@@ -473,3 +473,30 @@ def test_kuka_wrist_centre_on_axis_1_frees_joint_1():
     assert any(s.kind == "shoulder" and s.relation == "free" and s.joints == (0,) for s in result.singularities)
     # joint 1 is free: each solution takes the reference value for it and still reaches the target
     assert all(abs(s.joints[0] - 1.1) < 1e-9 for s in result.solutions)
+
+
+@pytest.mark.parametrize("name", sorted(DATA["arms"]))
+def test_published_tables_have_the_published_opw_geometry(name):
+    """The DH tables built from the OPW parameters have them as convention-free distances of the screw model."""
+    p = DATA["arms"][name]["opw"]
+    robot = published_arm(name)
+    model = screw_model(robot)
+    k, o = model.directions, model.points
+
+    def line_distance(i, j):
+        normal = np.cross(k[i], k[j])
+        if np.linalg.norm(normal) < 1e-12:
+            offset = o[j] - o[i]
+            return np.linalg.norm(offset - (offset @ k[i]) * k[i])
+        return abs((o[j] - o[i]) @ normal) / np.linalg.norm(normal)
+
+    assert np.isclose(line_distance(0, 1), p["a1"], atol=1e-12)  # the shoulder offset
+    assert np.isclose(line_distance(1, 2), p["c2"], atol=1e-12)  # the upper arm, between parallel axes 2 and 3
+    centre = o[4]  # axes 4, 5, 6 meet at the wrist centre; joint 5's point is on it
+    assert all(np.linalg.norm(np.cross(k[j], centre - o[j])) < 1e-12 for j in (3, 4, 5))
+    offset = centre - o[2]
+    assert np.isclose(np.linalg.norm(offset - (offset @ k[2]) * k[2]), np.hypot(p["a2"], p["c3"]), atol=1e-12)
+    assert np.isclose(np.linalg.norm(model.home[:3, 3] - centre), p["c4"], atol=1e-12)  # the flange
+    # axis 1 is the base z axis, and axis 2 is horizontal, c1 above the base plane
+    assert np.allclose(np.abs(k[0]), [0, 0, 1]) and np.allclose(np.cross(k[0], o[0]), 0)
+    assert abs(k[1][2]) < 1e-12 and np.isclose(o[1][2], p["c1"], atol=1e-12)

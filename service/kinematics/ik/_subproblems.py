@@ -42,11 +42,12 @@ Conventions
 Results
 -------
 Every function returns a record with the same flags. ``m`` is the number of
-candidate slots, which is fixed for each function (1 or 2):
+candidate slots, which is fixed for each function (1 or 2; 4 for subproblem 5):
 
 * ``valid`` (..., m) bool: the candidate exists. The first slot is always
   valid, because every problem has an exact, least-squares or representative
-  answer.
+  answer (subproblem 5 excepted: it has four slots and no least-squares
+  candidate, so a row with no real root has none).
 * ``exact`` (..., m) bool: the candidate satisfies the equation within
   tolerance. False means it is the least-squares answer.
 * ``degenerate`` (...,) bool: infinitely many candidates are equally good,
@@ -781,8 +782,9 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
     on the unit circle (within ``1e-5`` radially) has no valid slot. Roots closer than
     ``DUPLICATE_TOLERANCE`` (a tangent root, the edge of the workspace) are reported once with
     ``merged`` set. Scale: ``S = ||p0|| + ||p1|| + ||p2|| + ||p3||``; a candidate is ``exact``
-    when the vector equation holds to ``GEOMETRY_TOLERANCE * S`` (then to 10⁻⁹ after the FK
-    polish of the callers). ``degenerate``: the quartic vanishes identically, so ``theta_t`` is
+    when the vector equation holds to ``GEOMETRY_TOLERANCE * S``; near a tangent root a root
+    carries about the square root of the rounding error, and such valid but inexact candidates
+    are left to the caller (the IK solvers refine and verify every candidate by FK). ``degenerate``: the quartic vanishes identically, so ``theta_t`` is
     free (``p1`` on ``k1`` or ``p3`` on ``k3``, with the target reachable); the representative
     has ``theta_t = 0``. When neither block is invertible the equations do not separate the
     angles (``k1 ∥ k2`` with ``p2`` on ``k3``, or ``k2 ∥ k3``): no slot is valid, and those

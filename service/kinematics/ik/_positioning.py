@@ -362,11 +362,10 @@ class OffsetShoulderParallelElbow(Positioner):
             first = prismatic_to_plane(u, targets, -g.direction(i), np.full(n_targets, float(u @ w)))
             q1 = first.s
             y = targets[:, None, :] - q1[..., None] * g.direction(i)
-        in_plane = np.eye(3) - np.outer(u, u)
+        in_plane, elbow_to_point, elbow_to_shoulder = self._plane_constants
         reach = np.linalg.norm((y - g.point(j)) @ in_plane, axis=-1)  # (N, m1)
         if g.model.is_revolute[k]:
-            third = subproblem_3(g.direction(k), in_plane @ (w - g.point(k)), in_plane @ (g.point(j) - g.point(k)),
-                                 reach)
+            third = subproblem_3(g.direction(k), elbow_to_point, elbow_to_shoulder, reach)
             q3 = third.theta  # (N, m1, 2)
             w3 = g.point(k) + rotate_about(g.direction(k), q3, w - g.point(k))
         else:
@@ -394,19 +393,27 @@ class OffsetShoulderParallelElbow(Positioner):
             _flag_rows(first.merged, Singularity("shoulder", (i,), "boundary", "the point is as near axis 1 as "
                                                  "the shoulder offset allows: front and back meet"), singular)
         merged = (third.merged & first_ok).any(axis=1)
-        if g.model.is_revolute[k]:
+        if g.model.is_revolute[k] and merged.any():  # (no elbow flag to set otherwise)
             folded = self._folded(q3[:, :, 0])
             _flag_rows((third.merged & first_ok & ~folded).any(axis=1),
                        Singularity("elbow", (k,), "stretched", "the arm is fully stretched"), singular)
             _flag_rows((third.merged & first_ok & folded).any(axis=1),
                        Singularity("elbow", (k,), "folded", "the arm is fully folded"), singular)
-        else:
+        elif not g.model.is_revolute[k]:
             _flag_rows(merged, Singularity("reach", (k,), "boundary",
                                            "the point is at the nearest reach of the prismatic joint"), singular)
         _flag_rows((second.degenerate & first_ok[:, :, None]).any(axis=(1, 2)),
                    Singularity("elbow", (j,), "free", "the point is on axis 2; joint 2 is set to the reference "
                                "value (or 0)"), singular)
         return PositionerResult(joints, valid, singular)
+
+    @cached_property
+    def _plane_constants(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The projector onto the arm's plane (normal to axis 2), and in it the point and axis 2 seen from axis 3."""
+        g, (_, j, k) = self.geometry, self.joints
+        u = g.direction(j)
+        in_plane = np.eye(3) - np.outer(u, u)
+        return in_plane, in_plane @ (self.point - g.point(k)), in_plane @ (g.point(j) - g.point(k))
 
     def _folded(self, q3: np.ndarray) -> np.ndarray:
         """Whether joint 3 at q3 brings the point nearer axis 2 than its opposite turn (the folded elbow)."""

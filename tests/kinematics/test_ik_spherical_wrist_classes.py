@@ -500,3 +500,25 @@ def test_published_tables_have_the_published_opw_geometry(name):
     # axis 1 is the base z axis, and axis 2 is horizontal, c1 above the base plane
     assert np.allclose(np.abs(k[0]), [0, 0, 1]) and np.allclose(np.cross(k[0], o[0]), 0)
     assert abs(k[1][2]) < 1e-12 and np.isclose(o[1][2], p["c1"], atol=1e-12)
+
+
+def test_kuka_stated_in_khalil_columns_through_the_api_is_solved_in_closed_form(client):
+    """The KR 6 R900-2 sent inline in Khalil–Kleinfinger columns (renamed Craig rows) reaches the same family."""
+    standard = published_arm("kuka_kr6_r900_2")
+    rows = list(zip(standard.a, standard.alpha, standard.d, standard.theta))
+    joints = []
+    for i in range(6):  # Craig row i: (a_{i-1}, alpha_{i-1}, d_i, theta_i); Khalil: alpha_j, d_j = a, theta_j, r_j = d
+        a, alpha = (0.0, 0.0) if i == 0 else rows[i - 1][:2]
+        joints.append({"name": f"a{i + 1}", "type": "revolute", "alpha": float(np.degrees(alpha)), "d": float(a),
+                       "theta": float(np.degrees(rows[i][3])), "r": float(rows[i][2])})
+    robot = {"name": "KR 6 R900-2 (Khalil)", "convention": "khalil", "angle_unit": "deg", "length_unit": "m",
+             "joints": joints}  # the last row has a_6 = alpha_6 = 0: no tool transform needed
+    for q in configurations(standard, 10, seed=17):
+        target = forward_kinematics(standard, q)
+        response = client.post("/v1/ik", json={"robot": robot, "target": {"matrix": target.tolist()}})
+        assert response.status_code == 200, response.text
+        body = response.json()
+        assert body["solver"] == {"method": "analytic", "structure": "offset_shoulder_parallel_elbow+spherical_wrist",
+                                  "complete": True, "time_budget_exhausted": False}
+        solutions = np.array([s["joints"] for s in body["solutions"]])
+        assert np.abs(joint_difference(standard, solutions, q)).max(axis=1).min() < 1e-7

@@ -522,3 +522,23 @@ def test_kuka_stated_in_khalil_columns_through_the_api_is_solved_in_closed_form(
                                   "complete": True, "time_budget_exhausted": False}
         solutions = np.array([s["joints"] for s in body["solutions"]])
         assert np.abs(joint_difference(standard, solutions, q)).max(axis=1).min() < 1e-7
+
+
+@pytest.mark.parametrize("kind", sorted(CLASSES))
+def test_position_only_targets_hold_the_wrist_and_place_the_tool_in_closed_form(kind):
+    """A position target holds joints 4–6 at the reference; joints 1–3 then place the tool point (its positioner
+    family, complete); targets far out of reach are unreachable, with complete: true."""
+    robot = statements(kind, seed=sorted(CLASSES).index(kind))[2]
+    q = configurations(robot, 40, seed=23)
+    targets = forward_kinematics(robot, q)
+    for q_true, target in zip(q, targets):
+        result = solve_ik(robot, target, constrain_orientation=False, reference=q_true)
+        assert (result.method, result.complete, result.status) == ("analytic", True, "ok")
+        solutions = np.array([s.joints for s in result.solutions])
+        assert np.abs(joint_difference(robot, solutions, q_true)).max(axis=1).min() < 1e-7
+        assert np.allclose(solutions[:, 3:], q_true[3:])  # the held joints
+    if robot.is_revolute.all():
+        far = targets[0].copy()
+        far[:3, 3] *= 50
+        result = solve_ik(robot, far)
+        assert (result.status, result.complete) == ("unreachable", True)

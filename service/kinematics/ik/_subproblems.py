@@ -782,13 +782,14 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
     on the unit circle (within ``1e-5`` radially) has no valid slot. Roots closer than
     ``DUPLICATE_TOLERANCE`` (a tangent root, the edge of the workspace) are reported once with
     ``merged`` set. Scale: ``S = ||p0|| + ||p1|| + ||p2|| + ||p3||``; a candidate is ``exact``
-    when the vector equation holds to ``GEOMETRY_TOLERANCE * S``; near a tangent root a root
-    carries about the square root of the rounding error, and such valid but inexact candidates
-    are left to the caller (the IK solvers refine and verify every candidate by FK). ``degenerate``: the quartic vanishes identically, so ``theta_t`` is
-    free (``p1`` on ``k1`` or ``p3`` on ``k3``, with the target reachable); the representative
-    has ``theta_t = 0``. When neither block is invertible the equations do not separate the
-    angles (``k1 ∥ k2`` with ``p2`` on ``k3``, or ``k2 ∥ k3``): no slot is valid, and those
-    geometries are solved by subproblems 3 and 4 instead.
+    when the vector equation holds to ``GEOMETRY_TOLERANCE * S``. Near a tangent root a root
+    carries about the square root of the rounding error; such valid but inexact candidates are
+    left to the caller (the IK solvers refine and verify every candidate by FK).
+    ``degenerate``: the quartic vanishes identically, so ``theta_t`` is free (``p1`` on ``k1``
+    or ``p3`` on ``k3``, with the target reachable); the representative has ``theta_t = 0``.
+    When neither block is invertible the equations do not separate the angles (``k1 ∥ k2``
+    with ``p2`` on ``k3``, or ``k2 ∥ k3``): no slot is valid, and those geometries are solved
+    by subproblems 3 and 4 instead.
 
     Examples
     --------

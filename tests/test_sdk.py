@@ -79,8 +79,8 @@ def test_generated_names_are_clean(sdk):
     root = Path(sdk.__file__).parent
     models = sorted(p.stem for p in (root / "models").glob("*.py") if p.stem != "__init__")
     assert not [m for m in models if "_type_" in m or m.endswith("_item") or m.startswith("body_")], models
-    for expected in ("dh_robot", "khalil_robot", "urdf_robot", "screws_robot", "pose_target", "matrix_orientation", "quaternion_orientation",
-                     "euler_zyz_orientation", "rpy_orientation", "ik_response", "problem", "angle_unit"):
+    for expected in ("dh_robot", "khalil_robot", "urdf_robot", "screws_robot", "pose_target", "matrix_orientation",
+                     "quaternion_orientation", "euler_zyz_orientation", "rpy_orientation", "ik_response", "problem", "angle_unit"):
         assert expected in models
     operations = sorted(p.stem for p in (root / "api").rglob("*.py") if p.stem != "__init__")
     assert {"list_robots", "get_robot", "forward_kinematics", "forward_kinematics_inline",

@@ -61,7 +61,7 @@ def _converted_table(description: DHRobot | KhalilRobot, form: str) -> DHRobot |
         craig = DHRobot(**fields, convention="modified", joints=rows)
         return craig if form == "modified" else _converted_table(craig, form)
     rows = description.joints
-    if form == "modified":  # from standard: (θ1, d1 | a1, α1 θ2 d2 | … | an, αn) regrouped; the tail must be empty
+    if form == "modified":  # from standard: (θ1 d1 | a1 α1 θ2 d2 | … | an αn) regrouped; the tail must be empty
         if rows[-1].a != 0.0 or rows[-1].alpha != 0.0:
             raise FormNotExact("the last row has a or alpha ≠ 0: as a modified table its flange frame would move "
                                "into the tool; ask for form 'screws' or 'urdf' (exact)")
@@ -163,4 +163,5 @@ def _matrix(T: np.ndarray) -> list[list[float]]:
 def _limits(lower: float, upper: float, scale: float) -> dict | None:
     if math.isinf(lower) and math.isinf(upper):
         return None
-    return {"lower": None if math.isinf(lower) else lower * scale, "upper": None if math.isinf(upper) else upper * scale}
+    return {"lower": None if math.isinf(lower) else lower * scale,
+            "upper": None if math.isinf(upper) else upper * scale}

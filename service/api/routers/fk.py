@@ -28,7 +28,8 @@ def _forward(ref: RobotRef, body: FKRequest) -> FKResponse:
         frames = [{"name": name, **pose} for name, pose in zip(names, poses_from_matrices(stack))]
     else:
         world_T_tool = forward_kinematics(robot, q)
-    return FKResponse(robot_id=ref.id, joint_names=robot.joint_names, pose=pose_from_matrix(world_T_tool), frames=frames)
+    return FKResponse(robot_id=ref.id, joint_names=robot.joint_names, pose=pose_from_matrix(world_T_tool),
+                      frames=frames)
 
 
 @router.post("/robots/{robot_id}/fk", operation_id="forward_kinematics", response_model=FKResponse,
@@ -54,4 +55,5 @@ def forward_kinematics_batch(request: Request, body: FKBatchRequest,
     ref = with_request_frames(ref, body)
     with located("body", "joints"):
         q = joints_to_core(ref.robot, body.joints, body.angle_unit, batch=True)
-    return FKBatchResponse(robot_id=ref.id, joint_names=ref.robot.joint_names, poses=poses_from_matrices(forward_kinematics(ref.robot, q)))
+    return FKBatchResponse(robot_id=ref.id, joint_names=ref.robot.joint_names,
+                           poses=poses_from_matrices(forward_kinematics(ref.robot, q)))

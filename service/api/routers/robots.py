@@ -17,7 +17,8 @@ router = APIRouter(prefix="/v1/robots", tags=["robots"])
 def list_robots(catalogue: Catalogue = Depends(catalogue_of)) -> RobotList:
     """List the catalogue: id, name, degrees of freedom, convention and joint types of every robot."""
     return RobotList(robots=[
-        RobotSummary(id=e.description.id, name=e.description.name or e.robot.name, dof=e.robot.dof, format=e.description.format,
+        RobotSummary(id=e.description.id, name=e.description.name or e.robot.name, dof=e.robot.dof,
+                     format=e.description.format,
                      convention=getattr(e.description, "convention", None),
                      joint_types=["revolute" if r else "prismatic" for r in e.robot.is_revolute.tolist()],
                      joint_names=e.robot.joint_names, source=e.description.source,

@@ -237,3 +237,19 @@ def test_catalogue_urdf_needs_a_sidecar_with_source_and_licence(tmp_path):
     (tmp_path / "arm.urdf").write_text(BILLION_LAUGHS, encoding="utf-8")
     with pytest.raises(CatalogueError, match="refused"):
         load_catalogue([tmp_path], max_joints=32)
+
+
+def test_a_live_server_survives_hostile_urdfs():
+    """Over real HTTP: every hostile document is a 4xx, and the same process answers /healthz and FK after them."""
+    import httpx
+
+    from tests.live import serve
+
+    hostile = [BILLION_LAUGHS, EXTERNAL_ENTITY, PARAMETER_ENTITY,
+               '<robot name="d">' + "<a>" * 200_000 + "</a>" * 200_000 + "</robot>"]
+    with serve() as base_url, httpx.Client(base_url=base_url, timeout=30) as http:
+        for urdf in hostile:
+            response = http.post("/v1/fk", json={"robot": {"format": "urdf", "urdf": urdf}, "joints": [0]})
+            assert 400 <= response.status_code < 500, response.text[:200]
+        assert http.get("/healthz").status_code == 200
+        assert http.post("/v1/robots/ur5e/fk", json={"joints": [0] * 6}).status_code == 200

@@ -18,7 +18,9 @@ from ._decoupled import DecoupledPlan
 from ._positioning import find_positioner
 from ._screws import apply, chain_motion
 from ._structure import Geometry
-from ._three_parallel import ThreeParallelPlan
+from ._reversed import ReversedPlan, reversed_geometry
+from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
+from ._three_parallel_end import ThreeParallelAtEndPlan
 from ._types import Branch, Candidates, LabelCodes
 from ._wrist import Roll, SphericalWrist
 
@@ -74,7 +76,30 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
         if k and positioner is None:
             continue
         return DecoupledPlan(positioner, wrist, point, model.home, n)
-    return ThreeParallelPlan.match(geometry)
+    return _three_parallel_plan(geometry)
+
+
+#: Three consecutive parallel axes: the families as the chain is described, then (name, family) of the reversed
+#: chain: axes 3 ∥ 4 ∥ 5 are axes 2 ∥ 3 ∥ 4 seen from the tool, axes 1 ∥ 2 ∥ 3 are axes 4 ∥ 5 ∥ 6.
+_THREE_PARALLEL = (ThreeParallelPlan, SkewWristThreeParallelPlan, ThreeParallelAtEndPlan)
+_THREE_PARALLEL_REVERSED = (("three_parallel_intersecting_shoulder", ThreeParallelPlan),
+                            ("three_parallel_skew_shoulder", SkewWristThreeParallelPlan),
+                            ("three_parallel_at_base", ThreeParallelAtEndPlan))
+
+
+def _three_parallel_plan(geometry: Geometry) -> Plan | None:
+    for family in _THREE_PARALLEL:
+        plan = family.match(geometry)
+        if plan is not None:
+            return plan
+    if geometry.dof != 6:
+        return None
+    reverse = reversed_geometry(geometry)
+    for structure, family in _THREE_PARALLEL_REVERSED:
+        plan = family.match(reverse)
+        if plan is not None:
+            return ReversedPlan(plan, structure)
+    return None
 
 
 def _position_plan(geometry: Geometry, n: int, reference: np.ndarray | None) -> Plan | None:

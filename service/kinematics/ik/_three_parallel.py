@@ -1,4 +1,4 @@
-"""6R arms whose joints 2, 3 and 4 have parallel axes, and whose axes 5 and 6 meet (UR5 type).
+"""6R arms whose joints 2, 3 and 4 have parallel axes: axes 5 and 6 meeting (UR5 type) or skew.
 
 With ω_p the common direction of axes 2–4, A = world_T_target · home⁻¹ =
 G_1 ⋯ G_6, and c the point where axes 5 and 6 meet:
@@ -16,6 +16,9 @@ G_1 ⋯ G_6, and c the point where axes 5 and 6 meet:
    q_4 from the sum.
 
 2 × 2 × 2 = 8 solutions in general.
+
+When axes 5 and 6 are skew (:class:`SkewWristThreeParallelPlan`) steps 1 and 2
+are one subproblem 6 in (q_1, q_5); steps 3–5 are the same.
 """
 
 from __future__ import annotations
@@ -30,26 +33,14 @@ from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, 
 from ._wrist import _perpendicular_unit, wrist_codes
 
 
-class ThreeParallelPlan:
-    """The UR5-type family: axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersecting."""
+class _AxesTwoToFourParallel:
+    """What the families with axes 2 ∥ 3 ∥ 4 share: steps 3–5 from candidate pairs (q1, q5), and the labels.
+    A family supplies ``match`` and ``_shoulder_and_wrist`` (steps 1 and 2)."""
 
     method = "analytic"
-    structure = "three_parallel"
     generic_count = 8
     free_joints: list[int] = []
-
-    @classmethod
-    def match(cls, geometry: Geometry) -> "ThreeParallelPlan | None":
-        if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
-            return None
-        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.parallel(0, 1):
-            return None
-        if geometry.parallel(1, 4):
-            return None
-        centre = geometry.intersection(4, 5)
-        if centre is None:
-            return None
-        return cls(geometry, centre)
+    centre: np.ndarray
 
     def __init__(self, geometry: Geometry, centre: np.ndarray) -> None:
         self.geometry = geometry
@@ -70,25 +61,8 @@ class ThreeParallelPlan:
         return self._complete(A, q1, q5, valid, singular, reference)
 
     def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags) -> tuple[np.ndarray, ...]:
-        """Steps 1 and 2: candidate pairs (q1, q5), shape (N, 4) each, and which exist (N, 4)."""
-        g, w_p = self.geometry, self.omega_p
-        n = len(A)
-        c_world = apply(A, self.centre)
-        # 1. shoulder: two roots for q1
-        shoulder = subproblem_4(w_p, g.direction(0), c_world - g.point(0), w_p @ (self.centre - g.point(0)))
-        q1 = -shoulder.theta  # (N, 2)
-        R1 = rotation_about(g.direction(0), q1)  # (N, 2, 3, 3)
-        R_rest = np.swapaxes(R1, -1, -2) @ A[:, None, :3, :3]  # (N, 2, 3, 3)
-        # 2. wrist: two roots for q5
-        target_height = np.einsum("i,...ij,j->...", w_p, R_rest, g.direction(5))
-        wrist = subproblem_4(w_p, g.direction(4), g.direction(5), target_height)
-        _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
-                                                    "the wrist point is on the first axis; joint 1 is free"), singular)
-        _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",
-                                                "the two shoulder solutions meet"), singular)
-        valid = shoulder.valid[:, :, None] & wrist.valid
-        return (np.broadcast_to(q1[:, :, None], (n, 2, 2)).reshape(n, 4), wrist.theta.reshape(n, 4),
-                valid.reshape(n, 4))
+        raise NotImplementedError
+
 
     def _complete(self, A: np.ndarray, q1: np.ndarray, q5: np.ndarray, valid15: np.ndarray,
                   singular: SingularFlags, reference: np.ndarray | None) -> Candidates:
@@ -173,7 +147,46 @@ class ThreeParallelPlan:
                 **wrist_codes(joints[:, 4])}
 
 
-class SkewWristThreeParallelPlan(ThreeParallelPlan):
+class ThreeParallelPlan(_AxesTwoToFourParallel):
+    """The UR5-type family: axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersecting."""
+
+    structure = "three_parallel"
+
+    @classmethod
+    def match(cls, geometry: Geometry) -> "ThreeParallelPlan | None":
+        if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
+            return None
+        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.parallel(0, 1):
+            return None
+        if geometry.parallel(1, 4):
+            return None
+        centre = geometry.intersection(4, 5)
+        if centre is None:
+            return None
+        return cls(geometry, centre)
+
+    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags) -> tuple[np.ndarray, ...]:
+        """Steps 1 and 2: candidate pairs (q1, q5), shape (N, 4) each, and which exist (N, 4)."""
+        g, w_p = self.geometry, self.omega_p
+        n = len(A)
+        c_world = apply(A, self.centre)
+        # 1. shoulder: two roots for q1
+        shoulder = subproblem_4(w_p, g.direction(0), c_world - g.point(0), w_p @ (self.centre - g.point(0)))
+        q1 = -shoulder.theta  # (N, 2)
+        R1 = rotation_about(g.direction(0), q1)  # (N, 2, 3, 3)
+        R_rest = np.swapaxes(R1, -1, -2) @ A[:, None, :3, :3]  # (N, 2, 3, 3)
+        # 2. wrist: two roots for q5
+        target_height = np.einsum("i,...ij,j->...", w_p, R_rest, g.direction(5))
+        wrist = subproblem_4(w_p, g.direction(4), g.direction(5), target_height)
+        _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
+                                                    "the wrist point is on the first axis; joint 1 is free"), singular)
+        _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",
+                                                "the two shoulder solutions meet"), singular)
+        valid = shoulder.valid[:, :, None] & wrist.valid
+        return (np.broadcast_to(q1[:, :, None], (n, 2, 2)).reshape(n, 4), wrist.theta.reshape(n, 4),
+                valid.reshape(n, 4))
+
+class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
     """Axes 2 ∥ 3 ∥ 4 with axes 5 and 6 skew (no common point): steps 1 and 2 become one subproblem 6.
 
     With c a point on axis 6 (G_6 leaves it fixed) and G_2 G_3 G_4 keeping components along ω_p:

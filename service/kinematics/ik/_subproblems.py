@@ -900,8 +900,10 @@ def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2, scale):
     With ``z = exp(i t)`` the equation times ``z**2`` is a quartic in z whose roots on the unit circle are the
     real angles. Its roots come from the eigenvalues of the companion matrices, one batched ``eigvals``; each
     angle is then polished by Newton steps on the real equation. Returns ``(theta, found, residual)`` of
-    shape (..., 4): ``found`` where a root lies on the circle, ``residual`` = |f(theta)| / scale. When the
-    degree-2 part vanishes (``|alpha2| + |beta2|`` about 0) the equation is harmonic, with two roots.
+    shape (..., 4): ``found`` where a root lies on the circle (``theta`` elsewhere holds the angle of a root off
+    it), ``residual`` = |f(theta)| / scale, and ``double``. When the
+    degree-2 part vanishes (``|alpha2| + |beta2|`` about 0) the equation is harmonic, with two roots, and
+    ``double`` (...,) marks where they are one.
     """
     shape = np.shape(alpha0)
     c4 = 0.5 * (alpha2 - 1j * beta2)
@@ -911,6 +913,7 @@ def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2, scale):
     quartic = np.abs(c4) > 1e-8 * size
     theta = np.full(shape + (4,), np.nan)
     found = np.zeros(shape + (4,), dtype=bool)
+    double = np.zeros(shape, dtype=bool)
     if quartic.any():
         lead = np.where(quartic, c4, 1.0)
         companion = np.zeros(shape + (4, 4), dtype=complex)
@@ -921,16 +924,17 @@ def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2, scale):
         companion[..., 0, 3] = -np.conj(c4) / lead
         companion[~quartic] = np.eye(4) * 2.0  # placeholder rows: roots off the circle, overwritten below
         z = np.linalg.eigvals(companion)
-        on_circle = quartic[..., None] & (np.abs(np.abs(z) - 1.0) <= _ON_CIRCLE)
-        theta = np.where(on_circle, np.angle(z), np.nan)
-        found = on_circle
+        found = quartic[..., None] & (np.abs(np.abs(z) - 1.0) <= _ON_CIRCLE)
+        theta = np.angle(z)  # off the circle too: the nearest angle serves a row without a root
     if not quartic.all():
         harmonic = _harmonic(alpha1, beta1, -alpha0, size)
         two = harmonic.valid & harmonic.exact
-        theta[..., :2] = np.where(~quartic[..., None] & two, harmonic.theta, theta[..., :2])
+        theta[..., :2] = np.where(~quartic[..., None], np.nan_to_num(harmonic.theta), theta[..., :2])
+        theta[..., 2:] = np.where(~quartic[..., None], theta[..., :1], theta[..., 2:])
         found[..., :2] = np.where(~quartic[..., None], two, found[..., :2])
+        double = ~quartic & harmonic.merged
     a0, a1, b1, a2, b2 = (np.asarray(x)[..., None] for x in (alpha0, alpha1, beta1, alpha2, beta2))
-    t = np.where(found, theta, 0.0)
+    t = np.nan_to_num(theta)
     for _ in range(_NEWTON_STEPS):
         c, s, c2, s2 = np.cos(t), np.sin(t), np.cos(2 * t), np.sin(2 * t)
         value = a0 + a1 * c + b1 * s + a2 * c2 + b2 * s2
@@ -939,7 +943,7 @@ def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2, scale):
         t = t - np.clip(step, -0.1, 0.1)  # a step this small keeps a root near a double root on its side
     value = a0 + a1 * np.cos(t) + b1 * np.sin(t) + a2 * np.cos(2 * t) + b2 * np.sin(2 * t)
     residual = np.abs(value) / np.asarray(scale)[..., None]
-    return np.where(found, _wrap(t), np.nan), found, residual
+    return _wrap(t), found, residual, double
 
 
 def subproblem_6(
@@ -1033,7 +1037,7 @@ def subproblem_6(
     W = adj_q @ P
     S = np.swapaxes(W, -1, -2) @ W
     g = np.einsum("...ji,...j->...i", W, u)
-    theta_p, found, _ = _trig_quartic_roots(
+    theta_p, found, _, double = _trig_quartic_roots(
         _dot(u, u) - det_q**2 + 0.5 * (S[..., 0, 0] + S[..., 1, 1]), -2 * g[..., 0], -2 * g[..., 1],
         0.5 * (S[..., 0, 0] - S[..., 1, 1]), S[..., 0, 1], np.maximum(det_q**2 + _dot(u, u), 1e-300))
     xp = np.stack([np.cos(theta_p), np.sin(theta_p)], -1)  # (..., 4, 2)
@@ -1069,11 +1073,23 @@ def subproblem_6(
     else:
         rank_one = np.zeros(shape, dtype=bool)
 
-    # residuals of both equations at each candidate
-    c1, s1, c2, s2 = np.cos(theta1), np.sin(theta1), np.cos(theta2), np.sin(theta2)
+    # Newton steps on the pair itself (the quartic squared it: its roots are good to about sqrt of the
+    # rounding near a double root), then the residuals of both equations at each candidate
     ex = lambda x: x[..., None]  # noqa: E731
-    miss1 = ex(a11) * c1 + ex(a12) * s1 + ex(b11) * c2 + ex(b12) * s2 - ex(r1)
-    miss2 = ex(a21) * c1 + ex(a22) * s1 + ex(b21) * c2 + ex(b22) * s2 - ex(r2)
+    for step in range(_NEWTON_STEPS + 1):
+        c1, s1, c2, s2 = np.cos(theta1), np.sin(theta1), np.cos(theta2), np.sin(theta2)
+        miss1 = ex(a11) * c1 + ex(a12) * s1 + ex(b11) * c2 + ex(b12) * s2 - ex(r1)
+        miss2 = ex(a21) * c1 + ex(a22) * s1 + ex(b21) * c2 + ex(b22) * s2 - ex(r2)
+        if step == _NEWTON_STEPS:
+            break
+        j11, j12 = ex(a12) * c1 - ex(a11) * s1, ex(b12) * c2 - ex(b11) * s2
+        j21, j22 = ex(a22) * c1 - ex(a21) * s1, ex(b22) * c2 - ex(b21) * s2
+        jac = j11 * j22 - j12 * j21
+        usable = np.abs(jac) > 1e-6 * (j11**2 + j12**2 + j21**2 + j22**2)  # not at a double root
+        inverse = np.where(usable, 1.0 / np.where(usable, jac, 1.0), 0.0)
+        step1 = np.clip((j22 * miss1 - j12 * miss2) * inverse, -1e-3, 1e-3)
+        step2 = np.clip((j11 * miss2 - j21 * miss1) * inverse, -1e-3, 1e-3)
+        theta1, theta2 = theta1 - step1, theta2 - step2
     miss = np.nan_to_num(_hypot(miss1, miss2) / ex(scale), nan=np.inf)
     exact = found & (miss <= GEOMETRY_TOLERANCE * 1e3)
     # a row without a root keeps its nearest candidate in slot 0
@@ -1089,7 +1105,7 @@ def subproblem_6(
                                                                          <= DUPLICATE_TOLERANCE)
     earlier = np.tril(np.ones((4, 4), dtype=bool), -1)
     duplicate = (same & earlier & keep[..., None, :]).any(axis=-1) & keep
-    merged = duplicate.any(axis=-1)
+    merged = duplicate.any(axis=-1) | (double & coupled)
     keep &= ~duplicate
     order = np.argsort(~keep, axis=-1, kind="stable")
     keep = np.take_along_axis(keep, order, -1)

@@ -109,7 +109,7 @@ class _AxesTwoToFourParallel:
                                                    "axis 6 is parallel to axes 2–4: only q2 + q3 + q4 and q6 "
                                                    "together are determined; q6 is set to the reference value "
                                                    "(or 0)"), singular)
-        merged = elbow.merged & valid[..., 0]
+        merged = (elbow.merged | _split_double_root(q3, valid)) & valid[..., 0]
         merged_rows = merged.any(axis=1)
         if merged_rows.any():
             first = np.argmax(merged, axis=1)  # the first merged slot of each row, as argwhere found it
@@ -220,3 +220,15 @@ class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
                                                   "set to 0"))
         singular.add(pair.merged, Singularity("shoulder", (0, 4), "boundary", "two (q1, q5) solutions meet"))
         return pair.theta1, pair.theta2, pair.valid
+
+
+#: Two elbow roots closer than this (rad) are one double root split by rounding upstream (a root of subproblem
+#: 6 is good to ~1e-12 in an arm's chain, and a double root to about its square root). Both stay (each is FK-verified); the target
+#: is reported at the stretched or folded boundary.
+SPLIT_DOUBLE_ROOT = 1e-4
+
+
+def _split_double_root(elbow: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """Where the two elbow roots (..., 2) are both valid and a split double root apart."""
+    gap = np.abs(np.angle(np.exp(1j * (elbow[..., 0] - elbow[..., 1]))))
+    return valid[..., 0] & valid[..., 1] & (np.nan_to_num(gap, nan=np.inf) <= SPLIT_DOUBLE_ROOT)

@@ -28,6 +28,7 @@ from ._screws import apply, invert, joint_motion, rotate_about, rotation_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_6
 from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
+from ._three_parallel import _split_double_root
 from ._wrist import _perpendicular_unit
 
 
@@ -106,7 +107,7 @@ class ThreeParallelAtEndPlan:
                      Singularity("base", (1, 3, 4, 5), relation,
                                  "axis 2 is parallel to axes 4–6: only q2 and q4 + q5 + q6 together are determined; "
                                  "q2 is set to the reference value (or 0)"))
-        merged = elbow.merged & valid[..., 0]
+        merged = (elbow.merged | _split_double_root(q5, valid)) & valid[..., 0]
         merged_rows = merged.any(axis=1)
         if merged_rows.any():
             first = np.argmax(merged, axis=1)

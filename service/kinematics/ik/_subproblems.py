@@ -940,7 +940,7 @@ def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2, scale):
         value = a0 + a1 * c + b1 * s + a2 * c2 + b2 * s2
         slope = -a1 * s + b1 * c - 2 * a2 * s2 + 2 * b2 * c2
         step = np.where(np.abs(slope) > 1e-12 * size[..., None], value / np.where(slope != 0.0, slope, 1.0), 0.0)
-        t = t - np.clip(step, -0.1, 0.1)  # a step this small keeps a root near a double root on its side
+        t = t - np.minimum(np.maximum(step, -0.1), 0.1)  # small steps keep a root near a double root on its side
     value = a0 + a1 * np.cos(t) + b1 * np.sin(t) + a2 * np.cos(2 * t) + b2 * np.sin(2 * t)
     residual = np.abs(value) / np.asarray(scale)[..., None]
     return _wrap(t), found, residual, double
@@ -1087,8 +1087,8 @@ def subproblem_6(
         jac = j11 * j22 - j12 * j21
         usable = np.abs(jac) > 1e-6 * (j11**2 + j12**2 + j21**2 + j22**2)  # not at a double root
         inverse = np.where(usable, 1.0 / np.where(usable, jac, 1.0), 0.0)
-        step1 = np.clip((j22 * miss1 - j12 * miss2) * inverse, -1e-3, 1e-3)
-        step2 = np.clip((j11 * miss2 - j21 * miss1) * inverse, -1e-3, 1e-3)
+        step1 = np.minimum(np.maximum((j22 * miss1 - j12 * miss2) * inverse, -1e-3), 1e-3)  # (np.clip is slow)
+        step2 = np.minimum(np.maximum((j11 * miss2 - j21 * miss1) * inverse, -1e-3), 1e-3)
         theta1, theta2 = theta1 - step1, theta2 - step2
     miss = np.nan_to_num(_hypot(miss1, miss2) / ex(scale), nan=np.inf)
     exact = found & (miss <= GEOMETRY_TOLERANCE * 1e3)

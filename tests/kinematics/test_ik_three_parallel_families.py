@@ -176,3 +176,35 @@ def test_the_ur_type_is_still_its_own_family():
     joints = [Joint(j.name, j.kind, a[i], j.alpha, j.d, j.theta) for i, j in enumerate(robot.joints)]
     ur_like = Robot(joints, world_T_base=robot.world_T_base, flange_T_tool=robot.flange_T_tool)
     assert cached_plan(ur_like, constrain_orientation=True, reference=None).structure == "three_parallel"
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_the_generic_count_of_eight_is_reached(case):
+    """8 distinct FK-verified solutions for some pose of some arm of the class: the bound 4 × 2 is attained."""
+    for seed in range(60, 70):
+        robot = random_arm(case, "standard", seed)
+        q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (300, 6))
+        if solve_ik_arrays(robot, forward_kinematics(robot, q)).count.max() == 8:
+            return
+    pytest.fail("no pose with 8 solutions")
+
+
+def _labels_of_generating_vector(robot: Robot, q: np.ndarray) -> list[dict]:
+    found = solve_ik_arrays(robot, forward_kinematics(robot, q))
+    gap = np.abs(joint_difference(robot, found.joints, q[:, None, :])).max(axis=-1)
+    slot = np.argmin(np.where(found.valid, gap, np.inf), axis=1)
+    rows = np.arange(len(q))
+    return [{name: values[codes[row, slot[row]]] for name, (values, codes) in found.labels.items()
+             if codes[row, slot[row]] >= 0} for row in rows]
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_branch_labels_mean_the_same_in_every_convention(case):
+    q = np.random.default_rng(81).uniform(-np.pi, np.pi, (200, 6))
+    labels = [_labels_of_generating_vector(random_arm(case, c, seed=81), q) for c in CONVENTIONS]
+    assert labels[0] == labels[1] == labels[2]
+    if CASES[case][1] == (0, 1):  # axes 1-3 along the base z: no up in their plane, so no elbow label
+        assert not any("elbow" in row for row in labels[0])
+    else:
+        assert all("elbow" in row for row in labels[0])
+        assert {row["elbow"] for row in labels[0]} == {"up", "down"}

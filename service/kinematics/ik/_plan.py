@@ -20,7 +20,7 @@ from ._screws import apply, chain_motion
 from ._structure import Geometry
 from ._reversed import ReversedPlan, reversed_geometry
 from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
-from ._three_parallel_end import ThreeParallelAtEndPlan
+from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
 from ._types import Branch, Candidates, LabelCodes
 from ._wrist import Roll, SphericalWrist
 
@@ -79,12 +79,12 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
     return _three_parallel_plan(geometry)
 
 
-#: Three consecutive parallel axes: the families as the chain is described, then (name, family) of the reversed
-#: chain: axes 3 ∥ 4 ∥ 5 are axes 2 ∥ 3 ∥ 4 seen from the tool, axes 1 ∥ 2 ∥ 3 are axes 4 ∥ 5 ∥ 6.
+#: Three consecutive parallel axes: the families as the chain is described, then (name, family, first parallel
+#: axis) of the reversed chain: axes 3 ∥ 4 ∥ 5 are axes 2 ∥ 3 ∥ 4 seen from the tool, axes 1 ∥ 2 ∥ 3 are 4 ∥ 5 ∥ 6.
 _THREE_PARALLEL = (ThreeParallelPlan, SkewWristThreeParallelPlan, ThreeParallelAtEndPlan)
-_THREE_PARALLEL_REVERSED = (("three_parallel_intersecting_shoulder", ThreeParallelPlan),
-                            ("three_parallel_skew_shoulder", SkewWristThreeParallelPlan),
-                            ("three_parallel_at_base", ThreeParallelAtEndPlan))
+_THREE_PARALLEL_REVERSED = (("three_parallel_intersecting_shoulder", ThreeParallelPlan, 2),
+                            ("three_parallel_skew_shoulder", SkewWristThreeParallelPlan, 2),
+                            ("three_parallel_at_base", ThreeParallelAtEndPlan, 0))
 
 
 def _three_parallel_plan(geometry: Geometry) -> Plan | None:
@@ -95,10 +95,10 @@ def _three_parallel_plan(geometry: Geometry) -> Plan | None:
     if geometry.dof != 6:
         return None
     reverse = reversed_geometry(geometry)
-    for structure, family in _THREE_PARALLEL_REVERSED:
+    for structure, family, first in _THREE_PARALLEL_REVERSED:
         plan = family.match(reverse)
         if plan is not None:
-            return ReversedPlan(plan, structure)
+            return ReversedPlan(plan, structure, lambda joints: {"elbow": parallel_elbow_codes(geometry, joints, first)})
     return None
 
 

@@ -11,6 +11,8 @@ solves the inverse target, and the joint order is turned back.
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from .._forward import ScrewModel
@@ -36,8 +38,9 @@ class ReversedPlan:
 
     method = "analytic"
 
-    def __init__(self, inner, structure: str) -> None:
+    def __init__(self, inner, structure: str, label_codes: Callable[[np.ndarray], LabelCodes]) -> None:
         self.inner = inner
+        self._label_codes = label_codes
         self.structure = structure
         self.generic_count = inner.generic_count
         self.dof = inner.geometry.dof
@@ -56,6 +59,5 @@ class ReversedPlan:
         return branches_from_codes(self.label_codes(joints), len(joints))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        """The inner family's elbow label (its planar pair keeps its meaning; shoulder and wrist would swap)."""
-        codes = self.inner.label_codes(joints[..., ::-1])
-        return {name: codes[name] for name in ("elbow",) if name in codes}
+        """Labels computed on the arm as described (the reversed chain's up and sides are the tool's)."""
+        return self._label_codes(joints)

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._screws import apply, invert, joint_motion, rotate_about, rotation_about
+from ._positioning import side_codes
+from ._screws import apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_6
 from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
@@ -121,8 +122,25 @@ class ThreeParallelAtEndPlan:
         return branches_from_codes(self.label_codes(joints), len(joints))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        """Elbow: the sense of the bend of joint 5 away from axes 4–6 in line, turning about axis 4's direction
-        (−1 where they are in line, the two branches meeting)."""
-        bend = np.sin(self.signs[1] * (joints[:, 4] - self.stretched5))
-        codes = np.where(np.abs(bend) <= 1e-9, -1, np.where(bend > 0, 0, 1))
-        return {"elbow": (("counterclockwise", "clockwise"), codes.astype(int))}
+        return {"elbow": parallel_elbow_codes(self.geometry, joints, 3)}
+
+
+def parallel_elbow_codes(geometry: Geometry, joints: np.ndarray, first: int) -> tuple[tuple[str, str], np.ndarray]:
+    """Elbow up/down of the planar chain of parallel axes first, first + 1, first + 2, for joints (M, n): the side
+    of the line from the first axis to the third that the middle axis lies on, along the robot's up direction,
+    measured in the plane normal to the parallel axes (−1 where it is on the line, or where that plane holds no
+    up: the parallel axes vertical)."""
+    m = geometry.model
+    def moved(upto: int, x: np.ndarray) -> np.ndarray:
+        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x)
+
+    start, middle, end = (moved(first + j, geometry.point(first + j)) for j in range(3))
+    normal = chain_rotation(m.directions[:first], m.is_revolute[:first], joints[:, :first]) @ geometry.direction(first)
+    def planar(x: np.ndarray) -> np.ndarray:
+        return x - np.einsum("mi,mi->m", x, normal)[:, None] * normal
+
+    elbow, reach = planar(middle - start), planar(end - start)
+    line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
+    rejection = elbow - np.einsum("mi,mi->m", elbow, line)[:, None] * line
+    up = planar(np.broadcast_to(geometry.up, normal.shape))
+    return ("up", "down"), side_codes(np.einsum("mi,mi->m", rejection, up), np.linalg.norm(elbow, axis=-1))

@@ -8,6 +8,9 @@ no such pose is answered unreachable, and stretched or folded poses report the e
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -208,3 +211,24 @@ def test_branch_labels_mean_the_same_in_every_convention(case):
     else:
         assert all("elbow" in row for row in labels[0])
         assert {row["elbow"] for row in labels[0]} == {"up", "down"}
+
+
+UR_TABLES = json.loads((Path(__file__).resolve().parents[1] / "data" / "ur_dh_tables.json").read_text())
+
+
+@pytest.mark.parametrize("name", sorted(UR_TABLES["arms"]))
+def test_published_ur_tables_and_their_skew_wrist_variants(name):
+    """The UR arms as Universal Robots publishes them (three_parallel), and the same arm with its wrist axes 5 and
+    6 offset by a 2 cm link (three_parallel_skew_wrist): 1,000 poses each, every generating vector back."""
+    table = UR_TABLES["arms"][name]
+    for offset, structure in ((0.0, "three_parallel"), (0.02, "three_parallel_skew_wrist")):
+        a = list(table["a"])
+        a[4] = offset
+        robot = Robot([Joint(f"j{i + 1}", "revolute", a[i], UR_TABLES["alpha"][i], table["d"][i], 0.0)
+                       for i in range(6)])
+        q = np.random.default_rng(91).uniform(-np.pi, np.pi, (POSES, 6))
+        targets = forward_kinematics(robot, q)
+        found = solve_ik_arrays(robot, targets)
+        assert found.structure == structure
+        assert (found.count >= 1).all() and _hits(robot, found.joints, found.valid, q, SAME).all()
+        assert _fk_misses(robot, found.joints, found.valid, targets).max() <= 1e-9

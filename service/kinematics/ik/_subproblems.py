@@ -883,7 +883,7 @@ class AngleQuadSolutions(NamedTuple):
 # A root z of the quartic counts as a real angle when | |z| - 1 | is below this before polishing: generous, since
 # a double root splits by about sqrt(eps); polishing and the residual test below decide.
 _ON_CIRCLE = 1e-3
-_NEWTON_STEPS = 3
+_NEWTON_STEPS = 3  # on the pair of equations, after the quartic's roots
 
 
 def _term_coefficients(k: np.ndarray, h: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -894,14 +894,13 @@ def _term_coefficients(k: np.ndarray, h: np.ndarray, p: np.ndarray) -> tuple[np.
     return hx * px + hy * py, hy * px - hx * py, hz * pz
 
 
-def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2, scale):
+def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2):
     """The real roots of ``alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t = 0``, four slots.
 
     With ``z = exp(i t)`` the equation times ``z**2`` is a quartic in z whose roots on the unit circle are the
-    real angles. Its roots come from the eigenvalues of the companion matrices, one batched ``eigvals``; each
-    angle is then polished by Newton steps on the real equation. Returns ``(theta, found, residual)`` of
-    shape (..., 4): ``found`` where a root lies on the circle (``theta`` elsewhere holds the angle of a root off
-    it), ``residual`` = |f(theta)| / scale, and ``double``. When the
+    real angles. Its roots come from the eigenvalues of the companion matrices, one batched ``eigvals``.
+    Returns ``(theta, found, double)``: ``theta`` and ``found`` (..., 4), ``found`` where a root lies on the
+    circle (``theta`` elsewhere holds the angle of a root off it); ``double`` as below. When the
     degree-2 part vanishes (``|alpha2| + |beta2|`` about 0) the equation is harmonic, with two roots, and
     ``double`` (...,) marks where they are one.
     """
@@ -933,17 +932,7 @@ def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2, scale):
         theta[..., 2:] = np.where(~quartic[..., None], theta[..., :1], theta[..., 2:])
         found[..., :2] = np.where(~quartic[..., None], two, found[..., :2])
         double = ~quartic & harmonic.merged
-    a0, a1, b1, a2, b2 = (np.asarray(x)[..., None] for x in (alpha0, alpha1, beta1, alpha2, beta2))
-    t = np.nan_to_num(theta)
-    for _ in range(_NEWTON_STEPS):
-        c, s, c2, s2 = np.cos(t), np.sin(t), np.cos(2 * t), np.sin(2 * t)
-        value = a0 + a1 * c + b1 * s + a2 * c2 + b2 * s2
-        slope = -a1 * s + b1 * c - 2 * a2 * s2 + 2 * b2 * c2
-        step = np.where(np.abs(slope) > 1e-12 * size[..., None], value / np.where(slope != 0.0, slope, 1.0), 0.0)
-        t = t - np.minimum(np.maximum(step, -0.1), 0.1)  # small steps keep a root near a double root on its side
-    value = a0 + a1 * np.cos(t) + b1 * np.sin(t) + a2 * np.cos(2 * t) + b2 * np.sin(2 * t)
-    residual = np.abs(value) / np.asarray(scale)[..., None]
-    return _wrap(t), found, residual, double
+    return _wrap(np.nan_to_num(theta)), found, double
 
 
 def subproblem_6(
@@ -1026,10 +1015,15 @@ def subproblem_6(
     swap = np.abs(det_a) * size_b > np.abs(det_b) * size_a
     coupled = np.maximum(np.abs(det_a), np.abs(det_b)) > GEOMETRY_TOLERANCE * np.maximum(size_a, size_b)
     # kept block P (its angle solved from the quartic), eliminated block Q
-    P = np.stack([np.stack([np.where(swap, b11, a11), np.where(swap, b12, a12)], -1),
-                  np.stack([np.where(swap, b21, a21), np.where(swap, b22, a22)], -1)], -2)
-    Q = np.stack([np.stack([np.where(swap, a11, b11), np.where(swap, a12, b12)], -1),
-                  np.stack([np.where(swap, a21, b21), np.where(swap, a22, b22)], -1)], -2)
+    block_a = np.stack([a11, a12, a21, a22], -1).reshape(shape + (2, 2))
+    block_b = np.stack([b11, b12, b21, b22], -1).reshape(shape + (2, 2))
+    if not swap.any():
+        P, Q = block_a, block_b
+    elif swap.all():
+        P, Q = block_b, block_a
+    else:
+        P = np.where(swap[..., None, None], block_b, block_a)
+        Q = np.where(swap[..., None, None], block_a, block_b)
     det_q = np.where(swap, det_a, det_b)
     adj_q = np.stack([np.stack([Q[..., 1, 1], -Q[..., 0, 1]], -1), np.stack([-Q[..., 1, 0], Q[..., 0, 0]], -1)], -2)
     r = np.stack([r1, r2], -1)
@@ -1037,9 +1031,9 @@ def subproblem_6(
     W = adj_q @ P
     S = np.swapaxes(W, -1, -2) @ W
     g = np.einsum("...ji,...j->...i", W, u)
-    theta_p, found, _, double = _trig_quartic_roots(
+    theta_p, found, double = _trig_quartic_roots(
         _dot(u, u) - det_q**2 + 0.5 * (S[..., 0, 0] + S[..., 1, 1]), -2 * g[..., 0], -2 * g[..., 1],
-        0.5 * (S[..., 0, 0] - S[..., 1, 1]), S[..., 0, 1], np.maximum(det_q**2 + _dot(u, u), 1e-300))
+        0.5 * (S[..., 0, 0] - S[..., 1, 1]), S[..., 0, 1])
     xp = np.stack([np.cos(theta_p), np.sin(theta_p)], -1)  # (..., 4, 2)
     xq = (u[..., None, :] - np.einsum("...ij,...sj->...si", W, xp)) / np.where(det_q != 0.0, det_q, 1.0)[..., None,
                                                                                                              None]

@@ -4,8 +4,9 @@
     python -m benchmarks.three_parallel --quick     # tiny sizes: a smoke run
 
 One seeded random arm per class, given as a plain standard DH table (no base, tool or angle offsets, so that
-every library takes the same table). The rows are those of :mod:`benchmarks.core`: the same poses to every
-library that supports the arm, solutions per pose and recall beside the times. EAIK 1.2.2 has closed forms for
+every library takes the same table), after the catalogue UR5 (today's UR-type family) as the anchor. The rows
+are those of :mod:`benchmarks.core`: the same poses to every library that supports the arm, solutions per pose
+and recall beside the times. EAIK 1.2.2 has closed forms for
 axes 2 ∥ 3 ∥ 4 (its THREE_INNER_PARALLEL, any wrist), 3 ∥ 4 ∥ 5 (reversed) and 1 ∥ 2 ∥ 3 with axes 5 and 6
 meeting (THREE_PARALLEL_TWO_INTERSECTING); it says which arms it cannot solve.
 """
@@ -17,6 +18,8 @@ import sys
 
 import numpy as np
 
+from service.catalogue import load_catalogue
+from service.config import Settings
 from service.kinematics import Robot
 from service.kinematics._robot import Joint
 from service.kinematics.ik._arrays import cached_plan
@@ -58,6 +61,9 @@ def main(argv: list[str] | None = None) -> int:
     for name in anchors.LIBRARIES:
         if not anchors.installed(name):
             report.skipped.append(f"{name}: not installed (pip install -e '.[bench]'), skipped")
+    # today's UR-type family on the catalogue UR5, as the anchor of "the speed of today's families"
+    bench_robot(report, "UR5 (three_parallel)", load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+                .get("ur5").robot, args)
     for label in CLASSES:
         robot = class_arm(label)
         plan = cached_plan(robot, constrain_orientation=True, reference=None)

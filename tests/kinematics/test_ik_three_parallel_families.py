@@ -232,3 +232,30 @@ def test_published_ur_tables_and_their_skew_wrist_variants(name):
         assert found.structure == structure
         assert (found.count >= 1).all() and _hits(robot, found.joints, found.valid, q, SAME).all()
         assert _fk_misses(robot, found.joints, found.valid, targets).max() <= 1e-9
+
+
+@pytest.mark.parametrize("case", ["at_end_456", "at_base_123"])
+def test_axis_one_parallel_to_the_triple_is_a_free_base_with_verified_representatives(case):
+    """Where joints 2 and 3 turn the parallel axes 4–6 parallel to axis 1 (joints 4 and 5 turn axis 6 parallel
+    to axes 1–3 in the base case), four axes are parallel: a one-parameter self-motion. Every such pose is reached, its solutions verified, and the
+    singularity reported with the joints it frees."""
+    from service.kinematics.ik._subproblems import subproblem_2_chain
+
+    for seed in range(100, 140):
+        robot = random_arm(case, "standard", seed)
+        m = geometry_of(robot).model
+        # (turning joint, turning joint, the axis turned, the axis it is turned parallel to)
+        order = (1, 2, 3, 0) if case.startswith("at_end") else (3, 4, 5, 0)
+        turn = subproblem_2_chain(m.directions[order[0]], m.directions[order[1]], m.directions[order[2]],
+                                  m.directions[order[3]])
+        if turn.exact[0]:
+            break
+    q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (40, 6))
+    q[:, order[0]], q[:, order[1]] = turn.theta1[0], turn.theta2[0]
+    targets = forward_kinematics(robot, q)
+    found = solve_ik_arrays(robot, targets, reference=np.full(6, 0.3))
+    assert (found.count >= 1).all()
+    assert _fk_misses(robot, found.joints, found.valid, targets).max() <= 1e-9
+    freed = {(s.joints, s.relation) for row in range(len(q)) for s in found.singularities[row]}
+    expected = (0, 3, 4, 5) if case.startswith("at_end") else (0, 1, 2, 5)
+    assert (expected, "free") in freed

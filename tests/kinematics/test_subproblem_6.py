@@ -127,3 +127,11 @@ def test_batch_shapes_lead_every_result(shape):
     vectors = [rng.normal(size=shape + (3,)) for _ in range(8)]
     sol = subproblem_6(k1, k2, *vectors[:4], np.zeros(shape), *vectors[4:], np.zeros(shape))
     assert sol.theta1.shape == sol.valid.shape == shape + (4,) and sol.merged.shape == shape
+
+
+def test_an_angle_that_no_equation_fixes_is_free():
+    """theta1 enters neither equation (p1, p3 on k1): cos t2 = 0.6, sin t2 = 0.8, theta1 free."""
+    x, y, z = np.eye(3)
+    sol = subproblem_6(z, z, x, z, x, x, 0.6, x, z, y, x, 0.8)
+    assert sol.degenerate and sol.valid.tolist() == [True, False, False, False] and sol.exact[0]
+    assert sol.theta1[0] == 0.0 and np.isclose(sol.theta2[0], np.arctan2(0.8, 0.6))

@@ -949,8 +949,8 @@ def subproblem_6(
     ``A x1 + B x2 = r`` with A, B of shape (2, 2). Multiplying by the adjugate of B gives
     ``det(B) x2 = adj(B) (r - A x1)``; ``||x2|| = 1`` then reads ``||adj(B) (r - A x1)||**2 = det(B)**2``, a
     trigonometric polynomial of degree 2 in theta1, that is a quartic in ``exp(i theta1)``: at most four roots,
-    each giving x2 and so theta2. The elimination runs on the better-conditioned block (B, or A with the roles
-    of the angles swapped), row by row. When both blocks are singular but the pair is not, each equation
+    each giving x2 and so theta2. The elimination runs on the block with the larger determinant (B, or A with
+    the roles of the angles swapped), row by row. When both blocks are singular but the pair is not, each equation
     combination that removes one angle is a harmonic equation in the other: 2 x 2 candidates.
 
     Parameters
@@ -970,7 +970,8 @@ def subproblem_6(
         Four slots; valid slots first. There is no least-squares answer: a row without a root has only its
         first slot valid, holding the angle pair nearest to a solution (``exact`` false), so that a solver
         can still refine it. ``merged`` marks a double root (reported once). ``degenerate`` marks a pair that
-        does not fix both angles (rank below 2), with a representative whose free angle is 0.
+        does not fix both angles (rank below 2, or the eliminated equation met by every value of one angle),
+        with a representative whose free angle is 0.
 
     Notes
     -----
@@ -1011,8 +1012,9 @@ def subproblem_6(
     det_b = b11 * b22 - b12 * b21
     size_a = a11**2 + a12**2 + a21**2 + a22**2
     size_b = b11**2 + b12**2 + b21**2 + b22**2
-    # eliminate the block with the larger relative determinant; swap means "eliminate theta1, solve theta2"
-    swap = np.abs(det_a) * size_b > np.abs(det_b) * size_a
+    # eliminate the block with the larger determinant (a near-zero block, however well shaped, is never taken);
+    # swap means "eliminate theta1, solve theta2"
+    swap = np.abs(det_a) > np.abs(det_b)
     coupled = np.maximum(np.abs(det_a), np.abs(det_b)) > GEOMETRY_TOLERANCE * np.maximum(size_a, size_b)
     # kept block P (its angle solved from the quartic), eliminated block Q
     block_a = np.stack([a11, a12, a21, a22], -1).reshape(shape + (2, 2))
@@ -1031,9 +1033,15 @@ def subproblem_6(
     W = adj_q @ P
     S = np.swapaxes(W, -1, -2) @ W
     g = np.einsum("...ji,...j->...i", W, u)
-    theta_p, found, double = _trig_quartic_roots(
-        _dot(u, u) - det_q**2 + 0.5 * (S[..., 0, 0] + S[..., 1, 1]), -2 * g[..., 0], -2 * g[..., 1],
-        0.5 * (S[..., 0, 0] - S[..., 1, 1]), S[..., 0, 1])
+    coefficients = (_dot(u, u) - det_q**2 + 0.5 * (S[..., 0, 0] + S[..., 1, 1]), -2 * g[..., 0], -2 * g[..., 1],
+                    0.5 * (S[..., 0, 0] - S[..., 1, 1]), S[..., 0, 1])
+    theta_p, found, double = _trig_quartic_roots(*coefficients)
+    # every value of the kept angle solves the eliminated equation: that angle is free (its representative 0)
+    identically = coupled & (np.maximum.reduce([np.abs(c) for c in coefficients])
+                             <= GEOMETRY_TOLERANCE * (det_q**2 + _dot(u, u) + S[..., 0, 0] + S[..., 1, 1]))
+    if identically.any():
+        theta_p = np.where(identically[..., None], 0.0, theta_p)
+        found = np.where(identically[..., None], np.arange(4) == 0, found)
     xp = np.stack([np.cos(theta_p), np.sin(theta_p)], -1)  # (..., 4, 2)
     xq = (u[..., None, :] - np.einsum("...ij,...sj->...si", W, xp)) / np.where(det_q != 0.0, det_q, 1.0)[..., None,
                                                                                                              None]
@@ -1088,6 +1096,7 @@ def subproblem_6(
     exact = found & (miss <= GEOMETRY_TOLERANCE * 1e3)
     # a row without a root keeps its nearest candidate in slot 0
     nearest = np.argmin(miss, axis=-1)
+    rank_one = rank_one | identically
     none = ~exact.any(axis=-1) & ~rank_one
     keep = exact.copy()
     keep[none, nearest[none]] = True
@@ -1106,9 +1115,10 @@ def subproblem_6(
     exact = np.take_along_axis(exact, order, -1) & keep
     theta1 = np.where(keep, np.take_along_axis(_wrap(theta1), order, -1), np.nan)
     theta2 = np.where(keep, np.take_along_axis(_wrap(theta2), order, -1), np.nan)
-    if rank_one.any():
-        theta1[..., 0] = np.where(rank_one, np.where(one.degenerate, 0.0, one.theta[..., 0]), theta1[..., 0])
-        theta2[..., 0] = np.where(rank_one, np.where(two.degenerate, 0.0, two.theta[..., 0]), theta2[..., 0])
-        keep[..., 0] |= rank_one
+    decoupled_free = rank_one & ~identically
+    if decoupled_free.any():
+        theta1[..., 0] = np.where(decoupled_free, np.where(one.degenerate, 0.0, one.theta[..., 0]), theta1[..., 0])
+        theta2[..., 0] = np.where(decoupled_free, np.where(two.degenerate, 0.0, two.theta[..., 0]), theta2[..., 0])
+    keep[..., 0] |= rank_one
     return AngleQuadSolutions(theta1=theta1, theta2=theta2, valid=keep, exact=exact,
                               degenerate=np.asarray(rank_one), merged=np.asarray(merged))

@@ -57,10 +57,11 @@ class _AxesTwoToFourParallel:
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         A = world_T_targets @ self.home_inverse  # (N, 4, 4)
         singular = SingularFlags(len(A))
-        q1, q5, valid = self._shoulder_and_wrist(A, singular)
+        q1, q5, valid = self._shoulder_and_wrist(A, singular, reference)
         return self._complete(A, q1, q5, valid, singular, reference)
 
-    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags) -> tuple[np.ndarray, ...]:
+    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags,
+                            reference: np.ndarray | None) -> tuple[np.ndarray, ...]:
         raise NotImplementedError
 
 
@@ -165,7 +166,8 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
             return None
         return cls(geometry, centre)
 
-    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags) -> tuple[np.ndarray, ...]:
+    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags,
+                            reference: np.ndarray | None) -> tuple[np.ndarray, ...]:
         """Steps 1 and 2: candidate pairs (q1, q5), shape (N, 4) each, and which exist (N, 4)."""
         g, w_p = self.geometry, self.omega_p
         n = len(A)
@@ -209,17 +211,21 @@ class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
             return None
         return cls(geometry, geometry.point(5))
 
-    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags) -> tuple[np.ndarray, ...]:
+    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags,
+                            reference: np.ndarray | None) -> tuple[np.ndarray, ...]:
         g, w_p = self.geometry, self.omega_p
         c_world = apply(A, self.centre)  # the centre is a point on axis 6 here
         pair = subproblem_6(-g.direction(0), g.direction(4),
                             w_p, c_world - g.point(0), -w_p, self.centre - g.point(4), w_p @ (g.point(4) - g.point(0)),
                             w_p, A[:, :3, :3] @ g.direction(5), -w_p, g.direction(5), 0.0)
-        singular.add(pair.degenerate, Singularity("shoulder", (0, 4), "free",
-                                                  "the target does not fix joints 1 and 5 together; joint 1 is "
-                                                  "set to 0"))
+        singular.add(pair.degenerate, Singularity("shoulder", (0,), "free",
+                                                  "axis 6 and the point c on it are on axis 1: joint 1 is free "
+                                                  "and set to the reference value (or 0)"))
         singular.add(pair.merged, Singularity("shoulder", (0, 4), "boundary", "two (q1, q5) solutions meet"))
-        return pair.theta1, pair.theta2, pair.valid
+        q1 = pair.theta1
+        if pair.degenerate.any():  # the equations do not involve q1 there, so q5 holds for any value of it
+            q1 = np.where(pair.degenerate[:, None], 0.0 if reference is None else reference[0], q1)
+        return q1, pair.theta2, pair.valid
 
 
 #: Two elbow roots closer than this (rad) are one double root split by rounding upstream (a root of subproblem

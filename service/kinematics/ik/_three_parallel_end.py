@@ -61,6 +61,12 @@ class ThreeParallelAtEndPlan:
         def planar(x: np.ndarray) -> np.ndarray:
             return x - (x @ w) * w
         beyond, before = planar(geometry.point(5) - geometry.point(4)), planar(geometry.point(4) - geometry.point(3))
+        # the range of ||R(ω_5, q) (p_6 − p_5) − (p_4 − p_5)|| over q: the reach of the pair 4, 5 from axis 4
+        along = geometry.direction(4)
+        a, b = geometry.point(5) - geometry.point(4), geometry.point(3) - geometry.point(4)
+        ra, rb = np.linalg.norm(a - (a @ along) * along), np.linalg.norm(b - (b @ along) * along)
+        rise = (a - b) @ along
+        self.reach = (float(np.hypot(ra - rb, rise)), float(np.hypot(ra + rb, rise)))
         self.stretched5 = (float(np.arctan2(np.cross(beyond, before) @ geometry.direction(4), beyond @ before))
                            if np.linalg.norm(beyond) * np.linalg.norm(before) > 0 else 0.0)
 
@@ -75,8 +81,10 @@ class ThreeParallelAtEndPlan:
         height = np.einsum("ni,ni->n", v, apply(A, p4) - p1) - w @ (p4 - p3)
         pair = subproblem_6(h1, h3, v, p2 - p1, p3 - p2, w, height, v, h2, -h2, w, 0.0)
         q1, q3 = pair.theta1, pair.theta2  # (N, 4)
-        R1 = rotation_about(h1, q1)
         R3w = rotate_about(h3, q3, w)
+        if pair.degenerate.any():
+            q1 = np.where(pair.degenerate[:, None], self._free_base(A, v, q3, R3w, reference), q1)
+        R1 = rotation_about(h1, q1)
         second = subproblem_1(h2, R3w, np.einsum("nsji,nj->nsi", R1, v))
         q2 = second.theta[..., 0]
         free_two = second.degenerate
@@ -99,9 +107,9 @@ class ThreeParallelAtEndPlan:
         valid = pair.valid[..., None] & elbow.valid
         valid[..., 1] &= ~elbow.merged
         singular = SingularFlags(n)
-        singular.add(pair.degenerate, Singularity("base", (0, 2), "free",
-                                                  "the target does not fix joints 1 and 3 together; joint 1 is "
-                                                  "set to 0"))
+        singular.add(pair.degenerate, Singularity("base", (0, 3, 4, 5), "free",
+                                                  "axis 1 is parallel to axes 4–6: joint 1 is free and set to "
+                                                  "the reference value (or 0); joints 4–6 follow it"))
         singular.add(pair.merged, Singularity("base", (0, 2), "boundary", "two (q1, q3) solutions meet"))
         relation = "sum" if np.all(self.signs > 0) else "signed_sum"
         singular.add((free_two & pair.valid).any(axis=1),
@@ -117,6 +125,29 @@ class ThreeParallelAtEndPlan:
             for kind, mask in (("stretched", merged_rows & stretched), ("folded", merged_rows & ~stretched)):
                 singular.add(mask, Singularity("elbow", (4,), kind, f"axes 4–6 are {kind} in line"))
         return Candidates(joints.reshape(n, 8, 6), valid.reshape(n, 8), [], singular)
+
+    def _free_base(self, A: np.ndarray, v: np.ndarray, q3: np.ndarray, R3w: np.ndarray,
+                   reference: np.ndarray | None) -> np.ndarray:
+        """q1 (N, 4) where axis 1 is parallel to axes 4–6 (v = ±ω_1): joints 1, 4, 5, 6 then form a planar chain
+        with one self-motion, and subproblem 6 leaves q1 free. The representative q1 puts the point of axis 6 at
+        the middle of the distances from axis 4 that both joint 1 and the pair 4, 5 can give:
+        ``||G_1⁻¹ A p_6 − G_2 G_3 p_4|| = δ``, subproblem 3; the root nearest the reference value (or 0)."""
+        g = self.geometry
+        p1, p2, p3, p4 = (g.point(j) for j in range(4))
+        h1, h2, h3 = g.direction(0), g.direction(1), g.direction(2)
+        q2 = subproblem_1(h2, R3w, np.broadcast_to(v[:, None], R3w.shape)).theta[..., 0]  # R_1ᵀ v = v here
+        y = joint_motion(h2, p2, True, q2) @ joint_motion(h3, p3, True, q3)
+        y = apply(y, p4)  # (N, 4, 3): G_2 G_3 p_4
+        # the distance that joint 1 sweeps, [near, far], meets the reach of the pair 4, 5 (the pose is reached)
+        tip = np.broadcast_to((apply(A, g.point(5)) - p1)[:, None], y.shape)
+        radial = np.linalg.norm(np.cross(h1, tip), axis=-1), np.linalg.norm(np.cross(h1, y - p1), axis=-1)
+        rise = (tip - (y - p1)) @ h1
+        near, far = np.hypot(radial[0] - radial[1], rise), np.hypot(radial[0] + radial[1], rise)
+        low, high = np.maximum(near, self.reach[0]), np.minimum(far, self.reach[1])
+        roots = subproblem_3(-h1, tip, y - p1, 0.5 * (low + np.maximum(low, high)))
+        target = 0.0 if reference is None else float(reference[0])
+        near = np.argmin(np.abs(np.angle(np.exp(1j * (np.nan_to_num(roots.theta, nan=1e9) - target)))), axis=-1)
+        return np.take_along_axis(roots.theta, near[..., None], -1)[..., 0]
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
         return branches_from_codes(self.label_codes(joints), len(joints))

@@ -259,3 +259,20 @@ def test_axis_one_parallel_to_the_triple_is_a_free_base_with_verified_representa
     freed = {(s.joints, s.relation) for row in range(len(q)) for s in found.singularities[row]}
     expected = (0, 3, 4, 5) if case.startswith("at_end") else (0, 1, 2, 5)
     assert (expected, "free") in freed
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_a_sweep_towards_the_stretched_elbow_down_to_1e_12(case):
+    """The middle parallel joint ε from stretched, ε = 1e-2 … 1e-12: always reached, every solution verified, and
+    the generating vector back: exactly while the two elbow roots are apart, within the split of a double root
+    (1e-4) once they are not."""
+    robot = random_arm(case, "modified", seed=61)
+    middle = CASES[case][3]
+    q = np.random.default_rng(61).uniform(-np.pi, np.pi, (11, 6))
+    q[:, middle] = _in_line_value(robot, middle) + 10.0 ** -np.arange(2, 13)
+    targets = forward_kinematics(robot, q)
+    found = solve_ik_arrays(robot, targets)
+    assert (found.count >= 1).all()
+    assert _fk_misses(robot, found.joints, found.valid, targets).max() <= 1e-9
+    assert _hits(robot, found.joints[:3], found.valid[:3], q[:3], SAME).all()  # ε = 1e-2 … 1e-4
+    assert _hits(robot, found.joints, found.valid, q, 1e-4).all()

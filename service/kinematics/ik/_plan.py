@@ -79,8 +79,9 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
     return _three_parallel_plan(geometry)
 
 
-#: Three consecutive parallel axes: the families as the chain is described, then (name, family, first parallel
-#: axis) of the reversed chain: axes 3 ∥ 4 ∥ 5 are axes 2 ∥ 3 ∥ 4 seen from the tool, axes 1 ∥ 2 ∥ 3 are 4 ∥ 5 ∥ 6.
+#: Three consecutive parallel axes: the families as the chain is described, then (name, family, first
+#: parallel axis) of the reversed chain: axes 3 ∥ 4 ∥ 5 are axes 2 ∥ 3 ∥ 4 seen from the tool, and axes
+#: 1 ∥ 2 ∥ 3 are axes 4 ∥ 5 ∥ 6.
 _THREE_PARALLEL = (ThreeParallelPlan, SkewWristThreeParallelPlan, ThreeParallelAtEndPlan)
 _THREE_PARALLEL_REVERSED = (("three_parallel_intersecting_shoulder", ThreeParallelPlan, 2),
                             ("three_parallel_skew_shoulder", SkewWristThreeParallelPlan, 2),
@@ -98,7 +99,8 @@ def _three_parallel_plan(geometry: Geometry) -> Plan | None:
     for structure, family, first in _THREE_PARALLEL_REVERSED:
         plan = family.match(reverse)
         if plan is not None:
-            return ReversedPlan(plan, structure, lambda joints: {"elbow": parallel_elbow_codes(geometry, joints, first)})
+            return ReversedPlan(plan, structure,
+                                lambda joints: {"elbow": parallel_elbow_codes(geometry, joints, first)})
     return None
 
 

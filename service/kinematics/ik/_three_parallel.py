@@ -228,9 +228,9 @@ class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
         return q1, pair.theta2, pair.valid
 
 
-#: Two elbow roots closer than this (rad) are one double root split by rounding upstream (a root of subproblem
-#: 6 is good to ~1e-12 in an arm's chain, and a double root to about its square root). Both stay (each is FK-verified); the target
-#: is reported at the stretched or folded boundary.
+#: Two elbow roots closer than this (rad) are one double root split by rounding upstream (a root of
+#: subproblem 6 is good to ~1e-12 in an arm's chain, and a double root to about its square root). Both stay
+#: (each is FK-verified); the target is reported at the stretched or folded boundary.
 SPLIT_DOUBLE_ROOT = 1e-4
 
 

@@ -884,6 +884,7 @@ class AngleQuadSolutions(NamedTuple):
 # a double root splits by about sqrt(eps); polishing and the residual test below decide.
 _ON_CIRCLE = 1e-3
 _NEWTON_STEPS = 3  # on the pair of equations, after the quartic's roots
+_EXACT_PAIR = 10 * GEOMETRY_TOLERANCE  # relative residual of an exact root: Newton-polished roots reach ~1e-15
 
 
 def _term_coefficients(k: np.ndarray, h: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -976,7 +977,8 @@ def subproblem_6(
     Notes
     -----
     Scale: ``S = sum ||h_i|| ||p_i|| + |d1| + |d2|``. A root is exact when both equations hold to
-    ``GEOMETRY_TOLERANCE * S`` at the polished angles. A block counts as singular when its determinant is at
+    ``10 * GEOMETRY_TOLERANCE * S`` at the polished angles (Newton steps on the pair itself; near a double
+    root, where they stall, the residual is still quadratic in the error). A block counts as singular when its determinant is at
     most ``GEOMETRY_TOLERANCE`` times the squared size of the coefficients.
 
     Examples
@@ -1052,10 +1054,6 @@ def subproblem_6(
     if not coupled.all():
         # both blocks singular: A = a_u a_v^T, B = b_u b_v^T; the row combination orthogonal to b_u removes theta2
         # (and the one orthogonal to a_u removes theta1), leaving one harmonic equation per angle
-        def dominant_row(m11, m12, m21, m22):
-            first = m11**2 + m12**2 >= m21**2 + m22**2
-            return np.where(first, m11, m21), np.where(first, m12, m22), first
-
         def left_null(m11, m12, m21, m22):
             c1, c2 = np.where(m11**2 + m21**2 >= m12**2 + m22**2, m11, m12), np.where(
                 m11**2 + m21**2 >= m12**2 + m22**2, m21, m22)  # the block's column space direction
@@ -1093,7 +1091,7 @@ def subproblem_6(
         step2 = np.minimum(np.maximum((j11 * miss2 - j21 * miss1) * inverse, -1e-3), 1e-3)
         theta1, theta2 = theta1 - step1, theta2 - step2
     miss = np.nan_to_num(_hypot(miss1, miss2) / ex(scale), nan=np.inf)
-    exact = found & (miss <= GEOMETRY_TOLERANCE * 1e3)
+    exact = found & (miss <= _EXACT_PAIR)
     # a row without a root keeps its nearest candidate in slot 0
     nearest = np.argmin(miss, axis=-1)
     rank_one = rank_one | identically

@@ -883,7 +883,7 @@ class AngleQuadSolutions(NamedTuple):
 # A root z of the quartic counts as a real angle when | |z| - 1 | is below this before polishing: generous, since
 # a double root splits by about sqrt(eps); polishing and the residual test below decide.
 _ON_CIRCLE = 1e-3
-_NEWTON_STEPS = 3  # on the pair of equations, after the quartic's roots
+_NEWTON_STEPS = 2  # on the pair of equations, after the quartic's roots
 _EXACT_PAIR = 10 * GEOMETRY_TOLERANCE  # relative residual of an exact root: Newton-polished roots reach ~1e-15
 
 

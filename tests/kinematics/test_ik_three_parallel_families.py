@@ -276,3 +276,38 @@ def test_a_sweep_towards_the_stretched_elbow_down_to_1e_12(case):
     assert _fk_misses(robot, found.joints, found.valid, targets).max() <= 1e-9
     assert _hits(robot, found.joints[:3], found.valid[:3], q[:3], SAME).all()  # ε = 1e-2 … 1e-4
     assert _hits(robot, found.joints, found.valid, q, 1e-4).all()
+
+
+def _axis_six_on_axis_one(robot: Robot, rng: np.random.Generator) -> np.ndarray | None:
+    """A configuration whose axis 6 lies on axis 1 (Gauss–Newton on joints 2–5 from random starts), or None."""
+    from service.kinematics.ik._screws import chain_rotation, move_point
+
+    m = geometry_of(robot).model
+    def residual(q):
+        direction = chain_rotation(m.directions[:5], m.is_revolute[:5], q[None, :5])[0] @ m.directions[5]
+        point = move_point(m.directions[:5], m.points[:5], m.is_revolute[:5], q[None, :5], m.points[5])[0]
+        return np.r_[np.cross(direction, m.directions[0]), np.cross(point - m.points[0], m.directions[0])]
+    for _ in range(30):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        for _ in range(50):
+            f = residual(q)
+            J = np.stack([(residual(q + 1e-7 * np.eye(6)[j]) - f) / 1e-7 for j in range(1, 5)], 1)
+            q[1:5] -= np.linalg.lstsq(J, f, rcond=None)[0]
+        if np.abs(residual(q)).max() < 1e-13:
+            return q
+    return None
+
+
+def test_axis_six_on_axis_one_frees_the_sum_of_joints_one_and_six():
+    """The skew-wrist class's shoulder singularity: axis 6 on axis 1, where subproblem 6 leaves q1 free. q1 takes
+    the reference value, q6 the rest of the sum, and the pose is reached."""
+    robot = random_arm("skew_wrist_234", "standard", seed=0)
+    q = _axis_six_on_axis_one(robot, np.random.default_rng(0))
+    assert q is not None
+    target = forward_kinematics(robot, q[None])
+    found = solve_ik_arrays(robot, target, reference=np.full(6, 0.3))
+    assert found.count[0] >= 1
+    assert _fk_misses(robot, found.joints, found.valid, target).max() <= 1e-9
+    assert np.allclose(found.joints[0, :found.count[0], 0], 0.3)
+    flags = {(s.kind, s.joints, s.relation) for s in found.singularities[0]}
+    assert flags & {("shoulder", (0, 5), "sum"), ("shoulder", (0, 5), "difference")}

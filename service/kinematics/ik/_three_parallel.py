@@ -218,9 +218,12 @@ class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
         pair = subproblem_6(-g.direction(0), g.direction(4),
                             w_p, c_world - g.point(0), -w_p, self.centre - g.point(4), w_p @ (g.point(4) - g.point(0)),
                             w_p, A[:, :3, :3] @ g.direction(5), -w_p, g.direction(5), 0.0)
-        singular.add(pair.degenerate, Singularity("shoulder", (0,), "free",
-                                                  "axis 6 and the point c on it are on axis 1: joint 1 is free "
-                                                  "and set to the reference value (or 0)"))
+        if pair.degenerate.any():  # axis 6 on axis 1: only q1 + q6 (or q1 − q6, axes opposed) is determined
+            same_sense = (A[:, :3, :3] @ g.direction(5)) @ g.direction(0) > 0
+            for relation, rows in (("sum", same_sense), ("difference", ~same_sense)):
+                singular.add(pair.degenerate & rows, Singularity(
+                    "shoulder", (0, 5), relation, f"axis 6 lies on axis 1: only their {relation} is determined; "
+                    "q1 is set to the reference value (or 0)"))
         singular.add(pair.merged, Singularity("shoulder", (0, 4), "boundary", "two (q1, q5) solutions meet"))
         q1 = pair.theta1
         if pair.degenerate.any():  # the equations do not involve q1 there, so q5 holds for any value of it

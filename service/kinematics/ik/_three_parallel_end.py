@@ -56,17 +56,17 @@ class ThreeParallelAtEndPlan:
         self.omega = geometry.direction(3)
         self.signs = np.array([np.sign(geometry.direction(j) @ self.omega) for j in (3, 4, 5)])
         self.normal = _perpendicular_unit(self.omega)
-        # the bend of joint 5 at which axes 4, 5, 6 lie on one line in the plane normal to ω, p_6 beyond p_5
-        w = self.omega
-        def planar(x: np.ndarray) -> np.ndarray:
-            return x - (x @ w) * w
-        beyond, before = planar(geometry.point(5) - geometry.point(4)), planar(geometry.point(4) - geometry.point(3))
         # the range of ||R(ω_5, q) (p_6 − p_5) − (p_4 − p_5)|| over q: the reach of the pair 4, 5 from axis 4
         along = geometry.direction(4)
         a, b = geometry.point(5) - geometry.point(4), geometry.point(3) - geometry.point(4)
         ra, rb = np.linalg.norm(a - (a @ along) * along), np.linalg.norm(b - (b @ along) * along)
         rise = (a - b) @ along
         self.reach = (float(np.hypot(ra - rb, rise)), float(np.hypot(ra + rb, rise)))
+        # the bend of joint 5 at which axes 4, 5, 6 lie on one line in the plane normal to ω, p_6 beyond p_5
+        w = self.omega
+        def planar(x: np.ndarray) -> np.ndarray:
+            return x - (x @ w) * w
+        beyond, before = planar(geometry.point(5) - geometry.point(4)), planar(geometry.point(4) - geometry.point(3))
         self.stretched5 = (float(np.arctan2(np.cross(beyond, before) @ geometry.direction(4), beyond @ before))
                            if np.linalg.norm(beyond) * np.linalg.norm(before) > 0 else 0.0)
 

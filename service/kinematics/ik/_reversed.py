@@ -1,63 +1,85 @@
-"""Solving an arm from its tool end: the reversed chain.
+"""A spherical wrist (or any decoupling point, or three parallel axes) at the base: solve the inverse chain.
 
-With ``world_T_tool = G_1 ⋯ G_n M`` (G_i = exp([S_i] q_i), M the home pose),
-``tool_T_world = M⁻¹ G_n⁻¹ ⋯ G_1⁻¹ = G'_1 ⋯ G'_n M⁻¹``, where joint i' = n − 1 − i
-of the reversed chain turns about ``−R_Mᵀ ω_i`` through ``M⁻¹ p_i`` (a screw
-moved by the adjoint of M⁻¹, the sign making its angle q_i again). Its world
-frame is the tool frame at q = 0. A family that matches the reversed chain
-(three parallel axes at the base, say, seen as three parallel axes at the end)
-solves the inverse target, and the joint order is turned back.
+``world_T_tool = G_1(q_1) ⋯ G_n(q_n) · home`` inverts to
+``home · tool_T_world = G_n(q_n)⁻¹ ⋯ G_1(q_1)⁻¹ = G'_1(q_n) ⋯ G'_n(q_1) · I``, where joint
+``i' = n − 1 − i`` of the reversed chain has joint i's axis (or slide) negated through the same
+point and home pose I. A wrist whose three axes meet at the base is the reversed chain's wrist at
+its end, so every decoupled plan (positioner + wrist) applies to it unchanged. Targets are
+inverted on the way in; joint vectors, free joints and singular joints are reversed on the way out.
 """
 
 from __future__ import annotations
 
+import re
 from typing import Callable
 
 import numpy as np
 
 from .._forward import ScrewModel
+from ._decoupled import DecoupledPlan
 from ._screws import invert
 from ._structure import Geometry
 from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
 
 
 def reversed_geometry(geometry: Geometry) -> Geometry:
-    """The geometry of the reversed chain (joint i of the result is joint n − 1 − i of ``geometry``)."""
+    """The inverse chain's geometry: joints in reverse order, each axis negated, home pose the identity."""
     model = geometry.model
-    home_inverse = invert(model.home)
-    R = home_inverse[:3, :3]
-    directions = -(model.directions[::-1] @ R.T)
-    points = model.points[::-1] @ R.T + home_inverse[:3, 3]
-    reversed_model = ScrewModel(np.ascontiguousarray(directions), np.ascontiguousarray(points),
-                                model.is_revolute[::-1].copy(), home_inverse)
-    return Geometry(reversed_model, geometry.length_scale, up=R @ geometry.up, link_x=None)
+    reversed_model = ScrewModel(-model.directions[::-1].copy(), model.points[::-1].copy(),
+                                model.is_revolute[::-1].copy(), np.eye(4))
+    return Geometry(reversed_model, geometry.length_scale, up=geometry.up)
 
 
 class ReversedPlan:
-    """A plan of the reversed chain, answering for the arm as described."""
+    """A plan of the inverse chain (decoupled, or three parallel axes), answering for the chain itself."""
 
     method = "analytic"
 
-    def __init__(self, inner, structure: str, label_codes: Callable[[np.ndarray], LabelCodes]) -> None:
+    def __init__(self, inner: DecoupledPlan, home: np.ndarray, dof: int, *, structure: str | None = None,
+                 label_codes: Callable[[np.ndarray], LabelCodes] | None = None) -> None:
+        """``structure`` names the class when the inner one's name does not read in reverse (default: the
+        inner parts in the chain's own order, the wrist at the base first); ``label_codes`` labels joint
+        vectors (M, n) of the chain itself where the inner labels would not keep their meaning (default: the
+        inner ones)."""
         self.inner = inner
-        self._label_codes = label_codes
-        self.structure = structure
+        self.home = home
+        self.dof = dof
+        self.structure = structure or "+".join(reversed(inner.structure.split("+")))
         self.generic_count = inner.generic_count
-        self.dof = inner.geometry.dof
-        self.free_joints = [self.dof - 1 - j for j in inner.free_joints]
+        self.own_label_codes = label_codes
+
+    @property
+    def free_joints(self) -> list[int]:
+        return sorted(self.dof - 1 - j for j in self.inner.free_joints)
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
-        inner = self.inner.solve(invert(world_T_targets), None if reference is None else reference[::-1])
+        """Candidates (N, m, n) for targets (N, 4, 4)."""
+        inverse_targets = self.home @ invert(world_T_targets)
+        inner = self.inner.solve(inverse_targets, None if reference is None else reference[::-1])
         singular = SingularFlags(inner.singularities.count)
-        n = self.dof
         for mask, flag in inner.singularities.entries:
-            singular.add(mask, Singularity(flag.kind, tuple(sorted(n - 1 - j for j in flag.joints)), flag.relation,
-                                           f"{flag.detail} (axes numbered from the tool)"))
-        return Candidates(inner.joints[..., ::-1], inner.valid, [], singular)
+            singular.add(mask, self._renumbered(flag))
+        return Candidates(inner.joints[..., ::-1].copy(), inner.valid, [], singular)
+
+    def _renumbered(self, flag: Singularity) -> Singularity:
+        """The inverse chain's singularity with the chain's joint numbers (0-based in ``joints``, 1-based in text)."""
+        n = self.dof
+
+        def one_based(match: re.Match) -> str:
+            return f"{match.group(1)}{n + 1 - int(match.group(2))}"
+
+        def span(match: re.Match) -> str:  # "axes 2–4" of the inverse chain are "axes 3–5" of the chain
+            return f"axes {n + 1 - int(match.group(2))}–{n + 1 - int(match.group(1))}"
+
+        detail = re.sub(r"\baxes (\d+)–(\d+)", span, flag.detail)
+        detail = re.sub(r"(\bq|\bjoints? |\baxis )(\d+)", one_based, detail)
+        return Singularity(flag.kind, tuple(sorted(n - 1 - j for j in flag.joints)), flag.relation, detail)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
         return branches_from_codes(self.label_codes(joints), len(joints))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        """Labels computed on the arm as described (the reversed chain's up and sides are the tool's)."""
-        return self._label_codes(joints)
+        """The inverse chain's labels (its wrist flip and its positioner's branches) of joint vectors (M, n)."""
+        if self.own_label_codes is not None:
+            return self.own_label_codes(joints)
+        return self.inner.label_codes(joints[:, ::-1])

@@ -109,7 +109,7 @@ class ThreeParallelAtEndPlan:
         singular = SingularFlags(n)
         singular.add(pair.degenerate, Singularity("base", (0, 3, 4, 5), "free",
                                                   "axis 1 is parallel to axes 4–6: joint 1 is free and set to "
-                                                  "the reference value (or 0); joints 4–6 follow it"))
+                                                  "the reference value (or 0); q4, q5 and q6 follow it"))
         singular.add(pair.merged, Singularity("base", (0, 2), "boundary", "two (q1, q3) solutions meet"))
         relation = "sum" if np.all(self.signs > 0) else "signed_sum"
         singular.add((free_two & pair.valid).any(axis=1),

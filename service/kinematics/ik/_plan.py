@@ -12,12 +12,13 @@ from typing import Protocol
 
 import numpy as np
 
+from .._cache import memo
 from .._forward import link_frames, screw_model
 from .._robot import Robot
 from ._decoupled import DecoupledPlan
 from ._positioning import find_positioner
 from ._screws import apply, chain_motion
-from ._structure import Geometry
+from ._structure import Geometry, canonical_model, idealised
 from ._three_parallel import ThreeParallelPlan
 from ._types import Branch, Candidates, LabelCodes
 from ._wrist import Roll, SphericalWrist
@@ -36,10 +37,15 @@ class Plan(Protocol):
 
 
 def geometry_of(robot: Robot) -> Geometry:
-    """The robot's screw model, size, up direction (base z) and link x axes at q = 0, in the world frame."""
+    """The robot's canonical screw model and size (:func:`canonical_model`), up direction (base z) and link x axes
+    at q = 0, in the world frame."""
+    return memo(robot, "ik_geometry", lambda: _geometry_of(robot))
+
+
+def _geometry_of(robot: Robot) -> Geometry:
     frames = link_frames(robot, np.zeros(robot.dof))
-    return Geometry(screw_model(robot), robot.characteristic_length, up=robot.world_T_base[:3, 2].copy(),
-                    link_x=frames[1:, :3, 0].copy())
+    model, size = canonical_model(screw_model(robot), robot.world_T_base[:3, 3])
+    return Geometry(model, size, up=robot.world_T_base[:3, 2].copy(), link_x=frames[1:, :3, 0].copy())
 
 
 def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:

@@ -24,7 +24,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._forward import ScrewModel
+from .._cache import memo
+from .._forward import ScrewModel, screw_model
 from .._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
 
 
@@ -108,6 +109,14 @@ def _closest_common_point(points: list[np.ndarray], directions: list[np.ndarray]
     return x
 
 
+def arm_size(robot) -> float:
+    """The arm's size for relative tolerances in IK (residuals, duplicates, geometric tests): the size of its
+    canonical screw model (:func:`canonical_model`), which depends on the lines of its axes and its tool, not on
+    the numbers of its DH table (``Robot.characteristic_length`` sums those, and a table with offsets of 27 km on
+    a 1 m arm makes it 54 km)."""
+    return memo(robot, "ik_arm_size", lambda: canonical_model(screw_model(robot), robot.world_T_base[:3, 3])[1])
+
+
 #: A previous axis at least this far from parallel (sine of the angle) puts the canonical point of the next axis at
 #: their common normal's foot; closer to parallel the foot runs away (1/sine) and the nearest point is used instead.
 _FOOT_SINE = 0.1
@@ -151,11 +160,11 @@ def _polyline(points: list[np.ndarray]) -> float:
 
 def _common_normal_foot(p: np.ndarray, k: np.ndarray, p_other: np.ndarray, k_other: np.ndarray) -> np.ndarray | None:
     """The point of line (p, k) nearest to line (p_other, k_other); None when they are within 0.1 of parallel."""
-    normal = np.cross(k_other, k)
+    normal = np.cross(k, k_other)
     sine = float(np.linalg.norm(normal))
     if sine < _FOOT_SINE:
         return None
-    # p + t k − (p_other + s k_other) ⟂ k and k_other
+    # p + t k − (p_other + s k_other) ⟂ k and k_other: t = ((p_other − p) × k_other)·n / |n|², n = k × k_other
     t = float(np.cross(p_other - p, k_other) @ normal) / sine ** 2
     return p + t * k
 

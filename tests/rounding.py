@@ -89,3 +89,27 @@ def _perpendicular(k: np.ndarray) -> np.ndarray:
     trial = np.eye(3)[np.argmin(np.abs(k))]
     u = np.cross(k, trial)
     return u / np.linalg.norm(u)
+
+
+def urdf_chain_screws(joints: list[dict]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Joint axes (n, 3), points on them (n, 3) and the tool pose at q = 0 (4, 4) of a URDF chain of revolute
+    joints with ``<axis xyz="0 0 1">``, each given by its ``<origin>`` (``xyz``, ``rpy``: fixed-axis roll, pitch,
+    yaw, R = Rz(y) Ry(p) Rx(r)); the tool is the last joint's frame."""
+    frame = np.eye(4)
+    directions, points = [], []
+    for joint in joints:
+        r, p, y = joint["rpy"]
+        origin = np.eye(4)
+        origin[:3, :3] = _rot("z", y) @ _rot("y", p) @ _rot("x", r)
+        origin[:3, 3] = joint["xyz"]
+        frame = frame @ origin
+        directions.append(frame[:3, 2].copy())
+        points.append(frame[:3, 3].copy())
+    return np.array(directions), np.array(points), frame
+
+
+def _rot(axis: str, angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return {"x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
+            "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
+            "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]

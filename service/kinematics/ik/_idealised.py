@@ -80,6 +80,9 @@ class IdealisedPlan:
         self.deviation = deviation
         self.size = size
         self.constrain_orientation = constrain_orientation
+        task = (6 if constrain_orientation else 3)
+        #: the target constrains more than the arm's joints can set (a SCARA's pose, a planar arm's position)
+        self.under_determined = robot.dof < task
         self.structure = inner.structure
         self.generic_count = inner.generic_count
 
@@ -95,11 +98,12 @@ class IdealisedPlan:
         joints = wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0))
         # the idealised arm's own solutions (its closed form is exact up to rounding near a singularity)
         solutions = ideal.valid & finite & (self._ideal_error(joints, world_T_targets) <= IDEAL_RESIDUAL)
-        # 2. near misses: any other candidate that (nearly) reaches the target on the true arm
         position, orientation = residual_arrays(robot, joints, world_T_targets)
-        near_miss = (finite & ~solutions & (self._size(position, orientation) <= NEAR_MISS * self.deviation)).any(
-            axis=1)
-        tried = ideal.valid & finite
+        near_before = finite & (self._size(position, orientation) <= NEAR_MISS * self.deviation)
+        # refine the idealised solutions, and every other candidate that comes close (an arm with fewer joints than
+        # the target constrains reaches the true arm's targets only within δ, where the idealised family rejects
+        # them)
+        tried = finite & (ideal.valid | near_before)
         rows, slots = np.nonzero(tried)
         if len(rows):
             refined = polish(robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation,
@@ -110,9 +114,13 @@ class IdealisedPlan:
         if self.constrain_orientation:
             accepted &= orientation <= ACCEPT_RESIDUAL
         accepted &= tried
-        # 2 (continued). a refinement that came near the target on the true arm but did not converge
-        near_miss |= (tried & ~accepted & (self._size(position, orientation) <= NEAR_MISS * self.deviation)).any(
-            axis=1)
+        # 2. near misses: a candidate that came within NEAR_MISS δ of the target on the true arm, before or after
+        # refinement, without reaching it
+        after = self._size(position, orientation)
+        missed = (near_before | (tried & (after <= NEAR_MISS * self.deviation))) & ~accepted
+        if self.under_determined and missed.any():
+            missed &= ~self._stalled_apart(joints, world_T_targets, missed, after)
+        near_miss = missed.any(axis=1)
         # 1. every idealised solution refined to a verified one, and no two to the same one
         converged = ~(solutions & ~accepted).any(axis=1)
         distinct = _distinct_counts(robot, joints, solutions & accepted) == _distinct_counts(
@@ -125,6 +133,24 @@ class IdealisedPlan:
             singular |= mask
         complete = converged & distinct & ~near_miss & ~singular
         return Candidates(joints, accepted, [], ideal.singularities, complete=complete)
+
+    def _stalled_apart(self, joints: np.ndarray, world_T_targets: np.ndarray, missed: np.ndarray,
+                       after: np.ndarray) -> np.ndarray:
+        """Which ``missed`` slots (N, m) sit at a least-squares point clearly apart from the target.
+
+        An arm with fewer joints than the target constrains reaches a δ-thin neighbourhood of the idealised
+        family's targets on several sheets (e.g. a SCARA's two assembly modes); on the true arm a target from one
+        sheet is generally missed by the other by about δ. There Gauss–Newton stalls at a positive residual: one
+        more step lowers it by less than 1 %, and it is at least 1e-3 δ (far above the acceptance tolerance), so
+        no solution lies near that candidate.
+        """
+        rows, slots = np.nonzero(missed)
+        stepped = polish(self.robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation, steps=1)
+        position, orientation = residual_arrays(self.robot, stepped[:, None, :], world_T_targets[rows])
+        now, before = self._size(position, orientation)[:, 0], after[rows, slots]
+        apart = np.zeros_like(missed)
+        apart[rows, slots] = (before >= 1e-3 * self.deviation) & (now >= 0.99 * before)
+        return apart
 
     def _smallest_singular_value(self, joints: np.ndarray) -> np.ndarray:
         """σ_min of the true arm's Jacobian at joints (N, m, n), position rows in arm sizes; shape (N, m)."""

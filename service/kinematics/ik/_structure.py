@@ -188,8 +188,9 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
        of the group; directions within ``tolerance`` of perpendicular are made exactly perpendicular (each group's
        direction loses its components along the earlier groups' it is nearly perpendicular to).
     2. Revolute axes that (after step 1) pass within ``tolerance`` × size of a common point are moved to pass
-       through it: groups are grown from each nearly intersecting pair, adding every further axis that passes
-       that close to the group's least-squares point; an axis belongs to one group at most.
+       through it (their least-squares point), for the groups the families look for, in this order: the last
+       three axes (a wrist), the first three (a wrist at the base), then consecutive pairs (a shoulder, the
+       UR type's axes 5 and 6). An axis belongs to one group at most.
 
     Lines turn about their canonical points, which lie on the arm, so a turn by ε moves no part of the arm by much
     more than ε × size.
@@ -215,27 +216,25 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
         leader = directions[group_of[j]]
         directions[j] = leader if float(leader @ model.directions[j]) >= 0 else -leader
     points = model.points.copy()
-    # 2. nearly concurrent revolute axes
-    revolute = [i for i in range(n) if model.is_revolute[i]]
+    # 2. nearly concurrent revolute axes, in the groups the families use: a wrist at the end or at the base, then
+    # consecutive pairs (a shoulder, the UR type's last two axes)
+    revolute = set(i for i in range(n) if model.is_revolute[i])
+    candidates = [tuple(range(n - 3, n)), (0, 1, 2)] + [(i, i + 1) for i in range(n - 1)] if n >= 3 else \
+        [(i, i + 1) for i in range(n - 1)]
     assigned: set[int] = set()
-    for i in revolute:
-        for j in revolute:
-            if j <= i or i in assigned or j in assigned:
-                continue
-            if np.linalg.norm(np.cross(directions[i], directions[j])) <= 10 * GEOMETRY_TOLERANCE:
-                continue
-            group = [i, j]
-            centre = _least_squares_point(points[group], directions[group])
-            if max(_line_distance(centre, points[g], directions[g]) for g in group) > tolerance * scale:
-                continue
-            for k in revolute:
-                if k not in group and k not in assigned and \
-                        _line_distance(centre, points[k], directions[k]) <= tolerance * scale:
-                    group.append(k)
-                    centre = _least_squares_point(points[group], directions[group])
-            for g in group:
-                points[g] = centre
-            assigned.update(group)
+    for group in candidates:
+        members = list(group)
+        if not set(members) <= revolute or set(members) & assigned:
+            continue
+        if all(np.linalg.norm(np.cross(directions[members[0]], directions[g])) <= 10 * GEOMETRY_TOLERANCE
+               for g in members[1:]):
+            continue  # all parallel: no common point
+        centre = _least_squares_point(points[members], directions[members])
+        if max(_line_distance(centre, points[g], directions[g]) for g in members) > tolerance * scale:
+            continue
+        for g in members:
+            points[g] = centre
+        assigned.update(members)
     # how far each line moved: its angle, and its displacement at the canonical point
     angle = np.linalg.norm(np.cross(model.directions, directions), axis=1)
     shift = np.array([_line_distance(model.points[i], points[i], directions[i]) for i in range(n)]) / scale

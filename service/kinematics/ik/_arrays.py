@@ -205,13 +205,31 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     else:
         order = np.argsort(~kept, axis=1, kind="stable")
     count = kept.sum(axis=1)
+    complete = _promised(candidates, count)
     take = (np.arange(n_targets)[:, None], order)
     return IKArrays(
         joints=joints[take], valid=kept[take], count=count,
         position=position[take], orientation=orientation[take],
         labels={name: (values, codes.reshape(n_targets, m)[take]) for name, (values, codes) in labels.items()},
         singularities=candidates.singularities, structure=plan.structure, free_joints=list(plan.free_joints),
-        complete=candidates.complete)
+        complete=complete)
+
+
+#: Singular relations under which the family sets a joint it found undetermined to the reference value (or 0).
+_FREE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum"})
+
+
+def _promised(candidates, count: np.ndarray) -> np.ndarray:
+    """Which rows (N,) may claim every solution: the family's own word (:attr:`Candidates.complete`), except that
+    a row with no verified solution where the family set a joint it found free is not a proof of
+    unreachability: the representative it chose failed, another value of that joint may not (an arm whose
+    remaining axes are not exactly aligned with the free one, as rounded geometry gives). Those rows go to the
+    fallback."""
+    complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
+    for mask, flag in candidates.singularities.entries:
+        if flag.relation in _FREE_RELATIONS:
+            complete &= ~(mask & (count == 0))
+    return complete
 
 
 def _polish_near(robot: Robot, joints: np.ndarray, targets: np.ndarray, position: np.ndarray,

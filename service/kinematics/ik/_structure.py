@@ -158,11 +158,13 @@ def _polyline(points: list[np.ndarray]) -> float:
     return total if total > 0.0 else 1.0
 
 
-def _common_normal_foot(p: np.ndarray, k: np.ndarray, p_other: np.ndarray, k_other: np.ndarray) -> np.ndarray | None:
-    """The point of line (p, k) nearest to line (p_other, k_other); None when they are within 0.1 of parallel."""
+def _common_normal_foot(p: np.ndarray, k: np.ndarray, p_other: np.ndarray, k_other: np.ndarray,
+                        least_sine: float = _FOOT_SINE) -> np.ndarray | None:
+    """The point of line (p, k) nearest to line (p_other, k_other); None when the sine of their angle is below
+    ``least_sine`` (the foot runs away as 1/sine)."""
     normal = np.cross(k, k_other)
     sine = float(np.linalg.norm(normal))
-    if sine < _FOOT_SINE:
+    if sine <= least_sine:
         return None
     # p + t k − (p_other + s k_other) ⟂ k and k_other: t = ((p_other − p) × k_other)·n / |n|², n = k × k_other
     t = float(np.cross(p_other - p, k_other) @ normal) / sine ** 2
@@ -190,7 +192,8 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
     2. Revolute axes that (after step 1) pass within ``tolerance`` × size of a common point are moved to pass
        through it (their least-squares point), for the groups the families look for, in this order: the last
        three axes (a wrist), the first three (a wrist at the base), then consecutive pairs (a shoulder, the
-       UR type's axes 5 and 6). An axis belongs to one group at most.
+       UR type's axes 4–5 and 5–6). A pair whose first axis already meets another keeps that axis and
+       translates the second onto it; an axis is moved once at most.
 
     Lines turn about their canonical points, which lie on the arm, so a turn by ε moves no part of the arm by much
     more than ε × size.
@@ -224,7 +227,8 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
     assigned: set[int] = set()
     for group in candidates:
         members = list(group)
-        if not set(members) <= revolute or set(members) & assigned:
+        fixed = [g for g in members if g in assigned]
+        if not set(members) <= revolute or len(fixed) == len(members) or (fixed and len(members) > 2):
             continue
         if all(np.linalg.norm(np.cross(directions[members[0]], directions[g])) <= 10 * GEOMETRY_TOLERANCE
                for g in members[1:]):
@@ -232,8 +236,13 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
         centre = _least_squares_point(points[members], directions[members])
         if max(_line_distance(centre, points[g], directions[g]) for g in members) > tolerance * scale:
             continue
-        for g in members:
-            points[g] = centre
+        if fixed:  # a pair whose first axis already meets another: translate the free one onto it
+            (kept,), (moved,) = fixed, [g for g in members if g not in fixed]
+            foot_kept = _common_normal_foot(points[kept], directions[kept], points[moved], directions[moved], 0.0)
+            points[moved] = foot_kept  # on both lines now: the moved line passes through the kept one's foot
+        else:
+            for g in members:
+                points[g] = centre
         assigned.update(members)
     # how far each line moved: its angle, and its displacement at the canonical point
     angle = np.linalg.norm(np.cross(model.directions, directions), axis=1)

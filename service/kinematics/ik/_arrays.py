@@ -205,7 +205,10 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     else:
         order = np.argsort(~kept, axis=1, kind="stable")
     count = kept.sum(axis=1)
-    complete = _promised(candidates, count)
+    error = position / arm_size(robot)
+    if constrain_orientation:
+        error = np.maximum(error, orientation)
+    complete = _promised(candidates, count, np.where(candidates.valid, error, np.inf).min(axis=1))
     take = (np.arange(n_targets)[:, None], order)
     return IKArrays(
         joints=joints[take], valid=kept[take], count=count,
@@ -219,16 +222,18 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
 _FREE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum"})
 
 
-def _promised(candidates, count: np.ndarray) -> np.ndarray:
+def _promised(candidates, count: np.ndarray, nearest: np.ndarray) -> np.ndarray:
     """Which rows (N,) may claim every solution: the family's own word (:attr:`Candidates.complete`), except that
-    a row with no verified solution where the family set a joint it found free is not a proof of
-    unreachability: the representative it chose failed, another value of that joint may not (an arm whose
-    remaining axes are not exactly aligned with the free one, as rounded geometry gives). Those rows go to the
-    fallback."""
+    a row with no verified solution, where the family set a joint it found free and its nearest candidate missed
+    by less than ``POLISH_RESIDUAL`` (``nearest`` (N,): fraction of the arm's size, or radians), is not a proof
+    of unreachability: the representative it chose failed narrowly, another value of that joint may not (an arm
+    whose remaining axes are not exactly aligned with the free one, as rounded geometry gives). Those rows go to
+    the fallback."""
     complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
+    narrow = (count == 0) & (nearest <= POLISH_RESIDUAL)
     for mask, flag in candidates.singularities.entries:
         if flag.relation in _FREE_RELATIONS:
-            complete &= ~(mask & (count == 0))
+            complete &= ~(mask & narrow)
     return complete
 
 

@@ -16,7 +16,6 @@ import numpy as np
 
 from .._forward import forward_kinematics, geometric_jacobian
 from .._robot import Robot
-from ._structure import arm_size
 
 
 @dataclass(frozen=True)
@@ -50,7 +49,7 @@ def pose_error(world_T_tool: np.ndarray, world_T_target: np.ndarray, length_scal
 
 def initial_guesses(robot: Robot, count: int, rng: np.random.Generator, reference: np.ndarray | None) -> np.ndarray:
     """Spread starts over the joint ranges (±π, or ±scale for unlimited prismatic joints), shape (count, n)."""
-    scale = arm_size(robot)
+    scale = robot.characteristic_length
     default_lower = np.where(robot.is_revolute, -np.pi, -scale)
     default_upper = np.where(robot.is_revolute, np.pi, scale)
     lower = np.where(np.isfinite(robot.lower), np.maximum(robot.lower, default_lower - 2 * np.pi), default_lower)
@@ -91,7 +90,7 @@ def solve_numeric(
     """
     deadline = time.perf_counter() + options.time_budget_seconds
     rng = np.random.default_rng(options.seed)
-    scale = arm_size(robot)
+    scale = robot.characteristic_length
     rows = slice(0, 6) if constrain_orientation else slice(0, 3)
     q = initial_guesses(robot, options.starts, rng, reference)
     damping = np.full(len(q), 1e-3)

@@ -21,11 +21,19 @@ boundary or singular target). A row is claimed complete only when
    :data:`NEAR_MISS` × δ of the target on the true arm without reaching it:
    there a root pair the idealised arm lacks could appear. Every change of the
    solution count of a decoupled family happens where one of its subproblems'
-   root pairs meets, which is where those least-squares answers lie;
+   root pairs meets, which is where those least-squares answers lie. (For an
+   arm with fewer joints than the target constrains, such as a SCARA's pose, a
+   candidate of another sheet that Gauss–Newton leaves stalled at a residual of
+   at least 1e-3 δ is clearly apart and does not count);
 3. the idealised family reports no singularity for the target (a free joint or
    merged roots, whose continuation under the perturbation is not isolated),
    and no solution is within :data:`SINGULAR_MARGIN` × δ of a singularity of
    the true arm (σ_min of its scaled Jacobian).
+
+The true arm, a general arm near a decoupled one, may have more solutions in
+the complex domain (up to 16 for a 6R); the extra ones come from infinity
+(x = tan(θ/2) → ±i) as δ grows from 0 and stay far from real for small δ,
+so they do not break this count.
 
 Otherwise the row is marked incomplete and the caller's fallback answers it:
 the general solver when there is one (:data:`GENERAL_SOLVER` in ``_solve``),
@@ -39,11 +47,11 @@ import numpy as np
 
 from .._forward import ScrewModel, geometric_jacobian
 from .._robot import Robot
-from ._screws import chain_motion
 from .._tolerances import ACCEPT_RESIDUAL
-from ._verify import polish, residual_arrays, wrap_revolute
-from ._types import Branch, Candidates, LabelCodes
+from ._screws import chain_motion
 from ._structure import arm_size
+from ._types import Branch, Candidates, LabelCodes
+from ._verify import polish, residual_arrays, wrap_revolute
 
 #: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
 #: the idealisation's deviation marks the row incomplete: the perturbation moves the tool by at most a few δ

@@ -135,8 +135,11 @@ class IdealisedPlan:
             robot, wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0)), solutions)
         # 3. no singular target: none flagged by the family, and every solution clear of the true arm's
         # singularities (where the idealised family's roots may meet or split)
-        singular = (accepted & (self._smallest_singular_value(joints) <= SINGULAR_MARGIN * self.deviation)
-                    ).any(axis=1)
+        singular = np.zeros(len(world_T_targets), dtype=bool)
+        rows, slots = np.nonzero(accepted)
+        if len(rows):
+            near_singular = self._smallest_singular_value(joints[rows, slots]) <= SINGULAR_MARGIN * self.deviation
+            singular[rows[near_singular]] = True
         for mask, _ in ideal.singularities.entries:
             singular |= mask
         complete = converged & distinct & ~near_miss & ~singular
@@ -161,13 +164,17 @@ class IdealisedPlan:
         return apart
 
     def _smallest_singular_value(self, joints: np.ndarray) -> np.ndarray:
-        """σ_min of the true arm's Jacobian at joints (N, m, n), position rows in arm sizes; shape (N, m)."""
-        shape = joints.shape[:-1]
-        J = geometric_jacobian(self.robot, joints.reshape(-1, joints.shape[-1]))
+        """σ_min of the true arm's Jacobian at joints (k, n), position rows in arm sizes; shape (k,).
+
+        From the eigenvalues of JᵀJ (6 × 6 at most): σ_min² is far above their rounding (1e-16 σ_max²) at the
+        margins it is compared with (SINGULAR_MARGIN δ ≥ 1e-5).
+        """
+        J = geometric_jacobian(self.robot, joints)
         J[:, :3, :] /= self.size
         if not self.constrain_orientation:
             J = J[:, :3, :]
-        return np.linalg.svd(J, compute_uv=False)[:, -1].reshape(shape)
+        gram = np.swapaxes(J, -1, -2) @ J if J.shape[-1] <= J.shape[-2] else J @ np.swapaxes(J, -1, -2)
+        return np.sqrt(np.maximum(np.linalg.eigvalsh(gram)[:, 0], 0.0))
 
     def _ideal_error(self, joints: np.ndarray, world_T_targets: np.ndarray) -> np.ndarray:
         """The idealised arm's residual at joints (N, m, n): position / size, or the larger with the orientation."""

@@ -46,9 +46,12 @@ def _with_special_poses(robot: Robot, q: np.ndarray, seed: int) -> np.ndarray:
     return q
 
 
-def check_own_poses(robot: Robot, kind: str, structure: str, seed: int, *, poses: int = POSES,
+def check_own_poses(robot: Robot, kind: str, structure: str | set[str], seed: int, *, poses: int = POSES,
                     max_incomplete: float = MAX_INCOMPLETE) -> Counter:
-    """Solve the arm's own FK poses; assert the promises; return what answered (method, complete) per row."""
+    """Solve the arm's own FK poses; assert the promises; return what answered (method, complete) per row.
+
+    ``structure``: the family expected to answer the complete rows (or a set of acceptable ones)."""
+    structures = {structure} if isinstance(structure, str) else structure
     constrained = kind == "pose"
     q = _with_special_poses(robot, random_configurations(robot, poses, seed), seed)
     targets = forward_kinematics(robot, q)
@@ -63,7 +66,7 @@ def check_own_poses(robot: Robot, kind: str, structure: str, seed: int, *, poses
         # unreachable with complete: true is a promise the arm cannot reach the target
         assert not (result.status == "unreachable" and result.complete), (q_true, result.detail)
         if result.complete:
-            assert result.method == "analytic" and result.structure == structure
+            assert result.method == "analytic" and result.structure in structures
         solutions = np.array([s.joints for s in result.solutions]).reshape(-1, robot.dof)
         if len(solutions):  # no wrong solution, by this test's own FK
             reached = forward_kinematics(robot, solutions)
@@ -117,6 +120,25 @@ def test_rounded_random_arms_of_each_class(make, structure, seed):
     """Seeded random arms of the 6R classes, rounded and with base and tool; 500 poses each, 1,000 per class."""
     robot = rounded(make(np.random.default_rng(seed)), seed)
     check_own_poses(robot, "pose", structure, seed, poses=500)
+
+
+def _opw_arm(name: str) -> tuple[Robot, str]:
+    """An industrial arm of tests/data/opw_arms.json, from its OPW parameters (the file's row recipe)."""
+    arm = json.loads((DATA / "opw_arms.json").read_text())["arms"][name]
+    o = arm["opw"]
+    rows = [(o["a1"], -90, o["c1"], 0), (o["c2"], 0, o["b"], -90), (-o["a2"], -90, 0, 0), (0, 90, o["c3"], 0),
+            (0, -90, 0, 0), (0, 0, o["c4"], 0)]
+    return Robot([Joint(f"q{i + 1}", "revolute", a, math.radians(alpha), d, math.radians(theta))
+                  for i, (a, alpha, d, theta) in enumerate(rows)]), arm["structure"]
+
+
+@pytest.mark.parametrize("name", ["abb_irb120", "fanuc_lrmate200id", "kuka_kr6_r900_2"])
+def test_rounded_industrial_arms_keep_their_closed_form(name):
+    """The ortho-parallel industrial arms (offset shoulder, parallel elbow, spherical wrist), rounded. Rounding the
+    twists to 1.5708 keeps the wrist exactly spherical, so the exact general-positioner family (subproblem 5) may
+    answer before the idealised ortho-parallel one: both are complete closed forms."""
+    robot, structure = _opw_arm(name)
+    check_own_poses(rounded(robot, seed=31), "pose", {structure, "skew_axes+spherical_wrist"}, seed=31, poses=500)
 
 
 # --- The UFactory Lite6: exact, 7e-6 rad off parallel (DH offsets of 28 km), and with d2, d3 raised by 1e4 m

@@ -218,21 +218,24 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
         complete=complete)
 
 
-#: Singular relations under which the family sets a joint it found undetermined to the reference value (or 0).
-_FREE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum"})
+#: Singular relations under which a family's "no solution" is not a proof: it set a joint it found undetermined to
+#: the reference value (or 0), or two roots met (a double root that rounding can push just off the real line).
+_FRAGILE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum",
+                                "boundary", "stretched", "folded", "stretched_or_folded"})
 
 
 def _promised(candidates, count: np.ndarray, nearest: np.ndarray) -> np.ndarray:
     """Which rows (N,) may claim every solution: the family's own word (:attr:`Candidates.complete`), except that
-    a row with no verified solution, where the family set a joint it found free and its nearest candidate missed
-    by less than ``POLISH_RESIDUAL`` (``nearest`` (N,): fraction of the arm's size, or radians), is not a proof
-    of unreachability: the representative it chose failed narrowly, another value of that joint may not (an arm
-    whose remaining axes are not exactly aligned with the free one, as rounded geometry gives). Those rows go to
-    the fallback."""
+    a row with no verified solution, where the family set a joint it found free or saw two roots meet, and whose
+    nearest candidate missed by less than ``POLISH_RESIDUAL`` (``nearest`` (N,): fraction of the arm's size, or
+    radians), is not a proof of unreachability: the representative it chose, or the double root, failed
+    narrowly; another value of that joint, or the root pair a rounding error moved off the real line, may not
+    (an arm whose remaining axes are not exactly aligned with the free one, as rounded geometry gives). Those
+    rows go to the fallback."""
     complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
     narrow = (count == 0) & (nearest <= POLISH_RESIDUAL)
     for mask, flag in candidates.singularities.entries:
-        if flag.relation in _FREE_RELATIONS:
+        if flag.relation in _FRAGILE_RELATIONS:
             complete &= ~(mask & narrow)
     return complete
 

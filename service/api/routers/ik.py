@@ -75,14 +75,23 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
 def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference):
     """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
 
-    ``arrays`` is None when no analytic family covers the robot (the caller then runs the numeric search).
+    ``arrays`` is None when no analytic family covers the robot, or for the targets where a closed form on rounded
+    geometry could not promise every solution (the caller then runs :func:`solve_ik_batch`, whose fallback answers).
     """
     for constrained in (True, False):
         rows = np.flatnonzero(flags == constrained)
         if len(rows):
             started = time.perf_counter()
-            yield constrained, rows, solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained,
-                                                     reference=reference), started
+            arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
+            if arrays is None or arrays.complete.all():
+                yield constrained, rows, arrays, started
+                continue
+            # a closed form on rounded geometry that cannot promise every solution for some targets: those go to
+            # the fallback solver (through solve_ik_batch), the others keep the closed form's answer
+            complete = np.flatnonzero(arrays.complete)
+            if len(complete):
+                yield constrained, rows[complete], arrays.take(complete), started
+            yield constrained, rows[~arrays.complete], None, started
 
 
 def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: np.ndarray, rows: np.ndarray,

@@ -73,6 +73,15 @@ class Budget:
     def remaining_seconds(self) -> float | None:
         return None if self.deadline is None else max(0.0, self.deadline - time.monotonic())
 
+    def within(self, timeout_seconds: float) -> "Budget":
+        """A budget for part of the work: the earlier of this deadline and ``timeout_seconds`` from now, cancelled
+        with this one."""
+        part = Budget(timeout_seconds)
+        if self.deadline is not None and self.deadline < part.deadline:
+            part.deadline, part.timeout_seconds = self.deadline, self.timeout_seconds
+        part._cancelled = self._cancelled
+        return part
+
     def check(self, stage: str) -> None:
         """Raise :class:`BudgetExhausted` when cancelled or past the deadline; ``stage`` names the work."""
         if self._cancelled.is_set():

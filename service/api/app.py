@@ -61,7 +61,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         directories = [settings.builtin_robots_dir]
         if settings.robots_dir is not None:
             directories.append(settings.robots_dir)
-        app.state.catalogue = load_catalogue(directories, max_joints=settings.max_joints)
+        app.state.catalogue = load_catalogue(directories, max_joints=settings.max_joints,
+                                             max_file_bytes=settings.max_robot_file_bytes)
         logger.info("catalogue loaded: %d robots from %s", len(app.state.catalogue),
                     ", ".join(str(d) for d in directories))
         yield

@@ -173,10 +173,13 @@ def turn_offsets(robot: Robot, limits: Limits, q: np.ndarray, *, keep: int | Non
         lower, upper, value = limits.lower[i] - tolerance[i], limits.upper[i] + tolerance[i], float(q[i])
         if robot.is_revolute[i] and np.isfinite(lower) and np.isfinite(upper):
             first, last = _turn_range(lower, upper, value)
-            if keep is not None and last - first + 1 > keep:
+            if keep is not None and last - first + 1 > keep + 2:
+                # the keep values nearest the centre are consecutive turns: a window of keep + 2 around it holds
+                # them (one spare turn each side), slid inwards where it meets a bound
                 centre = value if around is None else float(around[i])
                 nearest = min(max(round((centre - value) / _TWO_PI), first), last)
-                first, last = max(first, nearest - keep), min(last, nearest + keep)
+                low = min(max(first, nearest - keep // 2 - 1), last - keep - 1)
+                first, last = low, low + keep + 1
             turns = np.arange(first, last + 1, dtype=float) if last >= first else np.zeros(0)
             candidates = value + _TWO_PI * turns
             options.append(candidates[(candidates >= lower) & (candidates <= upper)])

@@ -14,9 +14,10 @@ from ..budget import budget_of
 from ..boundary import joints_from_core, joints_to_core, located, target_matrix, violation_to_wire
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
 from ..problems import problem_responses
+from ..routing import FastJSONRoute
 from ..schemas.trajectory import TrajectoryInlineRequest, TrajectoryRequest, TrajectoryResponse
 
-router = APIRouter(prefix="/v1", tags=["trajectories"])
+router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["trajectories"])
 
 
 def _cartesian(parts, angle: float) -> list[float]:

@@ -192,11 +192,15 @@ def select(robot: Robot, result: IKResult, limits: Limits, *, filter_limits: boo
     if result.status == "unreachable":
         return Selection("unreachable", [], [])
     limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
-    keep = max(limit, 1)
+    all_counts = [turn_counts(robot, limits, solution.joints) for solution in result.solutions]
+    # Values each joint may need: with a reference any one solution may give all `limit` answers; without, the
+    # answers go round the solutions one at a time, so none gives more than the rounds needed to reach `limit`.
+    combinations = [capped_product(counts) if all(counts) else 1 for counts in all_counts
+                    if all(counts) or not filter_limits]
+    keep = limit if reference is not None else _rounds_needed(combinations, limit)
     candidates, rejected = [], []
-    for index, solution in enumerate(result.solutions):
+    for index, (solution, counts) in enumerate(zip(result.solutions, all_counts)):
         budget.check("selection")
-        counts = turn_counts(robot, limits, solution.joints)
         fits = all(counts)
         if not fits:
             closest = closest_equivalent(robot, limits, solution.joints)
@@ -229,6 +233,22 @@ def select(robot: Robot, result: IKResult, limits: Limits, *, filter_limits: boo
     selection = Selection(status, kept, rejected, truncated, trimmed, available)
     selection.notes.extend(_notes(selection, with_all_moves, max_equivalents, reference is not None))
     return selection
+
+
+def _rounds_needed(combinations: list[int], limit: int) -> int:
+    """Rounds of a round robin over streams of these lengths that yield ``limit`` items (all, if fewer), ≥ 1.
+
+    >>> _rounds_needed([1, 1, 1, 10**30], 1024)   # three streams end after round 1: the fourth gives 1,021
+    1021
+    """
+    remaining, previous, streams = limit, 0, len(combinations)
+    for position, length in enumerate(sorted(combinations)):
+        active = streams - position
+        if (length - previous) * active >= remaining:
+            return max(1, previous + -(-remaining // active))
+        remaining -= (length - previous) * active
+        previous = length
+    return max(1, previous)
 
 
 def _costed(robot: Robot, limits: Limits, index: int, solution: Solution, fits: bool, options: list[np.ndarray],

@@ -142,7 +142,8 @@ def _numeric(robot: Robot, target: np.ndarray, constrain_orientation: bool, refe
         joints = wrap_revolute(robot, polish(robot, joints, targets, constrain_orientation))
         position, orientation = residuals(robot, joints, target)
         ok = np.flatnonzero(accepted(robot, position, orientation, constrain_orientation))
-        kept = ok[distinct(robot, joints[ok])] if len(ok) else ok
+        options.budget.check("polishing the numeric solutions")
+        kept = ok[distinct(robot, joints[ok], options.budget)] if len(ok) else ok
         solutions = [Solution(joints[i], {}, float(position[i]), float(orientation[i])) for i in kept]
     detail = "" if solutions else (
         "No solution was found by the numeric search; the target may be outside the workspace "

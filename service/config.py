@@ -50,7 +50,7 @@ class Settings(BaseSettings):
         100.0, gt=0, description="most whole turns a revolute joint's limits may span (per-request limits included)")
     max_numeric_starts: int = Field(
         20_000, ge=1, description="most numeric-search starts in one request (targets × numeric.starts)")
-    max_in_flight: int = Field(8, ge=1, le=10_000, description="most requests worked on at once; more get 503")
+    max_in_flight: int = Field(32, ge=1, le=10_000, description="most requests worked on at once; more get 503")
     timeout_keep_alive_s: float = Field(5.0, gt=0, description="idle keep-alive connections close after this")
     header_timeout_s: float = Field(10.0, gt=0, description="a connection must send its request head within this")
     body_timeout_s: float = Field(30.0, gt=0, description="a request body must arrive within this")

@@ -17,9 +17,11 @@ from __future__ import annotations
 import asyncio
 import contextvars
 import json
+import os
 import threading
 from typing import Any, Callable, Coroutine
 
+import anyio.to_thread
 import orjson
 from fastapi import Request, Response
 from fastapi.routing import APIRoute
@@ -41,13 +43,24 @@ _work_loop: asyncio.AbstractEventLoop | None = None
 _work_loop_lock = threading.Lock()
 
 
+#: Threads that run the work routes' (sync) endpoints. The solvers are CPU-bound: more threads than cores only
+#: share the cores and the GIL, and every one of them delays the event loop (and /healthz) at each GIL hand-over.
+SOLVER_THREADS = max(2, os.cpu_count() or 1)
+
+
 def work_loop() -> asyncio.AbstractEventLoop:
-    """The event loop, in a daemon thread of this process, on which the work routes are handled."""
+    """The event loop, in a daemon thread of this process, on which the work routes are handled; its endpoints
+    run on at most :data:`SOLVER_THREADS` threads (the others wait, on the loop, for one)."""
     global _work_loop
     with _work_loop_lock:
         if _work_loop is None:
             loop = asyncio.new_event_loop()
             threading.Thread(target=loop.run_forever, name="kin-work-loop", daemon=True).start()
+
+            async def limit_threads() -> None:
+                anyio.to_thread.current_default_thread_limiter().total_tokens = SOLVER_THREADS
+
+            asyncio.run_coroutine_threadsafe(limit_threads(), loop).result()
             _work_loop = loop
         return _work_loop
 

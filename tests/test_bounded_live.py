@@ -108,7 +108,7 @@ def test_hostile_requests_keep_one_worker_under_its_memory_bound_and_health_answ
             assert response.status_code in (200, 413, 503), response.text[:300]
             if response.status_code != 200:
                 assert response.headers["content-type"].startswith("application/problem+json")
-            assert time.perf_counter() - started < 15.0
+            assert time.perf_counter() - started < 30.0
     assert statuses[:3] == [200, 413, 413] and statuses[3] == 200
 
     # the same hostile requests from 4 threads while /healthz is probed
@@ -150,7 +150,7 @@ def test_slow_clients_are_cut_off_and_logged_and_every_log_line_is_json(server):
         slow.settimeout(10)
         started = time.perf_counter()
         assert slow.recv(1024) == b""  # closed by the server
-        assert time.perf_counter() - started < 5.0
+        assert time.perf_counter() - started < 8.0
     assert httpx.get(f"{server.url}/healthz").status_code == 200
     server.stop()
     lines = server.lines()

@@ -53,7 +53,7 @@ def test_limits_spanning_too_many_turns_are_refused_naming_the_cap(client):
     response = client.post("/v1/robots/ur5/ik", json={"target": _ur5_target(client), "limits": _limits(1e6)})
     body = assert_problem(response, 422, loc=["body", "limits", 0], match="KIN_MAX_TURNS_PER_JOINT = 100")
     assert "318310" in body["detail"].replace(",", "")  # how many turns were asked for
-    assert time.perf_counter() - started < 2.0
+    assert time.perf_counter() - started < 20.0  # generous: a loaded CI machine; before, no answer at all
 
 
 def test_a_million_radian_limit_expands_only_what_is_returned(wide):
@@ -66,7 +66,7 @@ def test_a_million_radian_limit_expands_only_what_is_returned(wide):
     body = response.json()
     assert len(body["solutions"]) == 1024 and body["truncated"] is True
     assert body["available"] == COUNT_CAP and "At least 9007199254740991" in body["detail"]
-    assert elapsed < 3.0
+    assert elapsed < 20.0  # before: 7.6 GB; the bound that matters is memory, measured in the live test
 
 
 @pytest.mark.parametrize("form", ["objects", "arrays"])
@@ -101,15 +101,20 @@ def test_max_equivalents_beyond_the_solution_cap_is_413_before_solving():
         assert "8 more than" in problem["detail"]  # 100,000 kept + 8 rejected
 
 
-def test_a_whole_workspace_batch_is_413_before_solving(client):
-    """10,000 UR5 targets with ±360° limits: 8.2 GB and 118 s before. Refused in well under a second of work."""
+def test_a_whole_workspace_batch_is_413_before_solving(client, monkeypatch):
+    """10,000 UR5 targets with ±360° limits: 8.2 GB and 118 s before. Refused before the solver is called."""
+    from service.api.routers import ik as ik_router
+
     targets = [_ur5_target(client)] * 10_000
-    started = time.perf_counter()
+
+    def never(*args, **kwargs):
+        raise AssertionError("the solver ran")
+
+    monkeypatch.setattr(ik_router, "solve_ik_arrays", never)
     for form in ("objects", "arrays"):
         response = client.post("/v1/robots/ur5/ik/batch", json={"targets": targets, "format": form})
         problem = assert_problem(response, 413, match="KIN_MAX_SOLUTIONS_PER_RESPONSE")
         assert "5,200,000 solutions" in problem["detail"]  # 10,000 × (8 × 2⁶ kept + 8 rejected)
-    assert time.perf_counter() - started < 10.0  # two 10,000-target bodies parsed, nothing solved
 
 
 def test_the_response_byte_cap_is_checked_too():
@@ -137,7 +142,7 @@ def test_a_request_may_lower_its_deadline_and_gets_503_with_retry_after(client):
     elapsed = time.perf_counter() - started
     problem = assert_problem(response, 503, match="deadline of 30 ms")
     assert response.headers["retry-after"] == "1" and problem["type"].endswith("/deadline-exceeded")
-    assert elapsed < 2.0
+    assert elapsed < 10.0  # the whole 2,000-start search takes far longer
 
 
 def test_the_deadline_header_cannot_raise_the_servers_deadline():
@@ -163,7 +168,7 @@ def test_a_trajectory_of_unreachable_samples_stops_at_the_deadline():
         response = client.post("/v1/ik/trajectory", json={"robot": SEVEN_DOF, "samples": samples})
         elapsed = time.perf_counter() - started
     assert_problem(response, 503, match="deadline of 300 ms")
-    assert elapsed < 5.0
+    assert elapsed < 30.0  # before: about 0.5 s per sample, 1,000 s for these
 
 
 def test_numeric_answers_do_not_depend_on_load(client):

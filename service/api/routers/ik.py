@@ -50,7 +50,9 @@ router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinem
 def _numeric_options(request: Request, body: IKRequest | IKBatchRequest, targets: int) -> IKOptions:
     """The numeric search's bounds: starts and iterations (deterministic), under the request's deadline narrowed
     to the numeric time cap: the request's time_budget_ms per target, at most KIN_MAX_IK_TIME_MS per request."""
-    cap_ms = min(body.numeric.time_budget_ms * targets, settings_of(request).max_ik_time_ms)
+    cap_ms = settings_of(request).max_ik_time_ms
+    if body.numeric.time_budget_ms is not None:
+        cap_ms = min(body.numeric.time_budget_ms * targets, cap_ms)
     return IKOptions(NumericOptions(starts=body.numeric.starts, max_iterations=body.numeric.iterations),
                      budget=budget_of(request).within(cap_ms / 1000.0))
 
@@ -68,7 +70,9 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
     with located("body"):
         ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
                                     body.angle_unit)
-    plans = [cached_plan(robot, constrain_orientation=bool(kind), reference=reference) for kind in np.unique(flags)]
+    # the kept plans (a position-only plan holding joints at the reference is rebuilt per request; its count is
+    # the same as the kept one's)
+    plans = [cached_plan(robot, constrain_orientation=bool(kind), reference=None) for kind in np.unique(flags)]
     numeric = any(plan is None for plan in plans)
     per_target = max(body.numeric.starts if plan is None else plan.generic_count for plan in plans)
     check_ik_cost(settings_of(request), robot, limits, targets=len(matrices), solutions_per_target=per_target,

@@ -79,9 +79,9 @@ class NumericSearch(ApiModel):
 
     starts: int = Field(48, ge=1, le=2000)
     iterations: int = Field(200, ge=1, le=2000, description="Levenberg–Marquardt iterations per start at most")
-    time_budget_ms: int = Field(
-        500, ge=1, le=10_000, description="time allowed per target (a batch adds its targets' up), at most the "
-                                          "server's KIN_MAX_IK_TIME_MS per request; past it: 503")
+    time_budget_ms: int | None = Field(
+        None, ge=1, le=10_000, description="time allowed per target (a batch adds its targets' up), at most the "
+                                           "server's KIN_MAX_IK_TIME_MS per request (the default); past it: 503")
 
 
 class _Target(ApiModel):

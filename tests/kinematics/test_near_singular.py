@@ -120,8 +120,9 @@ def test_every_joint_near_zero_returns_the_generating_configuration(catalogue, r
     assert not failures, failures
 
 
-@pytest.mark.xfail(strict=True, reason="known, not fixed yet: the Stanford arm's two shoulder roots θ2 = ±eps merge "
-                                       "into θ2 = 0 for eps ≲ 1e-6 with no singularity reported (issue 11 note)")
+@pytest.mark.xfail(strict=True, reason="known, not fixed yet: at θ2 = eps ≲ 1e-6 the Stanford arm's answers are "
+                                       "FK-exact (residual ~1e-15) but come back with θ2 = 0, off by eps, and no "
+                                       "near-singularity is reported (issue 11 note)")
 def test_stanford_shoulder_near_zero_returns_the_generating_configuration(catalogue):
     robot = catalogue.get("spong_ex3_5_stanford").robot
     rng = np.random.default_rng(2)

@@ -131,3 +131,24 @@ def test_stanford_shoulder_near_zero_returns_the_generating_configuration(catalo
     q[1] = 1e-7
     solutions = np.array([s.joints for s in solve_ik(robot, forward_kinematics(robot, q), reference=q).solutions])
     assert np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= 1e-7
+
+
+def test_zero_length_links_report_every_free_shoulder_joint():
+    """All lengths zero: the wrist centre is the shoulder's centre whatever q1, q2, q3; both shoulder joints are
+    reported free and take the reference values, so the generating configuration comes back (q2 was left at 0,
+    unflagged, before)."""
+    from service.api.boundary import robot_from_description
+    from service.api.schemas.robots import DHRobot
+
+    half = np.pi / 2
+    robot = robot_from_description(DHRobot.model_validate({"id": "zero", "convention": "standard", "joints": [
+        {"a": 0, "alpha": half, "d": 0}, {"a": 0, "alpha": 0, "d": 0}, {"a": 0, "alpha": half, "d": 0},
+        {"a": 0, "alpha": -half, "d": 0}, {"a": 0, "alpha": half, "d": 0}, {"a": 0, "alpha": 0, "d": 0}]}),
+        max_joints=32)
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        q = rng.uniform(-np.pi, np.pi, 6)
+        result = solve_ik(robot, forward_kinematics(robot, q), reference=q)
+        assert any(s.kind == "shoulder" and tuple(s.joints) == (0, 1) for s in result.singularities)
+        solutions = np.array([s.joints for s in result.solutions])
+        assert np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= 1e-7

@@ -4,6 +4,14 @@
     python benchmarks/load_test.py --workers 2     # the same against KIN_WORKERS=2
     python benchmarks/load_test.py --smoke         # 5 s, 4 users: a quick check CI can run
     python benchmarks/load_test.py --url http://127.0.0.1:8000   # against a server already running
+    python benchmarks/load_test.py --mixed         # the soak: hostile requests among the normal ones
+
+``--mixed`` adds hostile users (one per four normal ones) sending what the caps must bound: ±1e6 rad limits
+(the server is started allowing a million turns, so the expansion runs), max_equivalents 100,000, a 2,000-target
+UR5 batch over ±360° (refused before solving), a numeric 7-joint arm with 2,000 starts, a 2,000-sample
+trajectory of unreachable poses, and ±5000 rad batches in the arrays form. They may be answered 200, 413, 422
+or 503 (problem+json); anything else is a failure. A prober reads /healthz every 100 ms. The report adds the p99
+of the normal requests alone, the /healthz latencies, and the server's peak RSS (VmHWM of its processes).
 
 Starts ``python -m service`` on a free loopback port (unless --url is given), warms it up, records the
 server's resident memory (RSS, all of its processes), runs the locust users for the given duration with no
@@ -77,6 +85,35 @@ def _workload(seed: int = 0, count: int = 200) -> dict[str, list]:
     return {"fk": fk, "fk_batch": batch, "ik": ik, "limits": limits}
 
 
+SEVEN_DOF = {"convention": "modified", "joints": [
+    {"a": 0.0, "alpha": 0.0, "d": 0.3}, {"a": 0.0, "alpha": -1.5707963267948966},
+    {"a": 0.0, "alpha": 1.5707963267948966, "d": 0.4}, {"a": 0.05, "alpha": 1.5707963267948966},
+    {"a": -0.05, "alpha": -1.5707963267948966, "d": 0.4}, {"a": 0.0, "alpha": 1.5707963267948966},
+    {"a": 0.1, "alpha": 1.5707963267948966, "d": 0.1}]}
+NORMAL_KINDS = ("fk", "ik", "limits", "fk_batch")
+
+
+def _hostile_workload() -> list[tuple[str, str, dict]]:
+    """(kind, path, body) of the hostile requests (see the module docstring)."""
+    catalogue = load_catalogue([BUILTIN_ROBOTS_DIR], max_joints=32)
+    ur5 = catalogue.get("ur5").robot
+    target = {"matrix": forward_kinematics(ur5, np.array([0.3, -1.0, 1.2, 0.4, 0.5, 0.6])).tolist()}
+    wide = [{"lower": -1e6, "upper": 1e6}] * 6
+    numeric_target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
+    far = {"position": [5.0, 5.0, 5.0], "orientation": {"type": "rpy", "angles": [0, 0, 0]}}
+    return [
+        ("hostile_wide_limits", "/v1/robots/ur5/ik", {"target": target, "limits": wide, "reference": [0.0] * 6}),
+        ("hostile_equivalents", "/v1/robots/ur5/ik", {"target": target, "limits": wide, "max_equivalents": 100_000}),
+        ("hostile_batch", "/v1/robots/ur5/ik/batch", {"targets": [target] * 2000}),
+        ("hostile_overflow", "/v1/robots/ur5/ik/batch", {"targets": [target] * 20, "format": "arrays",
+                                                          "limits": [{"lower": -5000, "upper": 5000}] * 6}),
+        ("hostile_numeric", "/v1/ik", {"robot": SEVEN_DOF, "target": numeric_target,
+                                        "numeric": {"starts": 2000, "time_budget_ms": 10_000}}),
+        ("hostile_trajectory", "/v1/ik/trajectory", {"robot": SEVEN_DOF, "samples": [
+            {"time": 0.01 * k, "pose": far} for k in range(2000)]}),
+    ]
+
+
 WORKLOAD: dict[str, list] = {}
 
 
@@ -113,10 +150,47 @@ class KinematicsUser(FastHttpUser):
         self._post("fk_batch", f"/v1/robots/{robot_id}/fk/batch", body)
 
 
+class HostileUser(FastHttpUser):
+    """A careless or hostile client (``--mixed`` only): a refusal within the caps is the right answer."""
+
+    wait_time = constant(0)
+    weight = 1
+
+    @task
+    def hostile(self) -> None:
+        kind, path, body = random.choice(WORKLOAD["hostile"])
+        with self.client.post(path, json=body, name=kind, catch_response=True) as response:
+            problem = response.headers.get("content-type", "").startswith("application/problem+json")
+            if response.status_code == 200 or (response.status_code in (413, 422, 503) and problem):
+                response.success()
+            else:
+                response.failure(f"{response.status_code}: {response.text[:200]}")
+
+
+class HealthProbe(FastHttpUser):
+    """A liveness probe every 100 ms (``--mixed`` only)."""
+
+    wait_time = constant(0.1)
+    fixed_count = 1
+
+    @task
+    def healthz(self) -> None:
+        with self.client.get("/healthz", name="healthz", catch_response=True) as response:
+            if response.status_code != 200:
+                response.failure(f"{response.status_code}")
+
+
 def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
+    """A free loopback port: any, or the first free one of ``KIN_TEST_PORTS`` ("18600-18699") when set."""
+    span = os.environ.get("KIN_TEST_PORTS")
+    for port in ([0] if not span else range(int(span.split("-")[0]), int(span.split("-")[1]) + 1)):
+        with socket.socket() as probe:
+            try:
+                probe.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+            return probe.getsockname()[1]
+    raise SystemExit(f"no free port in KIN_TEST_PORTS={span}")
 
 
 def _process_tree(pid: int) -> list[int]:
@@ -132,13 +206,13 @@ def _process_tree(pid: int) -> list[int]:
     return pids
 
 
-def _rss_mb(pid: int) -> float:
-    """Resident memory of the server and all its processes (uvicorn workers), in MiB."""
+def _rss_mb(pid: int, field: str = "VmRSS") -> float:
+    """Resident memory of the server and all its processes (uvicorn workers), in MiB; ``VmHWM`` for the peaks."""
     total_kb = 0
     for process in _process_tree(pid):
         try:
             for line in Path(f"/proc/{process}/status").read_text().splitlines():
-                if line.startswith("VmRSS:"):
+                if line.startswith(f"{field}:"):
                     total_kb += int(line.split()[1])
         except OSError:
             pass
@@ -161,13 +235,35 @@ def _wait_ready(base_url: str, server: subprocess.Popen | None, timeout: float =
         time.sleep(0.2)
 
 
-def _run_locust(base_url: str, users: int, seconds: float) -> Environment:
-    environment = Environment(user_classes=[KinematicsUser], host=base_url, events=events)
+def _run_locust(base_url: str, users: int, seconds: float, mixed: bool = False) -> Environment:
+    classes = [KinematicsUser, HostileUser, HealthProbe] if mixed else [KinematicsUser]
+    if mixed:
+        KinematicsUser.weight = 4
+        users += 1  # the probe
+    environment = Environment(user_classes=classes, host=base_url, events=events)
     runner = environment.create_local_runner()
     runner.start(users, spawn_rate=users)
     gevent.spawn_later(seconds, runner.quit)
     runner.greenlet.join()
     return environment
+
+
+def _merged_percentiles(entries) -> dict[str, float]:
+    """p50/p90/p99/max over several locust entries' response times together (locust keeps them bucketed)."""
+    times: dict[int, int] = {}
+    for entry in entries:
+        for value, count in entry.response_times.items():
+            times[value] = times.get(value, 0) + count
+    total, out = sum(times.values()), {}
+    for q in (0.5, 0.9, 0.99):
+        seen = 0
+        for value in sorted(times):
+            seen += times[value]
+            if seen >= q * total:
+                out[f"p{int(q * 100)}_ms"] = float(value)
+                break
+    out["max_ms"] = float(max(times)) if times else 0.0
+    return out
 
 
 def _percentiles(entry) -> dict[str, float]:
@@ -184,17 +280,21 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--max-rss-growth-mb", type=float, default=20.0,
                         help="fail a full run when the server's RSS grows by more than this (default 20 MiB)")
     parser.add_argument("--smoke", action="store_true", help="5 s with 4 users; memory is reported, not judged")
+    parser.add_argument("--mixed", action="store_true",
+                        help="the soak: hostile users among the normal ones, /healthz probed (module docstring)")
     args = parser.parse_args(argv)
     if args.smoke:
         args.duration, args.users = 5.0, 4
 
     WORKLOAD.update(_workload())
+    if args.mixed:
+        WORKLOAD["hostile"] = _hostile_workload()
     server = None
     base_url = args.url
     if base_url is None:
         port = _free_port()
         env = {**os.environ, "HOST": "127.0.0.1", "PORT": str(port), "KIN_WORKERS": str(args.workers),
-               "KIN_LOG_LEVEL": "warning"}
+               "KIN_LOG_LEVEL": "warning", **({"KIN_MAX_TURNS_PER_JOINT": "1000000"} if args.mixed else {})}
         server = subprocess.Popen([sys.executable, "-m", "service"], cwd=ROOT, env=env,
                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         base_url = f"http://127.0.0.1:{port}"
@@ -203,8 +303,9 @@ def main(argv: list[str] | None = None) -> int:
         # Warm-up (imports, first allocations, numpy caches), not counted.
         _run_locust(base_url, users=args.users, seconds=min(5.0, args.duration / 4))
         rss_before = _rss_mb(server.pid) if server else None
-        environment = _run_locust(base_url, users=args.users, seconds=args.duration)
+        environment = _run_locust(base_url, users=args.users, seconds=args.duration, mixed=args.mixed)
         rss_after = _rss_mb(server.pid) if server else None
+        rss_peak = _rss_mb(server.pid, "VmHWM") if server else None
     finally:
         if server is not None:
             server.send_signal(signal.SIGTERM)
@@ -223,13 +324,23 @@ def main(argv: list[str] | None = None) -> int:
                     for (name, _), entry in sorted(environment.stats.entries.items())},
         "rss_mb_before": None if rss_before is None else round(rss_before, 1),
         "rss_mb_after": None if rss_after is None else round(rss_after, 1),
+        "rss_mb_peak": None if rss_peak is None else round(rss_peak, 1),
     }
+    if args.mixed:
+        entries = environment.stats.entries
+        report["normal"] = {"requests": sum(e.num_requests for (n, _), e in entries.items() if n in NORMAL_KINDS),
+                            "errors": sum(e.num_failures for (n, _), e in entries.items() if n in NORMAL_KINDS),
+                            **_merged_percentiles([e for (n, _), e in entries.items() if n in NORMAL_KINDS])}
     failures = [f"{error.name}: {error.error} x{error.occurrences}" for error in environment.stats.errors.values()]
     if failures:
         report["failures"] = failures
     print(json.dumps(report, indent=2))
     ok = total.num_failures == 0 and total.num_requests > 0
-    if ok and rss_before is not None and not args.smoke and rss_after - rss_before > args.max_rss_growth_mb:
+    if ok and args.mixed and rss_peak is not None and rss_peak > 1024:
+        print(f"peak RSS {rss_peak:.0f} MiB is over the 1 GiB bound", file=sys.stderr)
+        ok = False
+    if ok and rss_before is not None and not args.smoke and not args.mixed and \
+            rss_after - rss_before > args.max_rss_growth_mb:
         print(f"RSS grew by {rss_after - rss_before:.1f} MiB (> {args.max_rss_growth_mb} MiB)", file=sys.stderr)
         ok = False
     return 0 if ok else 1

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import tempfile
@@ -9,6 +10,7 @@ import tempfile
 import uvicorn
 
 from .config import Settings
+from .server import WatchedProtocol, log_config
 
 MULTIPROC_ENV = "PROMETHEUS_MULTIPROC_DIR"
 
@@ -30,8 +32,15 @@ def main() -> None:
             port=settings.port,
             workers=settings.workers,
             log_level=settings.log_level,
+            log_config=log_config(settings.log_level),  # uvicorn's own lines as JSON too
             access_log=False,  # the service writes its own JSON access log, with the request id
-            timeout_graceful_shutdown=10,
+            http=WatchedProtocol,  # head and body deadlines for slow clients (service/server.py)
+            timeout_keep_alive=settings.timeout_keep_alive_s,
+            limit_concurrency=settings.max_connections,
+            h11_max_incomplete_event_size=64 * 1024,  # a request head larger than this is refused
+            # Every request ends by its deadline (a 503 problem past it), so waiting that long on SIGTERM lets each
+            # in-flight request finish or refuse cleanly instead of being cut off with a text/plain 500.
+            timeout_graceful_shutdown=math.ceil(settings.request_timeout_ms / 1000.0) + 2,
         )
     finally:
         if own_metrics_dir is not None:

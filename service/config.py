@@ -36,7 +36,28 @@ class Settings(BaseSettings):
     max_joints: int = Field(32, ge=1, le=1000, description="most joints a robot may have")
     max_ik_time_ms: int = Field(
         2000, ge=1, le=600_000,
-        description="server-side cap on the numeric IK search per request (a batch shares it across its targets)")
+        description="cap on the numeric IK search's time per request (a batch shares it across its targets); past "
+                    "it the request is refused with 503, never answered with a partial search")
+    request_timeout_ms: int = Field(
+        5000, ge=1, le=3_600_000,
+        description="deadline for a whole request (solve, select, encode); past it: 503 with Retry-After")
+    max_solutions_per_response: int = Field(
+        100_000, ge=1, description="most solutions (kept plus rejected) one answer may hold, estimated before "
+                                   "solving; more is refused with 413")
+    max_response_bytes: int = Field(
+        64 * 1024 * 1024, ge=1024, description="largest estimated answer in bytes; more is refused with 413")
+    max_turns_per_joint: float = Field(
+        100.0, gt=0, description="most whole turns a revolute joint's limits may span (per-request limits included)")
+    max_numeric_starts: int = Field(
+        20_000, ge=1, description="most numeric-search starts in one request (targets × numeric.starts)")
+    max_in_flight: int = Field(32, ge=1, le=10_000, description="most requests worked on at once; more get 503")
+    timeout_keep_alive_s: float = Field(5.0, gt=0, description="idle keep-alive connections close after this")
+    header_timeout_s: float = Field(10.0, gt=0, description="a connection must send its request head within this")
+    body_timeout_s: float = Field(30.0, gt=0, description="a request body must arrive within this")
+    max_connections: int = Field(
+        900, ge=1, description="most open connections per worker (uvicorn's limit_concurrency); keep it below "
+                               "the descriptor limit")
+    max_robot_file_bytes: int = Field(1024 * 1024, ge=1024, description="largest robot file the catalogue loads")
 
     @field_validator("cors_origins", mode="before")
     @classmethod

@@ -18,9 +18,17 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
+    """A free loopback port: any, or the first free one of ``KIN_TEST_PORTS`` ("18600-18699") when it is set."""
+    span = os.environ.get("KIN_TEST_PORTS")
+    candidates = [0] if not span else range(int(span.split("-")[0]), int(span.split("-")[1]) + 1)
+    for port in candidates:
+        with socket.socket() as probe:
+            try:
+                probe.bind(("127.0.0.1", port))
+            except OSError:
+                continue
+            return probe.getsockname()[1]
+    raise RuntimeError(f"no free port in KIN_TEST_PORTS={span}")
 
 
 def get(url: str, headers: dict[str, str] | None = None) -> tuple[int, str, dict]:

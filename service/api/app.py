@@ -15,6 +15,8 @@ from fastapi.routing import APIRoute
 from .. import __version__
 from ..robots.catalogue import load_catalogue
 from ..config import Settings
+from ..kinematics import BudgetExhausted
+from .budget import TIMEOUT_HEADER, InFlight, WorkLimits, budget_exhausted
 from .limits import BodySizeLimit
 from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
 from .problems import PROBLEM_MEDIA_TYPE, Problem, install_problem_handlers
@@ -32,11 +34,17 @@ Forward kinematics and **every** inverse-kinematics solution of serial robots, w
 * Every error is `application/problem+json` (RFC 9457) with field-level `errors`.
 * Every number in a request must be finite and within ±1e6 (see the README's "Limits of input").
 * When the service runs with `KIN_API_KEY`, every `/v1` operation needs the `X-API-Key` header.
+* Bounded work: every `POST /v1/...` request has a deadline (`KIN_REQUEST_TIMEOUT_MS`; the header
+  `X-Request-Timeout-Ms` may lower it) and stops when its client disconnects. Past the deadline it is answered
+  503 with `Retry-After`; more than `KIN_MAX_IN_FLIGHT` requests at once get the same. An answer that could hold
+  more than `KIN_MAX_SOLUTIONS_PER_RESPONSE` solutions (targets × solutions × 2π-equivalents, estimated before
+  solving) or `KIN_MAX_RESPONSE_BYTES` is refused with 413, naming the cap and by how much.
 """
 
 _PROBLEM_DESCRIPTIONS = {401: "Missing or wrong API key (only when the service runs with KIN_API_KEY)",
-                         404: "Unknown robot", 413: "Body or batch too large", 422: "Invalid request",
-                         503: "Not ready: the catalogue is not loaded"}
+                         404: "Unknown robot", 413: "Body, batch or answer too large", 422: "Invalid request",
+                         503: "Not ready, too many requests in flight (KIN_MAX_IN_FLIGHT), or past the request "
+                              "deadline (KIN_REQUEST_TIMEOUT_MS); retry after Retry-After seconds"}
 
 
 def _operation_id(route: APIRoute) -> str:
@@ -53,7 +61,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         directories = [settings.builtin_robots_dir]
         if settings.robots_dir is not None:
             directories.append(settings.robots_dir)
-        app.state.catalogue = load_catalogue(directories, max_joints=settings.max_joints)
+        app.state.catalogue = load_catalogue(directories, max_joints=settings.max_joints,
+                                             max_file_bytes=settings.max_robot_file_bytes)
         logger.info("catalogue loaded: %d robots from %s", len(app.state.catalogue),
                     ", ".join(str(d) for d in directories))
         yield
@@ -68,16 +77,20 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     app.state.catalogue = None
+    app.state.in_flight = InFlight(settings.max_in_flight)
     configure_logging(settings.log_level)
     install_problem_handlers(app)
+    app.add_exception_handler(BudgetExhausted, budget_exhausted)
     # add_middleware wraps what is already there: the last added runs first. Order of a request:
-    # request id + access log + metrics → CORS (answers preflights itself) → API key → body size → routes.
+    # request id + access log + metrics → CORS (answers preflights itself) → API key → body size → work limits
+    # (deadline, cancellation, in-flight) → routes.
+    app.add_middleware(WorkLimits, settings=settings, in_flight=app.state.in_flight)
     app.add_middleware(BodySizeLimit, max_body_bytes=settings.max_body_bytes)
     if settings.api_key is not None:
         app.add_middleware(ApiKeyMiddleware, api_key=settings.api_key.get_secret_value())
     if settings.cors_origins:
         app.add_middleware(CORSMiddleware, allow_origins=settings.cors_origins, allow_methods=["GET", "POST"],
-                           allow_headers=["Content-Type", API_KEY_HEADER, REQUEST_ID_HEADER],
+                           allow_headers=["Content-Type", API_KEY_HEADER, REQUEST_ID_HEADER, TIMEOUT_HEADER],
                            expose_headers=[REQUEST_ID_HEADER], max_age=600)
     app.add_middleware(RequestContextMiddleware)
     for module in (health, robots, fk, ik, limits, trajectory):
@@ -126,7 +139,7 @@ def _document_problems_and_security(spec: dict[str, Any]) -> None:
                 statuses.add(422)
             if "{robot_id}" in path:
                 statuses.add(404)
-            if path.startswith("/v1/robots"):
+            if path.startswith("/v1/robots") or "requestBody" in operation:
                 statuses.add(503)
             responses = operation.setdefault("responses", {})
             for status in statuses:

@@ -48,9 +48,11 @@ class Problem(ApiModel):
 class ProblemError(Exception):
     """Raise from a router to answer with a problem document."""
 
-    def __init__(self, status: int, slug: str, title: str, detail: str, errors: list[dict] | None = None) -> None:
+    def __init__(self, status: int, slug: str, title: str, detail: str, errors: list[dict] | None = None,
+                 headers: dict[str, str] | None = None) -> None:
         super().__init__(detail)
         self.status, self.slug, self.title, self.detail, self.errors = status, slug, title, detail, errors
+        self.headers = headers
 
 
 def problem_response(
@@ -94,7 +96,8 @@ async def _kinematics_error(request: Request, exc: KinematicsError) -> JSONRespo
 
 
 async def _problem_error(request: Request, exc: ProblemError) -> JSONResponse:
-    return problem_response(exc.status, exc.slug, exc.title, exc.detail, instance=request.url.path, errors=exc.errors)
+    return problem_response(exc.status, exc.slug, exc.title, exc.detail, instance=request.url.path, errors=exc.errors,
+                            headers=exc.headers)
 
 
 _HTTP_TITLES = {404: ("not-found", "Not found"), 405: ("method-not-allowed", "Method not allowed"),

@@ -4,6 +4,7 @@ Angles are radians, lengths are the robot's own unit, and every pose is a 4×4
 homogeneous transform named by the frames it relates (``world_T_tool``).
 """
 
+from ._budget import COUNT_CAP, UNLIMITED, Budget, BudgetExhausted
 from ._conventions import CONVENTIONS, Convention, craig_row_from_khalil, link_transforms
 from ._errors import InvalidInputError, KinematicsError
 from ._forward import (
@@ -45,6 +46,10 @@ from ._tolerances import RATE_SINGULARITY_TOLERANCE
 from ._trajectory import TrajectoryOptions, TrajectoryResult, follow_trajectory
 
 __all__ = [
+    "COUNT_CAP",
+    "UNLIMITED",
+    "Budget",
+    "BudgetExhausted",
     "CONVENTIONS",
     "Convention",
     "InvalidInputError",

@@ -27,6 +27,7 @@ from typing import Callable, Iterator, Sequence
 
 import numpy as np
 
+from ._budget import capped_product
 from ._errors import InvalidInputError
 from ._robot import Robot
 
@@ -114,11 +115,50 @@ def violations(robot: Robot, limits: Limits, q: np.ndarray) -> list[Violation]:
             for i in np.flatnonzero(outside)]
 
 
-def turn_offsets(robot: Robot, limits: Limits, q: np.ndarray) -> list[np.ndarray]:
+def _turn_range(lower: float, upper: float, value: float) -> tuple[int, int]:
+    """The whole turns k with ``value + 2kπ`` in [lower, upper] (bounds finite): (first, last), empty if last < first.
+
+    ceil/floor of a rounded quotient can admit a value a few ulps outside: the end values themselves are checked.
+    """
+    first = math.ceil((lower - value) / _TWO_PI)
+    last = math.floor((upper - value) / _TWO_PI)
+    if last >= first and value + _TWO_PI * first < lower:
+        first += 1
+    if last >= first and value + _TWO_PI * last > upper:
+        last -= 1
+    return first, last
+
+
+def turn_counts(robot: Robot, limits: Limits, q: np.ndarray) -> list[int]:
+    """How many values :func:`turn_offsets` gives each joint of q (shape (n,)), computed without generating them.
+
+    Examples
+    --------
+    A joint limited to ±1e6 rad has 318,310 equivalents of 0.5 rad; this counts them in constant time.
+    """
+    tolerance = limits.tolerance(robot)
+    counts = []
+    for i in range(robot.dof):
+        lower, upper, value = limits.lower[i] - tolerance[i], limits.upper[i] + tolerance[i], float(q[i])
+        if robot.is_revolute[i] and np.isfinite(lower) and np.isfinite(upper):
+            first, last = _turn_range(lower, upper, value)
+            counts.append(max(0, last - first + 1))
+        elif robot.is_revolute[i] and (value < lower or value > upper):
+            counts.append(1)
+        else:
+            counts.append(1 if lower <= value <= upper else 0)
+    return counts
+
+
+def turn_offsets(robot: Robot, limits: Limits, q: np.ndarray, *, keep: int | None = None,
+                 around: np.ndarray | None = None) -> list[np.ndarray]:
     """For each joint, the values of q_i that are usable within its bounds, ascending.
 
     * revolute with both bounds finite: every q_i + 2kπ inside the bounds
-      (empty when none is);
+      (empty when none is); with ``keep``, only the ``keep`` of them nearest
+      ``around[i]`` (default q_i), so that a joint limited to ±1e6 rad costs
+      what is kept, not its 318,310 equivalents (:func:`turn_counts` counts
+      them all);
     * revolute bounded on one side: the one q_i + 2kπ inside, nearest q_i;
     * continuous revolute, or prismatic: q_i itself, if it fits (a prismatic
       value outside its bounds gives an empty list).
@@ -130,13 +170,18 @@ def turn_offsets(robot: Robot, limits: Limits, q: np.ndarray) -> list[np.ndarray
     tolerance = limits.tolerance(robot)
     options = []
     for i in range(robot.dof):
-        lower, upper, value = limits.lower[i] - tolerance[i], limits.upper[i] + tolerance[i], q[i]
+        lower, upper, value = limits.lower[i] - tolerance[i], limits.upper[i] + tolerance[i], float(q[i])
         if robot.is_revolute[i] and np.isfinite(lower) and np.isfinite(upper):
-            first = np.ceil((lower - value) / _TWO_PI)
-            last = np.floor((upper - value) / _TWO_PI)
-            turns = np.arange(first, last + 1) if last >= first else np.zeros(0)
+            first, last = _turn_range(lower, upper, value)
+            if keep is not None and last - first + 1 > keep + 2:
+                # the keep values nearest the centre are consecutive turns: a window of keep + 2 around it holds
+                # them (one spare turn each side), slid inwards where it meets a bound
+                centre = value if around is None else float(around[i])
+                nearest = min(max(round((centre - value) / _TWO_PI), first), last)
+                low = min(max(first, nearest - keep // 2 - 1), last - keep - 1)
+                first, last = low, low + keep + 1
+            turns = np.arange(first, last + 1, dtype=float) if last >= first else np.zeros(0)
             candidates = value + _TWO_PI * turns
-            # ceil/floor of a rounded quotient can admit a value a few ulps outside: check the values themselves
             options.append(candidates[(candidates >= lower) & (candidates <= upper)])
         elif robot.is_revolute[i] and value < lower:
             options.append(np.array([value + _TWO_PI * np.ceil((lower - value) / _TWO_PI)]))
@@ -157,7 +202,7 @@ def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarra
     """
     q = np.asarray(q, dtype=float)
     closest = q.copy()
-    for i, options in enumerate(turn_offsets(robot, limits, q)):
+    for i, options in enumerate(turn_offsets(robot, limits, q, keep=1)):
         if len(options):
             closest[i] = options[np.argmin(np.abs(options - q[i]))]
         elif robot.is_revolute[i]:
@@ -184,8 +229,8 @@ def nearest_fitting_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> n
 
 
 def count_combinations(options: Sequence[np.ndarray]) -> int:
-    """Number of vectors in the product of per-joint options (exact, as a Python int)."""
-    return math.prod(len(o) for o in options)
+    """Number of vectors in the product of per-joint options, at most :data:`._budget.COUNT_CAP`."""
+    return capped_product(len(o) for o in options)
 
 
 def combinations_by_cost(costs: Sequence[np.ndarray],
@@ -240,10 +285,12 @@ def fitting_equivalents(robot: Robot, limits: Limits, q: np.ndarray, cap: int) -
     that order.
     """
     q = np.asarray(q, dtype=float)
-    options = [o[np.argsort(np.abs(o - value), kind="stable")] for o, value in zip(turn_offsets(robot, limits, q), q)]
+    # the cap cheapest combinations use at most the cap cheapest values of each joint
+    options = [o[np.argsort(np.abs(o - value), kind="stable")]
+               for o, value in zip(turn_offsets(robot, limits, q, keep=cap), q)]
     costs = [np.abs(o - value) for o, value in zip(options, q)]
     picked = [indices for _, indices in itertools.islice(combinations_by_cost(costs, math.fsum), cap)]
     if not picked:
         return np.zeros((0, robot.dof)), False
     equivalents = np.array([[options[j][k] for j, k in enumerate(indices)] for indices in picked])
-    return equivalents, count_combinations(options) > cap
+    return equivalents, capped_product(turn_counts(robot, limits, q)) > cap

@@ -327,6 +327,7 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
     reached = np.array([k for k, s in enumerate(samples) if s.reached], dtype=int)
     if len(reached):
         _rates_of(robot, samples, reached, targets, twist, acceleration, task, assur, options)
+    options.ik.budget.check("the trajectory's rates")
     for sample in samples:
         if sample.reached:
             sample.violations = violations(robot, limits, sample.joints)
@@ -348,6 +349,8 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
     previous_branch: dict | None = None
     samples: list[SampleResult] = []
     for k, result in enumerate(results):
+        if k % 64 == 0:
+            ik_options.budget.check("the trajectory")
         if previous_q is not None and _has_free_joint(result):
             result = solve_ik(robot, targets[k], constrain_orientation=constrain_orientation, reference=previous_q,
                               options=ik_options)

@@ -147,7 +147,7 @@ def test_readiness_is_503_until_the_catalogue_is_loaded():
         ready = started.get("/readyz")
         assert ready.status_code == 200
         files = [p for p in BUILTIN_ROBOTS_DIR.iterdir() if p.suffix in (".yaml", ".yml", ".json")]
-        assert ready.json() == {"status": "ready", "robots": len(files)}
+        assert ready.json() == {"status": "ready", "robots": len(files), "in_flight": 0}
 
 
 def test_a_bad_robot_file_keeps_the_service_from_becoming_ready(tmp_path):

@@ -19,9 +19,11 @@ from ...kinematics.ik import (
     select,
     select_arrays,
     solve_ik_arrays,
+    cached_plan,
     solve_ik_batch,
     unreachable_details,
 )
+from ...kinematics import Budget
 from ..boundary import (
     _unit_scale,
     joints_from_core,
@@ -33,6 +35,7 @@ from ..boundary import (
     target_matrix,
     violation_to_wire,
 )
+from ..budget import budget_of, check_ik_cost
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of, with_request_frames
 from ..observability import observe_ik
 from ..problems import problem_responses
@@ -44,16 +47,20 @@ from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinematics"])
 
 
-def _budget_seconds(request: Request, body: IKRequest | IKBatchRequest, targets: int) -> tuple[float, bool]:
-    """The numeric search's time per target: the request's, within the server's cap (KIN_MAX_IK_TIME_MS) per
-    request, which a batch shares across its targets. Also whether the cap lowered the request's budget."""
-    cap_ms = settings_of(request).max_ik_time_ms / targets
-    requested_ms = body.numeric.time_budget_ms
-    return min(requested_ms, cap_ms) / 1000.0, cap_ms < requested_ms
+def _numeric_options(request: Request, body: IKRequest | IKBatchRequest, targets: int) -> IKOptions:
+    """The numeric search's bounds: starts and iterations (deterministic), under the request's deadline narrowed
+    to the numeric time cap: the request's time_budget_ms per target, at most KIN_MAX_IK_TIME_MS per request."""
+    cap_ms = settings_of(request).max_ik_time_ms
+    if body.numeric.time_budget_ms is not None:
+        cap_ms = min(body.numeric.time_budget_ms * targets, cap_ms)
+    return IKOptions(NumericOptions(starts=body.numeric.starts, max_iterations=body.numeric.iterations),
+                     budget=budget_of(request).within(cap_ms / 1000.0))
 
 
-def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, targets: int):
-    """Reference, limits, ordering and numeric options of a request, in core units, and the numeric cap note."""
+def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, matrices: np.ndarray,
+              flags: np.ndarray, form: str):
+    """Reference, limits, ordering and numeric options of a request, in core units, after the cost model has
+    accepted the request's worst-case answer (413/422 before any solving otherwise)."""
     reference = None
     if body.reference is not None:
         with located("body", "reference"):
@@ -63,16 +70,18 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
     with located("body"):
         ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
                                     body.angle_unit)
-    budget, capped = _budget_seconds(request, body, targets)
-    options = IKOptions(NumericOptions(starts=body.numeric.starts, time_budget_seconds=budget))
-    note = None
-    if capped:
-        note = (f"The server capped the numeric search at {budget * 1000.0:g} ms per target "
-                f"(KIN_MAX_IK_TIME_MS per request), below the requested {body.numeric.time_budget_ms} ms.")
-    return reference, limits, ordering, options, note
+    # the kept plans (a position-only plan holding joints at the reference is rebuilt per request; its count is
+    # the same as the kept one's)
+    plans = [cached_plan(robot, constrain_orientation=bool(kind), reference=None) for kind in np.unique(flags)]
+    numeric = any(plan is None for plan in plans)
+    per_target = max(body.numeric.starts if plan is None else plan.generic_count for plan in plans)
+    check_ik_cost(settings_of(request), robot, limits, targets=len(matrices), solutions_per_target=per_target,
+                  max_equivalents=body.max_equivalents, max_solutions=body.max_solutions, form=form,
+                  numeric_starts=body.numeric.starts if numeric else None)
+    return reference, limits, ordering, _numeric_options(request, body, len(matrices))
 
 
-def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference):
+def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference, budget: Budget):
     """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
 
     ``arrays`` is None when no analytic family covers the robot, or for the targets where a closed form on rounded
@@ -82,7 +91,8 @@ def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, refer
         rows = np.flatnonzero(flags == constrained)
         if len(rows):
             started = time.perf_counter()
-            arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
+            arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
+                                     budget=budget)
             if arrays is None or arrays.complete.all():
                 yield constrained, rows, arrays, started
                 continue
@@ -95,7 +105,8 @@ def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, refer
 
 
 def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: np.ndarray, rows: np.ndarray,
-                     constrained: bool, reference, limits, ordering, options, note, started: float):
+                     constrained: bool, reference, limits, ordering, options: IKOptions, budget: Budget,
+                     started: float):
     """Wire answers (row, dict) from the numeric search, for structures no analytic family covers."""
     robot = ref.robot
     solved = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
@@ -104,8 +115,8 @@ def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: 
                [len(result.solutions) for result in solved])
     for row, result in zip(rows.tolist(), solved):
         selection = select(robot, result, limits, filter_limits=body.filter_limits, reference=reference,
-                           ordering=ordering, max_equivalents=body.max_equivalents)
-        yield row, _capped(_to_wire(ref.id, robot, result, selection, body.angle_unit, constrained), note)
+                           ordering=ordering, max_equivalents=body.max_equivalents, budget=budget)
+        yield row, _to_wire(ref.id, robot, result, selection, body.angle_unit, constrained)
 
 
 def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
@@ -117,18 +128,20 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
         matrices, flags = matrix[None], np.array([constrained])
     else:
         matrices, flags = target_matrices(targets, body.angle_unit, "body", "targets")
-    reference, limits, ordering, options, note = _settings(request, robot, body, len(targets))
+    reference, limits, ordering, options = _settings(request, robot, body, matrices, flags, "objects")
+    budget = budget_of(request)
     answers: list[dict | None] = [None] * len(targets)
-    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference):
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference, budget):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
-                                              options, note, started):
+                                              options, budget, started):
                 answers[row] = wire
             continue
         observe_ik("analytic", arrays.structure, time.perf_counter() - started, arrays.count.tolist())
         results = results_from_arrays(robot, arrays, matrices[rows], constrained, reference)
         chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
-                               ordering=ordering, max_equivalents=body.max_equivalents)
+                               ordering=ordering, max_equivalents=body.max_equivalents, budget=budget)
+        budget.check("encoding")
         kept = chosen.solutions
         joints = (kept.joints / _unit_scale(robot, body.angle_unit)).tolist()
         position = kept.position.tolist()
@@ -137,6 +150,8 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
                   for name, (values, codes) in kept.labels.items()]
         starts = np.searchsorted(kept.target, np.arange(len(rows) + 1)).tolist()
         for local, (row, result) in enumerate(zip(rows.tolist(), results)):
+            if local % 256 == 255:
+                budget.check("encoding")
             selection = chosen.selections.get(local)
             if selection is not None:
                 answers[row] = _to_wire(ref.id, robot, result, selection, body.angle_unit, constrained)
@@ -159,7 +174,8 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     ref = with_request_frames(ref, body)
     robot = ref.robot
     matrices, flags = target_matrices(body.targets, body.angle_unit, "body", "targets")
-    reference, limits, ordering, options, note = _settings(request, robot, body, len(matrices))
+    reference, limits, ordering, options = _settings(request, robot, body, matrices, flags, "arrays")
+    budget = budget_of(request)
     n_targets = len(matrices)
     status = np.empty(n_targets, dtype=object)
     detail: list[str | None] = [None] * n_targets
@@ -171,10 +187,10 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     reports: list[dict] = []
     kept_tables, rejected_tables = [], []
     scale = _unit_scale(robot, body.angle_unit)
-    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference):
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference, budget):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
-                                              options, note, started):
+                                              options, budget, started):
                 status[row], detail[row], truncated[row], trimmed[row], available[row] = (
                     wire["status"], wire["detail"], wire["truncated"], wire["trimmed"], wire["available"])
                 solver[row] = _index(solvers, {**wire["solver"], "free_joints": wire["free_joints"]})
@@ -184,12 +200,12 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
             continue
         observe_ik("analytic", arrays.structure, time.perf_counter() - started, arrays.count.tolist())
         chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
-                               ordering=ordering, max_equivalents=body.max_equivalents)
+                               ordering=ordering, max_equivalents=body.max_equivalents, budget=budget)
         status[rows], truncated[rows] = chosen.status, chosen.truncated
         trimmed[rows], available[rows] = chosen.trimmed, chosen.available
         solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
                                         "time_budget_exhausted": False, "free_joints": arrays.free_joints})
-        unreachable = unreachable_details(robot, arrays, matrices[rows], constrained, reference)
+        unreachable = unreachable_details(robot, arrays, matrices[rows], constrained, reference, budget)
         for local in set(unreachable) | set(chosen.notes):
             detail[rows[local]] = " ".join(filter(None, [unreachable.get(local), *chosen.notes.get(local, [])])) or None
         solved = arrays.count > 0
@@ -217,6 +233,7 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
             order.setdefault(index, len(order))
     reports = [reports[i] for i in sorted(order, key=order.get)]
     singular = [[order[i] for i in flags] for flags in singular] if order else singular
+    budget.check("encoding")
     return FastJSONResponse({
         "robot_id": ref.id,
         "joint_names": robot.joint_names,
@@ -230,13 +247,6 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
         "solutions": _columns(kept),
         "rejected": _columns(rejected),
     })
-
-
-def _capped(wire: dict, note: str | None) -> dict:
-    """Add the server's note on a capped numeric budget to an answer whose search ran out of time."""
-    if note and wire["solver"]["time_budget_exhausted"]:
-        wire["detail"] = f"{wire['detail']} {note}" if wire["detail"] else note
-    return wire
 
 
 def _index(items: list[dict], item: dict) -> int:

@@ -8,9 +8,10 @@ from ...kinematics import LIMIT_TOLERANCE, nearest_fitting_equivalent, violation
 from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, violation_to_wire
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
 from ..problems import problem_responses
+from ..routing import FastJSONRoute
 from ..schemas.limits import LimitsInlineRequest, LimitsRequest, LimitsResponse
 
-router = APIRouter(prefix="/v1", tags=["joint limits"])
+router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["joint limits"])
 
 
 def _check(request: Request, ref: RobotRef, body: LimitsRequest) -> dict:

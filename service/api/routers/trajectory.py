@@ -9,12 +9,15 @@ from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import InvalidInputError, Robot
 from ...kinematics import TrajectoryOptions, TrajectoryResult, follow_trajectory
+from ...kinematics.ik import IKOptions
+from ..budget import budget_of
 from ..boundary import joints_from_core, joints_to_core, located, target_matrix, violation_to_wire
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
 from ..problems import problem_responses
+from ..routing import FastJSONRoute
 from ..schemas.trajectory import TrajectoryInlineRequest, TrajectoryRequest, TrajectoryResponse
 
-router = APIRouter(prefix="/v1", tags=["trajectories"])
+router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["trajectories"])
 
 
 def _cartesian(parts, angle: float) -> list[float]:
@@ -46,13 +49,15 @@ def _follow(request: Request, ref: RobotRef, body: TrajectoryRequest) -> dict:
             reference = joints_to_core(robot, body.reference, body.angle_unit)
     options = TrajectoryOptions(
         branch=None if body.branch is None else body.branch.model_dump(), reference=reference,
-        singularity_tolerance=body.singularity_tolerance, damping=body.damping)
+        singularity_tolerance=body.singularity_tolerance, damping=body.damping,
+        ik=IKOptions(budget=budget_of(request)))
     with located("body"):
         result = follow_trajectory(
             robot, [s.time for s in body.samples], np.array(matrices), constrain_orientation=constrained[0],
             twists=np.array([_cartesian(s.twist, angle) for s in body.samples]),
             accelerations=np.array([_cartesian(s.acceleration, angle) for s in body.samples]),
             options=options)
+    budget_of(request).check("encoding")
     return _to_wire(ref.id, robot, result, body)
 
 

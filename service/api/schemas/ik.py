@@ -71,10 +71,17 @@ class Ordering(ApiModel):
 
 
 class NumericSearch(ApiModel):
-    """Bounds on the numeric fallback (used only for structures no analytic family covers)."""
+    """Bounds on the numeric fallback (used only for structures no analytic family covers).
+
+    The search is bounded by starts and iterations, so the same request gets the same answer under any load.
+    ``time_budget_ms`` bounds its time: a search that needs longer is refused (503 with Retry-After), never cut
+    into a partial answer."""
 
     starts: int = Field(48, ge=1, le=2000)
-    time_budget_ms: int = Field(500, ge=1, le=10_000)
+    iterations: int = Field(200, ge=1, le=2000, description="Levenberg–Marquardt iterations per start at most")
+    time_budget_ms: int | None = Field(
+        None, ge=1, le=10_000, description="time allowed per target (a batch adds its targets' up), at most the "
+                                           "server's KIN_MAX_IK_TIME_MS per request (the default); past it: 503")
 
 
 class _Target(ApiModel):
@@ -162,7 +169,9 @@ class SolverInfo(ApiModel):
     structure: str = Field(description="the kinematic family the solver recognised, e.g. "
                                        "'intersecting_shoulder+spherical_wrist'")
     complete: bool = Field(description="true when the method guarantees every solution was found")
-    time_budget_exhausted: bool = False
+    time_budget_exhausted: bool = Field(
+        False, description="the numeric search's iteration cap stopped some starts before they converged: "
+                           "raising numeric.iterations may find more")
 
 
 class SingularityReport(ApiModel):
@@ -186,8 +195,9 @@ class IKResponse(ApiModel):
                                    description="joints the target does not determine, set to reference or 0")
     truncated: bool = Field(False, description="max_equivalents left out some of the solutions that fit")
     trimmed: int = Field(0, description="solutions left out by max_solutions or max_joint_move")
-    available: int = Field(0, description="solutions after 2π expansion and max_joint_move, before "
-                                          "max_equivalents and max_solutions")
+    available: int = Field(0, ge=0, le=2**53 - 1,
+                           description="solutions after 2π expansion and max_joint_move, before max_equivalents "
+                                       "and max_solutions; at most 2**53 − 1, which then means at least that many")
 
 
 class IKBatchResponse(ApiModel):

@@ -7,7 +7,7 @@ prismatic joints), and decomposes the problem into geometric subproblems
 back to a bounded numeric search that says it may be incomplete.
 """
 
-from ._arrays import IKArrays, solve_ik_arrays
+from ._arrays import IKArrays, cached_plan, solve_ik_arrays
 from ._numeric import NumericOptions
 from ._plan import plan_for
 from ._select import MAX_EQUIVALENTS, Ordering, Selected, Selection, check_ordering, joint_travel, select, travel
@@ -28,6 +28,7 @@ __all__ = [
     "Singularity",
     "Solution",
     "SolutionTable",
+    "cached_plan",
     "check_ordering",
     "distance_to_reference",
     "joint_difference",

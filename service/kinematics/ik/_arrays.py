@@ -19,6 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._budget import UNLIMITED, Budget
 from .._cache import memo
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
@@ -109,7 +110,7 @@ CHUNK = 4096
 
 def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,
                     reference: np.ndarray | None = None, plan: Plan | None = None,
-                    threads: int | None = None) -> IKArrays | None:
+                    threads: int | None = None, budget: Budget = UNLIMITED) -> IKArrays | None:
     """Every solution for each of N targets, vectorised over the targets.
 
     Parameters
@@ -136,7 +137,8 @@ def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orie
 
     A batch larger than :data:`CHUNK` is solved in chunks, on up to
     ``threads`` threads (default: one per CPU); numpy releases the GIL inside
-    its array operations, so the chunks run in parallel.
+    its array operations, so the chunks run in parallel. ``budget`` is
+    checked before each chunk.
     """
     if plan is None:
         plan = cached_plan(robot, constrain_orientation=constrain_orientation, reference=reference)
@@ -148,6 +150,7 @@ def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orie
         workers = min(threads or os.cpu_count() or 1, len(chunks))
 
         def solve(chunk: np.ndarray) -> IKArrays:
+            budget.check("the analytic solve")
             return _solve_chunk(robot, chunk, constrain_orientation, reference, plan)
 
         if workers > 1:
@@ -156,6 +159,7 @@ def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orie
         else:
             parts = [solve(chunk) for chunk in chunks]
         return _concatenated(parts)
+    budget.check("the analytic solve")
     return _solve_chunk(robot, targets, constrain_orientation, reference, plan)
 
 

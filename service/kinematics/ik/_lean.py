@@ -297,7 +297,11 @@ def _subproblem_2_chain(k1: Vector, k2: Vector, p: Vector, q: Vector) -> tuple[t
     h1, h2 = p1 / norm_p, q2 / norm_q
     rho1, rho2 = radius_p / norm_p, radius_q / norm_q
     alpha, beta = (h1 - cos * h2) / sin2, (h2 - cos * h1) / sin2
-    g = 1.0 - alpha * h1 - beta * h2
+    # _subproblems._crossing_gap, in scalar form
+    if rho1 <= rho2:
+        g = (rho1 - abs(beta * sin)) * (rho1 + abs(beta * sin))
+    else:
+        g = (rho2 - abs(alpha * sin)) * (rho2 + abs(alpha * sin))
     if not g * (rho1 + rho2) > MARGIN * _MERGE_RESIDUAL * rho1 * rho2:
         raise _NotGeneric
     gamma = math.sqrt(g) / sin

@@ -2,18 +2,22 @@
 
 Used for structures no analytic family covers. It cannot promise that every
 solution was found (``complete`` is false), so it is bounded: a number of
-starts, an iteration cap, and a time budget, each configurable. All starts run
-together as one batch: each iteration is one batched FK and one batched
-Jacobian.
+starts and an iteration cap, each configurable. The budget is counted in
+iterations, never read off a clock, so the answer is the same under any load;
+the request's :class:`.._budget.Budget` (its deadline, a cancellation) is
+checked between iterations and stops the search with
+:class:`.._budget.BudgetExhausted` rather than with a partial answer. All
+starts run together as one batch: each iteration is one batched FK and one
+batched Jacobian.
 """
 
 from __future__ import annotations
 
-import time
 from dataclasses import dataclass
 
 import numpy as np
 
+from .._budget import UNLIMITED, Budget
 from .._forward import forward_kinematics, geometric_jacobian
 from .._robot import Robot
 
@@ -24,14 +28,13 @@ class NumericOptions:
 
     starts: int = 48
     max_iterations: int = 200
-    time_budget_seconds: float = 0.5
     seed: int = 0
 
 
 @dataclass(frozen=True)
 class NumericOutcome:
     joints: np.ndarray  # (k, n) converged joint vectors (not yet deduplicated or verified)
-    budget_exhausted: bool  # the time budget stopped the search before every start finished
+    budget_exhausted: bool  # the iteration cap stopped some starts before they converged or gave up
     iterations: int
 
 
@@ -77,6 +80,7 @@ def solve_numeric(
     options: NumericOptions,
     reference: np.ndarray | None = None,
     accept: float = 1e-20,
+    budget: Budget = UNLIMITED,
 ) -> NumericOutcome:
     """Run Levenberg–Marquardt from ``options.starts`` starts at once.
 
@@ -88,7 +92,6 @@ def solve_numeric(
     accept : float
         Squared-error threshold (normalised units) at which a start has converged.
     """
-    deadline = time.perf_counter() + options.time_budget_seconds
     rng = np.random.default_rng(options.seed)
     scale = robot.characteristic_length
     rows = slice(0, 6) if constrain_orientation else slice(0, 3)
@@ -102,11 +105,8 @@ def solve_numeric(
     cost = np.einsum("si,si->s", error, error)
     active = cost > accept
     iterations = 0
-    budget_exhausted = False
     while active.any() and iterations < options.max_iterations:
-        if time.perf_counter() > deadline:
-            budget_exhausted = True
-            break
+        budget.check("the numeric search")
         iterations += 1
         J = geometric_jacobian(robot, q[active])
         J[:, :3, :] /= scale
@@ -132,4 +132,5 @@ def solve_numeric(
         damping[worse] = damping[worse] * 10.0
         active = (cost > accept) & (damping < 1e8)
     converged = cost <= 1e-10  # polished and FK-checked by the caller
+    budget_exhausted = bool(active.any())  # starts still improving when the iterations ran out
     return NumericOutcome(q[converged], budget_exhausted, iterations)

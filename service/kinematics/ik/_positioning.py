@@ -161,11 +161,19 @@ class IntersectingShoulder(Positioner):
             w3 = w + g.direction(k) * q3[..., None]
         pair = subproblem_2_chain(g.direction(i), g.direction(j), w3 - c, (targets - c)[:, None, :])
         q1, q2 = pair.theta1, pair.theta2  # (N, 2 third roots, 2 pair roots)
+        singular = SingularFlags(n_targets)
         free_shoulder = pair.degenerate  # (N, 2): target on axis 1
+        free_both = np.zeros_like(free_shoulder)
         if free_shoulder.any():
             start = 0.0 if reference is None else reference[i]
             back = rotate_about(g.direction(i), -start, (targets - c)[:, None, :])
-            q2_free = subproblem_1(g.direction(j), w3 - c, back).theta[..., 0]
+            second = subproblem_1(g.direction(j), w3 - c, back)
+            # the point at the shoulder centre itself (zero-length links): joint 2 is free as well
+            free_both = free_shoulder & second.degenerate
+            q2_free = np.where(free_both, 0.0 if reference is None else reference[j], second.theta[..., 0])
+            _flag_rows(free_both.any(axis=1), Singularity(
+                "shoulder", (i, j), "free", "the point is at the shoulder's centre; joints 1 and 2 are set to the "
+                                            "reference values (or 0)"), singular)
             q1 = np.where(free_shoulder[..., None], start, q1)
             q2 = np.where(free_shoulder[..., None], q2_free[..., None], q2)
         joints = np.zeros((n_targets, 2, 2, 3))
@@ -173,8 +181,7 @@ class IntersectingShoulder(Positioner):
         joints[..., 2] = q3[:, :, None]
         valid = third.valid[:, :, None] & pair.valid & third.exact[:, :, None] & pair.exact
         valid[:, :, 1] &= ~free_shoulder  # one representative when the shoulder is free
-        singular = SingularFlags(n_targets)
-        _flag_rows(free_shoulder.any(axis=1),
+        _flag_rows(free_shoulder.any(axis=1) & ~free_both.any(axis=1),
                    Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "
                                "joint 1 is set to the reference value (or 0)"), singular)
         _flag_rows((pair.merged & ~free_shoulder & third.valid & third.exact).any(axis=1),

@@ -30,13 +30,14 @@ from typing import Callable, Iterable, Iterator, Literal
 
 import numpy as np
 
+from .._budget import COUNT_CAP, UNLIMITED, Budget, capped_product, capped_sum
 from .._errors import InvalidInputError
 from .._limits import (
     Limits,
     Violation,
     closest_equivalent,
     combinations_by_cost,
-    count_combinations,
+    turn_counts,
     turn_offsets,
     violations,
 )
@@ -156,13 +157,14 @@ class _Candidate:
     index: int
     solution: Solution
     fits: bool
-    options: list[np.ndarray]
+    options: list[np.ndarray]  # at most the values that can be picked: the cheapest few when a joint has many
     costs: list[np.ndarray]
+    counts: list[int]  # how many values each joint has in all (≥ len(options[j]))
 
 
 def select(robot: Robot, result: IKResult, limits: Limits, *, filter_limits: bool = True,
            reference: np.ndarray | None = None, ordering: Ordering = Ordering(),
-           max_equivalents: int = MAX_EQUIVALENTS) -> Selection:
+           max_equivalents: int = MAX_EQUIVALENTS, budget: Budget = UNLIMITED) -> Selection:
     """Apply limits, expand 2π-equivalents, order and trim the solutions of one IK result.
 
     Parameters
@@ -177,35 +179,52 @@ def select(robot: Robot, result: IKResult, limits: Limits, *, filter_limits: boo
         ``ordering.max_solutions``, ``ordering.max_joint_move`` and
         ``ordering.weights``.
     max_equivalents : int
-        Most solutions returned after expansion (≥ 1).
+        Most solutions returned after expansion (≥ 1). Only the values that
+        can be among them are generated (at most this many per joint); the
+        counts (``available``, ``trimmed``) are computed without generating
+        the rest and stop at :data:`.._budget.COUNT_CAP`.
+    budget : Budget
+        Checked between solutions and every few hundred picks.
     """
     check_ordering(robot, ordering, reference)
     if max_equivalents < 1:
         raise InvalidInputError("max_equivalents must be ≥ 1", location=("max_equivalents",))
     if result.status == "unreachable":
         return Selection("unreachable", [], [])
+    limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
+    all_counts = [turn_counts(robot, limits, solution.joints) for solution in result.solutions]
+    # Values each joint may need: with a reference any one solution may give all `limit` answers; without, the
+    # answers go round the solutions one at a time, so none gives more than the rounds needed to reach `limit`.
+    combinations = [capped_product(counts) if all(counts) else 1 for counts in all_counts
+                    if all(counts) or not filter_limits]
+    keep = limit if reference is not None else _rounds_needed(combinations, limit)
     candidates, rejected = [], []
-    for index, solution in enumerate(result.solutions):
-        options = turn_offsets(robot, limits, solution.joints)
-        fits = all(len(o) for o in options)
+    for index, (solution, counts) in enumerate(zip(result.solutions, all_counts)):
+        budget.check("selection")
+        fits = all(counts)
         if not fits:
             closest = closest_equivalent(robot, limits, solution.joints)
             if filter_limits:
                 rejected.append(Selected(_with_joints(solution, closest), False, violations(robot, limits, closest)))
                 continue
-            options = [np.array([value]) for value in closest]
-        candidates.append(_costed(robot, limits, index, solution, fits, options, reference, ordering))
-    with_all_moves = sum(count_combinations(c.options) for c in candidates)
+            options, counts = [np.array([value]) for value in closest], [1] * robot.dof
+        else:
+            options = turn_offsets(robot, limits, solution.joints, keep=keep, around=reference)
+        candidates.append(_costed(robot, limits, index, solution, fits, options, counts, reference, ordering))
+    with_all_moves = capped_sum(capped_product(c.counts) for c in candidates)
     if reference is not None and ordering.max_joint_move is not None:
         candidates = [_within_move(robot, limits, c, reference, ordering.max_joint_move) for c in candidates]
-    available = sum(count_combinations(c.options) for c in candidates)
+    available = capped_sum(capped_product(c.counts) for c in candidates)
 
-    limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
-    picked = list(itertools.islice(_merged(candidates, reference, ordering), limit))
+    picked = []
+    for pick in itertools.islice(_merged(candidates, reference, ordering), limit):
+        picked.append(pick)
+        if len(picked) % 256 == 0:
+            budget.check("selection")
     kept = [_selected(robot, limits, candidates[c], indices) for c, indices in picked]
     capped_by_max_solutions = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
     truncated = available > len(kept) and not capped_by_max_solutions
-    trimmed = with_all_moves - available + (available - len(kept) if capped_by_max_solutions else 0)
+    trimmed = min(with_all_moves - available + (available - len(kept) if capped_by_max_solutions else 0), COUNT_CAP)
 
     if reference is not None and rejected:
         distance = travel(robot, limits, np.array([e.solution.joints for e in rejected]), reference, ordering)
@@ -216,8 +235,24 @@ def select(robot: Robot, result: IKResult, limits: Limits, *, filter_limits: boo
     return selection
 
 
+def _rounds_needed(combinations: list[int], limit: int) -> int:
+    """Rounds of a round robin over streams of these lengths that yield ``limit`` items (all, if fewer), ≥ 1.
+
+    >>> _rounds_needed([1, 1, 1, 10**30], 1024)   # three streams end after round 1: the fourth gives 1,021
+    1021
+    """
+    remaining, previous, streams = limit, 0, len(combinations)
+    for position, length in enumerate(sorted(combinations)):
+        active = streams - position
+        if (length - previous) * active >= remaining:
+            return max(1, previous + -(-remaining // active))
+        remaining -= (length - previous) * active
+        previous = length
+    return max(1, previous)
+
+
 def _costed(robot: Robot, limits: Limits, index: int, solution: Solution, fits: bool, options: list[np.ndarray],
-            reference: np.ndarray | None, ordering: Ordering) -> _Candidate:
+            counts: list[int], reference: np.ndarray | None, ordering: Ordering) -> _Candidate:
     """Sort each joint's options by cost: weighted travel from the reference, or turning from the solution."""
     costs = []
     for j, values in enumerate(options):
@@ -230,7 +265,7 @@ def _costed(robot: Robot, limits: Limits, index: int, solution: Solution, fits: 
         order = np.argsort(cost, kind="stable")
         options[j], cost = values[order], cost[order]
         costs.append(cost)
-    return _Candidate(index, solution, fits, options, costs)
+    return _Candidate(index, solution, fits, options, costs, counts)
 
 
 def _joint_travel(robot: Robot, limits: Limits, joint: int, values: np.ndarray, reference: float) -> np.ndarray:
@@ -240,14 +275,27 @@ def _joint_travel(robot: Robot, limits: Limits, joint: int, values: np.ndarray, 
 
 def _within_move(robot: Robot, limits: Limits, candidate: _Candidate, reference: np.ndarray,
                  max_joint_move: np.ndarray) -> _Candidate:
-    """Drop the per-joint options that travel further than the joint's bound (tolerance included)."""
+    """Drop the per-joint options that travel further than the joint's bound (tolerance included).
+
+    A joint whose options were cut to the cheapest few is counted again over the bounds narrowed to
+    reference ± bound (its travel is |q − r| there: a joint with both bounds finite is never continuous).
+    """
     tolerance = limits.tolerance(robot)
-    options, costs = [], []
-    for j, (values, cost) in enumerate(zip(candidate.options, candidate.costs)):
+    options, costs, counts = [], [], []
+    for j, (values, cost, count) in enumerate(zip(candidate.options, candidate.costs, candidate.counts)):
         near = _joint_travel(robot, limits, j, values, reference[j]) <= max_joint_move[j] + tolerance[j]
         options.append(values[near])
         costs.append(cost[near])
-    return _Candidate(candidate.index, candidate.solution, candidate.fits, options, costs)
+        if count > len(values):
+            narrowed = Limits(limits.lower.copy(), limits.upper.copy())
+            narrowed.lower[j] = max(limits.lower[j], reference[j] - max_joint_move[j])
+            narrowed.upper[j] = min(limits.upper[j], reference[j] + max_joint_move[j])
+            count = turn_counts(robot, narrowed, candidate.solution.joints)[j] if narrowed.lower[j] <= \
+                narrowed.upper[j] else 0
+        else:
+            count = int(near.sum())
+        counts.append(count)
+    return _Candidate(candidate.index, candidate.solution, candidate.fits, options, costs, counts)
 
 
 def _merged(candidates: list[_Candidate], reference: np.ndarray | None,
@@ -306,7 +354,9 @@ def _notes(selection: Selection, with_all_moves: int, max_equivalents: int, has_
                      f"each is flagged with its violations.")
     if selection.expansion_truncated:
         which = "nearest" if has_reference else "least-turned"
-        notes.append(f"{selection.available} solutions fit; max_equivalents = {max_equivalents} kept the "
+        fit = (f"At least {COUNT_CAP} (2**53 − 1, the count's cap)" if selection.available >= COUNT_CAP
+               else f"{selection.available}")
+        notes.append(f"{fit} solutions fit; max_equivalents = {max_equivalents} kept the "
                      f"{which} {len(selection.solutions)}.")
     if selection.status == "ok" and not selection.solutions and with_all_moves:
         notes.append(f"{with_all_moves} solutions fit the limits, but none is within max_joint_move / "

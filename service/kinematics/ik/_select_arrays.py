@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._budget import UNLIMITED, Budget
 from .._limits import Limits
 from .._robot import Robot
 from ._arrays import IKArrays
@@ -86,8 +87,12 @@ class BatchSelection:
 
 def select_arrays(robot: Robot, arrays: IKArrays, limits: Limits, *, filter_limits: bool = True,
                   reference: np.ndarray | None = None, ordering: Ordering = Ordering(),
-                  max_equivalents: int = MAX_EQUIVALENTS) -> BatchSelection:
-    """Apply limits, expand 2π-equivalents, order and trim every target's solutions (see the module docstring)."""
+                  max_equivalents: int = MAX_EQUIVALENTS, budget: Budget = UNLIMITED) -> BatchSelection:
+    """Apply limits, expand 2π-equivalents, order and trim every target's solutions (see the module docstring).
+
+    ``budget`` is checked before the array step and between the targets that go through :func:`select`.
+    """
+    budget.check("selection")
     check_ordering(robot, ordering, reference)
     n_targets, _, n = arrays.joints.shape
     rows = SolutionTable(
@@ -130,8 +135,9 @@ def select_arrays(robot: Robot, arrays: IKArrays, limits: Limits, *, filter_limi
     kept_parts, rejected_parts = [kept], []
     selections: dict[int, Selection] = {}
     for row in np.flatnonzero(~simple).tolist():
-        selection = selections[row] = select(robot, _result(arrays, row), limits, filter_limits=filter_limits, reference=reference,
-                           ordering=ordering, max_equivalents=max_equivalents)
+        selection = selections[row] = select(robot, _result(arrays, row), limits, filter_limits=filter_limits,
+                                             reference=reference, ordering=ordering,
+                                             max_equivalents=max_equivalents, budget=budget)
         status[row], truncated[row], trimmed[row], available[row] = (
             selection.status, selection.expansion_truncated, selection.trimmed, selection.available)
         if selection.notes:

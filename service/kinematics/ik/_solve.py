@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._budget import UNLIMITED, Budget
 from .._robot import Robot
 from ._numeric import NumericOptions, solve_numeric
 from ._arrays import IKArrays, solve_ik_arrays
@@ -16,9 +17,10 @@ from ._verify import accepted, distance_to_reference, distinct, polish, residual
 
 @dataclass(frozen=True)
 class IKOptions:
-    """How to search: the numeric fallback's bounds."""
+    """How to search: the numeric fallback's bounds, and the request's budget (deadline, cancellation)."""
 
     numeric: NumericOptions = field(default_factory=NumericOptions)
+    budget: Budget = UNLIMITED
 
 
 def solve_ik(robot: Robot, world_T_target: np.ndarray, *, constrain_orientation: bool = True,
@@ -53,7 +55,8 @@ def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orien
     """
     options = options or IKOptions()
     targets = np.asarray(world_T_targets, dtype=float)
-    arrays = solve_ik_arrays(robot, targets, constrain_orientation=constrain_orientation, reference=reference)
+    arrays = solve_ik_arrays(robot, targets, constrain_orientation=constrain_orientation, reference=reference,
+                             budget=options.budget)
     if arrays is None:
         return [_numeric(robot, target, constrain_orientation, reference, options) for target in targets]
     return results_from_arrays(robot, arrays, targets, constrain_orientation, reference, options)
@@ -120,7 +123,7 @@ def _closed_form_results(robot: Robot, arrays: IKArrays, targets: np.ndarray, co
 
 
 def unreachable_details(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
-                         reference: np.ndarray | None) -> dict[int, str]:
+                         reference: np.ndarray | None, budget: Budget = UNLIMITED) -> dict[int, str]:
     """For each unreachable target: whether the position or only the orientation is out of reach (or only with
     the free joints held)."""
     rows = np.flatnonzero(arrays.count == 0)
@@ -130,12 +133,14 @@ def unreachable_details(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
         return {int(row): (f"The target position is out of reach with the free joints {names} held at the reference "
                            f"values (or 0); other values of those joints may reach it.") for row in rows}
     if constrain_orientation and len(rows):
-        position_only = solve_ik_arrays(robot, targets[rows], constrain_orientation=False, reference=reference)
+        position_only = solve_ik_arrays(robot, targets[rows], constrain_orientation=False, reference=reference,
+                                        budget=budget)
         if position_only is not None:
             reachable = position_only.count > 0
         else:  # no analytic family for the position alone: the numeric search decides, as for any target
             reachable = np.array([bool(result.solutions) for result in solve_ik_batch(
-                robot, targets[rows], constrain_orientation=False, reference=reference)])
+                robot, targets[rows], constrain_orientation=False, reference=reference,
+                options=IKOptions(budget=budget))])
         if reachable.any():
             for row in rows[reachable]:
                 details[int(row)] = ("The position is reachable but the orientation is not: " +
@@ -166,7 +171,7 @@ def _numeric(robot: Robot, target: np.ndarray, constrain_orientation: bool, refe
              options: IKOptions, seeds: np.ndarray | None = None) -> IKResult:
     """The numeric search's answer; ``seeds`` (k, n), solutions already verified, are kept among it."""
     outcome = solve_numeric(robot, target, constrain_orientation=constrain_orientation, options=options.numeric,
-                            reference=reference)
+                            reference=reference, budget=options.budget)
     joints = wrap_revolute(robot, outcome.joints)
     if seeds is not None and len(seeds):
         joints = np.concatenate([seeds, joints.reshape(-1, robot.dof)])
@@ -176,13 +181,15 @@ def _numeric(robot: Robot, target: np.ndarray, constrain_orientation: bool, refe
         joints = wrap_revolute(robot, polish(robot, joints, targets, constrain_orientation))
         position, orientation = residuals(robot, joints, target)
         ok = np.flatnonzero(accepted(robot, position, orientation, constrain_orientation))
-        kept = ok[distinct(robot, joints[ok])] if len(ok) else ok
+        options.budget.check("polishing the numeric solutions")
+        kept = ok[distinct(robot, joints[ok], options.budget)] if len(ok) else ok
         solutions = [Solution(joints[i], {}, float(position[i]), float(orientation[i])) for i in kept]
     detail = "" if solutions else (
         "No solution was found by the numeric search; the target may be outside the workspace "
         "(the numeric search cannot prove it).")
     if outcome.budget_exhausted:
-        detail = (detail + " " if detail else "") + "The time budget stopped the search before every start converged."
+        detail = (detail + " " if detail else "") + (
+            f"The iteration cap ({options.numeric.max_iterations}) stopped some starts before they converged.")
     return IKResult(status="ok" if solutions else "unreachable", solutions=_ordered(robot, solutions, reference),
                     method="numeric", structure="general", complete=False, detail=detail,
                     search_exhausted_budget=outcome.budget_exhausted)

@@ -501,7 +501,7 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
     rho2 = radius_q * inv_q
     alpha = (h1 - cos * h2) / sin2
     beta = (h2 - cos * h1) / sin2
-    g = 1.0 - alpha * h1 - beta * h2  # 1 - ||x0||**2 for x0 = alpha k1 + beta k2 (k1.x0 = h1, k2.x0 = h2)
+    g = _crossing_gap(rho1, rho2, alpha * sin, beta * sin)
     meet = g >= 0.0
     # With gamma = 0 each angle turns its vector to the arc midpoint between the
     # two crossings, a sagitta of at most g / rho from x0: the residual is at most g (1/rho1 + 1/rho2).
@@ -550,6 +550,20 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
         degenerate=np.asarray(degenerate),
         merged=np.asarray(merged),
     )
+
+
+def _crossing_gap(rho1, rho2, alpha_sin, beta_sin):
+    """``g = 1 - ||x0||**2`` for ``x0 = alpha k1 + beta k2`` (so ``gamma = sqrt(g) / sin``), without cancellation.
+
+    In the orthonormal frame (k1, (k2 - cos k1) / sin) of the axes' plane, ``x0 = (h1, beta sin)``, so
+    ``g = rho1**2 - (beta sin)**2``, and symmetrically ``g = rho2**2 - (alpha sin)**2``. The form of the
+    smaller radius is used, as a product of a difference and a sum. Computed as ``1 - alpha h1 - beta h2``, ``g``
+    carries an absolute error of about 1e-16: near a wrist singularity (a radius ``eps``, ``g ~ eps**2``) that
+    moved the roots by ``1e-16 / eps`` and, below ``eps ~ 1e-8``, merged the two roots into one wrong one.
+    """
+    first = (rho1 - np.abs(beta_sin)) * (rho1 + np.abs(beta_sin))
+    second = (rho2 - np.abs(alpha_sin)) * (rho2 + np.abs(alpha_sin))
+    return np.where(rho1 <= rho2, first, second)
 
 
 def subproblem_2_chain(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> AnglePairSolutions:

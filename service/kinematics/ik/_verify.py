@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from .._budget import UNLIMITED, Budget
 from .._forward import forward_kinematics, tool_columns, tool_columns_scalar
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE
@@ -115,12 +116,17 @@ def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constr
     return ok
 
 
-def distinct(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Indices of the first occurrence of each distinct joint vector, revolute joints compared modulo 2π."""
+def distinct(robot: Robot, q: np.ndarray, budget: Budget = UNLIMITED) -> np.ndarray:
+    """Indices of the first occurrence of each distinct joint vector, revolute joints compared modulo 2π.
+
+    Each row is compared with every kept row at once; ``budget`` is checked every 64 rows.
+    """
     tolerance = np.where(robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot))
     keep: list[int] = []
     for i in range(len(q)):
-        if not any(np.all(np.abs(joint_difference(robot, q[i], q[j])) <= tolerance) for j in keep):
+        if i % 64 == 63:
+            budget.check("merging the numeric solutions")
+        if not keep or not np.any(np.all(np.abs(joint_difference(robot, q[keep], q[i])) <= tolerance, axis=1)):
             keep.append(i)
     return np.array(keep, dtype=int)
 

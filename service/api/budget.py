@@ -1,0 +1,247 @@
+"""Bounded work, the HTTP side: each request's budget, the in-flight limit, and the cost model checked before work.
+
+* :class:`WorkLimits` (pure ASGI middleware) gives every ``POST /v1/...`` request a core
+  :class:`~service.kinematics.Budget`: a deadline of ``KIN_REQUEST_TIMEOUT_MS`` (or the lower value of the
+  request's ``X-Request-Timeout-Ms`` header), cancelled when the client disconnects. It refuses work beyond
+  ``KIN_MAX_IN_FLIGHT`` requests at once with 503 and ``Retry-After``; ``/readyz`` reports the same saturation.
+* The routers call :func:`check_ik_cost` before solving: the worst-case answer,
+  estimated from targets × solutions per target × 2π-equivalents per solution, is held against
+  ``KIN_MAX_SOLUTIONS_PER_RESPONSE`` and ``KIN_MAX_RESPONSE_BYTES``, and each joint's limits against
+  ``KIN_MAX_TURNS_PER_JOINT``. Over a cap → 413 (422 for the turns) naming the cap and by how much.
+* :class:`~service.kinematics.BudgetExhausted` from the core becomes a 503 problem with ``Retry-After``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import math
+
+import numpy as np
+from fastapi import Request
+from fastapi.responses import JSONResponse
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
+
+from ..config import Settings
+from ..kinematics import UNLIMITED, Budget, BudgetExhausted, Limits, Robot
+from .problems import PROBLEM_MEDIA_TYPE, PROBLEM_TYPE_BASE, ProblemError, problem_response
+
+logger = logging.getLogger("service.budget")
+
+TIMEOUT_HEADER = "X-Request-Timeout-Ms"
+BUDGET_STATE_KEY = "budget"
+RETRY_AFTER_SECONDS = 1
+
+#: Estimated encoded size of one solution: its joints (about 22 bytes a number) plus the rest of its record.
+_SOLUTION_OVERHEAD_BYTES = {"objects": 260, "arrays": 70}
+_BYTES_PER_NUMBER = 22
+
+
+class InFlight:
+    """How many requests are being worked on, against ``KIN_MAX_IN_FLIGHT`` (event-loop state: no lock)."""
+
+    def __init__(self, capacity: int) -> None:
+        self.capacity = capacity
+        self.count = 0
+
+    @property
+    def saturated(self) -> bool:
+        return self.count >= self.capacity
+
+
+def _is_work(scope: Scope) -> bool:
+    return scope.get("method") == "POST" and scope.get("path", "").startswith("/v1/")
+
+
+class WorkLimits:
+    """Per-request budget, cancellation on disconnect and the in-flight limit (see the module docstring)."""
+
+    def __init__(self, app: ASGIApp, settings: Settings, in_flight: InFlight) -> None:
+        self.app = app
+        self.timeout_seconds = settings.request_timeout_ms / 1000.0
+        self.in_flight = in_flight
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http" or not _is_work(scope):
+            await self.app(scope, receive, send)
+            return
+        timeout = self.timeout_seconds
+        for name, value in scope.get("headers", ()):
+            if name == TIMEOUT_HEADER.lower().encode():
+                try:
+                    asked = float(value)
+                except ValueError:
+                    asked = math.nan
+                if not (asked > 0 and math.isfinite(asked)):
+                    await _send_problem(send, 422, "validation-error", "Request is not valid",
+                                        f"{TIMEOUT_HEADER} must be a positive number of milliseconds.",
+                                        scope, errors=[{"loc": ["header", TIMEOUT_HEADER],
+                                                        "msg": "must be a positive number", "type": "value_error"}])
+                    return
+                timeout = min(timeout, asked / 1000.0)  # a request may lower its deadline, never raise it
+        if self.in_flight.saturated:
+            logger.warning("refused: %d requests in flight (KIN_MAX_IN_FLIGHT)", self.in_flight.count,
+                           extra={"fields": {"path": scope.get("path"), "in_flight": self.in_flight.count}})
+            await _send_problem(send, 503, "overloaded", "Too many requests in flight",
+                                f"The service is working on {self.in_flight.count} requests, its limit "
+                                f"(KIN_MAX_IN_FLIGHT = {self.in_flight.capacity}); retry after "
+                                f"{RETRY_AFTER_SECONDS} s.", scope, retry_after=True)
+            return
+        budget = Budget(timeout)
+        scope.setdefault("state", {})[BUDGET_STATE_KEY] = budget
+        disconnected = asyncio.Event()
+        body_done = False
+        watcher: asyncio.Task | None = None
+
+        async def watch() -> None:
+            # After the body, the server's receive() returns only when the client goes or the response is done.
+            message = await receive()
+            if message["type"] == "http.disconnect" and not response_done:
+                budget.cancel()
+                logger.info("client disconnected: cancelling the request at its next chunk",
+                            extra={"fields": {"path": scope.get("path")}})
+            disconnected.set()
+
+        async def receive_watched() -> Message:
+            nonlocal body_done, watcher
+            if body_done:
+                await disconnected.wait()
+                return {"type": "http.disconnect"}
+            message = await receive()
+            if message["type"] == "http.disconnect":
+                budget.cancel()
+                disconnected.set()
+            elif not message.get("more_body", False):
+                body_done = True
+                watcher = asyncio.get_running_loop().create_task(watch())
+            return message
+
+        response_done = False
+
+        async def send_tracked(message: Message) -> None:
+            nonlocal response_done
+            if message["type"] == "http.response.body" and not message.get("more_body", False):
+                response_done = True
+            await send(message)
+
+        self.in_flight.count += 1
+        try:
+            await self.app(scope, receive_watched, send_tracked)
+        finally:
+            self.in_flight.count -= 1
+            if watcher is not None:
+                watcher.cancel()
+
+
+async def _send_problem(send: Send, status: int, slug: str, title: str, detail: str, scope: Scope, *,
+                        retry_after: bool = False, errors: list | None = None) -> None:
+    body = {"type": PROBLEM_TYPE_BASE + slug, "title": title, "status": status, "detail": detail,
+            "instance": scope.get("path", "")}
+    if errors is not None:
+        body["errors"] = errors
+    encoded = json.dumps(body).encode()
+    headers = [(b"content-type", PROBLEM_MEDIA_TYPE.encode()), (b"content-length", str(len(encoded)).encode())]
+    if retry_after:
+        headers.append((b"retry-after", str(RETRY_AFTER_SECONDS).encode()))
+    await send({"type": "http.response.start", "status": status, "headers": headers})
+    await send({"type": "http.response.body", "body": encoded})
+
+
+def budget_of(request: Request) -> Budget:
+    """The request's budget (no deadline outside the middleware, e.g. a GET)."""
+    return getattr(request.state, BUDGET_STATE_KEY, UNLIMITED)
+
+
+async def budget_exhausted(request: Request, exc: BudgetExhausted) -> JSONResponse:
+    """503 with Retry-After: past the deadline (or cancelled) with nothing finished to return."""
+    if exc.reason == "cancelled":
+        detail = f"The client disconnected; the work stopped during {exc.stage}."
+    else:
+        detail = (f"{exc} Nothing finished is returned. Retry after {RETRY_AFTER_SECONDS} s with less work (fewer "
+                  f"targets, samples or numeric starts, a lower max_equivalents); the server's deadline is "
+                  f"KIN_REQUEST_TIMEOUT_MS, and {TIMEOUT_HEADER} may lower it.")
+    logger.warning("stopped: %s", detail, extra={"fields": {"reason": exc.reason, "stage": exc.stage,
+                                                            "path": request.url.path}})
+    return problem_response(503, "deadline-exceeded" if exc.reason == "deadline" else "cancelled",
+                            "Deadline exceeded" if exc.reason == "deadline" else "Request cancelled", detail,
+                            instance=request.url.path, headers={"Retry-After": str(RETRY_AFTER_SECONDS)})
+
+
+# --------------------------------------------------------------------------- the cost model
+
+
+def equivalents_per_solution(robot: Robot, limits: Limits) -> int:
+    """Most 2π-equivalents one generic solution can have within the limits: Π_j ceil(span_j / 2π) over revolute
+    joints with both bounds finite (1 for every other joint), capped at 2**53 − 1.
+
+    A joint whose span is not a whole number of turns holds at most ceil(span / 2π) values of a 2π-lattice; one
+    more only when a value lands exactly on both bounds. Examples: a ±160° joint 1, a ±360° joint 2 (a UR5 has at
+    most 2⁶ = 64 per solution).
+    """
+    both = robot.is_revolute & np.isfinite(limits.lower) & np.isfinite(limits.upper)
+    spans = np.where(both, limits.upper - limits.lower, 0.0)
+    per_joint = np.where(both, np.maximum(np.ceil(spans / (2 * np.pi)), 1), 1)
+    product = 1
+    for factor in per_joint.tolist():
+        product = min(product * int(factor), 2**53 - 1)
+    return product
+
+
+def check_turns(settings: Settings, robot: Robot, limits: Limits, location: tuple) -> None:
+    """422 when a revolute joint's limits span more turns than ``KIN_MAX_TURNS_PER_JOINT``."""
+    cap = settings.max_turns_per_joint
+    spans = np.where(robot.is_revolute & np.isfinite(limits.lower) & np.isfinite(limits.upper),
+                     limits.upper - limits.lower, 0.0) / (2 * np.pi)
+    over = np.flatnonzero(spans > cap)
+    if len(over):
+        joint = int(over[0])
+        raise ProblemError(422, "validation-error", "Request is not valid",
+                           f"joint {joint}: its limits span {spans[joint]:.6g} turns, more than "
+                           f"KIN_MAX_TURNS_PER_JOINT = {cap} (by {spans[joint] - cap:.6g}); a joint that turns "
+                           f"without end is given no limits (null).",
+                           errors=[{"loc": [*location, joint], "msg": f"limits span more than {cap} turns",
+                                    "type": "value_error"}])
+
+
+def check_answer_size(settings: Settings, robot: Robot, *, targets: int, per_target: int, form: str,
+                      what: str) -> None:
+    """413 when ``targets × per_target`` solutions would exceed KIN_MAX_SOLUTIONS_PER_RESPONSE or the estimated
+    response bytes KIN_MAX_RESPONSE_BYTES; says which cap, by how much, and what lowers it."""
+    solutions = targets * per_target
+    cap = settings.max_solutions_per_response
+    remedy = ("Lower max_equivalents or max_solutions (each caps the solutions per target), send fewer targets, "
+              "or narrow multi-turn limits.")
+    if solutions > cap:
+        raise ProblemError(413, "answer-too-large", "Answer too large",
+                           f"The answer could hold {solutions:,} solutions ({what}), "
+                           f"{solutions - cap:,} more than KIN_MAX_SOLUTIONS_PER_RESPONSE = {cap:,}. {remedy}")
+    size = solutions * (_SOLUTION_OVERHEAD_BYTES[form] + _BYTES_PER_NUMBER * robot.dof)
+    if size > settings.max_response_bytes:
+        raise ProblemError(413, "answer-too-large", "Answer too large",
+                           f"The answer could take about {size:,} bytes ({what}), {size - settings.max_response_bytes:,} "
+                           f"more than KIN_MAX_RESPONSE_BYTES = {settings.max_response_bytes:,}. {remedy}")
+
+
+def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: int, solutions_per_target: int,
+                  max_equivalents: int, max_solutions: int | None, form: str = "objects",
+                  numeric_starts: int | None = None) -> None:
+    """The IK cost model, before any solving: turns per joint, the numeric work, then the worst-case answer size.
+
+    ``solutions_per_target`` is the family's generic count (8 for a PUMA) or, for the numeric search, its starts
+    (``numeric_starts``, which also count as work).
+    """
+    check_turns(settings, robot, limits, ("body", "limits"))
+    if numeric_starts is not None and targets * numeric_starts > settings.max_numeric_starts:
+        work = targets * numeric_starts
+        raise ProblemError(413, "too-much-work", "Too much work",
+                           f"The numeric search would run {work:,} starts ({targets:,} targets × {numeric_starts} "
+                           f"starts), {work - settings.max_numeric_starts:,} more than KIN_MAX_NUMERIC_STARTS = "
+                           f"{settings.max_numeric_starts:,}. Send fewer targets or fewer numeric.starts.")
+    kept = max_equivalents if max_solutions is None else min(max_equivalents, max_solutions)
+    equivalents = equivalents_per_solution(robot, limits)
+    per_target = min(kept, solutions_per_target * equivalents) + solutions_per_target  # kept + rejected
+    check_answer_size(settings, robot, targets=targets, per_target=per_target, form=form,
+                      what=f"{targets:,} targets × up to {per_target:,} each: {solutions_per_target} solutions "
+                           f"× {equivalents:,} 2π-equivalents with at most {kept:,} kept, and up to "
+                           f"{solutions_per_target} rejected")

@@ -1,0 +1,265 @@
+"""Hostile and careless requests are bounded: caps checked before the work, a deadline, cancellation, in-flight.
+
+Each case is one the issue measured (7.6 GB for ±1e6 rad limits, 8.2 GB and 118 s for a 10,000-target batch, 500s
+from an int64 overflow, 17.5 s past a 2 s cap, answers that changed with load): here each answers within its cap.
+Memory under these requests is measured against a live server in tests/test_bounded_live.py.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import inspect
+import time
+
+import numpy as np
+import pytest
+from fastapi.testclient import TestClient
+
+from service.api.app import create_app
+from service.api.budget import InFlight, WorkLimits, budget_of
+from service.api.routers import health
+from service.config import Settings
+from service.kinematics import COUNT_CAP, Budget, BudgetExhausted
+from tests.conftest import assert_problem
+
+UR5_Q = [0.3, -1.0, 1.2, 0.4, 0.5, 0.6]
+SEVEN_DOF = {"convention": "modified", "joints": [
+    {"a": 0.0, "alpha": 0.0, "d": 0.3}, {"a": 0.0, "alpha": -1.5707963267948966},
+    {"a": 0.0, "alpha": 1.5707963267948966, "d": 0.4}, {"a": 0.05, "alpha": 1.5707963267948966},
+    {"a": -0.05, "alpha": -1.5707963267948966, "d": 0.4}, {"a": 0.0, "alpha": 1.5707963267948966},
+    {"a": 0.1, "alpha": 1.5707963267948966, "d": 0.1}]}
+
+
+def _ur5_target(client) -> dict:
+    return {"matrix": client.post("/v1/robots/ur5/fk", json={"joints": UR5_Q}).json()["pose"]["matrix"]}
+
+
+def _limits(half_span: float, n: int = 6) -> list[dict]:
+    return [{"lower": -half_span, "upper": half_span}] * n
+
+
+@pytest.fixture(scope="module")
+def wide():
+    """A server that allows a million turns per joint: the expansion itself must then stay bounded."""
+    with TestClient(create_app(Settings(_env_file=None, max_turns_per_joint=1e6))) as client:
+        yield client
+
+
+# --------------------------------------------------------------------------- the cost model, before any work
+
+
+def test_limits_spanning_too_many_turns_are_refused_naming_the_cap(client):
+    started = time.perf_counter()
+    response = client.post("/v1/robots/ur5/ik", json={"target": _ur5_target(client), "limits": _limits(1e6)})
+    body = assert_problem(response, 422, loc=["body", "limits", 0], match="KIN_MAX_TURNS_PER_JOINT = 100")
+    assert "318310" in body["detail"].replace(",", "")  # how many turns were asked for
+    assert time.perf_counter() - started < 20.0  # generous: a loaded CI machine; before, no answer at all
+
+
+def test_a_million_radian_limit_expands_only_what_is_returned(wide):
+    """±1e6 rad on every UR5 joint: 318,310 equivalents per joint, about 1e33 per solution. Before: 7.6 GB. Now
+    the 1,024 least-turned come back, and the count stops at 2**53 − 1 (the schema's integer range), said so."""
+    started = time.perf_counter()
+    response = wide.post("/v1/robots/ur5/ik", json={"target": _ur5_target(wide), "limits": _limits(1e6)})
+    elapsed = time.perf_counter() - started
+    assert response.status_code == 200, response.text
+    body = response.json()
+    assert len(body["solutions"]) == 1024 and body["truncated"] is True
+    assert body["available"] == COUNT_CAP and "At least 9007199254740991" in body["detail"]
+    assert elapsed < 20.0  # before: 7.6 GB; the bound that matters is memory, measured in the live test
+
+
+@pytest.mark.parametrize("form", ["objects", "arrays"])
+def test_counts_never_overflow_into_a_500(wide, form):
+    """±5000 rad on a UR5 (the int64 overflow of `available`), in a batch of both forms."""
+    target = _ur5_target(wide)
+    response = wide.post("/v1/robots/ur5/ik/batch", json={"targets": [target] * 3, "limits": _limits(5000.0),
+                                                          "max_equivalents": 10, "format": form})
+    assert response.status_code == 200, response.text
+    body = response.json()
+    available = body["targets"]["available"] if form == "arrays" else [r["available"] for r in body["results"]]
+    assert available == [COUNT_CAP] * 3
+
+
+def test_numeric_counts_stay_in_the_integer_range(wide):
+    """The single-request numeric path returned 175-digit integers in a field typed integer."""
+    target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
+    response = wide.post("/v1/ik", json={"robot": SEVEN_DOF, "target": target, "limits": _limits(1e5, 7),
+                                         "max_equivalents": 5})
+    assert response.status_code == 200, response.text
+    body = response.json()
+    assert body["solver"]["method"] == "numeric"
+    assert 0 <= body["available"] <= COUNT_CAP and len(body["solutions"]) <= 5
+
+
+def test_max_equivalents_beyond_the_solution_cap_is_413_before_solving():
+    """max_equivalents 100000 turned a 534-byte request into 30.6 MB; it is refused, and by how much is said."""
+    with TestClient(create_app(Settings(_env_file=None))) as client:
+        body = {"target": _ur5_target(client), "limits": _limits(300.0), "max_equivalents": 100_000}
+        problem = assert_problem(client.post("/v1/robots/ur5/ik", json=body), 413,
+                                 match="KIN_MAX_SOLUTIONS_PER_RESPONSE = 100,000")
+        assert "8 more than" in problem["detail"]  # 100,000 kept + 8 rejected
+
+
+def test_a_whole_workspace_batch_is_413_before_solving(client, monkeypatch):
+    """10,000 UR5 targets with ±360° limits: 8.2 GB and 118 s before. Refused before the solver is called."""
+    from service.api.routers import ik as ik_router
+
+    targets = [_ur5_target(client)] * 10_000
+
+    def never(*args, **kwargs):
+        raise AssertionError("the solver ran")
+
+    monkeypatch.setattr(ik_router, "solve_ik_arrays", never)
+    for form in ("objects", "arrays"):
+        response = client.post("/v1/robots/ur5/ik/batch", json={"targets": targets, "format": form})
+        problem = assert_problem(response, 413, match="KIN_MAX_SOLUTIONS_PER_RESPONSE")
+        assert "5,200,000 solutions" in problem["detail"]  # 10,000 × (8 × 2⁶ kept + 8 rejected)
+
+
+def test_the_response_byte_cap_is_checked_too():
+    with TestClient(create_app(Settings(_env_file=None, max_response_bytes=100_000))) as client:
+        targets = [_ur5_target(client)] * 100
+        assert_problem(client.post("/v1/robots/ur5/ik/batch", json={"targets": targets}), 413,
+                       match="KIN_MAX_RESPONSE_BYTES")
+
+
+def test_numeric_work_is_capped():
+    target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
+    with TestClient(create_app(Settings(_env_file=None, max_numeric_starts=1000))) as client:
+        response = client.post("/v1/ik", json={"robot": SEVEN_DOF, "target": target, "numeric": {"starts": 2000}})
+        assert_problem(response, 413, match="KIN_MAX_NUMERIC_STARTS = 1,000")
+
+
+# --------------------------------------------------------------------------- the deadline
+
+
+def test_a_request_may_lower_its_deadline_and_gets_503_with_retry_after(client):
+    target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
+    started = time.perf_counter()
+    response = client.post("/v1/ik", json={"robot": SEVEN_DOF, "target": target, "numeric": {"starts": 2000}},
+                           headers={"X-Request-Timeout-Ms": "30"})
+    elapsed = time.perf_counter() - started
+    problem = assert_problem(response, 503, match="deadline of 30 ms")
+    assert response.headers["retry-after"] == "1" and problem["type"].endswith("/deadline-exceeded")
+    assert elapsed < 10.0  # the whole 2,000-start search takes far longer
+
+
+def test_the_deadline_header_cannot_raise_the_servers_deadline():
+    target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
+    with TestClient(create_app(Settings(_env_file=None, request_timeout_ms=30))) as client:
+        response = client.post("/v1/ik", json={"robot": SEVEN_DOF, "target": target, "numeric": {"starts": 2000}},
+                               headers={"X-Request-Timeout-Ms": "600000"})
+        assert_problem(response, 503, match="deadline of 30 ms")
+
+
+@pytest.mark.parametrize("value", ["0", "-5", "soon", "nan"])
+def test_a_malformed_deadline_header_is_422(client, value):
+    response = client.post("/v1/robots/ur5/fk", json={"joints": UR5_Q}, headers={"X-Request-Timeout-Ms": value})
+    assert_problem(response, 422, loc=["header", "X-Request-Timeout-Ms"])
+
+
+def test_a_trajectory_of_unreachable_samples_stops_at_the_deadline():
+    """Before: about 0.5 s per unreachable sample of a numeric arm, hours for 10,000 samples."""
+    samples = [{"time": 0.01 * k, "pose": {"position": [5.0, 5.0, 5.0],
+                                           "orientation": {"type": "rpy", "angles": [0, 0, 0]}}} for k in range(2000)]
+    with TestClient(create_app(Settings(_env_file=None, request_timeout_ms=300))) as client:
+        started = time.perf_counter()
+        response = client.post("/v1/ik/trajectory", json={"robot": SEVEN_DOF, "samples": samples})
+        elapsed = time.perf_counter() - started
+    assert_problem(response, 503, match="deadline of 300 ms")
+    assert elapsed < 30.0  # before: about 0.5 s per sample, 1,000 s for these
+
+
+def test_numeric_answers_do_not_depend_on_load(client):
+    """The search is counted in iterations: the same request gets the same solutions, here with a busy thread."""
+    import threading
+
+    target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
+    body = {"robot": SEVEN_DOF, "target": target, "numeric": {"starts": 48, "time_budget_ms": 10_000}}
+    alone = client.post("/v1/ik", json=body).json()
+    stop = threading.Event()
+
+    def burn() -> None:
+        matrix = np.random.default_rng(0).normal(size=(300, 300))
+        while not stop.is_set():
+            matrix @ matrix
+
+    burners = [threading.Thread(target=burn) for _ in range(2)]
+    for thread in burners:
+        thread.start()
+    try:
+        loaded = client.post("/v1/ik", json=body).json()
+    finally:
+        stop.set()
+        for thread in burners:
+            thread.join()
+    assert alone["solutions"] == loaded["solutions"] and alone["solutions"]
+
+
+# --------------------------------------------------------------------------- in flight, health, cancellation
+
+
+def test_over_the_in_flight_limit_is_503_and_readiness_says_saturated():
+    app = create_app(Settings(_env_file=None, max_in_flight=2))
+    with TestClient(app) as client:
+        assert client.get("/readyz").status_code == 200
+        app.state.in_flight.count = 2  # two requests being worked on
+        try:
+            response = client.post("/v1/robots/ur5/fk", json={"joints": UR5_Q})
+            assert_problem(response, 503, match="KIN_MAX_IN_FLIGHT = 2")
+            assert response.headers["retry-after"] == "1"
+            assert_problem(client.get("/readyz"), 503, match="in flight")
+            assert client.get("/healthz").status_code == 200  # liveness is not readiness
+            assert client.get("/v1/robots").status_code == 200  # reads are not solver work
+        finally:
+            app.state.in_flight.count = 0
+        assert client.post("/v1/robots/ur5/fk", json={"joints": UR5_Q}).status_code == 200
+
+
+def test_health_routes_run_on_the_event_loop_not_the_solver_pool():
+    assert inspect.iscoroutinefunction(health.liveness) and inspect.iscoroutinefunction(health.readiness)
+
+
+def test_a_disconnect_cancels_the_request_budget():
+    """The middleware turns the client's disconnect into a cancelled budget, which the core checks per chunk."""
+    seen: dict = {}
+
+    async def app(scope, receive, send):
+        from starlette.requests import Request
+
+        budget = budget_of(Request(scope))
+        await receive()  # the body
+        for _ in range(200):  # "work": chunks, each checking the budget
+            await asyncio.sleep(0.005)
+            try:
+                budget.check("test work")
+            except BudgetExhausted as stopped:
+                seen["reason"] = stopped.reason
+                return
+        seen["reason"] = "finished"
+
+    messages = [{"type": "http.request", "body": b"{}", "more_body": False}]
+
+    async def receive():
+        if messages:
+            return messages.pop(0)
+        await asyncio.sleep(0.02)  # the client goes away while the work runs
+        return {"type": "http.disconnect"}
+
+    async def send(message):
+        pass
+
+    middleware = WorkLimits(app, Settings(_env_file=None), InFlight(4))
+    scope = {"type": "http", "method": "POST", "path": "/v1/ik", "headers": []}
+    asyncio.run(middleware(scope, receive, send))
+    assert seen["reason"] == "cancelled"
+
+
+def test_budget_within_shares_the_cancellation_and_keeps_the_earlier_deadline():
+    request = Budget(0.05)
+    part = request.within(10.0)
+    assert part.deadline == request.deadline
+    request.cancel()
+    with pytest.raises(BudgetExhausted, match="cancelled"):
+        part.check("part")

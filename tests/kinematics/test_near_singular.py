@@ -137,8 +137,8 @@ def test_zero_length_links_report_every_free_shoulder_joint():
     """All lengths zero: the wrist centre is the shoulder's centre whatever q1, q2, q3; both shoulder joints are
     reported free and take the reference values, so the generating configuration comes back (q2 was left at 0,
     unflagged, before)."""
-    from service.api.boundary import robot_from_description
-    from service.api.schemas.robots import DHRobot
+    from service.robots.build import robot_from_description
+    from service.robots.schemas import DHRobot
 
     half = np.pi / 2
     robot = robot_from_description(DHRobot.model_validate({"id": "zero", "convention": "standard", "joints": [

@@ -17,6 +17,7 @@ from ..catalogue import load_catalogue
 from ..config import Settings
 from .limits import BodySizeLimit
 from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
+from .pages import install_pages
 from .problems import PROBLEM_MEDIA_TYPE, Problem, install_problem_handlers
 from .routers import fk, health, ik, limits, robots, trajectory
 from .security import API_KEY_HEADER, API_KEY_SCHEME, ApiKeyMiddleware, is_protected
@@ -65,6 +66,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         description=DESCRIPTION,
         lifespan=lifespan,
         generate_unique_id_function=_operation_id,
+        # /docs and /redoc are served offline by install_pages (below), not from a CDN
+        docs_url=None,
+        redoc_url=None,
     )
     app.state.settings = settings
     app.state.catalogue = None
@@ -83,6 +87,10 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     for module in (health, robots, fk, ik, limits, trajectory):
         app.include_router(module.router)
     app.include_router(metrics_router)
+
+    # --- pages for people (issue 15): landing page, offline docs, viewer --------------------------------------
+    install_pages(app)
+    # ------------------------------------------------------------------------------------------------------------
 
     def openapi() -> dict[str, Any]:
         if app.openapi_schema is None:

@@ -42,25 +42,31 @@ class Problem(ApiModel):
     detail: str
     instance: str | None = None
     errors: list[FieldError] | None = None
+    nearest_ids: list[str] | None = Field(
+        None, description="with an unknown robot id (404): the catalogue ids nearest the one given, best first")
 
 
 class ProblemError(Exception):
     """Raise from a router to answer with a problem document."""
 
-    def __init__(self, status: int, slug: str, title: str, detail: str, errors: list[dict] | None = None) -> None:
+    def __init__(self, status: int, slug: str, title: str, detail: str, errors: list[dict] | None = None,
+                 **extensions: object) -> None:
         super().__init__(detail)
         self.status, self.slug, self.title, self.detail, self.errors = status, slug, title, detail, errors
+        #: RFC 9457 extension members, each declared in :class:`Problem` (e.g. ``nearest_ids``)
+        self.extensions = extensions
 
 
 def problem_response(
     status: int, slug: str, title: str, detail: str, *, instance: str | None = None, errors: list[dict] | None = None,
-    headers: dict[str, str] | None = None,
+    headers: dict[str, str] | None = None, extensions: dict[str, Any] | None = None,
 ) -> JSONResponse:
     body: dict[str, Any] = {"type": PROBLEM_TYPE_BASE + slug, "title": title, "status": status, "detail": detail}
     if instance:
         body["instance"] = instance
     if errors is not None:
         body["errors"] = errors
+    body.update(extensions or {})
     return JSONResponse(body, status_code=status, media_type=PROBLEM_MEDIA_TYPE, headers=headers)
 
 
@@ -108,7 +114,8 @@ async def _kinematics_error(request: Request, exc: KinematicsError) -> JSONRespo
 
 
 async def _problem_error(request: Request, exc: ProblemError) -> JSONResponse:
-    return problem_response(exc.status, exc.slug, exc.title, exc.detail, instance=request.url.path, errors=exc.errors)
+    return problem_response(exc.status, exc.slug, exc.title, exc.detail, instance=request.url.path, errors=exc.errors,
+                            extensions=exc.extensions)
 
 
 _HTTP_TITLES = {404: ("not-found", "Not found"), 405: ("method-not-allowed", "Method not allowed"),

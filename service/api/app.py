@@ -122,12 +122,18 @@ def _document_problems_and_security(spec: dict[str, Any]) -> None:
     components["securitySchemes"] = {API_KEY_SCHEME: {
         "type": "apiKey", "in": "header", "name": API_KEY_HEADER,
         "description": "Required on /v1 only when the service runs with KIN_API_KEY; compared in constant time."}}
+    # The key is optional (the empty requirement {}), and declared once for the document rather than on each
+    # operation: generated clients (openapi-python-client) then accept a plain Client on every operation, which
+    # is all a service without KIN_API_KEY needs, instead of demanding an AuthenticatedClient that sends
+    # "Authorization: Bearer". With a key: Client(headers={"X-API-Key": key}). Open routes opt out with [].
+    spec["security"] = [{API_KEY_SCHEME: []}, {}]
     for path, operations in spec.get("paths", {}).items():
         for operation in operations.values():
             statuses: set[int] = set()
             if is_protected(path):
                 statuses.add(401)
-                operation["security"] = [{API_KEY_SCHEME: []}]
+            else:
+                operation["security"] = []
             if "requestBody" in operation:
                 statuses |= {413, 422}
             if operation.get("parameters"):

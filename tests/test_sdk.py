@@ -42,7 +42,8 @@ def sdk(tmp_path_factory):
     """Generate the client package and import it."""
     root = tmp_path_factory.mktemp("sdk")
     config = root / "config.yaml"
-    config.write_text(f"project_name_override: kinematics-client\npackage_name_override: {PACKAGE}\n"
+    shared = (SPEC_PATH.parent / "client-config.yaml").read_text(encoding="utf-8")  # the README's settings
+    config.write_text(shared + f"project_name_override: kinematics-client\npackage_name_override: {PACKAGE}\n"
                       "post_hooks: []\n")
     result = subprocess.run(
         [sys.executable, "-m", "openapi_python_client", "generate", "--path", str(SPEC_PATH), "--meta", "none",
@@ -170,6 +171,15 @@ def test_inverse_kinematics_batch(client):
         assert np.allclose(result.solutions[0].joints, q, atol=1e-9)
 
 
+def test_render_returns_the_svg_text(client):
+    models = _models()
+    picture = _api("pictures.render").sync(
+        robot_id="ur5", client=client,
+        body=models.RenderRequest(joints=[[0.0] * 6, [0.1, -1.2, 1.0, 0.3, 1.5, 0.2]]))
+    assert isinstance(picture, str) and picture.startswith("<svg")
+    assert picture.count('class="configuration') == 2
+
+
 def test_check_joint_limits(client):
     models = _models()
     response = _api("joint_limits.check_joint_limits").sync(
@@ -290,4 +300,4 @@ def test_the_readme_sdk_script_runs_and_prints_what_the_readme_says(sdk, open_se
 def test_the_readme_generate_command_is_the_one_this_test_runs():
     command = re.search(r"```sh\n(openapi-python-client generate .+?)\n```", _readme_sdk_section()).group(1)
     assert command.split()[:4] == ["openapi-python-client", "generate", "--path", "openapi/openapi.json"]
-    assert "--meta none" in command
+    assert "--meta none" in command and "--config openapi/client-config.yaml" in command

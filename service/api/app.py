@@ -19,7 +19,7 @@ from .limits import BodySizeLimit
 from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
 from .pages import install_pages
 from .problems import PROBLEM_MEDIA_TYPE, Problem, install_problem_handlers
-from .routers import fk, health, ik, limits, robots, trajectory
+from .routers import fk, health, ik, limits, render, robots, trajectory
 from .security import API_KEY_HEADER, API_KEY_SCHEME, ApiKeyMiddleware, is_protected
 
 logger = logging.getLogger("service")
@@ -88,7 +88,8 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.include_router(module.router)
     app.include_router(metrics_router)
 
-    # --- pages for people (issue 15): landing page, offline docs, viewer --------------------------------------
+    # --- pages for people (issue 15): pictures, landing page, offline docs, viewer ----------------------------
+    app.include_router(render.router)
     install_pages(app)
     # ------------------------------------------------------------------------------------------------------------
 

@@ -105,6 +105,7 @@ def _without_repeats(points: np.ndarray) -> np.ndarray:
 def render_svg(poses: Sequence[ArmPose], *, view: View = "iso", columns: int | None = None, panel: int = 300,
                title: str = "") -> str:
     """SVG text of the poses as small multiples: one panel each, same projection and scale for all."""
+    view = getattr(view, "value", view)  # a str enum from the API's schema
     if view not in _SCREEN_AXES:
         raise ValueError(f"view must be one of {', '.join(VIEWS)}, not {view!r}")
     right, up = (np.array(axis) for axis in _SCREEN_AXES[view])

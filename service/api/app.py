@@ -17,6 +17,7 @@ from ..catalogue import load_catalogue
 from ..config import Settings
 from .limits import BodySizeLimit
 from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
+from .examples import add_examples
 from .pages import install_pages
 from .problems import PROBLEM_MEDIA_TYPE, Problem, install_problem_handlers
 from .routers import fk, health, ik, limits, render, robots, trajectory
@@ -96,6 +97,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     def openapi() -> dict[str, Any]:
         if app.openapi_schema is None:
             _document_problems_and_security(FastAPI.openapi(app))
+            add_examples(app.openapi_schema)  # issue 15: examples from the catalogue (service/api/examples.py)
         return app.openapi_schema
 
     app.openapi = openapi  # type: ignore[method-assign]

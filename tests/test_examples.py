@@ -88,3 +88,21 @@ def test_every_main_response_has_an_example_that_is_the_service_answer(client):
         response = client.request(method.upper(), path.replace("{robot_id}", robot_id), json=first.get("value"))
         assert response.status_code == 200
         _close(answers[operation_id], trimmed(response.json()), operation_id)
+
+
+def test_every_schema_and_every_property_is_described():
+    undescribed = []
+    for name, schema in SPEC["components"]["schemas"].items():
+        if not schema.get("description", "").strip():
+            undescribed.append(name)
+        for prop, value in schema.get("properties", {}).items():
+            if not value.get("description", "").strip():
+                undescribed.append(f"{name}.{prop}")
+    assert undescribed == []
+
+
+def test_every_operation_and_parameter_is_described():
+    for path, method, operation in _operations():
+        assert operation.get("description") or operation.get("summary"), f"{method} {path}"
+        for parameter in operation.get("parameters", []):
+            assert parameter.get("description"), f"{method} {path}: {parameter['name']}"

@@ -28,20 +28,22 @@ PROBLEM_TYPE_BASE = "https://kinematics-service.dev/problems/"
 
 
 class FieldError(ApiModel):
+    """One field-level problem."""
+
     loc: list[str | int] = Field(description="path of the offending field, starting with body, path, query or header")
-    msg: str
-    type: str
+    msg: str = Field(description="what is wrong with the field")
+    type: str = Field(description="machine-readable kind, e.g. missing, matrix_shape, quaternion_order")
 
 
 class Problem(ApiModel):
     """An RFC 9457 problem document."""
 
     type: str = Field(description="URI naming the kind of problem")
-    title: str
-    status: int
-    detail: str
-    instance: str | None = None
-    errors: list[FieldError] | None = None
+    title: str = Field(description="short summary of the kind of problem")
+    status: int = Field(description="the HTTP status code")
+    detail: str = Field(description="what went wrong with this request, and what to send instead")
+    instance: str | None = Field(None, description="the request path")
+    errors: list[FieldError] | None = Field(None, description="field-level problems, each with its location")
     nearest_ids: list[str] | None = Field(
         None, description="with an unknown robot id (404): the catalogue ids nearest the one given, best first")
 

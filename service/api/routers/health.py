@@ -5,14 +5,18 @@ from __future__ import annotations
 from fastapi import APIRouter, Request
 
 from ..problems import ProblemError, problem_responses
+from pydantic import Field
+
 from ..schemas.common import ApiModel
 
 router = APIRouter(tags=["health"])
 
 
 class Health(ApiModel):
-    status: str
-    robots: int | None = None
+    """Liveness or readiness of the process."""
+
+    status: str = Field(description="ok (liveness) or ready (readiness)")
+    robots: int | None = Field(None, description="robots in the loaded catalogue (readiness)")
 
 
 @router.get("/healthz", operation_id="liveness", response_model=Health, response_model_exclude_none=True)

@@ -10,17 +10,23 @@ from .robots import RobotDescription
 
 
 class FKRequest(ApiModel):
+    """Joint values whose tool pose (and link frames) to compute."""
+
     joints: list[Number] = Field(description="one value per joint, in table order")
     frames: bool = Field(False, description="also return the pose of every link frame")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
 
 
 class FKInlineRequest(FKRequest):
-    robot: RobotDescription
+    """Forward kinematics for a robot described in the request body."""
+
+    robot: RobotDescription = Field(description="the robot, described as in the catalogue")
 
 
 class FKResponse(ApiModel):
-    robot_id: RobotId
+    """The tool pose, and with frames=true every link frame's."""
+
+    robot_id: RobotId = Field(description="the catalogue id, or the inline robot's id")
     pose: Pose = Field(description="world_T_tool")
     frames: list[NamedPose] | None = Field(
         None, description="with frames=true: the base frame, every link frame (named by its joint), and the tool"
@@ -28,10 +34,14 @@ class FKResponse(ApiModel):
 
 
 class FKBatchRequest(ApiModel):
+    """Many joint vectors, one tool pose each (vectorised)."""
+
     joints: list[list[Number]] = Field(min_length=1, description="one row of joint values per configuration")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
 
 
 class FKBatchResponse(ApiModel):
-    robot_id: RobotId
+    """One tool pose per row of joint values."""
+
+    robot_id: RobotId = Field(description="the catalogue id")
     poses: list[Pose] = Field(description="one pose per row, in request order")

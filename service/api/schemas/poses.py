@@ -13,8 +13,8 @@ from .common import ApiModel, Matrix3, Matrix4, Number, RealMatrix4, RealVector3
 class MatrixOrientation(ApiModel):
     """A 3×3 rotation matrix, orthonormal within 1e-6 with determinant +1."""
 
-    type: Literal["matrix"]
-    matrix: Matrix3
+    type: Literal["matrix"] = Field(description="names this variant")
+    matrix: Matrix3 = Field(description="world_R_tool, 3×3, row-major")
 
 
 class QuaternionOrientation(ApiModel):
@@ -24,22 +24,22 @@ class QuaternionOrientation(ApiModel):
     ``[0, 0, 0, 1]`` here is w = 0, z = 1, a half turn about z, not the identity ``[1, 0, 0, 0]``.
     """
 
-    type: Literal["quaternion"]
+    type: Literal["quaternion"] = Field(description="names this variant")
     wxyz: Vector4 = Field(description="(w, x, y, z), scalar first")
 
 
 class EulerZYZOrientation(ApiModel):
     """ZYZ Euler angles (φ, θ, ψ): R = Rot_z(φ)·Rot_y(θ)·Rot_z(ψ), in the request's angle unit."""
 
-    type: Literal["euler_zyz"]
-    angles: Vector3
+    type: Literal["euler_zyz"] = Field(description="names this variant")
+    angles: Vector3 = Field(description="(φ, θ, ψ), the request's angle unit")
 
 
 class RPYOrientation(ApiModel):
     """Roll, pitch, yaw about the fixed X, Y, Z axes: R = Rot_z(yaw)·Rot_y(pitch)·Rot_x(roll), in the request's angle unit."""
 
-    type: Literal["rpy"]
-    angles: Vector3
+    type: Literal["rpy"] = Field(description="names this variant")
+    angles: Vector3 = Field(description="(roll, pitch, yaw), the request's angle unit")
 
 
 Orientation = Annotated[
@@ -109,12 +109,14 @@ class PoseTarget(ApiModel):
 class Pose(ApiModel):
     """A pose in the world frame, in three forms so that no client has to convert."""
 
-    matrix: RealMatrix4
-    position: RealVector3
+    matrix: RealMatrix4 = Field(description="the pose as a 4×4 homogeneous transform, row-major")
+    position: RealVector3 = Field(description="the frame's origin, robot length unit")
     quaternion_wxyz: RealVector4 = Field(description="unit quaternion (w, x, y, z) with w ≥ 0")
 
 
 class NamedPose(Pose):
+    """The pose of one named frame."""
+
     name: str = Field(description="'base', the joint name of the link frame, or 'tool'")
 
 

@@ -40,4 +40,4 @@ class RenderRequest(ApiModel):
 class RenderInlineRequest(RenderRequest):
     """A picture of a robot described in the request body."""
 
-    robot: RobotDescription
+    robot: RobotDescription = Field(description="the robot, described as in the catalogue")

@@ -15,6 +15,8 @@ from pydantic import Field, RootModel, model_validator
 from .common import AngleUnit, Matrix4, Number, RobotId, ApiModel
 
 class JointType(str, Enum):
+    """revolute: the variable is the angle θ; prismatic: the variable is the offset d (r in Khalil form)."""
+
     revolute = "revolute"
     prismatic = "prismatic"
 
@@ -36,8 +38,8 @@ class JointLimits(ApiModel):
     prismatic ones. A null bound is open on that side (a slide that only has to stay positive: lower 0, upper null).
     """
 
-    lower: Number | None
-    upper: Number | None
+    lower: Number | None = Field(description="lowest value of q; null: open below")
+    upper: Number | None = Field(description="highest value of q; null: open above")
 
     @model_validator(mode="after")
     def _ordered(self) -> "JointLimits":
@@ -55,12 +57,12 @@ class DHJoint(ApiModel):
     """
 
     name: str | None = Field(None, max_length=64, description="defaults to q1, q2, …")
-    type: JointType = "revolute"
-    a: Number = 0.0
-    alpha: Number = 0.0
-    theta: Number = 0.0
-    limits: JointLimits | None = None
-    d: Number = 0.0
+    type: JointType = Field("revolute", description="revolute (variable θ) or prismatic (variable d)")
+    a: Number = Field(0.0, description="link length along x, length unit (Craig: a_{i-1})")
+    alpha: Number = Field(0.0, description="link twist about x, the description's angle unit (Craig: α_{i-1})")
+    theta: Number = Field(0.0, description="joint angle about z, angle unit; an offset added to q when revolute")
+    limits: JointLimits | None = Field(None, description="bounds on q; null: unlimited (continuous)")
+    d: Number = Field(0.0, description="link offset along z, length unit; an offset added to q when prismatic")
 
 
 class KhalilJoint(ApiModel):
@@ -70,25 +72,26 @@ class KhalilJoint(ApiModel):
     """
 
     name: str | None = Field(None, max_length=64, description="defaults to q1, q2, …")
-    type: JointType = "revolute"
-    alpha: Number = 0.0
-    theta: Number = 0.0
-    r: Number = 0.0
-    limits: JointLimits | None = None
-    d: Number = 0.0
+    type: JointType = Field("revolute", description="revolute (variable θ) or prismatic (variable r)")
+    alpha: Number = Field(0.0, description="twist about x_{j-1}, the description's angle unit")
+    theta: Number = Field(0.0, description="angle about z_j, angle unit; an offset added to q when revolute")
+    r: Number = Field(0.0, description="distance along z_j, length unit; an offset added to q when prismatic")
+    limits: JointLimits | None = Field(None, description="bounds on q; null: unlimited (continuous)")
+    d: Number = Field(0.0, description="distance along x_{j-1}, length unit (Craig's a_{j-1})")
 
 
 class _RobotFields(ApiModel):
-    id: RobotId = "inline"
-    name: str = Field("", max_length=200)
+    id: RobotId = Field("inline", description="lower case [a-z0-9_-]; a catalogue file's id is its file name")
+    name: str = Field("", max_length=200, description="a readable name")
     source: str = Field("", max_length=2000, description="where the parameters come from")
     angle_unit: AngleUnit = Field("rad", description="unit of alpha, theta and revolute limits in this description")
-    length_unit: str = Field("m", max_length=16)
+    length_unit: str = Field("m", max_length=16, description="unit of every length in this description and its "
+                                                             "answers, e.g. m or mm")
     parameters: RobotParameters | None = Field(
         None, description="values given to the source's symbolic lengths (informational)"
     )
     limits_source: str | None = Field(None, max_length=2000, description="where the joint limits come from")
-    notes: str | None = Field(None, max_length=4000)
+    notes: str | None = Field(None, max_length=4000, description="free text: frame choices, joint zeros, caveats")
     base: Matrix4 | None = Field(None, description="world_T_base; identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool; identity when null")
 
@@ -96,28 +99,32 @@ class _RobotFields(ApiModel):
 class DHRobot(_RobotFields):
     """A robot described by a standard (Spong/Paul) or modified (Craig) DH table."""
 
-    convention: Literal["standard", "modified"]
-    joints: list[DHJoint] = Field(min_length=1)
+    convention: Literal["standard", "modified"] = Field(description="standard (Spong/Paul) or modified (Craig) DH")
+    joints: list[DHJoint] = Field(min_length=1, description="one row per joint, base to tool")
 
 
 class KhalilRobot(_RobotFields):
     """A robot described by a Khalil–Kleinfinger table."""
 
-    convention: Literal["khalil"]
-    joints: list[KhalilJoint] = Field(min_length=1)
+    convention: Literal["khalil"] = Field(description="Khalil–Kleinfinger")
+    joints: list[KhalilJoint] = Field(min_length=1, description="one row per joint, base to tool")
 
 
 RobotDescription = Annotated[Union[DHRobot, KhalilRobot], Field(discriminator="convention")]
 
 
 class RobotSummary(ApiModel):
-    id: RobotId
-    name: str
-    dof: int
-    convention: Convention
-    joint_types: list[JointType]
-    source: str
+    """One catalogue robot at a glance."""
+
+    id: RobotId = Field(description="catalogue id, for /v1/robots/{robot_id}/...")
+    name: str = Field(description="a readable name")
+    dof: int = Field(description="number of joints")
+    convention: Convention = Field(description="the table's DH convention")
+    joint_types: list[JointType] = Field(description="each joint's type, base to tool")
+    source: str = Field(description="where the parameters come from")
 
 
 class RobotList(ApiModel):
-    robots: list[RobotSummary]
+    """The catalogue."""
+
+    robots: list[RobotSummary] = Field(description="every robot, in id order")

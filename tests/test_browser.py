@@ -50,6 +50,27 @@ def test_swagger_ui_renders_every_operation_offline(browser, base_url):
     assert f"{base_url}/static/docs/swagger-ui-bundle.js" in browser.requests
 
 
+def test_swagger_try_it_out_runs_the_prefilled_ik_example(browser, base_url):
+    """The issue's first complaint: "Try it out" on IK pre-filled an invalid body and answered 422."""
+    browser.clear()
+    browser.navigate(f"{base_url}/docs?try-it-out")  # a new document, so the load event fires again
+    block = "document.querySelector('#operations-inverse_kinematics-inverse_kinematics')"
+    browser.wait_for(f"{block} !== null")
+    browser.evaluate(f"(() => {{ const b = {block}; if (!b.classList.contains('is-open'))"
+                     " b.querySelector('.opblock-summary-control').click(); })()")
+    browser.wait_for(f"{block}.querySelector('button.execute') !== null")
+    prefilled = browser.wait_for(f"{block}.querySelector('textarea.body-param__text')?.value")
+    assert json.loads(prefilled)["target"]["orientation"]["type"] == "quaternion"
+    robot_id = browser.evaluate(f"{block}.querySelector('tr[data-param-name=robot_id] input')?.value")
+    assert robot_id == "ur5"
+    browser.evaluate(f"{block}.querySelector('button.execute').click()")
+    status = browser.wait_for(f"{block}.querySelector('.live-responses-table .response .response-col_status')"
+                              "?.textContent.trim()", timeout=60)
+    assert status.startswith("200"), status
+    browser.screenshot("docs-try-it-out.png")
+    assert browser.foreign_requests(base_url) == []
+
+
 def test_redoc_renders_every_operation_offline(browser, base_url):
     browser.clear()
     browser.navigate(f"{base_url}/redoc")

@@ -159,3 +159,12 @@ def test_quaternion_wxyz_is_scalar_first(client):
     for solution in answer["solutions"][:8]:
         np.testing.assert_allclose(forward_kinematics(robot, solution["joints"])[:3, :3],
                                    matrix_from_quaternion(np.array([0.0, 0.0, 0.0, 1.0])), atol=1e-9)
+
+
+@pytest.mark.parametrize("path, body", [
+    ("/v1/robots/ur5/fk", {"joints": UR5_Q, "frames": 0}),
+    ("/v1/robots/ur5/ik", {"target": {"position": [0.3, 0.2, 0.4]}, "filter_limits": 1}),
+])
+def test_flags_are_json_booleans(client, path, body):
+    """Found by schemathesis once the spec had examples to start from: 0 and 1 were read as false and true."""
+    assert_problem(client.post(path, json=body), 422, loc=["body", next(iter(set(body) - {"joints", "target"}))])

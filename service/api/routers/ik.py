@@ -38,10 +38,10 @@ from ..observability import observe_ik
 from ..problems import problem_responses
 from ..responses import FastJSONResponse
 from ..routing import FastJSONRoute
-from ..schemas.render import RenderView
-from .render import IK_PICTURE_RESPONSE, ik_picture, wants_svg
 from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest,
                           IKResponse)
+from ..schemas.render import RenderView
+from .render import IK_PICTURE_RESPONSE, ik_picture, wants_svg
 
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinematics"])
 RENDER_QUERY = Query(None, description="answer with an SVG picture of every distinct solution (those that differ "

@@ -44,6 +44,9 @@ def _square_shape(size: int, what: str):
     return BeforeValidator(check)
 
 
+#: A JSON boolean in a request: true or false only (0, 1 and "yes" are refused, as the spec says).
+Flag = Annotated[bool, Strict()]
+
 Vector3 = Annotated[list[Number], Field(min_length=3, max_length=3)]
 Vector4 = Annotated[list[Number], Field(min_length=4, max_length=4)]
 Matrix3 = Annotated[list[Vector3], _square_shape(3, "rotation matrix"),

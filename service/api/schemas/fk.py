@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from .common import ANGLE_UNIT_FIELD, AngleUnit, Number, RobotId, ApiModel
+from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Flag, Number, RobotId
 from .poses import NamedPose, Pose
 from .robots import RobotDescription
 
@@ -13,7 +13,7 @@ class FKRequest(ApiModel):
     """Joint values whose tool pose (and link frames) to compute."""
 
     joints: list[Number] = Field(description="one value per joint, in table order")
-    frames: bool = Field(False, description="also return the pose of every link frame")
+    frames: Flag = Field(False, description="also return the pose of every link frame")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
 
 

@@ -8,7 +8,7 @@ from typing import Annotated, Literal
 from pydantic import Field, model_serializer
 
 from ...kinematics.ik import MAX_EQUIVALENTS
-from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RobotId
+from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Flag, Number, RobotId
 from .limits import JointLimitsOverride, LimitViolation
 from .poses import PoseTarget
 from .robots import RobotDescription
@@ -98,7 +98,7 @@ class _Targets(ApiModel):
 class IKRequestOptions(ApiModel):
     """What every IK request may say besides its target(s)."""
 
-    filter_limits: bool = Field(
+    filter_limits: Flag = Field(
         True, description="move solutions that violate a joint limit, whatever whole turns their revolute joints "
                           "make, to `rejected`; when false they stay in `solutions` with within_limits false")
     reference: list[Number] | None = Field(

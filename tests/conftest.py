@@ -41,3 +41,13 @@ def assert_problem(response, status: int, *, loc: list | None = None, match: str
 def catalogue_robot(client, robot_id: str):
     """The core Robot the service built from a catalogue entry (to compare in the core's units)."""
     return client.app.state.catalogue.get(robot_id).robot
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    """List the browser tests' screenshots (test artifacts) at the end of the run."""
+    from tests.browser import SCREENSHOTS
+
+    if SCREENSHOTS:
+        terminalreporter.section("screenshots (test artifacts)")
+        for path in SCREENSHOTS:
+            terminalreporter.write_line(str(path))

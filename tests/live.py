@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import random
 import signal
 import socket
 import subprocess
@@ -18,9 +19,12 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def free_port() -> int:
-    """A free loopback port: any, or the first free one of ``KIN_TEST_PORTS`` ("18600-18699") when it is set."""
+    """A free loopback port: any, or one in ``KIN_TEST_PORTS`` ("18700-18799") when that is set."""
     span = os.environ.get("KIN_TEST_PORTS")
-    candidates = [0] if not span else range(int(span.split("-")[0]), int(span.split("-")[1]) + 1)
+    candidates = [0]
+    if span:
+        low, high = (int(part) for part in span.split("-"))
+        candidates = random.sample(range(low, high + 1), high - low + 1)
     for port in candidates:
         with socket.socket() as probe:
             try:

@@ -43,3 +43,30 @@ def test_trajectories_example_answers_what_the_readme_shows(client):
     np.testing.assert_allclose(answer["summary"]["largest_joint_step"]["values"],
                                shown["summary"]["largest_joint_step"]["values"], atol=1e-6)
     assert answer["solver"] == shown["solver"]
+
+
+def test_the_ur5_solution_counts_the_readme_states(client):
+    """Inclusive bounds: a joint at exactly 0 within ±360° fits three ways, so the counts are not all 512."""
+    import numpy as np
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    paragraph = readme.split("Bounds are inclusive, so a joint at", 1)[1].split("\n\n", 1)[0]
+    stated = [int(n) for n in re.findall(r"\*\*(\d+)\*\*", paragraph)]
+    configurations = [[0.1, -1.2, 1.0, 0.3, 1.5, 0.2], [0.1, -1.2, 1.0, 0.3, 1.5, 0.0],
+                      [0.0, -1.2, 1.0, 0.3, 1.5, 0.2], [0.0] * 6]
+    counted = []
+    for q in configurations:
+        matrix = client.post("/v1/robots/ur5/fk", json={"joints": q}).json()["pose"]["matrix"]
+        answer = client.post("/v1/robots/ur5/ik", json={"target": {"matrix": matrix}}).json()
+        assert answer["status"] == "ok" and not answer["truncated"]
+        counted.append(len(answer["solutions"]))
+        # independent count: the distinct branches (angles wrapped to (-π, π]), times, per joint, the number of
+        # v + 2kπ inside the inclusive [-2π, 2π]
+        branches: list[np.ndarray] = []
+        for joints in np.array([s["joints"] for s in answer["solutions"]]):
+            if not any(np.all(np.abs(np.angle(np.exp(1j * (joints - b)))) < 1e-6) for b in branches):
+                branches.append(joints)
+        branches = np.array(branches)
+        fits = [sum(abs(v + 2 * k * np.pi) <= 2 * np.pi + 1e-9 for k in range(-2, 3)) for v in branches.ravel()]
+        assert len(answer["solutions"]) == int(np.prod(np.reshape(fits, branches.shape), axis=1).sum())
+    assert stated == counted

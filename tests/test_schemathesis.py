@@ -140,6 +140,9 @@ def _meaningful_case(path: str, method: str, robot_id: str, seed: int, variant: 
         "/v1/limits": {"joints": [q.tolist(), (q - 7.0).tolist()], "robot": inline},
         "/v1/robots/{robot_id}/ik/trajectory": {"samples": _samples(robot, q), "reference": q.tolist()},
         "/v1/ik/trajectory": {"samples": _samples(robot, q), "reference": q.tolist(), "robot": inline},
+        "/v1/robots/{robot_id}/render": {"joints": [q.tolist(), _joints(robot, rng).tolist()],
+                                         "view": ("iso", "front", "side", "top", "iso")[variant]},
+        "/v1/render": {"joints": [q.tolist()], "robot": inline, "captions": [f"seed {seed}"]},
     }
     bodies = {key: {**body, **frames} for key, body in bodies.items()}
     operation = schema[path][method.upper()]
@@ -181,6 +184,10 @@ def test_meaningful_requests_succeed_and_conform(path, method, robot_id, seed, v
         pytest.skip(f"no meaningful request written for {method.upper()} {path} yet; the fuzzing above covers it")
     response = case.call_and_validate(headers={"X-API-Key": API_KEY})
     assert response.status_code == 200, response.text
+    if path.endswith("/render"):
+        assert response.headers["content-type"] in ("image/svg+xml", ["image/svg+xml"])  # schemathesis: a list
+        assert response.text.count('class="configuration') == len(case.body["joints"])
+        return
     body = response.json()
     if path.endswith("/ik") or path == "/v1/ik":
         # The target is FK of a joint vector within the limits, so it is reachable within the limits.

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -41,7 +42,8 @@ def sdk(tmp_path_factory):
     """Generate the client package and import it."""
     root = tmp_path_factory.mktemp("sdk")
     config = root / "config.yaml"
-    config.write_text(f"project_name_override: kinematics-client\npackage_name_override: {PACKAGE}\n"
+    shared = (SPEC_PATH.parent / "client-config.yaml").read_text(encoding="utf-8")  # the README's settings
+    config.write_text(shared + f"project_name_override: kinematics-client\npackage_name_override: {PACKAGE}\n"
                       "post_hooks: []\n")
     result = subprocess.run(
         [sys.executable, "-m", "openapi_python_client", "generate", "--path", str(SPEC_PATH), "--meta", "none",
@@ -201,6 +203,15 @@ def test_inverse_kinematics_batch(client):
         assert np.allclose(result.solutions[0].joints, q, atol=1e-9)
 
 
+def test_render_returns_the_svg_text(client):
+    models = _models()
+    picture = _api("pictures.render").sync(
+        robot_id="ur5", client=client,
+        body=models.RenderRequest(joints=[[0.0] * 6, [0.1, -1.2, 1.0, 0.3, 1.5, 0.2]]))
+    assert isinstance(picture, str) and picture.startswith("<svg")
+    assert picture.count('class="configuration') == 2
+
+
 def test_check_joint_limits(client):
     models = _models()
     response = _api("joint_limits.check_joint_limits").sync(
@@ -238,3 +249,87 @@ def test_without_the_key_the_client_gets_a_typed_401(sdk, client):
     with sdk.Client(base_url=str(client._base_url)) as anonymous:
         detailed = _api("robots.list_robots").sync_detailed(client=anonymous)
     assert detailed.status_code == 401 and isinstance(detailed.parsed, models.Problem)
+
+
+# --------------------------------------------------------------------------- a plain Client, and the README script
+
+
+@pytest.fixture(scope="module")
+def open_server(sdk):
+    """A live server without KIN_API_KEY, as most deployments on a cell network run."""
+    with serve() as base_url:
+        yield base_url
+
+
+def test_every_v1_operation_takes_a_plain_client(sdk):
+    """The key is optional in the spec, so no operation demands an AuthenticatedClient."""
+    import inspect
+    import typing
+
+    root = Path(sdk.__file__).parent
+    modules = sorted(p for p in (root / "api").rglob("*.py") if p.stem != "__init__")
+    assert len(modules) >= 14
+    for path in modules:
+        module = importlib.import_module(f"{PACKAGE}.api.{path.parent.name}.{path.stem}")
+        annotation = inspect.signature(module.sync_detailed).parameters["client"].annotation
+        accepted = typing.get_args(annotation) or (annotation,)
+        assert sdk.Client in accepted, (path.stem, annotation)
+
+
+def test_the_security_scheme_names_the_header():
+    import json
+
+    spec = json.loads(SPEC_PATH.read_text(encoding="utf-8"))
+    scheme = spec["components"]["securitySchemes"]["ApiKeyHeader"]
+    assert (scheme["type"], scheme["in"], scheme["name"]) == ("apiKey", "header", "X-API-Key")
+    assert spec["security"] == [{"ApiKeyHeader": []}, {}]  # optional: a plain client is enough without a key
+    assert spec["paths"]["/healthz"]["get"]["security"] == []
+
+
+def test_a_plain_client_works_without_a_key(sdk, open_server):
+    models = _models()
+    with sdk.Client(base_url=open_server, raise_on_unexpected_status=True) as plain:
+        listed = _api("robots.list_robots").sync(client=plain)
+        assert "ur5" in {robot.id for robot in listed.robots}
+        q = [0.1, -1.2, 1.0, 0.3, 1.5, 0.2]
+        pose = _api("forward_kinematics.forward_kinematics").sync(
+            robot_id="ur5", client=plain, body=models.FKRequest(joints=q)).pose
+        # the FK pose as it stands is an IK target
+        answer = _api("inverse_kinematics.inverse_kinematics").sync(
+            robot_id="ur5", client=plain,
+            body=models.IKRequest(target=models.PoseTarget.from_dict(pose.to_dict()), reference=q))
+    assert answer.status == models.IKStatus.OK
+    assert np.allclose(answer.solutions[0].joints, q, atol=1e-9)
+
+
+def test_a_plain_client_with_the_header_works_with_a_key(sdk, client):
+    with sdk.Client(base_url=str(client._base_url), headers={"X-API-Key": API_KEY},
+                    raise_on_unexpected_status=True) as keyed:
+        listed = _api("robots.list_robots").sync(client=keyed)
+    assert len(listed.robots) == len(CATALOGUE)
+
+
+def _readme_sdk_section() -> str:
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
+    return readme.split("### Python SDK", 1)[1].split("\n### ", 1)[0]
+
+
+def test_the_readme_sdk_script_runs_and_prints_what_the_readme_says(sdk, open_server):
+    import os
+    import re
+
+    section = _readme_sdk_section()
+    script = re.search(r"```python\n(.+?)\n```", section, re.S).group(1)
+    shown = re.search(r"It prints `(.+?)`", section).group(1)
+    root = Path(sdk.__file__).parent.parent
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120,
+                            env={**os.environ, "KIN_URL": open_server,
+                                 "PYTHONPATH": os.pathsep.join([str(root), os.environ.get("PYTHONPATH", "")])})
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == shown
+
+
+def test_the_readme_generate_command_is_the_one_this_test_runs():
+    command = re.search(r"```sh\n(openapi-python-client generate .+?)\n```", _readme_sdk_section()).group(1)
+    assert command.split()[:4] == ["openapi-python-client", "generate", "--path", "openapi/openapi.json"]
+    assert "--meta none" in command and "--config openapi/client-config.yaml" in command

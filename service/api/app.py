@@ -19,8 +19,10 @@ from ..kinematics import BudgetExhausted
 from .budget import TIMEOUT_HEADER, InFlight, WorkLimits, budget_exhausted
 from .limits import BodySizeLimit
 from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
+from .examples import add_examples
+from .pages import install_pages
 from .problems import PROBLEM_MEDIA_TYPE, Problem, install_problem_handlers
-from .routers import fk, health, ik, limits, robots, trajectory
+from .routers import fk, health, ik, limits, render, robots, trajectory
 from .security import API_KEY_HEADER, API_KEY_SCHEME, ApiKeyMiddleware, is_protected
 
 logger = logging.getLogger("service")
@@ -74,6 +76,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         description=DESCRIPTION,
         lifespan=lifespan,
         generate_unique_id_function=_operation_id,
+        # /docs and /redoc are served offline by install_pages (below), not from a CDN
+        docs_url=None,
+        redoc_url=None,
     )
     app.state.settings = settings
     app.state.catalogue = None
@@ -97,9 +102,15 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.include_router(module.router)
     app.include_router(metrics_router)
 
+    # --- pages for people (issue 15): pictures, landing page, offline docs, viewer ----------------------------
+    app.include_router(render.router)
+    install_pages(app)
+    # ------------------------------------------------------------------------------------------------------------
+
     def openapi() -> dict[str, Any]:
         if app.openapi_schema is None:
             _document_problems_and_security(FastAPI.openapi(app))
+            add_examples(app.openapi_schema)  # issue 15: examples from the catalogue (service/api/examples.py)
         return app.openapi_schema
 
     app.openapi = openapi  # type: ignore[method-assign]
@@ -127,12 +138,18 @@ def _document_problems_and_security(spec: dict[str, Any]) -> None:
     components["securitySchemes"] = {API_KEY_SCHEME: {
         "type": "apiKey", "in": "header", "name": API_KEY_HEADER,
         "description": "Required on /v1 only when the service runs with KIN_API_KEY; compared in constant time."}}
+    # The key is optional (the empty requirement {}), and declared once for the document rather than on each
+    # operation: generated clients (openapi-python-client) then accept a plain Client on every operation, which
+    # is all a service without KIN_API_KEY needs, instead of demanding an AuthenticatedClient that sends
+    # "Authorization: Bearer". With a key: Client(headers={"X-API-Key": key}). Open routes opt out with [].
+    spec["security"] = [{API_KEY_SCHEME: []}, {}]
     for path, operations in spec.get("paths", {}).items():
         for operation in operations.values():
             statuses: set[int] = set()
             if is_protected(path):
                 statuses.add(401)
-                operation["security"] = [{API_KEY_SCHEME: []}]
+            else:
+                operation["security"] = []
             if "requestBody" in operation:
                 statuses |= {413, 422}
             if operation.get("parameters"):

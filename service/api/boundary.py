@@ -72,17 +72,29 @@ def joints_from_core(robot: Robot, q: np.ndarray, unit: AngleUnit) -> np.ndarray
     return np.asarray(q, dtype=float) / _unit_scale(robot, unit)
 
 
+#: How closely the position and quaternion that accompany a target's matrix must agree with it (an FK pose
+#: sent back as it stands agrees to rounding; a hand-edited one that disagrees is refused, not half-used).
+POSE_AGREEMENT_TOLERANCE = 1e-6
+
+
 def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool]:
     """The 4×4 ``world_T_tool`` a target asks for, and whether it constrains orientation.
 
-    A position-only target returns the identity rotation and ``False``.
+    A position-only target returns the identity rotation and ``False``. A matrix that comes with ``position``
+    and ``quaternion_wxyz`` (a forward-kinematics pose sent back as it stands) must agree with them.
     """
     if target.matrix is not None:
         with located("matrix"):
-            return check_transform(np.asarray(target.matrix, dtype=float)), True
+            T = check_transform(np.asarray(target.matrix, dtype=float))
+        _check_pose_agrees(T, target.position, target.quaternion_wxyz)
+        return T, True
     T = np.eye(4)
     T[:3, 3] = target.position
     orientation = target.orientation
+    if orientation is None and target.quaternion_wxyz is not None:
+        with located("quaternion_wxyz"):
+            T[:3, :3] = matrix_from_quaternion(check_unit_quaternion(np.asarray(target.quaternion_wxyz, dtype=float)))
+        return T, True
     if orientation is None:
         return T, False
     angle = _DEGREE if unit == "deg" else 1.0
@@ -100,6 +112,25 @@ def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool
     return T, True
 
 
+def _check_pose_agrees(T: np.ndarray, position: Sequence[float] | None, wxyz: Sequence[float] | None) -> None:
+    """Refuse a position or quaternion that disagrees with the target's matrix ``T``, shape (4, 4)."""
+    if position is not None:
+        gap = float(np.max(np.abs(np.asarray(position) - T[:3, 3])))
+        scale = max(1.0, float(np.max(np.abs(T[:3, 3]))))
+        if gap > POSE_AGREEMENT_TOLERANCE * scale:
+            raise InvalidInputError(f"position {list(position)} disagrees with the matrix's last column "
+                                    f"{T[:3, 3].tolist()} (by {gap:.3g}); send one of them, or both equal",
+                                    location=("position",))
+    if wxyz is not None:
+        q = np.asarray(wxyz, dtype=float)
+        expected = quaternions_from_matrices(T[None, :3, :3])[0]
+        gap = float(min(np.max(np.abs(q - expected)), np.max(np.abs(q + expected))))  # q and -q are one turn
+        if gap > POSE_AGREEMENT_TOLERANCE:
+            raise InvalidInputError(f"quaternion_wxyz {list(wxyz)} disagrees with the matrix's rotation, whose "
+                                    f"quaternion (w, x, y, z) is {np.round(expected, 9).tolist()}; send one of "
+                                    f"them, or both equal", location=("quaternion_wxyz",))
+
+
 def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str | int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`target_matrix` for many targets: (N, 4, 4) matrices and which constrain orientation (N,).
 
@@ -110,7 +141,12 @@ def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str
     if all(target.matrix is not None for target in targets):
         stacked = np.array([target.matrix for target in targets], dtype=float)
         try:
-            return check_transforms(stacked), np.ones(len(targets), dtype=bool)
+            matrices = check_transforms(stacked)
+            for index, target in enumerate(targets):  # FK poses sent back as they stand
+                if target.position is not None or target.quaternion_wxyz is not None:
+                    with located(*prefix, index):
+                        _check_pose_agrees(matrices[index], target.position, target.quaternion_wxyz)
+            return matrices, np.ones(len(targets), dtype=bool)
         except KinematicsError:
             pass  # the per-target pass below reports it with its full location
     matrices = np.empty((len(targets), 4, 4))

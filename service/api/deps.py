@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import difflib
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -37,13 +39,41 @@ def catalogue_of(request: Request) -> Catalogue:
 
 def catalogue_robot(
     request: Request,
-    robot_id: str = Path(pattern=r"^[a-z0-9][a-z0-9_-]{0,63}$", description="catalogue id, see GET /v1/robots"),
+    robot_id: str = Path(pattern=r"^[A-Za-z0-9][A-Za-z0-9_-]{0,63}$",
+                         description="catalogue id, see GET /v1/robots; ids are lower case and matched "
+                                     "case-insensitively (UR5 is ur5)"),
 ) -> RobotRef:
-    entry = catalogue_of(request).get(robot_id)
+    catalogue = catalogue_of(request)
+    entry = catalogue.get(robot_id.lower())
     if entry is None:
+        ids = [e.description.id for e in catalogue.entries()]
+        nearest = nearest_ids(robot_id, ids)
+        hint = f" Did you mean {' or '.join(repr(i) for i in nearest)}?" if nearest else ""
         raise ProblemError(404, "unknown-robot", "Unknown robot",
-                           f"No robot with id {robot_id!r} in the catalogue; GET /v1/robots lists them.")
-    return RobotRef(robot_id, entry.robot)
+                           f"No robot with id {robot_id!r} in the catalogue.{hint} GET /v1/robots lists all "
+                           f"{len(ids)}.", nearest_ids=nearest)
+    return RobotRef(entry.description.id, entry.robot)
+
+
+def nearest_ids(wanted: str, ids: list[str], limit: int = 5) -> list[str]:
+    """Catalogue ids a client may have meant by ``wanted``, best first.
+
+    First the ids equal to it once case, ``-`` and ``_`` are ignored (``UR-5`` → ``ur5``), then ids that
+    contain it or that it contains (``puma`` → the PUMA tables), then close spellings (difflib's ratio ≥ 0.6).
+    """
+    def folded(text: str) -> str:
+        return text.lower().replace("-", "").replace("_", "")
+
+    key = folded(wanted)
+    chosen = [i for i in ids if folded(i) == key]
+    chosen += [i for i in ids if i not in chosen and key and (
+        folded(i).startswith(key) or len(key) >= 3 and key in folded(i) or folded(i) in key)]
+    chosen += [i for i in difflib.get_close_matches(wanted.lower(), ids, n=limit, cutoff=0.6) if i not in chosen]
+    family = re.match(r"[a-z]{2,}", key)  # the maker's letters: ur10 → ur5
+    if family:
+        chosen += [i for i in ids if i not in chosen and folded(i).startswith(family[0])
+                   and not folded(i)[len(family[0]):][:1].isalpha()]
+    return chosen[:limit]
 
 
 def inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef:

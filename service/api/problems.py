@@ -29,41 +29,48 @@ PROBLEM_TYPE_BASE = "https://kinematics-service.dev/problems/"
 
 
 class FieldError(ApiModel):
+    """One field-level problem."""
+
     loc: list[str | int] = Field(description="path of the offending field, starting with body, path, query or header")
-    msg: str
-    type: str
+    msg: str = Field(description="what is wrong with the field")
+    type: str = Field(description="machine-readable kind, e.g. missing, matrix_shape, quaternion_order")
 
 
 class Problem(ApiModel):
     """An RFC 9457 problem document."""
 
     type: str = Field(description="URI naming the kind of problem")
-    title: str
-    status: int
-    detail: str
-    instance: str | None = None
-    errors: list[FieldError] | None = None
+    title: str = Field(description="short summary of the kind of problem")
+    status: int = Field(description="the HTTP status code")
+    detail: str = Field(description="what went wrong with this request, and what to send instead")
+    instance: str | None = Field(None, description="the request path")
+    errors: list[FieldError] | None = Field(None, description="field-level problems, each with its location")
+    nearest_ids: list[str] | None = Field(
+        None, description="with an unknown robot id (404): the catalogue ids nearest the one given, best first")
 
 
 class ProblemError(Exception):
     """Raise from a router to answer with a problem document."""
 
     def __init__(self, status: int, slug: str, title: str, detail: str, errors: list[dict] | None = None,
-                 headers: dict[str, str] | None = None) -> None:
+                 headers: dict[str, str] | None = None, **extensions: object) -> None:
         super().__init__(detail)
         self.status, self.slug, self.title, self.detail, self.errors = status, slug, title, detail, errors
         self.headers = headers
+        #: RFC 9457 extension members, each declared in :class:`Problem` (e.g. ``nearest_ids``)
+        self.extensions = extensions
 
 
 def problem_response(
     status: int, slug: str, title: str, detail: str, *, instance: str | None = None, errors: list[dict] | None = None,
-    headers: dict[str, str] | None = None,
+    headers: dict[str, str] | None = None, extensions: dict[str, Any] | None = None,
 ) -> JSONResponse:
     body: dict[str, Any] = {"type": PROBLEM_TYPE_BASE + slug, "title": title, "status": status, "detail": detail}
     if instance:
         body["instance"] = instance
     if errors is not None:
         body["errors"] = errors
+    body.update(extensions or {})
     return JSONResponse(body, status_code=status, media_type=PROBLEM_MEDIA_TYPE, headers=headers)
 
 
@@ -97,7 +104,7 @@ async def _kinematics_error(request: Request, exc: KinematicsError) -> JSONRespo
 
 async def _problem_error(request: Request, exc: ProblemError) -> JSONResponse:
     return problem_response(exc.status, exc.slug, exc.title, exc.detail, instance=request.url.path, errors=exc.errors,
-                            headers=exc.headers)
+                            headers=exc.headers, extensions=exc.extensions)
 
 
 _HTTP_TITLES = {404: ("not-found", "Not found"), 405: ("method-not-allowed", "Method not allowed"),

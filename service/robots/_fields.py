@@ -8,7 +8,8 @@ from __future__ import annotations
 from enum import Enum
 from typing import Annotated
 
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict
+from pydantic import AllowInfNan, BaseModel, BeforeValidator, ConfigDict, Field, Strict
+from pydantic_core import PydanticCustomError
 
 #: Largest magnitude of any number in a request. Float64 spacing at 1e6 is 1.2e-10, still below the service's
 #: tolerances (1e-9), so every answer inside the bound keeps the promised accuracy, and no product or sum of such
@@ -27,10 +28,30 @@ class AngleUnit(str, Enum):
     deg = "deg"
 
 
+def square_shape(size: int, what: str):
+    """A before-validator that names the expected shape when a matrix has the wrong number of rows or entries
+    (rather than pydantic's generic list-length message)."""
+
+    def check(value: object) -> object:
+        if isinstance(value, list):
+            if len(value) != size:
+                raise PydanticCustomError("matrix_shape", "a {size}×{size} {what} is expected, got {rows} rows",
+                                          {"size": size, "what": what, "rows": len(value)})
+            for index, row in enumerate(value):
+                if isinstance(row, list) and len(row) != size:
+                    raise PydanticCustomError(
+                        "matrix_shape", "a {size}×{size} {what} is expected, row {index} has {entries} entries",
+                        {"size": size, "what": what, "index": index, "entries": len(row)})
+        return value
+
+    return BeforeValidator(check)
+
+
 Vector3 = Annotated[list[Number], Field(min_length=3, max_length=3)]
 Matrix4Row = Annotated[list[Number], Field(min_length=4, max_length=4)]
 Matrix4 = Annotated[
     list[Matrix4Row],
+    square_shape(4, "homogeneous transform"),
     Field(min_length=4, max_length=4, description="4×4 homogeneous transform, row-major; last row 0 0 0 1"),
 ]
 RobotId = Annotated[str, Field(pattern=r"^[a-z0-9][a-z0-9_-]{0,63}$", examples=["puma560_modified"])]

@@ -7,6 +7,7 @@ every solver thread is busy.
 from __future__ import annotations
 
 from fastapi import APIRouter, Request
+from pydantic import Field
 
 from ..problems import ProblemError, problem_responses
 from ..schemas.common import ApiModel
@@ -15,9 +16,11 @@ router = APIRouter(tags=["health"])
 
 
 class Health(ApiModel):
-    status: str
-    robots: int | None = None
-    in_flight: int | None = None
+    """Liveness or readiness of the process."""
+
+    status: str = Field(description="ok (liveness) or ready (readiness)")
+    robots: int | None = Field(None, description="robots in the loaded catalogue (readiness)")
+    in_flight: int | None = Field(None, description="requests being solved now (readiness)")
 
 
 @router.get("/healthz", operation_id="liveness", response_model=Health, response_model_exclude_none=True)

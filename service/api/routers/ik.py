@@ -5,7 +5,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from fastapi import APIRouter, Depends, Request
+from fastapi import APIRouter, Depends, Query, Request
 
 from ...kinematics import Robot
 from ...kinematics.ik import (
@@ -43,8 +43,13 @@ from ..responses import FastJSONResponse
 from ..routing import FastJSONRoute
 from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest,
                           IKResponse)
+from ..schemas.render import RenderView
+from .render import IK_PICTURE_RESPONSE, ik_picture, wants_svg
 
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinematics"])
+RENDER_QUERY = Query(None, description="answer with an SVG picture of every distinct solution (those that differ "
+                                       "only by whole turns share a panel) seen from this view, instead of JSON; "
+                                       "the same as Accept: image/svg+xml with the iso view")
 
 
 def _numeric_options(request: Request, body: IKRequest | IKBatchRequest, targets: int) -> IKOptions:
@@ -329,17 +334,27 @@ def _wire(robot_id: str, result: IKResult, status: str, solutions: list[dict], r
 
 
 @router.post("/robots/{robot_id}/ik", operation_id="inverse_kinematics", response_model=IKResponse,
-             responses=problem_responses(404, 422))
-def inverse_kinematics(request: Request, body: IKRequest, ref: RobotRef = Depends(catalogue_robot)) -> dict:
+             responses={200: IK_PICTURE_RESPONSE, **problem_responses(404, 422)})
+def inverse_kinematics(request: Request, body: IKRequest, ref: RobotRef = Depends(catalogue_robot),
+                       render: RenderView | None = RENDER_QUERY):
     """Every joint vector that reaches the target pose, each checked by forward kinematics."""
-    return _solve(request, ref, body, [body.target])[0]
+    return _answer_or_picture(request, ref, body, render)
 
 
 @router.post("/ik", operation_id="inverse_kinematics_inline", response_model=IKResponse,
-             responses=problem_responses(422))
-def inverse_kinematics_inline(request: Request, body: IKInlineRequest) -> dict:
+             responses={200: IK_PICTURE_RESPONSE, **problem_responses(422)})
+def inverse_kinematics_inline(request: Request, body: IKInlineRequest, render: RenderView | None = RENDER_QUERY):
     """Inverse kinematics for a robot described in the request body."""
-    return _solve(request, inline_robot(request, body.robot), body, [body.target])[0]
+    return _answer_or_picture(request, inline_robot(request, body.robot), body, render)
+
+
+# --- the answer as a picture (issue 15): ?render=VIEW or Accept: image/svg+xml --------------------------------
+def _answer_or_picture(request: Request, ref: RobotRef, body: IKRequest, render: RenderView | None):
+    answer = _solve(request, ref, body, [body.target])[0]
+    if render is None and not wants_svg(request):
+        return answer
+    return ik_picture(ref.robot, ref.id, answer, body.angle_unit, render or "iso", body.reference is not None)
+# ---------------------------------------------------------------------------------------------------------------
 
 
 @router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch",

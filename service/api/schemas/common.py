@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import AllowInfNan, Field
+from pydantic import AllowInfNan, Field, Strict
 
 # The description fields live with the descriptions (service.robots); request schemas use them from here.
 from ...robots._fields import (  # noqa: F401
@@ -16,10 +16,15 @@ from ...robots._fields import (  # noqa: F401
     Number,
     RobotId,
     Vector3,
+    square_shape,
 )
 
+#: A JSON boolean in a request: true or false only (0, 1 and "yes" are refused, as the spec says).
+Flag = Annotated[bool, Strict()]
+
 Vector4 = Annotated[list[Number], Field(min_length=4, max_length=4)]
-Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3, description="3×3, row-major")]
+Matrix3 = Annotated[list[Vector3], square_shape(3, "rotation matrix"),
+                    Field(min_length=3, max_length=3, description="3×3, row-major")]
 #: Numbers in responses: finite, but not bounded (a pose can sum many request-sized lengths).
 Real = Annotated[float, AllowInfNan(False)]
 RealVector3 = Annotated[list[Real], Field(min_length=3, max_length=3)]

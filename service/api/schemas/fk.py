@@ -4,23 +4,29 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId
+from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames, RobotId
 from .poses import NamedPose, Pose
 from ...robots.schemas import RobotDescription
 
 
 class FKRequest(RequestFrames):
+    """Joint values whose tool pose (and link frames) to compute."""
+
     joints: list[Number] = Field(description="one value per joint, in table order")
-    frames: bool = Field(False, description="also return the pose of every link frame")
+    frames: Flag = Field(False, description="also return the pose of every link frame")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
 
 
 class FKInlineRequest(FKRequest):
-    robot: RobotDescription
+    """Forward kinematics for a robot described in the request body."""
+
+    robot: RobotDescription = Field(description="the robot, described as in the catalogue")
 
 
 class FKResponse(ApiModel):
-    robot_id: RobotId
+    """The tool pose, and with frames=true every link frame's."""
+
+    robot_id: RobotId = Field(description="the catalogue id, or the inline robot's id")
     joint_names: list[str] = JOINT_NAMES_FIELD
     pose: Pose = Field(description="world_T_tool")
     frames: list[NamedPose] | None = Field(
@@ -29,11 +35,15 @@ class FKResponse(ApiModel):
 
 
 class FKBatchRequest(RequestFrames):
+    """Many joint vectors, one tool pose each (vectorised)."""
+
     joints: list[list[Number]] = Field(min_length=1, description="one row of joint values per configuration")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
 
 
 class FKBatchResponse(ApiModel):
-    robot_id: RobotId
+    """One tool pose per row of joint values."""
+
+    robot_id: RobotId = Field(description="the catalogue id")
     joint_names: list[str] = JOINT_NAMES_FIELD
     poses: list[Pose] = Field(description="one pose per row, in request order")

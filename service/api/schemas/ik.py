@@ -8,7 +8,7 @@ from typing import Annotated, Literal
 from pydantic import Field, model_serializer
 
 from ...kinematics.ik import MAX_EQUIVALENTS
-from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId
+from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames, RobotId
 from .limits import JointLimitsOverride, LimitViolation
 from .poses import PoseTarget
 from ...robots.schemas import RobotDescription
@@ -25,16 +25,22 @@ class OrderingNorm(str, Enum):
 
 
 class Shoulder(str, Enum):
+    """Shoulder branch: which side of the base axis the wrist centre is on."""
+
     left = "left"
     right = "right"
 
 
 class Elbow(str, Enum):
+    """Elbow branch: above or below the line from shoulder to wrist centre."""
+
     up = "up"
     down = "down"
 
 
 class Wrist(str, Enum):
+    """Wrist branch: the two solutions of a spherical wrist, related by a half turn of the middle joint's sign."""
+
     flip = "flip"
     no_flip = "no_flip"
 
@@ -47,6 +53,8 @@ class AssemblyMode(IntEnum):
 
 
 class SolverMethod(str, Enum):
+    """analytic: closed form for the arm's kinematic family; numeric: multi-start search for other structures."""
+
     analytic = "analytic"
     numeric = "numeric"
 
@@ -77,7 +85,7 @@ class NumericSearch(ApiModel):
     ``time_budget_ms`` bounds its time: a search that needs longer is refused (503 with Retry-After), never cut
     into a partial answer."""
 
-    starts: int = Field(48, ge=1, le=2000)
+    starts: int = Field(48, ge=1, le=2000, description="number of starting points of the search")
     iterations: int = Field(200, ge=1, le=2000, description="Levenberg–Marquardt iterations per start at most")
     time_budget_ms: int | None = Field(
         None, ge=1, le=10_000, description="time allowed per target (a batch adds its targets' up), at most the "
@@ -85,17 +93,18 @@ class NumericSearch(ApiModel):
 
 
 class _Target(ApiModel):
-    target: PoseTarget
+    target: PoseTarget = Field(description="the tool pose to reach, in the world frame")
 
 
 class _Targets(ApiModel):
-    targets: list[PoseTarget] = Field(min_length=1)
+    targets: list[PoseTarget] = Field(min_length=1, description="the tool poses to reach, world frame; each is "
+                                                                "solved as an IKRequest target")
 
 
 class IKRequestOptions(RequestFrames):
     """What every IK request may say besides its target(s)."""
 
-    filter_limits: bool = Field(
+    filter_limits: Flag = Field(
         True, description="move solutions that violate a joint limit, whatever whole turns their revolute joints "
                           "make, to `rejected`; when false they stay in `solutions` with within_limits false")
     reference: list[Number] | None = Field(
@@ -119,7 +128,9 @@ class IKRequestOptions(RequestFrames):
         description="cap on the solutions returned after expanding multi-turn joints into their 2π-equivalents; "
                     "the nearest (with reference) or the least-turned are kept, and `truncated` says when the cap "
                     "left some out")
-    numeric: NumericSearch = Field(default_factory=NumericSearch)
+    numeric: NumericSearch = Field(default_factory=NumericSearch,
+                                   description="bounds on the numeric search, for structures no analytic family "
+                                               "covers")
 
 
 class IKRequest(IKRequestOptions, _Target):
@@ -127,7 +138,9 @@ class IKRequest(IKRequestOptions, _Target):
 
 
 class IKInlineRequest(IKRequest):
-    robot: RobotDescription
+    """Every solution for one target, for a robot described in the request body."""
+
+    robot: RobotDescription = Field(description="the robot, described as in the catalogue")
 
 
 class IKBatchRequest(IKRequestOptions, _Targets):
@@ -141,10 +154,10 @@ class IKBatchRequest(IKRequestOptions, _Targets):
 class Branch(ApiModel):
     """Branch labels; only the ones that apply to the arm's structure are present."""
 
-    shoulder: Shoulder | None = None
-    elbow: Elbow | None = None
-    wrist: Wrist | None = None
-    assembly_mode: AssemblyMode | None = None
+    shoulder: Shoulder | None = Field(None, description="left or right (arms with a shoulder)")
+    elbow: Elbow | None = Field(None, description="up or down (arms with an elbow)")
+    wrist: Wrist | None = Field(None, description="flip or no_flip (arms with a spherical wrist)")
+    assembly_mode: AssemblyMode | None = Field(None, description="1 or 2 (closed Assur groups)")
 
     @model_serializer(mode="wrap")
     def _present_only(self, handler):
@@ -152,20 +165,26 @@ class Branch(ApiModel):
 
 
 class Residual(ApiModel):
+    """How far forward kinematics of the solution lands from the target."""
+
     position: float = Field(description="FK position error, robot length unit")
     orientation: float | None = Field(description="FK orientation error, radians; null for a position-only target")
 
 
 class IKSolution(ApiModel):
-    joints: list[float]
-    branch: Branch
-    within_limits: bool
-    violations: list[LimitViolation]
-    residual: Residual
+    """One joint vector that reaches the target, verified by forward kinematics."""
+
+    joints: list[float] = Field(description="joint values in table order, the request's angle unit")
+    branch: Branch = Field(description="the solution's branch labels")
+    within_limits: bool = Field(description="every joint within the limits in force")
+    violations: list[LimitViolation] = Field(description="each joint outside its limits (empty when within)")
+    residual: Residual = Field(description="forward-kinematics error of this solution")
 
 
 class SolverInfo(ApiModel):
-    method: SolverMethod
+    """Which solver answered, and what it guarantees."""
+
+    method: SolverMethod = Field(description="analytic or numeric")
     structure: str = Field(description="the kinematic family the solver recognised, e.g. "
                                        "'intersecting_shoulder+spherical_wrist'")
     complete: bool = Field(description="true when the method guarantees every solution was found")
@@ -175,22 +194,27 @@ class SolverInfo(ApiModel):
 
 
 class SingularityReport(ApiModel):
+    """A singular condition the target meets, and how the joints it frees are coupled."""
+
     kind: str = Field(description="wrist, shoulder, elbow, reach or assur_group")
     joints: list[int] = Field(description="0-based joint indices involved")
     relation: str = Field(description="sum, difference, signed_sum, free, stretched, folded, aligned, coincident, "
                                       "boundary")
-    detail: str
+    detail: str = Field(description="the condition in words, e.g. which joint was set and to what")
 
 
 class IKResponse(ApiModel):
-    robot_id: RobotId
+    """Every solution of one target, each verified by forward kinematics."""
+
+    robot_id: RobotId = Field(description="the catalogue id, or the inline robot's id")
     joint_names: list[str] = JOINT_NAMES_FIELD
-    status: IKStatus
-    detail: str | None = None
-    solutions: list[IKSolution]
-    rejected: list[IKSolution]
-    solver: SolverInfo
-    singularities: list[SingularityReport]
+    status: IKStatus = Field(description="ok, unreachable, or no_solution_within_limits")
+    detail: str | None = Field(None, description="why a target is unreachable, and notes on caps and trims")
+    solutions: list[IKSolution] = Field(description="every distinct solution; nearest the reference first when "
+                                                    "one is given")
+    rejected: list[IKSolution] = Field(description="the solutions filter_limits removed, with their violations")
+    solver: SolverInfo = Field(description="which solver answered and what it guarantees")
+    singularities: list[SingularityReport] = Field(description="each singular condition the target meets")
     free_joints: list[int] = Field(default_factory=list,
                                    description="joints the target does not determine, set to reference or 0")
     truncated: bool = Field(False, description="max_equivalents left out some of the solutions that fit")
@@ -201,24 +225,28 @@ class IKResponse(ApiModel):
 
 
 class IKBatchResponse(ApiModel):
-    robot_id: RobotId
-    results: list[IKResponse]
+    """One IKResponse per target, in request order."""
+
+    robot_id: RobotId = Field(description="the catalogue id")
+    results: list[IKResponse] = Field(description="one answer per target, in request order")
 
 
 class SolverEntry(SolverInfo):
-    free_joints: list[int] = Field(default_factory=list)
+    """A solver used for some targets of an arrays-form batch."""
+
+    free_joints: list[int] = Field(default_factory=list, description="joints the targets do not determine")
 
 
 class TargetColumns(ApiModel):
     """Per-target fields of the arrays form, one entry per target in request order."""
 
-    status: list[IKStatus]
-    detail: list[str | None]
+    status: list[IKStatus] = Field(description="each target's status")
+    detail: list[str | None] = Field(description="each target's detail, as in IKResponse")
     solver: list[int] = Field(description="index into `solvers`")
     singularities: list[list[int]] = Field(description="indices into `singularity_reports`")
-    truncated: list[bool]
-    trimmed: list[int]
-    available: list[int]
+    truncated: list[bool] = Field(description="each target's truncated, as in IKResponse")
+    trimmed: list[int] = Field(description="each target's trimmed, as in IKResponse")
+    available: list[int] = Field(description="each target's available, as in IKResponse")
     solution_count: list[int] = Field(description="rows of `solutions` for this target")
     rejected_count: list[int] = Field(description="rows of `rejected` for this target")
 
@@ -231,10 +259,11 @@ class SolutionColumns(ApiModel):
     """
 
     target: list[int] = Field(description="index of the target this row solves")
-    joints: list[list[float]]
-    within_limits: list[bool]
-    residual_position: list[float]
-    residual_orientation: list[float | None]
+    joints: list[list[float]] = Field(description="each row's joint values, the request's angle unit")
+    within_limits: list[bool] = Field(description="each row within the limits in force")
+    residual_position: list[float] = Field(description="each row's FK position error, robot length unit")
+    residual_orientation: list[float | None] = Field(description="each row's FK orientation error, radians; "
+                                                                 "null for a position-only target")
     branch: dict[str, list[str | int | None]] = Field(
         description="one column per branch label that applies; null where a row has no such label")
 
@@ -242,11 +271,12 @@ class SolutionColumns(ApiModel):
 class IKBatchArraysResponse(ApiModel):
     """The batch answer in columns (``"format": "arrays"``): the same content as the objects form."""
 
-    robot_id: RobotId
+    robot_id: RobotId = Field(description="the catalogue id")
     joint_names: list[str] = JOINT_NAMES_FIELD
-    format: Literal["arrays"]
-    solvers: list[SolverEntry]
-    singularity_reports: list[SingularityReport]
-    targets: TargetColumns
-    solutions: SolutionColumns
-    rejected: SolutionColumns
+    format: Literal["arrays"] = Field(description="always arrays")
+    solvers: list[SolverEntry] = Field(description="the distinct solvers, indexed by targets.solver")
+    singularity_reports: list[SingularityReport] = Field(description="the distinct singular conditions, indexed "
+                                                                     "by targets.singularities")
+    targets: TargetColumns = Field(description="per-target fields")
+    solutions: SolutionColumns = Field(description="every kept solution, one row each")
+    rejected: SolutionColumns = Field(description="every solution filter_limits removed, one row each")

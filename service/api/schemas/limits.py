@@ -14,21 +14,22 @@ class JointLimitsOverride(ApiModel):
     Inclusive; a null side is open. lower > upper is a 422 that names the joint (checked against the robot).
     """
 
-    lower: Number | None
-    upper: Number | None
+    lower: Number | None = Field(description="lowest value allowed; null: open below")
+    upper: Number | None = Field(description="highest value allowed; null: open above")
 
 
 class LimitViolation(ApiModel):
     """One joint outside its inclusive bounds, in the request's angle unit / the robot's length unit."""
 
     joint: int = Field(description="0-based joint index")
-    value: float
+    value: float = Field(description="the joint's value")
     lower: float | None = Field(description="null when the range is open below")
     upper: float | None = Field(description="null when the range is open above")
 
 
 class LimitsRequest(RequestFrames):
-    """Limits concern joint values only: a base or tool given here is validated but changes no answer."""
+    """Joint vectors to check against the robot's limits (or the request's). Limits concern joint values only: a
+    base or tool given here is validated but changes no answer."""
 
     joints: list[list[Number]] = Field(min_length=1, description="joint vectors to check")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
@@ -37,20 +38,26 @@ class LimitsRequest(RequestFrames):
 
 
 class LimitsInlineRequest(LimitsRequest):
-    robot: RobotDescription
+    """Joint-limit checks for a robot described in the request body."""
+
+    robot: RobotDescription = Field(description="the robot, described as in the catalogue")
 
 
 class LimitsResult(ApiModel):
-    within_limits: bool
-    violations: list[LimitViolation]
+    """The check of one joint vector."""
+
+    within_limits: bool = Field(description="every joint within its inclusive bounds")
+    violations: list[LimitViolation] = Field(description="each joint outside its bounds")
     equivalent: list[float] | None = Field(
         description="when the vector is out of range only by whole turns of revolute joints: the 2π-equivalent "
                     "that fits (nearest to the given values); null otherwise or when already within limits")
 
 
 class LimitsResponse(ApiModel):
-    robot_id: str
+    """One result per joint vector, in request order."""
+
+    robot_id: str = Field(description="the catalogue id, or the inline robot's id")
     joint_names: list[str] = JOINT_NAMES_FIELD
     tolerance: float = Field(description="inclusive-bound tolerance: radians (revolute), fraction of the robot's "
                                          "size (prismatic)")
-    results: list[LimitsResult]
+    results: list[LimitsResult] = Field(description="one result per joint vector, in request order")

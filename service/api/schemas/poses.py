@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from typing import Annotated, Literal, Union
 
-from pydantic import Field, model_validator
+from pydantic import Field, field_validator, model_validator
+from pydantic_core import PydanticCustomError
 
 from .common import ApiModel, Matrix3, Matrix4, Number, RealMatrix4, RealVector3, RealVector4, Vector3, Vector4
 
@@ -12,29 +13,33 @@ from .common import ApiModel, Matrix3, Matrix4, Number, RealMatrix4, RealVector3
 class MatrixOrientation(ApiModel):
     """A 3×3 rotation matrix, orthonormal within 1e-6 with determinant +1."""
 
-    type: Literal["matrix"]
-    matrix: Matrix3
+    type: Literal["matrix"] = Field(description="names this variant")
+    matrix: Matrix3 = Field(description="world_R_tool, 3×3, row-major")
 
 
 class QuaternionOrientation(ApiModel):
-    """A unit quaternion (w, x, y, z), norm within 1e-6 of 1."""
+    """A unit quaternion, scalar first (w, x, y, z), norm within 1e-6 of 1.
 
-    type: Literal["quaternion"]
-    wxyz: Vector4
+    ROS, scipy and Eigen's coefficient order put the scalar last (x, y, z, w): reorder before sending.
+    ``[0, 0, 0, 1]`` here is w = 0, z = 1, a half turn about z, not the identity ``[1, 0, 0, 0]``.
+    """
+
+    type: Literal["quaternion"] = Field(description="names this variant")
+    wxyz: Vector4 = Field(description="(w, x, y, z), scalar first")
 
 
 class EulerZYZOrientation(ApiModel):
     """ZYZ Euler angles (φ, θ, ψ): R = Rot_z(φ)·Rot_y(θ)·Rot_z(ψ), in the request's angle unit."""
 
-    type: Literal["euler_zyz"]
-    angles: Vector3
+    type: Literal["euler_zyz"] = Field(description="names this variant")
+    angles: Vector3 = Field(description="(φ, θ, ψ), the request's angle unit")
 
 
 class RPYOrientation(ApiModel):
     """Roll, pitch, yaw about the fixed X, Y, Z axes: R = Rot_z(yaw)·Rot_y(pitch)·Rot_x(roll), in the request's angle unit."""
 
-    type: Literal["rpy"]
-    angles: Vector3
+    type: Literal["rpy"] = Field(description="names this variant")
+    angles: Vector3 = Field(description="(roll, pitch, yaw), the request's angle unit")
 
 
 Orientation = Annotated[
@@ -43,35 +48,75 @@ Orientation = Annotated[
 ]
 
 
-class PoseTarget(ApiModel):
-    """A target pose: either ``matrix`` (4×4), or ``position`` with an optional ``orientation``.
+def _xyzw_hint(xyzw: list) -> str:
+    """The wxyz form of a quaternion a client sent scalar last, for the error message."""
+    w = xyzw[3]
+    return f'{{"type": "quaternion", "wxyz": [{w}, {xyzw[0]}, {xyzw[1]}, {xyzw[2]}]}}'
 
-    Leaving out the orientation asks for the position only (robots with fewer than 6 joints).
-    Lengths are in the robot's length unit, expressed in the world frame.
+
+def _scalar_last_quaternion(orientation: dict) -> list | None:
+    """The (x, y, z, w) values of an orientation written in a scalar-last form, or None for any other form."""
+    if {"x", "y", "z", "w"} <= orientation.keys():
+        return [orientation[key] for key in "xyzw"]
+    if isinstance(orientation.get("xyzw"), list) and len(orientation["xyzw"]) == 4:
+        return orientation["xyzw"]
+    return None
+
+
+class PoseTarget(ApiModel):
+    """A target pose, in the world frame, lengths in the robot's length unit. One of:
+
+    * ``matrix``: a 4×4 homogeneous transform. ``position`` and ``quaternion_wxyz`` may accompany it, so that
+      a pose from a forward-kinematics answer is accepted as it stands; they must then agree with the matrix
+      (within 1e-6, relative to the position's size).
+    * ``position`` with an ``orientation`` (one of the tagged variants) or a ``quaternion_wxyz``.
+    * ``position`` alone: the position only is solved (arms with fewer than 6 joints).
     """
 
-    matrix: Matrix4 | None = None
-    position: Vector3 | None = None
-    orientation: Orientation | None = None
+    matrix: Matrix4 | None = Field(None, description="world_T_tool, 4×4, row-major; last row 0 0 0 1")
+    position: Vector3 | None = Field(None, description="tool origin in the world frame, robot length unit")
+    orientation: Orientation | None = Field(
+        None, description="tool orientation in the world frame; with position only, leave out for position-only IK")
+    quaternion_wxyz: Vector4 | None = Field(
+        None, description="tool orientation as a unit quaternion, scalar first (w, x, y, z), as forward "
+                          "kinematics returns it; the same as orientation {type: quaternion, wxyz}")
+
+    @field_validator("orientation", mode="before")
+    @classmethod
+    def _name_the_quaternion_order(cls, value: object) -> object:
+        # A ROS-style {x, y, z, w} or an "xyzw" list would otherwise meet the union's discriminator jargon,
+        # or worse, be read in the wrong order.
+        if isinstance(value, dict):
+            xyzw = _scalar_last_quaternion(value)
+            if xyzw is not None:
+                raise PydanticCustomError(
+                    "quaternion_order",
+                    "quaternions are taken scalar first, as {example} (w, x, y, z); this one looks scalar last "
+                    "(x, y, z, w, as ROS and scipy write it)", {"example": _xyzw_hint(xyzw)})
+        return value
 
     @model_validator(mode="after")
     def _one_form(self) -> "PoseTarget":
-        if (self.matrix is None) == (self.position is None):
-            raise ValueError("give either 'matrix' or 'position' (with an optional 'orientation'), not both or neither")
+        if self.matrix is None and self.position is None:
+            raise ValueError("give either 'matrix' or 'position' (with an optional 'orientation')")
         if self.matrix is not None and self.orientation is not None:
             raise ValueError("'orientation' goes with 'position'; a 'matrix' already holds the orientation")
+        if self.orientation is not None and self.quaternion_wxyz is not None:
+            raise ValueError("give the orientation once: 'orientation' or 'quaternion_wxyz', not both")
         return self
 
 
 class Pose(ApiModel):
     """A pose in the world frame, in three forms so that no client has to convert."""
 
-    matrix: RealMatrix4
-    position: RealVector3
+    matrix: RealMatrix4 = Field(description="the pose as a 4×4 homogeneous transform, row-major")
+    position: RealVector3 = Field(description="the frame's origin, robot length unit")
     quaternion_wxyz: RealVector4 = Field(description="unit quaternion (w, x, y, z) with w ≥ 0")
 
 
 class NamedPose(Pose):
+    """The pose of one named frame."""
+
     name: str = Field(description="'base', the joint name of the link frame, or 'tool'")
 
 

@@ -30,26 +30,30 @@ class Twist(_Rates):
     (see `solver.task_rows` in the response): a position-only target needs `linear` only.
     """
 
-    linear: Vector3 | None = None
-    angular: Vector3 | None = None
+    linear: Vector3 | None = Field(None, description="velocity of the tool origin, length unit/s")
+    angular: Vector3 | None = Field(None, description="angular velocity of the tool, the request's angle unit/s")
 
 
 class Acceleration(_Rates):
     """Second derivative of the tool position (length unit/s²) and the tool's angular acceleration
     (angle unit/s²), world frame."""
 
-    linear: Vector3 | None = None
-    angular: Vector3 | None = None
+    linear: Vector3 | None = Field(None, description="acceleration of the tool origin, length unit/s²")
+    angular: Vector3 | None = Field(None, description="angular acceleration of the tool, the request's angle unit/s²")
 
 
 class TrajectorySample(ApiModel):
+    """One sampled tool pose, with the tool's twist and acceleration at that time when known."""
+
     time: Number = Field(description="seconds; strictly increasing from one sample to the next")
-    pose: PoseTarget
+    pose: PoseTarget = Field(description="the tool pose at this time, world frame")
     twist: Twist | None = Field(None, description="without it the sample's velocities and accelerations are null")
     acceleration: Acceleration | None = Field(None, description="needs `twist`; without it accelerations are null")
 
 
 class TrajectoryRequest(RequestFrames):
+    """Sampled tool poses to follow on one consistent branch, with joint velocities and accelerations."""
+
     samples: list[TrajectorySample] = Field(
         min_length=1, description="every pose the same kind: all with an orientation (or matrix), or all "
                                   "position-only")
@@ -69,7 +73,9 @@ class TrajectoryRequest(RequestFrames):
 
 
 class TrajectoryInlineRequest(TrajectoryRequest):
-    robot: RobotDescription
+    """Trajectory IK for a robot described in the request body."""
+
+    robot: RobotDescription = Field(description="the robot, described as in the catalogue")
 
 
 class PaperJoints(ApiModel):
@@ -77,9 +83,10 @@ class PaperJoints(ApiModel):
     (θ1, θ2, l3) with θ2 = θ1 − θ_BC, the negative of the usual elbow angle, and l3 the downward extension.
     For `assur001_scara_rrp` the robot's joints are (θ1, −θ2, l3)."""
 
-    joints: list[float]
-    velocities: list[float] | None
-    accelerations: list[float] | None
+    joints: list[float] = Field(description="(θ1, θ2, l3) in the paper's convention, request's angle unit")
+    velocities: list[float] | None = Field(description="their rates, per second; null without a twist")
+    accelerations: list[float] | None = Field(description="their second derivatives, per second²; null without "
+                                                          "an acceleration")
     case: Literal["regular", "aligned", "coincident", "unreachable"] = Field(
         description="the RRR group's case: aligned (stretched or folded) and coincident are singular")
 
@@ -88,20 +95,24 @@ class RateResidual(ApiModel):
     """How well the rates reproduce the requested twist and acceleration, over the target's rows, with lengths in
     units of the robot's size: 0 (to rounding) when the arm can produce them."""
 
-    velocity: float | None
-    acceleration: float | None
+    velocity: float | None = Field(description="relative error of J·q̇ against the twist; null without rates")
+    acceleration: float | None = Field(description="relative error of J·q̈ + J̇·q̇ against the acceleration; null "
+                                                   "without accelerations")
 
 
 class TrajectorySampleResult(ApiModel):
-    time: float
+    """The joint solution at one sample, on the branch being followed."""
+
+    time: float = Field(description="the sample's time, seconds")
     status: Literal["ok", "unreachable", "branch_unavailable"] = Field(
         description="unreachable: no solution (joints null); branch_unavailable: no solution on the requested "
                     "branch, the sample continues on the nearest one")
-    joints: list[float] | None
+    joints: list[float] | None = Field(description="joint values, request's angle unit; null when unreachable")
     velocities: list[float] | None = Field(description="null without a twist, or at a singular sample without "
                                                        "damping")
-    accelerations: list[float] | None
-    branch: Branch
+    accelerations: list[float] | None = Field(description="joint accelerations; null without an acceleration, or "
+                                                          "at a singular sample without damping")
+    branch: Branch = Field(description="branch labels of this sample's solution")
     branch_changed: bool = Field(description="the labels differ from the previous reached sample's")
     singularities: list[SingularityReport] = Field(
         description="the IK's singular conditions, the Assur group's case, and kind 'jacobian' (near_singular) "
@@ -110,41 +121,52 @@ class TrajectorySampleResult(ApiModel):
         description="smallest singular value of the task Jacobian with linear rows divided by the robot's size "
                     "(and prismatic columns multiplied by it): dimensionless, 0 at a singularity")
     damped: bool = Field(description="the rates are damped least squares")
-    within_limits: bool | None
-    violations: list[LimitViolation]
-    residual: RateResidual | None
+    within_limits: bool | None = Field(description="the joints are within the robot's limits; null when unreachable")
+    violations: list[LimitViolation] = Field(description="each joint outside its limits")
+    residual: RateResidual | None = Field(description="how well the rates reproduce the twist and acceleration")
     paper: PaperJoints | None = Field(
         None, description="only for the paper's SCARA: joints, rates and accelerations as the paper states them")
 
 
 class JointStep(ApiModel):
+    """The largest move of each joint between consecutive reached samples, and where it happens."""
+
     values: list[float | None] = Field(
         description="per joint, the largest |q_i(k) − q_i(k−1)| between consecutive reached samples")
     samples: list[int | None] = Field(description="per joint, the sample k where it happens")
 
 
 class SingularityDistance(ApiModel):
+    """How close the trajectory comes to a singularity, and where."""
+
     value: float | None = Field(description="the smallest distance_to_singularity over the reached samples")
-    sample: int | None
+    sample: int | None = Field(description="index of that sample; null when no sample was reached")
 
 
 class SampleViolation(LimitViolation):
-    sample: int
+    """A joint outside its limits at one sample."""
+
+    sample: int = Field(description="index of the sample")
 
 
 class TrajectorySummary(ApiModel):
-    largest_joint_step: JointStep
-    smallest_distance_to_singularity: SingularityDistance
-    limit_violations: list[SampleViolation]
-    singular_samples: list[int]
+    """What a planner checks first: steps, nearness to singularities, limits, branch changes, misses."""
+
+    largest_joint_step: JointStep = Field(description="per joint, the largest move between consecutive samples")
+    smallest_distance_to_singularity: SingularityDistance = Field(
+        description="the nearest approach to a singularity")
+    limit_violations: list[SampleViolation] = Field(description="every joint outside its limits, by sample")
+    singular_samples: list[int] = Field(description="samples closer to a singularity than the tolerance")
     branch_changes: list[int] = Field(description="samples whose branch_changed is true")
-    unreachable_samples: list[int]
+    unreachable_samples: list[int] = Field(description="samples with no solution")
 
 
 class TrajectorySolver(ApiModel):
+    """How the positions and the rates were computed."""
+
     positions: Literal["analytic", "numeric"] = Field(description="how the position IK was solved")
-    structure: str
-    complete: bool
+    structure: str = Field(description="the kinematic family the position IK recognised")
+    complete: bool = Field(description="true when the position IK guarantees every solution was found")
     rates: Literal["jacobian", "assur_group"] = Field(
         description="assur_group: positions, velocities and accelerations from the RRR Assur group (the paper's "
                     "SCARA); jacobian: q̇ = J⁻¹v, q̈ = J⁻¹(a − J̇q̇)")
@@ -152,13 +174,15 @@ class TrajectorySolver(ApiModel):
                                              "['vx', 'vy', 'vz', 'wz'] for a SCARA pose")
     solve: Literal["exact", "least_squares", "minimum_norm"] = Field(
         description="as many task rows as moving joints (exact), more (least squares), or fewer (minimum norm)")
-    singularity_tolerance: float
-    damping: float | None
+    singularity_tolerance: float = Field(description="the tolerance in force (the request's, or the default)")
+    damping: float | None = Field(description="the damping λ in force; null when rates are undamped")
 
 
 class TrajectoryResponse(ApiModel):
-    robot_id: RobotId
+    """One joint solution per sample on a consistent branch, with rates, and a summary."""
+
+    robot_id: RobotId = Field(description="the catalogue id, or the inline robot's id")
     joint_names: list[str] = JOINT_NAMES_FIELD
-    samples: list[TrajectorySampleResult]
-    summary: TrajectorySummary
-    solver: TrajectorySolver
+    samples: list[TrajectorySampleResult] = Field(description="one result per request sample, in order")
+    summary: TrajectorySummary = Field(description="the trajectory at a glance")
+    solver: TrajectorySolver = Field(description="how the answer was computed")

@@ -1,0 +1,108 @@
+"""Pictures: the arm at joint vectors, and every IK solution of a target, as SVG small multiples."""
+
+from __future__ import annotations
+
+from xml.sax.saxutils import escape
+
+import numpy as np
+from fastapi import APIRouter, Depends, Request
+from fastapi.responses import Response
+
+from ...drawing import arm_poses, render_svg
+from ...kinematics import InvalidInputError, Robot
+from ..boundary import joints_to_core, located, _unit_scale
+from ..deps import RobotRef, catalogue_robot, inline_robot
+from ..problems import problem_responses
+from ..routing import FastJSONRoute
+from ..schemas.render import RenderInlineRequest, RenderRequest
+
+router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["pictures"])
+
+SVG_MEDIA_TYPE = "image/svg+xml"
+#: The 200 answer of the picture operations (and the SVG alternative of the IK operations) in the spec.
+SVG_RESPONSE = {"description": "An SVG picture: one panel per configuration, captioned with its labels and "
+                               "its limit status (class `configuration` on each panel's group)",
+                "content": {SVG_MEDIA_TYPE: {"schema": {"type": "string"}}}}
+#: The SVG alternative of the IK operations' 200 answer.
+IK_PICTURE_RESPONSE = {"description": "Every solution (JSON), or with `render` or `Accept: image/svg+xml`, a "
+                                      "picture of every distinct solution",
+                       "content": {SVG_MEDIA_TYPE: {"schema": {"type": "string"}}}}
+
+
+def svg_response(text: str) -> Response:
+    return Response(text, media_type=SVG_MEDIA_TYPE)
+
+
+def wants_svg(request: Request) -> bool:
+    """Whether the client asked for the picture: ``Accept: image/svg+xml`` before any JSON type."""
+    accept = request.headers.get("accept", "")
+    return SVG_MEDIA_TYPE in accept and "json" not in accept.split(SVG_MEDIA_TYPE, 1)[0]
+
+
+def _render(ref: RobotRef, body: RenderRequest) -> Response:
+    robot = ref.robot
+    with located("body", "joints"):
+        q = joints_to_core(robot, body.joints, body.angle_unit, batch=True)
+    if body.captions is not None and len(body.captions) != len(body.joints):
+        raise InvalidInputError(f"expected {len(body.joints)} captions, one per joint vector, got "
+                                f"{len(body.captions)}", location=("body", "captions"))
+    captions = None if body.captions is None else [caption.split("\n") for caption in body.captions]
+    poses = arm_poses(robot, q, captions)
+    return svg_response(render_svg(poses, view=body.view, columns=body.columns, panel=body.panel_size,
+                                   title=body.title or ""))
+
+
+@router.post("/robots/{robot_id}/render", operation_id="render", response_class=Response,
+             responses={200: SVG_RESPONSE, **problem_responses(404, 422)})
+def render(body: RenderRequest, ref: RobotRef = Depends(catalogue_robot)) -> Response:
+    """An SVG of the arm in each configuration, side by side: links, joint axes, base and tool frames."""
+    return _render(ref, body)
+
+
+@router.post("/render", operation_id="render_inline", response_class=Response,
+             responses={200: SVG_RESPONSE, **problem_responses(422)})
+def render_inline(request: Request, body: RenderInlineRequest) -> Response:
+    """An SVG of a robot described in the request body, in each configuration."""
+    return _render(inline_robot(request, body.robot), body)
+
+
+def ik_picture(robot: Robot, robot_id: str, answer: dict, unit: str, view: str, reference_given: bool) -> Response:
+    """Every distinct arm configuration of an IK answer (``solutions`` then ``rejected``) as one picture.
+
+    Solutions that differ only by whole turns of revolute joints put the arm in the same place: they share
+    one panel, whose caption says how many of the answer's solutions it stands for.
+    """
+    scale = _unit_scale(robot, unit)
+    groups: dict[tuple, dict] = {}
+    for kind in ("solutions", "rejected"):
+        for solution in answer[kind]:
+            q = np.asarray(solution["joints"], dtype=float) * scale
+            wrapped = np.where(robot.is_revolute, np.angle(np.exp(1j * q)), q)
+            key = (kind, tuple(np.round(wrapped, 6).tolist()), tuple(sorted(solution["branch"].items())))
+            group = groups.setdefault(key, {"q": q, "solution": solution, "count": 0, "kind": kind})
+            group["count"] += 1
+    captions, rows = [], []
+    for number, group in enumerate(groups.values(), start=1):
+        labels = " · ".join(f"{name} {value}" for name, value in group["solution"]["branch"].items())
+        nearest = number == 1 and reference_given and group["kind"] == "solutions"
+        lines = [f"#{number}" + (" (nearest the reference)" if nearest else "")]
+        if labels:
+            lines.append(labels)
+        if group["count"] > 1:
+            lines.append(f"{group['count']} solutions (whole turns of the joints)")
+        captions.append(lines)
+        rows.append(group["q"])
+    title = f"{robot_id}: {answer['status']}, {len(answer['solutions'])} solutions"
+    if answer["rejected"]:
+        title += f", {len(answer['rejected'])} outside the limits"
+    if not rows:
+        return svg_response(_empty_svg(title))
+    violated = [[v["joint"] for v in group["solution"]["violations"]] for group in groups.values()]
+    poses = arm_poses(robot, np.array(rows), captions, violated=violated)
+    return svg_response(render_svg(poses, view=view, title=title))
+
+
+def _empty_svg(title: str) -> str:
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="480" height="40" viewBox="0 0 480 40" '
+            f'font-family="DejaVu Sans, Arial, sans-serif" font-size="14"><text x="8" y="24">{escape(title)}'
+            f"</text></svg>\n")

@@ -22,6 +22,9 @@ from ._fields import AngleUnit, ApiModel, Matrix4, Number, RobotId, Vector3
 MAX_URDF_CHARS = 1_000_000
 
 class JointType(str, Enum):
+    """revolute: the variable is the angle θ; prismatic: the variable is the offset d (r in Khalil form, the
+    sliding distance in screw and URDF forms)."""
+
     revolute = "revolute"
     prismatic = "prismatic"
 
@@ -43,8 +46,8 @@ class JointLimits(ApiModel):
     prismatic ones. A null bound is open on that side (a slide that only has to stay positive: lower 0, upper null).
     """
 
-    lower: Number | None
-    upper: Number | None
+    lower: Number | None = Field(description="lowest value of q; null: open below")
+    upper: Number | None = Field(description="highest value of q; null: open above")
 
     @model_validator(mode="after")
     def _ordered(self) -> "JointLimits":
@@ -62,12 +65,12 @@ class DHJoint(ApiModel):
     """
 
     name: str | None = Field(None, max_length=64, description="defaults to q1, q2, …")
-    type: JointType = "revolute"
-    a: Number = 0.0
-    alpha: Number = 0.0
-    theta: Number = 0.0
-    limits: JointLimits | None = None
-    d: Number = 0.0
+    type: JointType = Field("revolute", description="revolute (variable θ) or prismatic (variable d)")
+    a: Number = Field(0.0, description="link length along x, length unit (Craig: a_{i-1})")
+    alpha: Number = Field(0.0, description="link twist about x, the description's angle unit (Craig: α_{i-1})")
+    theta: Number = Field(0.0, description="joint angle about z, angle unit; an offset added to q when revolute")
+    limits: JointLimits | None = Field(None, description="bounds on q; null: unlimited (continuous)")
+    d: Number = Field(0.0, description="link offset along z, length unit; an offset added to q when prismatic")
 
 
 class KhalilJoint(ApiModel):
@@ -77,26 +80,27 @@ class KhalilJoint(ApiModel):
     """
 
     name: str | None = Field(None, max_length=64, description="defaults to q1, q2, …")
-    type: JointType = "revolute"
-    alpha: Number = 0.0
-    theta: Number = 0.0
-    r: Number = 0.0
-    limits: JointLimits | None = None
-    d: Number = 0.0
+    type: JointType = Field("revolute", description="revolute (variable θ) or prismatic (variable r)")
+    alpha: Number = Field(0.0, description="twist about x_{j-1}, the description's angle unit")
+    theta: Number = Field(0.0, description="angle about z_j, angle unit; an offset added to q when revolute")
+    r: Number = Field(0.0, description="distance along z_j, length unit; an offset added to q when prismatic")
+    limits: JointLimits | None = Field(None, description="bounds on q; null: unlimited (continuous)")
+    d: Number = Field(0.0, description="distance along x_{j-1}, length unit (Craig's a_{j-1})")
 
 
 class _RobotFields(ApiModel):
-    id: RobotId = "inline"
-    name: str = Field("", max_length=200)
+    id: RobotId = Field("inline", description="lower case [a-z0-9_-]; a catalogue file's id is its file name")
+    name: str = Field("", max_length=200, description="a readable name")
     source: str = Field("", max_length=2000, description="where the parameters come from")
     licence: str | None = Field(None, max_length=200, description="licence of the source")
     angle_unit: AngleUnit = Field("rad", description="unit of alpha, theta and revolute limits in this description")
-    length_unit: str = Field("m", max_length=16)
+    length_unit: str = Field("m", max_length=16, description="unit of every length in this description and its "
+                                                             "answers, e.g. m or mm")
     parameters: RobotParameters | None = Field(
         None, description="values given to the source's symbolic lengths (informational)"
     )
     limits_source: str | None = Field(None, max_length=2000, description="where the joint limits come from")
-    notes: str | None = Field(None, max_length=4000)
+    notes: str | None = Field(None, max_length=4000, description="free text: frame choices, joint zeros, caveats")
     base: Matrix4 | None = Field(None, description="world_T_base; identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool; identity when null")
 
@@ -105,16 +109,16 @@ class DHRobot(_RobotFields):
     """A robot described by a standard (Spong/Paul) or modified (Craig) DH table."""
 
     format: Literal["dh"] = Field("dh", description="description form; the default")
-    convention: Literal["standard", "modified"]
-    joints: list[DHJoint] = Field(min_length=1)
+    convention: Literal["standard", "modified"] = Field(description="standard (Spong/Paul) or modified (Craig) DH")
+    joints: list[DHJoint] = Field(min_length=1, description="one row per joint, base to tool")
 
 
 class KhalilRobot(_RobotFields):
     """A robot described by a Khalil–Kleinfinger table."""
 
     format: Literal["dh"] = Field("dh", description="description form; the default")
-    convention: Literal["khalil"]
-    joints: list[KhalilJoint] = Field(min_length=1)
+    convention: Literal["khalil"] = Field(description="Khalil–Kleinfinger")
+    joints: list[KhalilJoint] = Field(min_length=1, description="one row per joint, base to tool")
 
 
 class URDFRobot(ApiModel):
@@ -125,17 +129,17 @@ class URDFRobot(ApiModel):
     fetched. Xacro is out of scope: expand it first (``xacro robot.urdf.xacro > robot.urdf``).
     """
 
-    format: Literal["urdf"]
+    format: Literal["urdf"] = Field(description="description form: a URDF document")
     urdf: str = Field(max_length=MAX_URDF_CHARS, description="the URDF document (XML); no DTD, no entities")
     base_link: str | None = Field(None, max_length=200, description="first link of the chain; default: the root")
     tip_link: str | None = Field(None, max_length=200,
                                  description="last link of the chain (the flange); default: the only leaf")
-    id: RobotId = "inline"
-    name: str = Field("", max_length=200)
+    id: RobotId = Field("inline", description="lower case [a-z0-9_-]; a catalogue file's id is its file name")
+    name: str = Field("", max_length=200, description="a readable name")
     source: str = Field("", max_length=2000, description="where the URDF comes from")
     licence: str | None = Field(None, max_length=200, description="licence of the source file")
     limits_source: str | None = Field(None, max_length=2000, description="where the joint limits come from")
-    notes: str | None = Field(None, max_length=4000)
+    notes: str | None = Field(None, max_length=4000, description="free text: frame choices, joint zeros, caveats")
     base: Matrix4 | None = Field(None, description="world_T_base (world_T_base_link); identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool (tip_link_T_tool); identity when null")
 
@@ -144,11 +148,11 @@ class ScrewJointDescription(ApiModel):
     """One joint as a screw at q = 0, in the base frame."""
 
     name: str | None = Field(None, max_length=64, description="defaults to q1, q2, …")
-    type: JointType = "revolute"
+    type: JointType = Field("revolute", description="revolute (turns about axis) or prismatic (slides along it)")
     axis: Vector3 = Field(description="unit vector: the rotation axis, or the sliding direction of a prismatic "
                                       "joint; positive q turns right-handed about it (or moves along it)")
     point: Vector3 = Field(description="a point on the axis, in the base frame at q = 0 (length unit)")
-    limits: JointLimits | None = None
+    limits: JointLimits | None = Field(None, description="bounds on q; null: unlimited (continuous)")
 
 
 class ScrewsRobot(_RobotFields):
@@ -157,8 +161,8 @@ class ScrewsRobot(_RobotFields):
     ``world_T_tool(q) = base · exp([S_1] q_1) ⋯ exp([S_n] q_n) · home · tool``.
     """
 
-    format: Literal["screws"]
-    joints: list[ScrewJointDescription] = Field(min_length=1)
+    format: Literal["screws"] = Field(description="description form: joint screws (product of exponentials)")
+    joints: list[ScrewJointDescription] = Field(min_length=1, description="one entry per joint, base to tool")
     home: Matrix4 = Field(description="base_T_flange at q = 0 (the tool pose when tool is null)")
 
 
@@ -203,16 +207,20 @@ class DescriptionForm(str, Enum):
 
 
 class RobotSummary(ApiModel):
-    id: RobotId
-    name: str
-    dof: int
-    format: Literal["dh", "urdf", "screws"] = "dh"
+    """One catalogue robot at a glance."""
+
+    id: RobotId = Field(description="catalogue id, for /v1/robots/{robot_id}/...")
+    name: str = Field(description="a readable name")
+    dof: int = Field(description="number of joints")
+    format: Literal["dh", "urdf", "screws"] = Field("dh", description="the form of the catalogue file")
     convention: Convention | None = Field(description="DH convention; null for URDF and screw descriptions")
-    joint_types: list[JointType]
-    joint_names: list[str]
-    source: str
-    licence: str | None = None
+    joint_types: list[JointType] = Field(description="each joint's type, base to tool")
+    joint_names: list[str] = Field(description="each joint's name, base to tool")
+    source: str = Field(description="where the parameters come from")
+    licence: str | None = Field(None, description="licence of the source, where it states one")
 
 
 class RobotList(ApiModel):
-    robots: list[RobotSummary]
+    """The catalogue."""
+
+    robots: list[RobotSummary] = Field(description="every robot, in id order")

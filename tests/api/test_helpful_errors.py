@@ -16,7 +16,7 @@ UR5_Q = [0.1, -1.2, 1.0, 0.3, 1.5, 0.2]
 
 
 @pytest.mark.parametrize("robot_id, nearest", [
-    ("ur-5", ["ur5"]), ("Ur_5", ["ur5"]), ("ur10", ["ur5"]),
+    ("ur-5", ["ur5"]), ("Ur_5", ["ur5"]), ("ur10", ["ur10e"]),
     ("puma", ["puma560_khalil", "puma560_modified", "puma560_standard"]),
     ("pumma560_standard", ["puma560_standard", "puma560_modified"]),
     ("stanford", ["spong_ex3_5_stanford"]),

@@ -12,6 +12,9 @@ from ...kinematics.ik import (
     IKOptions,
     IKResult,
     NumericOptions,
+    free_joints_for,
+    no_solution_detail,
+    solve_free_joint_family,
     Selected,
     Selection,
     SolutionTable,
@@ -72,17 +75,53 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
     return reference, limits, ordering, options, note
 
 
-def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference):
+def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference, free=None):
     """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
 
     ``arrays`` is None when no analytic family covers the robot (the caller then runs the numeric search).
+    Full poses of a redundant arm with ``free`` joints (see :func:`_free_joints`) are solved as the family over
+    the free values: one answer row per target holding every value's solutions.
     """
     for constrained in (True, False):
         rows = np.flatnonzero(flags == constrained)
         if len(rows):
             started = time.perf_counter()
+            if constrained and free is not None:
+                family = solve_free_joint_family(robot, matrices[rows], free, reference)
+                yield constrained, rows, None if family is None else family.arrays, started
+                continue
             yield constrained, rows, solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained,
                                                      reference=reference), started
+
+
+# --- redundant arms: free joints (issue 14) ---------------------------------------------------------------
+def _free_joints(robot: Robot, body: IKRequest | IKBatchRequest):
+    """The free joints of a redundant arm's full-pose targets, in core units, or None (not redundant, or no
+    locking leaves a family: the numeric search then answers, as before)."""
+    if body.free_joints is None and robot.dof <= 6:
+        return None
+    requested = None
+    if body.free_joints is not None:
+        requested = []
+        for index, choice in enumerate(body.free_joints):
+            values = choice.values
+            if values is not None and 0 <= choice.joint < robot.dof:
+                values = (np.asarray(values, dtype=float) * _unit_scale(robot, body.angle_unit)[choice.joint]).tolist()
+            requested.append((choice.joint, values, choice.samples))
+    with located("body"):
+        return free_joints_for(robot, requested)
+
+
+def _with_free_values(wire: dict, free, robot: Robot, position: np.ndarray) -> dict:
+    """Each solution's ``free_values`` (its own values of the answer's free joints, in the request's unit), and
+    the family's meaning of an empty answer."""
+    for key in ("solutions", "rejected"):
+        for solution in wire[key]:
+            solution["free_values"] = {str(j): solution["joints"][j] for j in wire["free_joints"]}
+    if free is not None and wire["status"] == "unreachable" and wire["solver"]["method"] == "analytic":
+        wire["detail"] = no_solution_detail(robot, free, position)
+    return wire
+# --- end of redundant arms ----------------------------------------------------------------------------------
 
 
 def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: np.ndarray, rows: np.ndarray,
@@ -108,8 +147,9 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
     else:
         matrices, flags = target_matrices(targets, body.angle_unit, "body", "targets")
     reference, limits, ordering, options, note = _settings(request, robot, body, len(targets))
+    free = _free_joints(robot, body)
     answers: list[dict | None] = [None] * len(targets)
-    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference):
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference, free):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, note, started):
@@ -139,7 +179,8 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
             answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
                                  chosen.notes.get(local, []), bool(chosen.truncated[local]),
                                  int(chosen.trimmed[local]), int(chosen.available[local]))
-    return answers
+    return [_with_free_values(wire, free if flag else None, robot, matrix[:3, 3])
+            for wire, flag, matrix in zip(answers, flags.tolist(), matrices)]
 
 
 def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
@@ -147,6 +188,7 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     robot = ref.robot
     matrices, flags = target_matrices(body.targets, body.angle_unit, "body", "targets")
     reference, limits, ordering, options, note = _settings(request, robot, body, len(matrices))
+    free = _free_joints(robot, body)
     n_targets = len(matrices)
     status = np.empty(n_targets, dtype=object)
     detail: list[str | None] = [None] * n_targets
@@ -158,7 +200,7 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     reports: list[dict] = []
     kept_tables, rejected_tables = [], []
     scale = _unit_scale(robot, body.angle_unit)
-    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference):
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference, free):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, note, started):
@@ -177,6 +219,9 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
         solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
                                         "time_budget_exhausted": False, "free_joints": arrays.free_joints})
         unreachable = unreachable_details(robot, arrays, matrices[rows], constrained, reference)
+        if constrained and free is not None:
+            unreachable = {local: no_solution_detail(robot, free, matrices[rows[local], :3, 3])
+                           for local in unreachable}
         for local in set(unreachable) | set(chosen.notes):
             detail[rows[local]] = " ".join(filter(None, [unreachable.get(local), *chosen.notes.get(local, [])])) or None
         solved = arrays.count > 0

@@ -10,6 +10,7 @@ back to a bounded numeric search that says it may be incomplete.
 from ._arrays import IKArrays, solve_ik_arrays
 from ._numeric import NumericOptions
 from ._plan import plan_for
+from ._redundant import MAX_FREE_VALUES, FamilyAnswer, beyond_reach, FreeJoint, free_joints_for, no_solution_detail, solve_free_joint_family
 from ._select import MAX_EQUIVALENTS, Ordering, Selected, Selection, check_ordering, joint_travel, select, travel
 from ._select_arrays import SolutionTable, select_arrays
 from ._solve import IKOptions, results_from_arrays, solve_ik, solve_ik_batch, unreachable_details
@@ -17,8 +18,11 @@ from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
 
 __all__ = [
+    "FamilyAnswer",
+    "FreeJoint",
     "IKArrays",
     "MAX_EQUIVALENTS",
+    "MAX_FREE_VALUES",
     "IKOptions",
     "IKResult",
     "NumericOptions",
@@ -28,7 +32,11 @@ __all__ = [
     "Singularity",
     "Solution",
     "SolutionTable",
+    "beyond_reach",
     "check_ordering",
+    "free_joints_for",
+    "no_solution_detail",
+    "solve_free_joint_family",
     "distance_to_reference",
     "joint_difference",
     "joint_travel",

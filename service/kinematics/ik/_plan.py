@@ -44,7 +44,12 @@ def geometry_of(robot: Robot) -> Geometry:
 
 def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     """The analytic plan for this robot and kind of target, or None when no family applies."""
-    geometry = geometry_of(robot)
+    return plan_for_geometry(geometry_of(robot), constrain_orientation=constrain_orientation, reference=reference)
+
+
+def plan_for_geometry(geometry: Geometry, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
+    """:func:`plan_for` on a screw model directly: also for arms that exist only as models, such as a redundant
+    arm with joints locked (see ``_redundant``)."""
     n = geometry.dof
     if constrain_orientation:
         return _pose_plan(geometry, n)

@@ -14,6 +14,7 @@ from ...kinematics.ik import (
     NumericOptions,
     free_joints_for,
     no_solution_detail,
+    search_position,
     solve_free_joint_family,
     Selected,
     Selection,
@@ -179,6 +180,12 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
             answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
                                  chosen.notes.get(local, []), bool(chosen.truncated[local]),
                                  int(chosen.trimmed[local]), int(chosen.available[local]))
+    for row, wire in enumerate(answers):  # position-only: held joints must not make a reachable point unreachable
+        if not flags[row] and wire["status"] == "unreachable" and wire["free_joints"]:
+            result = search_position(robot, matrices[row], wire["free_joints"], reference, options)
+            selection = select(robot, result, limits, filter_limits=body.filter_limits, reference=reference,
+                               ordering=ordering, max_equivalents=body.max_equivalents)
+            answers[row] = _capped(_to_wire(ref.id, robot, result, selection, body.angle_unit, False), note)
     return [_with_free_values(wire, free if flag else None, robot, matrix[:3, 3])
             for wire, flag, matrix in zip(answers, flags.tolist(), matrices)]
 

@@ -89,7 +89,7 @@ class FreeJointChoice(ApiModel):
     """A free joint of a redundant arm and where to solve it: `values`, or `samples` evenly over its limits
     (over [−π, π) when it has none or they span a turn)."""
 
-    joint: int = Field(ge=0, description="0-based joint index")
+    joint: int = Field(ge=0, le=1023, description="0-based joint index")
     values: list[Number] | None = Field(None, min_length=1, max_length=MAX_FREE_VALUES,
                                         description="values of the joint, in the request's angle unit")
     samples: int | None = Field(None, ge=1, le=MAX_FREE_VALUES)

@@ -10,6 +10,7 @@ back to a bounded numeric search that says it may be incomplete.
 from ._arrays import IKArrays, solve_ik_arrays
 from ._numeric import NumericOptions
 from ._plan import plan_for
+from ._position_search import search_position
 from ._redundant import MAX_FREE_VALUES, FamilyAnswer, beyond_reach, FreeJoint, free_joints_for, no_solution_detail, solve_free_joint_family
 from ._select import MAX_EQUIVALENTS, Ordering, Selected, Selection, check_ordering, joint_travel, select, travel
 from ._select_arrays import SolutionTable, select_arrays
@@ -42,6 +43,7 @@ __all__ = [
     "joint_travel",
     "plan_for",
     "results_from_arrays",
+    "search_position",
     "select",
     "select_arrays",
     "solve_ik",

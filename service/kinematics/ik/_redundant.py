@@ -53,8 +53,8 @@ DEFAULT_SAMPLES = 32
 MAX_FREE_VALUES = 2048
 #: Local minima of the distance to the reference refined per target, nearest first.
 REFINED_MINIMA = 4
-#: Golden-section steps per refined minimum: the bracket shrinks by 0.618 each step (a 2π / 32 bracket to ~3e-5 rad).
-GOLDEN_STEPS = 20
+#: Golden-section steps per refined minimum: the bracket shrinks by 0.618 each step (a 2π / 32 bracket to ~2e-9 rad).
+GOLDEN_STEPS = 40
 #: Values at which a candidate locking is tried when the free joints are chosen (generic, so that no accidental
 #: alignment of axes at 0 decides the class).
 _PROBE_VALUES = (0.713717, -1.921317)

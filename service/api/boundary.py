@@ -38,6 +38,7 @@ from ..kinematics.ik import Ordering, check_ordering
 from .schemas.common import AngleUnit
 from .schemas.ik import Ordering as OrderingOptions
 from .schemas.poses import (
+    DirectionOrientation,
     EulerZYZOrientation,
     MatrixOrientation,
     PoseTarget,
@@ -114,8 +115,12 @@ def joints_from_core(robot: Robot, q: np.ndarray, unit: AngleUnit) -> np.ndarray
 def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool]:
     """The 4×4 ``world_T_tool`` a target asks for, and whether it constrains orientation.
 
-    A position-only target returns the identity rotation and ``False``.
+    A position-only target returns the identity rotation and ``False``. A position + direction target is not a
+    pose: it is read by :func:`target_direction`, and refused here.
     """
+    if isinstance(target.orientation, DirectionOrientation):
+        raise InvalidInputError("a position + tool direction target is accepted by the IK endpoints only",
+                                location=("orientation",))
     if target.matrix is not None:
         with located("matrix"):
             return check_transform(np.asarray(target.matrix, dtype=float)), True
@@ -137,6 +142,21 @@ def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool
         elif isinstance(orientation, RPYOrientation):
             T[:3, :3] = matrix_from_rpy(*(np.asarray(orientation.angles) * angle))
     return T, True
+
+
+def target_direction(target: PoseTarget) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """(position, tool axis, world direction), each (3,), of a position + direction target, or None for another
+    kind. Zero vectors are refused."""
+    orientation = target.orientation
+    if not isinstance(orientation, DirectionOrientation):
+        return None
+    vectors = []
+    for name in ("tool_axis", "world_direction"):
+        vector = np.asarray(getattr(orientation, name), dtype=float)
+        if not np.linalg.norm(vector) > 1e-9:
+            raise InvalidInputError(f"{name} must be a non-zero vector", location=("orientation", name))
+        vectors.append(vector / np.linalg.norm(vector))
+    return np.asarray(target.position, dtype=float), vectors[0], vectors[1]
 
 
 def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str | int) -> tuple[np.ndarray, np.ndarray]:

@@ -12,9 +12,11 @@ from ...kinematics.ik import (
     IKOptions,
     IKResult,
     NumericOptions,
+    beyond_reach,
     free_joints_for,
     no_solution_detail,
     search_position,
+    solve_direction,
     solve_free_joint_family,
     Selected,
     Selection,
@@ -33,13 +35,14 @@ from ..boundary import (
     limits_to_core,
     located,
     ordering_to_core,
+    target_direction,
     target_matrices,
     target_matrix,
     violation_to_wire,
 )
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of
 from ..observability import observe_ik
-from ..problems import problem_responses
+from ..problems import ProblemError, problem_responses
 from ..responses import FastJSONResponse
 from ..routing import FastJSONRoute
 from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest,
@@ -76,13 +79,56 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
     return reference, limits, ordering, options, note
 
 
-def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference, free=None):
+def _targets_to_core(body: IKRequest | IKBatchRequest, targets: list) -> tuple[np.ndarray, np.ndarray, dict]:
+    """Matrices (N, 4, 4), which constrain orientation (N,), and the position + direction targets: row →
+    (position, tool axis, world direction). A direction row's matrix holds its position; its flag is true."""
+    prefix = ("body", "target") if isinstance(body, IKRequest) else ("body", "targets")
+    directions = {}
+    for index, target in enumerate(targets):
+        with located(*prefix) if isinstance(body, IKRequest) else located(*prefix, index):
+            direction = target_direction(target)
+        if direction is not None:
+            directions[index] = direction
+    if not directions:
+        if isinstance(body, IKRequest):
+            with located(*prefix):
+                matrix, constrained = target_matrix(targets[0], body.angle_unit)
+            return matrix[None], np.array([constrained]), directions
+        matrices, flags = target_matrices(targets, body.angle_unit, *prefix)
+        return matrices, flags, directions
+    matrices, flags = np.tile(np.eye(4), (len(targets), 1, 1)), np.ones(len(targets), dtype=bool)
+    for index, target in enumerate(targets):
+        if index in directions:
+            matrices[index, :3, 3] = directions[index][0]
+        else:
+            with located(*prefix) if isinstance(body, IKRequest) else located(*prefix, index):
+                matrices[index], flags[index] = target_matrix(target, body.angle_unit)
+    return matrices, flags, directions
+
+
+def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference, free=None,
+                    directions: dict | None = None):
     """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
 
     ``arrays`` is None when no analytic family covers the robot (the caller then runs the numeric search).
     Full poses of a redundant arm with ``free`` joints (see :func:`_free_joints`) are solved as the family over
     the free values: one answer row per target holding every value's solutions.
     """
+    directions = directions or {}
+    for axis in {tuple(direction[1].tolist()) for direction in directions.values()}:  # position + direction
+        rows = np.array([row for row, direction in sorted(directions.items())
+                         if tuple(direction[1].tolist()) == axis])
+        started = time.perf_counter()
+        with located("body"):
+            arrays = solve_direction(robot, np.array([directions[row][0] for row in rows]),
+                                     np.array([directions[row][2] for row in rows]), np.array(axis), reference)
+        if arrays is None:
+            raise ProblemError(422, "unsupported-target", "Target kind not solved for this arm",
+                               "No closed-form family covers position + tool direction targets of this arm with "
+                               "this tool axis; give a full pose or the position only.")
+        yield True, rows, arrays, started
+    flags = flags.copy()
+    flags[list(directions)] = 2  # solved above
     for constrained in (True, False):
         rows = np.flatnonzero(flags == constrained)
         if len(rows):
@@ -141,23 +187,20 @@ def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: 
 
 def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
     robot = ref.robot
-    if isinstance(body, IKRequest):
-        with located("body", "target"):
-            matrix, constrained = target_matrix(targets[0], body.angle_unit)
-        matrices, flags = matrix[None], np.array([constrained])
-    else:
-        matrices, flags = target_matrices(targets, body.angle_unit, "body", "targets")
+    matrices, flags, directions = _targets_to_core(body, targets)
     reference, limits, ordering, options, note = _settings(request, robot, body, len(targets))
     free = _free_joints(robot, body)
     answers: list[dict | None] = [None] * len(targets)
-    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference, free):
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags.astype(int), reference, free,
+                                                              directions):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, note, started):
                 answers[row] = wire
             continue
         observe_ik("analytic", arrays.structure, time.perf_counter() - started, arrays.count.tolist())
-        results = results_from_arrays(robot, arrays, matrices[rows], constrained, reference)
+        results = results_from_arrays(robot, arrays, matrices[rows], constrained and rows[0] not in directions,
+                                      reference)
         chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
                                ordering=ordering, max_equivalents=body.max_equivalents)
         kept = chosen.solutions
@@ -180,20 +223,30 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
             answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
                                  chosen.notes.get(local, []), bool(chosen.truncated[local]),
                                  int(chosen.trimmed[local]), int(chosen.available[local]))
+    for row in directions:
+        if answers[row]["status"] == "unreachable":
+            answers[row]["detail"] = _direction_detail(robot, matrices[row, :3, 3])
     for row, wire in enumerate(answers):  # position-only: held joints must not make a reachable point unreachable
         if not flags[row] and wire["status"] == "unreachable" and wire["free_joints"]:
             result = search_position(robot, matrices[row], wire["free_joints"], reference, options)
             selection = select(robot, result, limits, filter_limits=body.filter_limits, reference=reference,
                                ordering=ordering, max_equivalents=body.max_equivalents)
             answers[row] = _capped(_to_wire(ref.id, robot, result, selection, body.angle_unit, False), note)
-    return [_with_free_values(wire, free if flag else None, robot, matrix[:3, 3])
-            for wire, flag, matrix in zip(answers, flags.tolist(), matrices)]
+    return [_with_free_values(wire, free if flag and row not in directions else None, robot, matrix[:3, 3])
+            for row, (wire, flag, matrix) in enumerate(zip(answers, flags.tolist(), matrices))]
+
+
+def _direction_detail(robot: Robot, position: np.ndarray) -> str:
+    if bool(beyond_reach(robot, position)):
+        return "The target position is outside the workspace (farther from the base than the arm can reach)."
+    return ("No joint vector puts the tool at this position with its axis along the direction (every solution of "
+            "the closed form was checked).")
 
 
 def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
     """The batch answer as columns: solve, select and encode with array operations, no loop over targets."""
     robot = ref.robot
-    matrices, flags = target_matrices(body.targets, body.angle_unit, "body", "targets")
+    matrices, flags, directions = _targets_to_core(body, body.targets)
     reference, limits, ordering, options, note = _settings(request, robot, body, len(matrices))
     free = _free_joints(robot, body)
     n_targets = len(matrices)
@@ -207,7 +260,8 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     reports: list[dict] = []
     kept_tables, rejected_tables = [], []
     scale = _unit_scale(robot, body.angle_unit)
-    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference, free):
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags.astype(int), reference, free,
+                                                              directions):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, note, started):
@@ -226,7 +280,9 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
         solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
                                         "time_budget_exhausted": False, "free_joints": arrays.free_joints})
         unreachable = unreachable_details(robot, arrays, matrices[rows], constrained, reference)
-        if constrained and free is not None:
+        if rows[0] in directions:
+            unreachable = {local: _direction_detail(robot, matrices[rows[local], :3, 3]) for local in unreachable}
+        elif constrained and free is not None:
             unreachable = {local: no_solution_detail(robot, free, matrices[rows[local], :3, 3])
                            for local in unreachable}
         for local in set(unreachable) | set(chosen.notes):

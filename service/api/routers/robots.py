@@ -5,6 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Depends, Request
 
 from ...catalogue import Catalogue
+from ...kinematics.ik import target_kinds
 from ..deps import catalogue_of, catalogue_robot, RobotRef
 from ..problems import problem_responses
 from ..schemas.robots import DHRobot, KhalilRobot, RobotDescription, RobotList, RobotSummary
@@ -26,5 +27,6 @@ def list_robots(catalogue: Catalogue = Depends(catalogue_of)) -> RobotList:
 @router.get("/{robot_id}", operation_id="get_robot", response_model=RobotDescription,
             responses=problem_responses(404, 422))
 def get_robot(request: Request, ref: RobotRef = Depends(catalogue_robot)) -> DHRobot | KhalilRobot:
-    """Return one robot's full description, exactly as its catalogue file states it (units included)."""
-    return catalogue_of(request).get(ref.id).description
+    """Return one robot's full description, exactly as its catalogue file states it (units included), with the
+    IK target kinds it takes."""
+    return catalogue_of(request).get(ref.id).description.model_copy(update={"target_kinds": target_kinds(ref.robot)})

@@ -91,6 +91,9 @@ class _RobotFields(ApiModel):
     notes: str | None = Field(None, max_length=4000)
     base: Matrix4 | None = Field(None, description="world_T_base; identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool; identity when null")
+    target_kinds: list[Literal["pose", "position", "position_direction"]] | None = Field(
+        None, max_length=3, description="in GET /v1/robots/{robot_id}: the IK target kinds the arm takes (a full "
+                                        "pose, a position, a position + tool direction); ignored in requests")
 
 
 class DHRobot(_RobotFields):

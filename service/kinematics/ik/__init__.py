@@ -8,6 +8,7 @@ back to a bounded numeric search that says it may be incomplete.
 """
 
 from ._arrays import IKArrays, solve_ik_arrays
+from ._direction import solve_direction, target_kinds
 from ._numeric import NumericOptions
 from ._plan import plan_for
 from ._position_search import search_position
@@ -37,7 +38,9 @@ __all__ = [
     "check_ordering",
     "free_joints_for",
     "no_solution_detail",
+    "solve_direction",
     "solve_free_joint_family",
+    "target_kinds",
     "distance_to_reference",
     "joint_difference",
     "joint_travel",

@@ -45,9 +45,11 @@ needs_general_6r = pytest.mark.xfail(not PANDA_SOLVABLE, strict=True,
                                      reason="a Panda with q7 locked needs the general 6R solver (issue 10)")
 
 
-def test_default_free_joint_is_the_elbow_plane_joint_of_srs_arms():
-    assert default_free_joints(arm("iiwa14")) == (2,)
-    assert default_free_joints(arm("gen3")) == (2,)
+def test_default_free_joint_is_an_end_joint_whose_locking_leaves_a_family():
+    # q7 locked leaves no spherical wrist on these SRS arms; q1 locked leaves intersecting shoulder + wrist
+    assert default_free_joints(arm("iiwa14")) == (0,)
+    assert default_free_joints(arm("gen3")) == (0,)
+    assert family_for(arm("iiwa14"), (0,)).ends_only and not family_for(arm("iiwa14"), (2,)).ends_only
 
 
 def test_a_locked_class_that_is_degenerate_is_not_chosen():
@@ -88,10 +90,9 @@ def test_each_value_is_solved_completely():
     assert len({tuple(np.round(s, 6)) for s in solutions}) == 8
 
 
-@pytest.mark.parametrize("name", ["iiwa14", "gen3"])
-def test_nearest_to_reference_is_at_least_as_near_as_a_dense_grid(name):
+@pytest.mark.parametrize("name, joint", [("iiwa14", 0), ("iiwa14", 2), ("gen3", 0)])
+def test_nearest_to_reference_is_at_least_as_near_as_a_dense_grid(name, joint):
     robot = arm(name)
-    joint = default_free_joints(robot)[0]
     rng = np.random.default_rng(3)
     dense = sample_values(robot, joint, 1440)
     for trial in range(6):
@@ -121,8 +122,8 @@ def test_free_joints_for_checks_the_request():
     with pytest.raises(ValueError, match="0…6"):
         free_joints_for(robot, [(9, [0.0], None)])
     default = free_joints_for(robot, None)
-    assert [f.joint for f in default] == [2] and len(default[0].values) == 32
-    # the iiwa's q3 spans ±170°: 32 samples over the limits, ends included
+    assert [f.joint for f in default] == [0] and len(default[0].values) == 32
+    # the iiwa's q1 spans ±170°: 32 samples over the limits, ends included
     assert np.isclose(default[0].values[0], np.radians(-170)) and np.isclose(default[0].values[-1], np.radians(170))
 
 
@@ -132,3 +133,33 @@ def test_reach_sphere_is_a_proof():
     reachable = forward_kinematics(robot, rng.uniform(-np.pi, np.pi, (2000, 7)))[:, :3, 3]
     assert not beyond_reach(robot, reachable).any()
     assert beyond_reach(robot, np.array([1.5, 0.0, 0.36]))  # the arm reaches 0.36 + 0.42 + 0.40 + 0.126 m
+
+
+def test_trajectory_of_a_redundant_arm_keeps_the_free_joint_continuous():
+    from service.kinematics import TrajectoryOptions, follow_trajectory
+
+    robot = arm("iiwa14")
+    t = np.linspace(0.0, 1.0, 41)
+    start, end = np.array([0.2, 0.6, -0.4, 1.3, 0.3, -0.7, 0.1]), np.array([0.9, 0.2, 0.5, 0.7, -0.4, 0.5, 1.2])
+    path = start + (end - start) * t[:, None] ** 2 * (3 - 2 * t[:, None])
+    targets = forward_kinematics(robot, path)
+    result = follow_trajectory(robot, t, targets, options=TrajectoryOptions(reference=start))
+    joints = np.array([s.joints for s in result.samples])
+    assert all(s.reached for s in result.samples)
+    assert_fk_verified_each(robot, joints, targets)
+    assert np.allclose(joints[0], start, atol=1e-9)  # the reference is itself a solution: nearest first
+    steps = np.abs(np.diff(joints, axis=0)).max(axis=1)
+    # no jump between branches (a flip moves a wrist joint by ~π) or along the self-motion: the largest step, where
+    # this path passes near the wrist singularity q6 = 0, stays a few times the generating path's 0.045 rad
+    assert steps.max() < 0.25
+    free_steps = np.abs(np.diff(joints[:, 0]))
+    assert free_steps.max() < 0.25 and np.ptp(joints[:, 0]) > 0.5  # q1 moves continuously, as the path needs
+    # the answer is the greedy nearest one: each step no larger than to the generating path's next sample
+    for k in range(1, len(t)):
+        to_generating = np.abs(np.angle(np.exp(1j * (path[k] - joints[k - 1])))).max()
+        assert steps[k - 1] <= to_generating + 1e-9
+
+
+def assert_fk_verified_each(robot, joints: np.ndarray, targets: np.ndarray) -> None:
+    for q, target in zip(joints, targets):
+        assert_fk_verified(robot, q[None], target)

@@ -78,6 +78,14 @@ class KhalilJoint(ApiModel):
     d: Number = 0.0
 
 
+class TargetKind(str, Enum):
+    """An IK target kind (api.md): a full pose, a position only, or a position + tool direction."""
+
+    pose = "pose"
+    position = "position"
+    position_direction = "position_direction"
+
+
 class _RobotFields(ApiModel):
     id: RobotId = "inline"
     name: str = Field("", max_length=200)
@@ -91,9 +99,10 @@ class _RobotFields(ApiModel):
     notes: str | None = Field(None, max_length=4000)
     base: Matrix4 | None = Field(None, description="world_T_base; identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool; identity when null")
-    target_kinds: list[Literal["pose", "position", "position_direction"]] | None = Field(
-        None, max_length=3, description="in GET /v1/robots/{robot_id}: the IK target kinds the arm takes (a full "
-                                        "pose, a position, a position + tool direction); ignored in requests")
+    target_kinds: list[TargetKind] = Field(
+        default_factory=list, max_length=3,
+        description="in GET /v1/robots/{robot_id}: the IK target kinds the arm takes (a full pose, a position, a "
+                    "position + tool direction); ignored in requests")
 
 
 class DHRobot(_RobotFields):

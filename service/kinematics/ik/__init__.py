@@ -12,7 +12,8 @@ from ._direction import solve_direction, target_kinds
 from ._numeric import NumericOptions
 from ._plan import plan_for
 from ._position_search import search_position
-from ._redundant import MAX_FREE_VALUES, FamilyAnswer, beyond_reach, FreeJoint, free_joints_for, no_solution_detail, solve_free_joint_family
+from ._redundant import (MAX_FREE_VALUES, FamilyAnswer, FreeJoint, beyond_reach, follow_free_joints, free_joints_for,
+                         no_solution_detail, solve_free_joint_family)
 from ._select import MAX_EQUIVALENTS, Ordering, Selected, Selection, check_ordering, joint_travel, select, travel
 from ._select_arrays import SolutionTable, select_arrays
 from ._solve import IKOptions, results_from_arrays, solve_ik, solve_ik_batch, unreachable_details
@@ -36,6 +37,7 @@ __all__ = [
     "SolutionTable",
     "beyond_reach",
     "check_ordering",
+    "follow_free_joints",
     "free_joints_for",
     "no_solution_detail",
     "solve_direction",

@@ -56,8 +56,8 @@ MAX_FREE_VALUES = 2048
 REFINED_MINIMA = 4
 #: Values tried across each bracket per refinement round; the next bracket spans two of their spacings (8× narrower).
 REFINE_POINTS = 17
-#: Refinement rounds per minimum: a 2π / 32 bracket (0.4 rad) to ~4e-10 rad.
-REFINE_ROUNDS = 10
+#: Refinement rounds per minimum: a 2π / 32 bracket (0.4 rad) to ~3e-8 rad.
+REFINE_ROUNDS = 8
 #: Values at which a candidate locking is tried when the free joints are chosen (generic, so that no accidental
 #: alignment of axes at 0 decides the class).
 _PROBE_VALUES = (0.713717, -1.921317)
@@ -68,7 +68,7 @@ TRACK_SAMPLES = 9
 #: Refinement rounds per sample along a path: the window's 0.125 bracket to ~5e-7.
 TRACK_REFINE_ROUNDS = 6
 #: Newton steps that carry a branch's solution from one free value to a nearby one.
-TRACK_STEPS = 8
+TRACK_STEPS = 6
 
 
 @dataclass(frozen=True)
@@ -490,8 +490,9 @@ def _track_branch(robot: Robot, family: FreeJointFamily, target: np.ndarray, see
     q = seeds.copy()
     q[:, joint] = values
     error = pose_error(forward_kinematics(robot, q), target, scale)
+    size = np.abs(error).max(axis=1)
+    active = size > 1e-12
     for _ in range(TRACK_STEPS):
-        active = np.abs(error).max(axis=1) > 1e-12
         if not active.any():
             break
         J = geometric_jacobian(robot, q[active])
@@ -501,7 +502,11 @@ def _track_branch(robot: Robot, family: FreeJointFamily, target: np.ndarray, see
             step = np.linalg.solve(J + 1e-12 * np.eye(6), error[active][..., None])[..., 0]
         q[np.ix_(np.flatnonzero(active), kept)] += np.nan_to_num(step)
         error[active] = pose_error(forward_kinematics(robot, q[active]), target, scale)
-    ok = np.abs(error).max(axis=1) <= 1e-9
+        new_size = np.abs(error).max(axis=1)
+        # converged, or not converging quadratically (off the branch's reach): stop following that row
+        active &= (new_size > 1e-12) & (new_size < 0.5 * size)
+        size = new_size
+    ok = size <= 1e-9
     return wrap_revolute(robot, q), ok
 
 

@@ -445,7 +445,7 @@ def _refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, v
                 if periodic and s == len(v) - 1:
                     high += 2 * np.pi
                 minima.append((float(curve[s]), float(low), float(high), sorted_joints[s, slot[s]],
-                               float(v_sorted[s])))
+                               float(v_sorted[s]), int(key)))
     if not minima:
         return None
     minima.sort(key=lambda entry: entry[0])
@@ -453,6 +453,7 @@ def _refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, v
     low = np.array([entry[1] for entry in chosen])
     high = np.array([entry[2] for entry in chosen])
     start = np.array([entry[3] for entry in chosen])  # (K, n)
+    keys_chosen = np.array([entry[5] for entry in chosen])
 
     best_value = np.array([entry[4] for entry in chosen])
     best_distance = np.array([entry[0] for entry in chosen])
@@ -460,7 +461,11 @@ def _refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, v
     for _ in range(rounds):  # each round: REFINE_POINTS values across each bracket, then a bracket 8× narrower
         points = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, REFINE_POINTS)[None, :]
         seeds = np.repeat(start, REFINE_POINTS, axis=0)
-        tracked, ok = _track_branch(robot, family, target, seeds, points.ravel())
+        if family.ends_only:  # one plan for every value: the closed form at all the points in one batch
+            tracked, ok = _on_branch(robot, family, target, points.ravel(), np.repeat(keys_chosen, REFINE_POINTS),
+                                     seeds, reference)
+        else:
+            tracked, ok = _track_branch(robot, family, target, seeds, points.ravel())
         distance = np.where(ok, distance_to_reference(robot, tracked, reference), np.inf).reshape(count, -1)
         pick = distance.argmin(axis=1)
         found = distance[np.arange(count), pick]
@@ -476,6 +481,20 @@ def _refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, v
     if not len(best):
         return None
     return _solve_at(robot, family, target, best, reference)
+
+
+def _on_branch(robot: Robot, family: FreeJointFamily, target: np.ndarray, values: np.ndarray, keys: np.ndarray,
+               seeds: np.ndarray, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The solution on branch ``keys[i]`` (see :func:`_branch_keys`) at each free value ``values[i]`` (K,), by
+    the closed form, or the one nearest ``seeds[i]`` where no solution carries that branch's labels. Returns the
+    joint vectors (K, n) and which rows have a solution (K,)."""
+    answer = _solve_at(robot, family, target, values, reference)
+    same = (_branch_keys(answer) == keys[:, None]) & answer.valid
+    gap = np.abs(np.angle(np.exp(1j * (answer.joints - seeds[:, None, :])))).max(axis=-1)
+    gap = np.where(answer.valid, gap, np.inf)
+    slot = np.where(same.any(axis=1), np.argmax(same, axis=1), gap.argmin(axis=1))
+    rows = np.arange(len(values))
+    return answer.joints[rows, slot], answer.valid[rows, slot]
 
 
 def _track_branch(robot: Robot, family: FreeJointFamily, target: np.ndarray, seeds: np.ndarray,

@@ -51,3 +51,22 @@ def test_a_point_beyond_reach_is_unreachable_and_complete(client):
     answer = client.post("/v1/ik", json={"robot": ARMS["iiwa14"], "target": {"position": [0, 0, 2.0]}}).json()
     assert answer["status"] == "unreachable" and answer["solver"]["complete"] is True
     assert "outside the workspace" in answer["detail"]
+
+
+def test_the_arrays_batch_form_searches_too(client):
+    rng = np.random.default_rng(8)
+    points = []
+    for _ in range(4):
+        pose = client.post(f"/v1/robots/{UR5}/fk", json={"joints": rng.uniform(-np.pi, np.pi, 6).tolist()}).json()
+        points.append(np.array(pose["pose"]["matrix"])[:3, 3].tolist())
+    body = {"targets": [{"position": p} for p in points] + [{"position": [0, 0, 5.0]}], "filter_limits": False}
+    arrays = client.post(f"/v1/robots/{UR5}/ik/batch", json={**body, "format": "arrays"}).json()
+    objects = client.post(f"/v1/robots/{UR5}/ik/batch", json=body).json()["results"]
+    assert arrays["targets"]["status"] == [r["status"] for r in objects] == ["ok"] * 4 + ["unreachable"]
+    assert any(r["solver"]["method"] == "numeric" for r in objects)  # some point needed the search
+    assert arrays["targets"]["solution_count"] == [len(r["solutions"]) for r in objects]
+    for row, result in enumerate(objects):
+        assert arrays["solvers"][arrays["targets"]["solver"][row]]["complete"] == result["solver"]["complete"]
+    rows = [i for i, t in enumerate(arrays["solutions"]["target"]) if t == 0]
+    joints = np.array(arrays["solutions"]["joints"])[rows]
+    assert np.allclose(joints, [s["joints"] for s in objects[0]["solutions"]])

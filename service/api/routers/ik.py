@@ -300,6 +300,20 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
             if not constrained:
                 table.orientation = np.full(len(table.target), np.nan)
             into.append(table)
+    for row in np.flatnonzero(~flags & (status == "unreachable")).tolist():  # held joints: search every joint
+        entry = solvers[solver[row]]
+        if not entry["free_joints"] or entry["method"] != "analytic":
+            continue
+        result = search_position(robot, matrices[row], entry["free_joints"], reference, options)
+        selection = select(robot, result, limits, filter_limits=body.filter_limits, reference=reference,
+                           ordering=ordering, max_equivalents=body.max_equivalents)
+        wire = _capped(_to_wire(ref.id, robot, result, selection, body.angle_unit, False), note)
+        status[row], detail[row], truncated[row], trimmed[row], available[row] = (
+            wire["status"], wire["detail"], wire["truncated"], wire["trimmed"], wire["available"])
+        solver[row] = _index(solvers, {**wire["solver"], "free_joints": wire["free_joints"]})
+        singular[row] = [_index(reports, s) for s in wire["singularities"]]
+        kept_tables.append(_table_from_wire(row, wire["solutions"], robot.dof))  # wire joints: request units
+        rejected_tables.append(_table_from_wire(row, wire["rejected"], robot.dof))
     kept, rejected = (_merged(tables, robot.dof) for tables in (kept_tables, rejected_tables))
     # number solvers and singularity reports by first appearance in target order, as a reader meets them
     present, first = np.unique(solver, return_index=True)

@@ -163,3 +163,17 @@ def test_trajectory_of_a_redundant_arm_keeps_the_free_joint_continuous():
 def assert_fk_verified_each(robot, joints: np.ndarray, targets: np.ndarray) -> None:
     for q, target in zip(joints, targets):
         assert_fk_verified(robot, q[None], target)
+
+
+def test_values_whose_locked_arm_has_no_plan_are_counted(monkeypatch):
+    from service.kinematics.ik._redundant import FreeJointFamily
+
+    robot = arm("iiwa14")
+    original = FreeJointFamily.locked_plan
+    monkeypatch.setattr(FreeJointFamily, "locked_plan",
+                        lambda self, values: None if values[0] > 1.0 else original(self, values))
+    q = np.array([0.4, 0.7, -0.3, 1.2, 0.5, -0.8, 0.2])
+    values = np.array([-0.3, 0.5, 1.5, 2.0])
+    answer = solve_free_joint_family(robot, forward_kinematics(robot, q)[None], [FreeJoint(2, values)], None)
+    assert answer.missing.tolist() == [2]
+    assert find(robot, solutions_of(answer), q) is not None

@@ -107,7 +107,7 @@ def _targets_to_core(body: IKRequest | IKBatchRequest, targets: list) -> tuple[n
 
 
 def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference, free=None,
-                    directions: dict | None = None):
+                    directions: dict | None = None, incomplete: dict | None = None):
     """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
 
     ``arrays`` is None when no analytic family covers the robot (the caller then runs the numeric search).
@@ -135,6 +135,11 @@ def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, refer
             started = time.perf_counter()
             if constrained and free is not None:
                 family = solve_free_joint_family(robot, matrices[rows], free, reference)
+                if family is not None and incomplete is not None:
+                    for row, missing in zip(rows.tolist(), family.missing.tolist()):
+                        if missing:
+                            incomplete[row] = (f"At {missing} of the free values the locked arm falls outside the "
+                                               f"closed-form family, so no solution is listed there.")
                 yield constrained, rows, None if family is None else family.arrays, started
                 continue
             yield constrained, rows, solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained,
@@ -191,8 +196,9 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
     reference, limits, ordering, options, note = _settings(request, robot, body, len(targets))
     free = _free_joints(robot, body)
     answers: list[dict | None] = [None] * len(targets)
+    incomplete: dict[int, str] = {}
     for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags.astype(int), reference, free,
-                                                              directions):
+                                                              directions, incomplete):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, note, started):
@@ -223,6 +229,9 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
             answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
                                  chosen.notes.get(local, []), bool(chosen.truncated[local]),
                                  int(chosen.trimmed[local]), int(chosen.available[local]))
+    for row, why in incomplete.items():  # a free value whose locked arm no family covered
+        answers[row]["solver"]["complete"] = False
+        answers[row]["detail"] = " ".join(filter(None, [answers[row]["detail"], why]))
     for row in directions:
         if answers[row]["status"] == "unreachable":
             answers[row]["detail"] = _direction_detail(robot, matrices[row, :3, 3])
@@ -260,8 +269,9 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     reports: list[dict] = []
     kept_tables, rejected_tables = [], []
     scale = _unit_scale(robot, body.angle_unit)
+    incomplete: dict[int, str] = {}
     for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags.astype(int), reference, free,
-                                                              directions):
+                                                              directions, incomplete):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, note, started):
@@ -300,6 +310,9 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
             if not constrained:
                 table.orientation = np.full(len(table.target), np.nan)
             into.append(table)
+    for row, why in incomplete.items():  # a free value whose locked arm no family covered
+        solver[row] = _index(solvers, {**solvers[solver[row]], "complete": False})
+        detail[row] = " ".join(filter(None, [detail[row], why]))
     for row in np.flatnonzero(~flags & (status == "unreachable")).tolist():  # held joints: search every joint
         entry = solvers[solver[row]]
         if not entry["free_joints"] or entry["method"] != "analytic":

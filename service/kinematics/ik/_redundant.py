@@ -124,11 +124,11 @@ class FreeJointFamily:
             probes = [self._plan_locked_at(dict.fromkeys(free, value)) for value in _PROBE_VALUES]
         self.plan = probes[0]
         self.available = all(p is not None for p in probes) and len({p.structure for p in probes}) == 1
-        if self.available:  # a class can be recognised yet degenerate (a locked elbow): it must solve a real pose
-            self.available = self._recovers_probe_pose()
         names = ", ".join(f"q{j + 1}" for j in free)
         self.structure = f"{self.plan.structure} with {names} free" if self.available else ""
         self.generic_count = self.plan.generic_count if self.available else 0
+        if self.available:  # a class can be recognised yet degenerate (a locked elbow): it must solve a real pose
+            self.available = self._recovers_probe_pose()
 
     def _recovers_probe_pose(self) -> bool:
         """Whether the locked problem recovers the joint vector a pose was generated from (a fixed generic one)."""
@@ -137,8 +137,6 @@ class FreeJointFamily:
         robot = self.robot
         q = np.random.default_rng(7).uniform(-1.0, 1.0, robot.dof)
         q[list(self.free)] = _PROBE_VALUES[0]
-        self.generic_count = self.plan.generic_count
-        self.structure = self.plan.structure
         rows = self.rows_plan(q[list(self.free)][None])
         answer = solve_ik_arrays(robot, forward_kinematics(robot, q)[None], constrain_orientation=True,
                                  reference=None, plan=rows)
@@ -183,8 +181,7 @@ def default_free_joints(robot: Robot) -> tuple[int, ...] | None:
         order = [n - 1, 0, 2, *range(n)]
         order = list(dict.fromkeys(order))
         candidates = [(j,) for j in order] if extra == 1 else _combinations(order, extra)
-        best = None
-        for rank, free in enumerate(candidates):
+        for free in candidates:
             family = family_for(robot, tuple(sorted(free)))
             if family.available:
                 return family.free

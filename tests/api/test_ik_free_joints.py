@@ -74,3 +74,20 @@ def test_far_target_is_outside_the_workspace(client):
     far = client.post("/v1/ik", json={"robot": IIWA, "target": {"position": [3, 0, 0], "orientation": {
         "type": "rpy", "angles": [0, 0, 0]}}}).json()
     assert far["status"] == "unreachable" and "outside the workspace" in far["detail"]
+
+
+def test_free_joints_need_a_redundant_arm_and_bounded_values(client):
+    pose = client.post("/v1/robots/ur5/fk", json={"joints": [0.1] * 6}).json()["pose"]["matrix"]
+    assert_problem(client.post("/v1/robots/ur5/ik", json={"target": {"matrix": pose},
+                                                          "free_joints": [{"joint": 2, "values": [0]}]}),
+                   422, loc=["body", "free_joints"], match="more than 6 joints")
+    T = fk_inline(client, IIWA, Q).tolist()
+    assert_problem(client.post("/v1/ik", json={"robot": IIWA, "target": {"matrix": T},
+                                               "free_joints": [{"joint": 2, "samples": 1000}]}),
+                   422, loc=["body", "free_joints"], match="one plan per value")
+    wide = client.post("/v1/ik", json={"robot": IIWA, "target": {"matrix": T}, "filter_limits": False,
+                                       "free_joints": [{"joint": 0, "samples": 2048}]})
+    assert wide.status_code == 200 and len(wide.json()["solutions"]) > 0
+    assert_problem(client.post("/v1/ik", json={"robot": IIWA, "target": {"matrix": T},
+                                               "free_joints": [{"joint": 0, "samples": 2049}]}),
+                   422, loc=["body", "free_joints", 0, "samples"])

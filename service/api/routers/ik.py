@@ -134,7 +134,8 @@ def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, refer
         if len(rows):
             started = time.perf_counter()
             if constrained and free is not None:
-                family = solve_free_joint_family(robot, matrices[rows], free, reference)
+                with located("body"):
+                    family = solve_free_joint_family(robot, matrices[rows], free, reference)
                 if family is not None and incomplete is not None:
                     for row, missing in zip(rows.tolist(), family.missing.tolist()):
                         if missing:

@@ -52,6 +52,8 @@ from ._verify import distance_to_reference, wrap_revolute
 DEFAULT_SAMPLES = 32
 #: Most free values (rows of the grid, over all free joints) one target may ask for.
 MAX_FREE_VALUES = 2048
+#: Most free values when the free joint is inside the chain (each value builds its own plan).
+MAX_PLANNED_VALUES = 256
 #: Local minima of the distance to the reference refined per target, nearest first.
 REFINED_MINIMA = 4
 #: Values tried across each bracket per refinement round; the next bracket spans two of their spacings (8× narrower).
@@ -360,6 +362,10 @@ def solve_free_joint_family(robot: Robot, world_T_targets: np.ndarray, free: lis
     if len(values) > MAX_FREE_VALUES:
         raise InvalidInputError(f"{len(values)} free values requested; at most {MAX_FREE_VALUES} per target",
                                 location=("free_joints",))
+    if not family.ends_only and len(values) > MAX_PLANNED_VALUES:
+        raise InvalidInputError(
+            f"{len(values)} free values requested; a free joint inside the chain needs one plan per value, so at "
+            f"most {MAX_PLANNED_VALUES} (an end joint takes up to {MAX_FREE_VALUES})", location=("free_joints",))
     targets = np.asarray(world_T_targets, dtype=float)
     rows_plan = _cached_rows_plan(family, values)
     answers, refined = [], []

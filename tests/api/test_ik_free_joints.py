@@ -91,3 +91,12 @@ def test_free_joints_need_a_redundant_arm_and_bounded_values(client):
     assert_problem(client.post("/v1/ik", json={"robot": IIWA, "target": {"matrix": T},
                                                "free_joints": [{"joint": 0, "samples": 2049}]}),
                    422, loc=["body", "free_joints", 0, "samples"])
+
+
+def test_a_locking_no_family_covers_falls_back_to_the_numeric_search_and_says_so(client):
+    T = fk_inline(client, IIWA, Q).tolist()
+    # q4 locked fixes the shoulder–wrist distance of this SRS arm: no family solves that locked arm
+    answer = client.post("/v1/ik", json={"robot": IIWA, "target": {"matrix": T}, "filter_limits": False,
+                                         "free_joints": [{"joint": 3, "values": [Q[3]]}]}).json()
+    assert answer["solver"]["method"] == "numeric" and answer["solver"]["complete"] is False
+    assert "q4 locked" in answer["detail"]

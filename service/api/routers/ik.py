@@ -173,6 +173,11 @@ def _with_free_values(wire: dict, free, robot: Robot, position: np.ndarray) -> d
             solution["free_values"] = {str(j): solution["joints"][j] for j in wire["free_joints"]}
     if free is not None and wire["status"] == "unreachable" and wire["solver"]["method"] == "analytic":
         wire["detail"] = no_solution_detail(robot, free, position)
+    if free is not None and wire["solver"]["method"] == "numeric":
+        names = ", ".join(f"q{f.joint + 1}" for f in free)
+        note = (f"No closed-form family covers this arm with {names} locked, so the free joints were not applied: "
+                f"a numeric search over every joint answered.")
+        wire["detail"] = f"{wire['detail']} {note}" if wire["detail"] else note
     return wire
 # --- end of redundant arms ----------------------------------------------------------------------------------
 

@@ -90,7 +90,8 @@ def test_each_value_is_solved_completely():
     assert len({tuple(np.round(s, 6)) for s in solutions}) == 8
 
 
-@pytest.mark.parametrize("name, joint", [("iiwa14", 0), ("iiwa14", 2), ("gen3", 0)])
+@pytest.mark.parametrize("name, joint", [("iiwa14", 0), ("iiwa14", 2), ("gen3", 0),
+                                         pytest.param("panda", 6, marks=needs_general_6r)])
 def test_nearest_to_reference_is_at_least_as_near_as_a_dense_grid(name, joint):
     robot = arm(name)
     rng = np.random.default_rng(3)

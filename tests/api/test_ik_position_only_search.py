@@ -67,6 +67,11 @@ def test_the_arrays_batch_form_searches_too(client):
     assert arrays["targets"]["solution_count"] == [len(r["solutions"]) for r in objects]
     for row, result in enumerate(objects):
         assert arrays["solvers"][arrays["targets"]["solver"][row]]["complete"] == result["solver"]["complete"]
-    rows = [i for i, t in enumerate(arrays["solutions"]["target"]) if t == 0]
-    joints = np.array(arrays["solutions"]["joints"])[rows]
-    assert np.allclose(joints, [s["joints"] for s in objects[0]["solutions"]])
+    for target, result in enumerate(objects):
+        rows = [i for i, t in enumerate(arrays["solutions"]["target"]) if t == target]
+        joints = np.array(arrays["solutions"]["joints"]).reshape(-1, 6)[rows]
+        assert np.allclose(joints, np.array([s["joints"] for s in result["solutions"]]).reshape(-1, 6))
+        for row, solution in zip(rows, result["solutions"]):  # the free_values column, as the objects form
+            columns = {key: column[row] for key, column in arrays["solutions"]["free_values"].items()
+                       if column[row] is not None}
+            assert columns == solution["free_values"]

@@ -354,9 +354,19 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
                     "truncated": truncated, "trimmed": trimmed, "available": available,
                     "solution_count": np.bincount(kept.target, minlength=n_targets),
                     "rejected_count": np.bincount(rejected.target, minlength=n_targets)},
-        "solutions": _columns(kept),
-        "rejected": _columns(rejected),
+        "solutions": _with_free_columns(_columns(kept), kept, solvers, solver),
+        "rejected": _with_free_columns(_columns(rejected), rejected, solvers, solver),
     })
+
+
+def _with_free_columns(columns: dict, table: SolutionTable, solvers: list[dict], solver: np.ndarray) -> dict:
+    """The arrays form's ``free_values``: per free joint, each row's value of it (request units), or None where
+    the row's target has no such free joint."""
+    free_of_row = [solvers[index]["free_joints"] for index in np.asarray(solver)[table.target].tolist()]
+    joints = np.asarray(table.joints).tolist()
+    columns["free_values"] = {str(j): [row[j] if j in free else None for row, free in zip(joints, free_of_row)]
+                              for j in sorted({j for free in free_of_row for j in free})}
+    return columns
 
 
 def _capped(wire: dict, note: str | None) -> dict:

@@ -254,6 +254,10 @@ class SolutionColumns(ApiModel):
     residual_orientation: list[float | None]
     branch: dict[str, list[str | int | None]] = Field(
         description="one column per branch label that applies; null where a row has no such label")
+    free_values: dict[str, list[float | None]] = Field(
+        default_factory=dict, description="one column per free joint (keyed by joint index, as each solution's "
+                                          "free_values in the objects form); null where the row's target has no "
+                                          "such free joint")
 
 
 class IKBatchArraysResponse(ApiModel):

@@ -16,6 +16,7 @@ from .._forward import link_frames, screw_model
 from .._robot import Robot
 from ._decoupled import DecoupledPlan
 from ._positioning import find_positioner
+from ._reversed import ReversedPlan, reversed_geometry
 from ._screws import apply, chain_motion
 from ._structure import Geometry
 from ._three_parallel import ThreeParallelPlan
@@ -57,6 +58,18 @@ def plan_for_geometry(geometry: Geometry, *, constrain_orientation: bool, refere
 
 
 def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
+    decoupled = _decoupled_pose_plan(geometry, n)
+    if decoupled is not None:
+        return decoupled
+    three_parallel = ThreeParallelPlan.match(geometry)
+    if three_parallel is not None:
+        return three_parallel
+    # a wrist at the base: the inverse chain decouples
+    inverse = _decoupled_pose_plan(reversed_geometry(geometry), n)
+    return ReversedPlan(inverse, geometry.model.home, n) if inverse is not None else None
+
+
+def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
     model = geometry.model
     for k in (n - 3, n - 1, n):
         if k < 0:
@@ -79,7 +92,7 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
         if k and positioner is None:
             continue
         return DecoupledPlan(positioner, wrist, point, model.home, n)
-    return ThreeParallelPlan.match(geometry)
+    return None
 
 
 def _position_plan(geometry: Geometry, n: int, reference: np.ndarray | None) -> Plan | None:

@@ -1,7 +1,7 @@
 """Geometric subproblems of analytic inverse kinematics, vectorised over a batch.
 
 The solvers for each kinematic family reduce a pose to a few of these
-subproblems (Paden-Kahan 1-3, IK-Geo 4, and their prismatic analogues). Each
+subproblems (Paden-Kahan 1-3, IK-Geo 4 and 5, and their prismatic analogues). Each
 one returns every candidate, and each candidate carries its own flags. No
 solver here decides acceptance, so a solver can still use a least-squares
 candidate when the target is just outside the workspace.
@@ -42,11 +42,12 @@ Conventions
 Results
 -------
 Every function returns a record with the same flags. ``m`` is the number of
-candidate slots, which is fixed for each function (1 or 2):
+candidate slots, which is fixed for each function (1 or 2; 4 for subproblem 5):
 
 * ``valid`` (..., m) bool: the candidate exists. The first slot is always
   valid, because every problem has an exact, least-squares or representative
-  answer.
+  answer (subproblem 5 excepted: it has four slots and no least-squares
+  candidate, so a row with no real root has none).
 * ``exact`` (..., m) bool: the candidate satisfies the equation within
   tolerance. False means it is the least-squares answer.
 * ``degenerate`` (...,) bool: infinitely many candidates are equally good,
@@ -57,7 +58,8 @@ candidate slots, which is fixed for each function (1 or 2):
   the first slot is valid. Functions with one slot always report False.
 
 The records are :class:`AngleSolutions` (``theta``), :class:`AnglePairSolutions`
-(``theta1``, ``theta2``) and :class:`DisplacementSolutions` (``s``).
+(``theta1``, ``theta2``), :class:`AngleTripleSolutions` (``theta1``, ``theta2``,
+``theta3``: subproblem 5, four slots) and :class:`DisplacementSolutions` (``s``).
 """
 
 from __future__ import annotations
@@ -73,6 +75,7 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, ORTHONORMAL_T
 
 __all__ = [
     "AnglePairSolutions",
+    "AngleTripleSolutions",
     "AngleSolutions",
     "DisplacementSolutions",
     "planar_two_link_elbow",
@@ -83,6 +86,7 @@ __all__ = [
     "subproblem_2_chain",
     "subproblem_3",
     "subproblem_4",
+    "subproblem_5",
 ]
 
 
@@ -103,6 +107,18 @@ class AnglePairSolutions(NamedTuple):
     theta2: np.ndarray  #: (..., 2) float, radians in (-pi, pi]; NaN where not valid
     valid: np.ndarray  #: (..., 2) bool
     exact: np.ndarray  #: (..., 2) bool
+    degenerate: np.ndarray  #: (...,) bool
+    merged: np.ndarray  #: (...,) bool
+
+
+class AngleTripleSolutions(NamedTuple):
+    """Candidates for three joint angles (subproblem 5). Slot ``j`` of the three arrays is one candidate."""
+
+    theta1: np.ndarray  #: (..., 4) float, radians in (-pi, pi]; NaN where not valid
+    theta2: np.ndarray  #: (..., 4) float, radians in (-pi, pi]; NaN where not valid
+    theta3: np.ndarray  #: (..., 4) float, radians in (-pi, pi]; NaN where not valid
+    valid: np.ndarray  #: (..., 4) bool
+    exact: np.ndarray  #: (..., 4) bool
     degenerate: np.ndarray  #: (...,) bool
     merged: np.ndarray  #: (...,) bool
 
@@ -679,6 +695,192 @@ def subproblem_4(h: ArrayLike, k: ArrayLike, p: ArrayLike, delta: ArrayLike) -> 
     c = delta - hk * coords[..., 2]
     scale = _norm(p) + np.abs(delta)
     return _harmonic(a, b, c, scale)
+
+
+# Roots of subproblem 5's quartic count as on the unit circle (real angles) within this radial distance.
+# Roots off the circle come in pairs (z, 1 / conj(z)); a tangent (double) root that rounding splits
+# lies about sqrt(eps) off it. A root accepted here that is not a solution fails the FK check.
+_SP5_ROOT_RADIUS = 1e-5
+
+
+def _rotation_parts(k: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``R(k, theta) p = fixed + cos(theta) perp + sin(theta) cross`` for points ``p`` (..., 3)."""
+    fixed = (p @ k)[..., None] * k
+    return fixed, p - fixed, np.cross(k, p)
+
+
+def _inverse_2x2(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(inverse, determinant)`` of 2 × 2 matrices (..., 2, 2); the inverse is NaN where the determinant is 0."""
+    det = A[..., 0, 0] * A[..., 1, 1] - A[..., 0, 1] * A[..., 1, 0]
+    adjugate = np.empty_like(A)
+    adjugate[..., 0, 0], adjugate[..., 1, 1] = A[..., 1, 1], A[..., 0, 0]
+    adjugate[..., 0, 1], adjugate[..., 1, 0] = -A[..., 0, 1], -A[..., 1, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return adjugate / det[..., None, None], det
+
+
+def _unit_circle_roots(c2: np.ndarray, c1: np.ndarray, c0: np.ndarray, scale: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Angles of the roots on the unit circle of ``c2 z⁴ + c1 z³ + c0 z² + conj(c1) z + conj(c2)``.
+
+    Returns ``(theta (..., 4), valid (..., 4), identically_zero (...,))``. Rows whose leading
+    coefficient vanishes (relative to ``scale``) are solved as the quadratic left.
+    """
+    shape = c0.shape
+    z = np.full(shape + (4,), np.nan + 0j)
+    tol = 1e-12 * scale
+    quartic = np.abs(c2) > tol
+    if quartic.any():
+        a = np.stack([c1, c0, np.conj(c1), np.conj(c2)], axis=-1)[quartic] / c2[quartic][:, None]
+        companion = np.zeros(a.shape[:1] + (4, 4), dtype=complex)
+        companion[:, 0, :] = -a
+        companion[:, 1, 0] = companion[:, 2, 1] = companion[:, 3, 2] = 1.0
+        z[quartic] = np.linalg.eigvals(companion)
+    quadratic = ~quartic & (np.abs(c1) > tol)
+    if quadratic.any():
+        A, B, C = c1[quadratic], c0[quadratic], np.conj(c1[quadratic])
+        root = np.sqrt(B * B - 4 * A * C)
+        z[quadratic, 0] = (-B + root) / (2 * A)
+        z[quadratic, 1] = (-B - root) / (2 * A)
+    identically_zero = ~quartic & ~quadratic & (np.abs(c0) <= tol)
+    valid = np.abs(np.abs(z) - 1.0) <= _SP5_ROOT_RADIUS
+    return np.where(valid, np.angle(z), np.nan), valid, identically_zero
+
+
+def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1: ArrayLike, p2: ArrayLike,
+                 p3: ArrayLike) -> AngleTripleSolutions:
+    """IK-Geo 5: solve ``p0 + R(k1, theta1) p1 = R(k2, theta2) (p2 + R(k3, theta3) p3)``; up to 4 solutions.
+
+    With ``L(theta1) = p0 + R(k1, theta1) p1`` and ``M(theta3) = p2 + R(k3, theta3) p3``,
+    ``R(k2, theta2)`` keeps both the height along ``k2`` and the length, so a solution needs
+    ``k2.L = k2.M`` and ``||L||**2 = ||M||**2``. Both are linear in ``u1 = (cos theta1, sin theta1)``
+    and ``u3 = (cos theta3, sin theta3)``: ``A1 u1 - A3 u3 = r``, two rows of 2 × 2 blocks (the
+    length row divided by the problem's length ``S`` so that both rows are lengths). Solving for one
+    unit vector in terms of the other, ``u_s = f + G u_t`` (per row, the block with the larger
+    ``|det| / ||A||_F**2``), ``||u_s||**2 = 1`` is a trigonometric quartic in ``theta_t``. With
+    ``z = exp(i theta_t)`` it is a polynomial of degree 4 whose roots on the unit circle are the
+    solutions (no tangent half-angle, so ``theta = pi`` is an ordinary root). The roots are the
+    eigenvalues of its companion matrix, each refined by two Newton steps on the real equation;
+    ``theta2`` follows by subproblem 1, ``R(k2, theta2) M = L``. This is Pieper's quartic for a
+    3R positioner whose second and third axes are skew.
+
+    Parameters
+    ----------
+    k1, k2, k3 : array_like, shape (3,)
+        Unit rotation axes through the origin.
+    p0, p1, p2, p3 : array_like, shape (..., 3)
+        Offsets and rotated points, broadcast against each other.
+
+    Returns
+    -------
+    AngleTripleSolutions
+        ``theta1``, ``theta2``, ``theta3`` have shape (..., 4), the slots in no particular order.
+
+    Notes
+    -----
+    Unlike subproblems 1–4 there is no least-squares candidate: a row whose quartic has no root
+    on the unit circle (within ``1e-5`` radially) has no valid slot. Roots closer than
+    ``DUPLICATE_TOLERANCE`` (a tangent root, the edge of the workspace) are reported once with
+    ``merged`` set. Scale: ``S = ||p0|| + ||p1|| + ||p2|| + ||p3||``; a candidate is ``exact``
+    when the vector equation holds to ``GEOMETRY_TOLERANCE * S``. Near a tangent root a root
+    carries about the square root of the rounding error; such valid but inexact candidates are
+    left to the caller (the IK solvers refine and verify every candidate by FK).
+    ``degenerate``: the quartic vanishes identically, so ``theta_t`` is free (``p1`` on ``k1``
+    or ``p3`` on ``k3``, with the target reachable); the representative has ``theta_t = 0``.
+    When neither block is invertible the equations do not separate the angles (``k1 ∥ k2``
+    with ``p2`` on ``k3``, or ``k2 ∥ k3``): no slot is valid, and those geometries are solved
+    by subproblems 3 and 4 instead.
+
+    Examples
+    --------
+    A point turned by three skew axes and found again (one slot holds the generating angles):
+
+    >>> k1, k2, k3 = np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0.6, 0, 0.8])
+    >>> p0, p2, p3 = np.array([0.3, 0.1, 0.0]), np.array([0.0, 0.4, 0.2]), np.array([0.5, 0.2, 0.1])
+    >>> def R(k, t):
+    ...     return np.cos(t) * np.eye(3) + np.sin(t) * np.cross(np.eye(3), k) + (1 - np.cos(t)) * np.outer(k, k)
+    >>> p1 = R(k1, -0.4) @ (R(k2, 0.7) @ (p2 + R(k3, -1.1) @ p3) - p0)
+    >>> sol = subproblem_5(k1, k2, k3, p0, p1, p2, p3)
+    >>> found = np.stack([sol.theta1, sol.theta2, sol.theta3], axis=-1)[sol.valid]
+    >>> bool(np.isclose(found, [0.4, 0.7, -1.1]).all(axis=-1).any())
+    True
+    """
+    k1, k2, k3 = _unit(k1, "k1"), _unit(k2, "k2"), _unit(k3, "k3")
+    p0, p1, p2, p3 = (_points(p, name) for p, name in ((p0, "p0"), (p1, "p1"), (p2, "p2"), (p3, "p3")))
+    shape = np.broadcast_shapes(p0.shape, p1.shape, p2.shape, p3.shape)[:-1]
+    p0, p1, p2, p3 = (np.broadcast_to(p, shape + (3,)) for p in (p0, p1, p2, p3))
+    S = _norm(p0) + _norm(p1) + _norm(p2) + _norm(p3)
+    S = np.where(S > 0.0, S, 1.0)
+    fixed1, perp1, cross1 = _rotation_parts(k1, p1)
+    fixed3, perp3, cross3 = _rotation_parts(k3, p3)
+    A1 = np.stack([np.stack([perp1 @ k2, cross1 @ k2], axis=-1),
+                   2.0 * np.stack([_dot(p0, perp1), _dot(p0, cross1)], axis=-1) / S[..., None]], axis=-2)
+    A3 = np.stack([np.stack([perp3 @ k2, cross3 @ k2], axis=-1),
+                   2.0 * np.stack([_dot(p2, perp3), _dot(p2, cross3)], axis=-1) / S[..., None]], axis=-2)
+    r = np.stack([(p2 + fixed3 - p0 - fixed1) @ k2,
+                  (_dot(p2, p2) + _dot(p3, p3) + 2 * _dot(p2, fixed3)
+                   - _dot(p0, p0) - _dot(p1, p1) - 2 * _dot(p0, fixed1)) / S], axis=-1)
+    inverse1, det1 = _inverse_2x2(A1)
+    inverse3, det3 = _inverse_2x2(A3)
+    quality1 = np.abs(det1) / np.maximum((A1 * A1).sum(axis=(-1, -2)), 1e-300)
+    quality3 = np.abs(det3) / np.maximum((A3 * A3).sum(axis=(-1, -2)), 1e-300)
+    by_theta1 = quality3 >= quality1  # solve for u3, the quartic in theta1
+    # u_s = inverse_s (A_t u_t + rho): rho = -r solving for u3, +r solving for u1
+    inverse = np.where(by_theta1[..., None, None], inverse3, inverse1)
+    A_t = np.where(by_theta1[..., None, None], A1, A3)
+    rho = np.where(by_theta1[..., None], -r, r)
+    separable = np.maximum(quality1, quality3) > 1e-12
+    G = inverse @ A_t
+    f = np.einsum("...ij,...j->...i", inverse, rho)
+    Q = np.swapaxes(G, -1, -2) @ G
+    g = np.einsum("...ji,...j->...i", G, f)
+    h = _dot(f, f) - 1.0
+    c2 = (Q[..., 0, 0] - Q[..., 1, 1]) / 4 - 0.5j * Q[..., 0, 1]
+    c1 = g[..., 0] - 1j * g[..., 1]
+    c0 = (Q[..., 0, 0] + Q[..., 1, 1]) / 2 + h
+    scale = 1.0 + Q[..., 0, 0] + Q[..., 1, 1] + _dot(f, f)
+    with np.errstate(invalid="ignore"):
+        theta_t, valid, free = _unit_circle_roots(c2, c1, c0, np.where(separable, scale, np.inf))
+        free &= separable
+        valid &= separable[..., None]
+        theta_t[free, 0], valid[free, 0] = 0.0, True
+        for _ in range(2):  # Newton on F(t) = u Q u + 2 g u + h, u = (cos t, sin t)
+            u = np.stack([np.cos(theta_t), np.sin(theta_t)], axis=-1)
+            du = np.stack([-u[..., 1], u[..., 0]], axis=-1)
+            Qu = np.einsum("...ij,...mj->...mi", Q, u)
+            F = np.einsum("...mi,...mi->...m", u, Qu + 2 * g[..., None, :]) + h[..., None]
+            dF = 2 * np.einsum("...mi,...mi->...m", du, Qu + g[..., None, :])
+            step = np.where(np.abs(dF) > 1e-9 * scale[..., None], F / np.where(dF == 0, 1.0, dF), 0.0)
+            theta_t = np.where(free[..., None] | (np.abs(step) > 1e-3), theta_t, theta_t - step)
+        u_t = np.stack([np.cos(theta_t), np.sin(theta_t)], axis=-1)
+        u_s = f[..., None, :] + np.einsum("...ij,...mj->...mi", G, u_t)
+        theta_s = np.arctan2(u_s[..., 1], u_s[..., 0])
+    theta1 = _wrap(np.where(by_theta1[..., None], theta_t, theta_s))
+    theta3 = _wrap(np.where(by_theta1[..., None], theta_s, theta_t))
+    L = p0[..., None, :] + _rotate_points(k1, theta1, p1[..., None, :])
+    M = p2[..., None, :] + _rotate_points(k3, theta3, p3[..., None, :])
+    theta2, _, _ = _rotate_onto(_frame(k2), np.nan_to_num(M), np.nan_to_num(L), S[..., None])
+    miss = _norm(L - _rotate_points(k2, theta2, M))
+    # the same root twice (a tangent root): keep the first
+    merged = np.zeros(shape, dtype=bool)
+    for later in range(1, 4):
+        for earlier in range(later):
+            gap = np.abs(_wrap(theta_t[..., later] - theta_t[..., earlier]))
+            same = valid[..., later] & valid[..., earlier] & (gap <= DUPLICATE_TOLERANCE)
+            merged |= same
+            valid[..., later] &= ~same
+    nan = np.nan
+    return AngleTripleSolutions(
+        theta1=np.where(valid, theta1, nan), theta2=np.where(valid, theta2, nan),
+        theta3=np.where(valid, theta3, nan), valid=valid,
+        exact=valid & (miss <= GEOMETRY_TOLERANCE * S[..., None]), degenerate=free, merged=merged)
+
+
+def _rotate_points(k: np.ndarray, theta: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``R(k, theta) p`` (Rodrigues), broadcasting ``theta`` (...) against points ``p`` (..., 3)."""
+    fixed, perp, cross = _rotation_parts(k, p)
+    c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
+    return fixed + c * perp + s * cross
 
 
 def planar_two_link_elbow(l1: float, l2: float, r: ArrayLike) -> AngleSolutions:

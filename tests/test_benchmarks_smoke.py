@@ -51,5 +51,5 @@ def test_redundant_benchmark_runs_with_tiny_sizes(capsys):
 
     assert redundant.main(["--quick"]) == 0
     out = capsys.readouterr().out
-    assert "| iiwa 14 | full pose, q1 sampled 32× |" in out
+    assert "| iiwa 14 | full pose, q7 sampled 32× |" in out
     assert "| SO-101-like | position + direction, roll axis z |" in out

@@ -46,8 +46,11 @@ needs_general_6r = pytest.mark.xfail(not PANDA_SOLVABLE, strict=True,
 
 
 def test_default_free_joint_is_an_end_joint_whose_locking_leaves_a_family():
-    # q7 locked leaves no spherical wrist on these SRS arms; q1 locked leaves intersecting shoulder + wrist
-    assert default_free_joints(arm("iiwa14")) == (0,)
+    # iiwa and Panda with q7 locked: the shoulder (axes 1-3 through one point) is a spherical wrist at the base.
+    # The Gen3's shoulder axes do not meet (d2 = -0.0118 m), so its q7 leaves no family; q1 leaves the
+    # intersecting shoulder + spherical wrist.
+    assert default_free_joints(arm("iiwa14")) == (6,)
+    assert default_free_joints(arm("panda")) == (6,)
     assert default_free_joints(arm("gen3")) == (0,)
     assert family_for(arm("iiwa14"), (0,)).ends_only and not family_for(arm("iiwa14"), (2,)).ends_only
 
@@ -125,9 +128,9 @@ def test_free_joints_for_checks_the_request():
     with pytest.raises(ValueError, match="0…6"):
         free_joints_for(robot, [(9, [0.0], None)])
     default = free_joints_for(robot, None)
-    assert [f.joint for f in default] == [0] and len(default[0].values) == 32
-    # the iiwa's q1 spans ±170°: 32 samples over the limits, ends included
-    assert np.isclose(default[0].values[0], np.radians(-170)) and np.isclose(default[0].values[-1], np.radians(170))
+    assert [f.joint for f in default] == [6] and len(default[0].values) == 32
+    # the iiwa's q7 spans ±175°: 32 samples over the limits, ends included
+    assert np.isclose(default[0].values[0], np.radians(-175)) and np.isclose(default[0].values[-1], np.radians(175))
 
 
 def test_reach_sphere_is_a_proof():

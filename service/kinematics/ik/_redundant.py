@@ -169,9 +169,10 @@ def default_free_joints(robot: Robot) -> tuple[int, ...] | None:
     """The free joint(s) whose locking leaves a closed-form 6-DOF class, or None when no choice does.
 
     One joint is locked per degree of redundancy. The first candidate whose
-    locked arm a family solves wins, in this order: the last joint (a Panda's
-    q7), the first (an iiwa's or a Gen3's q1), the third (the SRS arms' other
-    classic choice, their q3), then the others. End joints come first because
+    locked arm a family solves wins, in this order: the last joint (a Panda's or
+    an iiwa's q7: their shoulder is then a spherical wrist at the base), the
+    first (a Gen3's q1), the third (the SRS arms' other classic choice, their
+    q3), then the others. End joints come first because
     the locked arm is then the same for every value: the samples solve as one
     vectorised batch, about four times faster than one plan per value.
     """

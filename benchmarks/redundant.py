@@ -6,7 +6,7 @@
 Rows, each timed on seeded poses from the arm's own FK and reported as the median and best per request:
 
 * a 7-DOF full pose with its free joint sampled 32 times (the issue's goal: < 20 ms of solve time), without and
-  with a reference (the continuous nearest-solution search), on the iiwa 14 and the Gen3;
+  with a reference (the continuous nearest-solution search), on the iiwa 14, the Gen3 and the Panda;
 * a 5-DOF position + direction target (SO-101-like arm, jaw axis and roll axis);
 * the anchor: the same 7-DOF request at one value of the free joint (one locked 6-DOF solve), in the same run.
 
@@ -76,7 +76,7 @@ def main(argv: list[str] | None = None) -> int:
     print("| arm | request | median ms | best ms | solutions | recall |")
     print("| --- | --- | --- | --- | --- | --- |")
     medians = {}
-    for name, label in (("iiwa14", "iiwa 14"), ("gen3", "Gen3")):
+    for name, label in (("iiwa14", "iiwa 14"), ("gen3", "Gen3"), ("panda", "Panda")):
         robot = _arm(name)
         joint = default_free_joints(robot)[0]
         grid = sample_values(robot, joint, args.samples)

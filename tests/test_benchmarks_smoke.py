@@ -53,3 +53,12 @@ def test_redundant_benchmark_runs_with_tiny_sizes(capsys):
     out = capsys.readouterr().out
     assert "| iiwa 14 | full pose, q7 sampled 32× |" in out
     assert "| SO-101-like | position + direction, roll axis z |" in out
+
+
+def test_three_parallel_benchmark_runs_with_tiny_sizes(capsys):
+    from benchmarks import three_parallel
+
+    assert three_parallel.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "| 4∥5∥6 | IK, batch of 20 | core |" in out
+    assert "core on 1∥2∥3: family three_parallel_at_base" in out

@@ -19,7 +19,8 @@ from ._positioning import find_positioner
 from ._reversed import ReversedPlan, reversed_geometry
 from ._screws import apply, chain_motion
 from ._structure import Geometry
-from ._three_parallel import ThreeParallelPlan
+from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
+from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
 from ._types import Branch, Candidates, LabelCodes
 from ._wrist import Roll, SphericalWrist
 
@@ -61,12 +62,41 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
     decoupled = _decoupled_pose_plan(geometry, n)
     if decoupled is not None:
         return decoupled
-    three_parallel = ThreeParallelPlan.match(geometry)
+    three_parallel = _three_parallel_plan(geometry)
     if three_parallel is not None:
         return three_parallel
     # a wrist at the base: the inverse chain decouples
-    inverse = _decoupled_pose_plan(reversed_geometry(geometry), n)
-    return ReversedPlan(inverse, geometry.model.home, n) if inverse is not None else None
+    reverse = reversed_geometry(geometry)
+    inverse = _decoupled_pose_plan(reverse, n)
+    if inverse is not None:
+        return ReversedPlan(inverse, geometry.model.home, n)
+    return _reversed_three_parallel_plan(geometry, reverse, n)
+
+
+#: Three consecutive parallel axes: the families as the chain is described, then (name, family, first
+#: parallel axis) of the inverse chain: axes 3 ∥ 4 ∥ 5 are axes 2 ∥ 3 ∥ 4 seen from the tool, and axes
+#: 1 ∥ 2 ∥ 3 are axes 4 ∥ 5 ∥ 6.
+_THREE_PARALLEL = (ThreeParallelPlan, SkewWristThreeParallelPlan, ThreeParallelAtEndPlan)
+_THREE_PARALLEL_REVERSED = (("three_parallel_intersecting_shoulder", ThreeParallelPlan, 2),
+                            ("three_parallel_skew_shoulder", SkewWristThreeParallelPlan, 2),
+                            ("three_parallel_at_base", ThreeParallelAtEndPlan, 0))
+
+
+def _three_parallel_plan(geometry: Geometry) -> Plan | None:
+    for family in _THREE_PARALLEL:
+        plan = family.match(geometry)
+        if plan is not None:
+            return plan
+    return None
+
+
+def _reversed_three_parallel_plan(geometry: Geometry, reverse: Geometry, n: int) -> Plan | None:
+    for structure, family, first in _THREE_PARALLEL_REVERSED:
+        plan = family.match(reverse)
+        if plan is not None:  # the elbow label of the parallel axes as the chain is described
+            return ReversedPlan(plan, geometry.model.home, n, structure=structure,
+                                label_codes=lambda joints: {"elbow": parallel_elbow_codes(geometry, joints, first)})
+    return None
 
 
 def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:

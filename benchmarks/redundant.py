@@ -27,8 +27,8 @@ from pathlib import Path
 import numpy as np
 from pydantic import TypeAdapter
 
-from service.api.boundary import robot_from_description
-from service.api.schemas.robots import RobotDescription
+from service.robots import robot_from_description
+from service.robots.schemas import RobotDescription
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import FreeJoint, solve_direction, solve_free_joint_family
 from service.kinematics.ik._redundant import default_free_joints, sample_values

@@ -18,7 +18,7 @@ import sys
 
 import numpy as np
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Robot
 from service.kinematics._robot import Joint

@@ -14,8 +14,8 @@ import numpy as np
 import pytest
 from pydantic import TypeAdapter
 
-from service.api.boundary import robot_from_description
-from service.api.schemas.robots import RobotDescription
+from service.robots import robot_from_description
+from service.robots.schemas import RobotDescription
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import FreeJoint, distance_to_reference, free_joints_for, solve_free_joint_family
 from service.kinematics.ik._redundant import beyond_reach, default_free_joints, family_for, sample_values

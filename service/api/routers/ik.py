@@ -40,7 +40,7 @@ from ..boundary import (
     target_matrix,
     violation_to_wire,
 )
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of, with_request_frames
 from ..observability import observe_ik
 from ..problems import ProblemError, problem_responses
 from ..responses import FastJSONResponse
@@ -110,7 +110,8 @@ def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, refer
                     directions: dict | None = None, incomplete: dict | None = None):
     """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
 
-    ``arrays`` is None when no analytic family covers the robot (the caller then runs the numeric search).
+    ``arrays`` is None when no analytic family covers the robot, or for the targets where a closed form on rounded
+    geometry could not promise every solution (the caller then runs :func:`solve_ik_batch`, whose fallback answers).
     Full poses of a redundant arm with ``free`` joints (see :func:`_free_joints`) are solved as the family over
     the free values: one answer row per target holding every value's solutions.
     """
@@ -143,8 +144,16 @@ def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, refer
                                                f"closed-form family, so no solution is listed there.")
                 yield constrained, rows, None if family is None else family.arrays, started
                 continue
-            yield constrained, rows, solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained,
-                                                     reference=reference), started
+            arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
+            if arrays is None or arrays.complete.all():
+                yield constrained, rows, arrays, started
+                continue
+            # a closed form on rounded geometry that cannot promise every solution for some targets: those go to
+            # the fallback solver (through solve_ik_batch), the others keep the closed form's answer
+            complete = np.flatnonzero(arrays.complete)
+            if len(complete):
+                yield constrained, rows[complete], arrays.take(complete), started
+            yield constrained, rows[~arrays.complete], None, started
 
 
 # --- redundant arms: free joints (issue 14) ---------------------------------------------------------------
@@ -197,6 +206,7 @@ def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: 
 
 
 def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     matrices, flags, directions = _targets_to_core(body, targets)
     reference, limits, ordering, options, note = _settings(request, robot, body, len(targets))
@@ -247,8 +257,11 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
             selection = select(robot, result, limits, filter_limits=body.filter_limits, reference=reference,
                                ordering=ordering, max_equivalents=body.max_equivalents)
             answers[row] = _capped(_to_wire(ref.id, robot, result, selection, body.angle_unit, False), note)
-    return [_with_free_values(wire, free if flag and row not in directions else None, robot, matrix[:3, 3])
-            for row, (wire, flag, matrix) in enumerate(zip(answers, flags.tolist(), matrices))]
+    answers = [_with_free_values(wire, free if flag and row not in directions else None, robot, matrix[:3, 3])
+               for row, (wire, flag, matrix) in enumerate(zip(answers, flags.tolist(), matrices))]
+    for answer in answers:
+        answer["joint_names"] = robot.joint_names
+    return answers
 
 
 def _direction_detail(robot: Robot, position: np.ndarray) -> str:
@@ -260,6 +273,7 @@ def _direction_detail(robot: Robot, position: np.ndarray) -> str:
 
 def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
     """The batch answer as columns: solve, select and encode with array operations, no loop over targets."""
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     matrices, flags, directions = _targets_to_core(body, body.targets)
     reference, limits, ordering, options, note = _settings(request, robot, body, len(matrices))
@@ -347,6 +361,7 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     singular = [[order[i] for i in flags] for flags in singular] if order else singular
     return FastJSONResponse({
         "robot_id": ref.id,
+        "joint_names": robot.joint_names,
         "format": "arrays",
         "solvers": solvers,
         "singularity_reports": reports,

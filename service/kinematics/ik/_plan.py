@@ -12,13 +12,15 @@ from typing import Protocol
 
 import numpy as np
 
+from .._cache import memo
 from .._forward import link_frames, screw_model
 from .._robot import Robot
 from ._decoupled import DecoupledPlan
+from ._idealised import IdealisedPlan
 from ._positioning import find_positioner
 from ._reversed import ReversedPlan, reversed_geometry
 from ._screws import apply, chain_motion
-from ._structure import Geometry
+from ._structure import Geometry, canonical_model, idealised
 from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
 from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
 from ._types import Branch, Candidates, LabelCodes
@@ -38,20 +40,44 @@ class Plan(Protocol):
 
 
 def geometry_of(robot: Robot) -> Geometry:
-    """The robot's screw model, size, up direction (base z) and link x axes at q = 0, in the world frame."""
+    """The robot's canonical screw model and size (:func:`canonical_model`), up direction (base z) and link x axes
+    at q = 0, in the world frame."""
+    return memo(robot, "ik_geometry", lambda: _geometry_of(robot))
+
+
+def _geometry_of(robot: Robot) -> Geometry:
     frames = link_frames(robot, np.zeros(robot.dof))
-    return Geometry(screw_model(robot), robot.characteristic_length, up=robot.world_T_base[:3, 2].copy(),
-                    link_x=frames[1:, :3, 0].copy())
+    model, size = canonical_model(screw_model(robot), robot.world_T_base[:3, 3])  # size: arm_size(robot)
+    return Geometry(model, size, up=robot.world_T_base[:3, 2].copy(), link_x=frames[1:, :3, 0].copy())
 
 
 def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
-    """The analytic plan for this robot and kind of target, or None when no family applies."""
-    return plan_for_geometry(geometry_of(robot), constrain_orientation=constrain_orientation, reference=reference)
+    """The analytic plan for this robot and kind of target, or None when no family applies.
+
+    A family is looked for in the arm as given (tolerance ``GEOMETRY_TOLERANCE``), then in its idealisation
+    (relations within ``RECOGNITION_TOLERANCE`` made exact, :func:`idealised`): that plan solves the idealised arm
+    and refines on the true one (:class:`IdealisedPlan`).
+    """
+    geometry = geometry_of(robot)
+    plan = _family_plan(geometry, constrain_orientation, reference)
+    if plan is not None:
+        return plan
+    ideal = idealised(geometry)
+    if ideal.deviation == 0.0:
+        return None
+    plan = _family_plan(ideal.geometry, constrain_orientation, reference)
+    if plan is None:
+        return None
+    return IdealisedPlan(plan, ideal.geometry.model, robot, ideal.deviation, geometry.length_scale, constrain_orientation)
 
 
 def plan_for_geometry(geometry: Geometry, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
-    """:func:`plan_for` on a screw model directly: also for arms that exist only as models, such as a redundant
-    arm with joints locked (see ``_redundant``)."""
+    """:func:`plan_for` on a screw model directly, exact recognition only (the idealised retry needs the robot):
+    also for arms that exist only as models, such as a redundant arm with joints locked (see ``_redundant``)."""
+    return _family_plan(geometry, constrain_orientation, reference)
+
+
+def _family_plan(geometry: Geometry, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     n = geometry.dof
     if constrain_orientation:
         return _pose_plan(geometry, n)

@@ -46,6 +46,15 @@ def test_http_benchmark_says_when_wrk_is_missing(capsys, monkeypatch):
     assert "wrk is not installed" in capsys.readouterr().out
 
 
+def test_redundant_benchmark_runs_with_tiny_sizes(capsys):
+    from benchmarks import redundant
+
+    assert redundant.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "| iiwa 14 | full pose, q7 sampled 32× |" in out
+    assert "| SO-101-like | position + direction, roll axis z |" in out
+
+
 def test_three_parallel_benchmark_runs_with_tiny_sizes(capsys):
     from benchmarks import three_parallel
 

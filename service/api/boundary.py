@@ -36,6 +36,7 @@ from ..robots.build import bounds as _bounds
 from .schemas.common import AngleUnit
 from .schemas.ik import Ordering as OrderingOptions
 from .schemas.poses import (
+    DirectionOrientation,
     EulerZYZOrientation,
     MatrixOrientation,
     PoseTarget,
@@ -81,8 +82,12 @@ def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool
     """The 4×4 ``world_T_tool`` a target asks for, and whether it constrains orientation.
 
     A position-only target returns the identity rotation and ``False``. A matrix that comes with ``position``
-    and ``quaternion_wxyz`` (a forward-kinematics pose sent back as it stands) must agree with them.
+    and ``quaternion_wxyz`` (a forward-kinematics pose sent back as it stands) must agree with them. A position +
+    direction target is not a pose: it is read by :func:`target_direction`, and refused here.
     """
+    if isinstance(target.orientation, DirectionOrientation):
+        raise InvalidInputError("a position + tool direction target is accepted by the IK endpoints only",
+                                location=("orientation",))
     if target.matrix is not None:
         with located("matrix"):
             T = check_transform(np.asarray(target.matrix, dtype=float))
@@ -129,6 +134,19 @@ def _check_pose_agrees(T: np.ndarray, position: Sequence[float] | None, wxyz: Se
             raise InvalidInputError(f"quaternion_wxyz {list(wxyz)} disagrees with the matrix's rotation, whose "
                                     f"quaternion (w, x, y, z) is {np.round(expected, 9).tolist()}; send one of "
                                     f"them, or both equal", location=("quaternion_wxyz",))
+def target_direction(target: PoseTarget) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """(position, tool axis, world direction), each (3,), of a position + direction target, or None for another
+    kind. Zero vectors are refused."""
+    orientation = target.orientation
+    if not isinstance(orientation, DirectionOrientation):
+        return None
+    vectors = []
+    for name in ("tool_axis", "world_direction"):
+        vector = np.asarray(getattr(orientation, name), dtype=float)
+        if not np.linalg.norm(vector) > 1e-9:
+            raise InvalidInputError(f"{name} must be a non-zero vector", location=("orientation", name))
+        vectors.append(vector / np.linalg.norm(vector))
+    return np.asarray(target.position, dtype=float), vectors[0], vectors[1]
 
 
 def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str | int) -> tuple[np.ndarray, np.ndarray]:

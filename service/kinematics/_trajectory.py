@@ -65,6 +65,7 @@ from .ik import (
     Singularity,
     distance_to_reference,
     joint_difference,
+    follow_free_joints,
     plan_for,
     solve_ik,
     solve_ik_batch,
@@ -310,16 +311,19 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
     limits = options.limits or Limits.of(robot)
 
     plan = plan_for(robot, constrain_orientation=constrain_orientation, reference=reference)
+    # a redundant arm (issue 14): the free joint held continuous along the path, its rate 0
+    family = follow_free_joints(robot, targets, reference) if constrain_orientation and robot.dof > 6 else None
     task = task_space(robot, constrain_orientation=constrain_orientation,
-                      free_joints=plan.free_joints if plan is not None else ())
+                      free_joints=family[1] if family is not None else
+                      plan.free_joints if plan is not None else ())
     twist, has_twist = _check_cartesian(twists, "twist", count, task)
     acceleration, has_acceleration = _check_cartesian(accelerations, "acceleration", count, task)
     orphan = np.flatnonzero(has_acceleration & ~has_twist)
     if len(orphan):
         raise InvalidInputError("an acceleration needs the sample's twist (q̈ = J⁻¹(a − J̇q̇) needs q̇)",
                                 location=("samples", int(orphan[0]), "acceleration"))
-    results = solve_ik_batch(robot, targets, constrain_orientation=constrain_orientation, reference=reference,
-                             options=options.ik)
+    results = family[0] if family is not None else solve_ik_batch(
+        robot, targets, constrain_orientation=constrain_orientation, reference=reference, options=options.ik)
     held = _check_branch(options.branch, results)
 
     samples = _follow(robot, times, targets, results, held, reference, limits, constrain_orientation, options.ik)

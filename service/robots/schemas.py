@@ -88,6 +88,20 @@ class KhalilJoint(ApiModel):
     d: Number = Field(0.0, description="distance along x_{j-1}, length unit (Craig's a_{j-1})")
 
 
+class TargetKind(str, Enum):
+    """An IK target kind (api.md): a full pose, a position only, or a position + tool direction."""
+
+    pose = "pose"
+    position = "position"
+    position_direction = "position_direction"
+
+
+TARGET_KINDS_FIELD = Field(
+    default_factory=list, max_length=3,
+    description="in GET /v1/robots/{robot_id}: the IK target kinds the arm takes (a full pose, a position, a "
+                "position + tool direction); ignored in requests")
+
+
 class _RobotFields(ApiModel):
     id: RobotId = Field("inline", description="lower case [a-z0-9_-]; a catalogue file's id is its file name")
     name: str = Field("", max_length=200, description="a readable name")
@@ -103,6 +117,7 @@ class _RobotFields(ApiModel):
     notes: str | None = Field(None, max_length=4000, description="free text: frame choices, joint zeros, caveats")
     base: Matrix4 | None = Field(None, description="world_T_base; identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool; identity when null")
+    target_kinds: list[TargetKind] = TARGET_KINDS_FIELD
 
 
 class DHRobot(_RobotFields):
@@ -142,6 +157,7 @@ class URDFRobot(ApiModel):
     notes: str | None = Field(None, max_length=4000, description="free text: frame choices, joint zeros, caveats")
     base: Matrix4 | None = Field(None, description="world_T_base (world_T_base_link); identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool (tip_link_T_tool); identity when null")
+    target_kinds: list[TargetKind] = TARGET_KINDS_FIELD
 
 
 class ScrewJointDescription(ApiModel):

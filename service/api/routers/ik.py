@@ -12,6 +12,12 @@ from ...kinematics.ik import (
     IKOptions,
     IKResult,
     NumericOptions,
+    beyond_reach,
+    free_joints_for,
+    no_solution_detail,
+    search_position,
+    solve_direction,
+    solve_free_joint_family,
     Selected,
     Selection,
     SolutionTable,
@@ -31,6 +37,7 @@ from ..boundary import (
     limits_to_core,
     located,
     ordering_to_core,
+    target_direction,
     target_matrices,
     target_matrix,
     violation_to_wire,
@@ -38,7 +45,7 @@ from ..boundary import (
 from ..budget import budget_of, check_ik_cost
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of, with_request_frames
 from ..observability import observe_ik
-from ..problems import problem_responses
+from ..problems import ProblemError, problem_responses
 from ..responses import FastJSONResponse
 from ..routing import FastJSONRoute
 from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest,
@@ -86,16 +93,71 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
     return reference, limits, ordering, _numeric_options(request, body, len(matrices))
 
 
-def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference, budget: Budget):
+def _targets_to_core(body: IKRequest | IKBatchRequest, targets: list) -> tuple[np.ndarray, np.ndarray, dict]:
+    """Matrices (N, 4, 4), which constrain orientation (N,), and the position + direction targets: row →
+    (position, tool axis, world direction). A direction row's matrix holds its position; its flag is true."""
+    prefix = ("body", "target") if isinstance(body, IKRequest) else ("body", "targets")
+    directions = {}
+    for index, target in enumerate(targets):
+        with located(*prefix) if isinstance(body, IKRequest) else located(*prefix, index):
+            direction = target_direction(target)
+        if direction is not None:
+            directions[index] = direction
+    if not directions:
+        if isinstance(body, IKRequest):
+            with located(*prefix):
+                matrix, constrained = target_matrix(targets[0], body.angle_unit)
+            return matrix[None], np.array([constrained]), directions
+        matrices, flags = target_matrices(targets, body.angle_unit, *prefix)
+        return matrices, flags, directions
+    matrices, flags = np.tile(np.eye(4), (len(targets), 1, 1)), np.ones(len(targets), dtype=bool)
+    for index, target in enumerate(targets):
+        if index in directions:
+            matrices[index, :3, 3] = directions[index][0]
+        else:
+            with located(*prefix) if isinstance(body, IKRequest) else located(*prefix, index):
+                matrices[index], flags[index] = target_matrix(target, body.angle_unit)
+    return matrices, flags, directions
+
+
+def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference, budget: Budget, free=None,
+                    directions: dict | None = None, incomplete: dict | None = None):
     """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
 
     ``arrays`` is None when no analytic family covers the robot, or for the targets where a closed form on rounded
     geometry could not promise every solution (the caller then runs :func:`solve_ik_batch`, whose fallback answers).
+    Full poses of a redundant arm with ``free`` joints (see :func:`_free_joints`) are solved as the family over
+    the free values: one answer row per target holding every value's solutions.
     """
+    directions = directions or {}
+    for axis in {tuple(direction[1].tolist()) for direction in directions.values()}:  # position + direction
+        rows = np.array([row for row, direction in sorted(directions.items())
+                         if tuple(direction[1].tolist()) == axis])
+        started = time.perf_counter()
+        with located("body"):
+            arrays = solve_direction(robot, np.array([directions[row][0] for row in rows]),
+                                     np.array([directions[row][2] for row in rows]), np.array(axis), reference)
+        if arrays is None:
+            raise ProblemError(422, "unsupported-target", "Target kind not solved for this arm",
+                               "No closed-form family covers position + tool direction targets of this arm with "
+                               "this tool axis; give a full pose or the position only.")
+        yield True, rows, arrays, started
+    flags = flags.copy()
+    flags[list(directions)] = 2  # solved above
     for constrained in (True, False):
         rows = np.flatnonzero(flags == constrained)
         if len(rows):
             started = time.perf_counter()
+            if constrained and free is not None:
+                with located("body"):
+                    family = solve_free_joint_family(robot, matrices[rows], free, reference)
+                if family is not None and incomplete is not None:
+                    for row, missing in zip(rows.tolist(), family.missing.tolist()):
+                        if missing:
+                            incomplete[row] = (f"At {missing} of the free values the locked arm falls outside the "
+                                               f"closed-form family, so no solution is listed there.")
+                yield constrained, rows, None if family is None else family.arrays, started
+                continue
             arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
                                      budget=budget)
             if arrays is None or arrays.complete.all():
@@ -107,6 +169,41 @@ def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, refer
             if len(complete):
                 yield constrained, rows[complete], arrays.take(complete), started
             yield constrained, rows[~arrays.complete], None, started
+
+
+# --- redundant arms: free joints (issue 14) ---------------------------------------------------------------
+def _free_joints(robot: Robot, body: IKRequest | IKBatchRequest):
+    """The free joints of a redundant arm's full-pose targets, in core units, or None (not redundant, or no
+    locking leaves a family: the numeric search then answers, as before)."""
+    if body.free_joints is None and robot.dof <= 6:
+        return None
+    requested = None
+    if body.free_joints is not None:
+        requested = []
+        for index, choice in enumerate(body.free_joints):
+            values = choice.values
+            if values is not None and 0 <= choice.joint < robot.dof:
+                values = (np.asarray(values, dtype=float) * _unit_scale(robot, body.angle_unit)[choice.joint]).tolist()
+            requested.append((choice.joint, values, choice.samples))
+    with located("body"):
+        return free_joints_for(robot, requested)
+
+
+def _with_free_values(wire: dict, free, robot: Robot, position: np.ndarray) -> dict:
+    """Each solution's ``free_values`` (its own values of the answer's free joints, in the request's unit), and
+    the family's meaning of an empty answer."""
+    for key in ("solutions", "rejected"):
+        for solution in wire[key]:
+            solution["free_values"] = {str(j): solution["joints"][j] for j in wire["free_joints"]}
+    if free is not None and wire["status"] == "unreachable" and wire["solver"]["method"] == "analytic":
+        wire["detail"] = no_solution_detail(robot, free, position)
+    if free is not None and wire["solver"]["method"] == "numeric":
+        names = ", ".join(f"q{f.joint + 1}" for f in free)
+        note = (f"No closed-form family covers this arm with {names} locked, so the free joints were not applied: "
+                f"a numeric search over every joint answered.")
+        wire["detail"] = f"{wire['detail']} {note}" if wire["detail"] else note
+    return wire
+# --- end of redundant arms ----------------------------------------------------------------------------------
 
 
 def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: np.ndarray, rows: np.ndarray,
@@ -127,23 +224,22 @@ def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: 
 def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
     ref = with_request_frames(ref, body)
     robot = ref.robot
-    if isinstance(body, IKRequest):
-        with located("body", "target"):
-            matrix, constrained = target_matrix(targets[0], body.angle_unit)
-        matrices, flags = matrix[None], np.array([constrained])
-    else:
-        matrices, flags = target_matrices(targets, body.angle_unit, "body", "targets")
+    matrices, flags, directions = _targets_to_core(body, targets)
     reference, limits, ordering, options = _settings(request, robot, body, matrices, flags, "objects")
     budget = budget_of(request)
+    free = _free_joints(robot, body)
     answers: list[dict | None] = [None] * len(targets)
-    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference, budget):
+    incomplete: dict[int, str] = {}
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags.astype(int), reference, budget,
+                                                              free, directions, incomplete):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, budget, started):
                 answers[row] = wire
             continue
         observe_ik("analytic", arrays.structure, time.perf_counter() - started, arrays.count.tolist())
-        results = results_from_arrays(robot, arrays, matrices[rows], constrained, reference)
+        results = results_from_arrays(robot, arrays, matrices[rows], constrained and rows[0] not in directions,
+                                      reference)
         chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
                                ordering=ordering, max_equivalents=body.max_equivalents, budget=budget)
         budget.check("encoding")
@@ -169,18 +265,40 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
             answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
                                  chosen.notes.get(local, []), bool(chosen.truncated[local]),
                                  int(chosen.trimmed[local]), int(chosen.available[local]))
+    for row, why in incomplete.items():  # a free value whose locked arm no family covered
+        answers[row]["solver"]["complete"] = False
+        answers[row]["detail"] = " ".join(filter(None, [answers[row]["detail"], why]))
+    for row in directions:
+        if answers[row]["status"] == "unreachable":
+            answers[row]["detail"] = _direction_detail(robot, matrices[row, :3, 3])
+    for row, wire in enumerate(answers):  # position-only: held joints must not make a reachable point unreachable
+        if not flags[row] and wire["status"] == "unreachable" and wire["free_joints"]:
+            result = search_position(robot, matrices[row], wire["free_joints"], reference, options)
+            selection = select(robot, result, limits, filter_limits=body.filter_limits, reference=reference,
+                               ordering=ordering, max_equivalents=body.max_equivalents, budget=budget)
+            answers[row] = _to_wire(ref.id, robot, result, selection, body.angle_unit, False)
+    answers = [_with_free_values(wire, free if flag and row not in directions else None, robot, matrix[:3, 3])
+               for row, (wire, flag, matrix) in enumerate(zip(answers, flags.tolist(), matrices))]
     for answer in answers:
         answer["joint_names"] = robot.joint_names
     return answers
+
+
+def _direction_detail(robot: Robot, position: np.ndarray) -> str:
+    if bool(beyond_reach(robot, position)):
+        return "The target position is outside the workspace (farther from the base than the arm can reach)."
+    return ("No joint vector puts the tool at this position with its axis along the direction (every solution of "
+            "the closed form was checked).")
 
 
 def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
     """The batch answer as columns: solve, select and encode with array operations, no loop over targets."""
     ref = with_request_frames(ref, body)
     robot = ref.robot
-    matrices, flags = target_matrices(body.targets, body.angle_unit, "body", "targets")
+    matrices, flags, directions = _targets_to_core(body, body.targets)
     reference, limits, ordering, options = _settings(request, robot, body, matrices, flags, "arrays")
     budget = budget_of(request)
+    free = _free_joints(robot, body)
     n_targets = len(matrices)
     status = np.empty(n_targets, dtype=object)
     detail: list[str | None] = [None] * n_targets
@@ -192,7 +310,9 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     reports: list[dict] = []
     kept_tables, rejected_tables = [], []
     scale = _unit_scale(robot, body.angle_unit)
-    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags, reference, budget):
+    incomplete: dict[int, str] = {}
+    for constrained, rows, arrays, started in _solved_by_kind(robot, matrices, flags.astype(int), reference, budget,
+                                                              free, directions, incomplete):
         if arrays is None:  # no analytic family: the numeric search, one target at a time
             for row, wire in _numeric_answers(ref, body, matrices, rows, constrained, reference, limits, ordering,
                                               options, budget, started):
@@ -211,6 +331,11 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
         solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
                                         "time_budget_exhausted": False, "free_joints": arrays.free_joints})
         unreachable = unreachable_details(robot, arrays, matrices[rows], constrained, reference, budget)
+        if rows[0] in directions:
+            unreachable = {local: _direction_detail(robot, matrices[rows[local], :3, 3]) for local in unreachable}
+        elif constrained and free is not None:
+            unreachable = {local: no_solution_detail(robot, free, matrices[rows[local], :3, 3])
+                           for local in unreachable}
         for local in set(unreachable) | set(chosen.notes):
             detail[rows[local]] = " ".join(filter(None, [unreachable.get(local), *chosen.notes.get(local, [])])) or None
         solved = arrays.count > 0
@@ -226,6 +351,23 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
             if not constrained:
                 table.orientation = np.full(len(table.target), np.nan)
             into.append(table)
+    for row, why in incomplete.items():  # a free value whose locked arm no family covered
+        solver[row] = _index(solvers, {**solvers[solver[row]], "complete": False})
+        detail[row] = " ".join(filter(None, [detail[row], why]))
+    for row in np.flatnonzero(~flags & (status == "unreachable")).tolist():  # held joints: search every joint
+        entry = solvers[solver[row]]
+        if not entry["free_joints"] or entry["method"] != "analytic":
+            continue
+        result = search_position(robot, matrices[row], entry["free_joints"], reference, options)
+        selection = select(robot, result, limits, filter_limits=body.filter_limits, reference=reference,
+                           ordering=ordering, max_equivalents=body.max_equivalents, budget=budget)
+        wire = _to_wire(ref.id, robot, result, selection, body.angle_unit, False)
+        status[row], detail[row], truncated[row], trimmed[row], available[row] = (
+            wire["status"], wire["detail"], wire["truncated"], wire["trimmed"], wire["available"])
+        solver[row] = _index(solvers, {**wire["solver"], "free_joints": wire["free_joints"]})
+        singular[row] = [_index(reports, s) for s in wire["singularities"]]
+        kept_tables.append(_table_from_wire(row, wire["solutions"], robot.dof))  # wire joints: request units
+        rejected_tables.append(_table_from_wire(row, wire["rejected"], robot.dof))
     kept, rejected = (_merged(tables, robot.dof) for tables in (kept_tables, rejected_tables))
     # number solvers and singularity reports by first appearance in target order, as a reader meets them
     present, first = np.unique(solver, return_index=True)
@@ -249,9 +391,19 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
                     "truncated": truncated, "trimmed": trimmed, "available": available,
                     "solution_count": np.bincount(kept.target, minlength=n_targets),
                     "rejected_count": np.bincount(rejected.target, minlength=n_targets)},
-        "solutions": _columns(kept),
-        "rejected": _columns(rejected),
+        "solutions": _with_free_columns(_columns(kept), kept, solvers, solver),
+        "rejected": _with_free_columns(_columns(rejected), rejected, solvers, solver),
     })
+
+
+def _with_free_columns(columns: dict, table: SolutionTable, solvers: list[dict], solver: np.ndarray) -> dict:
+    """The arrays form's ``free_values``: per free joint, each row's value of it (request units), or None where
+    the row's target has no such free joint."""
+    free_of_row = [solvers[index]["free_joints"] for index in np.asarray(solver)[table.target].tolist()]
+    joints = np.asarray(table.joints).tolist()
+    columns["free_values"] = {str(j): [row[j] if j in free else None for row, free in zip(joints, free_of_row)]
+                              for j in sorted({j for free in free_of_row for j in free})}
+    return columns
 
 
 def _index(items: list[dict], item: dict) -> int:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Depends, Query, Request
 
 from ...robots.catalogue import Catalogue
+from ...kinematics.ik import target_kinds
 from ..deps import catalogue_of, catalogue_robot, RobotRef
 from ..problems import ProblemError, problem_responses
 from ...robots.export import FormNotExact, description_in_form
@@ -33,12 +34,14 @@ def get_robot(request: Request, ref: RobotRef = Depends(catalogue_robot),
               form: DescriptionForm | None = Query(None, description="restate the description in this form "
                                                    "(422 when that form is not exact for this robot)")
               ) -> AnyRobotDescription:
-    """Return one robot's full description, as its catalogue file states it (units included), or in another form."""
+    """Return one robot's full description, as its catalogue file states it (units included), or in another form,
+    with the IK target kinds it takes."""
     entry = catalogue_of(request).get(ref.id)
+    kinds = {"target_kinds": target_kinds(ref.robot)}
     if form is None:
-        return entry.description
+        return entry.description.model_copy(update=kinds)
     try:
-        return description_in_form(entry.description, entry.robot, form)
+        return description_in_form(entry.description, entry.robot, form).model_copy(update=kinds)
     except FormNotExact as error:
         raise ProblemError(422, "form-not-exact", "Form not exact",
                            f"robot {ref.id!r} cannot be described exactly in form {form!r}: {error}",

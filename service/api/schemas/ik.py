@@ -5,9 +5,9 @@ from __future__ import annotations
 from enum import Enum, IntEnum
 from typing import Annotated, Literal
 
-from pydantic import Field, model_serializer
+from pydantic import Field, model_serializer, model_validator
 
-from ...kinematics.ik import MAX_EQUIVALENTS
+from ...kinematics.ik import MAX_EQUIVALENTS, MAX_FREE_VALUES
 from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames, RobotId
 from .limits import JointLimitsOverride, LimitViolation
 from .poses import PoseTarget
@@ -101,6 +101,23 @@ class _Targets(ApiModel):
                                                                 "solved as an IKRequest target")
 
 
+class FreeJointChoice(ApiModel):
+    """A free joint of a redundant arm and where to solve it: `values`, or `samples` evenly over its limits
+    (over [−π, π) when it has none or they span a turn)."""
+
+    joint: int = Field(ge=0, le=1023, description="0-based joint index")
+    values: list[Number] | None = Field(None, min_length=1, max_length=MAX_FREE_VALUES,
+                                        description="values of the joint, in the request's angle unit")
+    samples: int | None = Field(None, ge=1, le=MAX_FREE_VALUES,
+                                description="how many values, evenly over the joint's limits")
+
+    @model_validator(mode="after")
+    def _one_form(self) -> "FreeJointChoice":
+        if (self.values is None) == (self.samples is None):
+            raise ValueError("give either 'values' or 'samples' for a free joint, not both or neither")
+        return self
+
+
 class IKRequestOptions(RequestFrames):
     """What every IK request may say besides its target(s)."""
 
@@ -131,6 +148,13 @@ class IKRequestOptions(RequestFrames):
     numeric: NumericSearch = Field(default_factory=NumericSearch,
                                    description="bounds on the numeric search, for structures no analytic family "
                                                "covers")
+    free_joints: list[FreeJointChoice] | None = Field(
+        None, description="arms with more than 6 joints: the n − 6 free joints and where to solve them. Each "
+                          "value's locked 6-joint problem is solved completely. Without it the service picks the "
+                          "joint(s) whose locking leaves a closed-form family (the last, the first, then the third "
+                          "joint are tried first) and samples each 32 times. With "
+                          "`reference` the free joints are also searched continuously between the samples, so "
+                          "the first solution is the nearest over the whole family.")
 
 
 class IKRequest(IKRequestOptions, _Target):
@@ -179,6 +203,9 @@ class IKSolution(ApiModel):
     within_limits: bool = Field(description="every joint within the limits in force")
     violations: list[LimitViolation] = Field(description="each joint outside its limits (empty when within)")
     residual: Residual = Field(description="forward-kinematics error of this solution")
+    free_values: dict[str, float] = Field(
+        default_factory=dict, description="the value of each free joint in this solution (its joint value), "
+                                          "keyed by joint index, e.g. {\"2\": 0.5}")
 
 
 class SolverInfo(ApiModel):
@@ -216,7 +243,9 @@ class IKResponse(ApiModel):
     solver: SolverInfo = Field(description="which solver answered and what it guarantees")
     singularities: list[SingularityReport] = Field(description="each singular condition the target meets")
     free_joints: list[int] = Field(default_factory=list,
-                                   description="joints the target does not determine, set to reference or 0")
+                                   description="joints the target does not determine: a redundant arm's free "
+                                               "joints (see each solution's free_values), or joints held at the "
+                                               "reference or 0")
     truncated: bool = Field(False, description="max_equivalents left out some of the solutions that fit")
     trimmed: int = Field(0, description="solutions left out by max_solutions or max_joint_move")
     available: int = Field(0, ge=0, le=2**53 - 1,
@@ -266,6 +295,10 @@ class SolutionColumns(ApiModel):
                                                                  "null for a position-only target")
     branch: dict[str, list[str | int | None]] = Field(
         description="one column per branch label that applies; null where a row has no such label")
+    free_values: dict[str, list[float | None]] = Field(
+        default_factory=dict, description="one column per free joint (keyed by joint index, as each solution's "
+                                          "free_values in the objects form); null where the row's target has no "
+                                          "such free joint")
 
 
 class IKBatchArraysResponse(ApiModel):

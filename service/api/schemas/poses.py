@@ -42,8 +42,17 @@ class RPYOrientation(ApiModel):
     angles: Vector3 = Field(description="(roll, pitch, yaw), the request's angle unit")
 
 
+class DirectionOrientation(ApiModel):
+    """Position + tool direction (IK targets of 5-joint arms): the tool axis `tool_axis` (tool frame) must point
+    along `world_direction` (world frame); the roll about it is left free. Neither needs to be a unit vector."""
+
+    type: Literal["direction"]
+    tool_axis: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 1.0])
+    world_direction: Vector3
+
+
 Orientation = Annotated[
-    Union[MatrixOrientation, QuaternionOrientation, EulerZYZOrientation, RPYOrientation],
+    Union[MatrixOrientation, QuaternionOrientation, EulerZYZOrientation, RPYOrientation, DirectionOrientation],
     Field(discriminator="type"),
 ]
 
@@ -122,6 +131,7 @@ class NamedPose(Pose):
 
 # Re-exported so that the number type is visible where poses are built.
 __all__ = [
+    "DirectionOrientation",
     "EulerZYZOrientation",
     "MatrixOrientation",
     "NamedPose",

@@ -8,8 +8,12 @@ back to a bounded numeric search that says it may be incomplete.
 """
 
 from ._arrays import IKArrays, cached_plan, solve_ik_arrays
+from ._direction import solve_direction, target_kinds
 from ._numeric import NumericOptions
 from ._plan import plan_for
+from ._position_search import search_position
+from ._redundant import (MAX_FREE_VALUES, FamilyAnswer, FreeJoint, beyond_reach, follow_free_joints, free_joints_for,
+                         no_solution_detail, solve_free_joint_family)
 from ._select import MAX_EQUIVALENTS, Ordering, Selected, Selection, check_ordering, joint_travel, select, travel
 from ._select_arrays import SolutionTable, select_arrays
 from ._solve import IKOptions, results_from_arrays, solve_ik, solve_ik_batch, unreachable_details
@@ -17,8 +21,11 @@ from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
 
 __all__ = [
+    "FamilyAnswer",
+    "FreeJoint",
     "IKArrays",
     "MAX_EQUIVALENTS",
+    "MAX_FREE_VALUES",
     "IKOptions",
     "IKResult",
     "NumericOptions",
@@ -28,13 +35,21 @@ __all__ = [
     "Singularity",
     "Solution",
     "SolutionTable",
+    "beyond_reach",
     "cached_plan",
     "check_ordering",
+    "follow_free_joints",
+    "free_joints_for",
+    "no_solution_detail",
+    "solve_direction",
+    "solve_free_joint_family",
+    "target_kinds",
     "distance_to_reference",
     "joint_difference",
     "joint_travel",
     "plan_for",
     "results_from_arrays",
+    "search_position",
     "select",
     "select_arrays",
     "solve_ik",

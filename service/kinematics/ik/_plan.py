@@ -71,6 +71,12 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
     return IdealisedPlan(plan, ideal.geometry.model, robot, ideal.deviation, geometry.length_scale, constrain_orientation)
 
 
+def plan_for_geometry(geometry: Geometry, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
+    """:func:`plan_for` on a screw model directly, exact recognition only (the idealised retry needs the robot):
+    also for arms that exist only as models, such as a redundant arm with joints locked (see ``_redundant``)."""
+    return _family_plan(geometry, constrain_orientation, reference)
+
+
 def _family_plan(geometry: Geometry, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     n = geometry.dof
     if constrain_orientation:

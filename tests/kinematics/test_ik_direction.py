@@ -1,0 +1,70 @@
+"""Position + tool direction targets of 5-joint arms (issue 14): recall over poses from the arm's own FK.
+
+The arms are inline DH tables of the desktop class (tests/data/redundant_and_deficient_arms.json). For each random
+joint vector the target is the tool position and the direction of a tool axis; the generating vector must be among
+the solutions (with the roll joint at 0 when the axis is the gripper's roll axis, which the target leaves free),
+and every solution is checked here by FK.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from service.kinematics import forward_kinematics
+from service.kinematics.ik import solve_direction, target_kinds
+from service.kinematics.ik._direction import rotations_to
+from tests.ik_helpers import find
+from tests.kinematics.test_ik_redundant import arm
+
+AXES = {"roll axis z": [0.0, 0.0, 1.0], "jaw axis y": [0.0, 1.0, 0.0], "side axis x": [1.0, 0.0, 0.0],
+        "oblique": [0.3, -0.5, 0.8]}
+
+
+@pytest.mark.parametrize("name", ["widowx250_like", "so101_like"])
+@pytest.mark.parametrize("axis_name", list(AXES))
+def test_recall_of_direction_targets_is_complete(name, axis_name):
+    robot = arm(name)
+    axis = np.array(AXES[axis_name]) / np.linalg.norm(AXES[axis_name])
+    rng = np.random.default_rng(51)
+    q = rng.uniform(-np.pi, np.pi, (150, 5))
+    T = forward_kinematics(robot, q)
+    positions, directions = T[:, :3, 3], T[:, :3, :3] @ axis
+    answer = solve_direction(robot, positions, directions, axis, None)
+    assert answer is not None
+    roll_free = answer.free_joints == [4]
+    assert roll_free == (axis_name == "roll axis z")
+    recalled = 0
+    for row in range(len(q)):
+        solutions = answer.joints[row, :answer.count[row]]
+        expected = q[row].copy()
+        if roll_free:
+            expected[4] = 0.0
+            assert np.all(solutions[:, 4] == 0.0)
+        recalled += find(robot, solutions, expected) is not None
+        reached = forward_kinematics(robot, solutions)
+        assert np.abs(reached[:, :3, 3] - positions[row]).max() <= 1e-9 * robot.characteristic_length
+        assert np.abs(reached[:, :3, :3] @ axis - directions[row]).max() <= 1e-8
+    assert recalled == len(q)
+
+
+def test_an_unreachable_direction_gives_no_solution():
+    robot = arm("widowx250_like")
+    T = forward_kinematics(robot, np.array([0.3, 0.2, -0.4, 0.5, 0.6]))
+    # the gripper axis of this arm stays in the vertical plane through the base axis: a sideways one is out
+    sideways = np.cross([0.0, 0.0, 1.0], T[:3, 3])
+    answer = solve_direction(robot, T[None, :3, 3], sideways[None], np.array([0.0, 0.0, 1.0]), None)
+    assert answer.count[0] == 0
+
+
+def test_rotations_to_take_the_axis_onto_the_direction_also_when_opposite():
+    a = np.array([0.0, 0.0, 1.0])
+    d = np.array([[0.0, 0.0, -1.0], [0.0, 0.0, 1.0], [1.0, 2.0, -0.5]])
+    R = rotations_to(a, d)
+    assert np.allclose(R @ a, d / np.linalg.norm(d, axis=1, keepdims=True))
+    assert np.allclose(R @ np.swapaxes(R, 1, 2), np.eye(3)) and np.allclose(np.linalg.det(R), 1.0)
+
+
+def test_target_kinds_name_the_direction_kind_for_five_joint_arms():
+    assert target_kinds(arm("so101_like")) == ["pose", "position", "position_direction"]
+    assert target_kinds(arm("iiwa14")) == ["pose", "position"]

@@ -46,9 +46,10 @@ class DirectionOrientation(ApiModel):
     """Position + tool direction (IK targets of 5-joint arms): the tool axis `tool_axis` (tool frame) must point
     along `world_direction` (world frame); the roll about it is left free. Neither needs to be a unit vector."""
 
-    type: Literal["direction"]
-    tool_axis: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 1.0])
-    world_direction: Vector3
+    type: Literal["direction"] = Field(description="position + tool direction")
+    tool_axis: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 1.0],
+                               description="the tool axis to align, in the tool frame (default z)")
+    world_direction: Vector3 = Field(description="where the tool axis must point, in the world frame")
 
 
 Orientation = Annotated[

@@ -32,14 +32,22 @@ OPW_SOURCES = {
                          (-1, 1, 1, -1, 1, -1), (0, -90, 0, 0, 0, 0)),
     "abb_irb120": (dict(a1=0.0, a2=-0.070, b=0.0, c1=0.290, c2=0.270, c3=0.302, c4=0.072),
                    (1, 1, 1, 1, 1, 1), (0, 0, -90, 0, 0, 0)),
+    "fanuc_lrmate200id": (dict(a1=0.050, a2=-0.035, b=0.0, c1=0.330, c2=0.330, c3=0.335, c4=0.080),
+                          (1, 1, -1, -1, -1, -1), (0, 0, -90, 0, 0, 180)),
 }
 #: the same arms in tests/data/opw_arms.json (geometry only)
-OPW_DATA_IDS = {"kuka_kr6_r900_2": "kuka_kr6_r900_2", "abb_irb120": "abb_irb120"}
+OPW_DATA_IDS = {"kuka_kr6_r900_2": "kuka_kr6_r900_2", "abb_irb120": "abb_irb120",
+                "fanuc_lrmate200id": "fanuc_lrmate200id"}
 
 #: KR 210 R2700 extra, kr210r2700extra_macro.xacro: (origin xyz, axis) of joint_a1..a6, then tool0 = Rot_y(90 deg)
 KR210_URDF_JOINTS = [
     ((0, 0, 0.675), (0, 0, -1)), ((0.350, 0, 0), (0, 1, 0)), ((1.150, 0, 0), (0, 1, 0)),
     ((0, 0, -0.041), (-1, 0, 0)), ((1.200, 0, 0), (0, 1, 0)), ((0.215, 0, 0), (-1, 0, 0)),
+]
+#: LR Mate 200iD, lrmate200id_macro.xacro: (origin xyz, axis) of joint_1..6, then tool0 = rpy (pi, -pi/2, 0)
+LRMATE_URDF_JOINTS = [
+    ((0, 0, 0.330), (0, 0, 1)), ((0.050, 0, 0), (0, 1, 0)), ((0, 0, 0.330), (0, -1, 0)),
+    ((0, 0, 0.035), (-1, 0, 0)), ((0.335, 0, 0), (0, -1, 0)), ((0.080, 0, 0), (-1, 0, 0)),
 ]
 
 
@@ -150,11 +158,16 @@ def test_opw_parameters_agree_with_the_golden_data(robot_id):
     assert golden == pytest.approx(OPW_SOURCES[robot_id][0], abs=1e-12)
 
 
-def test_kr210_opw_parameters_are_those_of_its_urdf():
-    p, signs, offsets = OPW_SOURCES["kuka_kr210_r2700"]
+@pytest.mark.parametrize("robot_id, joints, tool_rotation", [
+    ("kuka_kr210_r2700", KR210_URDF_JOINTS, rot_y(math.pi / 2)),
+    ("fanuc_lrmate200id", LRMATE_URDF_JOINTS, rot_y(-math.pi / 2) @ np.diag([1.0, -1.0, -1.0])),  # Rz(0) Ry Rx(pi)
+])
+def test_opw_parameters_are_those_of_the_urdf(robot_id, joints, tool_rotation):
+    """The OPW data, signs and offsets used above reproduce the ROS-Industrial URDF the entry cites."""
+    p, signs, offsets = OPW_SOURCES[robot_id]
     for qi in random_joints(7):
-        np.testing.assert_allclose(opw_forward(p, signs, offsets, qi),
-                                   urdf_forward(KR210_URDF_JOINTS, rot_y(math.pi / 2), qi), rtol=0, atol=ATOL)
+        np.testing.assert_allclose(opw_forward(p, signs, offsets, qi), urdf_forward(joints, tool_rotation, qi),
+                                   rtol=0, atol=ATOL)
 
 
 @pytest.mark.parametrize("robot_id", ["ufactory_lite6", "ufactory_xarm6"])

@@ -60,6 +60,7 @@ EXPECTED_ROBOT_IDS = {
     "ufactory_xarm6",
     "ufactory_lite6",
     "fanuc_lrmate200id",
+    "abb_irb6700",
 }
 
 REQUIRED_KEYS = (
@@ -308,7 +309,7 @@ TEXTBOOK_ONLY_ROBOTS = EXPECTED_ROBOT_IDS - {
     "spong_ex3_5_stanford", "puma560_modified", "puma560_khalil", "puma560_standard", "ur5",
     "ur3e", "ur5e", "ur10e", "ur16e",
     "kuka_kr6_r900_2", "kuka_kr210_r2700", "abb_irb120", "ufactory_xarm6", "ufactory_lite6",
-    "fanuc_lrmate200id",
+    "fanuc_lrmate200id", "abb_irb6700",
 }
 
 

@@ -50,6 +50,7 @@ GENERIC = {
     "kuka_kr6_r900_2": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
     "kuka_kr210_r2700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
     "fanuc_lrmate200id": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "abb_irb6700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
     "abb_irb120": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
     "ufactory_lite6": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
     # URDF arms: the plan is read off their joint screws, as for DH tables

@@ -32,6 +32,8 @@ OPW_SOURCES = {
                          (-1, 1, 1, -1, 1, -1), (0, -90, 0, 0, 0, 0)),
     "abb_irb120": (dict(a1=0.0, a2=-0.070, b=0.0, c1=0.290, c2=0.270, c3=0.302, c4=0.072),
                    (1, 1, 1, 1, 1, 1), (0, 0, -90, 0, 0, 0)),
+    "abb_irb6700": (dict(a1=0.320, a2=-0.200, b=0.0, c1=0.780, c2=1.125, c3=1.1425, c4=0.200),
+                    (1, 1, 1, 1, 1, 1), (0, 0, -90, 0, 0, 0)),
     "fanuc_lrmate200id": (dict(a1=0.050, a2=-0.035, b=0.0, c1=0.330, c2=0.330, c3=0.335, c4=0.080),
                           (1, 1, -1, -1, -1, -1), (0, 0, -90, 0, 0, 180)),
 }
@@ -43,6 +45,11 @@ OPW_DATA_IDS = {"kuka_kr6_r900_2": "kuka_kr6_r900_2", "abb_irb120": "abb_irb120"
 KR210_URDF_JOINTS = [
     ((0, 0, 0.675), (0, 0, -1)), ((0.350, 0, 0), (0, 1, 0)), ((1.150, 0, 0), (0, 1, 0)),
     ((0, 0, -0.041), (-1, 0, 0)), ((1.200, 0, 0), (0, 1, 0)), ((0.215, 0, 0), (-1, 0, 0)),
+]
+#: IRB 6700-200/2.60, irb6700_200_260_macro.xacro: (origin xyz, axis) of joint_1..6, then tool0 = Rot_y(90 deg)
+IRB6700_URDF_JOINTS = [
+    ((0, 0, 0.78), (0, 0, 1)), ((0.32, 0, 0), (0, 1, 0)), ((0, 0, 1.125), (0, 1, 0)),
+    ((0, 0, 0.2), (1, 0, 0)), ((1.1425, 0, 0), (0, 1, 0)), ((0.2, 0, 0), (1, 0, 0)),
 ]
 #: LR Mate 200iD, lrmate200id_macro.xacro: (origin xyz, axis) of joint_1..6, then tool0 = rpy (pi, -pi/2, 0)
 LRMATE_URDF_JOINTS = [
@@ -160,6 +167,7 @@ def test_opw_parameters_agree_with_the_golden_data(robot_id):
 
 @pytest.mark.parametrize("robot_id, joints, tool_rotation", [
     ("kuka_kr210_r2700", KR210_URDF_JOINTS, rot_y(math.pi / 2)),
+    ("abb_irb6700", IRB6700_URDF_JOINTS, rot_y(math.pi / 2)),
     ("fanuc_lrmate200id", LRMATE_URDF_JOINTS, rot_y(-math.pi / 2) @ np.diag([1.0, -1.0, -1.0])),  # Rz(0) Ry Rx(pi)
 ])
 def test_opw_parameters_are_those_of_the_urdf(robot_id, joints, tool_rotation):

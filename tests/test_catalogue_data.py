@@ -53,6 +53,14 @@ EXPECTED_ROBOT_IDS = {
     "ur5e",
     "ur10e",
     "ur16e",
+    # industrial arms held to their sources in tests/robots/test_industrial_arms.py
+    "kuka_kr6_r900_2",
+    "kuka_kr210_r2700",
+    "abb_irb120",
+    "ufactory_xarm6",
+    "ufactory_lite6",
+    "fanuc_lrmate200id",
+    "abb_irb6700",
 }
 
 REQUIRED_KEYS = (
@@ -300,6 +308,8 @@ SLIDES_WITH_ZERO_LOWER_LIMIT = [
 TEXTBOOK_ONLY_ROBOTS = EXPECTED_ROBOT_IDS - {
     "spong_ex3_5_stanford", "puma560_modified", "puma560_khalil", "puma560_standard", "ur5",
     "ur3e", "ur5e", "ur10e", "ur16e",
+    "kuka_kr6_r900_2", "kuka_kr210_r2700", "abb_irb120", "ufactory_xarm6", "ufactory_lite6",
+    "fanuc_lrmate200id", "abb_irb6700",
 }
 
 

@@ -9,12 +9,15 @@ to the textbook's, see test_ik.py).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 from service.kinematics.ik import joint_difference
 from tests.conftest import catalogue_robot
 from tests.ik_helpers import random_configurations
+from tests.robots.test_industrial_arms import OPW_SOURCES, opw_forward
 
 SAMPLES = 1000
 
@@ -43,13 +46,20 @@ GENERIC = {
     "ur5e": ("pose", 8, "three_parallel"),
     "ur10e": ("pose", 8, "three_parallel"),
     "ur16e": ("pose", 8, "three_parallel"),
+    # industrial arms with a spherical wrist (OPW arms and the Lite 6)
+    "kuka_kr6_r900_2": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "kuka_kr210_r2700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "fanuc_lrmate200id": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "abb_irb6700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "abb_irb120": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "ufactory_lite6": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
     # URDF arms: the plan is read off their joint screws, as for DH tables
     "kinova_jaco2": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
     "unitree_z1": ("pose", 8, "three_parallel"),
 }
-#: Catalogue arms that no analytic family covers yet, solved by the numeric fallback: the 7-joint arms, and the
-#: 5-joint SO-101 for full poses.
-NUMERIC_FALLBACK = {"franka_panda", "kuka_iiwa14", "ufactory_xarm7", "so101"}
+#: Catalogue arms that no analytic family covers yet, solved by the numeric fallback: the 7-joint arms, the 5-joint
+#: SO-101 for full poses, and the xArm 6 (its wrist is not spherical: a5 = 76 mm).
+NUMERIC_FALLBACK = {"franka_panda", "kuka_iiwa14", "ufactory_xarm7", "so101", "ufactory_xarm6"}
 
 
 def test_every_catalogue_robot_has_an_analytic_class(client):
@@ -86,5 +96,21 @@ def test_generating_vector_is_among_the_solutions(client, robot_id):
         counts.append(len(solutions))
     if structure == "three_parallel":  # UR-type arms: up to 8 real solutions, 8 at most poses
         assert set(counts) <= {2, 4, 6, 8} and counts.count(8) > SAMPLES // 2
+    elif structure.startswith("offset_shoulder"):
+        # a1 != 0: the shoulder sits a1 off axis 1, at two places (theta1 and theta1 + pi); each gives 4 real solutions
+        # when the wrist centre lies within the elbow's annulus |c2 - k| .. c2 + k around it (k = |(a2, c3)|)
+        assert counts == [_offset_shoulder_count(robot_id, q_true) for q_true in q]
     else:
         assert counts == [generic_count] * SAMPLES
+
+
+def _offset_shoulder_count(robot_id: str, q: np.ndarray) -> int:
+    """The real IK count at the pose of q: 4 for each shoulder place (near and far side of axis 1) that reaches
+    the wrist centre (b = 0)."""
+    p, signs, offsets = OPW_SOURCES[robot_id]
+    pose = opw_forward(p, signs, offsets, q)
+    centre = pose[:3, 3] - p["c4"] * pose[:3, 2]
+    radial, height = math.hypot(centre[0], centre[1]), centre[2] - p["c1"]
+    k = math.hypot(p["a2"], p["c3"])
+    return sum(4 for distance in (math.hypot(radial - p["a1"], height), math.hypot(radial + p["a1"], height))
+               if abs(p["c2"] - k) <= distance <= p["c2"] + k)

@@ -94,7 +94,8 @@ def test_every_dh_robot_as_screws_and_urdf_gives_the_same_fk_and_ik(client):
                 for solution in answer["solutions"]:
                     solution["joints"] = np.where(revolute, solution["joints"],
                                                   np.array(solution["joints"]) / scale).tolist()
-                _same_solution_sets(answer["solutions"], reference["solutions"], revolute)
+                if reference["solver"]["complete"]:  # a numeric search (xArm 6) promises no particular set
+                    _same_solution_sets(answer["solutions"], reference["solutions"], revolute)
                 checked[form] += 1
     assert checked["screws"] >= 2 * 20 and checked["urdf"] >= 2 * 14, checked
 

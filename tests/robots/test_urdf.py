@@ -118,7 +118,8 @@ def test_catalogue_urdf_arms_match_their_source_files(client, robot_id):
 def test_the_catalogue_has_the_arms_of_the_issue(client):
     ids = {r["id"] for r in client.get("/v1/robots").json()["robots"]}
     assert {"ur3e", "ur5e", "ur10e", "ur16e", "franka_panda", "kuka_iiwa14", "kinova_jaco2", "unitree_z1",
-            "so101", "ufactory_xarm7"} <= ids
+            "so101", "ufactory_xarm7", "kuka_kr6_r900_2", "kuka_kr210_r2700", "abb_irb120", "ufactory_xarm6",
+            "ufactory_lite6", "fanuc_lrmate200id", "abb_irb6700"} <= ids
     for robot_id in ids:
         description = client.get(f"/v1/robots/{robot_id}").json()
         assert description["source"], robot_id

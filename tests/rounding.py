@@ -5,15 +5,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from service.kinematics import Joint, Robot
+from service.kinematics import Joint, Robot, ScrewJoint
 
 
 def rounded(robot: Robot, seed: int, *, base_and_tool: bool = True) -> Robot:
     """``robot`` as a CAD export writes it: angles in radians to 4 decimals (π/2 → 1.5708), parallel axes
     (α = 0 or π) 1e-5 rad off, lengths to 0.1 mm (the robot's unit taken as metres), and, with
     ``base_and_tool``, a random base and tool whose quaternions are written to 6 decimals (0.707107) and
-    translations to 0.1 mm."""
+    translations to 0.1 mm. A robot given by its screws is rounded as a URDF export writes it: see
+    :func:`_rounded_screws`."""
     rng = np.random.default_rng(seed)
+    if robot.convention == "screws":
+        return _rounded_screws(robot, rng, base_and_tool)
     joints = []
     for joint in robot.joints:
         alpha = round(joint.alpha, 4)
@@ -28,15 +31,64 @@ def rounded(robot: Robot, seed: int, *, base_and_tool: bool = True) -> Robot:
     return Robot(joints, convention=robot.convention, **transforms)
 
 
-def _rounded_transform(rng: np.random.Generator) -> np.ndarray:
-    w, x, y, z = quaternion = np.round(rng.normal(size=4) / 2, 6)
+def _rounded_screws(robot: Robot, rng: np.random.Generator, base_and_tool: bool) -> Robot:
+    """A screw robot as a URDF/CAD export writes it: axis components to 6 decimals (then normalised, as a reader
+    does), an axis parallel to the one before (within 1e-3 rad after rounding: the DH path's α = 0 or π) tilted 1e-5 rad
+    off it, points on
+    the axes and the home translation to 0.1 mm, the home rotation through a quaternion written to 6 decimals."""
+    joints, axes = [], []
+    for joint in robot.joints:
+        axis = np.round(np.asarray(joint.axis, dtype=float), 6)
+        axis /= np.linalg.norm(axis)
+        if axes and np.linalg.norm(np.cross(axis, axes[-1])) < 1e-3:
+            axis = _tilted(axis, 1e-5, rng)
+        axes.append(axis)
+        joints.append(ScrewJoint(joint.name, joint.kind, tuple(axis), tuple(np.round(joint.point, 4)),
+                                 joint.lower, joint.upper))
+    home = np.linalg.multi_dot(list(robot.chain_transforms))  # F_0 · F_1 ⋯ F_n = base_T_flange
+    transforms = {}
+    if base_and_tool:
+        for key in ("world_T_base", "flange_T_tool"):
+            transforms[key] = _rounded_transform(rng)
+    return Robot.from_screws(joints, _rounded_transform(rng, home), name=robot.name, **transforms)
+
+
+def _tilted(axis: np.ndarray, angle: float, rng: np.random.Generator) -> np.ndarray:
+    """``axis`` turned by ``angle`` towards a random perpendicular direction."""
+    normal = np.cross(axis, rng.normal(size=3))
+    normal /= np.linalg.norm(normal)
+    return np.cos(angle) * axis + np.sin(angle) * normal
+
+
+def _rounded_transform(rng: np.random.Generator, transform: np.ndarray | None = None) -> np.ndarray:
+    """``transform`` (random when None) with its quaternion written to 6 decimals, its translation to 0.1 mm."""
+    if transform is None:
+        quaternion, translation = rng.normal(size=4) / 2, rng.uniform(-0.2, 0.2, 3)
+    else:
+        quaternion, translation = _quaternion(transform[:3, :3]), transform[:3, 3]
+    w, x, y, z = quaternion = np.round(quaternion, 6)
     w, x, y, z = quaternion / np.linalg.norm(quaternion)  # a reader normalises the written quaternion
     T = np.eye(4)
     T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
                  [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
                  [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-    T[:3, 3] = np.round(rng.uniform(-0.2, 0.2, 3), 4)
+    T[:3, 3] = np.round(translation, 4)
     return T
+
+
+def _quaternion(R: np.ndarray) -> np.ndarray:
+    """(w, x, y, z) of a rotation matrix (Shepperd: from the largest of the four squared components)."""
+    squares = 0.25 * np.array([1 + R[0, 0] + R[1, 1] + R[2, 2], 1 + R[0, 0] - R[1, 1] - R[2, 2],
+                               1 - R[0, 0] + R[1, 1] - R[2, 2], 1 - R[0, 0] - R[1, 1] + R[2, 2]])
+    k = int(np.argmax(squares))
+    q = np.empty(4)
+    q[k] = np.sqrt(squares[k])
+    cross = {(0, 1): R[2, 1] - R[1, 2], (0, 2): R[0, 2] - R[2, 0], (0, 3): R[1, 0] - R[0, 1],
+             (1, 2): R[0, 1] + R[1, 0], (1, 3): R[0, 2] + R[2, 0], (2, 3): R[1, 2] + R[2, 1]}
+    for j in range(4):
+        if j != k:
+            q[j] = cross[(min(j, k), max(j, k))] / (4 * q[k])
+    return q
 
 
 def standard_dh_from_screws(directions: np.ndarray, points: np.ndarray, home: np.ndarray) -> Robot:

@@ -263,3 +263,42 @@ def test_the_api_hands_incomplete_rows_to_the_fallback(client, tmp_path):
         assert arrays.status_code == 200, arrays.text
         body = arrays.json()
         assert [body["solvers"][i]["complete"] for i in body["targets"]["solver"]] == [False, True]
+
+
+# --- UR arms with the elbow stretched (q3 = 0) and the wrist singular (q5 = 0) at once
+
+
+@pytest.mark.parametrize("robot_id", ["ur5", "ur5e"])
+@pytest.mark.parametrize("as_written", ["exact", "rounded"])
+def test_ur_stretched_elbow_at_wrist_singularity_is_never_called_unreachable(client, robot_id, as_written):
+    """Regression: on the rounded UR5e, q3 = 0 and q5 = 0 together made the idealised closed form compute q6 from a
+    near-degenerate subproblem (axis 6 within δ of parallel to axes 2–4): its candidates were least-squares answers
+    far from the target, none refined to a solution and none was a near miss, so the row was called unreachable
+    with complete: true. A row without a solution is now checked for singularities at every candidate, and goes to
+    the fallback.
+
+    The exact arm's closed form answers complete, with q6 = 0 as the representative at the wrist singularity, so the
+    generating vector itself comes back. The rounded arm is ~1e-5 rad off that singularity (joints 2, 3, 4 and 6
+    nearly parallel: a near self-motion); the fallback answers with complete: false. At the first pose it returns
+    the generating vector to within 1e-4 rad; at the others it must reach the pose (it may return other members of
+    the near self-motion, not this one)."""
+    robot = catalogue_robot(client, robot_id)
+    if as_written == "rounded":
+        robot = rounded(robot, sorted(GENERIC).index(robot_id))
+    q = np.array([[1.4514319, -2.26133035, 0.0, -math.pi / 2, 0.0, 0.0],
+                  [0.3, -1.0, 0.0, 0.7, 0.0, 0.0],
+                  [-2.0, -0.4, 0.0, 2.5, 0.0, 0.0]])
+    targets = forward_kinematics(robot, q)
+    for row, (q_true, target, result) in enumerate(zip(q, targets, solve_ik_batch(robot, targets))):
+        assert result.status == "ok", (q_true, result.detail)
+        solutions = np.array([s.joints for s in result.solutions]).reshape(-1, robot.dof)
+        reached = forward_kinematics(robot, solutions)
+        assert np.abs(reached[:, :3, 3] - target[:3, 3]).max() <= 1e-9 * robot.characteristic_length
+        gap = np.abs(joint_difference(robot, solutions, q_true)).max(axis=1).min()
+        if as_written == "exact":
+            assert result.complete and result.method == "analytic" and result.structure == "three_parallel"
+            assert gap < 1e-9, (q_true, gap)
+        else:
+            assert not result.complete
+            if row == 0:
+                assert gap < 1e-4, (q_true, gap)

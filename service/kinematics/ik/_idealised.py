@@ -28,7 +28,11 @@ boundary or singular target). A row is claimed complete only when
 3. the idealised family reports no singularity for the target (a free joint or
    merged roots, whose continuation under the perturbation is not isolated),
    and no solution is within :data:`SINGULAR_MARGIN` × δ of a singularity of
-   the true arm (σ_min of its scaled Jacobian).
+   the true arm (σ_min of its scaled Jacobian); for a row with no solution at
+   all, no candidate is (there a step of the closed form is ill-conditioned:
+   the UR type's q6 from q5 ≈ 0 turns by O(1) under a δ change of the target,
+   so the least-squares answers after it may lie far from a solution the true
+   arm has, and criterion 2 would not see it).
 
 The true arm, a general arm near a decoupled one, may have more solutions in
 the complex domain (up to 16 for a 6R); the extra ones come from infinity
@@ -136,7 +140,11 @@ class IdealisedPlan:
         # 3. no singular target: none flagged by the family, and every solution clear of the true arm's
         # singularities (where the idealised family's roots may meet or split)
         singular = np.zeros(len(world_T_targets), dtype=bool)
-        rows, slots = np.nonzero(accepted)
+        # (a row without a verified solution is checked at every candidate: at a singularity a downstream step of
+        # the closed form is ill-conditioned, e.g. q6 from q5 ≈ 0, so a least-squares answer's residual there
+        # does not bound how far the target is from a root pair, and "unreachable" could not be promised)
+        unanswered = ~accepted.any(axis=1)
+        rows, slots = np.nonzero(accepted | (finite & ideal.valid & unanswered[:, None]))
         if len(rows):
             near_singular = self._smallest_singular_value(joints[rows, slots]) <= SINGULAR_MARGIN * self.deviation
             singular[rows[near_singular]] = True

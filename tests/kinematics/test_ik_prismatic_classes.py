@@ -158,3 +158,122 @@ def test_random_arms_of_every_slide_class_in_every_convention(kind):
             a, b = first.joints[row, :first.count[row]], other.joints[row, :other.count[row]]
             gaps = np.abs(joint_difference(robots[0], a[:, None, :], b[None, :, :])).max(axis=-1)
             assert (gaps.min(axis=1) < 1e-7).all()
+
+
+@pytest.mark.parametrize("kind", sorted(CLASSES))
+def test_singular_poses_of_every_slide_class_report_a_singularity(kind):
+    """Zeros of the positioner's Jacobian (two solutions merging, a joint free): flagged, never unreachable,
+    never wrong. A double root is found to about √ε, so the generating vector is compared to 1e-5 here."""
+    robot = statements(kind, seed=sorted(CLASSES).index(kind))[0]
+    pose = robot.dof == 6
+    plan = cached_plan(robot, constrain_orientation=pose, reference=None)
+    # along the second revolute joint (turning the first moves the whole arm rigidly; along a slide of ±1 the
+    # Jacobian may not vanish)
+    search = None if "base_wrist" in kind else int(np.flatnonzero(robot.is_revolute[:3])[1])
+    q = _positioner_singular_configurations(robot, plan, 20, seed=13, search=search)
+    targets = forward_kinematics(robot, q)
+    answer = solve_ik_arrays(robot, targets, constrain_orientation=pose)
+    if pose:
+        assert_every_solution(robot, q, targets, answer, tolerance=1e-5)
+    else:
+        assert (answer.count >= 1).all()
+        rows, slots = np.nonzero(answer.valid)
+        assert (answer.position[rows, slots] <= 1e-9 * robot.characteristic_length).all()
+    for row in range(len(q)):
+        assert answer.singularities[row], (row, q[row])
+        assert any(s.kind == "positioner" or s.relation == "free" for s in answer.singularities[row])
+
+
+@pytest.mark.parametrize("kind", [k for k in sorted(CLASSES) if k.endswith("+wrist")])
+def test_position_only_targets_of_slide_arms_hold_the_wrist(kind):
+    """A position target of a 6-DOF slide arm holds joints 4–6 at the reference and places the tool point with
+    the same family, complete; the generating vector is among the solutions."""
+    robot = statements(kind, seed=sorted(CLASSES).index(kind))[2]
+    q = configurations(robot, 40, seed=23)
+    for q_true, target in zip(q, forward_kinematics(robot, q)):
+        result = solve_ik(robot, target, constrain_orientation=False, reference=q_true)
+        assert (result.method, result.complete, result.status) == ("analytic", True, "ok")
+        assert result.structure == "skew_axes_with_slide"
+        solutions = np.array([s.joints for s in result.solutions])
+        assert np.abs(joint_difference(robot, solutions, q_true)).max(axis=1).min() < 1e-7
+        assert np.allclose(solutions[:, 3:], q_true[3:])
+
+
+def test_subproblem_5_prismatic_agrees_with_a_dense_scan():
+    """Every root of the slide subproblem, against an independent count: sign changes of the eliminated
+    equation on a fine grid of theta (both slide placements, the normal-slide split too)."""
+    rng = np.random.default_rng(3)
+    for trial in range(60):
+        k2, k = (x / np.linalg.norm(x) for x in rng.normal(size=(2, 3)))
+        v = rng.normal(size=3)
+        if trial % 3 == 0:
+            v -= (v @ k2) * k2  # the slide normal to k2
+        v /= np.linalg.norm(v)
+        p0, p1 = rng.normal(size=(2, 3)) * 0.4
+        phi, theta, s = rng.uniform(-np.pi, np.pi), rng.uniform(-np.pi, np.pi), rng.uniform(-0.5, 0.5)
+        turns = bool(trial % 2)
+
+        def R(axis, t):
+            return np.cos(t) * np.eye(3) + np.sin(t) * np.cross(np.eye(3), axis) + (1 - np.cos(t)) * np.outer(axis, axis)
+
+        if turns:
+            p2 = R(k2, phi) @ (p0 + R(k, theta) @ p1 + s * v)
+        else:
+            p2 = R(k2, phi) @ (p0 + R(k, theta) @ p1) - s * v
+        sol = subproblem_5_prismatic(k2, k, p0, p1, p2, v, slide_turns=turns)
+        found = np.stack([sol.phi, sol.theta, sol.s], axis=-1)[sol.valid & sol.exact]
+        gaps = np.abs(np.stack([np.angle(np.exp(1j * (found[:, 0] - phi))),
+                                np.angle(np.exp(1j * (found[:, 1] - theta))), found[:, 2] - s], axis=-1))
+        assert gaps.max(axis=1).min() < 1e-9
+        for f in found:  # every candidate solves the vector equation
+            lhs = p2 if turns else p2 + f[2] * v
+            rhs = R(k2, f[0]) @ (p0 + R(k, f[1]) @ p1 + (f[2] * v if turns else 0))
+            assert np.linalg.norm(lhs - rhs) < 1e-9
+        if abs(k2 @ v) > 1e-6:  # the quartic: count its real roots by a dense scan
+            grid = np.linspace(-np.pi, np.pi, 200001)
+            L = p0 + np.einsum("ij,gj->gi", np.zeros((3, 3)), np.zeros((len(grid), 3)))
+            c, sn = np.cos(grid)[:, None], np.sin(grid)[:, None]
+            L = p0 + (p1 @ k) * k + c * (p1 - (p1 @ k) * k) + sn * np.cross(k, p1)
+            sign = 1.0 if turns else -1.0
+            slide = -(L @ k2 - p2 @ k2) / (sign * (k2 @ v))
+            moved = L + slide[:, None] * v if turns else L
+            other = np.broadcast_to(p2, L.shape) if turns else p2 + slide[:, None] * v
+            equation = np.einsum("gi,gi->g", moved, moved) - np.einsum("gi,gi->g", other, other)
+            changes = int((np.sign(equation[:-1]) != np.sign(equation[1:])).sum())
+            assert len(found) == changes, (trial, len(found), changes)
+
+
+@pytest.mark.parametrize("kind", ["prr+wrist", "rpr+wrist", "rrp+wrist", "prr"])
+def test_slide_limits_filter_the_solutions_like_a_linear_axis(kind):
+    """A linear axis with travel [−0.2, 0.4]: the closed form still finds every solution (limits never change
+    the solver's answer); selection keeps those whose slide is within travel, the generating vector among them,
+    and rejects the others with a violation on the slide; a pose reachable only beyond travel is
+    ``no_solution_within_limits``, not ``unreachable``."""
+    from service.kinematics import Limits
+    from service.kinematics.ik import select
+
+    limited = statements(kind, seed=sorted(CLASSES).index(kind), limits=(-0.2, 0.4))[0]
+    free = statements(kind, seed=sorted(CLASSES).index(kind))[0]
+    pose = limited.dof == 6
+    slide = int(np.flatnonzero(~limited.is_revolute)[0])
+    rng = np.random.default_rng(31)
+    q = configurations(limited, 60, seed=29)
+    q[:, slide] = rng.uniform(-0.2, 0.4, len(q))
+    q[-10:, slide] = rng.uniform(0.5, 0.9, 10)  # beyond travel
+    limits = Limits.of(limited)
+    statuses = []
+    for q_true, target in zip(q, forward_kinematics(limited, q)):
+        result = solve_ik(limited, target, constrain_orientation=pose, reference=None)
+        unlimited = solve_ik(free, target, constrain_orientation=pose, reference=None)
+        assert result.complete and len(result.solutions) == len(unlimited.solutions)
+        selection = select(limited, result, limits)
+        statuses.append(selection.status)
+        kept = np.array([s.solution.joints for s in selection.solutions]).reshape(-1, limited.dof)
+        assert ((kept[:, slide] >= -0.2 - 1e-12) & (kept[:, slide] <= 0.4 + 1e-12)).all()
+        for rejected in selection.rejected:
+            assert slide in [v.joint for v in rejected.violations]
+        if -0.2 <= q_true[slide] <= 0.4:
+            gaps = np.abs(joint_difference(limited, kept, q_true))[:, :3 if not pose else None].max(axis=1)
+            assert gaps.min() < 1e-7
+    assert all(status in ("ok", "no_solution_within_limits") for status in statuses)
+    assert "no_solution_within_limits" in statuses[-10:]

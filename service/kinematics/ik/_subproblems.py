@@ -1147,9 +1147,11 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
     Notes
     -----
     Like subproblem 5 there is no least-squares candidate. Scale: ``S = ||p0|| + ||p1|| + ||p2||``;
-    a candidate is ``exact`` when the vector equation holds to ``GEOMETRY_TOLERANCE * S``. Roots
-    closer than ``DUPLICATE_TOLERANCE`` (in theta and in ``s / S``) are reported once with ``merged``
-    set. ``degenerate``: E1 and E2 do not depend on theta (``p1`` on ``k``, with the target
+    a candidate is ``exact`` when the vector equation holds to ``GEOMETRY_TOLERANCE * S``. Two roots
+    are reported once, at their midpoint, with ``merged`` set (a tangent root, the edge of the
+    workspace) when they are closer than ``DUPLICATE_TOLERANCE`` (in theta and in ``s / S``), or,
+    for the quartic, closer than 1e-3 rad with the midpoint solving it to ``DUPLICATE_TOLERANCE**2``
+    of its coefficients: near a triple root rounding splits a double root by far more than √ε. ``degenerate``: E1 and E2 do not depend on theta (``p1`` on ``k``, with the target
     reachable); the representative has ``theta = 0``. ``phi_free`` marks slots whose turned vector
     lies on ``k2`` (phi is then 0).
 
@@ -1208,7 +1210,9 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
                                 0.0)
                 theta = np.where(degenerate[..., None] | (np.abs(step) > 1e-3), theta, theta - step)
             s = -_trig_value(A1, theta)[0] / b
+            quartic, quartic_scale = F, scale
         else:
+            quartic = None
             first = _harmonic(A1[..., 1], A1[..., 2], -A1[..., 0], np.ones(shape))
             degenerate = first.degenerate & first.exact[..., 0]
             roots = np.where(degenerate[..., None], np.array([0.0, np.nan]), first.theta)  # (..., 2)
@@ -1225,6 +1229,25 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
             merged = (first.merged & ok[..., 0]) | (touching & ok).any(axis=-1)
         theta = _wrap(np.where(valid, theta, np.nan))
         s = np.where(valid, s, np.nan)
+        # the same root twice (a tangent root): keep one, at the midpoint of the pair. A double root that
+        # rounding splits along the circle splits symmetrically, so the midpoint is nearer than either half
+        for later in range(1, 4):
+            for earlier in range(later):
+                gap = _wrap(theta[..., later] - theta[..., earlier])
+                middle = _wrap(theta[..., earlier] + gap / 2)
+                same = valid[..., later] & valid[..., earlier] & (np.abs(gap) <= DUPLICATE_TOLERANCE) \
+                    & (np.abs(s[..., later] - s[..., earlier]) <= DUPLICATE_TOLERANCE)
+                if quartic is not None:  # or a pair whose midpoint solves the quartic (a badly split double root)
+                    at_middle = np.abs(_trig_value(quartic, middle[..., None])[0][..., 0])
+                    same |= valid[..., later] & valid[..., earlier] & (np.abs(gap) <= 1e-3) \
+                        & (at_middle <= _MERGE_RESIDUAL * quartic_scale)
+                theta[..., earlier] = np.where(same, middle, theta[..., earlier])
+                s[..., earlier] = np.where(same, (s[..., earlier] + s[..., later]) / 2 if quartic is None
+                                           else -_trig_value(A1, middle[..., None])[0][..., 0] / b, s[..., earlier])
+                merged |= same
+                valid[..., later] &= ~same
+        theta = np.where(valid, theta, np.nan)
+        s = np.where(valid, s, np.nan)
         L = centre[..., None, :] + _rotate_points(k, np.nan_to_num(theta), p1[..., None, :]) - fixed[..., None, :]
         slide = s[..., None] * v
         turned, onto = (L + slide, np.broadcast_to(p2[..., None, :], L.shape)) if slide_turns \
@@ -1232,14 +1255,6 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
         phi, _, phi_free = _rotate_onto(_frame(k2), np.nan_to_num(turned), np.nan_to_num(onto),
                                         np.ones(shape)[..., None])
         miss = _norm(onto - _rotate_points(k2, phi, turned))
-    # the same root twice (a tangent root): keep the first
-    for later in range(1, 4):
-        for earlier in range(later):
-            same = valid[..., later] & valid[..., earlier] \
-                & (np.abs(_wrap(theta[..., later] - theta[..., earlier])) <= DUPLICATE_TOLERANCE) \
-                & (np.abs(s[..., later] - s[..., earlier]) <= DUPLICATE_TOLERANCE)
-            merged |= same
-            valid[..., later] &= ~same
     nan = np.nan
     return TurnSlideSolutions(
         phi=np.where(valid, phi, nan), theta=np.where(valid, theta, nan), s=np.where(valid, s * S[..., None], nan),

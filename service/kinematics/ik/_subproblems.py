@@ -1134,8 +1134,8 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
         Unit rotation axes through the origin.
     p0, p1, p2 : array_like, shape (..., 3)
         Offsets and the rotated point, broadcast against each other.
-    v : array_like, shape (3,)
-        Unit sliding direction.
+    v : array_like, shape (3,) or (..., 3)
+        Unit sliding direction, one for all rows or one per row (a slide whose direction the target sets).
     slide_turns : bool
         Whether ``R(k2, phi)`` turns the slide (inside) or not (outside).
 
@@ -1169,35 +1169,39 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
     >>> bool(np.isclose(found, [0.7, -1.1, 0.25]).all(axis=-1).any())
     True
     """
-    k2, k, v = _unit(k2, "k2"), _unit(k, "k"), _unit(v, "v")
+    k2, k = _unit(k2, "k2"), _unit(k, "k")
+    if np.ndim(v) == 1:
+        v = _unit(v, "v")
+    else:  # one sliding direction per row
+        v = _points(v, "v")
+        v = v / _norm(v)[..., None]
     p0, p1, p2 = (_points(p, name) for p, name in ((p0, "p0"), (p1, "p1"), (p2, "p2")))
-    shape = np.broadcast_shapes(p0.shape, p1.shape, p2.shape)[:-1]
+    shape = np.broadcast_shapes(p0.shape, p1.shape, p2.shape, np.shape(v))[:-1]
     S = _norm(p0) + _norm(p1) + _norm(p2)
-    S = np.where(S > 0.0, S, 1.0)
+    S = np.broadcast_to(np.where(S > 0.0, S, 1.0), shape)
     # work in units of S: every coefficient below is then of order 1
     p0, p1, p2 = (np.broadcast_to(p / S[..., None], shape + (3,)) for p in (p0, p1, p2))
+    v = np.broadcast_to(v, shape + (3,))
     fixed, perp, cross = _rotation_parts(k, p1)
     centre = p0 + fixed  # L(theta) = centre + cos perp + sin cross
     sign = 1.0 if slide_turns else -1.0
-    b = sign * float(k2 @ v)
+    b = sign * (v @ k2)  # (...)
     A1 = np.stack([centre @ k2 - p2 @ k2, perp @ k2, cross @ k2], axis=-1)
     A2 = np.stack([_dot(centre, centre) + _dot(perp, perp) - _dot(p2, p2), 2 * _dot(p0, perp),
                    2 * _dot(p0, cross)], axis=-1)
     if slide_turns:
-        B2 = 2 * np.stack([centre @ v, perp @ v, cross @ v], axis=-1)
+        B2 = 2 * np.stack([_dot(centre, v), _dot(perp, v), _dot(cross, v)], axis=-1)
         c = 1.0
     else:
         B2 = np.zeros(shape + (3,))
-        B2[..., 0] = -2 * (p2 @ v)
+        B2[..., 0] = -2 * _dot(p2, v)
         c = -1.0
-    valid = np.zeros(shape + (4,), dtype=bool)
-    theta = np.full(shape + (4,), np.nan)
-    s = np.full(shape + (4,), np.nan)
-    merged = np.zeros(shape, dtype=bool)
-    degenerate = np.zeros(shape, dtype=bool)
+    by_quartic = np.abs(b) > GEOMETRY_TOLERANCE  # (...): else the slide is normal to k2
     with np.errstate(invalid="ignore", divide="ignore"):
-        if abs(b) > GEOMETRY_TOLERANCE:
-            F = b * b * np.pad(A2, [(0, 0)] * len(shape) + [(0, 2)]) - b * _trig_product(A1, B2) \
+        quartic, quartic_scale = None, None
+        if by_quartic.any():
+            bq = np.where(by_quartic, b, 1.0)[..., None]
+            F = bq * bq * np.pad(A2, [(0, 0)] * len(shape) + [(0, 2)]) - bq * _trig_product(A1, B2) \
                 + c * _trig_product(A1, A1)
             scale = 1.0 + np.abs(F).sum(axis=-1)
             c2 = (F[..., 3] - 1j * F[..., 4]) / 2
@@ -1209,24 +1213,33 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
                 step = np.where(np.abs(slope) > 1e-9 * scale[..., None], value / np.where(slope == 0, 1.0, slope),
                                 0.0)
                 theta = np.where(degenerate[..., None] | (np.abs(step) > 1e-3), theta, theta - step)
-            s = -_trig_value(A1, theta)[0] / b
-            quartic, quartic_scale = F, scale
-        else:
-            quartic = None
+            s = -_trig_value(A1, theta)[0] / bq
+            merged = np.zeros(shape, dtype=bool)
+            quartic, quartic_scale = F, np.where(by_quartic, scale, -1.0)  # no residual merging elsewhere
+        if not by_quartic.all():
             first = _harmonic(A1[..., 1], A1[..., 2], -A1[..., 0], np.ones(shape))
-            degenerate = first.degenerate & first.exact[..., 0]
-            roots = np.where(degenerate[..., None], np.array([0.0, np.nan]), first.theta)  # (..., 2)
-            ok = first.valid & first.exact & ~(first.degenerate & ~degenerate)[..., None]
+            split_degenerate = first.degenerate & first.exact[..., 0]
+            roots = np.where(split_degenerate[..., None], np.array([0.0, np.nan]), first.theta)  # (..., 2)
+            ok = first.valid & first.exact & ~(first.degenerate & ~split_degenerate)[..., None]
             linear, _ = _trig_value(B2, roots)
             constant, _ = _trig_value(A2, roots)
             discriminant = linear * linear - 4 * c * constant
             touching = np.abs(discriminant) <= 4 * _MERGE_RESIDUAL * (1.0 + linear * linear)
             root = np.sqrt(np.maximum(discriminant, 0.0))
             real = ok & ((discriminant >= 0) | touching)
-            theta = np.repeat(roots, 2, axis=-1)
-            s = np.stack([(-linear + root) / (2 * c), (-linear - root) / (2 * c)], axis=-1).reshape(shape + (4,))
-            valid = np.stack([real, real & ~touching], axis=-1).reshape(shape + (4,))
-            merged = (first.merged & ok[..., 0]) | (touching & ok).any(axis=-1)
+            split_theta = np.repeat(roots, 2, axis=-1)
+            split_s = np.stack([(-linear + root) / (2 * c), (-linear - root) / (2 * c)], axis=-1).reshape(shape + (4,))
+            split_valid = np.stack([real, real & ~touching], axis=-1).reshape(shape + (4,))
+            split_merged = (first.merged & ok[..., 0]) | (touching & ok).any(axis=-1)
+            if quartic is None:
+                theta, s, valid, merged, degenerate = split_theta, split_s, split_valid, split_merged, split_degenerate
+            else:
+                rows = ~by_quartic
+                theta = np.where(rows[..., None], split_theta, theta)
+                s = np.where(rows[..., None], split_s, s)
+                valid = np.where(rows[..., None], split_valid, valid)
+                merged = np.where(rows, split_merged, merged)
+                degenerate = np.where(rows, split_degenerate, degenerate)
         theta = _wrap(np.where(valid, theta, np.nan))
         s = np.where(valid, s, np.nan)
         # the same root twice (a tangent root): keep one, at the midpoint of the pair. A double root that
@@ -1242,14 +1255,17 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
                     same |= valid[..., later] & valid[..., earlier] & (np.abs(gap) <= 1e-3) \
                         & (at_middle <= _MERGE_RESIDUAL * quartic_scale)
                 theta[..., earlier] = np.where(same, middle, theta[..., earlier])
-                s[..., earlier] = np.where(same, (s[..., earlier] + s[..., later]) / 2 if quartic is None
-                                           else -_trig_value(A1, middle[..., None])[0][..., 0] / b, s[..., earlier])
+                halfway = (s[..., earlier] + s[..., later]) / 2
+                if quartic is not None:  # s = -A1 / b at the midpoint
+                    halfway = np.where(by_quartic, -_trig_value(A1, middle[..., None])[0][..., 0]
+                                       / np.where(by_quartic, b, 1.0), halfway)
+                s[..., earlier] = np.where(same, halfway, s[..., earlier])
                 merged |= same
                 valid[..., later] &= ~same
         theta = np.where(valid, theta, np.nan)
         s = np.where(valid, s, np.nan)
         L = centre[..., None, :] + _rotate_points(k, np.nan_to_num(theta), p1[..., None, :]) - fixed[..., None, :]
-        slide = s[..., None] * v
+        slide = s[..., None] * v[..., None, :]
         turned, onto = (L + slide, np.broadcast_to(p2[..., None, :], L.shape)) if slide_turns \
             else (L, p2[..., None, :] + slide)
         phi, _, phi_free = _rotate_onto(_frame(k2), np.nan_to_num(turned), np.nan_to_num(onto),

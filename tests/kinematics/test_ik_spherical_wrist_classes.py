@@ -312,8 +312,8 @@ def _positioner_determinant(robot: Robot, q: np.ndarray, joints: tuple[int, ...]
     return np.linalg.det(np.stack(columns, axis=-1))
 
 
-def _positioner_singular_configurations(robot: Robot, plan, count: int, seed: int, search: int | None = None
-                                        ) -> np.ndarray:
+def _positioner_singular_configurations(robot: Robot, plan, count: int, seed: int, search: int | None = None,
+                                        pool: int = 2) -> np.ndarray:
     """Random joint vectors moved, along one positioner joint (``search``; by default the third), onto a zero of
     the positioner's Jacobian.
 
@@ -337,7 +337,7 @@ def _positioner_singular_configurations(robot: Robot, plan, count: int, seed: in
         def centre(q):
             return (forward_kinematics(robot, q) @ home_inverse @ np.append(plan.point, 1.0))[:, :3]
     grid = np.linspace(-np.pi, np.pi, 721) * (1.0 if robot.is_revolute[search] else 1 / np.pi)
-    q = configurations(robot, 2 * count, seed)
+    q = configurations(robot, pool * count, seed)  # the first ``count`` whose Jacobian changes sign on the grid
     trial = np.repeat(q[:, None], len(grid), axis=1)
     trial[..., search] = grid
     det = _positioner_determinant(robot, trial.reshape(-1, robot.dof), joints, centre).reshape(len(q), -1)

@@ -18,6 +18,7 @@ from ._decoupled import DecoupledPlan
 from ._positioning import find_positioner
 from ._reversed import ReversedPlan, reversed_geometry
 from ._screws import apply, chain_motion
+from ._slide_after_wrist import SlideAfterSphericalWrist
 from ._structure import Geometry
 from ._three_parallel import ThreeParallelPlan
 from ._types import Branch, Candidates, LabelCodes
@@ -59,8 +60,12 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
     three_parallel = ThreeParallelPlan.match(geometry)
     if three_parallel is not None:
         return three_parallel
+    slide_after_wrist = SlideAfterSphericalWrist.match(geometry)
+    if slide_after_wrist is not None:
+        return slide_after_wrist
     # a wrist at the base: the inverse chain decouples
-    inverse = _decoupled_pose_plan(reversed_geometry(geometry), n)
+    inverse_geometry = reversed_geometry(geometry)
+    inverse = _decoupled_pose_plan(inverse_geometry, n) or SlideAfterSphericalWrist.match(inverse_geometry)
     return ReversedPlan(inverse, geometry.model.home, n) if inverse is not None else None
 
 

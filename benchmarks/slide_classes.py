@@ -42,12 +42,27 @@ def _random(kinds: str, seed: int, wrist: bool) -> Robot:
                   for i, (row, k) in enumerate(zip(rows, kinds))])
 
 
+def _telescoping(seed: int) -> Robot:
+    """Two skew revolute joints, a spherical wrist over joints 3–5, a slide (0–1 m) as joint 6."""
+    rng = np.random.default_rng(seed)
+
+    def free():
+        return (rng.uniform(0.1, 0.5), rng.uniform(0.3, 2.8) * rng.choice([-1, 1]), rng.uniform(0.1, 0.5),
+                rng.uniform(-np.pi, np.pi))
+
+    twist = rng.uniform(0.3, 2.8)
+    rows = [free(), free(), (0.0, twist, rng.uniform(0.1, 0.5), 0.0), (0.0, -twist, 0.0, 0.0), free(), free()]
+    return Robot([Joint(f"q{i + 1}", "revolute", *row) for i, row in enumerate(rows[:5])]
+                 + [Joint("q6", "prismatic", *rows[5], lower=0.0, upper=1.0)])
+
+
 ARMS = {
     "KUKA KR 6 R900-2 (anchor)": kuka_kr6_r900_2,
     **{f"random {kinds}": (lambda kinds=kinds, seed=seed: _random(kinds, seed, False))
        for seed, kinds in enumerate(("RRP", "RPR", "PRR"))},
     **{f"random {kinds} + wrist": (lambda kinds=kinds, seed=seed: _random(kinds, 10 + seed, True))
        for seed, kinds in enumerate(("RRP", "RPR", "PRR"))},
+    "random RR + wrist + slide": lambda: _telescoping(20),
 }
 
 

@@ -256,7 +256,7 @@ def test_subproblem_5_prismatic_agrees_with_a_dense_scan():
             assert len(found) == changes, (trial, len(found), changes)
 
 
-@pytest.mark.parametrize("kind", ["prr+wrist", "rpr+wrist", "rrp+wrist", "prr"])
+@pytest.mark.parametrize("kind", ["prr+wrist", "rpr+wrist", "rrp+wrist", "prr", "rr+wrist+slide"])
 def test_slide_limits_filter_the_solutions_like_a_linear_axis(kind):
     """A linear axis with travel [−0.2, 0.4]: the closed form still finds every solution (limits never change
     the solver's answer); selection keeps those whose slide is within travel, the generating vector among them,

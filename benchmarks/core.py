@@ -26,7 +26,7 @@ from typing import Callable
 
 import numpy as np
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Robot, forward_kinematics
 from service.kinematics.ik import solve_ik, solve_ik_batch

@@ -36,7 +36,7 @@ from pathlib import Path
 
 import numpy as np
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import forward_kinematics
 from service.kinematics.ik._arrays import solve_ik_arrays

@@ -19,7 +19,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from service.catalogue import load_catalogue  # noqa: E402
+from service.robots.catalogue import load_catalogue  # noqa: E402
 from service.kinematics import Limits, forward_kinematics  # noqa: E402
 from service.kinematics.ik import select, solve_ik_batch  # noqa: E402
 

@@ -38,7 +38,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from service.catalogue import load_catalogue  # noqa: E402
+from service.robots.catalogue import load_catalogue  # noqa: E402
 from service.config import BUILTIN_ROBOTS_DIR  # noqa: E402
 from service.kinematics import forward_kinematics, quaternions_from_matrices  # noqa: E402
 

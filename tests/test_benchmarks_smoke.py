@@ -51,3 +51,12 @@ def test_http_benchmark_says_when_wrk_is_missing(capsys, monkeypatch):
     monkeypatch.setattr(shutil, "which", lambda name: None)
     assert http_throughput.main(["--quick"]) == 0
     assert "wrk is not installed" in capsys.readouterr().out
+
+
+def test_three_parallel_benchmark_runs_with_tiny_sizes(capsys):
+    from benchmarks import three_parallel
+
+    assert three_parallel.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "| 4∥5∥6 | IK, batch of 20 | core |" in out
+    assert "core on 1∥2∥3: family three_parallel_at_base" in out

@@ -49,13 +49,17 @@ EXPECTED_ROBOT_IDS = {
     "puma560_khalil",
     "puma560_standard",
     "ur5",
+    "ur3e",
+    "ur5e",
+    "ur10e",
+    "ur16e",
 }
 
 REQUIRED_KEYS = (
     "id", "name", "source", "convention", "angle_unit", "length_unit",
     "parameters", "limits_source", "joints", "base", "tool",
 )
-OPTIONAL_KEYS = ("notes",)
+OPTIONAL_KEYS = ("notes", "licence")
 
 #: Keys of one joint mapping per convention, in the required order (``d`` last:
 #: openapi-python-client binds the parsed dict to a local named ``d``).
@@ -77,8 +81,8 @@ EXACT_ATOL = 1e-9
 
 
 def robot_files() -> list[Path]:
-    """Every robot description file, sorted by name."""
-    return sorted(ROBOTS_DIR.glob("*.yaml"))
+    """Every DH robot file, sorted by name (the URDF sidecars ``*.urdf.yaml`` are checked in tests/robots/)."""
+    return sorted(p for p in ROBOTS_DIR.glob("*.yaml") if not p.name.endswith(".urdf.yaml"))
 
 
 def load_robot(robot_id: str) -> dict:
@@ -295,6 +299,7 @@ SLIDES_WITH_ZERO_LOWER_LIMIT = [
 #: Robots whose sources give no limits: only the slides above may be limited.
 TEXTBOOK_ONLY_ROBOTS = EXPECTED_ROBOT_IDS - {
     "spong_ex3_5_stanford", "puma560_modified", "puma560_khalil", "puma560_standard", "ur5",
+    "ur3e", "ur5e", "ur10e", "ur16e",
 }
 
 
@@ -320,6 +325,9 @@ def test_published_limits():
     corke_puma = [(-160, 160), (-45, 225), (-225, 45), (-110, 170), (-100, 100), (-266, 266)]
     assert limits("puma560_standard") == corke_puma
     assert limits("ur5") == [(-360, 360)] * 6
+    for robot_id in ("ur5e", "ur10e", "ur16e"):
+        assert limits(robot_id) == [(-360, 360)] * 6
+    assert limits("ur3e") == [(-360, 360)] * 5 + [None]  # wrist 3: infinite rotation
     stanford = limits("spong_ex3_5_stanford")
     assert stanford[2][0] >= 0, "the Stanford slide d3 cannot be negative"
     assert stanford == [(-170, 170), (-170, 170), (0.3048, 1.27), (-260, 80), (-90, 90), (-170, 170)]

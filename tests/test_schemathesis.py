@@ -24,7 +24,7 @@ from hypothesis import strategies as st
 from schemathesis.specs.openapi.checks import positive_data_acceptance
 
 from service.api.app import create_app
-from service.catalogue import ROBOT_FILE_SUFFIXES
+from service.robots.catalogue import load_catalogue
 from service.config import BUILTIN_ROBOTS_DIR, Settings
 from service.openapi import SPEC_PATH
 
@@ -38,7 +38,8 @@ schema.app = app
 schema.config.generation.update(modes=["positive", "negative"], max_examples=MAX_EXAMPLES, deterministic=True)
 
 
-CATALOGUE_IDS = sorted(p.stem for p in BUILTIN_ROBOTS_DIR.iterdir() if p.suffix in ROBOT_FILE_SUFFIXES)
+CATALOGUE_IDS = sorted(entry.description.id
+                       for entry in load_catalogue([BUILTIN_ROBOTS_DIR], max_joints=32).entries())
 _ROBOT_ID = re.compile(r"^[a-z0-9][a-z0-9_-]{0,63}$")
 
 
@@ -76,7 +77,7 @@ def test_api_conforms_to_its_spec(case):
 import numpy as np  # noqa: E402
 from hypothesis import given  # noqa: E402
 
-from service.catalogue import load_catalogue  # noqa: E402
+from service.robots.export import screws_description  # noqa: E402
 from service.kinematics import forward_kinematics, quaternions_from_matrices  # noqa: E402
 from service.kinematics._rotations import euler_zyz_from_matrix, rpy_from_matrix  # noqa: E402
 
@@ -111,30 +112,60 @@ def _samples(robot, q) -> list[dict]:
 
 
 def _meaningful_case(path: str, method: str, robot_id: str, seed: int, variant: int):
+    """One request per seed; a third of them carry a per-request base and tool, and a third of the inline ones
+    describe the robot by its joint screws instead of its own form."""
     entry = CATALOGUE.get(robot_id)
     robot, rng = entry.robot, np.random.default_rng(seed)
     q = _joints(robot, rng)
     inline = entry.description.model_dump(mode="json")
+    if seed % 3 == 1:
+        inline = screws_description(entry.description, robot).model_dump(mode="json")
+    frames = {}
+    if seed % 3 == 2:
+        base, tool = np.eye(4), np.eye(4)
+        base[:3, :3] = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+        base[:3, 3] = [0.1, 0.0, 0.2]
+        tool[:3, 3] = [0.0, 0.0, 0.05 * robot.characteristic_length]
+        frames = {"base": base.tolist(), "tool": tool.tolist()}
+        robot = robot.with_frames(base, tool)
     target = _targets(robot, q)[variant]
     bodies = {
         "/v1/robots/{robot_id}/fk": {"joints": q.tolist(), "frames": bool(seed % 2)},
         "/v1/fk": {"joints": q.tolist(), "robot": inline},
         "/v1/robots/{robot_id}/fk/batch": {"joints": [q.tolist(), _joints(robot, rng).tolist()]},
         "/v1/robots/{robot_id}/ik": {"target": target, "reference": q.tolist()},
-        "/v1/ik": {"target": target, "robot": inline},
-        "/v1/robots/{robot_id}/ik/batch": {"targets": _targets(robot, q)},
+        "/v1/ik": {"target": target, "robot": inline, "reference": q.tolist()},
+        "/v1/robots/{robot_id}/ik/batch": {"targets": _targets(robot, q), "reference": q.tolist()},
         "/v1/robots/{robot_id}/limits": {"joints": [q.tolist(), (q + 7.0).tolist()]},
         "/v1/limits": {"joints": [q.tolist(), (q - 7.0).tolist()], "robot": inline},
         "/v1/robots/{robot_id}/ik/trajectory": {"samples": _samples(robot, q), "reference": q.tolist()},
         "/v1/ik/trajectory": {"samples": _samples(robot, q), "reference": q.tolist(), "robot": inline},
     }
+    bodies = {key: {**body, **frames} for key, body in bodies.items()}
     operation = schema[path][method.upper()]
     parameters = {"robot_id": robot_id} if "{robot_id}" in path else {}
     if method.upper() == "GET":
-        return operation.Case(path_parameters=parameters)
+        query = {"form": ("screws", "urdf")[seed % 2]} if "{robot_id}" in path and seed % 3 == 0 else None
+        if query and query["form"] == "urdf" and "urdf" not in _exact_forms(robot_id):
+            query = {"form": "screws"}
+        return operation.Case(path_parameters=parameters, query=query) if query else \
+            operation.Case(path_parameters=parameters)
     if path not in bodies:
         return None
     return operation.Case(path_parameters=parameters, body=bodies[path], media_type="application/json")
+
+
+def _exact_forms(robot_id: str) -> set[str]:
+    from service.robots.export import FormNotExact, description_in_form
+
+    entry, forms = CATALOGUE.get(robot_id), set()
+    for form in ("screws", "urdf"):
+        try:
+            description_in_form(entry.description, entry.robot, form)
+            forms.add(form)
+        except FormNotExact:
+            pass
+    return forms
 
 
 _SPEC = json.loads(SPEC_PATH.read_text(encoding="utf-8"))

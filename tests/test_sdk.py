@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import BUILTIN_ROBOTS_DIR
 from service.kinematics import forward_kinematics
 from service.openapi import SPEC_PATH
@@ -79,8 +79,8 @@ def test_generated_names_are_clean(sdk):
     root = Path(sdk.__file__).parent
     models = sorted(p.stem for p in (root / "models").glob("*.py") if p.stem != "__init__")
     assert not [m for m in models if "_type_" in m or m.endswith("_item") or m.startswith("body_")], models
-    for expected in ("dh_robot", "khalil_robot", "pose_target", "matrix_orientation", "quaternion_orientation",
-                     "euler_zyz_orientation", "rpy_orientation", "ik_response", "problem", "angle_unit"):
+    for expected in ("dh_robot", "khalil_robot", "urdf_robot", "screws_robot", "pose_target", "matrix_orientation",
+                     "quaternion_orientation", "euler_zyz_orientation", "rpy_orientation", "ik_response", "problem", "angle_unit"):
         assert expected in models
     operations = sorted(p.stem for p in (root / "api").rglob("*.py") if p.stem != "__init__")
     assert {"list_robots", "get_robot", "forward_kinematics", "forward_kinematics_inline",
@@ -102,8 +102,40 @@ def test_every_catalogue_robot_parses_with_its_d_values(client):
     get_robot = _api("robots.get_robot")
     for entry in CATALOGUE.entries():
         robot = get_robot.sync(robot_id=entry.description.id, client=client)
+        if entry.description.format == "urdf":
+            assert type(robot).__name__ == "URDFRobot" and robot.urdf == entry.description.urdf
+            continue
         assert type(robot).__name__ == ("KhalilRobot" if entry.description.convention == "khalil" else "DHRobot")
         assert [joint.d for joint in robot.joints] == [joint.d for joint in entry.description.joints]
+
+
+def test_descriptions_in_other_forms_parse_and_work_inline(client):
+    """?form=screws and ?form=urdf come back as typed models, and those models work as inline robots."""
+    models = _models()
+    get_robot = _api("robots.get_robot")
+    screws = get_robot.sync(robot_id="ur5", client=client, form=models.DescriptionForm.SCREWS)
+    urdf = get_robot.sync(robot_id="ur5", client=client, form=models.DescriptionForm.URDF)
+    assert type(screws).__name__ == "ScrewsRobot" and type(urdf).__name__ == "URDFRobot"
+    q = [0.1, -1.2, 1.0, 0.3, 1.5, 0.2]
+    expected = forward_kinematics(CATALOGUE.get("ur5").robot, np.array(q))
+    fk_inline = _api("forward_kinematics.forward_kinematics_inline")
+    for robot in (screws, urdf):
+        pose = fk_inline.sync(client=client, body=models.FKInlineRequest(joints=q, robot=robot)).pose
+        assert np.allclose(pose.matrix, expected, atol=1e-12)
+    refused = get_robot.sync_detailed(robot_id="franka_panda", client=client, form=models.DescriptionForm.DH)
+    assert refused.status_code == 422 and isinstance(refused.parsed, models.Problem)
+
+
+def test_per_request_tool(client):
+    models = _models()
+    tool = np.eye(4)
+    tool[:3, 3] = [0.0, 0.0, 0.15]
+    q = [0.1, -1.2, 1.0, 0.3, 1.5, 0.2]
+    response = _api("forward_kinematics.forward_kinematics").sync(
+        robot_id="ur5", client=client, body=models.FKRequest(joints=q, tool=tool.tolist()))
+    assert np.allclose(response.pose.matrix, forward_kinematics(CATALOGUE.get("ur5").robot, np.array(q)) @ tool,
+                       atol=1e-12)
+    assert response.joint_names == CATALOGUE.get("ur5").robot.joint_names
 
 
 def test_forward_kinematics(client):

@@ -13,7 +13,7 @@ from fastapi.middleware.cors import CORSMiddleware
 from fastapi.routing import APIRoute
 
 from .. import __version__
-from ..catalogue import load_catalogue
+from ..robots.catalogue import load_catalogue
 from ..config import Settings
 from .limits import BodySizeLimit
 from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router

@@ -1,7 +1,6 @@
 """Translation between wire models and the core, with units converted once, here.
 
-Inbound: robot descriptions become :class:`~service.kinematics.Robot` (radians,
-Craig rows for Khalil tables), joint values become radians, targets become
+Inbound: robot descriptions become core robots in :mod:`service.robots.build`; joint values become radians, targets become
 4×4 ``world_T_tool`` matrices. Outbound: matrices become :class:`Pose` dicts
 and radians go back to the request's unit. Errors raised by the core carry
 locations relative to the value passed in; they are prefixed here with the
@@ -20,7 +19,6 @@ from ..kinematics import (
     InvalidInputError,
     Limits,
     Violation,
-    Joint,
     KinematicsError,
     Robot,
     check_joint_values,
@@ -28,13 +26,13 @@ from ..kinematics import (
     check_transform,
     check_transforms,
     check_unit_quaternion,
-    craig_row_from_khalil,
     matrix_from_euler_zyz,
     matrix_from_quaternion,
     matrix_from_rpy,
     quaternions_from_matrices,
 )
 from ..kinematics.ik import Ordering, check_ordering
+from ..robots.build import bounds as _bounds
 from .schemas.common import AngleUnit
 from .schemas.ik import Ordering as OrderingOptions
 from .schemas.poses import (
@@ -44,7 +42,6 @@ from .schemas.poses import (
     QuaternionOrientation,
     RPYOrientation,
 )
-from .schemas.robots import DHRobot, KhalilRobot
 
 _DEGREE = math.pi / 180.0
 
@@ -56,42 +53,6 @@ def located(*prefix: str | int) -> Iterator[None]:
         yield
     except KinematicsError as error:
         raise error.relocated(*prefix) from None
-
-
-def robot_from_description(description: DHRobot | KhalilRobot, *, max_joints: int) -> Robot:
-    """Build the core robot, converting the table's angles to radians once."""
-    if len(description.joints) > max_joints:
-        raise InvalidInputError(
-            f"a robot may have at most {max_joints} joints, this one has {len(description.joints)}",
-            location=("joints",),
-        )
-    angle = _DEGREE if description.angle_unit == "deg" else 1.0
-    joints = []
-    for index, row in enumerate(description.joints):
-        if isinstance(description, KhalilRobot):
-            a, alpha, d, theta = craig_row_from_khalil(row.alpha, row.d, row.theta, row.r)
-        else:
-            a, alpha, d, theta = row.a, row.alpha, row.d, row.theta
-        scale = angle if row.type == "revolute" else 1.0
-        lower, upper = _bounds(row.limits, scale)
-        joints.append(Joint(row.name or f"q{index + 1}", row.type, a, alpha * angle, d, theta * angle, lower, upper))
-    with located():
-        return Robot(
-            joints,
-            convention=description.convention,
-            world_T_base=None if description.base is None else np.asarray(description.base, dtype=float),
-            flange_T_tool=None if description.tool is None else np.asarray(description.tool, dtype=float),
-            name=description.name or description.id,
-        )
-
-
-def _bounds(limits, scale: float) -> tuple[float, float]:
-    """(lower, upper) in core units from a wire limits object; open sides become ∓inf."""
-    if limits is None:
-        return -math.inf, math.inf
-    lower = -math.inf if limits.lower is None else limits.lower * scale
-    upper = math.inf if limits.upper is None else limits.upper * scale
-    return lower, upper
 
 
 def _unit_scale(robot: Robot, unit: AngleUnit) -> np.ndarray:

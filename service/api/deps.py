@@ -4,14 +4,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numpy as np
 from fastapi import Path, Request
 
-from ..catalogue import Catalogue
+from ..robots.catalogue import Catalogue
 from ..config import Settings
 from ..kinematics import Robot
-from .boundary import located, robot_from_description
+from ..robots.build import robot_from_description
+from ..robots.schemas import AnyRobotDescription
+from .boundary import located
 from .problems import ProblemError
-from .schemas.robots import DHRobot, KhalilRobot
 
 
 @dataclass(frozen=True)
@@ -44,10 +46,22 @@ def catalogue_robot(
     return RobotRef(robot_id, entry.robot)
 
 
-def inline_robot(request: Request, description: DHRobot | KhalilRobot) -> RobotRef:
+def inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef:
     with located("body", "robot"):
         robot = robot_from_description(description, max_joints=settings_of(request).max_joints)
     return RobotRef(description.id, robot)
+
+
+def with_request_frames(ref: RobotRef, body) -> RobotRef:
+    """The robot with the request's own ``base`` (world_T_base) and ``tool`` (flange_T_tool), when it has them."""
+    base, tool = getattr(body, "base", None), getattr(body, "tool", None)
+    if base is None and tool is None:
+        return ref
+    robot = ref.robot
+    with located("body"):
+        robot = robot.with_frames(None if base is None else np.asarray(base, dtype=float),
+                                  None if tool is None else np.asarray(tool, dtype=float))
+    return RobotRef(ref.id, robot)
 
 
 def check_batch_size(request: Request, rows: int, field: str) -> None:

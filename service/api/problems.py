@@ -18,6 +18,7 @@ from pydantic import Field
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
 from ..kinematics import KinematicsError
+from ..robots._fields import field_location
 from .observability import REQUEST_ID_HEADER, REQUEST_ID_SCOPE_KEY
 from .schemas.common import ApiModel
 
@@ -69,21 +70,6 @@ def _describe(errors: list[dict]) -> str:
     where = ".".join(str(part) for part in first["loc"])
     more = f" (and {len(errors) - 1} more)" if len(errors) > 1 else ""
     return f"{where}: {first['msg']}{more}"
-
-
-#: Tags pydantic inserts into locations inside tagged unions: robot conventions and orientation types.
-_UNION_TAGS = {"standard", "modified", "khalil", "matrix", "quaternion", "euler_zyz", "rpy"}
-_UNION_FIELDS = {"robot", "orientation"}
-
-
-def field_location(loc: tuple | list) -> list[str | int]:
-    """A validation location as a client reads it: the union tags pydantic inserts are left out.
-
-    ``("body", "robot", "standard", "joints", 0)`` becomes ``["body", "robot", "joints", 0]``.
-    """
-    parts = [part if isinstance(part, (str, int)) else str(part) for part in loc]
-    return [part for i, part in enumerate(parts)
-            if not (part in _UNION_TAGS and (i == 0 or parts[i - 1] in _UNION_FIELDS))]
 
 
 def _jsonable_errors(raw: list[dict]) -> list[dict]:

@@ -29,7 +29,7 @@ from ._limits import (
     within,
 )
 from ._rates import JointRates, TaskSpace, jacobian_derivative, joint_rates, task_space
-from ._robot import JOINT_KINDS, Joint, JointKind, Robot, check_joint_values
+from ._robot import JOINT_KINDS, Joint, JointKind, Robot, ScrewJoint, check_joint_values
 from ._rotations import (
     check_rotation,
     check_transform,
@@ -39,6 +39,7 @@ from ._rotations import (
     matrix_from_quaternion,
     matrix_from_rpy,
     quaternions_from_matrices,
+    rpy_from_matrix,
 )
 from ._tolerances import RATE_SINGULARITY_TOLERANCE
 from ._trajectory import TrajectoryOptions, TrajectoryResult, follow_trajectory
@@ -65,6 +66,7 @@ __all__ = [
     "KinematicsError",
     "RATE_SINGULARITY_TOLERANCE",
     "Robot",
+    "ScrewJoint",
     "TaskSpace",
     "TrajectoryOptions",
     "TrajectoryResult",
@@ -88,6 +90,7 @@ __all__ = [
     "matrix_from_quaternion",
     "matrix_from_rpy",
     "quaternions_from_matrices",
+    "rpy_from_matrix",
     "screw_model",
     "task_space",
 ]

@@ -2,7 +2,10 @@
 
 Frames: ``world`` is the frame poses are given in; ``base`` is the robot's
 frame 0 (``world_T_base``); frame i is the DH frame attached after joint i;
-``flange`` is frame n and ``tool`` is ``flange_T_tool`` after it.
+``flange`` is frame n and ``tool`` is ``flange_T_tool`` after it. For a robot
+built from screws (URDF chains too) frame i is ``F_0 · M(q_1) · F_1 ⋯ M(q_i) · F_i``:
+like a standard DH frame it carries the axis of joint i + 1 as its z axis, and
+frame n is the flange (see :meth:`Robot.from_screws`).
 
 Every function takes joint values ``q`` with shape (n,) or a batch (N, n) and
 vectorises over N: there is no Python loop over configurations.
@@ -40,12 +43,36 @@ def link_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
         ``world_T_frame[i]`` for i = 0 (the base frame) … n (the flange).
     """
     q = np.asarray(q, dtype=float)
+    if robot.chain_transforms is not None:
+        return _chain_frames(robot, q)[..., [0, *range(2, robot.dof + 2)], :, :]
     theta, d = _dh_variables(robot, q)
     prev_T_link = link_transforms(robot.convention, robot.a, robot.alpha, d, theta)
     frames = np.empty(q.shape[:-1] + (robot.dof + 1, 4, 4))
     frames[..., 0, :, :] = robot.world_T_base
     for i in range(robot.dof):
         frames[..., i + 1, :, :] = frames[..., i, :, :] @ prev_T_link[..., i, :, :]
+    return frames
+
+
+def _chain_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
+    """For a screws robot: world_T_base, then the frame of joint 1's axis (world_T_base · F_0), then frames 1 … n;
+    shape (..., n + 2, 4, 4)."""
+    chain = robot.chain_transforms
+    motion = np.zeros(q.shape + (4, 4))
+    c, s = np.cos(q), np.sin(q)
+    revolute = robot.is_revolute
+    motion[..., 0, 0] = np.where(revolute, c, 1.0)
+    motion[..., 0, 1] = np.where(revolute, -s, 0.0)
+    motion[..., 1, 0] = np.where(revolute, s, 0.0)
+    motion[..., 1, 1] = np.where(revolute, c, 1.0)
+    motion[..., 2, 2] = 1.0
+    motion[..., 3, 3] = 1.0
+    motion[..., 2, 3] = np.where(revolute, 0.0, q)
+    frames = np.empty(q.shape[:-1] + (robot.dof + 2, 4, 4))
+    frames[..., 0, :, :] = robot.world_T_base
+    frames[..., 1, :, :] = robot.world_T_base @ chain[0]
+    for i in range(robot.dof):
+        frames[..., i + 2, :, :] = frames[..., i + 1, :, :] @ motion[..., i, :, :] @ chain[i + 1]
     return frames
 
 
@@ -125,6 +152,8 @@ def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     x, y, z, p : ndarrays, shape (3, N)
         The rotation's columns and the position of the tool, in the world frame.
     """
+    if robot.chain_transforms is not None:
+        return _screw_chain_columns(robot, np.asarray(q, dtype=float))
     steps = memo(robot, "chain_steps", lambda: _chain_steps(robot))
     qt = np.asarray(q, dtype=float).T  # (n, N)
     angles = np.array([s.theta for s in steps])[:, None] + np.where(robot.is_revolute[:, None], qt, 0.0)
@@ -165,6 +194,59 @@ def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
 _IDENTITY = np.eye(4)
 
 
+def _apply_columns(x, y, z, p, T: np.ndarray):
+    """Columns of frame · T for a fixed rigid T, shape (4, 4); works on arrays and on scalars alike."""
+    R, t = T[:3, :3], T[:3, 3]
+    p = p + x * t[0] + y * t[1] + z * t[2]
+    return (*(x * R[0, k] + y * R[1, k] + z * R[2, k] for k in range(3)), p)
+
+
+def _screw_chain_columns(robot: Robot, q: np.ndarray):
+    """:func:`tool_columns` of a screws robot: base · F_0, then per joint its motion about local z and F_i."""
+    chain = robot.chain_transforms
+    qt = q.T
+    count = qt.shape[1]
+    base = robot.world_T_base @ chain[0]
+    x, y, z = (np.repeat(base[:3, k:k + 1], count, axis=1) for k in range(3))
+    p = np.repeat(base[:3, 3:4], count, axis=1)
+    cos, sin = np.cos(qt), np.sin(qt)
+    for i in range(robot.dof):
+        if robot.is_revolute[i]:
+            c, s = cos[i], sin[i]
+            x, y = x * c + y * s, y * c - x * s
+        else:
+            p = p + z * qt[i]
+        x, y, z, p = _apply_columns(x, y, z, p, chain[i + 1] @ robot.flange_T_tool if i == robot.dof - 1
+                                    else chain[i + 1])
+    return x, y, z, p
+
+
+def _screw_chain_scalar(robot: Robot, q: list[float]):
+    """:func:`_screw_chain_columns` for one joint vector, in scalar arithmetic (unrolled, no array overhead)."""
+    def build():
+        fixed = [robot.world_T_base @ robot.chain_transforms[0], *robot.chain_transforms[1:-1],
+                 robot.chain_transforms[-1] @ robot.flange_T_tool]
+        return [tuple(T[:3, :].T.ravel().tolist()) for T in fixed]  # x, y, z, p columns, flattened
+
+    fixed = memo(robot, "screw_chain_scalar", build)
+    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = fixed[0]
+    for revolute, value, F in zip(robot.is_revolute.tolist(), q, fixed[1:]):
+        if revolute:
+            c, s = math.cos(value), math.sin(value)
+            x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
+                                      y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
+        else:
+            p0, p1, p2 = p0 + z0 * value, p1 + z1 * value, p2 + z2 * value
+        a0, a1, a2, b0, b1, b2, c0, c1, c2, t0, t1, t2 = F
+        p0, p1, p2 = (p0 + x0 * t0 + y0 * t1 + z0 * t2, p1 + x1 * t0 + y1 * t1 + z1 * t2,
+                      p2 + x2 * t0 + y2 * t1 + z2 * t2)
+        x0, x1, x2, y0, y1, y2, z0, z1, z2 = (
+            x0 * a0 + y0 * a1 + z0 * a2, x1 * a0 + y1 * a1 + z1 * a2, x2 * a0 + y2 * a1 + z2 * a2,
+            x0 * b0 + y0 * b1 + z0 * b2, x1 * b0 + y1 * b1 + z1 * b2, x2 * b0 + y2 * b1 + z2 * b2,
+            x0 * c0 + y0 * c1 + z0 * c2, x1 * c0 + y1 * c1 + z1 * c2, x2 * c0 + y2 * c1 + z2 * c2)
+    return (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)
+
+
 def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:
     """``world_T_tool`` for one joint vector: :func:`tool_columns` in scalar arithmetic (no array overhead)."""
     (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = tool_columns_scalar(robot, q)
@@ -195,6 +277,8 @@ def _screw_x(frame: tuple, step) -> tuple:
 def tool_columns_scalar(robot: Robot, q: list[float]) -> tuple[tuple[float, float, float], ...]:
     """:func:`tool_columns` for one joint vector (a list of floats), in scalar arithmetic: the columns x, y, z, p
     of ``world_T_tool`` as tuples of three floats."""
+    if robot.chain_transforms is not None:
+        return _screw_chain_scalar(robot, q)
     steps = memo(robot, "chain_steps", lambda: _chain_steps(robot))
     start = memo(robot, "base_columns", lambda: robot.world_T_base[:3].T.tolist())
     (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = start
@@ -245,6 +329,12 @@ def joint_screws(robot: Robot, q: np.ndarray) -> JointScrews:
     is z_i. Either way it is read off the link frames, so the result does not
     depend on the convention the robot was described in.
     """
+    q = np.asarray(q, dtype=float)
+    if robot.chain_transforms is not None:
+        frames = _chain_frames(robot, q)
+        world_T_tool = frames[..., -1, :, :] @ robot.flange_T_tool
+        axis_frames = frames[..., 1:-1, :, :]
+        return JointScrews(axis_frames[..., :3, 2].copy(), axis_frames[..., :3, 3].copy(), world_T_tool)
     frames = link_frames(robot, q)
     if robot.convention == "standard":
         axis_frames = frames[..., :-1, :, :]

@@ -1,4 +1,11 @@
-"""The kinematic model of a serial robot: joints, DH rows, base and tool.
+"""The kinematic model of a serial robot: joints, DH rows or joint screws, base and tool.
+
+A robot is described either by a DH table (:class:`Joint` rows in one of the
+conventions of :mod:`._conventions`) or by its joint screws (:class:`ScrewJoint`:
+an axis and a point on it in the base frame at q = 0, plus the home pose of the
+flange), the product-of-exponentials form that URDF chains reduce to. Both are
+one model underneath: a chain of joint motions about local z axes between fixed
+transforms (see :meth:`Robot.from_screws`).
 
 All angles are radians and all lengths are in the robot's own length unit.
 Unit conversion happens once, at the API boundary, before a :class:`Robot` is
@@ -41,6 +48,29 @@ class Joint:
     alpha: float
     d: float
     theta: float
+    lower: float = -math.inf
+    upper: float = math.inf
+
+    @property
+    def is_revolute(self) -> bool:
+        return self.kind == "revolute"
+
+
+@dataclass(frozen=True)
+class ScrewJoint:
+    """One joint given by its screw at q = 0, in the base frame.
+
+    ``axis`` is the unit rotation axis of a revolute joint or the sliding
+    direction of a prismatic one, oriented so that a positive q turns (or moves)
+    the outboard links positively about (or along) it; ``point`` is any point on
+    the axis (for a prismatic joint it only places the joint frame). Limits as
+    in :class:`Joint`.
+    """
+
+    name: str
+    kind: JointKind
+    axis: tuple[float, float, float]
+    point: tuple[float, float, float]
     lower: float = -math.inf
     upper: float = math.inf
 
@@ -96,6 +126,9 @@ class Robot:
         self.joints: tuple[Joint, ...] = joints
         self.world_T_base = _checked_transform(world_T_base, "base")
         self.flange_T_tool = _checked_transform(flange_T_tool, "tool")
+        #: For a robot built from screws: ``chain_transforms[i]`` (n + 1, 4, 4) is the fixed transform after joint
+        #: i's motion (F_0 before joint 1); None for a DH robot.
+        self.chain_transforms: np.ndarray | None = None
 
         self.a = np.array([j.a for j in joints], dtype=float)
         self.alpha = np.array([j.alpha for j in joints], dtype=float)
@@ -106,6 +139,72 @@ class Robot:
         self.upper = np.array([j.upper for j in joints], dtype=float)
         for array in (self.a, self.alpha, self.d, self.theta, self.is_revolute, self.lower, self.upper):
             array.setflags(write=False)
+
+    @classmethod
+    def from_screws(
+        cls,
+        joints: Sequence[ScrewJoint],
+        base_T_flange: np.ndarray,
+        *,
+        world_T_base: np.ndarray | None = None,
+        flange_T_tool: np.ndarray | None = None,
+        name: str = "",
+    ) -> "Robot":
+        """A robot from its joint screws at q = 0 and the flange pose there (product of exponentials).
+
+        ``world_T_tool(q) = world_T_base · exp([S_1] q_1) ⋯ exp([S_n] q_n) · base_T_flange · flange_T_tool``.
+
+        Internally each joint gets a frame J_i at q = 0 with its origin at ``point`` and z along ``axis``, so that
+        the chain is ``F_0 · M(q_1) · F_1 ⋯ M(q_n) · F_n`` with M a rotation about (or a slide along) local z and
+        ``F_0 = J_1``, ``F_i = J_i⁻¹ J_{i+1}``, ``F_n = J_n⁻¹ · base_T_flange``. ``convention`` is ``"screws"``.
+
+        Raises
+        ------
+        InvalidInputError
+            A zero or non-finite axis, a non-finite point, bad limits (located at the joint), or a home pose that is
+            not a rigid transform (located at ``home``).
+        """
+        joints = tuple(joints)
+        if not joints:
+            raise InvalidInputError("a robot needs at least one joint", location=("joints",))
+        frames = []
+        for index, joint in enumerate(joints):
+            frames.append(_joint_frame(joint, index))
+        home = _checked_transform(base_T_flange, "home")
+        robot = cls.__new__(cls)
+        robot.name = name
+        robot.convention = "screws"
+        robot.joints = joints
+        robot.world_T_base = _checked_transform(world_T_base, "base")
+        robot.flange_T_tool = _checked_transform(flange_T_tool, "tool")
+        chain = np.empty((len(joints) + 1, 4, 4))
+        chain[0] = frames[0]
+        for i in range(1, len(joints)):
+            chain[i] = _inverse(frames[i - 1]) @ frames[i]
+        chain[-1] = _inverse(frames[-1]) @ home
+        chain.setflags(write=False)
+        robot.chain_transforms = chain
+        robot.a = robot.alpha = robot.d = robot.theta = None
+        robot.is_revolute = np.array([j.is_revolute for j in joints], dtype=bool)
+        robot.lower = np.array([j.lower for j in joints], dtype=float)
+        robot.upper = np.array([j.upper for j in joints], dtype=float)
+        for array in (robot.is_revolute, robot.lower, robot.upper):
+            array.setflags(write=False)
+        return robot
+
+    def with_frames(self, world_T_base: np.ndarray | None = None,
+                    flange_T_tool: np.ndarray | None = None) -> "Robot":
+        """The same arm with another ``world_T_base`` and/or ``flange_T_tool`` (None keeps the robot's own).
+
+        A new object, so nothing derived from the old frames (plans, screw models) is carried over.
+        """
+        other = Robot.__new__(Robot)
+        other.__dict__.update({key: value for key, value in self.__dict__.items() if key != "_derived"})
+        if world_T_base is not None:
+            other.world_T_base = _checked_transform(world_T_base, "base")
+        if flange_T_tool is not None:
+            other.flange_T_tool = _checked_transform(flange_T_tool, "tool")
+        return other
 
     @property
     def dof(self) -> int:
@@ -126,7 +225,10 @@ class Robot:
         return memo(self, "characteristic_length", self._characteristic_length)
 
     def _characteristic_length(self) -> float:
-        total = float(np.sum(np.abs(self.a)) + np.sum(np.abs(self.d)))
+        if self.chain_transforms is not None:
+            total = float(np.sum(np.linalg.norm(self.chain_transforms[:, :3, 3], axis=1)))
+        else:
+            total = float(np.sum(np.abs(self.a)) + np.sum(np.abs(self.d)))
         total += float(np.linalg.norm(self.flange_T_tool[:3, 3]))
         return total if total > 0.0 else 1.0
 
@@ -145,6 +247,47 @@ def _check_joint(joint: Joint, index: int) -> None:
         value = getattr(joint, field)
         if not math.isfinite(value):
             raise InvalidInputError(f"{field} must be a finite number, not {value}", location=(*where, field))
+    _check_limits(joint, where)
+
+
+def _joint_frame(joint: ScrewJoint, index: int) -> np.ndarray:
+    """The frame of a screw joint at q = 0: origin at its point, z along its axis, x and y completing it."""
+    where = ("joints", index)
+    if joint.kind not in JOINT_KINDS:
+        raise InvalidInputError(
+            f"joint type must be one of {', '.join(JOINT_KINDS)}, not {joint.kind!r}", location=(*where, "type")
+        )
+    axis = np.asarray(joint.axis, dtype=float)
+    point = np.asarray(joint.point, dtype=float)
+    if axis.shape != (3,) or not np.all(np.isfinite(axis)):
+        raise InvalidInputError("axis must be 3 finite numbers", location=(*where, "axis"))
+    if point.shape != (3,) or not np.all(np.isfinite(point)):
+        raise InvalidInputError("point must be 3 finite numbers", location=(*where, "point"))
+    norm = float(np.linalg.norm(axis))
+    if norm < 1e-9:
+        raise InvalidInputError("axis must not be the zero vector", location=(*where, "axis"))
+    if abs(norm - 1.0) > 1e-6:
+        raise InvalidInputError(f"axis must be a unit vector (within 1e-6), its length is {norm:.9g}",
+                                location=(*where, "axis"))
+    _check_limits(joint, where)
+    z = axis / norm
+    # x: the base axis least aligned with z, made orthogonal to it (deterministic, well conditioned)
+    helper = np.eye(3)[int(np.argmin(np.abs(z)))]
+    x = helper - (helper @ z) * z
+    x /= np.linalg.norm(x)
+    frame = np.eye(4)
+    frame[:3, 0], frame[:3, 1], frame[:3, 2], frame[:3, 3] = x, np.cross(z, x), z, point
+    return frame
+
+
+def _inverse(T: np.ndarray) -> np.ndarray:
+    inverse = np.eye(4)
+    inverse[:3, :3] = T[:3, :3].T
+    inverse[:3, 3] = -T[:3, :3].T @ T[:3, 3]
+    return inverse
+
+
+def _check_limits(joint, where: tuple) -> None:
     if math.isnan(joint.lower) or math.isnan(joint.upper):
         raise InvalidInputError("joint limits must be numbers, not NaN", location=(*where, "limits"))
     if joint.lower > joint.upper:

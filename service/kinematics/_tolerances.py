@@ -17,6 +17,14 @@ ORTHONORMAL_TOLERANCE = 1e-6
 #: intersecting axes, zero-length projections).
 GEOMETRY_TOLERANCE = 1e-9
 
+#: Geometry as CAD exports and vendors state it: axes within this angle (radians) of parallel, intersecting or
+#: perpendicular, or lines within this fraction of the arm's size of meeting, are recognised as exactly so.
+#: The closed form then solves the idealised arm and every candidate is refined and verified on the true arm
+#: (see :mod:`.ik._idealised`, which also decides when that answer is still complete). π/2 written 1.5708 is
+#: 7e-6 rad off and a length rounded to 0.1 mm at most 5e-5 of a 1 m arm; vendors' URDFs write rpy angles to
+#: three decimals (Doosan: 1.571, 2.0e-4 rad off; 3.142 is 4.1e-4 off), which sets this bound.
+RECOGNITION_TOLERANCE = 5e-4
+
 #: An IK solution is accepted when its FK position error is below this
 #: fraction of the robot's characteristic length, and its orientation error
 #: (radians) below the same number.

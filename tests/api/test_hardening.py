@@ -219,14 +219,14 @@ def test_a_robot_with_no_joints_is_422(client):
 
 
 def test_a_robot_over_the_joint_maximum_is_422_and_at_the_maximum_is_fine():
-    with TestClient(create_app(Settings(_env_file=None, max_joints=6))) as small:  # the catalogue has 6 at most
-        too_many = {"convention": "standard", "joints": [{"a": 0.1}] * 7}
-        assert_problem(small.post("/v1/fk", json={"joints": [0] * 7, "robot": too_many}), 422,
-                       loc=["body", "robot", "joints"], match="at most 6 joints")
-        enough = {"convention": "standard", "joints": [{"a": 0.1}] * 6}
-        response = small.post("/v1/fk", json={"joints": [0] * 6, "robot": enough})
+    with TestClient(create_app(Settings(_env_file=None, max_joints=7))) as small:  # the catalogue has 7 at most
+        too_many = {"convention": "standard", "joints": [{"a": 0.1}] * 8}
+        assert_problem(small.post("/v1/fk", json={"joints": [0] * 8, "robot": too_many}), 422,
+                       loc=["body", "robot", "joints"], match="at most 7 joints")
+        enough = {"convention": "standard", "joints": [{"a": 0.1}] * 7}
+        response = small.post("/v1/fk", json={"joints": [0] * 7, "robot": enough})
         assert response.status_code == 200
-        assert response.json()["pose"]["position"] == pytest.approx([0.6, 0, 0])
+        assert response.json()["pose"]["position"] == pytest.approx([0.7, 0, 0])
 
 
 @pytest.mark.parametrize(("path", "body", "loc"), [

@@ -556,6 +556,8 @@ def test_catalogue_states_where_every_limit_comes_from(client):
     for robot_id in robot_ids:
         description = client.get(f"/v1/robots/{robot_id}").json()
         assert description["limits_source"] and description["limits_source"].strip(), robot_id
+        if description["format"] == "urdf":  # limits are the source file's: tests/robots/test_urdf.py
+            continue
         served = [None if j["limits"] is None else (j["limits"]["lower"], j["limits"]["upper"])
                   for j in description["joints"]]
         if robot_id in PUBLISHED:

@@ -13,7 +13,7 @@ from fastapi.testclient import TestClient
 
 from service.api import security
 from service.api.app import create_app
-from service.catalogue import CatalogueError, load_robot_file
+from service.robots.catalogue import CatalogueError, load_robot_file
 from service.config import Settings
 from tests.conftest import assert_problem
 
@@ -169,7 +169,7 @@ def test_yaml_is_only_read_with_safe_load():
             if isinstance(node, ast.keyword) and node.arg == "Loader":
                 offenders.append(f"{path.relative_to(ROOT)}:{node.lineno}: Loader=")
     assert offenders == []
-    assert "yaml.safe_load(" in (ROOT / "service" / "catalogue.py").read_text(encoding="utf-8")
+    assert "yaml.safe_load(" in (ROOT / "service" / "robots" / "catalogue.py").read_text(encoding="utf-8")
 
 
 def test_a_robot_file_with_a_python_tag_is_refused(tmp_path):

@@ -14,7 +14,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.api.app import create_app
-from service.catalogue import CatalogueError, load_catalogue
+from service.robots.catalogue import CatalogueError, load_catalogue
 from service.config import BUILTIN_ROBOTS_DIR, Settings
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -11,7 +11,7 @@ import doctest
 import numpy as np
 import pytest
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Joint, Robot, forward_kinematics, geometric_jacobian
 from service.kinematics import _rates

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Limits, forward_kinematics
 from service.kinematics.ik import Ordering, select

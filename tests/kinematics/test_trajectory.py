@@ -11,7 +11,7 @@ import json
 import numpy as np
 import pytest
 
-from service.catalogue import load_catalogue
+from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import InvalidInputError, Joint, Robot, forward_kinematics
 from service.kinematics._assur import assur_scara_forward, assur_scara_inverse

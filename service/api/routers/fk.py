@@ -6,7 +6,7 @@ from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import forward_kinematics, link_frames
 from ..boundary import joints_to_core, located, pose_from_matrix, poses_from_matrices
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..routing import FastJSONRoute
 from ..schemas.fk import FKBatchRequest, FKBatchResponse, FKInlineRequest, FKRequest, FKResponse
@@ -15,6 +15,7 @@ router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["forward kinem
 
 
 def _forward(ref: RobotRef, body: FKRequest) -> FKResponse:
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     with located("body", "joints"):
         q = joints_to_core(robot, body.joints, body.angle_unit)
@@ -27,7 +28,8 @@ def _forward(ref: RobotRef, body: FKRequest) -> FKResponse:
         frames = [{"name": name, **pose} for name, pose in zip(names, poses_from_matrices(stack))]
     else:
         world_T_tool = forward_kinematics(robot, q)
-    return FKResponse(robot_id=ref.id, pose=pose_from_matrix(world_T_tool), frames=frames)
+    return FKResponse(robot_id=ref.id, joint_names=robot.joint_names, pose=pose_from_matrix(world_T_tool),
+                      frames=frames)
 
 
 @router.post("/robots/{robot_id}/fk", operation_id="forward_kinematics", response_model=FKResponse,
@@ -50,6 +52,8 @@ def forward_kinematics_batch(request: Request, body: FKBatchRequest,
                              ref: RobotRef = Depends(catalogue_robot)) -> FKBatchResponse:
     """One tool pose per row of joint values, computed as one vectorised batch."""
     check_batch_size(request, len(body.joints), "joints")
+    ref = with_request_frames(ref, body)
     with located("body", "joints"):
         q = joints_to_core(ref.robot, body.joints, body.angle_unit, batch=True)
-    return FKBatchResponse(robot_id=ref.id, poses=poses_from_matrices(forward_kinematics(ref.robot, q)))
+    return FKBatchResponse(robot_id=ref.id, joint_names=ref.robot.joint_names,
+                           poses=poses_from_matrices(forward_kinematics(ref.robot, q)))

@@ -33,7 +33,7 @@ from ..boundary import (
     target_matrix,
     violation_to_wire,
 )
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of, with_request_frames
 from ..observability import observe_ik
 from ..problems import problem_responses
 from ..responses import FastJSONResponse
@@ -75,14 +75,23 @@ def _settings(request: Request, robot: Robot, body: IKRequest | IKBatchRequest, 
 def _solved_by_kind(robot: Robot, matrices: np.ndarray, flags: np.ndarray, reference):
     """Solve full-pose and position-only targets apart: yields (constrained, rows, arrays, started).
 
-    ``arrays`` is None when no analytic family covers the robot (the caller then runs the numeric search).
+    ``arrays`` is None when no analytic family covers the robot, or for the targets where a closed form on rounded
+    geometry could not promise every solution (the caller then runs :func:`solve_ik_batch`, whose fallback answers).
     """
     for constrained in (True, False):
         rows = np.flatnonzero(flags == constrained)
         if len(rows):
             started = time.perf_counter()
-            yield constrained, rows, solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained,
-                                                     reference=reference), started
+            arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference)
+            if arrays is None or arrays.complete.all():
+                yield constrained, rows, arrays, started
+                continue
+            # a closed form on rounded geometry that cannot promise every solution for some targets: those go to
+            # the fallback solver (through solve_ik_batch), the others keep the closed form's answer
+            complete = np.flatnonzero(arrays.complete)
+            if len(complete):
+                yield constrained, rows[complete], arrays.take(complete), started
+            yield constrained, rows[~arrays.complete], None, started
 
 
 def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: np.ndarray, rows: np.ndarray,
@@ -100,6 +109,7 @@ def _numeric_answers(ref: RobotRef, body: IKRequest | IKBatchRequest, matrices: 
 
 
 def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, targets: list) -> list[dict]:
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     if isinstance(body, IKRequest):
         with located("body", "target"):
@@ -139,11 +149,14 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
             answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
                                  chosen.notes.get(local, []), bool(chosen.truncated[local]),
                                  int(chosen.trimmed[local]), int(chosen.available[local]))
+    for answer in answers:
+        answer["joint_names"] = robot.joint_names
     return answers
 
 
 def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> FastJSONResponse:
     """The batch answer as columns: solve, select and encode with array operations, no loop over targets."""
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     matrices, flags = target_matrices(body.targets, body.angle_unit, "body", "targets")
     reference, limits, ordering, options, note = _settings(request, robot, body, len(matrices))
@@ -206,6 +219,7 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
     singular = [[order[i] for i in flags] for flags in singular] if order else singular
     return FastJSONResponse({
         "robot_id": ref.id,
+        "joint_names": robot.joint_names,
         "format": "arrays",
         "solvers": solvers,
         "singularity_reports": reports,

@@ -6,7 +6,7 @@ from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import LIMIT_TOLERANCE, nearest_fitting_equivalent, violations, within
 from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, violation_to_wire
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..schemas.limits import LimitsInlineRequest, LimitsRequest, LimitsResponse
 
@@ -15,6 +15,7 @@ router = APIRouter(prefix="/v1", tags=["joint limits"])
 
 def _check(request: Request, ref: RobotRef, body: LimitsRequest) -> dict:
     check_batch_size(request, len(body.joints), "joints")
+    ref = with_request_frames(ref, body)  # validated; limits do not depend on base or tool
     robot = ref.robot
     with located("body", "joints"):
         rows = joints_to_core(robot, body.joints, body.angle_unit, batch=True)
@@ -28,7 +29,7 @@ def _check(request: Request, ref: RobotRef, body: LimitsRequest) -> dict:
         results.append({"within_limits": bool(inside),
                         "violations": [violation_to_wire(robot, v, body.angle_unit) for v in broken],
                         "equivalent": equivalent})
-    return {"robot_id": ref.id, "tolerance": LIMIT_TOLERANCE, "results": results}
+    return {"robot_id": ref.id, "joint_names": robot.joint_names, "tolerance": LIMIT_TOLERANCE, "results": results}
 
 
 @router.post("/robots/{robot_id}/limits", operation_id="check_joint_limits", response_model=LimitsResponse,

@@ -10,7 +10,7 @@ from fastapi import APIRouter, Depends, Request
 from ...kinematics import InvalidInputError, Robot
 from ...kinematics import TrajectoryOptions, TrajectoryResult, follow_trajectory
 from ..boundary import joints_from_core, joints_to_core, located, target_matrix, violation_to_wire
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..schemas.trajectory import TrajectoryInlineRequest, TrajectoryRequest, TrajectoryResponse
 
@@ -28,6 +28,7 @@ def _cartesian(parts, angle: float) -> list[float]:
 
 def _follow(request: Request, ref: RobotRef, body: TrajectoryRequest) -> dict:
     check_batch_size(request, len(body.samples), "samples")
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     matrices, constrained = [], []
     for k, sample in enumerate(body.samples):
@@ -92,6 +93,7 @@ def _to_wire(robot_id: str, robot: Robot, result: TrajectoryResult, body: Trajec
     step = joints_from_core(robot, summary.largest_joint_step, unit)
     return {
         "robot_id": robot_id,
+        "joint_names": robot.joint_names,
         "samples": samples,
         "summary": {
             "largest_joint_step": {"values": [None if np.isnan(v) else float(v) for v in step],

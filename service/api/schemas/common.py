@@ -2,36 +2,24 @@
 
 from __future__ import annotations
 
-from enum import Enum
 from typing import Annotated
 
-from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict
+from pydantic import AllowInfNan, Field
 
-#: Largest magnitude of any number in a request. Float64 spacing at 1e6 is 1.2e-10, still below the service's
-#: tolerances (1e-9), so every answer inside the bound keeps the promised accuracy, and no product or sum of such
-#: values over KIN_MAX_JOINTS joints can overflow. Beyond it (1e308, say) answers would be overflow or rounding
-#: noise, so such values are refused with a 422 that names the field.
-MAX_MAGNITUDE = 1e6
+# The description fields live with the descriptions (service.robots); request schemas use them from here.
+from ...robots._fields import (  # noqa: F401
+    MAX_MAGNITUDE,
+    AngleUnit,
+    ApiModel,
+    Matrix4,
+    Matrix4Row,
+    Number,
+    RobotId,
+    Vector3,
+)
 
-#: A JSON number in a request: finite and within ±MAX_MAGNITUDE; strings, booleans, NaN and ±inf are rejected.
-Number = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
-
-
-class AngleUnit(str, Enum):
-    """Unit of angles: radians or degrees."""
-
-    rad = "rad"
-    deg = "deg"
-
-
-Vector3 = Annotated[list[Number], Field(min_length=3, max_length=3)]
 Vector4 = Annotated[list[Number], Field(min_length=4, max_length=4)]
 Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3, description="3×3, row-major")]
-Matrix4Row = Annotated[list[Number], Field(min_length=4, max_length=4)]
-Matrix4 = Annotated[
-    list[Matrix4Row],
-    Field(min_length=4, max_length=4, description="4×4 homogeneous transform, row-major; last row 0 0 0 1"),
-]
 #: Numbers in responses: finite, but not bounded (a pose can sum many request-sized lengths).
 Real = Annotated[float, AllowInfNan(False)]
 RealVector3 = Annotated[list[Real], Field(min_length=3, max_length=3)]
@@ -40,15 +28,18 @@ RealMatrix4 = Annotated[
     list[RealVector4],
     Field(min_length=4, max_length=4, description="4×4 homogeneous transform, row-major; last row 0 0 0 1"),
 ]
-RobotId = Annotated[str, Field(pattern=r"^[a-z0-9][a-z0-9_-]{0,63}$", examples=["puma560_modified"])]
 
 
-class ApiModel(BaseModel):
-    """Base for request bodies: unknown fields are errors, not silently dropped."""
+class RequestFrames(ApiModel):
+    """Per-request base and tool: they replace the robot's own for this request only."""
 
-    # Enums are named schemas in the spec (clean names in generated clients), but validated values are plain
-    # strings, so code compares them with string literals.
-    model_config = ConfigDict(extra="forbid", use_enum_values=True)
+    base: Matrix4 | None = Field(None, description="world_T_base for this request, replacing the robot's own; "
+                                                   "validated as a rigid transform")
+    tool: Matrix4 | None = Field(None, description="flange_T_tool for this request, replacing the robot's own; "
+                                                   "validated as a rigid transform")
+
+
+JOINT_NAMES_FIELD = Field(description="the robot's joint names, in the order of every joint vector in this answer")
 
 
 ANGLE_UNIT_FIELD = Field(

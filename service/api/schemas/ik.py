@@ -8,10 +8,10 @@ from typing import Annotated, Literal
 from pydantic import Field, model_serializer
 
 from ...kinematics.ik import MAX_EQUIVALENTS
-from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RobotId
+from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId
 from .limits import JointLimitsOverride, LimitViolation
 from .poses import PoseTarget
-from .robots import RobotDescription
+from ...robots.schemas import RobotDescription
 
 
 NonNegative = Annotated[Number, Field(ge=0)]
@@ -85,7 +85,7 @@ class _Targets(ApiModel):
     targets: list[PoseTarget] = Field(min_length=1)
 
 
-class IKRequestOptions(ApiModel):
+class IKRequestOptions(RequestFrames):
     """What every IK request may say besides its target(s)."""
 
     filter_limits: bool = Field(
@@ -175,6 +175,7 @@ class SingularityReport(ApiModel):
 
 class IKResponse(ApiModel):
     robot_id: RobotId
+    joint_names: list[str] = JOINT_NAMES_FIELD
     status: IKStatus
     detail: str | None = None
     solutions: list[IKSolution]
@@ -232,6 +233,7 @@ class IKBatchArraysResponse(ApiModel):
     """The batch answer in columns (``"format": "arrays"``): the same content as the objects form."""
 
     robot_id: RobotId
+    joint_names: list[str] = JOINT_NAMES_FIELD
     format: Literal["arrays"]
     solvers: list[SolverEntry]
     singularity_reports: list[SingularityReport]

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pydantic import Field
 
-from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number
-from .robots import RobotDescription
+from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames
+from ...robots.schemas import RobotDescription
 
 
 class JointLimitsOverride(ApiModel):
@@ -27,7 +27,9 @@ class LimitViolation(ApiModel):
     upper: float | None = Field(description="null when the range is open above")
 
 
-class LimitsRequest(ApiModel):
+class LimitsRequest(RequestFrames):
+    """Limits concern joint values only: a base or tool given here is validated but changes no answer."""
+
     joints: list[list[Number]] = Field(min_length=1, description="joint vectors to check")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
     limits: list[JointLimitsOverride | None] | None = Field(
@@ -48,6 +50,7 @@ class LimitsResult(ApiModel):
 
 class LimitsResponse(ApiModel):
     robot_id: str
+    joint_names: list[str] = JOINT_NAMES_FIELD
     tolerance: float = Field(description="inclusive-bound tolerance: radians (revolute), fraction of the robot's "
                                          "size (prismatic)")
     results: list[LimitsResult]

@@ -7,11 +7,11 @@ from typing import Literal
 from pydantic import Field, model_validator
 
 from ...kinematics import RATE_SINGULARITY_TOLERANCE
-from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RobotId, Vector3
+from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId, Vector3
 from .ik import Branch, SingularityReport
 from .limits import LimitViolation
 from .poses import PoseTarget
-from .robots import RobotDescription
+from ...robots.schemas import RobotDescription
 
 
 class _Rates(ApiModel):
@@ -49,7 +49,7 @@ class TrajectorySample(ApiModel):
     acceleration: Acceleration | None = Field(None, description="needs `twist`; without it accelerations are null")
 
 
-class TrajectoryRequest(ApiModel):
+class TrajectoryRequest(RequestFrames):
     samples: list[TrajectorySample] = Field(
         min_length=1, description="every pose the same kind: all with an orientation (or matrix), or all "
                                   "position-only")
@@ -158,6 +158,7 @@ class TrajectorySolver(ApiModel):
 
 class TrajectoryResponse(ApiModel):
     robot_id: RobotId
+    joint_names: list[str] = JOINT_NAMES_FIELD
     samples: list[TrajectorySampleResult]
     summary: TrajectorySummary
     solver: TrajectorySolver

@@ -26,6 +26,7 @@ from ._lean import lean_candidates, lean_label_codes
 from ._plan import Plan, plan_for
 from ._types import LabelCodes, SingularFlags
 from ._verify import distance_to_reference, polish, residual_arrays, wrap_revolute
+from ._structure import arm_size
 
 
 @dataclass(frozen=True)
@@ -52,6 +53,11 @@ class IKArrays:
         The kinematic family that solved it.
     free_joints : list of int
         Joints the target does not determine, set to the reference value (or 0).
+    complete : ndarray of bool, shape (N,)
+        Whether row i's solutions are known to be all of them. Always true for
+        an exact closed form; a closed form on an idealised (rounded) arm sets
+        it false where refinement cannot promise it (:mod:`._idealised`), and
+        the object API then asks the fallback solver.
     """
 
     joints: np.ndarray
@@ -63,6 +69,21 @@ class IKArrays:
     singularities: SingularFlags
     structure: str
     free_joints: list[int]
+    complete: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.complete is None:
+            object.__setattr__(self, "complete", np.ones(len(self.count), dtype=bool))
+
+    def take(self, rows: np.ndarray) -> "IKArrays":
+        """The answer for the targets ``rows`` (indices) only, in that order."""
+        singularities = SingularFlags(len(rows))
+        for mask, flag in self.singularities.entries:
+            singularities.add(mask[rows], flag)
+        return IKArrays(self.joints[rows], self.valid[rows], self.count[rows], self.position[rows],
+                        self.orientation[rows], {name: (values, codes[rows]) for name, (values, codes)
+                                                 in self.labels.items()},
+                        singularities, self.structure, self.free_joints, self.complete[rows])
 
 
 def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
@@ -155,7 +176,8 @@ def _concatenated(parts: list[IKArrays]) -> IKArrays:
         orientation=np.concatenate([p.orientation for p in parts]),
         labels={name: (values, np.concatenate([p.labels[name][1] for p in parts]))
                 for name, (values, _) in first.labels.items()},
-        singularities=singularities, structure=first.structure, free_joints=first.free_joints)
+        singularities=singularities, structure=first.structure, free_joints=first.free_joints,
+        complete=np.concatenate([p.complete for p in parts]))
 
 
 def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
@@ -169,7 +191,7 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
     position, orientation = residual_arrays(robot, joints, targets)
     _polish_near(robot, joints, targets, position, orientation, candidates.valid, constrain_orientation)
-    ok = candidates.valid & (position <= ACCEPT_RESIDUAL * robot.characteristic_length)
+    ok = candidates.valid & (position <= ACCEPT_RESIDUAL * arm_size(robot))
     if constrain_orientation:
         ok &= orientation <= ACCEPT_RESIDUAL
     kept = _first_of_each(robot, joints, ok)
@@ -183,18 +205,45 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     else:
         order = np.argsort(~kept, axis=1, kind="stable")
     count = kept.sum(axis=1)
+    error = position / arm_size(robot)
+    if constrain_orientation:
+        error = np.maximum(error, orientation)
+    complete = _promised(candidates, count, np.where(candidates.valid, error, np.inf).min(axis=1))
     take = (np.arange(n_targets)[:, None], order)
     return IKArrays(
         joints=joints[take], valid=kept[take], count=count,
         position=position[take], orientation=orientation[take],
         labels={name: (values, codes.reshape(n_targets, m)[take]) for name, (values, codes) in labels.items()},
-        singularities=candidates.singularities, structure=plan.structure, free_joints=list(plan.free_joints))
+        singularities=candidates.singularities, structure=plan.structure, free_joints=list(plan.free_joints),
+        complete=complete)
+
+
+#: Singular relations under which a family's "no solution" is not a proof: it set a joint it found undetermined to
+#: the reference value (or 0), or two roots met (a double root that rounding can push just off the real line).
+_FRAGILE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum",
+                                "boundary", "stretched", "folded", "stretched_or_folded"})
+
+
+def _promised(candidates, count: np.ndarray, nearest: np.ndarray) -> np.ndarray:
+    """Which rows (N,) may claim every solution: the family's own word (:attr:`Candidates.complete`), except that
+    a row with no verified solution, where the family set a joint it found free or saw two roots meet, and whose
+    nearest candidate missed by less than ``POLISH_RESIDUAL`` (``nearest`` (N,): fraction of the arm's size, or
+    radians), is not a proof of unreachability: the representative it chose, or the double root, failed
+    narrowly; another value of that joint, or the root pair a rounding error moved off the real line, may not
+    (an arm whose remaining axes are not exactly aligned with the free one, as rounded geometry gives). Those
+    rows go to the fallback."""
+    complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
+    narrow = (count == 0) & (nearest <= POLISH_RESIDUAL)
+    for mask, flag in candidates.singularities.entries:
+        if flag.relation in _FRAGILE_RELATIONS:
+            complete &= ~(mask & narrow)
+    return complete
 
 
 def _polish_near(robot: Robot, joints: np.ndarray, targets: np.ndarray, position: np.ndarray,
                  orientation: np.ndarray, valid: np.ndarray, constrain_orientation: bool) -> None:
     """Refine, in place, candidates close to their target but outside the acceptance tolerance."""
-    size = np.maximum(position / robot.characteristic_length, orientation if constrain_orientation else 0.0)
+    size = np.maximum(position / arm_size(robot), orientation if constrain_orientation else 0.0)
     near = valid & (size > ACCEPT_RESIDUAL * 1e-3) & (size <= POLISH_RESIDUAL)
     if not near.any():
         return
@@ -255,7 +304,7 @@ def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarr
     revolute = robot.is_revolute
     all_revolute = bool(revolute.all())
     tolerance = memo(robot, "duplicate_tolerance", lambda: np.where(
-        revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length))
+        revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot)))
     if joints.size <= 16 * len(revolute):  # one pose's slots: a scan in Python is cheaper than the array ops
         return _first_of_each_scalar(joints, ok, revolute.tolist(), tolerance.tolist())
     # every pair (earlier slot, later slot) at once; joints are wrapped to (−π, π], so a revolute difference d

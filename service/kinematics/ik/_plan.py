@@ -12,15 +12,18 @@ from typing import Protocol
 
 import numpy as np
 
+from .._cache import memo
 from .._forward import link_frames, screw_model
 from .._robot import Robot
 from ._decoupled import DecoupledPlan
+from ._idealised import IdealisedPlan
 from ._positioning import find_positioner
 from ._reversed import ReversedPlan, reversed_geometry
 from ._screws import apply, chain_motion
 from ._slide_after_wrist import SlideAfterSphericalWrist
-from ._structure import Geometry
-from ._three_parallel import ThreeParallelPlan
+from ._structure import Geometry, canonical_model, idealised
+from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
+from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
 from ._types import Branch, Candidates, LabelCodes
 from ._wrist import Roll, SphericalWrist
 
@@ -38,15 +41,38 @@ class Plan(Protocol):
 
 
 def geometry_of(robot: Robot) -> Geometry:
-    """The robot's screw model, size, up direction (base z) and link x axes at q = 0, in the world frame."""
+    """The robot's canonical screw model and size (:func:`canonical_model`), up direction (base z) and link x axes
+    at q = 0, in the world frame."""
+    return memo(robot, "ik_geometry", lambda: _geometry_of(robot))
+
+
+def _geometry_of(robot: Robot) -> Geometry:
     frames = link_frames(robot, np.zeros(robot.dof))
-    return Geometry(screw_model(robot), robot.characteristic_length, up=robot.world_T_base[:3, 2].copy(),
-                    link_x=frames[1:, :3, 0].copy())
+    model, size = canonical_model(screw_model(robot), robot.world_T_base[:3, 3])  # size: arm_size(robot)
+    return Geometry(model, size, up=robot.world_T_base[:3, 2].copy(), link_x=frames[1:, :3, 0].copy())
 
 
 def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
-    """The analytic plan for this robot and kind of target, or None when no family applies."""
+    """The analytic plan for this robot and kind of target, or None when no family applies.
+
+    A family is looked for in the arm as given (tolerance ``GEOMETRY_TOLERANCE``), then in its idealisation
+    (relations within ``RECOGNITION_TOLERANCE`` made exact, :func:`idealised`): that plan solves the idealised arm
+    and refines on the true one (:class:`IdealisedPlan`).
+    """
     geometry = geometry_of(robot)
+    plan = _family_plan(geometry, constrain_orientation, reference)
+    if plan is not None:
+        return plan
+    ideal = idealised(geometry)
+    if ideal.deviation == 0.0:
+        return None
+    plan = _family_plan(ideal.geometry, constrain_orientation, reference)
+    if plan is None:
+        return None
+    return IdealisedPlan(plan, ideal.geometry.model, robot, ideal.deviation, geometry.length_scale, constrain_orientation)
+
+
+def _family_plan(geometry: Geometry, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     n = geometry.dof
     if constrain_orientation:
         return _pose_plan(geometry, n)
@@ -57,16 +83,44 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
     decoupled = _decoupled_pose_plan(geometry, n)
     if decoupled is not None:
         return decoupled
-    three_parallel = ThreeParallelPlan.match(geometry)
+    three_parallel = _three_parallel_plan(geometry)
     if three_parallel is not None:
         return three_parallel
     slide_after_wrist = SlideAfterSphericalWrist.match(geometry)
     if slide_after_wrist is not None:
         return slide_after_wrist
     # a wrist at the base: the inverse chain decouples
-    inverse_geometry = reversed_geometry(geometry)
-    inverse = _decoupled_pose_plan(inverse_geometry, n) or SlideAfterSphericalWrist.match(inverse_geometry)
-    return ReversedPlan(inverse, geometry.model.home, n) if inverse is not None else None
+    reverse = reversed_geometry(geometry)
+    inverse = _decoupled_pose_plan(reverse, n) or SlideAfterSphericalWrist.match(reverse)
+    if inverse is not None:
+        return ReversedPlan(inverse, geometry.model.home, n)
+    return _reversed_three_parallel_plan(geometry, reverse, n)
+
+
+#: Three consecutive parallel axes: the families as the chain is described, then (name, family, first
+#: parallel axis) of the inverse chain: axes 3 ∥ 4 ∥ 5 are axes 2 ∥ 3 ∥ 4 seen from the tool, and axes
+#: 1 ∥ 2 ∥ 3 are axes 4 ∥ 5 ∥ 6.
+_THREE_PARALLEL = (ThreeParallelPlan, SkewWristThreeParallelPlan, ThreeParallelAtEndPlan)
+_THREE_PARALLEL_REVERSED = (("three_parallel_intersecting_shoulder", ThreeParallelPlan, 2),
+                            ("three_parallel_skew_shoulder", SkewWristThreeParallelPlan, 2),
+                            ("three_parallel_at_base", ThreeParallelAtEndPlan, 0))
+
+
+def _three_parallel_plan(geometry: Geometry) -> Plan | None:
+    for family in _THREE_PARALLEL:
+        plan = family.match(geometry)
+        if plan is not None:
+            return plan
+    return None
+
+
+def _reversed_three_parallel_plan(geometry: Geometry, reverse: Geometry, n: int) -> Plan | None:
+    for structure, family, first in _THREE_PARALLEL_REVERSED:
+        plan = family.match(reverse)
+        if plan is not None:  # the elbow label of the parallel axes as the chain is described
+            return ReversedPlan(plan, geometry.model.home, n, structure=structure,
+                                label_codes=lambda joints: {"elbow": parallel_elbow_codes(geometry, joints, first)})
+    return None
 
 
 def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:

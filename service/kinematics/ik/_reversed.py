@@ -1,4 +1,4 @@
-"""A spherical wrist (or any decoupling point) at the base: solve the inverse chain.
+"""A spherical wrist (or any decoupling point, or three parallel axes) at the base: solve the inverse chain.
 
 ``world_T_tool = G_1(q_1) ⋯ G_n(q_n) · home`` inverts to
 ``home · tool_T_world = G_n(q_n)⁻¹ ⋯ G_1(q_1)⁻¹ = G'_1(q_n) ⋯ G'_n(q_1) · I``, where joint
@@ -11,6 +11,7 @@ inverted on the way in; joint vectors, free joints and singular joints are rever
 from __future__ import annotations
 
 import re
+from typing import Callable
 
 import numpy as np
 
@@ -30,17 +31,22 @@ def reversed_geometry(geometry: Geometry) -> Geometry:
 
 
 class ReversedPlan:
-    """A decoupled plan of the inverse chain, answering for the chain itself."""
+    """A plan of the inverse chain (decoupled, or three parallel axes), answering for the chain itself."""
 
     method = "analytic"
 
-    def __init__(self, inner: DecoupledPlan, home: np.ndarray, dof: int) -> None:
+    def __init__(self, inner: DecoupledPlan, home: np.ndarray, dof: int, *, structure: str | None = None,
+                 label_codes: Callable[[np.ndarray], LabelCodes] | None = None) -> None:
+        """``structure`` names the class when the inner one's name does not read in reverse (default: the
+        inner parts in the chain's own order, the wrist at the base first); ``label_codes`` labels joint
+        vectors (M, n) of the chain itself where the inner labels would not keep their meaning (default: the
+        inner ones)."""
         self.inner = inner
         self.home = home
         self.dof = dof
-        # the parts in the chain's own order: the wrist at the base first
-        self.structure = "+".join(reversed(inner.structure.split("+")))
+        self.structure = structure or "+".join(reversed(inner.structure.split("+")))
         self.generic_count = inner.generic_count
+        self.own_label_codes = label_codes
 
     @property
     def free_joints(self) -> list[int]:
@@ -62,7 +68,11 @@ class ReversedPlan:
         def one_based(match: re.Match) -> str:
             return f"{match.group(1)}{n + 1 - int(match.group(2))}"
 
-        detail = re.sub(r"(\bq|\bjoint )(\d+)", one_based, flag.detail)
+        def span(match: re.Match) -> str:  # "axes 2–4" of the inverse chain are "axes 3–5" of the chain
+            return f"axes {n + 1 - int(match.group(2))}–{n + 1 - int(match.group(1))}"
+
+        detail = re.sub(r"\baxes (\d+)–(\d+)", span, flag.detail)
+        detail = re.sub(r"(\bq|\bjoints? |\baxis )(\d+)", one_based, detail)
         return Singularity(flag.kind, tuple(sorted(n - 1 - j for j in flag.joints)), flag.relation, detail)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
@@ -70,4 +80,6 @@ class ReversedPlan:
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """The inverse chain's labels (its wrist flip and its positioner's branches) of joint vectors (M, n)."""
+        if self.own_label_codes is not None:
+            return self.own_label_codes(joints)
         return self.inner.label_codes(joints[:, ::-1])

@@ -56,12 +56,48 @@ def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orien
     arrays = solve_ik_arrays(robot, targets, constrain_orientation=constrain_orientation, reference=reference)
     if arrays is None:
         return [_numeric(robot, target, constrain_orientation, reference, options) for target in targets]
-    return results_from_arrays(robot, arrays, targets, constrain_orientation, reference)
+    return results_from_arrays(robot, arrays, targets, constrain_orientation, reference, options)
+
+
+#: The solver for any 6R arm, for the targets where a closed form on rounded geometry cannot promise every
+#: solution (see :mod:`._idealised`): a callable ``(robot, world_T_target, constrain_orientation, reference, known)
+#: -> IKResult | None``, None when it does not apply. Until the general solver is plugged in here, the numeric
+#: search answers those targets with ``complete: false``.
+GENERAL_SOLVER = None
 
 
 def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
-                        reference: np.ndarray | None) -> list[IKResult]:
-    """One :class:`IKResult` per row of :func:`solve_ik_arrays`' answer."""
+                        reference: np.ndarray | None, options: IKOptions | None = None) -> list[IKResult]:
+    """One :class:`IKResult` per row of :func:`solve_ik_arrays`' answer.
+
+    Rows the closed form could not promise complete (:attr:`IKArrays.complete`, rounded geometry only) are
+    answered by the fallback, keeping the closed form's verified solutions (:func:`_incomplete_row`).
+    """
+    results = _closed_form_results(robot, arrays, targets, constrain_orientation, reference)
+    for row in np.flatnonzero(~arrays.complete).tolist():
+        known = arrays.joints[row, :arrays.count[row]]
+        results[row] = _incomplete_row(robot, targets[row], known, arrays.structure, constrain_orientation,
+                                       reference, options or IKOptions())
+    return results
+
+
+def _incomplete_row(robot: Robot, target: np.ndarray, known: np.ndarray, structure: str,
+                    constrain_orientation: bool, reference: np.ndarray | None, options: IKOptions) -> IKResult:
+    """The general solver's answer (when plugged in), else the numeric search's, merged with ``known`` (k, n)."""
+    if GENERAL_SOLVER is not None:
+        answer = GENERAL_SOLVER(robot, target, constrain_orientation, reference, known)
+        if answer is not None:
+            return answer
+    result = _numeric(robot, target, constrain_orientation, reference, options, seeds=known)
+    note = (f"The arm is within rounding of the {structure} family but not exactly of it; its closed form, refined "
+            f"on the arm as given, cannot promise every solution for this target (a pair of solutions may appear "
+            f"or vanish between the two), so the numeric search completed it.")
+    result.detail = f"{note} {result.detail}".strip() if result.detail else note
+    return result
+
+
+def _closed_form_results(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
+                         reference: np.ndarray | None) -> list[IKResult]:
     counts = arrays.count.tolist()
     details = unreachable_details(robot, arrays, targets, constrain_orientation, reference)
     joints, position, orientation = arrays.joints, arrays.position.tolist(), arrays.orientation.tolist()
@@ -127,10 +163,13 @@ def _ordered(robot: Robot, solutions: list[Solution], reference: np.ndarray | No
 
 
 def _numeric(robot: Robot, target: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
-             options: IKOptions) -> IKResult:
+             options: IKOptions, seeds: np.ndarray | None = None) -> IKResult:
+    """The numeric search's answer; ``seeds`` (k, n), solutions already verified, are kept among it."""
     outcome = solve_numeric(robot, target, constrain_orientation=constrain_orientation, options=options.numeric,
                             reference=reference)
     joints = wrap_revolute(robot, outcome.joints)
+    if seeds is not None and len(seeds):
+        joints = np.concatenate([seeds, joints.reshape(-1, robot.dof)])
     solutions: list[Solution] = []
     if len(joints):
         targets = np.broadcast_to(target, (len(joints), 4, 4))

@@ -4,6 +4,18 @@ Everything here works on the product-of-exponentials model (axes and points in
 the world frame at q = 0), so the facts do not depend on the DH convention,
 on the frame choices, or on base and tool transforms. Tests use tolerances
 relative to the robot's size, never exact equality.
+
+The screw model is first made canonical (:func:`canonical_model`): each
+revolute axis is represented by a point near the arm (the foot of its common
+normal with the previous axis, or the point nearest the previous one), never by
+wherever a DH table happened to put its frame origin. A description whose DH
+table carries huge compensating offsets (two nearly parallel axes whose common
+normal lies kilometres away) therefore gives the same geometry, the same size
+and the same plan as the compact description of the same arm.
+
+:func:`idealised` snaps relations that hold within
+:data:`~service.kinematics._tolerances.RECOGNITION_TOLERANCE` (rounded CAD
+values) to exact ones, so that a closed form can be chosen for the idealised arm.
 """
 
 from __future__ import annotations
@@ -12,8 +24,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._forward import ScrewModel
-from .._tolerances import GEOMETRY_TOLERANCE
+from .._cache import memo
+from .._forward import ScrewModel, screw_model
+from .._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
 
 
 @dataclass(frozen=True)
@@ -94,3 +107,158 @@ def _closest_common_point(points: list[np.ndarray], directions: list[np.ndarray]
         if np.linalg.norm(np.cross(k, x - p)) > GEOMETRY_TOLERANCE * 10 * scale:
             return None
     return x
+
+
+def arm_size(robot) -> float:
+    """The arm's size for relative tolerances in IK (residuals, duplicates, geometric tests): the size of its
+    canonical screw model (:func:`canonical_model`), which depends on the lines of its axes and its tool, not on
+    the numbers of its DH table (``Robot.characteristic_length`` sums those, and a table with offsets of 27 km on
+    a 1 m arm makes it 54 km)."""
+    return memo(robot, "ik_arm_size", lambda: canonical_model(screw_model(robot), robot.world_T_base[:3, 3])[1])
+
+
+#: A previous axis at least this far from parallel (sine of the angle) puts the canonical point of the next axis at
+#: their common normal's foot; closer to parallel the foot runs away (1/sine) and the nearest point is used instead.
+_FOOT_SINE = 0.1
+
+
+def canonical_model(model: ScrewModel, base_origin: np.ndarray) -> tuple[ScrewModel, float]:
+    """The screw model with every revolute axis represented by a point near the arm, and the arm's size.
+
+    The point on revolute axis i is the foot of the common normal with the previous revolute axis when the two are
+    clearly not parallel (sine of their angle at least 0.1, and the foot no farther from the previous point than
+    the arm's size), else the point of axis i nearest to the previous axis' point; the first axis takes the point
+    nearest ``base_origin`` (3,), the origin of the robot's base frame in the world frame. Both choices depend on
+    the lines only, not on where a description puts its frames.
+
+    The size is the length of the polyline base origin → canonical points → tool origin at q = 0 (1 when that is
+    zero): the sum of the arm's offsets and link lengths, measured on the lines themselves.
+    """
+    directions, points = model.directions, model.points.copy()
+    revolute = [i for i in range(len(directions)) if model.is_revolute[i]]
+    previous = np.asarray(base_origin, dtype=float)
+    nearest = {}
+    for i in revolute:  # first pass: nearest points, always well conditioned
+        k = directions[i]
+        nearest[i] = points[i] + k * float(k @ (previous - points[i]))
+        previous = nearest[i]
+    size = _polyline([base_origin, *(nearest[i] for i in revolute), model.home[:3, 3]])
+    for before, i in zip(revolute, revolute[1:]):
+        foot = _common_normal_foot(points[i], directions[i], nearest[before], directions[before])
+        if foot is not None and np.linalg.norm(foot - nearest[i]) <= size:
+            nearest[i] = foot
+    for i in revolute:
+        points[i] = nearest[i]
+    size = _polyline([base_origin, *(points[i] for i in revolute), model.home[:3, 3]])
+    return ScrewModel(directions.copy(), points, model.is_revolute.copy(), model.home.copy()), size
+
+
+def _polyline(points: list[np.ndarray]) -> float:
+    total = float(sum(np.linalg.norm(b - a) for a, b in zip(points, points[1:])))
+    return total if total > 0.0 else 1.0
+
+
+def _common_normal_foot(p: np.ndarray, k: np.ndarray, p_other: np.ndarray, k_other: np.ndarray,
+                        least_sine: float = _FOOT_SINE) -> np.ndarray | None:
+    """The point of line (p, k) nearest to line (p_other, k_other); None when the sine of their angle is below
+    ``least_sine`` (the foot runs away as 1/sine)."""
+    normal = np.cross(k, k_other)
+    sine = float(np.linalg.norm(normal))
+    if sine <= least_sine:
+        return None
+    # p + t k − (p_other + s k_other) ⟂ k and k_other: t = ((p_other − p) × k_other)·n / |n|², n = k × k_other
+    t = float(np.cross(p_other - p, k_other) @ normal) / sine ** 2
+    return p + t * k
+
+
+@dataclass(frozen=True)
+class Idealisation:
+    """An arm with its nearly special relations made exact, and how far that moved its axes.
+
+    ``deviation`` is the largest change of any joint axis: its angle (radians) plus the displacement of its line at
+    its canonical point, as a fraction of the arm's size. 0 means nothing was snapped.
+    """
+
+    geometry: Geometry
+    deviation: float
+
+
+def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> Idealisation:
+    """Snap the relations that hold within ``tolerance`` (rad, or fraction of the arm's size) to exact ones.
+
+    1. Directions within ``tolerance`` of parallel (or anti-parallel) take one common direction, the first joint's
+       of the group; directions within ``tolerance`` of perpendicular are made exactly perpendicular (each group's
+       direction loses its components along the earlier groups' it is nearly perpendicular to).
+    2. Revolute axes that (after step 1) pass within ``tolerance`` × size of a common point are moved to pass
+       through it (their least-squares point), for the groups the families look for, in this order: the last
+       three axes (a wrist), the first three (a wrist at the base), then consecutive pairs (a shoulder, the
+       UR type's axes 4–5 and 5–6). A pair whose first axis already meets another keeps that axis and
+       translates the second onto it; an axis is moved once at most.
+
+    Lines turn about their canonical points, which lie on the arm, so a turn by ε moves no part of the arm by much
+    more than ε × size.
+    """
+    model, scale = geometry.model, geometry.length_scale
+    n = geometry.dof
+    directions = model.directions.copy()
+    # 1. parallel groups, then perpendicular snapping between group directions
+    group_of = list(range(n))
+    for j in range(n):
+        for i in range(j):
+            if group_of[i] == i and np.linalg.norm(np.cross(directions[i], directions[j])) <= tolerance:
+                group_of[j] = i
+                break
+    leaders = [i for i in range(n) if group_of[i] == i]
+    for position, j in enumerate(leaders):
+        earlier = [directions[i] for i in leaders[:position] if abs(float(directions[i] @ directions[j])) <= tolerance]
+        if 0 < len(earlier) < 3:  # remove the components along the span of those directions
+            E = np.array(earlier).T  # (3, m)
+            projected = directions[j] - E @ np.linalg.solve(E.T @ E, E.T @ directions[j])
+            directions[j] = projected / np.linalg.norm(projected)
+    for j in range(n):
+        leader = directions[group_of[j]]
+        directions[j] = leader if float(leader @ model.directions[j]) >= 0 else -leader
+    points = model.points.copy()
+    # 2. nearly concurrent revolute axes, in the groups the families use: a wrist at the end or at the base, then
+    # consecutive pairs (a shoulder, the UR type's last two axes)
+    revolute = set(i for i in range(n) if model.is_revolute[i])
+    candidates = [tuple(range(n - 3, n)), (0, 1, 2)] + [(i, i + 1) for i in range(n - 1)] if n >= 3 else \
+        [(i, i + 1) for i in range(n - 1)]
+    assigned: set[int] = set()
+    for group in candidates:
+        members = list(group)
+        fixed = [g for g in members if g in assigned]
+        if not set(members) <= revolute or len(fixed) == len(members) or (fixed and len(members) > 2):
+            continue
+        if all(np.linalg.norm(np.cross(directions[members[0]], directions[g])) <= 10 * GEOMETRY_TOLERANCE
+               for g in members[1:]):
+            continue  # all parallel: no common point
+        centre = _least_squares_point(points[members], directions[members])
+        if max(_line_distance(centre, points[g], directions[g]) for g in members) > tolerance * scale:
+            continue
+        if fixed:  # a pair whose first axis already meets another: translate the free one onto it
+            (kept,), (moved,) = fixed, [g for g in members if g not in fixed]
+            foot_kept = _common_normal_foot(points[kept], directions[kept], points[moved], directions[moved], 0.0)
+            points[moved] = foot_kept  # on both lines now: the moved line passes through the kept one's foot
+        else:
+            for g in members:
+                points[g] = centre
+        assigned.update(members)
+    # how far each line moved: its angle, and its displacement at the canonical point
+    angle = np.linalg.norm(np.cross(model.directions, directions), axis=1)
+    shift = np.array([_line_distance(model.points[i], points[i], directions[i]) for i in range(n)]) / scale
+    shift[~model.is_revolute] = 0.0
+    deviation = float((angle + shift).max()) if n else 0.0
+    ideal = Geometry(ScrewModel(directions, points, model.is_revolute.copy(), model.home.copy()), scale,
+                     up=geometry.up, link_x=geometry.link_x)
+    return Idealisation(ideal, deviation)
+
+
+def _least_squares_point(points: np.ndarray, directions: np.ndarray) -> np.ndarray:
+    """The point nearest (least squares) to the lines (points[i], directions[i]), which are not all parallel."""
+    projectors = np.eye(3) - directions[:, :, None] * directions[:, None, :]
+    return np.linalg.solve(projectors.sum(axis=0), np.einsum("kij,kj->i", projectors, points))
+
+
+def _line_distance(x: np.ndarray, p: np.ndarray, k: np.ndarray) -> float:
+    return float(np.linalg.norm(np.cross(k, x - p)))

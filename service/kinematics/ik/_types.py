@@ -94,13 +94,16 @@ class Candidates:
     ``valid`` (N, m) says which slots hold a candidate. ``branches`` gives
     the labels of each slot, per target: a list of N lists of m dicts (built
     lazily by the family's labeller). ``singularities`` gives, per target, the
-    singular conditions met.
+    singular conditions met. ``complete`` (N,), when given, says for which
+    targets the valid slots are known to be every solution (None: all of them,
+    as for an exact closed form; see :mod:`._idealised` for when it is not).
     """
 
     joints: np.ndarray
     valid: np.ndarray
     branches: list[list[Branch]]
     singularities: SingularFlags
+    complete: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

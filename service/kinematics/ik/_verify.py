@@ -13,6 +13,7 @@ import numpy as np
 from .._forward import forward_kinematics, tool_columns, tool_columns_scalar
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE
+from ._structure import arm_size
 
 
 def wrap_revolute(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -108,7 +109,7 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool) -> np.ndarray:
     """Which residuals pass the FK check."""
-    ok = position <= ACCEPT_RESIDUAL * robot.characteristic_length
+    ok = position <= ACCEPT_RESIDUAL * arm_size(robot)
     if constrain_orientation:
         ok &= orientation <= ACCEPT_RESIDUAL
     return ok
@@ -116,7 +117,7 @@ def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constr
 
 def distinct(robot: Robot, q: np.ndarray) -> np.ndarray:
     """Indices of the first occurrence of each distinct joint vector, revolute joints compared modulo 2π."""
-    tolerance = np.where(robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * robot.characteristic_length)
+    tolerance = np.where(robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot))
     keep: list[int] = []
     for i in range(len(q)):
         if not any(np.all(np.abs(joint_difference(robot, q[i], q[j])) <= tolerance) for j in keep):
@@ -147,7 +148,7 @@ def polish(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray, constrain_o
     from .._forward import geometric_jacobian
     from ._numeric import pose_error
 
-    scale = robot.characteristic_length
+    scale = arm_size(robot)
     rows = slice(0, 6) if constrain_orientation else slice(0, 3)
     q = q.copy()
     for _ in range(steps):

@@ -1,0 +1,205 @@
+"""Closed forms for geometry as files state it: solve the idealised arm, refine on the true arm.
+
+A description rounded the way CAD exports and vendors round (π/2 written
+1.5708, axes 1e-5 off parallel, lengths to 0.1 mm) is not exactly of any
+family, but :func:`~._structure.idealised` snaps it to one within
+:data:`~service.kinematics._tolerances.RECOGNITION_TOLERANCE`. This plan runs
+that family's closed form on the idealised arm, then Newton-refines every
+candidate on the true arm (FK and Jacobian of the robot as described); the
+usual FK check then verifies it at the usual tolerance.
+
+When is the answer still complete? The true arm is the idealised one moved by
+δ (``deviation``: radians, or fractions of the arm's size). Its real solutions
+are the idealised ones continued, except where a pair of roots meets, which
+near δ = 0 happens only close to where the idealised arm's roots meet (a
+boundary or singular target). A row is claimed complete only when
+
+1. every idealised solution refines to a verified solution of the true arm,
+   and no two refine to the same one (no root pair merged or vanished);
+2. no other candidate (a subproblem's least-squares answer, the nearest the
+   idealised arm gets on that branch, before or after refinement) comes within
+   :data:`NEAR_MISS` × δ of the target on the true arm without reaching it:
+   there a root pair the idealised arm lacks could appear. Every change of the
+   solution count of a decoupled family happens where one of its subproblems'
+   root pairs meets, which is where those least-squares answers lie. (For an
+   arm with fewer joints than the target constrains, such as a SCARA's pose, a
+   candidate of another sheet that Gauss–Newton leaves stalled at a residual of
+   at least 1e-3 δ is clearly apart and does not count);
+3. the idealised family reports no singularity for the target (a free joint or
+   merged roots, whose continuation under the perturbation is not isolated),
+   and no solution is within :data:`SINGULAR_MARGIN` × δ of a singularity of
+   the true arm (σ_min of its scaled Jacobian).
+
+The true arm, a general arm near a decoupled one, may have more solutions in
+the complex domain (up to 16 for a 6R); the extra ones come from infinity
+(x = tan(θ/2) → ±i) as δ grows from 0 and stay far from real for small δ,
+so they do not break this count.
+
+Otherwise the row is marked incomplete and the caller's fallback answers it:
+the general solver when there is one (:data:`GENERAL_SOLVER` in ``_solve``),
+else the numeric search, with ``complete: false``. The refined solutions found
+here are kept either way.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .._forward import ScrewModel, geometric_jacobian
+from .._robot import Robot
+from .._tolerances import ACCEPT_RESIDUAL
+from ._screws import chain_motion
+from ._structure import arm_size
+from ._types import Branch, Candidates, LabelCodes
+from ._verify import polish, residual_arrays, wrap_revolute
+
+#: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
+#: the idealisation's deviation marks the row incomplete: the perturbation moves the tool by at most a few δ
+#: (each of up to six axes turned by δ about a point on the arm), so a smaller margin could miss a root pair.
+NEAR_MISS = 50.0
+
+#: An idealised candidate is one of the idealised arm's solutions when its residual there (fraction of the arm's
+#: size, or radians) is below this: the closed forms are exact to rounding, a few digits fewer near a singularity.
+IDEAL_RESIDUAL = 1e-7
+
+#: A solution where the smallest singular value of the true arm's scaled Jacobian is within this many times the
+#: deviation is near a singular set of the arm (a wrist or shoulder singularity, where the idealised family has a
+#: free joint): the perturbation there may move or split the roots by more than Newton's step can be trusted to
+#: follow, so the row is not claimed complete. (Root pairs meeting at a fold need no such margin: a pair that
+#: vanishes fails criterion 1, a pair that appears is a near miss, criterion 2.)
+SINGULAR_MARGIN = 10.0
+
+#: Newton (Gauss–Newton) steps from an idealised solution onto the true arm. The start is δ-close, so a regular root
+#: is reached to machine precision in two or three; more steps only help near a fold, which criterion 3 excludes.
+REFINE_STEPS = 6
+
+
+class IdealisedPlan:
+    """A family's plan for the idealised arm, answering for the true ``robot``."""
+
+    method = "analytic"
+
+    def __init__(self, inner, model: ScrewModel, robot: Robot, deviation: float, size: float,
+                 constrain_orientation: bool) -> None:
+        """``inner`` is the family's plan for the idealised arm, whose screw model is ``model``."""
+        self.inner = inner
+        self.inner_model = model
+        self.robot = robot
+        self.deviation = deviation
+        self.size = size
+        self.constrain_orientation = constrain_orientation
+        task = (6 if constrain_orientation else 3)
+        #: the target constrains more than the arm's joints can set (a SCARA's pose, a planar arm's position)
+        self.under_determined = robot.dof < task
+        self.structure = inner.structure
+        self.generic_count = inner.generic_count
+
+    @property
+    def free_joints(self) -> list[int]:
+        return self.inner.free_joints
+
+    def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
+        """Candidates (N, m, n), refined on the true arm, with ``complete`` (N,) set by the criteria above."""
+        ideal = self.inner.solve(world_T_targets, reference)
+        robot = self.robot
+        finite = np.isfinite(ideal.joints).all(axis=-1)
+        joints = wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0))
+        # the idealised arm's own solutions (its closed form is exact up to rounding near a singularity)
+        solutions = ideal.valid & finite & (self._ideal_error(joints, world_T_targets) <= IDEAL_RESIDUAL)
+        position, orientation = residual_arrays(robot, joints, world_T_targets)
+        near_before = finite & (self._size(position, orientation) <= NEAR_MISS * self.deviation)
+        # refine the idealised solutions, and every other candidate that comes close (an arm with fewer joints than
+        # the target constrains reaches the true arm's targets only within δ, where the idealised family rejects
+        # them)
+        tried = finite & (ideal.valid | near_before)
+        rows, slots = np.nonzero(tried)
+        if len(rows):
+            refined = polish(robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation,
+                             steps=REFINE_STEPS)
+            joints[rows, slots] = wrap_revolute(robot, refined)
+        position, orientation = residual_arrays(robot, joints, world_T_targets)
+        accepted = position <= ACCEPT_RESIDUAL * arm_size(robot)
+        if self.constrain_orientation:
+            accepted &= orientation <= ACCEPT_RESIDUAL
+        accepted &= tried
+        # 2. near misses: a candidate that came within NEAR_MISS δ of the target on the true arm, before or after
+        # refinement, without reaching it
+        after = self._size(position, orientation)
+        missed = (near_before | (tried & (after <= NEAR_MISS * self.deviation))) & ~accepted
+        if self.under_determined and missed.any():
+            missed &= ~self._stalled_apart(joints, world_T_targets, missed, after)
+        near_miss = missed.any(axis=1)
+        # 1. every idealised solution refined to a verified one, and no two to the same one
+        converged = ~(solutions & ~accepted).any(axis=1)
+        distinct = _distinct_counts(robot, joints, solutions & accepted) == _distinct_counts(
+            robot, wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0)), solutions)
+        # 3. no singular target: none flagged by the family, and every solution clear of the true arm's
+        # singularities (where the idealised family's roots may meet or split)
+        singular = np.zeros(len(world_T_targets), dtype=bool)
+        rows, slots = np.nonzero(accepted)
+        if len(rows):
+            near_singular = self._smallest_singular_value(joints[rows, slots]) <= SINGULAR_MARGIN * self.deviation
+            singular[rows[near_singular]] = True
+        for mask, _ in ideal.singularities.entries:
+            singular |= mask
+        complete = converged & distinct & ~near_miss & ~singular
+        return Candidates(joints, accepted, [], ideal.singularities, complete=complete)
+
+    def _stalled_apart(self, joints: np.ndarray, world_T_targets: np.ndarray, missed: np.ndarray,
+                       after: np.ndarray) -> np.ndarray:
+        """Which ``missed`` slots (N, m) sit at a least-squares point clearly apart from the target.
+
+        An arm with fewer joints than the target constrains reaches a δ-thin neighbourhood of the idealised
+        family's targets on several sheets (e.g. a SCARA's two assembly modes); on the true arm a target from one
+        sheet is generally missed by the other by about δ. There Gauss–Newton stalls at a positive residual: one
+        more step lowers it by less than 1 %, and it is at least 1e-3 δ (far above the acceptance tolerance), so
+        no solution lies near that candidate.
+        """
+        rows, slots = np.nonzero(missed)
+        stepped = polish(self.robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation, steps=1)
+        position, orientation = residual_arrays(self.robot, stepped[:, None, :], world_T_targets[rows])
+        now, before = self._size(position, orientation)[:, 0], after[rows, slots]
+        apart = np.zeros_like(missed)
+        apart[rows, slots] = (before >= 1e-3 * self.deviation) & (now >= 0.99 * before)
+        return apart
+
+    def _smallest_singular_value(self, joints: np.ndarray) -> np.ndarray:
+        """σ_min of the true arm's Jacobian at joints (k, n), position rows in arm sizes; shape (k,).
+
+        From the eigenvalues of JᵀJ (6 × 6 at most): σ_min² is far above their rounding (1e-16 σ_max²) at the
+        margins it is compared with (SINGULAR_MARGIN δ ≥ 1e-5).
+        """
+        J = geometric_jacobian(self.robot, joints)
+        J[:, :3, :] /= self.size
+        if not self.constrain_orientation:
+            J = J[:, :3, :]
+        gram = np.swapaxes(J, -1, -2) @ J if J.shape[-1] <= J.shape[-2] else J @ np.swapaxes(J, -1, -2)
+        return np.sqrt(np.maximum(np.linalg.eigvalsh(gram)[:, 0], 0.0))
+
+    def _ideal_error(self, joints: np.ndarray, world_T_targets: np.ndarray) -> np.ndarray:
+        """The idealised arm's residual at joints (N, m, n): position / size, or the larger with the orientation."""
+        model = self.inner_model
+        world_T_tool = chain_motion(model.directions, model.points, model.is_revolute, joints) @ model.home
+        position = np.linalg.norm(world_T_tool[..., :3, 3] - world_T_targets[:, None, :3, 3], axis=-1)
+        relative = np.swapaxes(world_T_targets[:, None, :3, :3], -1, -2) @ world_T_tool[..., :3, :3]
+        cosine = np.clip(0.5 * (np.trace(relative, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0)
+        skew = relative - np.swapaxes(relative, -1, -2)
+        sine = 0.5 * np.linalg.norm(np.stack([skew[..., 2, 1], skew[..., 0, 2], skew[..., 1, 0]], axis=-1), axis=-1)
+        return self._size(position, np.arctan2(sine, cosine))
+
+    def _size(self, position: np.ndarray, orientation: np.ndarray) -> np.ndarray:
+        size = position / self.size
+        return np.maximum(size, orientation) if self.constrain_orientation else size
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        return self.inner.labels(joints)
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        return self.inner.label_codes(joints)
+
+
+def _distinct_counts(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """How many distinct joint vectors (revolute joints modulo 2π, within 1e-6) each row's ``ok`` slots hold."""
+    from ._arrays import _first_of_each
+
+    return _first_of_each(robot, joints, ok).sum(axis=1)

@@ -1,0 +1,60 @@
+"""Scalar and array field types of robot descriptions, shared with the request schemas of the web layer.
+
+They depend on pydantic only, so that description files can be validated without the web framework.
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+from typing import Annotated
+
+from pydantic import AllowInfNan, BaseModel, ConfigDict, Field, Strict
+
+#: Largest magnitude of any number in a request. Float64 spacing at 1e6 is 1.2e-10, still below the service's
+#: tolerances (1e-9), so every answer inside the bound keeps the promised accuracy, and no product or sum of such
+#: values over KIN_MAX_JOINTS joints can overflow. Beyond it (1e308, say) answers would be overflow or rounding
+#: noise, so such values are refused with a 422 that names the field.
+MAX_MAGNITUDE = 1e6
+
+#: A JSON number in a request: finite and within ±MAX_MAGNITUDE; strings, booleans, NaN and ±inf are rejected.
+Number = Annotated[float, Strict(), AllowInfNan(False), Field(ge=-MAX_MAGNITUDE, le=MAX_MAGNITUDE)]
+
+
+class AngleUnit(str, Enum):
+    """Unit of angles: radians or degrees."""
+
+    rad = "rad"
+    deg = "deg"
+
+
+Vector3 = Annotated[list[Number], Field(min_length=3, max_length=3)]
+Matrix4Row = Annotated[list[Number], Field(min_length=4, max_length=4)]
+Matrix4 = Annotated[
+    list[Matrix4Row],
+    Field(min_length=4, max_length=4, description="4×4 homogeneous transform, row-major; last row 0 0 0 1"),
+]
+RobotId = Annotated[str, Field(pattern=r"^[a-z0-9][a-z0-9_-]{0,63}$", examples=["puma560_modified"])]
+
+
+class ApiModel(BaseModel):
+    """Base for request bodies: unknown fields are errors, not silently dropped."""
+
+    # Enums are named schemas in the spec (clean names in generated clients), but validated values are plain
+    # strings, so code compares them with string literals.
+    model_config = ConfigDict(extra="forbid", use_enum_values=True)
+
+
+#: Tags pydantic inserts into locations inside tagged unions: robot description forms and orientation types.
+_UNION_TAGS = {"dh", "standard", "modified", "khalil", "urdf", "screws", "matrix", "quaternion", "euler_zyz", "rpy"}
+_UNION_FIELDS = {"robot", "orientation"}
+
+
+def field_location(loc: tuple | list) -> list[str | int]:
+    """A validation location as a client reads it: the union tags pydantic inserts are left out.
+
+    ``("body", "robot", "standard", "joints", 0)`` becomes ``["body", "robot", "joints", 0]``; a top-level tag
+    (a description file validated on its own) is dropped too.
+    """
+    parts = [part if isinstance(part, (str, int)) else str(part) for part in loc]
+    return [part for i, part in enumerate(parts)
+            if not (part in _UNION_TAGS and (i == 0 or parts[i - 1] in _UNION_FIELDS))]

@@ -1,0 +1,64 @@
+"""Robot descriptions become core robots: units converted once, here, and every form reduced to the core's model.
+
+DH tables become :class:`~service.kinematics.Robot` rows (radians, Craig rows for Khalil tables); joint screws and
+URDF chains become :meth:`Robot.from_screws`. Errors are the core's :class:`InvalidInputError`, located relative to
+the description.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..kinematics import InvalidInputError, Joint, Robot, ScrewJoint, craig_row_from_khalil
+from .schemas import AnyRobotDescription, KhalilRobot, ScrewsRobot, URDFRobot
+from .urdf import parse_urdf
+
+_DEGREE = math.pi / 180.0
+
+
+def robot_from_description(description: AnyRobotDescription, *, max_joints: int) -> Robot:
+    """Build the core robot of any description form, converting angles to radians once."""
+    base = None if description.base is None else np.asarray(description.base, dtype=float)
+    tool = None if description.tool is None else np.asarray(description.tool, dtype=float)
+    name = description.name or description.id
+    if isinstance(description, URDFRobot):
+        chain = parse_urdf(description.urdf, base_link=description.base_link, tip_link=description.tip_link)
+        _check_joint_count(len(chain.joints), max_joints)
+        return Robot.from_screws(chain.joints, chain.base_T_tip, world_T_base=base, flange_T_tool=tool,
+                                 name=description.name or chain.robot_name or description.id)
+    _check_joint_count(len(description.joints), max_joints)
+    angle = _DEGREE if description.angle_unit == "deg" else 1.0
+    if isinstance(description, ScrewsRobot):
+        joints = []
+        for index, row in enumerate(description.joints):
+            lower, upper = bounds(row.limits, angle if row.type == "revolute" else 1.0)
+            joints.append(ScrewJoint(row.name or f"q{index + 1}", row.type, tuple(row.axis), tuple(row.point),
+                                     lower, upper))
+        return Robot.from_screws(joints, np.asarray(description.home, dtype=float), world_T_base=base,
+                                 flange_T_tool=tool, name=name)
+    joints = []
+    for index, row in enumerate(description.joints):
+        if isinstance(description, KhalilRobot):
+            a, alpha, d, theta = craig_row_from_khalil(row.alpha, row.d, row.theta, row.r)
+        else:
+            a, alpha, d, theta = row.a, row.alpha, row.d, row.theta
+        lower, upper = bounds(row.limits, angle if row.type == "revolute" else 1.0)
+        joints.append(Joint(row.name or f"q{index + 1}", row.type, a, alpha * angle, d, theta * angle, lower, upper))
+    return Robot(joints, convention=description.convention, world_T_base=base, flange_T_tool=tool, name=name)
+
+
+def _check_joint_count(count: int, max_joints: int) -> None:
+    if count > max_joints:
+        raise InvalidInputError(f"a robot may have at most {max_joints} joints, this one has {count}",
+                                location=("joints",))
+
+
+def bounds(limits, scale: float) -> tuple[float, float]:
+    """(lower, upper) in core units from a wire limits object; open sides become ∓inf."""
+    if limits is None:
+        return -math.inf, math.inf
+    lower = -math.inf if limits.lower is None else limits.lower * scale
+    upper = math.inf if limits.upper is None else limits.upper * scale
+    return lower, upper

@@ -1,0 +1,218 @@
+"""Robot descriptions: the format of the catalogue files and of inline robots.
+
+Three forms, told apart by ``format``: a DH table (``"dh"``, the default when ``format`` is absent, with its
+``convention``), a URDF chain (``"urdf"``) and joint screws (``"screws"``); see ../shared/api.md.
+
+The ``d`` property is declared last in each joint schema, and joints forbid
+extra properties: generated Python clients (openapi-python-client) bind the
+incoming dict to a local named ``d`` and break otherwise (see api.md).
+"""
+
+from __future__ import annotations
+
+from enum import Enum
+from typing import Annotated, Any, Literal, Union
+
+from pydantic import Discriminator, Field, RootModel, Tag, model_validator
+
+from ._fields import AngleUnit, ApiModel, Matrix4, Number, RobotId, Vector3
+
+#: Largest URDF text accepted inline or in a catalogue file, in characters (a kinematic URDF of a 7-joint arm
+#: without meshes is about 10 kB; vendor files with every visual are under 100 kB).
+MAX_URDF_CHARS = 1_000_000
+
+class JointType(str, Enum):
+    revolute = "revolute"
+    prismatic = "prismatic"
+
+
+class Convention(str, Enum):
+    """standard: DH (Spong/Paul); modified: Craig; khalil: Khalil–Kleinfinger."""
+
+    standard = "standard"
+    modified = "modified"
+    khalil = "khalil"
+
+
+class RobotParameters(RootModel[dict[str, Number]]):
+    """Values given to the source's symbolic lengths, by symbol (informational)."""
+
+
+class JointLimits(ApiModel):
+    """Inclusive bounds on the joint variable q: the robot's angle unit for revolute joints, its length unit for
+    prismatic ones. A null bound is open on that side (a slide that only has to stay positive: lower 0, upper null).
+    """
+
+    lower: Number | None
+    upper: Number | None
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "JointLimits":
+        if self.lower is not None and self.upper is not None and self.lower > self.upper:
+            raise ValueError(f"lower limit {self.lower:g} is greater than upper limit {self.upper:g}")
+        return self
+
+
+class DHJoint(ApiModel):
+    """One row of a standard (Spong) or modified (Craig) DH table.
+
+    Standard: A_i = Rot_z(theta)·Trans_z(d)·Trans_x(a)·Rot_x(alpha). Modified: the row holds
+    a_{i-1}, alpha_{i-1}, d_i, theta_i and T_i = Rot_x(alpha)·Trans_x(a)·Rot_z(theta)·Trans_z(d).
+    The value of the joint's variable parameter (theta or d) is an offset added to q.
+    """
+
+    name: str | None = Field(None, max_length=64, description="defaults to q1, q2, …")
+    type: JointType = "revolute"
+    a: Number = 0.0
+    alpha: Number = 0.0
+    theta: Number = 0.0
+    limits: JointLimits | None = None
+    d: Number = 0.0
+
+
+class KhalilJoint(ApiModel):
+    """One row of a Khalil–Kleinfinger table: T_j = Rot_x(alpha_j)·Trans_x(d_j)·Rot_z(theta_j)·Trans_z(r_j).
+
+    ``d`` is the distance along x_{j-1} (Craig's a_{j-1}); ``r`` the distance along z_j.
+    """
+
+    name: str | None = Field(None, max_length=64, description="defaults to q1, q2, …")
+    type: JointType = "revolute"
+    alpha: Number = 0.0
+    theta: Number = 0.0
+    r: Number = 0.0
+    limits: JointLimits | None = None
+    d: Number = 0.0
+
+
+class _RobotFields(ApiModel):
+    id: RobotId = "inline"
+    name: str = Field("", max_length=200)
+    source: str = Field("", max_length=2000, description="where the parameters come from")
+    licence: str | None = Field(None, max_length=200, description="licence of the source")
+    angle_unit: AngleUnit = Field("rad", description="unit of alpha, theta and revolute limits in this description")
+    length_unit: str = Field("m", max_length=16)
+    parameters: RobotParameters | None = Field(
+        None, description="values given to the source's symbolic lengths (informational)"
+    )
+    limits_source: str | None = Field(None, max_length=2000, description="where the joint limits come from")
+    notes: str | None = Field(None, max_length=4000)
+    base: Matrix4 | None = Field(None, description="world_T_base; identity when null")
+    tool: Matrix4 | None = Field(None, description="flange_T_tool; identity when null")
+
+
+class DHRobot(_RobotFields):
+    """A robot described by a standard (Spong/Paul) or modified (Craig) DH table."""
+
+    format: Literal["dh"] = Field("dh", description="description form; the default")
+    convention: Literal["standard", "modified"]
+    joints: list[DHJoint] = Field(min_length=1)
+
+
+class KhalilRobot(_RobotFields):
+    """A robot described by a Khalil–Kleinfinger table."""
+
+    format: Literal["dh"] = Field("dh", description="description form; the default")
+    convention: Literal["khalil"]
+    joints: list[KhalilJoint] = Field(min_length=1)
+
+
+class URDFRobot(ApiModel):
+    """A robot described by a URDF: the chain from ``base_link`` to ``tip_link`` of its kinematic tree.
+
+    Lengths are metres and angles radians, as URDF states them. Fixed joints are folded into their neighbours;
+    ``revolute``, ``continuous`` (no limits) and ``prismatic`` joints move. Meshes and visuals are ignored, never
+    fetched. Xacro is out of scope: expand it first (``xacro robot.urdf.xacro > robot.urdf``).
+    """
+
+    format: Literal["urdf"]
+    urdf: str = Field(max_length=MAX_URDF_CHARS, description="the URDF document (XML); no DTD, no entities")
+    base_link: str | None = Field(None, max_length=200, description="first link of the chain; default: the root")
+    tip_link: str | None = Field(None, max_length=200,
+                                 description="last link of the chain (the flange); default: the only leaf")
+    id: RobotId = "inline"
+    name: str = Field("", max_length=200)
+    source: str = Field("", max_length=2000, description="where the URDF comes from")
+    licence: str | None = Field(None, max_length=200, description="licence of the source file")
+    limits_source: str | None = Field(None, max_length=2000, description="where the joint limits come from")
+    notes: str | None = Field(None, max_length=4000)
+    base: Matrix4 | None = Field(None, description="world_T_base (world_T_base_link); identity when null")
+    tool: Matrix4 | None = Field(None, description="flange_T_tool (tip_link_T_tool); identity when null")
+
+
+class ScrewJointDescription(ApiModel):
+    """One joint as a screw at q = 0, in the base frame."""
+
+    name: str | None = Field(None, max_length=64, description="defaults to q1, q2, …")
+    type: JointType = "revolute"
+    axis: Vector3 = Field(description="unit vector: the rotation axis, or the sliding direction of a prismatic "
+                                      "joint; positive q turns right-handed about it (or moves along it)")
+    point: Vector3 = Field(description="a point on the axis, in the base frame at q = 0 (length unit)")
+    limits: JointLimits | None = None
+
+
+class ScrewsRobot(_RobotFields):
+    """A robot described by its joint screws (product of exponentials; EAIK's H and P):
+
+    ``world_T_tool(q) = base · exp([S_1] q_1) ⋯ exp([S_n] q_n) · home · tool``.
+    """
+
+    format: Literal["screws"]
+    joints: list[ScrewJointDescription] = Field(min_length=1)
+    home: Matrix4 = Field(description="base_T_flange at q = 0 (the tool pose when tool is null)")
+
+
+def _description_tag(value: Any) -> str | None:
+    """The union member a robot description belongs to: its format, or for DH tables its convention."""
+    if isinstance(value, dict):
+        form = value.get("format", "dh")
+        if form == "dh":
+            return "khalil" if value.get("convention") == "khalil" else "dh"
+        return form
+    if isinstance(value, KhalilRobot):
+        return "khalil"
+    return getattr(value, "format", None)
+
+
+RobotDescription = Annotated[
+    Union[
+        Annotated[DHRobot, Tag("dh")],
+        Annotated[KhalilRobot, Tag("khalil")],
+        Annotated[URDFRobot, Tag("urdf")],
+        Annotated[ScrewsRobot, Tag("screws")],
+    ],
+    Discriminator(
+        _description_tag,
+        custom_error_type="robot_description",
+        custom_error_message="a robot needs format 'dh' (with convention 'standard', 'modified' or 'khalil'), "
+                             "'urdf' or 'screws'",
+    ),
+]
+AnyRobotDescription = DHRobot | KhalilRobot | URDFRobot | ScrewsRobot
+
+
+class DescriptionForm(str, Enum):
+    """A description form for ``GET /v1/robots/{robot_id}?form=``; ``standard`` and ``modified`` are DH tables in
+    that convention."""
+
+    dh = "dh"
+    screws = "screws"
+    urdf = "urdf"
+    standard = "standard"
+    modified = "modified"
+
+
+class RobotSummary(ApiModel):
+    id: RobotId
+    name: str
+    dof: int
+    format: Literal["dh", "urdf", "screws"] = "dh"
+    convention: Convention | None = Field(description="DH convention; null for URDF and screw descriptions")
+    joint_types: list[JointType]
+    joint_names: list[str]
+    source: str
+    licence: str | None = None
+
+
+class RobotList(ApiModel):
+    robots: list[RobotSummary]

@@ -1,0 +1,265 @@
+"""Geometry as CAD exports and vendors state it: rounded values, huge compensating DH offsets, vendors' URDFs.
+
+Every arm here is the *true* arm (the rounded description is the robot); targets come from its own FK. The solver
+recognises the family within ``RECOGNITION_TOLERANCE``, solves the idealised arm in closed form, refines on the true
+arm and verifies; rows where that cannot promise every solution say ``complete: false`` and are completed by the
+fallback. Checked independently here: the generating joint vector is among the solutions (recall), every solution
+reproduces the target by this test's own FK (no wrong solution), and ``unreachable`` with ``complete: true`` never
+answers a pose the arm reaches.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from collections import Counter
+
+import numpy as np
+import pytest
+
+from service.kinematics import Joint, Robot
+from service.kinematics._forward import forward_kinematics
+from service.kinematics.ik import joint_difference, solve_ik_arrays, solve_ik_batch
+from service.kinematics.ik._plan import geometry_of
+from service.kinematics.ik._screws import rotate_about
+from tests.api.test_ik_recall import GENERIC
+from tests.conftest import DATA, catalogue_robot
+from tests.ik_helpers import random_configurations, same_set
+from tests.rounding import rounded, standard_dh_from_screws, urdf_chain_screws
+
+POSES = 1000
+
+#: rows the closed form may leave to the fallback (near a boundary or a singularity of the idealised family)
+MAX_INCOMPLETE = 0.03
+
+
+def _with_special_poses(robot: Robot, q: np.ndarray, seed: int) -> np.ndarray:
+    """q with every tenth row's revolute joints snapped, at random, to multiples of π/2 (stretched and folded
+    elbows, aligned wrist axes, a wrist centre over the shoulder): the singular and boundary poses."""
+    rng = np.random.default_rng(seed)
+    q = q.copy()
+    rows = np.arange(0, len(q), 10)
+    snap = rng.random((len(rows), robot.dof)) < 0.5
+    snap &= robot.is_revolute
+    special = np.round(q[rows] / (np.pi / 2)) * (np.pi / 2)
+    q[rows] = np.where(snap, special, q[rows])
+    return q
+
+
+def check_own_poses(robot: Robot, kind: str, structure: str | set[str], seed: int, *, poses: int = POSES,
+                    max_incomplete: float = MAX_INCOMPLETE) -> Counter:
+    """Solve the arm's own FK poses; assert the promises; return what answered (method, complete) per row.
+
+    ``structure``: the family expected to answer the complete rows (or a set of acceptable ones)."""
+    structures = {structure} if isinstance(structure, str) else structure
+    constrained = kind == "pose"
+    q = _with_special_poses(robot, random_configurations(robot, poses, seed), seed)
+    targets = forward_kinematics(robot, q)
+    results = solve_ik_batch(robot, targets, constrain_orientation=constrained)
+    size = robot.characteristic_length  # the DH sum: these tables carry no huge offsets
+    answered = Counter()
+    missed_by_fallback = incomplete = 0
+    for row, (q_true, target, result) in enumerate(zip(q, targets, results)):
+        answered[(result.method, result.complete)] += 1
+        special = row % 10 == 0  # see _with_special_poses
+        incomplete += not result.complete and not special
+        # unreachable with complete: true is a promise the arm cannot reach the target
+        assert not (result.status == "unreachable" and result.complete), (q_true, result.detail)
+        if result.complete:
+            assert result.method == "analytic" and result.structure in structures
+        solutions = np.array([s.joints for s in result.solutions]).reshape(-1, robot.dof)
+        if len(solutions):  # no wrong solution, by this test's own FK
+            reached = forward_kinematics(robot, solutions)
+            assert np.abs(reached[:, :3, 3] - target[:3, 3]).max() <= 1e-9 * size
+            if constrained:
+                # the rotation angle of R_reachedᵀ R_target, from ‖R_reached − R_target‖_F = 2√2 sin(angle / 2)
+                gap = np.linalg.norm(reached[:, :3, :3] - target[:3, :3], axis=(-2, -1))
+                assert (2 * np.arcsin(np.minimum(gap / (2 * np.sqrt(2)), 1.0))).max() <= 1e-9
+        found = len(solutions) and np.abs(joint_difference(robot, solutions, q_true)).max(axis=1).min() < 1e-7
+        if result.complete and not special:
+            assert found, q_true  # every solution means this one too
+        # (at the snapped poses a joint may be free: the answer holds one representative of that family)
+        elif not result.complete and not found and not special:
+            missed_by_fallback += 1
+    assert incomplete <= max_incomplete * poses, answered
+    assert missed_by_fallback <= 0.002 * poses, (missed_by_fallback, answered)
+    return answered
+
+
+@pytest.mark.parametrize("robot_id", sorted(GENERIC))
+def test_rounded_catalogue_arms_keep_their_closed_form(client, robot_id):
+    """π/2 written 1.5708, parallel axes 1e-5 off, lengths to 0.1 mm, base and tool from rounded quaternions."""
+    kind, _, structure = GENERIC[robot_id]
+    seed = sorted(GENERIC).index(robot_id)
+    robot = rounded(catalogue_robot(client, robot_id), seed)
+    check_own_poses(robot, kind, structure, seed)
+
+
+def _elbow_with_wrist(rng: np.random.Generator) -> Robot:
+    """A random elbow arm with shoulder offset and spherical wrist (the PUMA's class), standard DH."""
+    a2, a3, d2, d3, d4, d1, d6 = rng.uniform(0.05, 0.6, 7) * rng.choice([-1, 1], 7)
+    s = rng.choice([-1, 1], 4) * math.pi / 2
+    rows = [(0, s[0], d1), (a2, 0.0, d2), (a3, s[1], d3), (0, s[2], d4), (0, s[3], 0.0), (0, 0.0, d6)]
+    return Robot([Joint(f"q{i + 1}", "revolute", a, alpha, d, float(rng.uniform(-math.pi, math.pi)))
+                  for i, (a, alpha, d) in enumerate(rows)])
+
+
+def _three_parallel(rng: np.random.Generator) -> Robot:
+    """A random UR-type arm: axes 2 ∥ 3 ∥ 4, axes 5 and 6 meeting, standard DH."""
+    d1, a2, a3, d4, d5, d6 = rng.uniform(0.05, 0.6, 6) * rng.choice([-1, 1], 6)
+    s = rng.choice([-1, 1], 3) * math.pi / 2
+    rows = [(0, s[0], d1), (a2, 0.0, 0.0), (a3, 0.0, 0.0), (0, s[1], d4), (0, s[2], d5), (0, 0.0, d6)]
+    return Robot([Joint(f"q{i + 1}", "revolute", a, alpha, d, float(rng.uniform(-math.pi, math.pi)))
+                  for i, (a, alpha, d) in enumerate(rows)])
+
+
+@pytest.mark.parametrize("make, structure", [(_elbow_with_wrist, "intersecting_shoulder+spherical_wrist"),
+                                             (_three_parallel, "three_parallel")])
+@pytest.mark.parametrize("seed", [11, 12])
+def test_rounded_random_arms_of_each_class(make, structure, seed):
+    """Seeded random arms of the 6R classes, rounded and with base and tool; 500 poses each, 1,000 per class."""
+    robot = rounded(make(np.random.default_rng(seed)), seed)
+    check_own_poses(robot, "pose", structure, seed, poses=500)
+
+
+def _opw_arm(name: str) -> tuple[Robot, str]:
+    """An industrial arm of tests/data/opw_arms.json, from its OPW parameters (the file's row recipe)."""
+    arm = json.loads((DATA / "opw_arms.json").read_text())["arms"][name]
+    o = arm["opw"]
+    rows = [(o["a1"], -90, o["c1"], 0), (o["c2"], 0, o["b"], -90), (-o["a2"], -90, 0, 0), (0, 90, o["c3"], 0),
+            (0, -90, 0, 0), (0, 0, o["c4"], 0)]
+    return Robot([Joint(f"q{i + 1}", "revolute", a, math.radians(alpha), d, math.radians(theta))
+                  for i, (a, alpha, d, theta) in enumerate(rows)]), arm["structure"]
+
+
+@pytest.mark.parametrize("name", ["abb_irb120", "fanuc_lrmate200id", "kuka_kr6_r900_2"])
+def test_rounded_industrial_arms_keep_their_closed_form(name):
+    """The ortho-parallel industrial arms (offset shoulder, parallel elbow, spherical wrist), rounded. Rounding the
+    twists to 1.5708 keeps the wrist exactly spherical, so the exact general-positioner family (subproblem 5) may
+    answer before the idealised ortho-parallel one: both are complete closed forms."""
+    robot, structure = _opw_arm(name)
+    check_own_poses(rounded(robot, seed=31), "pose", {structure, "skew_axes+spherical_wrist"}, seed=31, poses=500)
+
+
+# --- The UFactory Lite6: exact, 7e-6 rad off parallel (DH offsets of 28 km), and with d2, d3 raised by 1e4 m
+
+
+def _lite6(convention: str, raised: float = 0.0) -> Robot:
+    table = json.loads((DATA / "lite6_dh.json").read_text())[convention]
+    return Robot([Joint(f"j{i + 1}", "revolute", a / 1000, math.radians(alpha),
+                        d / 1000 + (raised if i in (1, 2) else 0.0), math.radians(theta))
+                  for i, (theta, d, alpha, a) in enumerate(table)], convention=convention)
+
+
+def _lite6_off_parallel(angle: float) -> Robot:
+    """The Lite6 with axis 3 turned by ``angle`` in the plane of axes 2 and 3 (so that they meet ~0.2 m / angle
+    away), stated by its exact standard-DH table."""
+    model = geometry_of(_lite6("modified")).model
+    directions = model.directions.copy()
+    normal = np.cross(directions[1], model.points[2] - model.points[1])
+    directions[2] = rotate_about(normal / np.linalg.norm(normal), angle, directions[2])
+    return standard_dh_from_screws(directions, model.points, model.home)
+
+
+@pytest.mark.parametrize("convention", ["modified", "standard"])
+def test_lite6_with_huge_compensating_offsets_is_the_same_arm(convention):
+    """Raising d2 and d3 by 1e4 m (axes 2 and 3 anti-parallel) does not change the arm, nor its answers."""
+    compact, raised = _lite6(convention), _lite6(convention, 1e4)
+    q = random_configurations(compact, 300, seed=21)
+    targets = forward_kinematics(compact, q)
+    assert np.abs(forward_kinematics(raised, q) - targets).max() < 1e-9
+    for a, b in zip(solve_ik_batch(compact, targets), solve_ik_batch(raised, targets)):
+        assert a.status == b.status == "ok" and a.complete and b.complete
+        assert a.structure == b.structure == "intersecting_shoulder+spherical_wrist"
+        assert same_set(compact, np.array([s.joints for s in a.solutions]), np.array([s.joints for s in b.solutions]),
+                        tolerance=1e-9)
+
+
+def test_lite6_seven_microradians_off_parallel_solves_its_own_poses():
+    """The exact DH table of a Lite6 whose axes 2 and 3 are 7e-6 rad from parallel has d2 = d3 ≈ 28 km."""
+    robot = _lite6_off_parallel(7e-6)
+    assert min(abs(j.d) for j in robot.joints[1:3]) > 2e4
+    answered = check_own_poses(robot, "pose", "intersecting_shoulder+spherical_wrist", seed=22, poses=500)
+    assert answered[("analytic", True)] == 500
+    # and it is, to within the tilt's effect, the exact Lite6: the same number of solutions, close by
+    exact = _lite6("modified")
+    q = random_configurations(exact, 300, seed=23)
+    targets = forward_kinematics(robot, q)
+    tilted, straight = solve_ik_arrays(robot, targets), solve_ik_arrays(exact, targets)
+    assert np.array_equal(tilted.count, straight.count)
+    for row in range(len(q)):
+        a, b = tilted.joints[row, :tilted.count[row]], straight.joints[row, :straight.count[row]]
+        gaps = np.abs(joint_difference(exact, a[:, None], b[None])).max(axis=-1).min(axis=1)
+        assert gaps.max() < 0.05
+
+
+def test_doosan_m1013_urdf_with_three_decimal_angles_gets_the_closed_form():
+    """The vendor's URDF writes π/2 as 1.571 (2e-4 rad off): the closed form still answers, refined on the arm."""
+    joints = json.loads((DATA / "doosan_m1013_urdf_joints.json").read_text())["joints"]
+    robot = standard_dh_from_screws(*urdf_chain_screws(joints))
+    # 2e-4 rad is 30 times the 1.5708 rounding: more rows sit within its margin of a boundary or a singularity
+    check_own_poses(robot, "pose", "intersecting_shoulder+spherical_wrist", seed=24, poses=500, max_incomplete=0.06)
+
+
+# --- When rounding changes the structure, the closed form does not claim completeness
+
+
+def test_a_perturbation_beyond_the_tolerance_is_not_solved_as_the_family(client):
+    """A PUMA whose wrist axes miss each other by 5 mm (0.4 % of its size) is a general 6R arm: up to 16
+    solutions, no decoupling. It must not be answered by the spherical-wrist closed form."""
+    puma = catalogue_robot(client, "puma560_standard")
+    joints = list(puma.joints)
+    joints[4] = Joint(joints[4].name, "revolute", 0.005, joints[4].alpha, joints[4].d, joints[4].theta)
+    robot = Robot(joints, convention=puma.convention)
+    assert solve_ik_arrays(robot, forward_kinematics(robot, np.zeros((1, 6)))) is None
+    q = random_configurations(robot, 3, seed=25)
+    for q_true, result in zip(q, solve_ik_batch(robot, forward_kinematics(robot, q))):
+        assert not result.complete and result.method == "numeric"
+
+
+def test_where_a_root_pair_splits_between_the_arms_the_closed_form_does_not_claim_completeness(client):
+    """A rounded UR5 at poses within a few δ of its wrist singularity (q5 ≈ 0) and of a stretched elbow: the
+    idealised arm's roots there merge or split under the rounding. Every answer either says complete: false or
+    holds the generating vector among verified solutions; and some must say complete: false."""
+    robot = rounded(catalogue_robot(client, "ur5"), seed=26)
+    rng = np.random.default_rng(27)
+    q = rng.uniform(-np.pi, np.pi, (200, 6))
+    q[:100, 4] = rng.uniform(-3e-5, 3e-5, 100)
+    q[100:, 2] = rng.uniform(-3e-5, 3e-5, 100)
+    targets = forward_kinematics(robot, q)
+    arrays = solve_ik_arrays(robot, targets)
+    assert arrays.structure == "three_parallel"
+    assert (~arrays.complete).sum() >= 20
+    for row in np.flatnonzero(arrays.complete):
+        solutions = arrays.joints[row, :arrays.count[row]]
+        assert len(solutions) and np.abs(joint_difference(robot, solutions, q[row])).max(axis=1).min() < 1e-7
+    for result in solve_ik_batch(robot, targets[~arrays.complete][:5]):
+        assert not result.complete and "rounding" in result.detail
+
+
+def test_the_api_hands_incomplete_rows_to_the_fallback(client, tmp_path):
+    """Through the endpoints (single target, batch objects and arrays forms): the rows the closed form cannot
+    promise say complete: false, the others keep the closed form's answer."""
+    from fastapi.testclient import TestClient
+
+    from service.api.app import create_app
+    from service.config import Settings
+
+    robot = rounded(catalogue_robot(client, "ur5"), seed=28, base_and_tool=False)
+    description = {"convention": "standard", "joints": [
+        {"name": j.name, "type": "revolute", "a": j.a, "alpha": j.alpha, "d": j.d, "theta": j.theta}
+        for j in robot.joints]}
+    (tmp_path / "ur5_rounded.json").write_text(json.dumps({"id": "ur5_rounded", "name": "UR5, rounded", **description}))
+    q = np.array([[0.3, -1.0, 1.2, 0.4, 2e-5, 0.7], [0.3, -1.0, 1.2, 0.4, 1.1, 0.7]])
+    targets = [{"matrix": T.tolist()} for T in forward_kinematics(robot, q)]
+    single = [client.post("/v1/ik", json={"robot": description, "target": target}).json() for target in targets]
+    assert [r["solver"]["complete"] for r in single] == [False, True]
+    assert single[1]["solver"]["structure"] == "three_parallel"
+    with TestClient(create_app(Settings(robots_dir=tmp_path))) as local:
+        objects = local.post("/v1/robots/ur5_rounded/ik/batch", json={"targets": targets})
+        assert objects.status_code == 200, objects.text
+        assert [r["solver"]["complete"] for r in objects.json()["results"]] == [False, True]
+        arrays = local.post("/v1/robots/ur5_rounded/ik/batch", json={"targets": targets, "format": "arrays"})
+        assert arrays.status_code == 200, arrays.text
+        body = arrays.json()
+        assert [body["solvers"][i]["complete"] for i in body["targets"]["solver"]] == [False, True]

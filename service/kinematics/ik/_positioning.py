@@ -15,7 +15,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, SINGULARITY_TOLERANCE
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, SINGULARITY_TOLERANCE
 from ._screws import chain_motion, chain_rotation, move_point, rotate_about
 from ._structure import Geometry
 from ._subproblems import (
@@ -821,9 +821,13 @@ class SkewAxesWithSlide(Positioner):
             eliminated, circle = revolute
             if geometry.on_axis(circle, point):
                 return None  # the circle is a point: joint b does not move it
-        normal = abs(float(geometry.direction(eliminated) @ geometry.direction(slide))) <= 1e-9
+        along = abs(float(geometry.direction(eliminated) @ geometry.direction(slide)))
+        normal = along <= 1e-9
         if normal and geometry.parallel(eliminated, circle):
             return None  # planar: the height along the parallel axes never changes
+        turn = float(np.linalg.norm(np.cross(geometry.direction(eliminated), geometry.direction(circle))))
+        if 1e-9 < along <= RECOGNITION_TOLERANCE or 10 * GEOMETRY_TOLERANCE < turn <= RECOGNITION_TOLERANCE:
+            return None  # nearly special (a rounded SCARA): the idealised family answers, refined on this arm
         solver = cls(geometry, joints, point)
         solver.kinds, solver.slide, solver.revolute = kinds, slide, tuple(revolute)
         if geometry.parallel(eliminated, circle) and not normal:

@@ -10,7 +10,7 @@ import shutil
 
 import pytest
 
-from benchmarks import anchors, core, http_throughput, wrist_classes
+from benchmarks import anchors, core, http_throughput, slide_classes, wrist_classes
 
 
 def test_core_benchmark_runs_with_tiny_sizes(capsys):
@@ -30,6 +30,13 @@ def test_wrist_classes_benchmark_runs_with_tiny_sizes(capsys):
     assert "- KUKA KR 6 R900-2: offset_shoulder_parallel_elbow+spherical_wrist" in out
     assert "| random skew axes | IK, batch of 20 | core |" in out
     assert "| random wrist at the base | IK, single pose | core |" in out
+
+
+def test_slide_classes_benchmark_runs_with_tiny_sizes(capsys):
+    assert slide_classes.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "- random PRR + wrist: skew_axes_with_slide+spherical_wrist" in out
+    assert "| random RPR | IK, batch of 20 | core |" in out
 
 
 @pytest.mark.skipif(shutil.which("wrk") is None, reason="wrk (Debian package) is not installed")

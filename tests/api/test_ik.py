@@ -396,6 +396,9 @@ SKEW_7R = {"convention": "standard", "joints": [_revolute(0.1 * i, 0.3 + 0.2 * i
 SKEW_PRISMATIC = {"convention": "standard", "joints": [
     _revolute(0.1, 0.4, 0.2), _revolute(0.2, -0.7, 0.0, "prismatic"), _revolute(0.3, 1.0, 0.1),
     _revolute(0.05, 0.6, 0.0, "prismatic"), _revolute(0.1, -1.1, 0.2), _revolute(0.0, 0.3, 0.1)]}
+PLANAR_START = {"convention": "standard", "joints": [
+    _revolute(0.3, 0.0, 0.1), _revolute(0.25, 0.0, 0.0), _revolute(0.2, 0.8, 0.1),
+    _revolute(0.05, 0.6, 0.0, "prismatic"), _revolute(0.1, -1.1, 0.2), _revolute(0.0, 0.3, 0.1)]}
 NO_LENGTHS = {"convention": "standard", "joints": [_revolute(0, al, 0) for al in (0.9, -1.2, 0.5, 0.8, -0.6, 1.3)]}
 SKEW_2R = {"convention": "standard", "joints": [_revolute(0.3, 0.7, 0.1), _revolute(0.2, 0.0, 0.4)]}
 ONE_JOINT = {"convention": "modified", "joints": [_revolute(0.3, 0.7, 0.1)]}
@@ -404,7 +407,9 @@ ONE_JOINT = {"convention": "modified", "joints": [_revolute(0.3, 0.7, 0.1)]}
 REACHABLE = [
     (SKEW_7R, [0.3, -0.2, 0.9, 1.4, -0.7, 0.2, 0.5], "pose"),  # redundant: infinitely many, some returned
     (SKEW_PRISMATIC, [0.4, 0.3, -1.1, 0.2, 2.0, -0.6], "pose"),
-    (SKEW_PRISMATIC, [0.4, 0.3, -1.1, 0.2, 2.0, -0.6], "position"),  # 3 joints more than the target fixes
+    # 3 joints more than the target fixes, and joints 1–3 (planar: axes 1 ∥ 2 ∥ 3) cannot place a point alone. (The
+    # skew RPR start of SKEW_PRISMATIC can: its position targets are solved in closed form, skew_axes_with_slide.)
+    (PLANAR_START, [0.4, 0.3, -1.1, 0.2, 2.0, -0.6], "position"),
     (SKEW_2R, [1.0, -0.5], "position"),
     (ONE_JOINT, [0.7], "position"),
 ]

@@ -312,8 +312,10 @@ def _positioner_determinant(robot: Robot, q: np.ndarray, joints: tuple[int, ...]
     return np.linalg.det(np.stack(columns, axis=-1))
 
 
-def _positioner_singular_configurations(robot: Robot, plan, count: int, seed: int) -> np.ndarray:
-    """Random joint vectors moved, along one positioner joint, onto a zero of the positioner's Jacobian.
+def _positioner_singular_configurations(robot: Robot, plan, count: int, seed: int, search: int | None = None,
+                                        pool: int = 2) -> np.ndarray:
+    """Random joint vectors moved, along one positioner joint (``search``; by default the third), onto a zero of
+    the positioner's Jacobian.
 
     The 6 × 6 Jacobian about the wrist centre is block-triangular, so these are exactly the arm's singular
     configurations other than the wrist's: a stretched or folded elbow, a shoulder at its boundary, two
@@ -329,13 +331,13 @@ def _positioner_singular_configurations(robot: Robot, plan, count: int, seed: in
             return np.broadcast_to(fixed, (len(q), 3))
     else:
         joints = plan.positioner.joints
-        search = joints[2]
+        search = joints[2] if search is None else search
         home_inverse = np.linalg.inv(robot_home(robot))
 
         def centre(q):
             return (forward_kinematics(robot, q) @ home_inverse @ np.append(plan.point, 1.0))[:, :3]
     grid = np.linspace(-np.pi, np.pi, 721) * (1.0 if robot.is_revolute[search] else 1 / np.pi)
-    q = configurations(robot, 2 * count, seed)
+    q = configurations(robot, pool * count, seed)  # the first ``count`` whose Jacobian changes sign on the grid
     trial = np.repeat(q[:, None], len(grid), axis=1)
     trial[..., search] = grid
     det = _positioner_determinant(robot, trial.reshape(-1, robot.dof), joints, centre).reshape(len(q), -1)

@@ -20,6 +20,7 @@ from ._idealised import IdealisedPlan
 from ._positioning import find_positioner
 from ._reversed import ReversedPlan, reversed_geometry
 from ._screws import apply, chain_motion
+from ._slide_after_wrist import SlideAfterSphericalWrist
 from ._structure import Geometry, canonical_model, idealised
 from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
 from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
@@ -91,9 +92,12 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
     three_parallel = _three_parallel_plan(geometry)
     if three_parallel is not None:
         return three_parallel
+    slide_after_wrist = SlideAfterSphericalWrist.match(geometry)
+    if slide_after_wrist is not None:
+        return slide_after_wrist
     # a wrist at the base: the inverse chain decouples
     reverse = reversed_geometry(geometry)
-    inverse = _decoupled_pose_plan(reverse, n)
+    inverse = _decoupled_pose_plan(reverse, n) or SlideAfterSphericalWrist.match(reverse)
     if inverse is not None:
         return ReversedPlan(inverse, geometry.model.home, n)
     return _reversed_three_parallel_plan(geometry, reverse, n)

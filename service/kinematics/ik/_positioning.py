@@ -15,7 +15,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, SINGULARITY_TOLERANCE
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, SINGULARITY_TOLERANCE
 from ._screws import chain_motion, chain_rotation, move_point, rotate_about
 from ._structure import Geometry
 from ._subproblems import (
@@ -26,6 +26,7 @@ from ._subproblems import (
     subproblem_3,
     subproblem_4,
     subproblem_5,
+    subproblem_5_prismatic,
 )
 from ._types import Branch, LabelCodes, SingularFlags, Singularity, branches_from_codes
 
@@ -786,6 +787,98 @@ class Cartesian(Positioner):
                                 SingularFlags(len(targets)))
 
 
+class SkewAxesWithSlide(Positioner):
+    """Two revolute joints and one slide in any order (RRP, RPR, PRR), the axes skew: a quartic.
+
+    What is left of the 3-joint positioners with one slide once the intersecting shoulder, the
+    parallel shoulder (SCARA) and the offset-shoulder classes have taken theirs: a gantry's linear
+    axis carrying a skew two-axis head (PRR), a turret with a telescoping boom and a skew elbow
+    (RPR), two skew revolute axes with an oblique slide (RRP). One revolute joint ``a`` is
+    eliminated as in subproblem 5, by the height along its axis and the length it keeps; the other,
+    ``b``, moves the point on a circle; the slide on a line. With ``o`` points on the axes, ``v`` the
+    slide and ``w`` the point (subproblem 5 with a slide, :func:`subproblem_5_prismatic`):
+
+    * PRR: ``x − o_a − s v = R(k_a, q_a)((o_b − o_a) + R(k_b, q_b)(w − o_b))``;
+    * RRP: ``(w − o_b) + s v = R(k_b, −q_b)((o_a − o_b) + R(−k_a, q_a)(x − o_a))``;
+    * RPR: ``x − o_a = R(k_a, q_a)((o_b − o_a) + R(k_b, q_b)(w − o_b) + s v)``.
+
+    Eliminating s (linear in the height equation) leaves a trigonometric quartic in the circle's
+    angle: 4 solutions (2 when that axis is parallel to the eliminated one). A slide normal to the
+    eliminated axis splits it into a harmonic equation and a quadratic in s (still 4). When the
+    slide is normal to it and the two axes are parallel the arm is planar and does not place a
+    point: no match. No textbook names its branches, so it gives no labels.
+    """
+
+    name = "skew_axes_with_slide"
+    generic_count = 4
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "SkewAxesWithSlide | None":
+        kinds = geometry.kinds(joints) if len(joints) == 3 else ""
+        if kinds not in ("RRP", "RPR", "PRR"):
+            return None
+        point = np.asarray(point, dtype=float)
+        slide = joints[kinds.index("P")]
+        revolute = [j for j in joints if j != slide]
+        if kinds == "RRP":
+            eliminated, circle = revolute[1], revolute[0]
+            if geometry.intersection(eliminated, circle) is not None:
+                return None  # the intersecting shoulder
+        else:
+            eliminated, circle = revolute
+            if geometry.on_axis(circle, point):
+                return None  # the circle is a point: joint b does not move it
+        along = abs(float(geometry.direction(eliminated) @ geometry.direction(slide)))
+        normal = along <= 1e-9
+        if normal and geometry.parallel(eliminated, circle):
+            return None  # planar: the height along the parallel axes never changes
+        turn = float(np.linalg.norm(np.cross(geometry.direction(eliminated), geometry.direction(circle))))
+        if 1e-9 < along <= RECOGNITION_TOLERANCE or 10 * GEOMETRY_TOLERANCE < turn <= RECOGNITION_TOLERANCE:
+            return None  # nearly special (a rounded SCARA): the idealised family answers, refined on this arm
+        solver = cls(geometry, joints, point)
+        solver.kinds, solver.slide, solver.revolute = kinds, slide, tuple(revolute)
+        if geometry.parallel(eliminated, circle) and not normal:
+            solver.generic_count = 2
+        return solver
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        g, kinds = self.geometry, self.kinds
+        (a, b), p = self.revolute, self.slide  # the first and second revolute joints
+        ka, kb, oa, ob, v = g.direction(a), g.direction(b), g.point(a), g.point(b), g.direction(p)
+        if kinds == "PRR":
+            sol = subproblem_5_prismatic(ka, kb, ob - oa, self.point - ob, targets - oa, -v, slide_turns=False)
+            qa, qb = sol.phi, sol.theta
+        elif kinds == "RRP":
+            sol = subproblem_5_prismatic(kb, -ka, oa - ob, targets - oa, self.point - ob, v, slide_turns=False)
+            qa, qb = sol.theta, -sol.phi
+        else:
+            sol = subproblem_5_prismatic(ka, kb, ob - oa, self.point - ob, targets - oa, v, slide_turns=True)
+            qa, qb = sol.phi, sol.theta
+        # a free turn (its vector on its axis) takes the reference value: the others do not depend on it
+        free_joint = b if kinds == "RRP" else a
+        start = {j: (0.0 if reference is None else float(reference[j])) for j in (a, b)}
+        if sol.phi_free.any():
+            if kinds == "RRP":
+                qb = np.where(sol.phi_free, start[b], qb)
+            else:
+                qa = np.where(sol.phi_free, start[a], qa)
+        if sol.degenerate.any():  # RRP only: the target on axis a
+            qa = np.where(sol.degenerate[:, None], start[a], qa)
+        values = {a: qa, b: qb, p: sol.s}
+        joints = np.stack([values[j] for j in self.joints], axis=-1)
+        singular = SingularFlags(len(targets))
+        if kinds == "RRP":
+            _flag_rows(sol.degenerate, Singularity("shoulder", (a,), "free", "the point is on the first joint's "
+                                                   "axis; joint 1 is set to the reference value (or 0)"), singular)
+        _flag_rows(sol.phi_free.any(axis=1), Singularity("shoulder" if free_joint == self.joints[0] else "elbow",
+                                                         (free_joint,), "free",
+                                                         f"the point is on axis {free_joint + 1}; that joint is set "
+                                                         "to the reference value (or 0)"), singular)
+        _flag_rows(sol.merged, Singularity("positioner", self.joints, "boundary", "two solutions of the "
+                                           "positioner meet: the point is on the edge of the workspace"), singular)
+        return PositionerResult(joints, sol.valid & sol.exact, singular)
+
+
 def _quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale: float):
     """Real roots of A t² + B t + C = 0 per row: (N, 2) roots, validity, and merged flags."""
     A = np.broadcast_to(np.asarray(A, dtype=float), B.shape)
@@ -810,7 +903,7 @@ def _quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale:
 
 
 POSITIONERS = (IntersectingShoulder, ParallelShoulder, OneRevoluteTwoPrismatic, Cartesian, PlanarTwoLink,
-               OffsetShoulderParallelElbow, OffsetShoulderIntersectingElbow, SkewAxes)
+               OffsetShoulderParallelElbow, OffsetShoulderIntersectingElbow, SkewAxes, SkewAxesWithSlide)
 
 
 def find_positioner(geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> Positioner | None:

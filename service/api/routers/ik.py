@@ -174,8 +174,12 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
                                ordering=ordering, max_equivalents=body.max_equivalents)
         status[rows], truncated[rows] = chosen.status, chosen.truncated
         trimmed[rows], available[rows] = chosen.trimmed, chosen.available
-        solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
-                                        "time_budget_exhausted": False, "free_joints": arrays.free_joints})
+        for promise in (True, False):  # the general 6R solver may not promise every target complete
+            part = arrays.complete == promise
+            if part.any():
+                solver[rows[part]] = _index(solvers, {
+                    "method": "analytic", "structure": arrays.structure, "complete": promise,
+                    "time_budget_exhausted": False, "free_joints": arrays.free_joints})
         unreachable = unreachable_details(robot, arrays, matrices[rows], constrained, reference)
         for local in set(unreachable) | set(chosen.notes):
             detail[rows[local]] = " ".join(filter(None, [unreachable.get(local), *chosen.notes.get(local, [])])) or None

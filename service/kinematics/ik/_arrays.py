@@ -52,6 +52,9 @@ class IKArrays:
         The kinematic family that solved it.
     free_joints : list of int
         Joints the target does not determine, set to the reference value (or 0).
+    complete : ndarray of bool, shape (N,)
+        Whether the family promises that these are every solution of the target (always, for the closed
+        forms; the general 6R solver says where its algebra does, see :mod:`._general_6r`).
     """
 
     joints: np.ndarray
@@ -63,6 +66,7 @@ class IKArrays:
     singularities: SingularFlags
     structure: str
     free_joints: list[int]
+    complete: np.ndarray
 
 
 def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
@@ -155,7 +159,8 @@ def _concatenated(parts: list[IKArrays]) -> IKArrays:
         orientation=np.concatenate([p.orientation for p in parts]),
         labels={name: (values, np.concatenate([p.labels[name][1] for p in parts]))
                 for name, (values, _) in first.labels.items()},
-        singularities=singularities, structure=first.structure, free_joints=first.free_joints)
+        singularities=singularities, structure=first.structure, free_joints=first.free_joints,
+        complete=np.concatenate([p.complete for p in parts]))
 
 
 def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
@@ -183,12 +188,16 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     else:
         order = np.argsort(~kept, axis=1, kind="stable")
     count = kept.sum(axis=1)
+    complete = np.ones(n_targets, dtype=bool)
+    if candidates.complete is not None:  # the solver's promise holds only if every valid slot gave a solution
+        complete = candidates.complete & (count == candidates.valid.sum(axis=1))
     take = (np.arange(n_targets)[:, None], order)
     return IKArrays(
         joints=joints[take], valid=kept[take], count=count,
         position=position[take], orientation=orientation[take],
         labels={name: (values, codes.reshape(n_targets, m)[take]) for name, (values, codes) in labels.items()},
-        singularities=candidates.singularities, structure=plan.structure, free_joints=list(plan.free_joints))
+        singularities=candidates.singularities, structure=plan.structure, free_joints=list(plan.free_joints),
+        complete=complete)
 
 
 def _polish_near(robot: Robot, joints: np.ndarray, targets: np.ndarray, position: np.ndarray,

@@ -15,6 +15,7 @@ import numpy as np
 from .._forward import link_frames, screw_model
 from .._robot import Robot
 from ._decoupled import DecoupledPlan
+from ._general_6r import General6RPlan
 from ._positioning import find_positioner
 from ._screws import apply, chain_motion
 from ._structure import Geometry
@@ -74,7 +75,7 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
         if k and positioner is None:
             continue
         return DecoupledPlan(positioner, wrist, point, model.home, n)
-    return ThreeParallelPlan.match(geometry)
+    return ThreeParallelPlan.match(geometry) or General6RPlan.match(geometry)
 
 
 def _position_plan(geometry: Geometry, n: int, reference: np.ndarray | None) -> Plan | None:

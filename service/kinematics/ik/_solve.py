@@ -67,6 +67,7 @@ def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
     joints, position, orientation = arrays.joints, arrays.position.tolist(), arrays.orientation.tolist()
     labels = [(name, values, codes.tolist()) for name, (values, codes) in arrays.labels.items()]
     free_joints = arrays.free_joints
+    complete = arrays.complete.tolist()
     results = []
     for row, count in enumerate(counts):
         if count:
@@ -74,11 +75,11 @@ def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
                                                    if codes[row][s] >= 0},
                                   position[row][s], orientation[row][s]) for s in range(count)]
             results.append(IKResult(status="ok", solutions=solutions, method="analytic",
-                                    structure=arrays.structure, complete=True,
+                                    structure=arrays.structure, complete=complete[row],
                                     singularities=arrays.singularities[row], free_joints=list(free_joints)))
         else:
             results.append(IKResult(status="unreachable", solutions=[], method="analytic",
-                                    structure=arrays.structure, complete=True, singularities=[],
+                                    structure=arrays.structure, complete=complete[row], singularities=[],
                                     free_joints=list(free_joints), detail=details[row]))
     return results
 

@@ -95,12 +95,18 @@ class Candidates:
     the labels of each slot, per target: a list of N lists of m dicts (built
     lazily by the family's labeller). ``singularities`` gives, per target, the
     singular conditions met.
+
+    ``complete`` (N,), when a solver gives it, says which targets it can
+    promise every solution for *provided* each valid slot then verifies as a
+    distinct solution (the verification checks that part); None means every
+    target is complete, as for the closed-form families.
     """
 
     joints: np.ndarray
     valid: np.ndarray
     branches: list[list[Branch]]
     singularities: SingularFlags
+    complete: np.ndarray | None = None
 
 
 @dataclass(frozen=True)

@@ -73,11 +73,27 @@ _HALF2 = np.kron(_HALF, _HALF)  # (9 trig products, 9 power products)
 _SHIFTS = (0.0, 1.0, -1.3, 2.1, -2.6, 0.45)
 
 
+def _cross_matrix(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """[k]× and [k]×² for a unit axis k, memoised by value (an arm has a few axes)."""
+    key = tuple(k.tolist())
+    pair = _CROSS.get(key)
+    if pair is None:
+        K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+        pair = (K, K @ K)
+        if len(_CROSS) < 4096:
+            _CROSS[key] = pair
+    return pair
+
+
+_CROSS: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray]] = {}
+_EYE3 = np.eye(3)
+
+
 def _rodrigues(k: np.ndarray, q: np.ndarray) -> np.ndarray:
     """R(k, q) for q of shape (...,): (..., 3, 3)."""
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+    K, KK = _cross_matrix(k)
     q = np.asarray(q, dtype=float)[..., None, None]
-    return np.eye(3) + np.sin(q) * K + (1.0 - np.cos(q)) * (K @ K)
+    return _EYE3 + np.sin(q) * K + (1.0 - np.cos(q)) * KK
 
 
 def _motion(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -90,11 +106,18 @@ def _motion(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
     return T
 
 
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b along the last axis (np.cross without its axis bookkeeping)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
 def _fourteen(p: np.ndarray, l: np.ndarray) -> np.ndarray:
     """Raghavan and Roth's 14 quantities of a point p and unit direction l (..., 3): (..., 14)."""
     pp = np.einsum("...i,...i->...", p, p)[..., None]
     pl = np.einsum("...i,...i->...", p, l)[..., None]
-    return np.concatenate([p, l, pp, pl, np.cross(p, l), l * pp - 2.0 * p * pl], axis=-1)
+    return np.concatenate([p, l, pp, pl, _cross(p, l), l * pp - 2.0 * p * pl], axis=-1)
 
 
 class _Arrangement:
@@ -267,45 +290,52 @@ def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarr
     for slot, joint in enumerate((a, a + 1, a + 2, a + 3, *arr.rhs)):
         q[..., joint] = chain[..., slot]
     d = a + 3
-    R_before = np.eye(3)
-    for j in range(d):
+    R_before = _rodrigues(arr.directions[0], q[..., 0])
+    for j in range(1, d):
         R_before = R_before @ _rodrigues(arr.directions[j], q[..., j])
-    R_after = np.eye(3)
-    for j in range(d + 1, 6):
-        R_after = R_after @ _rodrigues(arr.directions[j], q[..., j])
-    R_d = np.swapaxes(R_before, -1, -2) @ A[:, None, :3, :3] @ np.swapaxes(R_after, -1, -2)
+    R_d = np.swapaxes(R_before, -1, -2) @ A[:, None, :3, :3]
+    if d < 5:
+        R_after = _rodrigues(arr.directions[5], q[..., 5])
+        for j in range(4, d, -1):
+            R_after = _rodrigues(arr.directions[j], q[..., j]) @ R_after
+        R_d = R_d @ np.swapaxes(R_after, -1, -2)
     k = arr.directions[d]
-    u = np.cross(k, np.eye(3)[np.argmin(np.abs(k))])
+    u = _cross(k, np.eye(3)[np.argmin(np.abs(k))])
     u /= np.linalg.norm(u)
     turned = R_d @ u
-    return np.arctan2(turned @ np.cross(k, u), turned @ u)
+    return np.arctan2(turned @ _cross(k, u), turned @ u)
 
 
 def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q: np.ndarray,
             steps: int = NEWTON_STEPS) -> np.ndarray:
-    """Newton's method on G_1 ⋯ G_6 = A for candidates q (K, 6) and targets A (K, 4, 4), normalised lengths."""
+    """Newton's method on G_1 ⋯ G_6 = A for candidates q (K, 6) and targets A (K, 4, 4), normalised lengths.
+
+    Stops once every candidate's error twist is below 1e-14 (roots come from the eigenproblem to about 1e-12,
+    so one step usually suffices); singular candidates get a tiny damping instead of a failed solve.
+    """
     q = q.copy()
-    for _ in range(steps):
-        T = np.broadcast_to(np.eye(4), q.shape[:-1] + (4, 4))
-        axes = np.empty(q.shape[:-1] + (6, 3))
-        through = np.empty(q.shape[:-1] + (6, 3))
+    R_A, p_A = A_targets[:, :3, :3], A_targets[:, :3, 3]
+    for _ in range(steps + 1):
+        R = np.broadcast_to(_EYE3, q.shape[:-1] + (3, 3))
+        p = np.zeros(q.shape[:-1] + (3,))
+        axes = np.empty(q.shape + (3,))
+        through = np.empty(q.shape + (3,))
         for j in range(6):
-            axes[:, j] = T[:, :3, :3] @ directions[j]
-            through[:, j] = T[:, :3, :3] @ points[j] + T[:, :3, 3]
-            T = T @ _motion(directions[j], points[j], q[:, j])
+            axes[:, j] = R @ directions[j]
+            through[:, j] = R @ points[j] + p
+            turn = _rodrigues(directions[j], q[:, j])
+            p = p + (R @ (points[j] - turn @ points[j])[..., None])[..., 0]
+            R = R @ turn
         # spatial error twist (ω, v): A ≈ exp([ξ]) T
-        R_err = A_targets[:, :3, :3] @ np.swapaxes(T[:, :3, :3], -1, -2)
+        R_err = R_A @ np.swapaxes(R, -1, -2)
         omega = 0.5 * np.stack([R_err[:, 2, 1] - R_err[:, 1, 2], R_err[:, 0, 2] - R_err[:, 2, 0],
                                 R_err[:, 1, 0] - R_err[:, 0, 1]], axis=-1)
-        v = A_targets[:, :3, 3] - T[:, :3, 3] - np.cross(omega, T[:, :3, 3])
-        J = np.concatenate([axes, np.cross(through, axes)], axis=-1)  # (K, 6 joints, 6): rows ω, −ω × p
-        error = np.concatenate([omega, v], axis=-1)
-        if np.abs(error).max() < 1e-15:
+        error = np.concatenate([omega, p_A - p - _cross(omega, p)], axis=-1)  # (K, 6)
+        if _ == steps or np.abs(error).max() < 1e-14:
             break
-        Jm = np.swapaxes(J, -1, -2)  # (K, 6 twist rows, 6 joints)
-        JtJ = np.swapaxes(Jm, -1, -2) @ Jm + 1e-14 * np.eye(6)
-        step = np.linalg.solve(JtJ, np.einsum("kji,kj->ki", Jm, error)[..., None])[..., 0]
-        q += step
+        J = np.concatenate([axes, _cross(through, axes)], axis=-1)  # (K, 6 joints, 6): rows ω, p × ω
+        JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6)  # (K, joints, joints) = Jᵀ J of the twist map
+        q += np.linalg.solve(JJt, (J @ error[..., None]))[..., 0]
     return q
 
 
@@ -371,14 +401,16 @@ class General6RPlan:
         targets[:, :3, 3] /= self.scale
         A = targets @ self.home_inverse
         roots = _solve_arrangement(self.arrangement, A)
-        # slots: the 16 roots nearest the real axis; real ones are candidates
-        order = np.argsort(roots.imaginary, axis=1, kind="stable")[:, :16]
+        # slots: the real roots (at most 16 when the answer is complete), nearest the real axis first
+        real = roots.imaginary < REAL_ROOT
+        slots = int(min(max(real.sum(axis=1).max(initial=0), 1), 16))
+        order = np.argsort(roots.imaginary, axis=1, kind="stable")[:, :slots]
         take = (np.arange(n)[:, None], order)
         imaginary = roots.imaginary[take]
         joints = roots.joints[take]
         valid = imaginary < REAL_ROOT
         ambiguous = ((roots.imaginary >= REAL_ROOT) & (roots.imaginary < COMPLEX_ROOT)).any(axis=1)
-        too_many = (roots.imaginary < REAL_ROOT).sum(axis=1) > 16
+        too_many = real.sum(axis=1) > 16
         rows, slots = np.nonzero(valid)
         if len(rows):
             joints[rows, slots] = _newton(self.directions, self.points, A[rows], joints[rows, slots])

@@ -36,7 +36,7 @@ Back-substitution
 Completeness
     A target's answer is complete only when the algebra accounts for every solution: the right-hand
     coefficients have full rank 8, the leading matrix is well conditioned, no eigenvalue is ambiguous (an
-    imaginary part between :data:`REAL_ROOT` and :data:`COMPLEX_ROOT` in angle: a root pair about to merge or
+    imaginary part within :data:`AMBIGUITY_FACTOR` times its first-order error bound: a root pair about to merge or
     split), at most 16 roots are real, and (checked after verification) every real root gave one distinct
     verified solution. Anything else is answered with ``complete: false``.
 
@@ -52,10 +52,11 @@ from ._screws import invert
 from ._structure import Geometry
 from ._types import Branch, Candidates, LabelCodes, SingularFlags
 
-#: A root is taken as real when the imaginary part of its angle is below this (radians).
-REAL_ROOT = 1e-6
-#: A root whose angle has an imaginary part between REAL_ROOT and this is ambiguous: the answer is incomplete.
-COMPLEX_ROOT = 1e-3
+#: A complex root whose angle's imaginary part is within this many times its error bound of the real axis
+#: (a pair about to become two real roots, or two real roots split by rounding) is ambiguous.
+AMBIGUITY_FACTOR = 100.0
+#: Roots y with |1 + y²| below this are the spurious ones at ±i.
+SPURIOUS_RADIUS = 1e-2
 #: Smallest reciprocal condition number of the leading matrix and of the right-hand coefficients accepted.
 CONDITION_FLOOR = 1e-9
 #: Newton steps on the FK for every root.
@@ -203,11 +204,18 @@ def _trig2(qb: np.ndarray, qc: np.ndarray) -> np.ndarray:
 
 
 class _Roots:
-    """The roots of one arrangement for N targets: joint candidates (N, 24, 6) in the robot's order, the
-    imaginary part of each root's angle (N, 24), and per-target conditioning (N,)."""
+    """The real roots of one arrangement for N targets.
 
-    def __init__(self, joints: np.ndarray, imaginary: np.ndarray, conditioned: np.ndarray) -> None:
-        self.joints, self.imaginary, self.conditioned = joints, imaginary, conditioned
+    ``joints`` (N, m, 6) in the robot's order and ``valid`` (N, m): the m slots hold each target's real roots
+    (m is the largest count in the batch, at least 1). ``real_count`` (N,) counts them before the cut to 16;
+    ``ambiguous`` (N,) marks targets with a root neither clearly real nor clearly complex; ``conditioned``
+    (N,) that the right-hand coefficients and the leading matrix were well conditioned.
+    """
+
+    def __init__(self, joints: np.ndarray, valid: np.ndarray, real_count: np.ndarray, ambiguous: np.ndarray,
+                 conditioned: np.ndarray) -> None:
+        self.joints, self.valid, self.real_count = joints, valid, real_count
+        self.ambiguous, self.conditioned = ambiguous, conditioned
 
 
 def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
@@ -254,24 +262,45 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     with np.errstate(divide="ignore", invalid="ignore"):  # a spurious root exactly at ±i
         angle = 2.0 * np.arctan(y.astype(complex))
     imaginary = np.nan_to_num(np.abs(angle.imag), nan=np.inf)
-    qa = shift[:, None] + angle.real
+    real = y.imag == 0.0  # LAPACK returns the real eigenvalues of a real matrix with no imaginary part
+    real_count = real.sum(axis=1)
+    # first-order error bound of each eigenvalue (backward-stable QR: ~ n ε ‖M‖ times its condition number,
+    # from the left eigenvectors, the rows of V⁻¹), carried to the angle: dq = 2 dy / |1 + y²|
+    left_vectors = np.linalg.inv(vectors)
+    condition = np.linalg.norm(left_vectors, axis=2) * np.linalg.norm(vectors, axis=1)
+    size = np.linalg.norm(companions, axis=(1, 2))[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bound = 2.0 * 24 * np.finfo(float).eps * size * condition / np.abs(1.0 + y * y)
+    # the spurious roots at ±i (of the (1 + x²) factors, a defective quadruple pair, so rounding spreads them
+    # by ~ε^¼) are far from real and never ambiguous
+    spurious = np.abs(1.0 + y * y) < SPURIOUS_RADIUS
+    near = ~real & ~spurious & (imaginary <= AMBIGUITY_FACTOR * np.nan_to_num(bound, nan=np.inf))
+    ambiguous = near.any(axis=1)
+    # back-substitute the real and the ambiguous roots only: m slots, nearest the real axis first
+    real = real | near
+    m = int(min(max(real.sum(axis=1).max(initial=0), 1), 16))
+    order = np.argsort(imaginary, axis=1, kind="stable")[:, :m]
+    take = (np.arange(n)[:, None], order)
+    valid = real[take]
+    y, qa = y[take], shift[:, None] + angle.real[take]
+    vectors = np.take_along_axis(vectors, order[:, None, :], axis=2)  # (N, 24, m)
     # monomials x_b^i x_c^j (i ≤ 3, j ≤ 2) of each root, from the block of the eigenvector that is not small
     top, bottom = vectors[:, :12, :], vectors[:, 12:, :]
-    monomials = np.where((np.abs(y) <= 1.0)[:, None, :], top, bottom)  # (N, 12, 24)
-    monomials = np.swapaxes(monomials, 1, 2).reshape(n, 24, 4, 3)
+    monomials = np.where((np.abs(y) <= 1.0)[:, None, :], top, bottom)  # (N, 12, m)
+    monomials = np.swapaxes(monomials, 1, 2).reshape(n, m, 4, 3)
     qb = _ratio_angle(monomials[:, :, 1:, :], monomials[:, :, :-1, :])
     qc = _ratio_angle(monomials[:, :, :, 1:], monomials[:, :, :, :-1])
     # right-hand monomials by least squares, then q_e, q_f from the linear ones
-    left = np.einsum("ntk,kem,ntm->nte", _trig(qa), arr.left, _trig2(qb, qc))  # (N, 24, 14)
+    left = np.einsum("ntk,kem,ntm->nte", _trig(qa), arr.left, _trig2(qb, qc))  # (N, m, 14)
     pinv = np.einsum("nji,nj,nej->nie", Vt, 1.0 / sigma, U[:, :, :8])  # (N, 8, 14)
-    mono = np.einsum("nie,nte->nti", pinv, left - b1[:, None, :])  # (N, 24, 8): index m − 1 of 3i + j
+    mono = np.einsum("nie,nte->nti", pinv, left - b1[:, None, :])  # (N, m, 8): index m − 1 of 3i + j
     qe = np.arctan2(mono[..., 5], mono[..., 2])  # s_e (m = 6), c_e (m = 3)
     qf = np.arctan2(mono[..., 1], mono[..., 0])  # s_f (m = 2), c_f (m = 1)
     chain = np.stack([qa, qb, qc, np.zeros_like(qa), qe, qf], axis=-1)  # joints (a, b, c, d, e, f)
     chain[..., 3] = _last_joint(arr, chain_A, chain)
     joints = np.empty_like(chain)
     joints[..., arr.order] = chain
-    return _Roots(joints, imaginary, rank_ok & lead_ok)
+    return _Roots(joints, valid, real_count, ambiguous, rank_ok & lead_ok)
 
 
 def _ratio_angle(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
@@ -380,7 +409,7 @@ class General6RPlan:
                 if not roots.conditioned.all():
                     continue
                 gap = np.abs(np.angle(np.exp(1j * (roots.joints - q[:, None, :])))).max(axis=-1)
-                gap = np.where(roots.imaginary < REAL_ROOT, gap, np.inf)
+                gap = np.where(roots.valid, gap, np.inf)
                 error = float(gap.min(axis=1).max())
                 if error < best_error:
                     best, best_error = arrangement, error
@@ -401,20 +430,11 @@ class General6RPlan:
         targets[:, :3, 3] /= self.scale
         A = targets @ self.home_inverse
         roots = _solve_arrangement(self.arrangement, A)
-        # slots: the real roots (at most 16 when the answer is complete), nearest the real axis first
-        real = roots.imaginary < REAL_ROOT
-        slots = int(min(max(real.sum(axis=1).max(initial=0), 1), 16))
-        order = np.argsort(roots.imaginary, axis=1, kind="stable")[:, :slots]
-        take = (np.arange(n)[:, None], order)
-        imaginary = roots.imaginary[take]
-        joints = roots.joints[take]
-        valid = imaginary < REAL_ROOT
-        ambiguous = ((roots.imaginary >= REAL_ROOT) & (roots.imaginary < COMPLEX_ROOT)).any(axis=1)
-        too_many = real.sum(axis=1) > 16
+        joints, valid = roots.joints, roots.valid
         rows, slots = np.nonzero(valid)
         if len(rows):
             joints[rows, slots] = _newton(self.directions, self.points, A[rows], joints[rows, slots])
-        complete = roots.conditioned & ~ambiguous & ~too_many
+        complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
         return Candidates(joints, valid, [], SingularFlags(n), complete=complete)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:

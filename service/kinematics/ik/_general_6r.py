@@ -209,13 +209,14 @@ class _Roots:
     ``joints`` (N, m, 6) in the robot's order and ``valid`` (N, m): the m slots hold each target's real roots
     (m is the largest count in the batch, at least 1). ``real_count`` (N,) counts them before the cut to 16;
     ``ambiguous`` (N,) marks targets with a root neither clearly real nor clearly complex; ``conditioned``
-    (N,) that the right-hand coefficients and the leading matrix were well conditioned.
+    (N,) that the right-hand coefficients and the leading matrix were well conditioned; ``shift`` (N,) the origin
+    φ of the half-angle used for each target.
     """
 
     def __init__(self, joints: np.ndarray, valid: np.ndarray, real_count: np.ndarray, ambiguous: np.ndarray,
-                 conditioned: np.ndarray) -> None:
+                 conditioned: np.ndarray, shift: np.ndarray) -> None:
         self.joints, self.valid, self.real_count = joints, valid, real_count
-        self.ambiguous, self.conditioned = ambiguous, conditioned
+        self.ambiguous, self.conditioned, self.shift = ambiguous, conditioned, shift
 
 
 def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
@@ -252,7 +253,11 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
             good[:] = True
         rows, S, lead = rows[good], S[good], lead[good]
         lead_ok[rows] = (singular[good, -1] > CONDITION_FLOOR * singular[good, 0])
-        tail = np.linalg.solve(lead, np.concatenate([S[:, 0], S[:, 1]], axis=2))  # (R, 12, 24)
+        rhs = np.concatenate([S[:, 0], S[:, 1]], axis=2)
+        if phi == _SHIFTS[-1] and not lead_ok[rows].all():  # no shift helped: least squares, marked incomplete
+            tail = np.linalg.pinv(lead) @ rhs
+        else:
+            tail = np.linalg.solve(lead, rhs)  # (R, 12, 24)
         companions[rows, :12, 12:] = np.eye(12)
         companions[rows, 12:, :12] = -tail[:, :, :12]
         companions[rows, 12:, 12:] = -tail[:, :, 12:]
@@ -292,7 +297,8 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     qc = _ratio_angle(monomials[:, :, :, 1:], monomials[:, :, :, :-1])
     # right-hand monomials by least squares, then q_e, q_f from the linear ones
     left = np.einsum("ntk,kem,ntm->nte", _trig(qa), arr.left, _trig2(qb, qc))  # (N, m, 14)
-    pinv = np.einsum("nji,nj,nej->nie", Vt, 1.0 / sigma, U[:, :, :8])  # (N, 8, 14)
+    inverse_sigma = np.where(sigma > CONDITION_FLOOR * sigma[:, :1], 1.0 / np.maximum(sigma, 1e-300), 0.0)
+    pinv = np.einsum("nji,nj,nej->nie", Vt, inverse_sigma, U[:, :, :8])  # (N, 8, 14)
     mono = np.einsum("nie,nte->nti", pinv, left - b1[:, None, :])  # (N, m, 8): index m − 1 of 3i + j
     qe = np.arctan2(mono[..., 5], mono[..., 2])  # s_e (m = 6), c_e (m = 3)
     qf = np.arctan2(mono[..., 1], mono[..., 0])  # s_f (m = 2), c_f (m = 1)
@@ -300,7 +306,7 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     chain[..., 3] = _last_joint(arr, chain_A, chain)
     joints = np.empty_like(chain)
     joints[..., arr.order] = chain
-    return _Roots(joints, valid, real_count, ambiguous, rank_ok & lead_ok)
+    return _Roots(joints, valid, real_count, ambiguous, rank_ok & lead_ok, shift)
 
 
 def _ratio_angle(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:

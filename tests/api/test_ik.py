@@ -331,7 +331,7 @@ def test_the_spherical_wrist_places_its_tool_point_with_two_solutions(client):
 # The numeric fallback
 # --------------------------------------------------------------------------
 
-#: a 6R arm with skew axes (no two axes parallel or intersecting): no analytic family applies
+#: a 6R arm with skew axes (no two axes parallel or intersecting): no closed form, the general 6R solver
 SKEW = dict(a=np.array([0.1, 0.5, 0.2, 0.05, 0.1, 0.03]), alpha=np.array([0.5, -0.9, 1.1, 0.7, -1.3, 0.4]),
             d=np.array([0.2, 0.1, -0.15, 0.3, 0.05, 0.1]))
 SKEW_ROBOT = {"convention": "standard", "angle_unit": "rad",
@@ -347,12 +347,12 @@ def _inline_ik(client, robot: dict, target: dict, **options):
 
 
 @pytest.mark.parametrize("seed", range(5))
-def test_numeric_fallback_for_an_arm_no_family_covers(client, seed):
+def test_a_skew_6r_arm_gets_every_solution_from_the_general_solver(client, seed):
     q = np.random.default_rng(seed).uniform(-np.pi, np.pi, 6)
     T = dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], q)
     result = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()})
     assert result["status"] == "ok"
-    assert result["solver"] == {"method": "numeric", "structure": "general", "complete": False,
+    assert result["solver"] == {"method": "analytic", "structure": "general_6r", "complete": True,
                                 "time_budget_exhausted": False}
     solutions = joints_of(result)
     for solution in result["solutions"]:  # every solution passes an FK check independent of the service
@@ -370,17 +370,19 @@ def test_numeric_fallback_for_an_arm_no_family_covers(client, seed):
 def test_numeric_time_budget_is_respected_and_reported(client):
     import time
 
-    T = dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], [0.3, -1.2, 0.8, 2.0, -0.4, 1.1])
+    # an RPRPRR arm with skew axes: no analytic family, so the numeric search answers
+    T = _fk_pose(client, SKEW_PRISMATIC, [0.3, 0.4, 0.8, 0.2, -0.4, 1.1])
+    scale = _scale(SKEW_PRISMATIC)
     start = time.perf_counter()
-    cut = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()}, numeric={"starts": 2000, "time_budget_ms": 5})
+    cut = _inline_ik(client, SKEW_PRISMATIC, {"matrix": T.tolist()}, numeric={"starts": 2000, "time_budget_ms": 5})
     elapsed = time.perf_counter() - start
     assert cut["solver"]["method"] == "numeric" and cut["solver"]["complete"] is False
     assert cut["solver"]["time_budget_exhausted"] is True
     assert "time budget" in cut["detail"]
     assert elapsed < 2.0  # 5 ms of search plus one iteration, polishing and HTTP; not the whole 2,000-start search
     for solution in cut["solutions"]:  # what was found before the cut is still verified
-        assert np.abs(dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], solution["joints"]) - T).max() < 1e-9 * SKEW_SCALE
-    full = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
+        assert np.abs(_fk_pose(client, SKEW_PRISMATIC, solution["joints"]) - T).max() < 1e-9 * scale
+    full = _inline_ik(client, SKEW_PRISMATIC, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
     assert full["solver"]["time_budget_exhausted"] is False and full["status"] == "ok"
 
 

@@ -298,3 +298,49 @@ def test_general_arms_are_routed_to_the_general_solver_with_no_labels():
     q = np.random.default_rng(1).uniform(-np.pi, np.pi, 6)
     result = solve_ik(robot, forward_kinematics(robot, q))
     assert result.method == "analytic" and all(s.branch == {} for s in result.solutions)
+
+
+def test_on_pieper_arms_the_elimination_agrees_with_the_closed_forms():
+    """The router keeps PUMA- and UR5-type arms away, but the elimination itself (in the arrangement the plan
+    picks) still solves them: its solution sets must equal the closed-form families' — an independent check of
+    both."""
+    rng = np.random.default_rng(4)
+    compared = 0
+    for entry in CATALOGUE.entries():
+        robot = entry.robot
+        if robot.dof != 6 or not robot.is_revolute.all():
+            continue
+        closed = plan_for(robot, constrain_orientation=True, reference=None)
+        general = General6RPlan(geometry_of(robot))
+        if closed is None or general.arrangement is None:
+            continue
+        q = rng.uniform(-np.pi, np.pi, (40, 6))
+        targets = forward_kinematics(robot, q)
+        mine = solve_ik_arrays(robot, targets, plan=general)
+        theirs = solve_ik_arrays(robot, targets, plan=closed)
+        for row in range(len(q)):
+            ours, textbook = mine.joints[row, :mine.count[row]], theirs.joints[row, :theirs.count[row]]
+            assert len(ours) == len(textbook), (robot.name, row)
+            assert all(found(robot, ours, s, 1e-7) for s in textbook), (robot.name, row)
+        compared += 1
+    assert compared >= 4  # PUMA 560 in three conventions and the UR5 (the Spong elbows: no arrangement fits)
+
+
+def test_unreachable_is_a_promise_the_multistart_search_cannot_break():
+    """Random targets within the arm's reach sphere: where the answer is `unreachable` and complete, a dense
+    search finds no solution either; where it is not, the search's solutions are among ours."""
+    rng = np.random.default_rng(21)
+    robot = random_arm(rng, "modified")
+    reach = robot.characteristic_length
+    unreachable = 0
+    for _ in range(8):
+        target = np.eye(4)
+        target[:3, :3] = _rotation(rng)
+        target[:3, 3] = robot.world_T_base[:3, 3] + rng.uniform(-0.5, 0.5, 3) * reach
+        result = solve_ik(robot, target)
+        assert result.structure == "general_6r" and result.complete
+        oracle = multistart_solutions(robot, target, 600, rng)
+        mine = np.array([s.joints for s in result.solutions]).reshape(-1, 6)
+        assert all(found(robot, mine, s, 1e-6) for s in oracle)
+        unreachable += result.status == "unreachable"
+    assert 0 < unreachable < 8  # both kinds of answer were put to the test

@@ -30,7 +30,7 @@ Conditioning
     chain read forwards with q_a = q_3, q_2, q_1 or backwards with q_a = q_4, q_5, q_6) the plan keeps the one
     that recovers random configurations most accurately.
 Back-substitution
-    q_b, q_c from the eigenvector (ratios of its largest entries, so x → ∞ is just an angle of π); q_e, q_f from
+    q_b, q_c from the eigenvector (runs of three powers give cos and sin, so x → ∞ is just an angle of π); q_e, q_f from
     the linear right-hand monomials; q_d from the remaining rotation. Every root is then polished by Newton's
     method on the screw model's FK, and the shared verification (FK residual, merging) decides what is kept.
 Completeness
@@ -266,7 +266,7 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     y, vectors = np.linalg.eig(companions)  # (N, 24), (N, 24, 24)
     with np.errstate(divide="ignore", invalid="ignore"):  # a spurious root exactly at ±i
         angle = 2.0 * np.arctan(y.astype(complex))
-    imaginary = np.nan_to_num(np.abs(angle.imag), nan=np.inf)
+        imaginary = np.abs(angle.imag)  # NaN at exactly ±i: never real, never ambiguous, sorted last
     real = y.imag == 0.0  # LAPACK returns the real eigenvalues of a real matrix with no imaginary part
     real_count = real.sum(axis=1)
     # first-order error bound of each eigenvalue (backward-stable QR: ~ n ε ‖M‖ times its condition number,
@@ -279,7 +279,8 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     # the spurious roots at ±i (of the (1 + x²) factors, a defective quadruple pair, so rounding spreads them
     # by ~ε^¼) are far from real and never ambiguous
     spurious = np.abs(1.0 + y * y) < SPURIOUS_RADIUS
-    near = ~real & ~spurious & (imaginary <= AMBIGUITY_FACTOR * np.nan_to_num(bound, nan=np.inf))
+    with np.errstate(invalid="ignore"):
+        near = ~real & ~spurious & (imaginary <= AMBIGUITY_FACTOR * bound)
     ambiguous = near.any(axis=1)
     # back-substitute the real and the ambiguous roots only: m slots, nearest the real axis first
     real = real | near
@@ -293,8 +294,8 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     top, bottom = vectors[:, :12, :], vectors[:, 12:, :]
     monomials = np.where((np.abs(y) <= 1.0)[:, None, :], top, bottom)  # (N, 12, m)
     monomials = np.swapaxes(monomials, 1, 2).reshape(n, m, 4, 3)
-    qb = _ratio_angle(monomials[:, :, 1:, :], monomials[:, :, :-1, :])
-    qc = _ratio_angle(monomials[:, :, :, 1:], monomials[:, :, :, :-1])
+    qb = _monomial_angle(monomials)
+    qc = _monomial_angle(np.swapaxes(monomials, -1, -2))
     # right-hand monomials by least squares, then q_e, q_f from the linear ones
     left = np.einsum("ntk,kem,ntm->nte", _trig(qa), arr.left, _trig2(qb, qc))  # (N, m, 14)
     inverse_sigma = np.where(sigma > CONDITION_FLOOR * sigma[:, :1], 1.0 / np.maximum(sigma, 1e-300), 0.0)
@@ -309,13 +310,18 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     return _Roots(joints, valid, real_count, ambiguous, rank_ok & lead_ok, shift)
 
 
-def _ratio_angle(numerator: np.ndarray, denominator: np.ndarray) -> np.ndarray:
-    """2 atan(x) for x = numerator / denominator of the pair with the largest entries (..., P, Q) → (...)."""
-    size = (np.abs(numerator) ** 2 + np.abs(denominator) ** 2).reshape(numerator.shape[:-2] + (-1,))
-    best = np.argmax(size, axis=-1)[..., None]
-    num = np.take_along_axis(numerator.reshape(size.shape), best, -1)[..., 0]
-    den = np.take_along_axis(denominator.reshape(size.shape), best, -1)[..., 0]
-    return 2.0 * np.arctan2((num * den.conj()).real, np.abs(den) ** 2)
+def _monomial_angle(m: np.ndarray) -> np.ndarray:
+    """The angle q with x = tan(q/2) from powers along the second-last axis, m (..., P ≥ 3, Q) ∝ x^i · (…).
+
+    Each run of three consecutive powers (m_i, m_i+1, m_i+2) = m_i (1, x, x²) gives
+    (cos q, sin q) ∝ (m_i − m_i+2, 2 m_i+1) / (m_i + m_i+2); summing every run, each weighted by
+    |m_i + m_i+2|², uses the largest entries and is exact at x → ∞ (q = π), where only the top power is left.
+    """
+    low, middle, high = m[..., :-2, :], m[..., 1:-1, :], m[..., 2:, :]
+    weight = (low + high).conj()
+    cosine = ((low - high) * weight).real.sum(axis=(-2, -1))
+    sine = (2.0 * middle * weight).real.sum(axis=(-2, -1))
+    return np.arctan2(sine, cosine)
 
 
 def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarray:

@@ -160,6 +160,26 @@ def test_solution_counts_agree_with_a_dense_multistart_search():
     assert max(counts) > 2  # the comparison covered poses with several solutions (measured: 2 to 8)
 
 
+def kinova_j2n6s300() -> Robot:
+    """Kinova Jaco 2 6-DOF with its curved 60° wrist: Kinova's published standard DH table (no axes meet at
+    the wrist, so no closed-form family)."""
+    D1, D2, D3, D4, D5, D6, e2 = 0.2755, 0.41, 0.2073, 0.0741, 0.0741, 0.16, 0.0098
+    aa = np.pi / 6
+    ratio = np.sin(aa) / np.sin(2 * aa)
+    alpha = [np.pi / 2, np.pi, np.pi / 2, 2 * aa, 2 * aa, np.pi]
+    a = [0.0, D2, 0.0, 0.0, 0.0, 0.0]
+    d = [D1, 0.0, -e2, -(D3 + ratio * D4), -(ratio * D4 + ratio * D5), -(ratio * D5 + D6)]
+    return Robot([Joint(f"q{i + 1}", "revolute", a[i], alpha[i], d[i], 0.0) for i in range(6)], name="j2n6s300")
+
+
+def test_every_solution_of_a_kinova_jaco():
+    robot = kinova_j2n6s300()
+    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (300, 6))
+    arrays = check_answers(robot, q)
+    assert arrays.complete.all()
+    assert arrays.count.max() >= 10  # measured: 2 to 12 solutions per pose
+
+
 # ---------------------------------------------------------------------------
 # the published 16-solution example
 # ---------------------------------------------------------------------------

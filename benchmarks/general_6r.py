@@ -12,8 +12,8 @@ Per library and arm: solutions per pose (only those whose FK residual is within 
 generating vector is among those, modulo 2π, to 1e-6 rad), and the median and 99th percentile of one call per
 pose; for the core also one batched call for all poses (``solve_ik_arrays``), per pose. Repeats are interleaved
 and the best repeat kept, so that the load of a shared machine falls on all alike; compare ratios of one run.
-roboticstoolbox derives its equations with SymPy once per arm before solving: that time is reported, not
-counted in the per-pose times.
+roboticstoolbox derives its equations with SymPy once per arm before solving (minutes for a general arm): it
+runs in a child process with a time limit, and the derivation time is reported, not counted per pose.
 """
 
 from __future__ import annotations
@@ -21,8 +21,11 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import platform
+import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -71,21 +74,61 @@ def ik_geo_single(robot: Robot) -> Callable[[np.ndarray], np.ndarray] | str:
     return solve
 
 
-def roboticstoolbox_single(robot: Robot, notes: list[str]) -> Callable[[np.ndarray], np.ndarray] | str:
-    if importlib.util.find_spec("roboticstoolbox") is None:
-        return "not installed (pip install 'roboticstoolbox-python[ik]')"
+def roboticstoolbox_worker(path: str) -> int:
+    """In a child process: derive roboticstoolbox's analytic IK for the arm in ``path`` (an .npz with the DH table,
+    poses and repeats), solve every pose, and write the answers and times back into ``path`` + '.out.npz'."""
     from roboticstoolbox import DHRobot, RevoluteDH
 
-    bot = DHRobot([RevoluteDH(a=a, alpha=al, d=d, offset=th)
-                   for a, al, d, th in zip(robot.a, robot.alpha, robot.d, robot.theta)])
+    data = np.load(path)
+    bot = DHRobot([RevoluteDH(a=a, alpha=al, d=d, offset=th) for a, al, d, th in data["dh"]])
     start = time.perf_counter()
-    try:
-        solver = bot.analytic_ik()
-    except Exception as error:  # noqa: BLE001 - the reason is the result
-        return f"analytic_ik unavailable: {error}"
-    notes.append(f"roboticstoolbox analytic_ik derivation (SymPy, once per arm, not timed): "
-                 f"{time.perf_counter() - start:.1f} s")
-    return lambda T: np.asarray(solver.solve(T, joint_limits=False).q, dtype=float).reshape(-1, 6)
+    solver = bot.analytic_ik()
+    derivation = time.perf_counter() - start
+    targets = data["targets"]
+    answers, best = [], None
+    for T in targets:
+        answers.append(np.asarray(solver.solve(T, joint_limits=False).q, dtype=float).reshape(-1, 6))
+    for _ in range(int(data["repeats"])):
+        times = np.empty(len(targets))
+        for i, T in enumerate(targets):
+            begin = time.perf_counter()
+            solver.solve(T, joint_limits=False)
+            times[i] = time.perf_counter() - begin
+        best = times if best is None or np.median(times) < np.median(best) else best
+    counts = np.array([len(a) for a in answers])
+    np.savez(path + ".out.npz", derivation=derivation, times=best, counts=counts,
+             solutions=np.concatenate(answers + [np.zeros((0, 6))]))
+    return 0
+
+
+def roboticstoolbox_rows(robot: Robot, q: np.ndarray, targets: np.ndarray, repeats: int, timeout: float,
+                         notes: list[str]) -> dict | None:
+    """roboticstoolbox's ``analytic_ik`` run in a child process (its SymPy derivation can take minutes for a
+    general arm, so it gets ``timeout`` seconds in all); None, with a note, when it cannot answer."""
+    if importlib.util.find_spec("roboticstoolbox") is None or importlib.util.find_spec("sympy") is None:
+        notes.append("roboticstoolbox analytic_ik: not installed (pip install 'roboticstoolbox-python[ik]')")
+        return None
+    with tempfile.TemporaryDirectory() as folder:
+        path = str(Path(folder) / "arm.npz")
+        np.savez(path, dh=np.stack([robot.a, robot.alpha, robot.d, robot.theta], axis=1), targets=targets,
+                 repeats=repeats)
+        try:
+            subprocess.run([sys.executable, "-m", "benchmarks.general_6r", "--roboticstoolbox-worker", path],
+                           check=True, timeout=timeout, capture_output=True)
+        except subprocess.TimeoutExpired:
+            notes.append(f"roboticstoolbox analytic_ik on {robot.name}: no answer within {timeout:.0f} s "
+                         f"(SymPy derivation plus {len(targets)} poses)")
+            return None
+        except subprocess.CalledProcessError as error:
+            reason = error.stderr.decode(errors="replace").strip().splitlines()[-1:] or ["failed"]
+            notes.append(f"roboticstoolbox analytic_ik on {robot.name}: {reason[0]}")
+            return None
+        out = np.load(path + ".out.npz")
+        derivation, times, counts, flat = out["derivation"], out["times"], out["counts"], out["solutions"]
+    notes.append(f"roboticstoolbox analytic_ik derivation on {robot.name} (SymPy, once per arm, not in the "
+                 f"per-pose times): {float(derivation):.1f} s")
+    answers = np.split(flat, np.cumsum(counts)[:-1])
+    return summary(robot, "roboticstoolbox analytic_ik", answers, q, targets, times)
 
 
 def verified(robot: Robot, solutions: np.ndarray, target: np.ndarray) -> np.ndarray:
@@ -96,11 +139,19 @@ def verified(robot: Robot, solutions: np.ndarray, target: np.ndarray) -> np.ndar
     return solutions[(position <= ACCEPT * robot.characteristic_length) & (orientation <= ACCEPT)]
 
 
+def summary(robot: Robot, name: str, answers: list[np.ndarray], q: np.ndarray, targets: np.ndarray,
+            times: np.ndarray) -> dict:
+    good = [verified(robot, a, T) for a, T in zip(answers, targets)]
+    found = sum(bool(len(a)) and np.abs(joint_difference(robot, a, g)).max(axis=1).min() <= RECALL_TOLERANCE
+                for a, g in zip(good, q))
+    return {"library": name, "solutions": float(np.mean([len(a) for a in good])), "recall": found / len(q),
+            "median": float(np.median(times)), "p99": float(np.percentile(times, 99)),
+            "raw": float(np.mean([len(a) for a in answers]))}
+
+
 def measure(robot: Robot, name: str, solve: Callable[[np.ndarray], np.ndarray], q: np.ndarray,
             targets: np.ndarray, repeats: int) -> dict:
-    answers = [verified(robot, solve(T), T) for T in targets]  # warm-up, and the answers for recall
-    found = sum(bool(len(a)) and np.abs(joint_difference(robot, a, g)).max(axis=1).min() <= RECALL_TOLERANCE
-                for a, g in zip(answers, q))
+    answers = [solve(T) for T in targets]  # warm-up, and the answers for recall
     best = None
     for _ in range(repeats):
         times = np.empty(len(targets))
@@ -109,10 +160,7 @@ def measure(robot: Robot, name: str, solve: Callable[[np.ndarray], np.ndarray], 
             solve(T)
             times[i] = time.perf_counter() - start
         best = times if best is None or np.median(times) < np.median(best) else best
-    returned = [len(solve(T)) for T in targets[: min(len(targets), 20)]]
-    return {"library": name, "solutions": float(np.mean([len(a) for a in answers])), "recall": found / len(q),
-            "median": float(np.median(best)), "p99": float(np.percentile(best, 99)),
-            "raw": float(np.mean(returned))}
+    return summary(robot, name, answers, q, targets, best)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -121,10 +169,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--batch", type=int, default=5000, help="poses in the batched core call")
     parser.add_argument("--repeats", type=int, default=3)
     parser.add_argument("--anchor-poses", type=int, default=100, help="poses given to the (slower) anchors")
-    parser.add_argument("--no-roboticstoolbox", action="store_true", help="skip roboticstoolbox (its SymPy "
-                        "derivation takes minutes per arm)")
+    parser.add_argument("--roboticstoolbox-timeout", type=float, default=900.0,
+                        help="seconds roboticstoolbox gets per arm, its SymPy derivation included")
+    parser.add_argument("--no-roboticstoolbox", action="store_true", help="skip roboticstoolbox")
     parser.add_argument("--quick", action="store_true", help="tiny sizes, roboticstoolbox skipped")
+    parser.add_argument("--roboticstoolbox-worker", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.roboticstoolbox_worker:
+        return roboticstoolbox_worker(args.roboticstoolbox_worker)
     if args.quick:
         args.poses, args.batch, args.repeats, args.anchor_poses, args.no_roboticstoolbox = 10, 50, 1, 5, True
     print(f"# General 6R IK: core vs ik-geo gen_six_dof vs roboticstoolbox analytic_ik\n\n"
@@ -142,15 +194,16 @@ def main(argv: list[str] | None = None) -> int:
         start = time.perf_counter()
         solve_ik_arrays(robot, targets[:args.batch])
         rows[0]["batch"] = (time.perf_counter() - start) / args.batch
-        anchors: list[tuple[str, Callable | str]] = [("ik-geo gen_six_dof", ik_geo_single(robot))]
+        n = args.anchor_poses
+        solve = ik_geo_single(robot)
+        if isinstance(solve, str):
+            notes.append(f"ik-geo gen_six_dof: {solve}")
+        else:
+            rows.append(measure(robot, "ik-geo gen_six_dof", solve, q[:n], targets[:n], args.repeats))
         if not args.no_roboticstoolbox:
-            anchors.append(("roboticstoolbox analytic_ik", roboticstoolbox_single(robot, notes)))
-        for name, solve in anchors:
-            if isinstance(solve, str):
-                notes.append(f"{name} on {robot.name}: {solve}")
-                continue
-            n = args.anchor_poses
-            rows.append(measure(robot, name, solve, q[:n], targets[:n], args.repeats))
+            row = roboticstoolbox_rows(robot, q[:n], targets[:n], args.repeats, args.roboticstoolbox_timeout, notes)
+            if row is not None:
+                rows.append(row)
         for row in rows:
             batch = f"{1e3 * row['batch']:.3f}" if "batch" in row else "—"
             print(f"| {robot.name} | {row['library']} | {row['solutions']:.2f} | {row['raw']:.2f} | "

@@ -36,3 +36,12 @@ def test_http_benchmark_says_when_wrk_is_missing(capsys, monkeypatch):
     monkeypatch.setattr(shutil, "which", lambda name: None)
     assert http_throughput.main(["--quick"]) == 0
     assert "wrk is not installed" in capsys.readouterr().out
+
+
+def test_general_6r_benchmark_runs_with_tiny_sizes(capsys):
+    from benchmarks import general_6r
+
+    assert general_6r.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "| random general 6R (seed 2026) | core |" in out
+    assert "| Manocha-Canny 16-solution arm | core |" in out

@@ -364,3 +364,15 @@ def test_unreachable_is_a_promise_the_multistart_search_cannot_break():
         assert all(found(robot, mine, s, 1e-6) for s in oracle)
         unreachable += result.status == "unreachable"
     assert 0 < unreachable < 8  # both kinds of answer were put to the test
+
+
+@pytest.mark.parametrize("distance", [3.0, 1e3, 1e6])
+def test_targets_beyond_the_reach_bound_are_unreachable_and_complete(distance):
+    """Every turn keeps the distance to a point of its axis, so no tool position is farther from axis 1's point
+    than |home − p6| + Σ|p_i+1 − p_i|; beyond it the answer is a certain `unreachable`."""
+    robot = random_arm(np.random.default_rng(8), "standard")
+    target = np.eye(4)
+    target[:3, 3] = [distance * robot.characteristic_length, 0.0, 0.0]
+    result = solve_ik(robot, target)
+    assert result.structure == "general_6r" and result.status == "unreachable" and result.complete
+    assert result.solutions == []

@@ -57,10 +57,15 @@ from ._types import Branch, Candidates, LabelCodes, SingularFlags
 AMBIGUITY_FACTOR = 100.0
 #: Roots y with |1 + y²| below this are the spurious ones at ±i.
 SPURIOUS_RADIUS = 1e-2
+#: Complex roots whose angle's imaginary part is below this get an error bound (the others are clearly complex:
+#: no double-precision eigenproblem is that far off without its matrices being flagged ill-conditioned).
+SUSPECT_IMAGINARY = 1e-2
 #: Smallest reciprocal condition number of the leading matrix and of the right-hand coefficients accepted.
 CONDITION_FLOOR = 1e-9
-#: Newton steps on the FK for every root.
+#: Newton steps on the FK at most, for every root whose error twist (normalised lengths, radians) is above
+#: NEWTON_TOLERANCE; the shared verification then accepts at 1e-9.
 NEWTON_STEPS = 5
+NEWTON_TOLERANCE = 1e-13
 #: The worst error (radians) in recovering random configurations before polishing that a plan accepts.
 PLAN_ACCURACY = 1e-4
 #: An arrangement this accurate on the test configurations is taken without trying the others.
@@ -277,16 +282,20 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     real_count = real.sum(axis=1)
     # first-order error bound of each eigenvalue (backward-stable QR: ~ n ε ‖M‖ times its condition number,
     # from the left eigenvectors, the rows of V⁻¹), carried to the angle: dq = 2 dy / |1 + y²|
-    left_vectors = np.linalg.inv(vectors)
-    condition = np.linalg.norm(left_vectors, axis=2) * np.linalg.norm(vectors, axis=1)
-    size = np.linalg.norm(companions, axis=(1, 2))[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        bound = 2.0 * 24 * np.finfo(float).eps * size * condition / np.abs(1.0 + y * y)
     # the spurious roots at ±i (of the (1 + x²) factors, a defective quadruple pair, so rounding spreads them
     # by ~ε^¼) are far from real and never ambiguous
     spurious = np.abs(1.0 + y * y) < SPURIOUS_RADIUS
     with np.errstate(invalid="ignore"):
-        near = ~real & ~spurious & (imaginary <= AMBIGUITY_FACTOR * bound)
+        suspect = ~real & ~spurious & (imaginary < SUSPECT_IMAGINARY)
+    near = np.zeros_like(real)
+    rows = np.flatnonzero(suspect.any(axis=1))
+    if len(rows):  # the bound needs the left eigenvectors: only for targets with a complex root near the axis
+        left_vectors = np.linalg.inv(vectors[rows])
+        condition = np.linalg.norm(left_vectors, axis=2) * np.linalg.norm(vectors[rows], axis=1)
+        size = np.linalg.norm(companions[rows], axis=(1, 2))[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = 2.0 * 24 * np.finfo(float).eps * size * condition / np.abs(1.0 + y[rows] ** 2)
+            near[rows] = suspect[rows] & (imaginary[rows] <= AMBIGUITY_FACTOR * bound)
     ambiguous = near.any(axis=1)
     # back-substitute the real and the ambiguous roots only: m slots, nearest the real axis first
     real = real | near
@@ -357,8 +366,9 @@ def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q
             steps: int = NEWTON_STEPS) -> np.ndarray:
     """Newton's method on G_1 ⋯ G_6 = A for candidates q (K, 6) and targets A (K, 4, 4), normalised lengths.
 
-    Stops once every candidate's error twist is below 1e-14 (roots come from the eigenproblem to about 1e-12,
-    so one step usually suffices); singular candidates get a tiny damping instead of a failed solve.
+    Steps the candidates whose error twist is above :data:`NEWTON_TOLERANCE` (roots come from the eigenproblem
+    to about 1e-12, so one step, or none, usually suffices); singular candidates get a tiny damping instead of a
+    failed solve.
     """
     q = q.copy()
     R_A, p_A = A_targets[:, :3, :3], A_targets[:, :3, 3]
@@ -378,11 +388,12 @@ def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q
         omega = 0.5 * np.stack([R_err[:, 2, 1] - R_err[:, 1, 2], R_err[:, 0, 2] - R_err[:, 2, 0],
                                 R_err[:, 1, 0] - R_err[:, 0, 1]], axis=-1)
         error = np.concatenate([omega, p_A - p - _cross(omega, p)], axis=-1)  # (K, 6)
-        if _ == steps or np.abs(error).max() < 1e-14:
+        active = np.abs(error).max(axis=1) > NEWTON_TOLERANCE
+        if _ == steps or not active.any():
             break
-        J = np.concatenate([axes, _cross(through, axes)], axis=-1)  # (K, 6 joints, 6): rows ω, p × ω
+        J = np.concatenate([axes[active], _cross(through[active], axes[active])], axis=-1)  # rows ω, p × ω
         JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6)  # (K, joints, joints) = Jᵀ J of the twist map
-        q += np.linalg.solve(JJt, (J @ error[..., None]))[..., 0]
+        q[active] += np.linalg.solve(JJt, (J @ error[active][..., None]))[..., 0]
     return q
 
 

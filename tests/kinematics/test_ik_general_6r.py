@@ -376,3 +376,24 @@ def test_targets_beyond_the_reach_bound_are_unreachable_and_complete(distance):
     result = solve_ik(robot, target)
     assert result.structure == "general_6r" and result.status == "unreachable" and result.complete
     assert result.solutions == []
+
+
+def test_a_batch_larger_than_a_chunk_is_answered_in_one_piece():
+    """The solver gives each chunk of targets only the slots it needs; chunks of different widths are merged."""
+    from service.kinematics.ik import _arrays
+
+    robot = random_arm(np.random.default_rng(12), "standard")
+    q = np.random.default_rng(13).uniform(-np.pi, np.pi, (3 * 64 + 5, 6))
+    chunk = _arrays.CHUNK
+    _arrays.CHUNK = 64
+    try:
+        whole = solve_ik_arrays(robot, forward_kinematics(robot, q), threads=2)
+    finally:
+        _arrays.CHUNK = chunk
+    assert len(whole.count) == len(q) and (whole.count > 0).all()
+    pieces = [solve_ik_arrays(robot, forward_kinematics(robot, q[start:start + 64]))
+              for start in range(0, len(q), 64)]
+    assert len({p.joints.shape[1] for p in pieces}) > 1  # the chunks really had different widths
+    np.testing.assert_array_equal(whole.count, np.concatenate([p.count for p in pieces]))
+    for row in range(len(q)):
+        assert found(robot, whole.joints[row, :whole.count[row]], q[row])

@@ -97,9 +97,9 @@ _CROSS: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray]] = {}
 _EYE3 = np.eye(3)
 
 
-def _rodrigues(k: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """R(k, q) for q of shape (...,): (..., 3, 3)."""
-    K, KK = _cross_matrix(k)
+def _rodrigues(k: np.ndarray | tuple[np.ndarray, np.ndarray], q: np.ndarray) -> np.ndarray:
+    """R(k, q) for q of shape (...,): (..., 3, 3). ``k`` is the unit axis or its pair ([k]×, [k]×²)."""
+    K, KK = k if isinstance(k, tuple) else _cross_matrix(k)
     q = np.asarray(q, dtype=float)[..., None, None]
     return _EYE3 + np.sin(q) * K + (1.0 - np.cos(q)) * KK
 
@@ -140,6 +140,7 @@ class _Arrangement:
             directions, points = -directions[::-1], points[::-1]
         self.reverse, self.first = reverse, first
         self.directions, self.points = directions, points
+        self.cross = [_cross_matrix(k) for k in directions]
         a, d = first, first + 3
         # the target's side: joints (e, f) and where they stand around A
         self.rhs = {2: (0, 1), 1: (0, 5), 0: (5, 4)}[first]
@@ -346,14 +347,14 @@ def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarr
     for slot, joint in enumerate((a, a + 1, a + 2, a + 3, *arr.rhs)):
         q[..., joint] = chain[..., slot]
     d = a + 3
-    R_before = _rodrigues(arr.directions[0], q[..., 0])
+    R_before = _rodrigues(arr.cross[0], q[..., 0])
     for j in range(1, d):
-        R_before = R_before @ _rodrigues(arr.directions[j], q[..., j])
+        R_before = R_before @ _rodrigues(arr.cross[j], q[..., j])
     R_d = np.swapaxes(R_before, -1, -2) @ A[:, None, :3, :3]
     if d < 5:
-        R_after = _rodrigues(arr.directions[5], q[..., 5])
+        R_after = _rodrigues(arr.cross[5], q[..., 5])
         for j in range(4, d, -1):
-            R_after = _rodrigues(arr.directions[j], q[..., j]) @ R_after
+            R_after = _rodrigues(arr.cross[j], q[..., j]) @ R_after
         R_d = R_d @ np.swapaxes(R_after, -1, -2)
     k = arr.directions[d]
     u = _cross(k, np.eye(3)[np.argmin(np.abs(k))])
@@ -372,6 +373,7 @@ def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q
     """
     q = q.copy()
     R_A, p_A = A_targets[:, :3, :3], A_targets[:, :3, 3]
+    cross = [_cross_matrix(k) for k in directions]
     for _ in range(steps + 1):
         R = np.broadcast_to(_EYE3, q.shape[:-1] + (3, 3))
         p = np.zeros(q.shape[:-1] + (3,))
@@ -380,7 +382,7 @@ def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q
         for j in range(6):
             axes[:, j] = R @ directions[j]
             through[:, j] = R @ points[j] + p
-            turn = _rodrigues(directions[j], q[:, j])
+            turn = _rodrigues(cross[j], q[:, j])
             p = p + (R @ (points[j] - turn @ points[j])[..., None])[..., 0]
             R = R @ turn
         # spatial error twist (ω, v): A ≈ exp([ξ]) T
@@ -477,7 +479,8 @@ class General6RPlan:
             joints[rows, slots] = _newton(self.directions, self.points, A[rows], start)
         complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
         # out of reach by the bound: certainly no solution, however the eigenproblem was conditioned
-        beyond = np.linalg.norm(targets[:, :3, 3] - self.points[0], axis=1) > self.reach * (1.0 + 1e-9)
+        offset = targets[:, :3, 3] - self.points[0]
+        beyond = np.einsum("ni,ni->n", offset, offset) > (self.reach * (1.0 + 1e-9)) ** 2
         valid[beyond] = False
         complete[beyond] = True
         return Candidates(joints, valid, [], SingularFlags(n), complete=complete)

@@ -40,8 +40,12 @@ Completeness
     split), at most 16 roots are real, and (checked after verification) every real root gave one distinct
     verified solution. Anything else is answered with ``complete: false``.
 
-Pieper-class arms (three consecutive axes through one point, or parallel) make Σ singular for every x: those
-are the closed-form families' and :meth:`General6RPlan.match` refuses them.
+Pieper-class arms (three consecutive axes through one point, or parallel) make Σ singular for every x in some
+arrangements (and give double eigenvalues, solutions that share q_a, in others); they are the closed-form
+families' and :meth:`General6RPlan.match` refuses them. (The plan's choice of arrangement does solve PUMA- and
+UR5-type arms, which a test uses to check the elimination against the closed forms.) Arms within ~1e-5 of a
+Pieper arm are accepted; there a few targets in a thousand meet a near-double eigenvalue, and those answers
+say ``complete: false``.
 """
 
 from __future__ import annotations

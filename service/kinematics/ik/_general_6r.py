@@ -31,8 +31,9 @@ Conditioning
     that recovers random configurations most accurately.
 Back-substitution
     q_b, q_c from the eigenvector (runs of three powers give cos and sin, so x → ∞ is just an angle of π);
-    q_e, q_f from the linear right-hand monomials; q_d from the remaining rotation. Every root is then polished by Newton's
-    method on the screw model's FK, and the shared verification (FK residual, merging) decides what is kept.
+    q_e, q_f from the linear right-hand monomials; q_d from the remaining rotation. Every root is then polished
+    by Newton's method on the screw model's FK, and the shared verification (FK residual, merging) decides what
+    is kept.
 Completeness
     A target's answer is complete only when the algebra accounts for every solution: the right-hand
     coefficients have full rank 8, the leading matrix is well conditioned, no eigenvalue is ambiguous (an

@@ -397,3 +397,42 @@ def test_a_batch_larger_than_a_chunk_is_answered_in_one_piece():
     np.testing.assert_array_equal(whole.count, np.concatenate([p.count for p in pieces]))
     for row in range(len(q)):
         assert found(robot, whole.joints[row, :whole.count[row]], q[row])
+
+
+def singular_configuration(robot: Robot, rng: np.random.Generator) -> np.ndarray:
+    """A configuration with det J = 0: bisection along the first random segment on which det J changes sign."""
+    while True:
+        start, end = rng.uniform(-np.pi, np.pi, (2, 6))
+        det = lambda t: np.linalg.det(geometric_jacobian(robot, start + t * (end - start)))
+        low, high = 0.0, 1.0
+        if np.sign(det(low)) != np.sign(det(high)):
+            break
+    for _ in range(60):
+        middle = 0.5 * (low + high)
+        low, high = (middle, high) if np.sign(det(middle)) == np.sign(det(low)) else (low, middle)
+    return start + low * (end - start)
+
+
+def test_the_api_reports_the_general_solvers_completeness_per_target(client):
+    """An arm given inline: the response's solver block says general_6r, and `complete` is the core's promise for
+    that very target (false at a singular configuration found by bisection on det J, true elsewhere)."""
+    rng = np.random.default_rng(5)
+    robot = random_arm(rng, "standard")
+    robot = Robot(robot.joints, convention="standard")  # the inline description below has no base or tool
+    body = {"convention": "standard", "angle_unit": "rad",
+            "joints": [{"a": j.a, "alpha": j.alpha, "d": j.d, "theta": j.theta} for j in robot.joints]}
+    singular = singular_configuration(robot, np.random.default_rng(1))
+    configurations = [singular, *np.random.default_rng(2).uniform(-np.pi, np.pi, (3, 6))]
+    promises = []
+    for q in configurations:
+        target = forward_kinematics(robot, q)
+        response = client.post("/v1/ik", json={"robot": body, "target": {"matrix": target.tolist()},
+                                                "filter_limits": False})
+        assert response.status_code == 200, response.text
+        answer = response.json()
+        core = solve_ik(robot, target)
+        assert answer["solver"]["structure"] == "general_6r" and answer["solver"]["method"] == "analytic"
+        assert answer["solver"]["complete"] is core.complete
+        assert len(answer["solutions"]) == len(core.solutions)
+        promises.append(core.complete)
+    assert promises[1:] == [True, True, True] and promises[0] is False

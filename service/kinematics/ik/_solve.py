@@ -106,6 +106,9 @@ def unreachable_details(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
                 details[int(row)] = ("The position is reachable but the orientation is not: " +
                                      _orientation_freedom(robot) +
                                      " No joint vector gives the requested orientation at that position.")
+    for row in rows[~arrays.complete[rows]]:  # the general 6R solver could not vouch for this answer
+        details[int(row)] = ("No solution was found, but the solver cannot promise that none exists: the target "
+                             "is near a singular or ill-conditioned case of the elimination (complete: false).")
     return details
 
 

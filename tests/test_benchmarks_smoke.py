@@ -10,7 +10,7 @@ import shutil
 
 import pytest
 
-from benchmarks import anchors, core, http_throughput
+from benchmarks import anchors, core, http_throughput, wrist_classes
 
 
 def test_core_benchmark_runs_with_tiny_sizes(capsys):
@@ -22,6 +22,14 @@ def test_core_benchmark_runs_with_tiny_sizes(capsys):
     for name in anchors.LIBRARIES:
         if not anchors.installed(name):
             assert f"{name}: not installed" in out
+
+
+def test_wrist_classes_benchmark_runs_with_tiny_sizes(capsys):
+    assert wrist_classes.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "- KUKA KR 6 R900-2: offset_shoulder_parallel_elbow+spherical_wrist" in out
+    assert "| random skew axes | IK, batch of 20 | core |" in out
+    assert "| random wrist at the base | IK, single pose | core |" in out
 
 
 @pytest.mark.skipif(shutil.which("wrk") is None, reason="wrk (Debian package) is not installed")
@@ -45,3 +53,12 @@ def test_general_6r_benchmark_runs_with_tiny_sizes(capsys):
     out = capsys.readouterr().out
     assert "| random general 6R (seed 2026) | core |" in out
     assert "| Manocha-Canny 16-solution arm | core |" in out
+
+
+def test_three_parallel_benchmark_runs_with_tiny_sizes(capsys):
+    from benchmarks import three_parallel
+
+    assert three_parallel.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "| 4∥5∥6 | IK, batch of 20 | core |" in out
+    assert "core on 1∥2∥3: family three_parallel_at_base" in out

@@ -734,3 +734,93 @@ def test_core_imports_numpy_and_standard_library_only():
         elif isinstance(node, ast.ImportFrom) and node.level == 0:
             imported.add(node.module.split(".")[0])
     assert imported <= {"__future__", "math", "typing", "numpy"}
+
+
+# ---------------------------------------------------------------------------
+# Subproblem 5: p0 + R(k1, t1) p1 = R(k2, t2) (p2 + R(k3, t3) p3)
+# ---------------------------------------------------------------------------
+
+
+def sp5_instances(rng, known):
+    """Random axes and points with p1 chosen so that the known angles (rows, 3) solve the equation."""
+    k1, k2, k3 = random_unit(rng, 3)
+    rows = len(known)
+    p0, p2, p3 = rng.normal(size=(3, rows, 3))
+    p1 = rotate(k1, -known[:, 0], rotate(k2, known[:, 1], p2 + rotate(k3, known[:, 2], p3)) - p0)
+    return (k1, k2, k3), (p0, p1, p2, p3)
+
+
+def sp5_residual(axes, points, sol):
+    k1, k2, k3 = axes
+    p0, p1, p2, p3 = (p[..., None, :] for p in points)
+    left = p0 + rotate(k1, sol.theta1, p1)
+    right = rotate(k2, sol.theta2, p2 + rotate(k3, sol.theta3, p3))
+    scale = sum(np.linalg.norm(p, axis=-1) for p in (p0, p1, p2, p3))
+    return np.linalg.norm(left - right, axis=-1) / scale
+
+
+def test_sp5_exact_instances(rng):
+    for _ in range(N_AXES):
+        known = rng.uniform(-np.pi, np.pi, (N_ROWS, 3))
+        axes, points = sp5_instances(rng, known)
+        sol = _subproblems.subproblem_5(*axes, *points)
+        assert_record_shapes_sp5(sol, (N_ROWS,))
+        gap = np.where(sol.valid[..., None], angle_gap(np.stack([sol.theta1, sol.theta2, sol.theta3], -1),
+                                                        known[:, None, :]), np.inf).max(axis=-1).min(axis=-1)
+        assert (gap < ANGLE).all()
+        assert (sp5_residual(axes, points, sol)[sol.valid] < RESIDUAL).all()
+        assert sol.exact[sol.valid].all()
+        # a real trigonometric quartic has its real roots in pairs: 2 or 4 here (one is known)
+        assert set(sol.valid.sum(axis=1).tolist()) <= {2, 4}
+        assert_rows_match(sol, lambda i: _subproblems.subproblem_5(*axes, *(p[i] for p in points)),
+                          range(0, N_ROWS, 9))
+
+
+def assert_record_shapes_sp5(sol, batch_shape):
+    for value in (sol.theta1, sol.theta2, sol.theta3):
+        assert value.shape == (*batch_shape, 4)
+        assert np.array_equal(np.isnan(value), ~sol.valid)
+    assert sol.degenerate.shape == sol.merged.shape == batch_shape
+    assert not (sol.exact & ~sol.valid).any()
+
+
+def test_sp5_roots_at_pi_are_ordinary(rng):
+    """z = exp(i t) has no pole at t = π (a tangent half-angle would)."""
+    known = np.array([[np.pi, 0.3, np.pi], [np.pi, np.pi, -0.7], [0.2, -1.0, np.pi]])
+    axes, points = sp5_instances(rng, known)
+    sol = _subproblems.subproblem_5(*axes, *points)
+    found = np.stack([sol.theta1, sol.theta2, sol.theta3], -1)
+    gap = np.where(sol.valid[..., None], angle_gap(found, known[:, None, :]), np.inf).max(axis=-1).min(axis=-1)
+    assert (gap < ANGLE).all()
+
+
+def test_sp5_infeasible_degenerate_and_inseparable(rng):
+    k1, k2, k3 = random_unit(rng, 3)
+    p0, p2, p3 = rng.normal(size=(3, 3))
+    # far out of reach: no root on the unit circle, no slot (no least-squares candidate for this one)
+    far = _subproblems.subproblem_5(k1, k2, k3, p0, 100 * rng.normal(size=3) + 1000 * k1[[1, 2, 0]], p2, p3)
+    assert not far.valid.any()
+    # p1 on k1: the left side does not depend on t1, which is free when the target is reachable
+    t2, t3 = 0.4, -1.2
+    right = rotate(k2, t2, p2 + rotate(k3, t3, p3))
+    p1_free = 0.7 * k1
+    p0_free = right - p1_free  # L = p0 + R(k1, t1) p1 = right for every t1
+    sol = _subproblems.subproblem_5(k1, k2, k3, p0_free, p1_free, p2, p3)
+    assert sol.degenerate and sol.valid[0] and sol.theta1[0] == 0.0
+    assert (sp5_residual((k1, k2, k3), (p0_free, p1_free, p2, p3), sol)[sol.valid] < 1e-9).all()
+    # k2 ∥ k3: the height row does not involve t3 and neither block inverts: no slot (use subproblems 3, 4)
+    assert not _subproblems.subproblem_5(k1, k2, k2, p0, rng.normal(size=3), p2, p3).valid.any()
+
+
+def test_sp5_quartic_that_drops_to_a_quadratic():
+    """||f + G u||² = 1 with G a scaled rotation has no 2θ terms: the leading coefficient vanishes and the
+    harmonic equation 2 g·u + c0 = 0 is what is left (here 0.6 cos θ + 0.8 sin θ = 0.25)."""
+    theta, valid, free = _subproblems._unit_circle_roots(
+        np.array([0.0 + 0.0j]), np.array([0.3 - 0.4j]), np.array([-0.25 + 0.0j]), np.array([1.0]))
+    phi, half = np.arctan2(0.8, 0.6), np.arccos(0.25)
+    assert valid.sum() == 2 and not free[0]
+    assert np.allclose(np.sort(theta[valid]), np.sort(np.angle(np.exp(1j * np.array([phi + half, phi - half])))))
+    # and the constant left when g vanishes too: identically zero (free) or never
+    _, valid, free = _subproblems._unit_circle_roots(np.zeros(2, complex), np.zeros(2, complex),
+                                                     np.array([0.0, 0.5 + 0j]), np.ones(2))
+    assert free.tolist() == [True, False] and not valid.any()

@@ -3,7 +3,7 @@
 The solver reads the joint axes off the robot's product-of-exponentials
 model, detects the structure (intersecting and parallel axes, wrists,
 prismatic joints), and decomposes the problem into geometric subproblems
-(Paden–Kahan 1–4 and their prismatic analogues). Arms no family covers fall
+(Paden–Kahan 1–4, IK-Geo 5 and their prismatic analogues). Arms no family covers fall
 back to a bounded numeric search that says it may be incomplete.
 """
 

@@ -17,9 +17,11 @@ from .._robot import Robot
 from ._decoupled import DecoupledPlan
 from ._general_6r import General6RPlan
 from ._positioning import find_positioner
+from ._reversed import ReversedPlan, reversed_geometry
 from ._screws import apply, chain_motion
 from ._structure import Geometry
-from ._three_parallel import ThreeParallelPlan
+from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
+from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
 from ._types import Branch, Candidates, LabelCodes
 from ._wrist import Roll, SphericalWrist
 
@@ -53,6 +55,48 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
 
 
 def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
+    decoupled = _decoupled_pose_plan(geometry, n)
+    if decoupled is not None:
+        return decoupled
+    three_parallel = _three_parallel_plan(geometry)
+    if three_parallel is not None:
+        return three_parallel
+    # a wrist at the base: the inverse chain decouples
+    reverse = reversed_geometry(geometry)
+    inverse = _decoupled_pose_plan(reverse, n)
+    if inverse is not None:
+        return ReversedPlan(inverse, geometry.model.home, n)
+    # no closed form: the general 6R elimination (it refuses Pieper arms and anything not 6R)
+    return _reversed_three_parallel_plan(geometry, reverse, n) or General6RPlan.match(geometry)
+
+
+#: Three consecutive parallel axes: the families as the chain is described, then (name, family, first
+#: parallel axis) of the inverse chain: axes 3 ∥ 4 ∥ 5 are axes 2 ∥ 3 ∥ 4 seen from the tool, and axes
+#: 1 ∥ 2 ∥ 3 are axes 4 ∥ 5 ∥ 6.
+_THREE_PARALLEL = (ThreeParallelPlan, SkewWristThreeParallelPlan, ThreeParallelAtEndPlan)
+_THREE_PARALLEL_REVERSED = (("three_parallel_intersecting_shoulder", ThreeParallelPlan, 2),
+                            ("three_parallel_skew_shoulder", SkewWristThreeParallelPlan, 2),
+                            ("three_parallel_at_base", ThreeParallelAtEndPlan, 0))
+
+
+def _three_parallel_plan(geometry: Geometry) -> Plan | None:
+    for family in _THREE_PARALLEL:
+        plan = family.match(geometry)
+        if plan is not None:
+            return plan
+    return None
+
+
+def _reversed_three_parallel_plan(geometry: Geometry, reverse: Geometry, n: int) -> Plan | None:
+    for structure, family, first in _THREE_PARALLEL_REVERSED:
+        plan = family.match(reverse)
+        if plan is not None:  # the elbow label of the parallel axes as the chain is described
+            return ReversedPlan(plan, geometry.model.home, n, structure=structure,
+                                label_codes=lambda joints: {"elbow": parallel_elbow_codes(geometry, joints, first)})
+    return None
+
+
+def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
     model = geometry.model
     for k in (n - 3, n - 1, n):
         if k < 0:
@@ -75,7 +119,7 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
         if k and positioner is None:
             continue
         return DecoupledPlan(positioner, wrist, point, model.home, n)
-    return ThreeParallelPlan.match(geometry) or General6RPlan.match(geometry)
+    return None
 
 
 def _position_plan(geometry: Geometry, n: int, reference: np.ndarray | None) -> Plan | None:

@@ -1,7 +1,7 @@
 """Geometric subproblems of analytic inverse kinematics, vectorised over a batch.
 
 The solvers for each kinematic family reduce a pose to a few of these
-subproblems (Paden-Kahan 1-3, IK-Geo 4, and their prismatic analogues). Each
+subproblems (Paden-Kahan 1-3, IK-Geo 4, 5 and 6, and their prismatic analogues). Each
 one returns every candidate, and each candidate carries its own flags. No
 solver here decides acceptance, so a solver can still use a least-squares
 candidate when the target is just outside the workspace.
@@ -42,11 +42,12 @@ Conventions
 Results
 -------
 Every function returns a record with the same flags. ``m`` is the number of
-candidate slots, which is fixed for each function (1 or 2):
+candidate slots, which is fixed for each function (1 or 2; 4 for subproblems 5 and 6):
 
 * ``valid`` (..., m) bool: the candidate exists. The first slot is always
   valid, because every problem has an exact, least-squares or representative
-  answer.
+  answer (subproblem 5 excepted: it has four slots and no least-squares
+  candidate, so a row with no real root has none).
 * ``exact`` (..., m) bool: the candidate satisfies the equation within
   tolerance. False means it is the least-squares answer.
 * ``degenerate`` (...,) bool: infinitely many candidates are equally good,
@@ -57,7 +58,9 @@ candidate slots, which is fixed for each function (1 or 2):
   the first slot is valid. Functions with one slot always report False.
 
 The records are :class:`AngleSolutions` (``theta``), :class:`AnglePairSolutions`
-(``theta1``, ``theta2``) and :class:`DisplacementSolutions` (``s``).
+(``theta1``, ``theta2``), :class:`AngleTripleSolutions` (``theta1``, ``theta2``,
+``theta3``: subproblem 5, four slots), :class:`AngleQuadSolutions` (``theta1``, ``theta2``:
+subproblem 6, four slots) and :class:`DisplacementSolutions` (``s``).
 """
 
 from __future__ import annotations
@@ -73,6 +76,8 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, ORTHONORMAL_T
 
 __all__ = [
     "AnglePairSolutions",
+    "AngleQuadSolutions",
+    "AngleTripleSolutions",
     "AngleSolutions",
     "DisplacementSolutions",
     "planar_two_link_elbow",
@@ -83,6 +88,8 @@ __all__ = [
     "subproblem_2_chain",
     "subproblem_3",
     "subproblem_4",
+    "subproblem_5",
+    "subproblem_6",
 ]
 
 
@@ -103,6 +110,18 @@ class AnglePairSolutions(NamedTuple):
     theta2: np.ndarray  #: (..., 2) float, radians in (-pi, pi]; NaN where not valid
     valid: np.ndarray  #: (..., 2) bool
     exact: np.ndarray  #: (..., 2) bool
+    degenerate: np.ndarray  #: (...,) bool
+    merged: np.ndarray  #: (...,) bool
+
+
+class AngleTripleSolutions(NamedTuple):
+    """Candidates for three joint angles (subproblem 5). Slot ``j`` of the three arrays is one candidate."""
+
+    theta1: np.ndarray  #: (..., 4) float, radians in (-pi, pi]; NaN where not valid
+    theta2: np.ndarray  #: (..., 4) float, radians in (-pi, pi]; NaN where not valid
+    theta3: np.ndarray  #: (..., 4) float, radians in (-pi, pi]; NaN where not valid
+    valid: np.ndarray  #: (..., 4) bool
+    exact: np.ndarray  #: (..., 4) bool
     degenerate: np.ndarray  #: (...,) bool
     merged: np.ndarray  #: (...,) bool
 
@@ -681,6 +700,192 @@ def subproblem_4(h: ArrayLike, k: ArrayLike, p: ArrayLike, delta: ArrayLike) -> 
     return _harmonic(a, b, c, scale)
 
 
+# Roots of subproblem 5's quartic count as on the unit circle (real angles) within this radial distance.
+# Roots off the circle come in pairs (z, 1 / conj(z)); a tangent (double) root that rounding splits
+# lies about sqrt(eps) off it. A root accepted here that is not a solution fails the FK check.
+_SP5_ROOT_RADIUS = 1e-5
+
+
+def _rotation_parts(k: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``R(k, theta) p = fixed + cos(theta) perp + sin(theta) cross`` for points ``p`` (..., 3)."""
+    fixed = (p @ k)[..., None] * k
+    return fixed, p - fixed, np.cross(k, p)
+
+
+def _inverse_2x2(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(inverse, determinant)`` of 2 × 2 matrices (..., 2, 2); the inverse is NaN where the determinant is 0."""
+    det = A[..., 0, 0] * A[..., 1, 1] - A[..., 0, 1] * A[..., 1, 0]
+    adjugate = np.empty_like(A)
+    adjugate[..., 0, 0], adjugate[..., 1, 1] = A[..., 1, 1], A[..., 0, 0]
+    adjugate[..., 0, 1], adjugate[..., 1, 0] = -A[..., 0, 1], -A[..., 1, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return adjugate / det[..., None, None], det
+
+
+def _unit_circle_roots(c2: np.ndarray, c1: np.ndarray, c0: np.ndarray, scale: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Angles of the roots on the unit circle of ``c2 z⁴ + c1 z³ + c0 z² + conj(c1) z + conj(c2)``.
+
+    Returns ``(theta (..., 4), valid (..., 4), identically_zero (...,))``. Rows whose leading
+    coefficient vanishes (relative to ``scale``) are solved as the quadratic left.
+    """
+    shape = c0.shape
+    z = np.full(shape + (4,), np.nan + 0j)
+    tol = 1e-12 * scale
+    quartic = np.abs(c2) > tol
+    if quartic.any():
+        a = np.stack([c1, c0, np.conj(c1), np.conj(c2)], axis=-1)[quartic] / c2[quartic][:, None]
+        companion = np.zeros(a.shape[:1] + (4, 4), dtype=complex)
+        companion[:, 0, :] = -a
+        companion[:, 1, 0] = companion[:, 2, 1] = companion[:, 3, 2] = 1.0
+        z[quartic] = np.linalg.eigvals(companion)
+    quadratic = ~quartic & (np.abs(c1) > tol)
+    if quadratic.any():
+        A, B, C = c1[quadratic], c0[quadratic], np.conj(c1[quadratic])
+        root = np.sqrt(B * B - 4 * A * C)
+        z[quadratic, 0] = (-B + root) / (2 * A)
+        z[quadratic, 1] = (-B - root) / (2 * A)
+    identically_zero = ~quartic & ~quadratic & (np.abs(c0) <= tol)
+    valid = np.abs(np.abs(z) - 1.0) <= _SP5_ROOT_RADIUS
+    return np.where(valid, np.angle(z), np.nan), valid, identically_zero
+
+
+def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1: ArrayLike, p2: ArrayLike,
+                 p3: ArrayLike) -> AngleTripleSolutions:
+    """IK-Geo 5: solve ``p0 + R(k1, theta1) p1 = R(k2, theta2) (p2 + R(k3, theta3) p3)``; up to 4 solutions.
+
+    With ``L(theta1) = p0 + R(k1, theta1) p1`` and ``M(theta3) = p2 + R(k3, theta3) p3``,
+    ``R(k2, theta2)`` keeps both the height along ``k2`` and the length, so a solution needs
+    ``k2.L = k2.M`` and ``||L||**2 = ||M||**2``. Both are linear in ``u1 = (cos theta1, sin theta1)``
+    and ``u3 = (cos theta3, sin theta3)``: ``A1 u1 - A3 u3 = r``, two rows of 2 × 2 blocks (the
+    length row divided by the problem's length ``S`` so that both rows are lengths). Solving for one
+    unit vector in terms of the other, ``u_s = f + G u_t`` (per row, the block with the larger
+    ``|det| / ||A||_F**2``), ``||u_s||**2 = 1`` is a trigonometric quartic in ``theta_t``. With
+    ``z = exp(i theta_t)`` it is a polynomial of degree 4 whose roots on the unit circle are the
+    solutions (no tangent half-angle, so ``theta = pi`` is an ordinary root). The roots are the
+    eigenvalues of its companion matrix, each refined by two Newton steps on the real equation;
+    ``theta2`` follows by subproblem 1, ``R(k2, theta2) M = L``. This is Pieper's quartic for a
+    3R positioner whose second and third axes are skew.
+
+    Parameters
+    ----------
+    k1, k2, k3 : array_like, shape (3,)
+        Unit rotation axes through the origin.
+    p0, p1, p2, p3 : array_like, shape (..., 3)
+        Offsets and rotated points, broadcast against each other.
+
+    Returns
+    -------
+    AngleTripleSolutions
+        ``theta1``, ``theta2``, ``theta3`` have shape (..., 4), the slots in no particular order.
+
+    Notes
+    -----
+    Unlike subproblems 1–4 there is no least-squares candidate: a row whose quartic has no root
+    on the unit circle (within ``1e-5`` radially) has no valid slot. Roots closer than
+    ``DUPLICATE_TOLERANCE`` (a tangent root, the edge of the workspace) are reported once with
+    ``merged`` set. Scale: ``S = ||p0|| + ||p1|| + ||p2|| + ||p3||``; a candidate is ``exact``
+    when the vector equation holds to ``GEOMETRY_TOLERANCE * S``. Near a tangent root a root
+    carries about the square root of the rounding error; such valid but inexact candidates are
+    left to the caller (the IK solvers refine and verify every candidate by FK).
+    ``degenerate``: the quartic vanishes identically, so ``theta_t`` is free (``p1`` on ``k1``
+    or ``p3`` on ``k3``, with the target reachable); the representative has ``theta_t = 0``.
+    When neither block is invertible the equations do not separate the angles (``k1 ∥ k2``
+    with ``p2`` on ``k3``, or ``k2 ∥ k3``): no slot is valid, and those geometries are solved
+    by subproblems 3 and 4 instead.
+
+    Examples
+    --------
+    A point turned by three skew axes and found again (one slot holds the generating angles):
+
+    >>> k1, k2, k3 = np.array([1.0, 0, 0]), np.array([0, 1.0, 0]), np.array([0.6, 0, 0.8])
+    >>> p0, p2, p3 = np.array([0.3, 0.1, 0.0]), np.array([0.0, 0.4, 0.2]), np.array([0.5, 0.2, 0.1])
+    >>> def R(k, t):
+    ...     return np.cos(t) * np.eye(3) + np.sin(t) * np.cross(np.eye(3), k) + (1 - np.cos(t)) * np.outer(k, k)
+    >>> p1 = R(k1, -0.4) @ (R(k2, 0.7) @ (p2 + R(k3, -1.1) @ p3) - p0)
+    >>> sol = subproblem_5(k1, k2, k3, p0, p1, p2, p3)
+    >>> found = np.stack([sol.theta1, sol.theta2, sol.theta3], axis=-1)[sol.valid]
+    >>> bool(np.isclose(found, [0.4, 0.7, -1.1]).all(axis=-1).any())
+    True
+    """
+    k1, k2, k3 = _unit(k1, "k1"), _unit(k2, "k2"), _unit(k3, "k3")
+    p0, p1, p2, p3 = (_points(p, name) for p, name in ((p0, "p0"), (p1, "p1"), (p2, "p2"), (p3, "p3")))
+    shape = np.broadcast_shapes(p0.shape, p1.shape, p2.shape, p3.shape)[:-1]
+    p0, p1, p2, p3 = (np.broadcast_to(p, shape + (3,)) for p in (p0, p1, p2, p3))
+    S = _norm(p0) + _norm(p1) + _norm(p2) + _norm(p3)
+    S = np.where(S > 0.0, S, 1.0)
+    fixed1, perp1, cross1 = _rotation_parts(k1, p1)
+    fixed3, perp3, cross3 = _rotation_parts(k3, p3)
+    A1 = np.stack([np.stack([perp1 @ k2, cross1 @ k2], axis=-1),
+                   2.0 * np.stack([_dot(p0, perp1), _dot(p0, cross1)], axis=-1) / S[..., None]], axis=-2)
+    A3 = np.stack([np.stack([perp3 @ k2, cross3 @ k2], axis=-1),
+                   2.0 * np.stack([_dot(p2, perp3), _dot(p2, cross3)], axis=-1) / S[..., None]], axis=-2)
+    r = np.stack([(p2 + fixed3 - p0 - fixed1) @ k2,
+                  (_dot(p2, p2) + _dot(p3, p3) + 2 * _dot(p2, fixed3)
+                   - _dot(p0, p0) - _dot(p1, p1) - 2 * _dot(p0, fixed1)) / S], axis=-1)
+    inverse1, det1 = _inverse_2x2(A1)
+    inverse3, det3 = _inverse_2x2(A3)
+    quality1 = np.abs(det1) / np.maximum((A1 * A1).sum(axis=(-1, -2)), 1e-300)
+    quality3 = np.abs(det3) / np.maximum((A3 * A3).sum(axis=(-1, -2)), 1e-300)
+    by_theta1 = quality3 >= quality1  # solve for u3, the quartic in theta1
+    # u_s = inverse_s (A_t u_t + rho): rho = -r solving for u3, +r solving for u1
+    inverse = np.where(by_theta1[..., None, None], inverse3, inverse1)
+    A_t = np.where(by_theta1[..., None, None], A1, A3)
+    rho = np.where(by_theta1[..., None], -r, r)
+    separable = np.maximum(quality1, quality3) > 1e-12
+    G = inverse @ A_t
+    f = np.einsum("...ij,...j->...i", inverse, rho)
+    Q = np.swapaxes(G, -1, -2) @ G
+    g = np.einsum("...ji,...j->...i", G, f)
+    h = _dot(f, f) - 1.0
+    c2 = (Q[..., 0, 0] - Q[..., 1, 1]) / 4 - 0.5j * Q[..., 0, 1]
+    c1 = g[..., 0] - 1j * g[..., 1]
+    c0 = (Q[..., 0, 0] + Q[..., 1, 1]) / 2 + h
+    scale = 1.0 + Q[..., 0, 0] + Q[..., 1, 1] + _dot(f, f)
+    with np.errstate(invalid="ignore"):
+        theta_t, valid, free = _unit_circle_roots(c2, c1, c0, np.where(separable, scale, np.inf))
+        free &= separable
+        valid &= separable[..., None]
+        theta_t[free, 0], valid[free, 0] = 0.0, True
+        for _ in range(2):  # Newton on F(t) = u Q u + 2 g u + h, u = (cos t, sin t)
+            u = np.stack([np.cos(theta_t), np.sin(theta_t)], axis=-1)
+            du = np.stack([-u[..., 1], u[..., 0]], axis=-1)
+            Qu = np.einsum("...ij,...mj->...mi", Q, u)
+            F = np.einsum("...mi,...mi->...m", u, Qu + 2 * g[..., None, :]) + h[..., None]
+            dF = 2 * np.einsum("...mi,...mi->...m", du, Qu + g[..., None, :])
+            step = np.where(np.abs(dF) > 1e-9 * scale[..., None], F / np.where(dF == 0, 1.0, dF), 0.0)
+            theta_t = np.where(free[..., None] | (np.abs(step) > 1e-3), theta_t, theta_t - step)
+        u_t = np.stack([np.cos(theta_t), np.sin(theta_t)], axis=-1)
+        u_s = f[..., None, :] + np.einsum("...ij,...mj->...mi", G, u_t)
+        theta_s = np.arctan2(u_s[..., 1], u_s[..., 0])
+    theta1 = _wrap(np.where(by_theta1[..., None], theta_t, theta_s))
+    theta3 = _wrap(np.where(by_theta1[..., None], theta_s, theta_t))
+    L = p0[..., None, :] + _rotate_points(k1, theta1, p1[..., None, :])
+    M = p2[..., None, :] + _rotate_points(k3, theta3, p3[..., None, :])
+    theta2, _, _ = _rotate_onto(_frame(k2), np.nan_to_num(M), np.nan_to_num(L), S[..., None])
+    miss = _norm(L - _rotate_points(k2, theta2, M))
+    # the same root twice (a tangent root): keep the first
+    merged = np.zeros(shape, dtype=bool)
+    for later in range(1, 4):
+        for earlier in range(later):
+            gap = np.abs(_wrap(theta_t[..., later] - theta_t[..., earlier]))
+            same = valid[..., later] & valid[..., earlier] & (gap <= DUPLICATE_TOLERANCE)
+            merged |= same
+            valid[..., later] &= ~same
+    nan = np.nan
+    return AngleTripleSolutions(
+        theta1=np.where(valid, theta1, nan), theta2=np.where(valid, theta2, nan),
+        theta3=np.where(valid, theta3, nan), valid=valid,
+        exact=valid & (miss <= GEOMETRY_TOLERANCE * S[..., None]), degenerate=free, merged=merged)
+
+
+def _rotate_points(k: np.ndarray, theta: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``R(k, theta) p`` (Rodrigues), broadcasting ``theta`` (...) against points ``p`` (..., 3)."""
+    fixed, perp, cross = _rotation_parts(k, p)
+    c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
+    return fixed + c * perp + s * cross
+
+
 def planar_two_link_elbow(l1: float, l2: float, r: ArrayLike) -> AngleSolutions:
     """Elbow angle of a planar two-link arm: solve ``||l1 e(0) + l2 e(q2)|| = r`` for ``q2``.
 
@@ -859,3 +1064,262 @@ def prismatic_to_plane(h: ArrayLike, p: ArrayLike, v: ArrayLike, delta: ArrayLik
         degenerate=degenerate,
         merged=np.zeros(miss.shape, dtype=bool),
     )
+
+
+# ---------------------------------------------------------------------------
+# Subproblem 6: two angles from two linear equations
+# ---------------------------------------------------------------------------
+
+
+class AngleQuadSolutions(NamedTuple):
+    """Candidates for two joint angles with up to four slots. Slot ``j`` of ``theta1`` and ``theta2`` is one
+    candidate. See the module docstring for the flags; ``merged`` marks a double root."""
+
+    theta1: np.ndarray  #: (..., 4) float, radians in (-pi, pi]; NaN where not valid
+    theta2: np.ndarray  #: (..., 4) float, radians in (-pi, pi]; NaN where not valid
+    valid: np.ndarray  #: (..., 4) bool
+    exact: np.ndarray  #: (..., 4) bool
+    degenerate: np.ndarray  #: (...,) bool
+    merged: np.ndarray  #: (...,) bool
+
+
+# A root z of the quartic counts as a real angle when | |z| - 1 | is below this before polishing: generous, since
+# a double root splits by about sqrt(eps); polishing and the residual test below decide.
+_ON_CIRCLE = 1e-3
+_NEWTON_STEPS = 2  # on the pair of equations, after the quartic's roots
+_EXACT_PAIR = 10 * GEOMETRY_TOLERANCE  # relative residual of an exact root: Newton-polished roots reach ~1e-15
+
+
+def _term_coefficients(k: np.ndarray, h: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``h.R(k, theta) p = a cos(theta) + b sin(theta) + e``: the coefficients (a, b, e), each of the batch shape."""
+    frame = _frame(k)
+    hx, hy, hz = _coords(h, frame)
+    px, py, pz = _coords(p, frame)
+    return hx * px + hy * py, hy * px - hx * py, hz * pz
+
+
+def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2):
+    """The real roots of ``alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t = 0``, four slots.
+
+    With ``z = exp(i t)`` the equation times ``z**2`` is a quartic in z whose roots on the unit circle are the
+    real angles. Its roots come from the eigenvalues of the companion matrices, one batched ``eigvals``.
+    Returns ``(theta, found, double)``: ``theta`` and ``found`` (..., 4), ``found`` where a root lies on the
+    circle (``theta`` elsewhere holds the angle of a root off it); ``double`` as below. When the
+    degree-2 part vanishes (``|alpha2| + |beta2|`` about 0) the equation is harmonic, with two roots, and
+    ``double`` (...,) marks where they are one.
+    """
+    shape = np.shape(alpha0)
+    c4 = 0.5 * (alpha2 - 1j * beta2)
+    c3 = 0.5 * (alpha1 - 1j * beta1)
+    size = np.maximum.reduce([np.abs(alpha0), np.abs(alpha1) + np.abs(beta1), np.abs(alpha2) + np.abs(beta2)])
+    size = np.where(size > 0.0, size, 1.0)
+    quartic = np.abs(c4) > 1e-8 * size
+    theta = np.full(shape + (4,), np.nan)
+    found = np.zeros(shape + (4,), dtype=bool)
+    double = np.zeros(shape, dtype=bool)
+    if quartic.any():
+        lead = np.where(quartic, c4, 1.0)
+        companion = np.zeros(shape + (4, 4), dtype=complex)
+        companion[..., 1, 0] = companion[..., 2, 1] = companion[..., 3, 2] = 1.0
+        companion[..., 0, 0] = -c3 / lead
+        companion[..., 0, 1] = -alpha0 / lead
+        companion[..., 0, 2] = -np.conj(c3) / lead
+        companion[..., 0, 3] = -np.conj(c4) / lead
+        companion[~quartic] = np.eye(4) * 2.0  # placeholder rows: roots off the circle, overwritten below
+        z = np.linalg.eigvals(companion)
+        found = quartic[..., None] & (np.abs(np.abs(z) - 1.0) <= _ON_CIRCLE)
+        theta = np.angle(z)  # off the circle too: the nearest angle serves a row without a root
+    if not quartic.all():
+        harmonic = _harmonic(alpha1, beta1, -alpha0, size)
+        two = harmonic.valid & harmonic.exact
+        theta[..., :2] = np.where(~quartic[..., None], np.nan_to_num(harmonic.theta), theta[..., :2])
+        theta[..., 2:] = np.where(~quartic[..., None], theta[..., :1], theta[..., 2:])
+        found[..., :2] = np.where(~quartic[..., None], two, found[..., :2])
+        double = ~quartic & harmonic.merged
+    return _wrap(np.nan_to_num(theta)), found, double
+
+
+def subproblem_6(
+    k1: ArrayLike, k2: ArrayLike,
+    h1: ArrayLike, p1: ArrayLike, h2: ArrayLike, p2: ArrayLike, d1: ArrayLike,
+    h3: ArrayLike, p3: ArrayLike, h4: ArrayLike, p4: ArrayLike, d2: ArrayLike,
+) -> AngleQuadSolutions:
+    """IK-Geo 6: solve the pair of equations
+
+    ``h1.R(k1, theta1) p1 + h2.R(k2, theta2) p2 = d1`` and ``h3.R(k1, theta1) p3 + h4.R(k2, theta2) p4 = d2``.
+
+    Each term ``h.R(k, theta) p`` is ``a cos(theta) + b sin(theta) + e`` (coordinates in a frame around ``k``), so
+    the pair is linear in ``x1 = (cos theta1, sin theta1)`` and ``x2 = (cos theta2, sin theta2)``:
+    ``A x1 + B x2 = r`` with A, B of shape (2, 2). Multiplying by the adjugate of B gives
+    ``det(B) x2 = adj(B) (r - A x1)``; ``||x2|| = 1`` then reads ``||adj(B) (r - A x1)||**2 = det(B)**2``, a
+    trigonometric polynomial of degree 2 in theta1, that is a quartic in ``exp(i theta1)``: at most four roots,
+    each giving x2 and so theta2. The elimination runs on the block with the larger determinant (B, or A with
+    the roles of the angles swapped), row by row. When both blocks are singular but the pair is not, each equation
+    combination that removes one angle is a harmonic equation in the other: 2 x 2 candidates.
+
+    Parameters
+    ----------
+    k1, k2 : array_like, shape (3,)
+        Unit rotation axes through the origin.
+    h1, h2, h3, h4 : array_like, shape (..., 3)
+        Fixed vectors (any length) of the linear forms.
+    p1, p2, p3, p4 : array_like, shape (..., 3)
+        Rotated points: ``p1``, ``p3`` about ``k1``; ``p2``, ``p4`` about ``k2``.
+    d1, d2 : array_like, shape (...)
+        Right-hand sides.
+
+    Returns
+    -------
+    AngleQuadSolutions
+        Four slots; valid slots first. There is no least-squares answer: a row without a root has only its
+        first slot valid, holding the angle pair nearest to a solution (``exact`` false), so that a solver
+        can still refine it. ``merged`` marks a double root (reported once). ``degenerate`` marks a pair that
+        does not fix both angles (rank below 2, or the eliminated equation met by every value of one angle),
+        with a representative whose free angle is 0.
+
+    Notes
+    -----
+    Scale: ``S = sum ||h_i|| ||p_i|| + |d1| + |d2|``. A root is exact when both equations hold to
+    ``10 * GEOMETRY_TOLERANCE * S`` at the polished angles (Newton steps on the pair itself; near a double
+    root, where they stall, the residual is still quadratic in the error). A block counts as singular when its determinant is at
+    most ``GEOMETRY_TOLERANCE`` times the squared size of the coefficients.
+
+    Examples
+    --------
+    ``cos(theta1) + cos(theta2) = 1`` and ``sin(theta1) - sin(theta2) = 0``: theta1 = theta2 = +/-60 degrees.
+
+    >>> x, y, z = [1, 0, 0], [0, 1, 0], [0, 0, 1]
+    >>> sol = subproblem_6(z, z, x, x, x, x, 1.0, y, x, y, [-1, 0, 0], 0.0)
+    >>> sorted(np.degrees(sol.theta1[sol.valid]).round(9).tolist())
+    [-60.0, 60.0]
+    """
+    k1 = _unit(k1, "k1")
+    k2 = _unit(k2, "k2")
+    vectors = [np.asarray(v, dtype=float) for v in (h1, p1, h2, p2, h3, p3, h4, p4)]
+    for name, v in zip(("h1", "p1", "h2", "p2", "h3", "p3", "h4", "p4"), vectors):
+        _points(v, name)
+    h1, p1, h2, p2, h3, p3, h4, p4 = vectors
+    d1 = np.asarray(d1, dtype=float)
+    d2 = np.asarray(d2, dtype=float)
+    a11, a12, e1 = _term_coefficients(k1, h1, p1)
+    b11, b12, f1 = _term_coefficients(k2, h2, p2)
+    a21, a22, e2 = _term_coefficients(k1, h3, p3)
+    b21, b22, f2 = _term_coefficients(k2, h4, p4)
+    r1 = d1 - e1 - f1
+    r2 = d2 - e2 - f2
+    a11, a12, a21, a22, b11, b12, b21, b22, r1, r2 = np.broadcast_arrays(a11, a12, a21, a22, b11, b12, b21, b22,
+                                                                         r1, r2)
+    shape = a11.shape
+    scale = (_norm(h1) * _norm(p1) + _norm(h2) * _norm(p2) + _norm(h3) * _norm(p3) + _norm(h4) * _norm(p4)
+             + np.abs(d1) + np.abs(d2))
+    scale = np.broadcast_to(np.where(scale > 0.0, scale, 1.0), shape)
+    det_a = a11 * a22 - a12 * a21
+    det_b = b11 * b22 - b12 * b21
+    size_a = a11**2 + a12**2 + a21**2 + a22**2
+    size_b = b11**2 + b12**2 + b21**2 + b22**2
+    # eliminate the block with the larger determinant (a near-zero block, however well shaped, is never taken);
+    # swap means "eliminate theta1, solve theta2"
+    swap = np.abs(det_a) > np.abs(det_b)
+    coupled = np.maximum(np.abs(det_a), np.abs(det_b)) > GEOMETRY_TOLERANCE * np.maximum(size_a, size_b)
+    # kept block P (its angle solved from the quartic), eliminated block Q
+    block_a = np.stack([a11, a12, a21, a22], -1).reshape(shape + (2, 2))
+    block_b = np.stack([b11, b12, b21, b22], -1).reshape(shape + (2, 2))
+    if not swap.any():
+        P, Q = block_a, block_b
+    elif swap.all():
+        P, Q = block_b, block_a
+    else:
+        P = np.where(swap[..., None, None], block_b, block_a)
+        Q = np.where(swap[..., None, None], block_a, block_b)
+    det_q = np.where(swap, det_a, det_b)
+    adj_q = np.stack([np.stack([Q[..., 1, 1], -Q[..., 0, 1]], -1), np.stack([-Q[..., 1, 0], Q[..., 0, 0]], -1)], -2)
+    r = np.stack([r1, r2], -1)
+    u = np.einsum("...ij,...j->...i", adj_q, r)
+    W = adj_q @ P
+    S = np.swapaxes(W, -1, -2) @ W
+    g = np.einsum("...ji,...j->...i", W, u)
+    coefficients = (_dot(u, u) - det_q**2 + 0.5 * (S[..., 0, 0] + S[..., 1, 1]), -2 * g[..., 0], -2 * g[..., 1],
+                    0.5 * (S[..., 0, 0] - S[..., 1, 1]), S[..., 0, 1])
+    theta_p, found, double = _trig_quartic_roots(*coefficients)
+    # every value of the kept angle solves the eliminated equation: that angle is free (its representative 0)
+    identically = coupled & (np.maximum.reduce([np.abs(c) for c in coefficients])
+                             <= GEOMETRY_TOLERANCE * (det_q**2 + _dot(u, u) + S[..., 0, 0] + S[..., 1, 1]))
+    if identically.any():
+        theta_p = np.where(identically[..., None], 0.0, theta_p)
+        found = np.where(identically[..., None], np.arange(4) == 0, found)
+    xp = np.stack([np.cos(theta_p), np.sin(theta_p)], -1)  # (..., 4, 2)
+    xq = (u[..., None, :] - np.einsum("...ij,...sj->...si", W, xp)) / np.where(det_q != 0.0, det_q, 1.0)[..., None,
+                                                                                                             None]
+    theta_q = np.arctan2(xq[..., 1], xq[..., 0])
+    theta1 = np.where(swap[..., None], theta_q, theta_p)
+    theta2 = np.where(swap[..., None], theta_p, theta_q)
+
+    if not coupled.all():
+        # both blocks singular: A = a_u a_v^T, B = b_u b_v^T; the row combination orthogonal to b_u removes theta2
+        # (and the one orthogonal to a_u removes theta1), leaving one harmonic equation per angle
+        def left_null(m11, m12, m21, m22):
+            c1, c2 = np.where(m11**2 + m21**2 >= m12**2 + m22**2, m11, m12), np.where(
+                m11**2 + m21**2 >= m12**2 + m22**2, m21, m22)  # the block's column space direction
+            return -c2, c1
+
+        wb1, wb2 = left_null(b11, b12, b21, b22)
+        wa1, wa2 = left_null(a11, a12, a21, a22)
+        one = _harmonic(wb1 * a11 + wb2 * a21, wb1 * a12 + wb2 * a22, wb1 * r1 + wb2 * r2, scale)
+        two = _harmonic(wa1 * b11 + wa2 * b21, wa1 * b12 + wa2 * b22, wa1 * r1 + wa2 * r2, scale)
+        t1 = np.repeat(one.theta, 2, axis=-1)
+        t2 = np.tile(two.theta, 2)
+        ok = np.repeat(one.valid & one.exact, 2, axis=-1) & np.tile(two.valid & two.exact, 2)
+        theta1 = np.where(coupled[..., None], theta1, t1)
+        theta2 = np.where(coupled[..., None], theta2, t2)
+        found = np.where(coupled[..., None], found, ok)
+        rank_one = ~coupled & (one.degenerate | two.degenerate)
+    else:
+        rank_one = np.zeros(shape, dtype=bool)
+
+    # Newton steps on the pair itself (the quartic squared it: its roots are good to about sqrt of the
+    # rounding near a double root), then the residuals of both equations at each candidate
+    ex = lambda x: x[..., None]  # noqa: E731
+    for step in range(_NEWTON_STEPS + 1):
+        c1, s1, c2, s2 = np.cos(theta1), np.sin(theta1), np.cos(theta2), np.sin(theta2)
+        miss1 = ex(a11) * c1 + ex(a12) * s1 + ex(b11) * c2 + ex(b12) * s2 - ex(r1)
+        miss2 = ex(a21) * c1 + ex(a22) * s1 + ex(b21) * c2 + ex(b22) * s2 - ex(r2)
+        if step == _NEWTON_STEPS:
+            break
+        j11, j12 = ex(a12) * c1 - ex(a11) * s1, ex(b12) * c2 - ex(b11) * s2
+        j21, j22 = ex(a22) * c1 - ex(a21) * s1, ex(b22) * c2 - ex(b21) * s2
+        jac = j11 * j22 - j12 * j21
+        usable = np.abs(jac) > 1e-6 * (j11**2 + j12**2 + j21**2 + j22**2)  # not at a double root
+        inverse = np.where(usable, 1.0 / np.where(usable, jac, 1.0), 0.0)
+        step1 = np.minimum(np.maximum((j22 * miss1 - j12 * miss2) * inverse, -1e-3), 1e-3)  # (np.clip is slow)
+        step2 = np.minimum(np.maximum((j11 * miss2 - j21 * miss1) * inverse, -1e-3), 1e-3)
+        theta1, theta2 = theta1 - step1, theta2 - step2
+    miss = np.nan_to_num(_hypot(miss1, miss2) / ex(scale), nan=np.inf)
+    exact = found & (miss <= _EXACT_PAIR)
+    # a row without a root keeps its nearest candidate in slot 0
+    nearest = np.argmin(miss, axis=-1)
+    rank_one = rank_one | identically
+    none = ~exact.any(axis=-1) & ~rank_one
+    keep = exact.copy()
+    keep[none, nearest[none]] = True
+
+    # merge equal roots (a double root appears twice), keep distinct ones first
+    gap1 = np.abs(_wrap(theta1[..., :, None] - theta1[..., None, :]))
+    gap2 = np.abs(_wrap(theta2[..., :, None] - theta2[..., None, :]))
+    same = (np.nan_to_num(gap1, nan=np.inf) <= DUPLICATE_TOLERANCE) & (np.nan_to_num(gap2, nan=np.inf)
+                                                                         <= DUPLICATE_TOLERANCE)
+    earlier = np.tril(np.ones((4, 4), dtype=bool), -1)
+    duplicate = (same & earlier & keep[..., None, :]).any(axis=-1) & keep
+    merged = duplicate.any(axis=-1) | (double & coupled)
+    keep &= ~duplicate
+    order = np.argsort(~keep, axis=-1, kind="stable")
+    keep = np.take_along_axis(keep, order, -1)
+    exact = np.take_along_axis(exact, order, -1) & keep
+    theta1 = np.where(keep, np.take_along_axis(_wrap(theta1), order, -1), np.nan)
+    theta2 = np.where(keep, np.take_along_axis(_wrap(theta2), order, -1), np.nan)
+    decoupled_free = rank_one & ~identically
+    if decoupled_free.any():
+        theta1[..., 0] = np.where(decoupled_free, np.where(one.degenerate, 0.0, one.theta[..., 0]), theta1[..., 0])
+        theta2[..., 0] = np.where(decoupled_free, np.where(two.degenerate, 0.0, two.theta[..., 0]), theta2[..., 0])
+    keep[..., 0] |= rank_one
+    return AngleQuadSolutions(theta1=theta1, theta2=theta2, valid=keep, exact=exact,
+                              degenerate=np.asarray(rank_one), merged=np.asarray(merged))

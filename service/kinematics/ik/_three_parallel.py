@@ -1,4 +1,4 @@
-"""6R arms whose joints 2, 3 and 4 have parallel axes, and whose axes 5 and 6 meet (UR5 type).
+"""6R arms whose joints 2, 3 and 4 have parallel axes: axes 5 and 6 meeting (UR5 type) or skew.
 
 With ω_p the common direction of axes 2–4, A = world_T_target · home⁻¹ =
 G_1 ⋯ G_6, and c the point where axes 5 and 6 meet:
@@ -16,6 +16,9 @@ G_1 ⋯ G_6, and c the point where axes 5 and 6 meet:
    q_4 from the sum.
 
 2 × 2 × 2 = 8 solutions in general.
+
+When axes 5 and 6 are skew (:class:`SkewWristThreeParallelPlan`) steps 1 and 2
+are one subproblem 6 in (q_1, q_5); steps 3–5 are the same.
 """
 
 from __future__ import annotations
@@ -23,33 +26,21 @@ from __future__ import annotations
 import numpy as np
 
 from ._positioning import _flag_rows, _unit, side_codes
-from ._screws import apply, invert, joint_motion, move_point, rotate_about
+from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
-from ._subproblems import subproblem_1, subproblem_3, subproblem_4
+from ._subproblems import subproblem_1, subproblem_3, subproblem_4, subproblem_6
 from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
 from ._wrist import _perpendicular_unit, wrist_codes
 
 
-class ThreeParallelPlan:
-    """The UR5-type family: axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersecting."""
+class _AxesTwoToFourParallel:
+    """What the families with axes 2 ∥ 3 ∥ 4 share: steps 3–5 from candidate pairs (q1, q5), and the labels.
+    A family supplies ``match`` and ``_shoulder_and_wrist`` (steps 1 and 2)."""
 
     method = "analytic"
-    structure = "three_parallel"
     generic_count = 8
     free_joints: list[int] = []
-
-    @classmethod
-    def match(cls, geometry: Geometry) -> "ThreeParallelPlan | None":
-        if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
-            return None
-        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.parallel(0, 1):
-            return None
-        if geometry.parallel(1, 4):
-            return None
-        centre = geometry.intersection(4, 5)
-        if centre is None:
-            return None
-        return cls(geometry, centre)
+    centre: np.ndarray
 
     def __init__(self, geometry: Geometry, centre: np.ndarray) -> None:
         self.geometry = geometry
@@ -64,23 +55,26 @@ class ThreeParallelPlan:
         self.forward = forward if forward @ reach >= 0 else -forward
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
-        g, w_p = self.geometry, self.omega_p
-        n = len(world_T_targets)
         A = world_T_targets @ self.home_inverse  # (N, 4, 4)
-        R_A = A[:, :3, :3]
-        c_world = apply(A, self.centre)
-        # 1. shoulder: two roots for q1
-        shoulder = subproblem_4(w_p, g.direction(0), c_world - g.point(0), w_p @ (self.centre - g.point(0)))
-        q1 = -shoulder.theta  # (N, 2)
-        R1 = joint_motion(g.direction(0), g.point(0), True, q1)  # (N, 2, 4, 4)
-        R_rest = np.swapaxes(R1[..., :3, :3], -1, -2) @ R_A[:, None]  # (N, 2, 3, 3)
-        # 2. wrist: two roots for q5
-        target_height = np.einsum("i,...ij,j->...", w_p, R_rest, g.direction(5))
-        wrist = subproblem_4(w_p, g.direction(4), g.direction(5), target_height)
-        q5 = wrist.theta  # (N, 2, 2)
+        singular = SingularFlags(len(A))
+        q1, q5, valid = self._shoulder_and_wrist(A, singular, reference)
+        return self._complete(A, q1, q5, valid, singular, reference)
+
+    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags,
+                            reference: np.ndarray | None) -> tuple[np.ndarray, ...]:
+        raise NotImplementedError
+
+
+    def _complete(self, A: np.ndarray, q1: np.ndarray, q5: np.ndarray, valid15: np.ndarray,
+                  singular: SingularFlags, reference: np.ndarray | None) -> Candidates:
+        """Steps 3–5 from candidate pairs (q1, q5) of shape (N, m): 2m joint vectors per target."""
+        g, w_p = self.geometry, self.omega_p
+        n, m = q1.shape
+        R1 = joint_motion(g.direction(0), g.point(0), True, q1)  # (N, m, 4, 4)
+        R_rest = np.swapaxes(R1[..., :3, :3], -1, -2) @ A[:, None, :3, :3]  # (N, m, 3, 3)
         # 3. q6
-        p = rotate_about(g.direction(4), -q5, w_p)  # (N, 2, 2, 3)
-        q = np.einsum("...ji,j->...i", R_rest, w_p)[:, :, None, :]
+        p = rotate_about(g.direction(4), -q5, w_p)  # (N, m, 3)
+        q = np.einsum("...ji,j->...i", R_rest, w_p)
         sixth = subproblem_1(g.direction(5), p, q)
         q6 = -sixth.theta[..., 0]
         free_six = sixth.degenerate
@@ -90,45 +84,40 @@ class ThreeParallelPlan:
         G5 = joint_motion(g.direction(4), g.point(4), True, q5)
         G6 = joint_motion(g.direction(5), g.point(5), True, q6)
         R5, R6 = G5[..., :3, :3], G6[..., :3, :3]
-        R234 = R_rest[:, :, None] @ np.swapaxes(R6, -1, -2) @ np.swapaxes(R5, -1, -2)
-        angle_sum = subproblem_1(w_p, self.normal_p, R234 @ self.normal_p).theta[..., 0]  # (N, 2, 2)
+        R234 = R_rest @ np.swapaxes(R6, -1, -2) @ np.swapaxes(R5, -1, -2)
+        angle_sum = subproblem_1(w_p, self.normal_p, R234 @ self.normal_p).theta[..., 0]  # (N, m)
         # 5. point on axis 4 through joints 2 and 3
         # G_1 G_2 G_3 p_4 = A G_6⁻¹ G_5⁻¹ p_4 (G_4 leaves p_4 where it is)
         y = apply(invert(G5), g.point(3))
         y = apply(invert(G6), y)
-        p4_world = apply(A[:, None, None], y)
-        z = apply(invert(R1)[:, :, None], p4_world)  # (N, 2, 2, 3)
+        p4_world = apply(A[:, None], y)
+        z = apply(invert(R1), p4_world)  # (N, m, 3)
         elbow = subproblem_3(g.direction(2), g.point(3) - g.point(2), g.point(1) - g.point(2),
                              np.linalg.norm(z - g.point(1), axis=-1))
-        q3 = elbow.theta  # (N, 2, 2, 2)
+        q3 = elbow.theta  # (N, m, 2)
         moved = g.point(2) + rotate_about(g.direction(2), q3, g.point(3) - g.point(2))
         second = subproblem_1(g.direction(1), moved - g.point(1), (z - g.point(1))[..., None, :])
         q2 = second.theta[..., 0]
         s2, s3, s4 = self.signs
         q4 = s4 * (angle_sum[..., None] - s2 * q2 - s3 * q3)
-        shape = (n, 2, 2, 2)
-        joints = np.stack([np.broadcast_to(q1[:, :, None, None], shape), q2, q3, q4,
+        shape = (n, m, 2)
+        joints = np.stack([np.broadcast_to(q1[..., None], shape), q2, q3, q4,
                            np.broadcast_to(q5[..., None], shape), np.broadcast_to(q6[..., None], shape)], axis=-1)
-        valid = (shoulder.valid[:, :, None, None] & wrist.valid[..., None] & elbow.valid)
-        valid[:, :, :, 1] &= ~elbow.merged
-        singular = SingularFlags(n)
-        _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
-                                                    "the wrist point is on the first axis; joint 1 is free"), singular)
-        _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",
-                                                "the two shoulder solutions meet"), singular)
+        valid = valid15[..., None] & elbow.valid
+        valid[..., 1] &= ~elbow.merged
         relation = "sum" if np.all(self.signs > 0) else "signed_sum"
-        _flag_rows((free_six & shoulder.valid[..., None]).any(axis=(1, 2)),
-                   Singularity("wrist", (1, 2, 3, 5), relation,
-                               "axis 6 is parallel to axes 2–4: only q2 + q3 + q4 and q6 together are "
-                               "determined; q6 is set to the reference value (or 0)"), singular)
-        merged = (elbow.merged & valid[..., 0]).reshape(n, 4)
+        _flag_rows((free_six & valid15).any(axis=1), Singularity("wrist", (1, 2, 3, 5), relation,
+                                                   "axis 6 is parallel to axes 2–4: only q2 + q3 + q4 and q6 "
+                                                   "together are determined; q6 is set to the reference value "
+                                                   "(or 0)"), singular)
+        merged = (elbow.merged | _split_double_root(q3, valid)) & valid[..., 0]
         merged_rows = merged.any(axis=1)
         if merged_rows.any():
             first = np.argmax(merged, axis=1)  # the first merged slot of each row, as argwhere found it
-            stretched = np.cos(q3[..., 0].reshape(n, 4)[np.arange(n), first]) > 0
+            stretched = np.cos(q3[..., 0][np.arange(n), first]) > 0
             for kind, mask in (("stretched", merged_rows & stretched), ("folded", merged_rows & ~stretched)):
                 singular.add(mask, Singularity("elbow", (2,), kind, f"the arm is fully {kind}"))
-        return Candidates(joints.reshape(n, 8, 6), valid.reshape(n, 8), [], singular)
+        return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), [], singular)
 
     def labels(self, joints: np.ndarray) -> list[Branch]:
         return branches_from_codes(self.label_codes(joints), len(joints))
@@ -157,3 +146,98 @@ class ThreeParallelPlan:
         return {"shoulder": (("left", "right"), side_codes(shoulder, np.linalg.norm(wrist_point - g.point(0), axis=-1))),
                 "elbow": (("up", "down"), side_codes(side, np.linalg.norm(elbow_point, axis=-1))),
                 **wrist_codes(joints[:, 4])}
+
+
+class ThreeParallelPlan(_AxesTwoToFourParallel):
+    """The UR5-type family: axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersecting."""
+
+    structure = "three_parallel"
+
+    @classmethod
+    def match(cls, geometry: Geometry) -> "ThreeParallelPlan | None":
+        if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
+            return None
+        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.parallel(0, 1):
+            return None
+        if geometry.parallel(1, 4):
+            return None
+        centre = geometry.intersection(4, 5)
+        if centre is None:
+            return None
+        return cls(geometry, centre)
+
+    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags,
+                            reference: np.ndarray | None) -> tuple[np.ndarray, ...]:
+        """Steps 1 and 2: candidate pairs (q1, q5), shape (N, 4) each, and which exist (N, 4)."""
+        g, w_p = self.geometry, self.omega_p
+        n = len(A)
+        c_world = apply(A, self.centre)
+        # 1. shoulder: two roots for q1
+        shoulder = subproblem_4(w_p, g.direction(0), c_world - g.point(0), w_p @ (self.centre - g.point(0)))
+        q1 = -shoulder.theta  # (N, 2)
+        R1 = rotation_about(g.direction(0), q1)  # (N, 2, 3, 3)
+        R_rest = np.swapaxes(R1, -1, -2) @ A[:, None, :3, :3]  # (N, 2, 3, 3)
+        # 2. wrist: two roots for q5
+        target_height = np.einsum("i,...ij,j->...", w_p, R_rest, g.direction(5))
+        wrist = subproblem_4(w_p, g.direction(4), g.direction(5), target_height)
+        _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
+                                                    "the wrist point is on the first axis; joint 1 is free"), singular)
+        _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",
+                                                "the two shoulder solutions meet"), singular)
+        valid = shoulder.valid[:, :, None] & wrist.valid
+        return (np.broadcast_to(q1[:, :, None], (n, 2, 2)).reshape(n, 4), wrist.theta.reshape(n, 4),
+                valid.reshape(n, 4))
+
+class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
+    """Axes 2 ∥ 3 ∥ 4 with axes 5 and 6 skew (no common point): steps 1 and 2 become one subproblem 6.
+
+    With c a point on axis 6 (G_6 leaves it fixed) and G_2 G_3 G_4 keeping components along ω_p:
+
+    * position: ``ω_p·R(ω_1, −q_1)(A c − p_1) − ω_p·R(ω_5, q_5)(c − p_5) = ω_p·(p_5 − p_1)``;
+    * rotation: ``ω_p·R(ω_1, −q_1) R_A ω_6 − ω_p·R(ω_5, q_5) ω_6 = 0``.
+
+    Subproblem 6 gives up to four pairs (q_1, q_5); steps 3–5 are the UR type's. Up to 4 × 2 = 8 solutions.
+    """
+
+    structure = "three_parallel_skew_wrist"
+
+    @classmethod
+    def match(cls, geometry: Geometry) -> "SkewWristThreeParallelPlan | None":
+        if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
+            return None
+        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.parallel(0, 1):
+            return None
+        if geometry.parallel(1, 4) or geometry.intersection(4, 5) is not None:
+            return None
+        return cls(geometry, geometry.point(5))
+
+    def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags,
+                            reference: np.ndarray | None) -> tuple[np.ndarray, ...]:
+        g, w_p = self.geometry, self.omega_p
+        c_world = apply(A, self.centre)  # the centre is a point on axis 6 here
+        pair = subproblem_6(-g.direction(0), g.direction(4),
+                            w_p, c_world - g.point(0), -w_p, self.centre - g.point(4), w_p @ (g.point(4) - g.point(0)),
+                            w_p, A[:, :3, :3] @ g.direction(5), -w_p, g.direction(5), 0.0)
+        if pair.degenerate.any():  # axis 6 on axis 1: only q1 + q6 (or q1 − q6, axes opposed) is determined
+            same_sense = (A[:, :3, :3] @ g.direction(5)) @ g.direction(0) > 0
+            for relation, rows in (("sum", same_sense), ("difference", ~same_sense)):
+                singular.add(pair.degenerate & rows, Singularity(
+                    "shoulder", (0, 5), relation, f"axis 6 lies on axis 1: only their {relation} is determined; "
+                    "q1 is set to the reference value (or 0)"))
+        singular.add(pair.merged, Singularity("shoulder", (0, 4), "boundary", "two (q1, q5) solutions meet"))
+        q1 = pair.theta1
+        if pair.degenerate.any():  # the equations do not involve q1 there, so q5 holds for any value of it
+            q1 = np.where(pair.degenerate[:, None], 0.0 if reference is None else reference[0], q1)
+        return q1, pair.theta2, pair.valid
+
+
+#: Two elbow roots closer than this (rad) are one double root split by rounding upstream (a root of
+#: subproblem 6 is good to ~1e-12 in an arm's chain, and a double root to about its square root). Both stay
+#: (each is FK-verified); the target is reported at the stretched or folded boundary.
+SPLIT_DOUBLE_ROOT = 1e-4
+
+
+def _split_double_root(elbow: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    """Where the two elbow roots (..., 2) are both valid and a split double root apart."""
+    gap = np.abs(np.angle(np.exp(1j * (elbow[..., 0] - elbow[..., 1]))))
+    return valid[..., 0] & valid[..., 1] & (np.nan_to_num(gap, nan=np.inf) <= SPLIT_DOUBLE_ROOT)

@@ -60,6 +60,13 @@ def test_redundant_benchmark_runs_with_tiny_sizes(capsys):
     out = capsys.readouterr().out
     assert "| iiwa 14 | full pose, q7 sampled 32× |" in out
     assert "| SO-101-like | position + direction, roll axis z |" in out
+def test_general_6r_benchmark_runs_with_tiny_sizes(capsys):
+    from benchmarks import general_6r
+
+    assert general_6r.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "| random general 6R (seed 2026) | core |" in out
+    assert "| Manocha-Canny 16-solution arm | core |" in out
 
 
 def test_three_parallel_benchmark_runs_with_tiny_sizes(capsys):

@@ -331,7 +331,7 @@ def test_the_spherical_wrist_places_its_tool_point_with_two_solutions(client):
 # The numeric fallback
 # --------------------------------------------------------------------------
 
-#: a 6R arm with skew axes (no two axes parallel or intersecting): no analytic family applies
+#: a 6R arm with skew axes (no two axes parallel or intersecting): no closed form, the general 6R solver
 SKEW = dict(a=np.array([0.1, 0.5, 0.2, 0.05, 0.1, 0.03]), alpha=np.array([0.5, -0.9, 1.1, 0.7, -1.3, 0.4]),
             d=np.array([0.2, 0.1, -0.15, 0.3, 0.05, 0.1]))
 SKEW_ROBOT = {"convention": "standard", "angle_unit": "rad",
@@ -347,12 +347,12 @@ def _inline_ik(client, robot: dict, target: dict, **options):
 
 
 @pytest.mark.parametrize("seed", range(5))
-def test_numeric_fallback_for_an_arm_no_family_covers(client, seed):
+def test_a_skew_6r_arm_gets_every_solution_from_the_general_solver(client, seed):
     q = np.random.default_rng(seed).uniform(-np.pi, np.pi, 6)
     T = dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], q)
     result = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()})
     assert result["status"] == "ok"
-    assert result["solver"] == {"method": "numeric", "structure": "general", "complete": False,
+    assert result["solver"] == {"method": "analytic", "structure": "general_6r", "complete": True,
                                 "time_budget_exhausted": False}
     solutions = joints_of(result)
     for solution in result["solutions"]:  # every solution passes an FK check independent of the service
@@ -372,24 +372,32 @@ def test_numeric_time_budget_refuses_rather_than_cuts(client):
     that needs longer is a 503 with Retry-After, never a partial answer that depends on the server's load."""
     import time
 
-    T = dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], [0.3, -1.2, 0.8, 2.0, -0.4, 1.1])
+    # a 7R arm with skew axes: no family covers it, nor any 6 of its joints with the seventh locked, so the
+    # numeric search answers
+    T = _fk_pose(client, NUMERIC_7R, [0.3, 0.4, 0.8, 0.2, -0.4, 1.1, 0.5])
     start = time.perf_counter()
-    cut = client.post("/v1/ik", json={"robot": SKEW_ROBOT, "target": {"matrix": T.tolist()},
+    cut = client.post("/v1/ik", json={"robot": NUMERIC_7R, "target": {"matrix": T.tolist()},
                                       "numeric": {"starts": 2000, "time_budget_ms": 5}})
     elapsed = time.perf_counter() - start
     body = assert_problem(cut, 503, match="numeric search")
     assert cut.headers["retry-after"] == "1" and "5 ms" in body["detail"]
     assert elapsed < 2.0  # 5 ms of search plus one iteration and HTTP; not the whole 2,000-start search
-    full = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
-    again = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
+    full = _inline_ik(client, NUMERIC_7R, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
+    again = _inline_ik(client, NUMERIC_7R, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
     assert full["solver"]["time_budget_exhausted"] is False and full["status"] == "ok"
     assert full["solutions"] == again["solutions"]  # the same answer every time
-    short = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()}, numeric={"starts": 48, "iterations": 3})
+    short = _inline_ik(client, NUMERIC_7R, {"matrix": T.tolist()}, numeric={"starts": 48, "iterations": 3})
     assert short["solver"]["time_budget_exhausted"] is True and "iteration cap (3)" in short["detail"]
 
 
 def _revolute(a, alpha, d, kind="revolute"):
     return {"type": kind, "a": a, "alpha": alpha, "d": d}
+
+
+NUMERIC_7R = {"convention": "modified", "joints": [
+    _revolute(a, alpha, d) for a, alpha, d in zip([0.05, 0.3, 0.07, 0.25, 0.04, 0.06, 0.03],
+                                                  [0.5, -0.9, 1.1, 0.7, -1.3, 0.4, 0.8],
+                                                  [0.2, 0.1, -0.15, 0.3, 0.05, 0.1, 0.08])]}
 
 
 SKEW_7R = {"convention": "standard", "joints": [_revolute(0.1 * i, 0.3 + 0.2 * i, 0.05 * (i % 3)) for i in range(7)]}

@@ -328,8 +328,12 @@ def _solve_arrays(request: Request, ref: RobotRef, body: IKBatchRequest) -> Fast
                                ordering=ordering, max_equivalents=body.max_equivalents, budget=budget)
         status[rows], truncated[rows] = chosen.status, chosen.truncated
         trimmed[rows], available[rows] = chosen.trimmed, chosen.available
-        solver[rows] = _index(solvers, {"method": "analytic", "structure": arrays.structure, "complete": True,
-                                        "time_budget_exhausted": False, "free_joints": arrays.free_joints})
+        for promise in (True, False):  # the general 6R solver may not promise every target complete
+            part = arrays.complete == promise
+            if part.any():
+                solver[rows[part]] = _index(solvers, {
+                    "method": "analytic", "structure": arrays.structure, "complete": promise,
+                    "time_budget_exhausted": False, "free_joints": arrays.free_joints})
         unreachable = unreachable_details(robot, arrays, matrices[rows], constrained, reference, budget)
         if rows[0] in directions:
             unreachable = {local: _direction_detail(robot, matrices[rows[local], :3, 3]) for local in unreachable}

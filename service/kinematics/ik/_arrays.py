@@ -58,6 +58,7 @@ class IKArrays:
         Whether row i's solutions are known to be all of them. Always true for
         an exact closed form; a closed form on an idealised (rounded) arm sets
         it false where refinement cannot promise it (:mod:`._idealised`), and
+        the general 6R solver where its algebra does not (:mod:`._general_6r`);
         the object API then asks the fallback solver.
     """
 
@@ -164,7 +165,10 @@ def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orie
 
 
 def _concatenated(parts: list[IKArrays]) -> IKArrays:
-    """One IKArrays from the answers for consecutive chunks of targets."""
+    """One IKArrays from the answers for consecutive chunks of targets (padded to the widest chunk's slots: a
+    solver may give each chunk only as many slots as it needs, as the general 6R solver does)."""
+    width = max(p.joints.shape[1] for p in parts)
+    parts = [_padded(p, width) for p in parts]
     singularities = SingularFlags(sum(len(p.count) for p in parts))
     offset = 0
     for part in parts:
@@ -182,6 +186,21 @@ def _concatenated(parts: list[IKArrays]) -> IKArrays:
                 for name, (values, _) in first.labels.items()},
         singularities=singularities, structure=first.structure, free_joints=first.free_joints,
         complete=np.concatenate([p.complete for p in parts]))
+
+
+def _padded(part: IKArrays, width: int) -> IKArrays:
+    """``part`` with empty slots appended up to ``width`` (no solution in them: invalid, label code −1)."""
+    extra = width - part.joints.shape[1]
+    if extra == 0:
+        return part
+    def pad(array: np.ndarray, value) -> np.ndarray:
+        widths = [(0, 0), (0, extra)] + [(0, 0)] * (array.ndim - 2)
+        return np.pad(array, widths, constant_values=value)
+    return IKArrays(joints=pad(part.joints, 0.0), valid=pad(part.valid, False), count=part.count,
+                    position=pad(part.position, np.inf), orientation=pad(part.orientation, np.inf),
+                    labels={name: (values, pad(codes, -1)) for name, (values, codes) in part.labels.items()},
+                    singularities=part.singularities, structure=part.structure, free_joints=part.free_joints,
+                    complete=part.complete)
 
 
 def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
@@ -213,6 +232,8 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     if constrain_orientation:
         error = np.maximum(error, orientation)
     complete = _promised(candidates, count, np.where(candidates.valid, error, np.inf).min(axis=1))
+    if candidates.promise_needs_every_slot:  # the solver's promise holds only if every valid slot gave a solution
+        complete &= count == candidates.valid.sum(axis=1)
     take = (np.arange(n_targets)[:, None], order)
     return IKArrays(
         joints=joints[take], valid=kept[take], count=count,

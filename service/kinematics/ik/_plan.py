@@ -16,6 +16,7 @@ from .._cache import memo
 from .._forward import link_frames, screw_model
 from .._robot import Robot
 from ._decoupled import DecoupledPlan
+from ._general_6r import General6RPlan
 from ._idealised import IdealisedPlan
 from ._positioning import find_positioner
 from ._reversed import ReversedPlan, reversed_geometry
@@ -100,7 +101,8 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
     inverse = _decoupled_pose_plan(reverse, n) or SlideAfterSphericalWrist.match(reverse)
     if inverse is not None:
         return ReversedPlan(inverse, geometry.model.home, n)
-    return _reversed_three_parallel_plan(geometry, reverse, n)
+    # no closed form: the general 6R elimination (it refuses Pieper arms and anything not 6R)
+    return _reversed_three_parallel_plan(geometry, reverse, n) or General6RPlan.match(geometry)
 
 
 #: Three consecutive parallel axes: the families as the chain is described, then (name, family, first

@@ -106,6 +106,7 @@ def _closed_form_results(robot: Robot, arrays: IKArrays, targets: np.ndarray, co
     joints, position, orientation = arrays.joints, arrays.position.tolist(), arrays.orientation.tolist()
     labels = [(name, values, codes.tolist()) for name, (values, codes) in arrays.labels.items()]
     free_joints = arrays.free_joints
+    complete = arrays.complete.tolist()
     results = []
     for row, count in enumerate(counts):
         if count:
@@ -113,11 +114,11 @@ def _closed_form_results(robot: Robot, arrays: IKArrays, targets: np.ndarray, co
                                                    if codes[row][s] >= 0},
                                   position[row][s], orientation[row][s]) for s in range(count)]
             results.append(IKResult(status="ok", solutions=solutions, method="analytic",
-                                    structure=arrays.structure, complete=True,
+                                    structure=arrays.structure, complete=complete[row],
                                     singularities=arrays.singularities[row], free_joints=list(free_joints)))
         else:
             results.append(IKResult(status="unreachable", solutions=[], method="analytic",
-                                    structure=arrays.structure, complete=True, singularities=[],
+                                    structure=arrays.structure, complete=complete[row], singularities=[],
                                     free_joints=list(free_joints), detail=details[row]))
     return results
 
@@ -146,6 +147,9 @@ def unreachable_details(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
                 details[int(row)] = ("The position is reachable but the orientation is not: " +
                                      _orientation_freedom(robot) +
                                      " No joint vector gives the requested orientation at that position.")
+    for row in rows[~arrays.complete[rows]]:  # the general 6R solver could not vouch for this answer
+        details[int(row)] = ("No solution was found, but the solver cannot promise that none exists: the target "
+                             "is near a singular or ill-conditioned case of the elimination (complete: false).")
     return details
 
 

@@ -94,9 +94,16 @@ class Candidates:
     ``valid`` (N, m) says which slots hold a candidate. ``branches`` gives
     the labels of each slot, per target: a list of N lists of m dicts (built
     lazily by the family's labeller). ``singularities`` gives, per target, the
-    singular conditions met. ``complete`` (N,), when given, says for which
-    targets the valid slots are known to be every solution (None: all of them,
-    as for an exact closed form; see :mod:`._idealised` for when it is not).
+    singular conditions met.
+
+    ``complete`` (N,), when a solver gives it, says which targets it can
+    promise every solution for; None means every target is complete, as for
+    the exact closed-form families (see :mod:`._idealised` and
+    :mod:`._general_6r` for the solvers that say less). With
+    ``promise_needs_every_slot`` the promise holds only *provided* each valid
+    slot then verifies as a distinct solution (the verification checks that
+    part): the general solver's valid slots are roots, not least-squares
+    candidates.
     """
 
     joints: np.ndarray
@@ -104,6 +111,7 @@ class Candidates:
     branches: list[list[Branch]]
     singularities: SingularFlags
     complete: np.ndarray | None = None
+    promise_needs_every_slot: bool = False
 
 
 @dataclass(frozen=True)

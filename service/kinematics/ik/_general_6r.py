@@ -1,0 +1,510 @@
+"""Every solution of a general 6R arm: the Raghavan–Roth elimination solved as Manocha and Canny solve it.
+
+Notation: the screw model ``world_T_tool = G_1(q_1) ⋯ G_6(q_6) · home``, A = world_T_target · home⁻¹. All
+lengths are divided by the robot's size, so every coefficient below is of order one.
+
+The 14 equations
+    One *arrangement* (chosen per robot, see below) splits the loop into three consecutive joints a, b, c, the
+    next joint d, and two joints e, f on the target's side. G_d fixes its own axis line, so with a point c_d and
+    the direction ω_d of that line,
+        G_a G_b G_c (c_d, ω_d) = Left(q_e, q_f) · A · Right(q_e, q_f) (c_d, ω_d).
+    Both sides are a point p (measured from a point o on axis a) and a unit direction l; Raghavan and Roth's
+    14 quantities of each side, p, l, p·p, p·l, p×l and l(p·p) − 2p(p·l), are *linear* in the products
+    (1, c_b, s_b) ⊗ (1, c_c, s_c) with coefficients linear in (1, c_a, s_a) on the left, and linear in
+    (1, c_e, s_e) ⊗ (1, c_f, s_f) on the right: 14 × 9 on each side.
+Numerical coefficients
+    The left side depends on the robot only: its 14 × 27 coefficients are interpolated once per robot from the
+    3 × 3 × 3 grid of angles 0, ±2π/3 (on which the basis is exactly invertible) and checked at random angles,
+    so no symbolic algebra is done for any robot. The right side, 14 × 9, is interpolated per target from the
+    3 × 3 grid: nine rigid motions of the line and one product with a constant matrix.
+Elimination
+    The 8 non-constant right-hand monomials are eliminated with the left null space N (6 × 14) of their
+    coefficients (an SVD): six equations in q_a, q_b, q_c. Half-angle tangents and a product with x_b give
+    12 equations, Σ(x_a) · [x_b^i x_c^j] = 0 (i ≤ 3, j ≤ 2), with Σ quadratic in x_a. det Σ has degree 24: 16
+    roots of the arm and the spurious pairs at ±i from the (1 + x_a²) factors. The companion form is a 24 × 24
+    eigenproblem, stacked over targets for ``np.linalg.eig``.
+Conditioning
+    Rows are equilibrated. The half-angle is taken about a shifted origin, q_a = φ + 2 atan y (a Möbius map of
+    x_a that fixes ±i), with φ chosen per target so that the leading matrix Σ(φ + π) is well conditioned: a root
+    at q_a = π is then an ordinary finite eigenvalue. Of the six arrangements (each joint in turn as q_a: the
+    chain read forwards with q_a = q_3, q_2, q_1 or backwards with q_a = q_4, q_5, q_6) the plan keeps the one
+    that recovers random configurations most accurately.
+Back-substitution
+    q_b, q_c from the eigenvector (runs of three powers give cos and sin, so x → ∞ is just an angle of π);
+    q_e, q_f from the linear right-hand monomials; q_d from the remaining rotation. Every root is then polished
+    by Newton's method on the screw model's FK, and the shared verification (FK residual, merging) decides what
+    is kept.
+Completeness
+    A target's answer is complete only when the algebra accounts for every solution: the right-hand
+    coefficients have full rank 8, the leading matrix is well conditioned, no eigenvalue is ambiguous (an
+    imaginary part within :data:`AMBIGUITY_FACTOR` times its first-order error bound: a root pair about to merge
+    or split), at most 16 roots are real, and (checked after verification) every real root gave one distinct
+    verified solution. Anything else is answered with ``complete: false``. A target farther from axis 1 than
+    the arm's reach bound is a certain ``unreachable`` (complete) whatever the conditioning.
+
+Pieper-class arms (three consecutive axes through one point, or parallel) make Σ singular for every x in some
+arrangements (and give double eigenvalues, solutions that share q_a, in others); they are the closed-form
+families' and :meth:`General6RPlan.match` refuses them. (The plan's choice of arrangement does solve PUMA- and
+UR5-type arms, which a test uses to check the elimination against the closed forms.) Arms within ~1e-5 of a
+Pieper arm are accepted; there up to ~1 % of targets meet a near-double eigenvalue (measured on a PUMA 560
+perturbed by 1e-5…1e-7: a solution missed on 1–2 targets in 300), and those answers say ``complete: false``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._screws import invert
+from ._structure import Geometry
+from ._types import Branch, Candidates, LabelCodes, SingularFlags
+
+#: A complex root whose angle's imaginary part is within this many times its error bound of the real axis
+#: (a pair about to become two real roots, or two real roots split by rounding) is ambiguous.
+AMBIGUITY_FACTOR = 100.0
+#: Roots y with |1 + y²| below this are the spurious ones at ±i.
+SPURIOUS_RADIUS = 1e-2
+#: Complex roots whose angle's imaginary part is below this get an error bound (the others are clearly complex:
+#: no double-precision eigenproblem is that far off without its matrices being flagged ill-conditioned).
+SUSPECT_IMAGINARY = 1e-2
+#: Smallest reciprocal condition number of the leading matrix and of the right-hand coefficients accepted.
+CONDITION_FLOOR = 1e-9
+#: Newton steps on the FK at most, for every root whose error twist (normalised lengths, radians) is above
+#: NEWTON_TOLERANCE; the shared verification then accepts at 1e-9.
+NEWTON_STEPS = 5
+NEWTON_TOLERANCE = 1e-13
+#: The worst error (radians) in recovering random configurations before polishing that a plan accepts.
+PLAN_ACCURACY = 1e-4
+#: An arrangement this accurate on the test configurations is taken without trying the others.
+GOOD_ENOUGH = 1e-10
+
+#: Trigonometric basis (1, cos, sin) sampled at 0, 2π/3, 4π/3: rows are samples.
+_GRID = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
+_TRIG = np.stack([np.ones(3), np.cos(_GRID), np.sin(_GRID)], axis=1)  # (3 samples, 3 basis)
+#: (1, cos, sin)·(1 + x²) in the powers (1, x, x²).
+_HALF = np.array([[1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [0.0, 2.0, 0.0]])
+_HALF2 = np.kron(_HALF, _HALF)  # (9 trig products, 9 power products)
+#: Shifts φ of the half-angle origin tried, in order, until the leading matrix is well conditioned.
+_SHIFTS = (0.0, 1.0, -1.3, 2.1, -2.6, 0.45)
+
+
+def _cross_matrix(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """[k]× and [k]×² for a unit axis k, memoised by value (an arm has a few axes)."""
+    key = tuple(k.tolist())
+    pair = _CROSS.get(key)
+    if pair is None:
+        K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+        pair = (K, K @ K)
+        if len(_CROSS) < 4096:
+            _CROSS[key] = pair
+    return pair
+
+
+_CROSS: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray]] = {}
+_EYE3 = np.eye(3)
+
+
+def _rodrigues(k: np.ndarray | tuple[np.ndarray, np.ndarray], q: np.ndarray) -> np.ndarray:
+    """R(k, q) for q of shape (...,): (..., 3, 3). ``k`` is the unit axis or its pair ([k]×, [k]×²)."""
+    K, KK = k if isinstance(k, tuple) else _cross_matrix(k)
+    q = np.asarray(q, dtype=float)[..., None, None]
+    return _EYE3 + np.sin(q) * K + (1.0 - np.cos(q)) * KK
+
+
+def _motion(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """The turn by q about the line (k, p): (..., 4, 4)."""
+    R = _rodrigues(k, q)
+    T = np.zeros(R.shape[:-2] + (4, 4))
+    T[..., :3, :3] = R
+    T[..., :3, 3] = p - R @ p
+    T[..., 3, 3] = 1.0
+    return T
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """a × b along the last axis (np.cross without its axis bookkeeping)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
+def _fourteen(p: np.ndarray, l: np.ndarray) -> np.ndarray:
+    """Raghavan and Roth's 14 quantities of a point p and unit direction l (..., 3): (..., 14)."""
+    pp = np.einsum("...i,...i->...", p, p)[..., None]
+    pl = np.einsum("...i,...i->...", p, l)[..., None]
+    return np.concatenate([p, l, pp, pl, _cross(p, l), l * pp - 2.0 * p * pl], axis=-1)
+
+
+class _Arrangement:
+    """One way of writing the loop for the elimination (see the module docstring).
+
+    ``reverse`` reads the chain backwards (joints 6…1, axes negated, target A⁻¹); ``first`` (0, 1 or 2) is the
+    index, in the chain as read, of joint a. ``order`` maps the chain's joints (a, b, c, d, e, f) to the robot's.
+    """
+
+    def __init__(self, directions: np.ndarray, points: np.ndarray, reverse: bool, first: int) -> None:
+        if reverse:
+            directions, points = -directions[::-1], points[::-1]
+        self.reverse, self.first = reverse, first
+        self.directions, self.points = directions, points
+        self.cross = [_cross_matrix(k) for k in directions]
+        a, d = first, first + 3
+        # the target's side: joints (e, f) and where they stand around A
+        self.rhs = {2: (0, 1), 1: (0, 5), 0: (5, 4)}[first]
+        chain = [a, a + 1, a + 2, d, *self.rhs]
+        self.order = np.array([5 - j if reverse else j for j in chain])
+        self.line_point, self.line_direction = points[d], directions[d]
+        # the point o on axis a nearest the other axes' points (any point of the axis keeps the structure)
+        k = directions[a]
+        centre = points.mean(axis=0)
+        self.origin = points[a] + k * (k @ (centre - points[a]))
+        self._fit_left()
+        self._prepare_right()
+
+    def _fit_left(self) -> None:
+        """The left side's coefficients C (3, 14, 9): F_L = (C_0 + C_1 cos q_a + C_2 sin q_a) · t(q_b) ⊗ t(q_c)."""
+        g = np.array(np.meshgrid(_GRID, _GRID, _GRID, indexing="ij")).reshape(3, -1).T  # (27, 3)
+        values = self.left_values(g)  # (27, 14)
+        basis = np.kron(np.kron(_TRIG, _TRIG), _TRIG)  # (27 samples, 27 basis)
+        coefficients = np.linalg.solve(basis, values).T  # (14, 27)
+        self.left = coefficients.reshape(14, 3, 9).transpose(1, 0, 2).copy()
+        check = np.random.default_rng(7).uniform(-np.pi, np.pi, (8, 3))
+        predicted = np.einsum("kem,nk,nm->ne", self.left, _trig(check[:, 0]), _trig2(check[:, 1], check[:, 2]))
+        self.left_fit_error = float(np.abs(predicted - self.left_values(check)).max())
+
+    def left_values(self, q: np.ndarray) -> np.ndarray:
+        """The 14 left-hand quantities at (q_a, q_b, q_c) of shape (M, 3): (M, 14)."""
+        a = self.first
+        T = np.eye(4)
+        for i in range(3):
+            T = T @ _motion(self.directions[a + i], self.points[a + i], q[:, i])
+        p = np.einsum("mij,j->mi", T[:, :3, :3], self.line_point) + T[:, :3, 3] - self.origin
+        l = np.einsum("mij,j->mi", T[:, :3, :3], self.line_direction)
+        return _fourteen(p, l)
+
+    def _prepare_right(self) -> None:
+        """The nine rigid motions Left_k, Right_k of the 3 × 3 sample grid of (q_e, q_f), and the fit matrix."""
+        e, f = self.rhs
+        ge, gf = (m.reshape(-1) for m in np.meshgrid(_GRID, _GRID, indexing="ij"))
+        Ge = _motion(self.directions[e], self.points[e], -ge)  # G_e⁻¹ at the samples
+        Gf = _motion(self.directions[f], self.points[f], -gf)
+        eye = np.broadcast_to(np.eye(4), Ge.shape)
+        # G_2⁻¹ G_1⁻¹ A | G_1⁻¹ A G_6⁻¹ | A G_6⁻¹ G_5⁻¹ (chain as read, 0-based joints)
+        left, right = {2: (Gf @ Ge, eye), 1: (Ge, Gf), 0: (eye, Ge @ Gf)}[self.first]
+        self.sample_left = left[:, :3, :]  # (9, 3, 4)
+        self.sample_right_point = np.einsum("kij,j->ki", right[:, :3, :3], self.line_point) + right[:, :3, 3]
+        self.sample_right_direction = np.einsum("kij,j->ki", right[:, :3, :3], self.line_direction)
+        # B = values · (basis⁻¹)ᵀ: with basis (9 samples, 9 products)
+        self.right_fit = np.linalg.inv(np.kron(_TRIG, _TRIG)).T  # values (.., 9 samples) → coefficients
+
+    def right_coefficients(self, A: np.ndarray) -> np.ndarray:
+        """The right side's coefficients B (N, 14, 9) for chain targets A (N, 4, 4) (normalised lengths)."""
+        point = np.einsum("nij,kj->nki", A[:, :3, :3], self.sample_right_point) + A[:, None, :3, 3]
+        direction = np.einsum("nij,kj->nki", A[:, :3, :3], self.sample_right_direction)
+        L = self.sample_left
+        p = np.einsum("kij,nkj->nki", L[:, :, :3], point) + L[:, :, 3] - self.origin
+        l = np.einsum("kij,nkj->nki", L[:, :, :3], direction)
+        values = _fourteen(p, l)  # (N, 9 samples, 14)
+        return np.einsum("nse,sm->nem", values, self.right_fit)
+
+
+def _trig(q: np.ndarray) -> np.ndarray:
+    """(1, cos q, sin q): (..., 3)."""
+    return np.stack([np.ones_like(q), np.cos(q), np.sin(q)], axis=-1)
+
+
+def _trig2(qb: np.ndarray, qc: np.ndarray) -> np.ndarray:
+    """t(q_b) ⊗ t(q_c): (..., 9), index 3i + j."""
+    return (_trig(qb)[..., :, None] * _trig(qc)[..., None, :]).reshape(qb.shape + (9,))
+
+
+class _Roots:
+    """The real roots of one arrangement for N targets.
+
+    ``joints`` (N, m, 6) in the robot's order and ``valid`` (N, m): the m slots hold each target's real roots
+    (m is the largest count in the batch, at least 1). ``real_count`` (N,) counts them before the cut to 16;
+    ``ambiguous`` (N,) marks targets with a root neither clearly real nor clearly complex; ``conditioned``
+    (N,) that the right-hand coefficients and the leading matrix were well conditioned; ``shift`` (N,) the origin
+    φ of the half-angle used for each target.
+    """
+
+    def __init__(self, joints: np.ndarray, valid: np.ndarray, real_count: np.ndarray, ambiguous: np.ndarray,
+                 conditioned: np.ndarray, shift: np.ndarray) -> None:
+        self.joints, self.valid, self.real_count = joints, valid, real_count
+        self.ambiguous, self.conditioned, self.shift = ambiguous, conditioned, shift
+
+
+def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
+    """Candidates of the elimination for chain targets A (N, 4, 4) in normalised lengths."""
+    n = len(A)
+    chain_A = invert(A) if arr.reverse else A
+    B = arr.right_coefficients(chain_A)  # (N, 14, 9)
+    B8, b1 = B[:, :, 1:], B[:, :, 0]
+    U, sigma, Vt = np.linalg.svd(B8)  # U (N, 14, 14)
+    rank_ok = sigma[:, -1] > CONDITION_FLOOR ** 0.5 * sigma[:, 0]
+    null = np.swapaxes(U[:, :, 8:], 1, 2)  # (N, 6, 14)
+    E = np.einsum("nre,kem->nkrm", null, arr.left)  # (N, 3, 6, 9)
+    E[:, 0, :, 0] -= np.einsum("nre,ne->nr", null, b1)
+    # Σ for each shift, keep the first shift with a well-conditioned leading matrix
+    shift = np.zeros(n)
+    pending = np.ones(n, dtype=bool)
+    companions = np.zeros((n, 24, 24))
+    lead_ok = np.zeros(n, dtype=bool)
+    for phi in _SHIFTS:
+        rows = np.flatnonzero(pending)
+        if not len(rows):
+            break
+        c, s = np.cos(phi), np.sin(phi)
+        E0, E1, E2 = E[rows, 0], c * E[rows, 1] + s * E[rows, 2], -s * E[rows, 1] + c * E[rows, 2]
+        D = np.stack([E0 + E1, 2.0 * E2, E0 - E1], axis=1) @ _HALF2  # (R, 3, 6, 9): powers 1, y, y²
+        D /= np.abs(D).max(axis=(1, 3), keepdims=True)  # row equilibration
+        S = np.zeros((len(rows), 3, 12, 12))
+        S[:, :, :6, :9] = D
+        S[:, :, 6:, 3:] = D
+        lead = S[:, 2]
+        singular = np.linalg.svd(lead, compute_uv=False)
+        good = singular[:, -1] > CONDITION_FLOOR * singular[:, 0]
+        if phi == _SHIFTS[-1]:
+            good[:] = True
+        rows, S, lead = rows[good], S[good], lead[good]
+        lead_ok[rows] = (singular[good, -1] > CONDITION_FLOOR * singular[good, 0])
+        rhs = np.concatenate([S[:, 0], S[:, 1]], axis=2)
+        if phi == _SHIFTS[-1] and not lead_ok[rows].all():  # no shift helped: least squares, marked incomplete
+            tail = np.linalg.pinv(lead) @ rhs
+        else:
+            tail = np.linalg.solve(lead, rhs)  # (R, 12, 24)
+        companions[rows, :12, 12:] = np.eye(12)
+        companions[rows, 12:, :12] = -tail[:, :, :12]
+        companions[rows, 12:, 12:] = -tail[:, :, 12:]
+        shift[rows] = phi
+        pending[rows] = False
+    finite = np.isfinite(companions).all(axis=(1, 2))
+    if not finite.all():  # overflow in a degenerate target: no roots from it, and not complete
+        companions[~finite] = 0.0
+        lead_ok &= finite
+    y, vectors = np.linalg.eig(companions)  # (N, 24), (N, 24, 24)
+    with np.errstate(divide="ignore", invalid="ignore"):  # a spurious root exactly at ±i
+        angle = 2.0 * np.arctan(y.astype(complex))
+        imaginary = np.abs(angle.imag)  # NaN at exactly ±i: never real, never ambiguous, sorted last
+    real = y.imag == 0.0  # LAPACK returns the real eigenvalues of a real matrix with no imaginary part
+    real_count = real.sum(axis=1)
+    # first-order error bound of each eigenvalue (backward-stable QR: ~ n ε ‖M‖ times its condition number,
+    # from the left eigenvectors, the rows of V⁻¹), carried to the angle: dq = 2 dy / |1 + y²|
+    # the spurious roots at ±i (of the (1 + x²) factors, a defective quadruple pair, so rounding spreads them
+    # by ~ε^¼) are far from real and never ambiguous
+    spurious = np.abs(1.0 + y * y) < SPURIOUS_RADIUS
+    with np.errstate(invalid="ignore"):
+        suspect = ~real & ~spurious & (imaginary < SUSPECT_IMAGINARY)
+    near = np.zeros_like(real)
+    rows = np.flatnonzero(suspect.any(axis=1))
+    if len(rows):  # the bound needs the left eigenvectors: only for targets with a complex root near the axis
+        left_vectors = np.linalg.inv(vectors[rows])
+        condition = np.linalg.norm(left_vectors, axis=2) * np.linalg.norm(vectors[rows], axis=1)
+        size = np.linalg.norm(companions[rows], axis=(1, 2))[:, None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            bound = 2.0 * 24 * np.finfo(float).eps * size * condition / np.abs(1.0 + y[rows] ** 2)
+            near[rows] = suspect[rows] & (imaginary[rows] <= AMBIGUITY_FACTOR * bound)
+    ambiguous = near.any(axis=1)
+    # back-substitute the real and the ambiguous roots only: m slots, nearest the real axis first
+    real = real | near
+    m = int(min(max(real.sum(axis=1).max(initial=0), 1), 16))
+    order = np.argsort(imaginary, axis=1, kind="stable")[:, :m]
+    take = (np.arange(n)[:, None], order)
+    valid = real[take]
+    y, qa = y[take], shift[:, None] + angle.real[take]
+    vectors = np.take_along_axis(vectors, order[:, None, :], axis=2)  # (N, 24, m)
+    # monomials x_b^i x_c^j (i ≤ 3, j ≤ 2) of each root, from the block of the eigenvector that is not small
+    top, bottom = vectors[:, :12, :], vectors[:, 12:, :]
+    monomials = np.where((np.abs(y) <= 1.0)[:, None, :], top, bottom)  # (N, 12, m)
+    monomials = np.swapaxes(monomials, 1, 2).reshape(n, m, 4, 3)
+    qb = _monomial_angle(monomials)
+    qc = _monomial_angle(np.swapaxes(monomials, -1, -2))
+    # right-hand monomials by least squares, then q_e, q_f from the linear ones
+    left = np.einsum("ntk,kem,ntm->nte", _trig(qa), arr.left, _trig2(qb, qc))  # (N, m, 14)
+    inverse_sigma = np.where(sigma > CONDITION_FLOOR * sigma[:, :1], 1.0 / np.maximum(sigma, 1e-300), 0.0)
+    pinv = np.einsum("nji,nj,nej->nie", Vt, inverse_sigma, U[:, :, :8])  # (N, 8, 14)
+    mono = np.einsum("nie,nte->nti", pinv, left - b1[:, None, :])  # (N, m, 8): index m − 1 of 3i + j
+    qe = np.arctan2(mono[..., 5], mono[..., 2])  # s_e (m = 6), c_e (m = 3)
+    qf = np.arctan2(mono[..., 1], mono[..., 0])  # s_f (m = 2), c_f (m = 1)
+    chain = np.stack([qa, qb, qc, np.zeros_like(qa), qe, qf], axis=-1)  # joints (a, b, c, d, e, f)
+    chain[..., 3] = _last_joint(arr, chain_A, chain)
+    joints = np.empty_like(chain)
+    joints[..., arr.order] = chain
+    return _Roots(joints, valid, real_count, ambiguous, rank_ok & lead_ok, shift)
+
+
+def _monomial_angle(m: np.ndarray) -> np.ndarray:
+    """The angle q with x = tan(q/2) from powers along the second-last axis, m (..., P ≥ 3, Q) ∝ x^i · (…).
+
+    Each run of three consecutive powers (m_i, m_i+1, m_i+2) = m_i (1, x, x²) gives
+    (cos q, sin q) ∝ (m_i − m_i+2, 2 m_i+1) / (m_i + m_i+2); summing every run, each weighted by
+    |m_i + m_i+2|², uses the largest entries and is exact at x → ∞ (q = π), where only the top power is left.
+    """
+    low, middle, high = m[..., :-2, :], m[..., 1:-1, :], m[..., 2:, :]
+    weight = (low + high).conj()
+    cosine = ((low - high) * weight).real.sum(axis=(-2, -1))
+    sine = (2.0 * middle * weight).real.sum(axis=(-2, -1))
+    return np.arctan2(sine, cosine)
+
+
+def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarray:
+    """q_d from the rotation left over once the other five joints are known (chain as read)."""
+    q = np.zeros(chain.shape[:-1] + (6,))
+    a = arr.first
+    for slot, joint in enumerate((a, a + 1, a + 2, a + 3, *arr.rhs)):
+        q[..., joint] = chain[..., slot]
+    d = a + 3
+    R_before = _rodrigues(arr.cross[0], q[..., 0])
+    for j in range(1, d):
+        R_before = R_before @ _rodrigues(arr.cross[j], q[..., j])
+    R_d = np.swapaxes(R_before, -1, -2) @ A[:, None, :3, :3]
+    if d < 5:
+        R_after = _rodrigues(arr.cross[5], q[..., 5])
+        for j in range(4, d, -1):
+            R_after = _rodrigues(arr.cross[j], q[..., j]) @ R_after
+        R_d = R_d @ np.swapaxes(R_after, -1, -2)
+    k = arr.directions[d]
+    u = _cross(k, np.eye(3)[np.argmin(np.abs(k))])
+    u /= np.linalg.norm(u)
+    turned = R_d @ u
+    return np.arctan2(turned @ _cross(k, u), turned @ u)
+
+
+def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q: np.ndarray,
+            steps: int = NEWTON_STEPS) -> np.ndarray:
+    """Newton's method on G_1 ⋯ G_6 = A for candidates q (K, 6) and targets A (K, 4, 4), normalised lengths.
+
+    Steps the candidates whose error twist is above :data:`NEWTON_TOLERANCE` (roots come from the eigenproblem
+    to about 1e-12, so one step, or none, usually suffices); singular candidates get a tiny damping instead of a
+    failed solve.
+    """
+    q = q.copy()
+    R_A, p_A = A_targets[:, :3, :3], A_targets[:, :3, 3]
+    cross = [_cross_matrix(k) for k in directions]
+    for _ in range(steps + 1):
+        R = np.broadcast_to(_EYE3, q.shape[:-1] + (3, 3))
+        p = np.zeros(q.shape[:-1] + (3,))
+        axes = np.empty(q.shape + (3,))
+        through = np.empty(q.shape + (3,))
+        for j in range(6):
+            axes[:, j] = R @ directions[j]
+            through[:, j] = R @ points[j] + p
+            turn = _rodrigues(cross[j], q[:, j])
+            p = p + (R @ (points[j] - turn @ points[j])[..., None])[..., 0]
+            R = R @ turn
+        # spatial error twist (ω, v): A ≈ exp([ξ]) T
+        R_err = R_A @ np.swapaxes(R, -1, -2)
+        omega = 0.5 * np.stack([R_err[:, 2, 1] - R_err[:, 1, 2], R_err[:, 0, 2] - R_err[:, 2, 0],
+                                R_err[:, 1, 0] - R_err[:, 0, 1]], axis=-1)
+        error = np.concatenate([omega, p_A - p - _cross(omega, p)], axis=-1)  # (K, 6)
+        active = np.abs(error).max(axis=1) > NEWTON_TOLERANCE
+        if _ == steps or not active.any():
+            break
+        J = np.concatenate([axes[active], _cross(through[active], axes[active])], axis=-1)  # rows ω, p × ω
+        JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6)  # (K, joints, joints) = Jᵀ J of the twist map
+        q[active] += np.linalg.solve(JJt, (J @ error[active][..., None]))[..., 0]
+    return q
+
+
+class General6RPlan:
+    """Every solution of a 6R arm with no decomposable geometry, by the elimination of this module."""
+
+    method = "analytic"
+    structure = "general_6r"
+    generic_count = 16
+    free_joints: list[int] = []
+
+    @classmethod
+    def match(cls, geometry: Geometry) -> "General6RPlan | None":
+        """The plan for a 6R arm, or None for other arms, Pieper-class arms and arms no arrangement solves."""
+        if geometry.dof != 6 or geometry.kinds() != "RRRRRR" or is_pieper(geometry):
+            return None
+        plan = cls(geometry)
+        return plan if plan.arrangement is not None else None
+
+    def __init__(self, geometry: Geometry) -> None:
+        model = geometry.model
+        self.scale = geometry.length_scale
+        self.directions = model.directions / np.linalg.norm(model.directions, axis=1, keepdims=True)
+        self.points = model.points / self.scale
+        home = model.home.copy()
+        home[:3, 3] /= self.scale
+        self.home_inverse = invert(home)
+        # no tool position is farther than this from the point on axis 1: each turn keeps the distance to a point
+        # of its axis, so |x − p_1| ≤ |home − p_6| + Σ |p_i+1 − p_i| (normalised lengths)
+        self.reach = float(np.linalg.norm(home[:3, 3] - self.points[5])
+                           + np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
+        self.arrangement, self.accuracy = self._choose()
+
+    def _choose(self) -> tuple[_Arrangement | None, float]:
+        """The arrangement that recovers random configurations best, and its worst error (radians).
+
+        Arrangements are tried in a fixed order and the first that recovers every test configuration to
+        :data:`GOOD_ENOUGH` is kept at once (the usual case: planning an inline robot per request stays cheap);
+        otherwise the most accurate of the six, if it reaches :data:`PLAN_ACCURACY`.
+        """
+        rng = np.random.default_rng(20260601)
+        q = rng.uniform(-np.pi, np.pi, (6, 6))
+        A = self._chain_targets(q)
+        best, best_error = None, np.inf
+        for reverse in (False, True):
+            for first in (2, 1, 0):
+                arrangement = _Arrangement(self.directions, self.points, reverse, first)
+                if arrangement.left_fit_error > 1e-9:
+                    continue
+                roots = _solve_arrangement(arrangement, A)
+                if not roots.conditioned.all():
+                    continue
+                gap = np.abs(np.angle(np.exp(1j * (roots.joints - q[:, None, :])))).max(axis=-1)
+                gap = np.where(roots.valid, gap, np.inf)
+                error = float(gap.min(axis=1).max())
+                if error < best_error:
+                    best, best_error = arrangement, error
+                if best_error <= GOOD_ENOUGH:
+                    return best, best_error
+        if best_error > PLAN_ACCURACY:
+            return None, best_error
+        return best, best_error
+
+    def _chain_targets(self, q: np.ndarray) -> np.ndarray:
+        """A = G_1 ⋯ G_6 (normalised lengths) at configurations q (N, 6)."""
+        T = np.broadcast_to(np.eye(4), (len(q), 4, 4))
+        for j in range(6):
+            T = T @ _motion(self.directions[j], self.points[j], q[:, j])
+        return T
+
+    def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
+        n = len(world_T_targets)
+        targets = np.array(world_T_targets, dtype=float)
+        targets[:, :3, 3] /= self.scale
+        A = targets @ self.home_inverse
+        roots = _solve_arrangement(self.arrangement, A)
+        joints, valid = roots.joints, roots.valid
+        rows, slots = np.nonzero(valid)
+        if len(rows):
+            start = np.nan_to_num(joints[rows, slots])
+            joints[rows, slots] = _newton(self.directions, self.points, A[rows], start)
+        complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
+        # out of reach by the bound: certainly no solution, however the eigenproblem was conditioned
+        offset = targets[:, :3, 3] - self.points[0]
+        beyond = np.einsum("ni,ni->n", offset, offset) > (self.reach * (1.0 + 1e-9)) ** 2
+        valid[beyond] = False
+        complete[beyond] = True
+        return Candidates(joints, valid, [], SingularFlags(n), complete=complete, promise_needs_every_slot=True)
+
+    def labels(self, joints: np.ndarray) -> list[Branch]:
+        """A general 6R arm has no textbook branch names: no labels."""
+        return [{} for _ in range(len(joints))]
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        return {}
+
+
+def is_pieper(geometry: Geometry) -> bool:
+    """Whether three consecutive axes meet in one point or are parallel (Pieper's condition)."""
+    for start in range(geometry.dof - 2):
+        triple = (start, start + 1, start + 2)
+        if geometry.common_point(triple) is not None:
+            return True
+        if geometry.parallel(start, start + 1) and geometry.parallel(start, start + 2):
+            return True
+    return False

@@ -8,7 +8,7 @@
 
 ``--mixed`` adds hostile users (one per four normal ones) sending what the caps must bound: ±1e6 rad limits
 (the server is started allowing a million turns, so the expansion runs), max_equivalents 100,000, a 2,000-target
-UR5 batch over ±360° (refused before solving), a numeric 7-joint arm with 2,000 starts, a 2,000-sample
+UR5 batch over ±360° (refused before solving), a numeric arm (five skew revolute joints and a slide) with 2,000 starts, a 2,000-sample
 trajectory of unreachable poses, and ±5000 rad batches in the arrays form. They may be answered 200, 413, 422
 or 503 (problem+json); anything else is a failure. A prober reads /healthz every 100 ms. The report adds the p99
 of the normal requests alone, the /healthz latencies, and the server's peak RSS (VmHWM of its processes).
@@ -85,12 +85,12 @@ def _workload(seed: int = 0, count: int = 200) -> dict[str, list]:
     return {"fk": fk, "fk_batch": batch, "ik": ik, "limits": limits}
 
 
-# Skew axes everywhere: no family covers this arm, nor any 6 of its joints with the seventh locked, so the numeric
-# search answers (a Panda-like table is solved in closed form with a free joint since issue 14).
-SEVEN_DOF = {"convention": "modified", "joints": [
-    {"a": a, "alpha": alpha, "d": d} for a, alpha, d in zip([0.05, 0.3, 0.07, 0.25, 0.04, 0.06, 0.03],
-                                                            [0.5, -0.9, 1.1, 0.7, -1.3, 0.4, 0.8],
-                                                            [0.2, 0.1, -0.15, 0.3, 0.05, 0.1, 0.08])]}
+# Five skew revolute joints and a slide: no closed-form family or general solver covers it, so the numeric
+# search answers (every 6R arm is solved by the general 6R solver, and a 7R one by locking a joint).
+NUMERIC_ARM = {"convention": "modified", "joints": [
+    {"type": kind, "a": a, "alpha": alpha, "d": d}
+    for kind, a, alpha, d in zip(["revolute"] * 5 + ["prismatic"], [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
+                                 [0.5, -0.9, 1.1, 0.7, -1.3, 0.4], [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
 NORMAL_KINDS = ("fk", "ik", "limits", "fk_batch")
 
 
@@ -108,9 +108,9 @@ def _hostile_workload() -> list[tuple[str, str, dict]]:
         ("hostile_batch", "/v1/robots/ur5/ik/batch", {"targets": [target] * 2000}),
         ("hostile_overflow", "/v1/robots/ur5/ik/batch", {"targets": [target] * 20, "format": "arrays",
                                                           "limits": [{"lower": -5000, "upper": 5000}] * 6}),
-        ("hostile_numeric", "/v1/ik", {"robot": SEVEN_DOF, "target": numeric_target,
+        ("hostile_numeric", "/v1/ik", {"robot": NUMERIC_ARM, "target": numeric_target,
                                         "numeric": {"starts": 2000, "time_budget_ms": 10_000}}),
-        ("hostile_trajectory", "/v1/ik/trajectory", {"robot": SEVEN_DOF, "samples": [
+        ("hostile_trajectory", "/v1/ik/trajectory", {"robot": NUMERIC_ARM, "samples": [
             {"time": 0.01 * k, "pose": far} for k in range(2000)]}),
     ]
 

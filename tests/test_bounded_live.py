@@ -21,12 +21,12 @@ from tests.live import ROOT, free_port
 pytestmark = pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs /proc")
 
 UR5_Q = [0.3, -1.0, 1.2, 0.4, 0.5, 0.6]
-# Skew axes everywhere: no family covers this arm, nor any 6 of its joints with the seventh locked, so the numeric
-# search answers (a Panda-like table is solved in closed form with a free joint since issue 14).
-SEVEN_DOF = {"convention": "modified", "joints": [
-    {"a": a, "alpha": alpha, "d": d} for a, alpha, d in zip([0.05, 0.3, 0.07, 0.25, 0.04, 0.06, 0.03],
-                                                            [0.5, -0.9, 1.1, 0.7, -1.3, 0.4, 0.8],
-                                                            [0.2, 0.1, -0.15, 0.3, 0.05, 0.1, 0.08])]}
+# Five skew revolute joints and a slide: no closed-form family or general solver covers it, so the numeric
+# search answers (every 6R arm is solved by the general 6R solver, and a 7R one by locking a joint).
+NUMERIC_ARM = {"convention": "modified", "joints": [
+    {"type": kind, "a": a, "alpha": alpha, "d": d}
+    for kind, a, alpha, d in zip(["revolute"] * 5 + ["prismatic"], [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
+                                 [0.5, -0.9, 1.1, 0.7, -1.3, 0.4], [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
 NUMERIC_TARGET = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
 
 
@@ -96,7 +96,7 @@ def test_hostile_requests_keep_one_worker_under_its_memory_bound_and_health_answ
         ("/v1/robots/ur5/ik/batch", {"targets": [target] * 10_000}),  # was 8.2 GB, 118 s
         ("/v1/robots/ur5/ik/batch", {"targets": [target] * 50, "limits": [{"lower": -5000, "upper": 5000}] * 6,
                                      "format": "arrays", "max_equivalents": 50}),  # was an int64-overflow 500
-        ("/v1/ik", {"robot": SEVEN_DOF, "target": NUMERIC_TARGET, "limits": [{"lower": -1e6, "upper": 1e6}] * 7,
+        ("/v1/ik", {"robot": NUMERIC_ARM, "target": NUMERIC_TARGET, "limits": [{"lower": -1e6, "upper": 1e6}] * 6,
                     "numeric": {"starts": 2000, "time_budget_ms": 10_000}}),  # was past 12 GB
     ]
     baseline = peak_rss_mb(server.process.pid)
@@ -168,7 +168,7 @@ def test_sigterm_during_a_request_finishes_or_refuses_it_cleanly(tmp_path):
     def slow_request() -> None:
         with httpx.Client(timeout=60) as client:
             response = client.post(f"{server.url}/v1/ik", json={
-                "robot": SEVEN_DOF, "target": NUMERIC_TARGET, "numeric": {"starts": 2000, "time_budget_ms": 10_000}})
+                "robot": NUMERIC_ARM, "target": NUMERIC_TARGET, "numeric": {"starts": 2000, "time_budget_ms": 10_000}})
             answer["status"], answer["type"] = response.status_code, response.headers["content-type"]
 
     try:

@@ -23,12 +23,12 @@ from service.kinematics import COUNT_CAP, Budget, BudgetExhausted
 from tests.conftest import assert_problem
 
 UR5_Q = [0.3, -1.0, 1.2, 0.4, 0.5, 0.6]
-# Skew axes everywhere: no family covers this arm, nor any 6 of its joints with the seventh locked, so the numeric
-# search answers (a Panda-like table is solved in closed form with a free joint since issue 14).
-SEVEN_DOF = {"convention": "modified", "joints": [
-    {"a": a, "alpha": alpha, "d": d} for a, alpha, d in zip([0.05, 0.3, 0.07, 0.25, 0.04, 0.06, 0.03],
-                                                            [0.5, -0.9, 1.1, 0.7, -1.3, 0.4, 0.8],
-                                                            [0.2, 0.1, -0.15, 0.3, 0.05, 0.1, 0.08])]}
+# Five skew revolute joints and a slide: no closed-form family or general solver covers it, so the numeric
+# search answers (every 6R arm is solved by the general 6R solver, and a 7R one by locking a joint).
+NUMERIC_ARM = {"convention": "modified", "joints": [
+    {"type": kind, "a": a, "alpha": alpha, "d": d}
+    for kind, a, alpha, d in zip(["revolute"] * 5 + ["prismatic"], [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
+                                 [0.5, -0.9, 1.1, 0.7, -1.3, 0.4], [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
 
 
 def _ur5_target(client) -> dict:
@@ -85,7 +85,7 @@ def test_counts_never_overflow_into_a_500(wide, form):
 def test_numeric_counts_stay_in_the_integer_range(wide):
     """The single-request numeric path returned 175-digit integers in a field typed integer."""
     target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
-    response = wide.post("/v1/ik", json={"robot": SEVEN_DOF, "target": target, "limits": _limits(1e5, 7),
+    response = wide.post("/v1/ik", json={"robot": NUMERIC_ARM, "target": target, "limits": _limits(1e5, 6),
                                          "max_equivalents": 5})
     assert response.status_code == 200, response.text
     body = response.json()
@@ -128,7 +128,7 @@ def test_the_response_byte_cap_is_checked_too():
 def test_numeric_work_is_capped():
     target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
     with TestClient(create_app(Settings(_env_file=None, max_numeric_starts=1000))) as client:
-        response = client.post("/v1/ik", json={"robot": SEVEN_DOF, "target": target, "numeric": {"starts": 2000}})
+        response = client.post("/v1/ik", json={"robot": NUMERIC_ARM, "target": target, "numeric": {"starts": 2000}})
         assert_problem(response, 413, match="KIN_MAX_NUMERIC_STARTS = 1,000")
 
 
@@ -138,7 +138,7 @@ def test_numeric_work_is_capped():
 def test_a_request_may_lower_its_deadline_and_gets_503_with_retry_after(client):
     target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
     started = time.perf_counter()
-    response = client.post("/v1/ik", json={"robot": SEVEN_DOF, "target": target, "numeric": {"starts": 2000}},
+    response = client.post("/v1/ik", json={"robot": NUMERIC_ARM, "target": target, "numeric": {"starts": 2000}},
                            headers={"X-Request-Timeout-Ms": "30"})
     elapsed = time.perf_counter() - started
     problem = assert_problem(response, 503, match="deadline of 30 ms")
@@ -149,7 +149,7 @@ def test_a_request_may_lower_its_deadline_and_gets_503_with_retry_after(client):
 def test_the_deadline_header_cannot_raise_the_servers_deadline():
     target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
     with TestClient(create_app(Settings(_env_file=None, request_timeout_ms=30))) as client:
-        response = client.post("/v1/ik", json={"robot": SEVEN_DOF, "target": target, "numeric": {"starts": 2000}},
+        response = client.post("/v1/ik", json={"robot": NUMERIC_ARM, "target": target, "numeric": {"starts": 2000}},
                                headers={"X-Request-Timeout-Ms": "600000"})
         assert_problem(response, 503, match="deadline of 30 ms")
 
@@ -166,7 +166,7 @@ def test_a_trajectory_of_unreachable_samples_stops_at_the_deadline():
                                            "orientation": {"type": "rpy", "angles": [0, 0, 0]}}} for k in range(2000)]
     with TestClient(create_app(Settings(_env_file=None, request_timeout_ms=300))) as client:
         started = time.perf_counter()
-        response = client.post("/v1/ik/trajectory", json={"robot": SEVEN_DOF, "samples": samples})
+        response = client.post("/v1/ik/trajectory", json={"robot": NUMERIC_ARM, "samples": samples})
         elapsed = time.perf_counter() - started
     assert_problem(response, 503, match="deadline of 300 ms")
     assert elapsed < 30.0  # before: about 0.5 s per sample, 1,000 s for these
@@ -177,7 +177,7 @@ def test_numeric_answers_do_not_depend_on_load(client):
     import threading
 
     target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
-    body = {"robot": SEVEN_DOF, "target": target, "numeric": {"starts": 48, "time_budget_ms": 10_000}}
+    body = {"robot": NUMERIC_ARM, "target": target, "numeric": {"starts": 48, "time_budget_ms": 10_000}}
     alone = client.post("/v1/ik", json=body).json()
     stop = threading.Event()
 

@@ -306,22 +306,22 @@ def test_a_body_that_is_not_utf8_is_422_not_400(client):
 
 # --------------------------------------------------------------------------- the numeric search's time budget
 
-# Skew axes everywhere: no family covers this arm, nor any 6 of its joints with the seventh locked (issue 14 solves
-# redundant arms whose locked arm a family covers, as a Panda-like table now is).
-SEVEN_DOF = {"convention": "modified", "joints": [
-    {"a": a, "alpha": alpha, "d": d} for a, alpha, d in zip([0.05, 0.3, 0.07, 0.25, 0.04, 0.06, 0.03],
-                                                            [0.5, -0.9, 1.1, 0.7, -1.3, 0.4, 0.8],
-                                                            [0.2, 0.1, -0.15, 0.3, 0.05, 0.1, 0.08])]}
+# Five skew revolute joints and a slide: no closed-form family or general solver covers it, so the numeric
+# search answers (every 6R arm is solved by the general 6R solver, and a 7R one by locking a joint).
+NUMERIC_ARM = {"convention": "modified", "joints": [
+    {"type": kind, "a": a, "alpha": alpha, "d": d}
+    for kind, a, alpha, d in zip(["revolute"] * 5 + ["prismatic"], [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
+                                 [0.5, -0.9, 1.1, 0.7, -1.3, 0.4], [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
 
 
 def test_the_server_caps_the_numeric_time_and_refuses_past_it():
-    """A 7-joint arm no family covers (even with a joint locked): the numeric search runs, the client asks for 10 s,
+    """An arm no family covers: the numeric search runs, the client asks for 10 s,
     the server allows 20 ms per request: the search stops there and the answer is a 503 that names the cap, not a
     partial search."""
     target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
     with TestClient(create_app(Settings(_env_file=None, max_ik_time_ms=20))) as capped:
         started = time.perf_counter()
-        response = capped.post("/v1/ik", json={"target": target, "robot": SEVEN_DOF,
+        response = capped.post("/v1/ik", json={"target": target, "robot": NUMERIC_ARM,
                                                "numeric": {"starts": 2000, "time_budget_ms": 10_000}})
         elapsed = time.perf_counter() - started
     assert_problem(response, 503, match="deadline of 20 ms during the numeric search")
@@ -331,9 +331,9 @@ def test_the_server_caps_the_numeric_time_and_refuses_past_it():
 
 def test_a_batch_shares_the_servers_numeric_time(tmp_path):
     """Four targets in one batch, a 40 ms cap per request: the batch as a whole gets 40 ms."""
-    (tmp_path / "seven_dof.json").write_text(json.dumps({"id": "seven_dof", **SEVEN_DOF}))
+    (tmp_path / "numeric_arm.json").write_text(json.dumps({"id": "numeric_arm", **NUMERIC_ARM}))
     target = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
     with TestClient(create_app(Settings(_env_file=None, robots_dir=tmp_path, max_ik_time_ms=40))) as capped:
-        response = capped.post("/v1/robots/seven_dof/ik/batch",
+        response = capped.post("/v1/robots/numeric_arm/ik/batch",
                                json={"targets": [target] * 4, "numeric": {"starts": 2000, "time_budget_ms": 10_000}})
     assert_problem(response, 503, match="deadline of 40 ms during the numeric search")

@@ -30,7 +30,7 @@ def test_unknown_robot_lists_the_nearest_ids(client, robot_id, nearest):
 
 
 def test_unknown_robot_without_a_near_id_says_where_the_list_is(client):
-    body = assert_problem(client.get("/v1/robots/kuka_kr6"), 404, match="GET /v1/robots lists all")
+    body = assert_problem(client.get("/v1/robots/delta_robot_x"), 404, match="GET /v1/robots lists all")
     assert body["nearest_ids"] == [] and "Did you mean" not in body["detail"]
 
 

@@ -372,21 +372,21 @@ def test_numeric_time_budget_refuses_rather_than_cuts(client):
     that needs longer is a 503 with Retry-After, never a partial answer that depends on the server's load."""
     import time
 
-    # a 7R arm with skew axes: no family covers it, nor any 6 of its joints with the seventh locked, so the
-    # numeric search answers
-    T = _fk_pose(client, NUMERIC_7R, [0.3, 0.4, 0.8, 0.2, -0.4, 1.1, 0.5])
+    # five skew revolute joints and a slide: no family (nor the general 6R solver) covers it, so the numeric
+    # search answers
+    T = _fk_pose(client, NUMERIC_ARM, [0.3, 0.4, 0.8, 0.2, -0.4, 0.1])
     start = time.perf_counter()
-    cut = client.post("/v1/ik", json={"robot": NUMERIC_7R, "target": {"matrix": T.tolist()},
+    cut = client.post("/v1/ik", json={"robot": NUMERIC_ARM, "target": {"matrix": T.tolist()},
                                       "numeric": {"starts": 2000, "time_budget_ms": 5}})
     elapsed = time.perf_counter() - start
     body = assert_problem(cut, 503, match="numeric search")
     assert cut.headers["retry-after"] == "1" and "5 ms" in body["detail"]
     assert elapsed < 2.0  # 5 ms of search plus one iteration and HTTP; not the whole 2,000-start search
-    full = _inline_ik(client, NUMERIC_7R, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
-    again = _inline_ik(client, NUMERIC_7R, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
+    full = _inline_ik(client, NUMERIC_ARM, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
+    again = _inline_ik(client, NUMERIC_ARM, {"matrix": T.tolist()}, numeric={"starts": 48, "time_budget_ms": 5000})
     assert full["solver"]["time_budget_exhausted"] is False and full["status"] == "ok"
     assert full["solutions"] == again["solutions"]  # the same answer every time
-    short = _inline_ik(client, NUMERIC_7R, {"matrix": T.tolist()}, numeric={"starts": 48, "iterations": 3})
+    short = _inline_ik(client, NUMERIC_ARM, {"matrix": T.tolist()}, numeric={"starts": 48, "iterations": 3})
     assert short["solver"]["time_budget_exhausted"] is True and "iteration cap (3)" in short["detail"]
 
 
@@ -394,10 +394,11 @@ def _revolute(a, alpha, d, kind="revolute"):
     return {"type": kind, "a": a, "alpha": alpha, "d": d}
 
 
-NUMERIC_7R = {"convention": "modified", "joints": [
-    _revolute(a, alpha, d) for a, alpha, d in zip([0.05, 0.3, 0.07, 0.25, 0.04, 0.06, 0.03],
-                                                  [0.5, -0.9, 1.1, 0.7, -1.3, 0.4, 0.8],
-                                                  [0.2, 0.1, -0.15, 0.3, 0.05, 0.1, 0.08])]}
+NUMERIC_ARM = {"convention": "modified", "joints": [
+    _revolute(a, alpha, d, kind) for kind, a, alpha, d in zip(["revolute"] * 5 + ["prismatic"],
+                                                              [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
+                                                              [0.5, -0.9, 1.1, 0.7, -1.3, 0.4],
+                                                              [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
 
 
 SKEW_7R = {"convention": "standard", "joints": [_revolute(0.1 * i, 0.3 + 0.2 * i, 0.05 * (i % 3)) for i in range(7)]}
@@ -413,7 +414,7 @@ ONE_JOINT = {"convention": "modified", "joints": [_revolute(0.3, 0.7, 0.1)]}
 
 #: (robot, joint vector whose FK is the target, target kind): every one reachable
 REACHABLE = [
-    (SKEW_7R, [0.3, -0.2, 0.9, 1.4, -0.7, 0.2, 0.5], "pose"),  # redundant: infinitely many, some returned
+    (NUMERIC_ARM, [0.3, -0.2, 0.9, 1.4, -0.7, 0.2], "pose"),  # five skew revolute joints and a slide
     (SKEW_PRISMATIC, [0.4, 0.3, -1.1, 0.2, 2.0, -0.6], "pose"),
     # 3 joints more than the target fixes, and joints 1–3 (planar: axes 1 ∥ 2 ∥ 3) cannot place a point alone. (The
     # skew RPR start of SKEW_PRISMATIC can: its position targets are solved in closed form, skew_axes_with_slide.)

@@ -11,7 +11,7 @@ from fastapi.responses import Response
 from ...drawing import arm_poses, render_svg
 from ...kinematics import InvalidInputError, Robot
 from ..boundary import joints_to_core, located, _unit_scale
-from ..deps import RobotRef, catalogue_robot, inline_robot
+from ..deps import RobotRef, catalogue_robot, inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..routing import FastJSONRoute
 from ..schemas.render import RenderInlineRequest, RenderRequest
@@ -40,6 +40,7 @@ def wants_svg(request: Request) -> bool:
 
 
 def _render(ref: RobotRef, body: RenderRequest) -> Response:
+    ref = with_request_frames(ref, body)
     robot = ref.robot
     with located("body", "joints"):
         q = joints_to_core(robot, body.joints, body.angle_unit, batch=True)

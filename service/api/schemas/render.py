@@ -6,7 +6,7 @@ from enum import Enum
 
 from pydantic import Field
 
-from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number
+from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RequestFrames
 from ...robots.schemas import RobotDescription
 
 #: Most configurations one picture draws (each is a panel of its own).
@@ -22,7 +22,7 @@ class RenderView(str, Enum):
     top = "top"
 
 
-class RenderRequest(ApiModel):
+class RenderRequest(RequestFrames):
     """The arm in each configuration, drawn side by side with one projection and scale for all."""
 
     joints: list[list[Number]] = Field(

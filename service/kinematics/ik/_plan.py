@@ -56,27 +56,31 @@ def _geometry_of(robot: Robot) -> Geometry:
 def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     """The analytic plan for this robot and kind of target, or None when no family applies.
 
-    A family is looked for in the arm as given (tolerance ``GEOMETRY_TOLERANCE``), then in its idealisation
-    (relations within ``RECOGNITION_TOLERANCE`` made exact, :func:`idealised`): that plan solves the idealised arm
-    and refines on the true one (:class:`IdealisedPlan`).
+    A closed-form family is looked for in the arm as given (tolerance ``GEOMETRY_TOLERANCE``), then in its
+    idealisation (relations within ``RECOGNITION_TOLERANCE`` made exact, :func:`idealised`): that plan solves the
+    idealised arm and refines on the true one (:class:`IdealisedPlan`). A 6R pose target that neither finds goes
+    to the general 6R solver, last, because a rounded Pieper arm is nearly degenerate for its elimination.
     """
     geometry = geometry_of(robot)
     plan = _family_plan(geometry, constrain_orientation, reference)
     if plan is not None:
         return plan
     ideal = idealised(geometry)
-    if ideal.deviation == 0.0:
-        return None
-    plan = _family_plan(ideal.geometry, constrain_orientation, reference)
-    if plan is None:
-        return None
-    return IdealisedPlan(plan, ideal.geometry.model, robot, ideal.deviation, geometry.length_scale, constrain_orientation)
+    if ideal.deviation > 0.0:
+        plan = _family_plan(ideal.geometry, constrain_orientation, reference)
+        if plan is not None:
+            return IdealisedPlan(plan, ideal.geometry.model, robot, ideal.deviation, geometry.length_scale,
+                                 constrain_orientation)
+    return General6RPlan.match(geometry) if constrain_orientation else None
 
 
 def plan_for_geometry(geometry: Geometry, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     """:func:`plan_for` on a screw model directly, exact recognition only (the idealised retry needs the robot):
     also for arms that exist only as models, such as a redundant arm with joints locked (see ``_redundant``)."""
-    return _family_plan(geometry, constrain_orientation, reference)
+    plan = _family_plan(geometry, constrain_orientation, reference)
+    if plan is None and constrain_orientation:
+        plan = General6RPlan.match(geometry)
+    return plan
 
 
 def _family_plan(geometry: Geometry, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
@@ -102,7 +106,7 @@ def _pose_plan(geometry: Geometry, n: int) -> Plan | None:
     if inverse is not None:
         return ReversedPlan(inverse, geometry.model.home, n)
     # no closed form: the general 6R elimination (it refuses Pieper arms and anything not 6R)
-    return _reversed_three_parallel_plan(geometry, reverse, n) or General6RPlan.match(geometry)
+    return _reversed_three_parallel_plan(geometry, reverse, n)
 
 
 #: Three consecutive parallel axes: the families as the chain is described, then (name, family, first

@@ -92,9 +92,13 @@ def _incomplete_row(robot: Robot, target: np.ndarray, known: np.ndarray, structu
         if answer is not None:
             return answer
     result = _numeric(robot, target, constrain_orientation, reference, options, seeds=known)
-    note = (f"The arm is within rounding of the {structure} family but not exactly of it; its closed form, refined "
-            f"on the arm as given, cannot promise every solution for this target (a pair of solutions may appear "
-            f"or vanish between the two), so the numeric search completed it.")
+    if structure == "general_6r":
+        note = ("The general 6R solver cannot promise every solution for this target (an ill-conditioned "
+                "eigenproblem or a near-double root), so the numeric search completed its answer.")
+    else:
+        note = (f"The arm is within rounding of the {structure} family but not exactly of it; its closed form, "
+                f"refined on the arm as given, cannot promise every solution for this target (a pair of solutions "
+                f"may appear or vanish between the two), so the numeric search completed it.")
     result.detail = f"{note} {result.detail}".strip() if result.detail else note
     return result
 

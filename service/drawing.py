@@ -71,12 +71,17 @@ def arm_poses(robot: Robot, q: np.ndarray, captions: Sequence[Sequence[str]] | N
     frames = link_frames(robot, q)  # (N, n + 1, 4, 4)
     screws = joint_screws(robot, q)
     limits = limits or Limits.of(robot)
-    offsets = robot.d + np.where(robot.is_revolute, 0.0, q)  # (N, n): d of each row, prismatic travel included
+    described_by_dh = robot.chain_transforms is None  # URDF and screw robots: the links join the joint frames
+    if described_by_dh:
+        offsets = robot.d + np.where(robot.is_revolute, 0.0, q)  # (N, n): d of each row, prismatic travel included
     poses = []
     for row in range(len(q)):
         origins = frames[row, :, :3, 3]
         chain = [origins[0]]
         for i in range(robot.dof):
+            if not described_by_dh:
+                chain.append(origins[i + 1])
+                continue
             # the foot of the common normal between axes i and i+1: where the offset along z ends
             if robot.convention == "standard":
                 foot = origins[i] + offsets[row, i] * frames[row, i, :3, 2]

@@ -54,7 +54,8 @@ def test_one_panel_per_joint_vector_with_its_limit_status(client):
         assert len(panel.findall(f"{SVG}line[@class='axis']")) == 6  # one segment per joint axis
 
 
-@pytest.mark.parametrize("robot_id", ["ur5", "puma560_modified", "puma560_khalil", "spong_ex3_5_stanford"])
+@pytest.mark.parametrize("robot_id", ["ur5", "puma560_modified", "puma560_khalil", "spong_ex3_5_stanford",
+                                      "kinova_jaco2"])  # the last from a URDF (a screw robot)
 def test_top_view_is_the_fk_tool_position_at_one_scale(client, robot_id):
     robot = catalogue_robot(client, robot_id)
     rng = np.random.default_rng(7)

@@ -168,8 +168,9 @@ def family_for(robot: Robot, free: tuple[int, ...]) -> FreeJointFamily:
 def default_free_joints(robot: Robot) -> tuple[int, ...] | None:
     """The free joint(s) whose locking leaves a closed-form 6-DOF class, or None when no choice does.
 
-    One joint is locked per degree of redundancy. The first candidate whose
-    locked arm a family solves wins, in this order: the last joint (a Panda's or
+    One joint is locked per degree of redundancy. A decomposable class wins over
+    the general 6R solver; among equals, the first candidate whose locked arm a
+    family solves wins, in this order: the last joint (a Panda's or
     an iiwa's q7: their shoulder is then a spherical wrist at the base), the
     first (a Gen3's q1), the third (the SRS arms' other classic choice, their
     q3), then the others. End joints come first because
@@ -184,11 +185,14 @@ def default_free_joints(robot: Robot) -> tuple[int, ...] | None:
         order = [n - 1, 0, 2, *range(n)]
         order = list(dict.fromkeys(order))
         candidates = [(j,) for j in order] if extra == 1 else _combinations(order, extra)
+        general = None  # a decomposable class wins over the general 6R solver (an eigenproblem per value)
         for free in candidates:
             family = family_for(robot, tuple(sorted(free)))
             if family.available:
-                return family.free
-        return None
+                if family.plan.structure != "general_6r":
+                    return family.free
+                general = general or family.free
+        return general
 
     return memo(robot, "default_free_joints", choose)
 

@@ -61,6 +61,8 @@ EXPECTED_ROBOT_IDS = {
     "ufactory_lite6",
     "fanuc_lrmate200id",
     "abb_irb6700",
+    # a 7-joint arm from its vendor's DH table (tests/robots/test_industrial_arms.py)
+    "kinova_gen3",
 }
 
 REQUIRED_KEYS = (
@@ -309,7 +311,7 @@ TEXTBOOK_ONLY_ROBOTS = EXPECTED_ROBOT_IDS - {
     "spong_ex3_5_stanford", "puma560_modified", "puma560_khalil", "puma560_standard", "ur5",
     "ur3e", "ur5e", "ur10e", "ur16e",
     "kuka_kr6_r900_2", "kuka_kr210_r2700", "abb_irb120", "ufactory_xarm6", "ufactory_lite6",
-    "fanuc_lrmate200id", "abb_irb6700",
+    "fanuc_lrmate200id", "abb_irb6700", "kinova_gen3",
 }
 
 

@@ -57,13 +57,42 @@ GENERIC = {
     "kinova_jaco2": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
     "unitree_z1": ("pose", 8, "three_parallel"),
 }
-#: Catalogue arms that no analytic family covers yet, solved by the numeric fallback: the 7-joint arms, the 5-joint
-#: SO-101 for full poses, and the xArm 6 (its wrist is not spherical: a5 = 76 mm).
-NUMERIC_FALLBACK = {"franka_panda", "kuka_iiwa14", "ufactory_xarm7", "so101", "ufactory_xarm6"}
+#: The 7-joint catalogue arms: every solution at each value of a free joint (the service's default choice), each
+#: value's locked 6-joint arm solved by a family.
+REDUNDANT = {"franka_panda": "spherical_wrist+intersecting_shoulder with q7 free",
+             "kuka_iiwa14": "spherical_wrist+intersecting_shoulder with q7 free",
+             "ufactory_xarm7": "general_6r with q7 free",
+             "kinova_gen3": "intersecting_shoulder+spherical_wrist with q1 free"}
+#: Answered elsewhere: the xArm 6 (no spherical wrist, a5 = 76 mm) by the general 6R solver
+#: (tests/kinematics/test_ik_general_6r.py), the 5-joint SO-101's full poses by the numeric search (its targets are
+#: position + direction, tests/api/test_ik_direction.py).
+ELSEWHERE = {"so101", "ufactory_xarm6"}
 
 
 def test_every_catalogue_robot_has_an_analytic_class(client):
-    assert {robot["id"] for robot in client.get("/v1/robots").json()["robots"]} == set(GENERIC) | NUMERIC_FALLBACK
+    assert {robot["id"] for robot in client.get("/v1/robots").json()["robots"]} == (
+        set(GENERIC) | set(REDUNDANT) | ELSEWHERE)
+
+
+@pytest.mark.parametrize("robot_id", sorted(REDUNDANT))
+def test_redundant_catalogue_arms_return_the_generating_vector(client, robot_id):
+    """Poses from random joint vectors; the generating vector's free-joint value among the requested values (with
+    two others): the generating vector comes back, from the closed-form family the service chose."""
+    robot = catalogue_robot(client, robot_id)
+    q = random_configurations(robot, 12, seed=sorted(REDUNDANT).index(robot_id))
+    poses = client.post(f"/v1/robots/{robot_id}/fk/batch", json={"joints": q.tolist()}).json()["poses"]
+    free = int(REDUNDANT[robot_id].split(" with q")[1].split()[0]) - 1
+    for q_true, pose in zip(q, poses):
+        values = [float(q_true[free]), float(q_true[free]) + 0.3, float(q_true[free]) - 0.4]
+        answer = client.post(f"/v1/robots/{robot_id}/ik", json={
+            "target": {"matrix": pose["matrix"]}, "limits": [None] * robot.dof,  # no limits: no 2π copies
+            "free_joints": [{"joint": free, "values": values}]}).json()
+        assert answer["status"] == "ok", answer["detail"]
+        assert answer["solver"] == {"method": "analytic", "structure": REDUNDANT[robot_id], "complete": True,
+                                    "time_budget_exhausted": False}
+        assert answer["free_joints"] == [free]
+        solutions = np.array([solution["joints"] for solution in answer["solutions"]])
+        assert np.abs(joint_difference(robot, solutions, q_true)).max(axis=1).min() < 1e-7, q_true
 
 
 def targets_for(client, robot_id: str, q: np.ndarray, kind: str) -> list[dict]:

@@ -201,3 +201,18 @@ def test_opw_arm_is_solved_in_closed_form(client, robot_id):
         assert body["solver"]["complete"] is True
         solutions = np.array([s["joints"] for s in body["solutions"]])
         assert np.abs(joint_difference(robot, solutions, q_true)).max(axis=1).min() < 1e-7, q_true
+
+
+def test_kinova_gen3_fk_matches_the_user_guides_table(client):
+    """The catalogue's Gen3 against the Kinova Gen3 User Guide's classical DH table (restated with its source in
+    tests/data/redundant_and_deficient_arms.json), evaluated here: base Rx(180°), then the seven rows."""
+    with open(DATA_DIR / "redundant_and_deficient_arms.json", encoding="utf-8") as stream:
+        guide = json.load(stream)["gen3"]
+    rows = [(math.radians(row["theta"]), row["d"], math.radians(row["alpha"]), row["a"]) for row in guide["joints"]]
+    base = np.array(guide["base"], dtype=float)
+    rng = np.random.default_rng(37)
+    q = rng.uniform(-2.0, 2.0, (50, 7))  # within every actuator's limits
+    poses = client.post("/v1/robots/kinova_gen3/fk/batch", json={"joints": q.tolist()}).json()["poses"]
+    actual = np.array([pose["matrix"] for pose in poses])
+    expected = np.array([base @ dh_forward(rows, qi, modified=False) for qi in q])
+    np.testing.assert_allclose(actual, expected, rtol=0, atol=ATOL)

@@ -59,6 +59,33 @@ class Report:
         return next((r for r in self.rows if (r.robot, r.task, r.library) == (robot, task, library)), None)
 
 
+def timing_arguments(prog: str, description: str) -> argparse.ArgumentParser:
+    """The options every benchmark script shares: batch and single-pose sizes, interleaved rounds, a quick mode."""
+    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser.add_argument("--batch", type=int, default=10_000, help="poses in a batch (default 10,000)")
+    parser.add_argument("--single", type=int, default=500, help="poses timed one call at a time (default 500)")
+    parser.add_argument("--repeats", type=int, default=5, help="interleaved rounds, best kept (default 5)")
+    parser.add_argument("--quick", action="store_true", help="tiny sizes, for a smoke run")
+    return parser
+
+
+def parse_timing_arguments(parser: argparse.ArgumentParser, argv: list[str] | None) -> argparse.Namespace:
+    """Parsed options; ``--quick`` shrinks the sizes to a smoke run's."""
+    args = parser.parse_args(argv)
+    if args.quick:
+        args.batch, args.single, args.repeats = 20, 5, 1
+    return args
+
+
+def report_noting_missing_anchors() -> Report:
+    """An empty report that names each anchor library that is not installed (it is then skipped)."""
+    report = Report()
+    for name in anchors.LIBRARIES:
+        if not anchors.installed(name):
+            report.skipped.append(f"{name}: not installed (pip install -e '.[bench]'), skipped")
+    return report
+
+
 def sample_configurations(robot: Robot, count: int, seed: int) -> np.ndarray:
     """Revolute joints uniform in ±π; prismatic joints uniform within their limits (or 0.1–1 robot sizes)."""
     rng = np.random.default_rng(seed)
@@ -233,22 +260,15 @@ def machine() -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.core", description=__doc__.splitlines()[0])
-    parser.add_argument("--batch", type=int, default=10_000, help="poses in a batch (default 10,000)")
-    parser.add_argument("--single", type=int, default=500, help="poses timed one call at a time (default 500)")
-    parser.add_argument("--repeats", type=int, default=5, help="interleaved rounds, best kept (default 5)")
+    parser = timing_arguments("python -m benchmarks.core", __doc__.splitlines()[0])
     parser.add_argument("--memory-poses", type=int, default=100_000, help="poses in the memory run (0: skip)")
     parser.add_argument("--robots", nargs="*", default=list(ROBOTS), choices=list(ROBOTS))
-    parser.add_argument("--quick", action="store_true", help="tiny sizes, for a smoke run")
-    args = parser.parse_args(argv)
+    args = parse_timing_arguments(parser, argv)
     if args.quick:
-        args.batch, args.single, args.repeats, args.memory_poses = 20, 5, 1, 200
+        args.memory_poses = 200
 
     catalogue = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
-    report = Report()
-    missing = [name for name in anchors.LIBRARIES if not anchors.installed(name)]
-    for name in missing:
-        report.skipped.append(f"{name}: not installed (pip install -e '.[bench]'), skipped")
+    report = report_noting_missing_anchors()
     for label in args.robots:
         bench_robot(report, label, catalogue.get(ROBOTS[label]).robot, args)
     if args.memory_poses:

@@ -21,7 +21,8 @@ from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import solve_ik
 from service.kinematics.ik._arrays import cached_plan, solve_ik_arrays
 
-from .core import Report, Row, best_of, format_report, machine, recall, sample_configurations
+from .core import (Report, Row, best_of, format_report, machine, parse_timing_arguments, recall,
+                   sample_configurations, timing_arguments)
 from .wrist_classes import kuka_kr6_r900_2
 
 
@@ -85,14 +86,7 @@ def bench_arm(report: Report, label: str, robot: Robot, args: argparse.Namespace
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.slide_classes", description=__doc__.splitlines()[0])
-    parser.add_argument("--batch", type=int, default=10_000, help="poses in a batch (default 10,000)")
-    parser.add_argument("--single", type=int, default=500, help="poses timed one call at a time (default 500)")
-    parser.add_argument("--repeats", type=int, default=5, help="interleaved rounds, best kept (default 5)")
-    parser.add_argument("--quick", action="store_true", help="tiny sizes, for a smoke run")
-    args = parser.parse_args(argv)
-    if args.quick:
-        args.batch, args.single, args.repeats = 20, 5, 1
+    args = parse_timing_arguments(timing_arguments("python -m benchmarks.slide_classes", __doc__.splitlines()[0]), argv)
     report, structures = Report(), []
     for label, build in ARMS.items():
         robot = build()

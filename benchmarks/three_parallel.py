@@ -13,7 +13,6 @@ meeting (THREE_PARALLEL_TWO_INTERSECTING); it says which arms it cannot solve.
 
 from __future__ import annotations
 
-import argparse
 import sys
 
 import numpy as np
@@ -24,8 +23,8 @@ from service.kinematics import Robot
 from service.kinematics._robot import Joint
 from service.kinematics.ik._arrays import cached_plan
 
-from . import anchors
-from .core import Report, bench_robot, format_report, machine
+from .core import (bench_robot, format_report, machine, parse_timing_arguments,
+                   report_noting_missing_anchors, timing_arguments)
 
 #: class label → (0-based standard-DH twists set to 0 (parallel axes i+1, i+2), link lengths set to 0)
 CLASSES = {
@@ -49,18 +48,8 @@ def class_arm(label: str, seed: int = 5) -> Robot:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.three_parallel", description=__doc__.splitlines()[0])
-    parser.add_argument("--batch", type=int, default=10_000, help="poses in a batch (default 10,000)")
-    parser.add_argument("--single", type=int, default=500, help="poses timed one call at a time (default 500)")
-    parser.add_argument("--repeats", type=int, default=5, help="interleaved rounds, best kept (default 5)")
-    parser.add_argument("--quick", action="store_true", help="tiny sizes, for a smoke run")
-    args = parser.parse_args(argv)
-    if args.quick:
-        args.batch, args.single, args.repeats = 20, 5, 1
-    report = Report()
-    for name in anchors.LIBRARIES:
-        if not anchors.installed(name):
-            report.skipped.append(f"{name}: not installed (pip install -e '.[bench]'), skipped")
+    args = parse_timing_arguments(timing_arguments("python -m benchmarks.three_parallel", __doc__.splitlines()[0]), argv)
+    report = report_noting_missing_anchors()
     # today's UR-type family on the catalogue UR5, as the anchor of "the speed of today's families"
     bench_robot(report, "UR5 (three_parallel)", load_catalogue([Settings().builtin_robots_dir], max_joints=32)
                 .get("ur5").robot, args)

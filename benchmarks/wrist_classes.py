@@ -27,7 +27,8 @@ from service.kinematics.ik import solve_ik
 from service.kinematics.ik._arrays import cached_plan, solve_ik_arrays
 
 from . import anchors
-from .core import Report, Row, best_of, format_report, machine, recall, sample_configurations
+from .core import (Report, Row, best_of, format_report, machine, parse_timing_arguments, recall,
+                   report_noting_missing_anchors, sample_configurations, timing_arguments)
 
 DEG = np.pi / 180
 
@@ -119,18 +120,8 @@ def bench_arm(report: Report, label: str, robot: Robot, args: argparse.Namespace
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m benchmarks.wrist_classes", description=__doc__.splitlines()[0])
-    parser.add_argument("--batch", type=int, default=10_000, help="poses in a batch (default 10,000)")
-    parser.add_argument("--single", type=int, default=500, help="poses timed one call at a time (default 500)")
-    parser.add_argument("--repeats", type=int, default=5, help="interleaved rounds, best kept (default 5)")
-    parser.add_argument("--quick", action="store_true", help="tiny sizes, for a smoke run")
-    args = parser.parse_args(argv)
-    if args.quick:
-        args.batch, args.single, args.repeats = 20, 5, 1
-    report = Report()
-    for name in anchors.LIBRARIES:
-        if not anchors.installed(name):
-            report.skipped.append(f"{name}: not installed (pip install -e '.[bench]'), skipped")
+    args = parse_timing_arguments(timing_arguments("python -m benchmarks.wrist_classes", __doc__.splitlines()[0]), argv)
+    report = report_noting_missing_anchors()
     structures = []
     for label, build in ARMS.items():
         robot = build()

@@ -11,7 +11,12 @@ bodies go in through a Lua script):
   ``GET /healthz`` of the same server as the framework's ceiling;
 * poses/s for one IK batch of N targets (``format: arrays``, and the default
   objects form for comparison), against the core's own time for the same batch
-  measured in this process (``solve_ik_arrays``).
+  measured in this process (``solve_ik_arrays``);
+* the workload a reachability study sends: the same N targets (drawn over the
+  whole ±π joint range) with the robot's catalogue limits in force, the whole
+  answer (solve, limits, 2π-equivalents, encoding) over HTTP, per pose, against
+  EAIK's batched in-process solve of the same poses (``IK_batched``, when EAIK is
+  installed).
 
 Traffic goes only to 127.0.0.1, each wrk run is bounded in time, and the
 server is stopped at the end.
@@ -147,11 +152,14 @@ def main(argv: list[str] | None = None) -> int:
         "batch_arrays": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "limits": unlimited,
                                     "format": "arrays"}).encode(),
         "batch_objects": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "limits": unlimited}).encode(),
+        # no "limits": the catalogue's limits apply, as they do for a user who sends none
+        "batch_limited": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "format": "arrays"}).encode(),
     }
 
     # the core's own time for the same batch, in this process, before the server starts
     solve_ik_arrays(robot, T[:10])
     core = min(_timed(lambda: solve_ik_arrays(robot, T)) for _ in range(3))
+    eaik = _eaik_batch_seconds(robot, T)
 
     port = free_port()
     base = f"http://127.0.0.1:{port}"
@@ -166,11 +174,12 @@ def main(argv: list[str] | None = None) -> int:
             loads.append(run_wrk("GET /healthz (framework ceiling)", f"{base}/healthz", scripts["healthz"], **single))
             loads.append(run_wrk("POST fk, one configuration", f"{base}/v1/robots/{ROBOT}/fk", scripts["fk"], **single))
             loads.append(run_wrk("POST ik, one pose", f"{base}/v1/robots/{ROBOT}/ik", scripts["ik"], **single))
-            for form in ("arrays", "objects"):
+            for form, what in (("arrays", "format arrays"), ("objects", "format objects"),
+                               ("limited", "format arrays, catalogue limits")):
                 # one request first (warm-up), so that the run is long enough for several requests of this size
                 once = _post(f"{base}/v1/robots/{ROBOT}/ik/batch", bodies[f"batch_{form}"])
                 seconds = min(max(args.seconds, 2, 4 * once + 1), 120)
-                loads.append(run_wrk(f"POST ik/batch, {args.batch:,} targets, format {form}",
+                loads.append(run_wrk(f"POST ik/batch, {args.batch:,} targets, {what}",
                                      f"{base}/v1/robots/{ROBOT}/ik/batch", scripts[f"batch_{form}"],
                                      seconds=seconds, connections=1, timeout=120))
     finally:
@@ -187,7 +196,10 @@ def main(argv: list[str] | None = None) -> int:
               f"{load.requests:,} | {'' if poses is None else f'{poses:,.0f}'} |")
     print(f"| core solve_ik_arrays, same {args.batch:,} targets, in process | {1 / core:,.1f} | {core * 1e3:.2f} | "
           f" | | {args.batch / core:,.0f} |")
-    ceiling, fk, ik, arrays, objects = loads
+    if eaik is not None:
+        print(f"| EAIK IK_batched, same {args.batch:,} targets, in process | {1 / eaik:,.1f} | {eaik * 1e3:.2f} | "
+              f" | | {args.batch / eaik:,.0f} |")
+    ceiling, fk, ik, arrays, objects, limited = loads
     print("\ntargets (ratios from this run):")
     share = ik.requests_per_second / ceiling.requests_per_second
     print(f"- single-IK throughput / trivial endpoint: {share:.2f} (target >= 0.60: {'met' if share >= 0.6 else 'NOT met'})")
@@ -197,7 +209,26 @@ def main(argv: list[str] | None = None) -> int:
           f"(target <= 3: {'met' if ratio <= 3 else 'NOT met'})")
     print(f"- {args.batch:,}-target batch over HTTP (objects form, p50) / core batch time: "
           f"{(objects.p50_ms / 1e3) / core:.2f}")
+    if eaik is None:
+        print("- EAIK is not installed (pip install -e '.[bench]'): the limits-on batch has no anchor in this run")
+    else:
+        ratio = (limited.p50_ms / 1e3) / eaik
+        print(f"- {args.batch:,}-target batch over HTTP with the catalogue limits (p50) / EAIK's batched in-process "
+              f"solve: {ratio:.2f} per pose (target <= 8: {'met' if ratio <= 8 else 'NOT met'})")
     return 0
+
+
+def _eaik_batch_seconds(robot, T: np.ndarray) -> float | None:
+    """EAIK's best-of-three time for ``IK_batched`` on the poses T (N, 4, 4), or None without EAIK."""
+    from . import anchors
+
+    if not anchors.installed("EAIK"):
+        return None
+    anchor = anchors.eaik(robot)
+    if isinstance(anchor, str):
+        return None
+    anchor.ik_batch(T[:10])
+    return min(_timed(lambda: anchor.ik_batch(T)) for _ in range(3))
 
 
 def _post(url: str, body: bytes) -> float:

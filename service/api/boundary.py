@@ -285,6 +285,20 @@ def ordering_to_core(robot: Robot, ordering: OrderingOptions, max_solutions: int
     return core
 
 
+def ik_selection_to_core(robot: Robot, body) -> tuple[np.ndarray | None, Limits, Ordering]:
+    """An IK request's reference, limits and ordering in core units, errors located in the body."""
+    reference = None
+    if body.reference is not None:
+        with located("body", "reference"):
+            reference = joints_to_core(robot, body.reference, body.angle_unit)
+    with located("body", "limits"):
+        limits = limits_to_core(robot, body.limits, body.angle_unit)
+    with located("body"):
+        ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
+                                    body.angle_unit)
+    return reference, limits, ordering
+
+
 def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:
     """A violation in the request's units; an open side of the range is null."""
     scale = float(_unit_scale(robot, unit)[violation.joint])

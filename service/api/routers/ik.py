@@ -5,10 +5,9 @@ from __future__ import annotations
 import numpy as np
 from fastapi import APIRouter, Depends, Query, Request
 
-from ...kinematics.ik import AnswerOptions, IKAnswer, IKOptions, NumericOptions, UnsupportedTargetError, answer_ik
-from ...kinematics.ik import cached_plan
-from ..boundary import free_joints_to_core, ik_targets_to_core, joints_to_core, limits_to_core, located, \
-    ordering_to_core
+from ...kinematics.ik import (AnswerOptions, IKAnswer, IKOptions, NumericOptions, UnsupportedTargetError, answer_ik,
+                               cached_plan)
+from ..boundary import free_joints_to_core, ik_selection_to_core, ik_targets_to_core, located
 from ..budget import budget_of, check_ik_cost
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of, with_request_frames
 from ..ik_encoding import ik_columns, ik_objects
@@ -32,14 +31,8 @@ def _answer(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, f
     robot, unit, single = ref.robot, body.angle_unit, isinstance(body, IKRequest)
     targets = ik_targets_to_core([body.target] if single else body.targets, unit, "body",
                                  "target" if single else "targets", indexed=not single)
-    with located("body", "reference"):
-        reference = None if body.reference is None else joints_to_core(robot, body.reference, unit)
-    with located("body", "limits"):
-        limits = limits_to_core(robot, body.limits, unit)
-    with located("body"):
-        ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference, unit)
-    # the kept plans (a position-only plan holding joints at the reference is rebuilt per request; its count is
-    # the same as the kept one's)
+    reference, limits, ordering = ik_selection_to_core(robot, body)
+    # the kept plans (a position-only plan holding joints at the reference has the same count as the kept one)
     plans = [cached_plan(robot, constrain_orientation=bool(kind), reference=None)
              for kind in np.unique(targets.kinds > 0)]
     per_target = max(body.numeric.starts if plan is None else plan.generic_count for plan in plans)
@@ -82,7 +75,6 @@ def inverse_kinematics_inline(request: Request, body: IKInlineRequest, render: R
 
 
 def _answer_or_picture(request: Request, ref: RobotRef, body: IKRequest, render: RenderView | None):
-    """The answer, or (``?render=VIEW`` or Accept: image/svg+xml) its picture."""
     ref = with_request_frames(ref, body)
     answer = ik_objects(ref.id, ref.robot, _answer(request, ref, body, "objects"), body.angle_unit,
                         budget_of(request))[0]
@@ -93,8 +85,7 @@ def _answer_or_picture(request: Request, ref: RobotRef, body: IKRequest, render:
 
 @router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch",
              response_model=IKBatchResponse | IKBatchArraysResponse, responses=problem_responses(404, 413, 422))
-def inverse_kinematics_batch(request: Request, body: IKBatchRequest,
-                             ref: RobotRef = Depends(catalogue_robot)):
+def inverse_kinematics_batch(request: Request, body: IKBatchRequest, ref: RobotRef = Depends(catalogue_robot)):
     """Every solution for each target; the analytic solvers run vectorised over the targets."""
     check_batch_size(request, len(body.targets), "targets")
     ref = with_request_frames(ref, body)

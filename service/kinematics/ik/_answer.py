@@ -161,8 +161,8 @@ class IKAnswer:
 
 @dataclass
 class _Solved:
-    """Solved rows of one kind: ``rows`` (k,) target indices, their solutions, and per row its solver, base
-    detail and singular conditions."""
+    """Solved rows of one kind: ``rows`` (k,) target indices, their solutions, and per row its solver, detail
+    (before the selection's notes), remark (after them) and singular conditions."""
 
     rows: np.ndarray
     arrays: IKArrays
@@ -170,6 +170,7 @@ class _Solved:
     details: list[str | None]
     singularities: list[list[Singularity]]
     constrained: bool  # whether the orientation residual means something (pose and direction rows)
+    remarks: list[str | None] = field(default_factory=list)
     chosen: BatchSelection | None = None  # the selection of its rows, once made
 
 
@@ -251,7 +252,7 @@ def _solved_poses(robot: Robot, matrices: np.ndarray, kinds: np.ndarray, free: l
                     part.solvers[local] = SolverReport(**{**vars(part.solvers[local]), "complete": False})
                     why = (f"At {missing} of the free values the locked arm falls outside the closed-form family, "
                            f"so no solution is listed there.")
-                    part.details[local] = f"{part.details[local]} {why}" if part.details[local] else why
+                    part.remarks[local] = why
             yield part
             continue
         arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
@@ -288,7 +289,7 @@ def _numeric(robot: Robot, matrices: np.ndarray, rows: np.ndarray, constrained: 
         names = ", ".join(f"q{f.joint + 1}" for f in free)
         note = (f"No closed-form family covers this arm with {names} locked, so the free joints were not applied: "
                 f"a numeric search over every joint answered.")
-        part.details = [f"{detail} {note}" if detail else note for detail in part.details]
+        part.remarks = [note] * len(rows)
     return part
 
 
@@ -303,7 +304,7 @@ def _from_arrays(arrays: IKArrays, rows: np.ndarray, details: list[str | None], 
             if flag not in singularities[local]:
                 singularities[local].append(flag)
     return _Solved(rows, arrays, [reports[promise] for promise in arrays.complete.tolist()], list(details),
-                   singularities, constrained)
+                   singularities, constrained, [None] * len(rows))
 
 
 def _from_results(robot: Robot, rows: np.ndarray, results: list[IKResult], constrained: bool) -> _Solved:
@@ -311,7 +312,7 @@ def _from_results(robot: Robot, rows: np.ndarray, results: list[IKResult], const
     return _Solved(rows, arrays_from_results(robot, results),
                    [SolverReport(r.method, r.structure, r.complete, r.search_exhausted_budget, tuple(r.free_joints))
                     for r in results], [r.detail or None for r in results], [list(r.singularities) for r in results],
-                   constrained)
+                   constrained, [None] * len(rows))
 
 
 def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits, options: AnswerOptions) -> IKAnswer:
@@ -343,7 +344,7 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
         for local in np.flatnonzero(live).tolist():
             row = int(rows[local])
             solver_of[row], singular_of[row] = part.solvers[local], part.singularities[local]
-            words = [part.details[local], *chosen.notes.get(local, [])]
+            words = [part.details[local], *chosen.notes.get(local, []), part.remarks[local]]
             detail[row] = " ".join(filter(None, words)) or None
         for table, into in ((chosen.solutions, kept_parts), (chosen.rejected, rejected_parts)):
             table = table.take(np.flatnonzero(live[table.target]))

@@ -23,8 +23,8 @@ def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
                 "time_budget_exhausted": s.time_budget_exhausted} for s in answer.solvers]
     reports = [_report(report) for report in answer.singularity_reports]
     free_of_target = [list(answer.solvers[index].free_joints) for index in answer.solver.tolist()]
-    kept = _solution_dicts(robot, answer.solutions, answer.solution_violations, answer, scale, free_of_target)
-    rejected = _solution_dicts(robot, answer.rejected, answer.rejected_violations, answer, scale, free_of_target)
+    kept = _solution_dicts(answer.solutions, answer.solution_violations, answer, scale, free_of_target)
+    rejected = _solution_dicts(answer.rejected, answer.rejected_violations, answer, scale, free_of_target)
     status, truncated = answer.status.tolist(), answer.truncated.tolist()
     trimmed, available = answer.trimmed.tolist(), answer.available.tolist()
     answers = []
@@ -40,7 +40,7 @@ def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
     return answers
 
 
-def _solution_dicts(robot: Robot, table: SolutionTable, outside: np.ndarray, answer: IKAnswer, scale: np.ndarray,
+def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer, scale: np.ndarray,
                     free_of_target: list[list[int]]) -> list[list[dict]]:
     """Each target's rows of ``table`` as solution dicts; ``outside`` (S, n) marks the joints a row violates."""
     joints = (table.joints / scale).tolist()

@@ -184,7 +184,7 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
     timings: list[SolveTiming] = []
     solved = [*_solved_directions(robot, targets, options, timings),
               *_solved_poses(robot, matrices, kinds, free, options, timings)]
-    answer = _selected(robot, len(matrices), solved, limits, options)
+    answer = _selected(robot, len(matrices), solved, limits, options, timings)
     retry = [row for row in np.flatnonzero((kinds == POSITION) & (answer.status == "unreachable")).tolist()
              if answer.solvers[answer.solver[row]].free_joints
              and answer.solvers[answer.solver[row]].method == "analytic"]
@@ -192,8 +192,7 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
         results = [search_position(robot, matrices[row], list(answer.solvers[answer.solver[row]].free_joints),
                                    options.reference, options.search) for row in retry]
         solved.append(_from_results(robot, np.array(retry), results, False))
-        answer = _selected(robot, len(matrices), solved, limits, options)
-    answer.timings = timings
+        answer = _selected(robot, len(matrices), solved, limits, options, timings)
     return answer
 
 
@@ -315,7 +314,8 @@ def _from_results(robot: Robot, rows: np.ndarray, results: list[IKResult], const
                    constrained, [None] * len(rows))
 
 
-def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits, options: AnswerOptions) -> IKAnswer:
+def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits, options: AnswerOptions,
+              timings: list[SolveTiming]) -> IKAnswer:
     """Select every part's rows (once: a part keeps its selection) and gather them into one answer; a later
     part's rows replace an earlier part's answer for the same targets (the position search after an unreachable
     held-joint solve)."""
@@ -356,7 +356,7 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
     reports, singularities = _numbered_lists(singular_of)
     kept, rejected = _merged(kept_parts, robot.dof), _merged(rejected_parts, robot.dof)
     return IKAnswer(status, detail, solver, solvers, singularities, reports, truncated, trimmed, available, kept,
-                    rejected, _violations(robot, limits, kept), _violations(robot, limits, rejected), limits, [])
+                    rejected, _violations(robot, limits, kept), _violations(robot, limits, rejected), limits, timings)
 
 
 def _numbered(items: list) -> tuple[list, np.ndarray]:

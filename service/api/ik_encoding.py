@@ -101,10 +101,12 @@ def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer) -> dict:
         orientation = [None if np.isnan(value) else value for value in orientation.tolist()]
     branch = {name: np.array([*values, None], dtype=object)[codes].tolist()
               for name, (values, codes) in table.labels.items()}
-    free_of_row = [answer.solvers[index].free_joints for index in answer.solver[table.target].tolist()]
-    rows = joints.tolist()
-    free_values = {str(j): [row[j] if j in free else None for row, free in zip(rows, free_of_row)]
-                   for j in sorted({j for free in free_of_row for j in free})}
+    free_values = {}
+    if any(solver.free_joints for solver in answer.solvers):
+        free_of_row = [answer.solvers[index].free_joints for index in answer.solver[table.target].tolist()]
+        rows = joints.tolist()
+        free_values = {str(j): [row[j] if j in free else None for row, free in zip(rows, free_of_row)]
+                       for j in sorted({j for free in free_of_row for j in free})}
     return {"target": table.target, "joints": joints, "within_limits": table.within_limits,
             "residual_position": table.position, "residual_orientation": orientation, "branch": branch,
             "free_values": free_values}

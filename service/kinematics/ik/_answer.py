@@ -161,16 +161,18 @@ class IKAnswer:
 
 @dataclass
 class _Solved:
-    """Solved rows of one kind: ``rows`` (k,) target indices, their solutions, and per row its solver, detail
-    (before the selection's notes), remark (after them) and singular conditions."""
+    """Solved rows of one kind: ``rows`` (k,) target indices and their solutions; ``solver`` (k,) indexes
+    ``solvers``. Only the rows that have them appear in ``details`` (put before the selection's notes),
+    ``remarks`` (after them) and ``singularities`` (local row → its singular conditions)."""
 
     rows: np.ndarray
     arrays: IKArrays
     solvers: list[SolverReport]
-    details: list[str | None]
-    singularities: list[list[Singularity]]
+    solver: np.ndarray
+    details: dict[int, str]
+    singularities: dict[int, list[Singularity]]
     constrained: bool  # whether the orientation residual means something (pose and direction rows)
-    remarks: list[str | None] = field(default_factory=list)
+    remarks: dict[int, str] = field(default_factory=dict)
     chosen: BatchSelection | None = None  # the selection of its rows, once made
 
 
@@ -213,8 +215,7 @@ def _solved_directions(robot: Robot, targets: IKTargets, options: AnswerOptions,
         timings.append(SolveTiming("analytic", arrays.structure, time.perf_counter() - started,
                                    arrays.count.tolist()))
         positions = targets.matrices[rows, :3, 3]
-        details = [None if count else _direction_detail(robot, position)
-                   for count, position in zip(arrays.count.tolist(), positions)]
+        details = {local: _direction_detail(robot, positions[local]) for local in np.flatnonzero(arrays.count == 0)}
         yield _from_arrays(arrays, rows, details, True)
 
 
@@ -243,15 +244,15 @@ def _solved_poses(robot: Robot, matrices: np.ndarray, kinds: np.ndarray, free: l
             arrays = family.arrays
             timings.append(SolveTiming("analytic", arrays.structure, time.perf_counter() - started,
                                        arrays.count.tolist()))
-            details = [None if count else no_solution_detail(robot, free, matrices[row, :3, 3])
-                       for row, count in zip(rows.tolist(), arrays.count.tolist())]
+            details = {local: no_solution_detail(robot, free, matrices[rows[local], :3, 3])
+                       for local in np.flatnonzero(arrays.count == 0).tolist()}
             part = _from_arrays(arrays, rows, details, True)
-            for local, missing in enumerate(family.missing.tolist()):
-                if missing:  # the answer is not complete at those values
-                    part.solvers[local] = SolverReport(**{**vars(part.solvers[local]), "complete": False})
-                    why = (f"At {missing} of the free values the locked arm falls outside the closed-form family, "
-                           f"so no solution is listed there.")
-                    part.remarks[local] = why
+            missing = family.missing > 0  # the answer is not complete at those values
+            part.solver[missing] += len(part.solvers)
+            part.solvers += [SolverReport(**{**vars(report), "complete": False}) for report in part.solvers]
+            part.remarks = {local: f"At {family.missing[local]} of the free values the locked arm falls outside "
+                                   f"the closed-form family, so no solution is listed there."
+                            for local in np.flatnonzero(missing).tolist()}
             yield part
             continue
         arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
@@ -267,8 +268,7 @@ def _solved_poses(robot: Robot, matrices: np.ndarray, kinds: np.ndarray, free: l
         if len(promised):
             unreachable = unreachable_details(robot, arrays, matrices[rows[promised]], constrained, reference,
                                               options.budget)
-            yield _from_arrays(arrays, rows[promised], [unreachable.get(local) for local in range(len(promised))],
-                               constrained)
+            yield _from_arrays(arrays, rows[promised], unreachable, constrained)
         if len(promised) < len(rows):
             yield _numeric(robot, matrices, rows[~np.isin(np.arange(len(rows)), promised)], constrained, options,
                            timings, time.perf_counter())
@@ -288,30 +288,32 @@ def _numeric(robot: Robot, matrices: np.ndarray, rows: np.ndarray, constrained: 
         names = ", ".join(f"q{f.joint + 1}" for f in free)
         note = (f"No closed-form family covers this arm with {names} locked, so the free joints were not applied: "
                 f"a numeric search over every joint answered.")
-        part.remarks = [note] * len(rows)
+        part.remarks = dict.fromkeys(range(len(rows)), note)
     return part
 
 
-def _from_arrays(arrays: IKArrays, rows: np.ndarray, details: list[str | None], constrained: bool) -> _Solved:
-    """Closed-form rows: one solver for all, each row's singular conditions where it has a solution."""
-    reports = {promise: SolverReport("analytic", arrays.structure, promise, False, tuple(arrays.free_joints))
-               for promise in (True, False)}
+def _from_arrays(arrays: IKArrays, rows: np.ndarray, details: dict[int, str], constrained: bool) -> _Solved:
+    """Closed-form rows: one solver (complete, or not where the family cannot promise it), each row's singular
+    conditions where it has a solution."""
+    solvers = [SolverReport("analytic", arrays.structure, promise, False, tuple(arrays.free_joints))
+               for promise in (True, False)]
     solved = arrays.count > 0
-    singularities: list[list[Singularity]] = [[] for _ in rows]
+    singularities: dict[int, list[Singularity]] = {}
     for mask, flag in arrays.singularities.entries:
         for local in np.flatnonzero(mask & solved).tolist():
-            if flag not in singularities[local]:
-                singularities[local].append(flag)
-    return _Solved(rows, arrays, [reports[promise] for promise in arrays.complete.tolist()], list(details),
-                   singularities, constrained, [None] * len(rows))
+            met = singularities.setdefault(local, [])
+            if flag not in met:
+                met.append(flag)
+    return _Solved(rows, arrays, solvers, (~arrays.complete).astype(int), details, singularities, constrained)
 
 
 def _from_results(robot: Robot, rows: np.ndarray, results: list[IKResult], constrained: bool) -> _Solved:
     """Rows answered as :class:`IKResult` records (the fallback, the position search), as arrays."""
-    return _Solved(rows, arrays_from_results(robot, results),
-                   [SolverReport(r.method, r.structure, r.complete, r.search_exhausted_budget, tuple(r.free_joints))
-                    for r in results], [r.detail or None for r in results], [list(r.singularities) for r in results],
-                   constrained, [None] * len(rows))
+    solvers, solver = _numbered([SolverReport(r.method, r.structure, r.complete, r.search_exhausted_budget,
+                                              tuple(r.free_joints)) for r in results])
+    return _Solved(rows, arrays_from_results(robot, results), solvers, solver,
+                   {local: r.detail for local, r in enumerate(results) if r.detail},
+                   {local: list(r.singularities) for local, r in enumerate(results) if r.singularities}, constrained)
 
 
 def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits, options: AnswerOptions,
@@ -321,7 +323,7 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
     held-joint solve)."""
     status = np.empty(n_targets, dtype=object)
     detail: list[str | None] = [None] * n_targets
-    solver_of: list[SolverReport | None] = [None] * n_targets
+    solver_of, reports_of = np.zeros(n_targets, dtype=int), []  # index into every part's solvers, in part order
     singular_of: list[list[Singularity]] = [[] for _ in range(n_targets)]
     truncated, trimmed = np.zeros(n_targets, dtype=bool), np.zeros(n_targets, dtype=int)
     available = np.zeros(n_targets, dtype=int)
@@ -341,18 +343,27 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
         rows = part.rows
         status[rows[live]], truncated[rows[live]] = chosen.status[live], chosen.truncated[live]
         trimmed[rows[live]], available[rows[live]] = chosen.trimmed[live], chosen.available[live]
-        for local in np.flatnonzero(live).tolist():
-            row = int(rows[local])
-            solver_of[row], singular_of[row] = part.solvers[local], part.singularities[local]
-            words = [part.details[local], *chosen.notes.get(local, []), part.remarks[local]]
-            detail[row] = " ".join(filter(None, words)) or None
+        solver_of[rows[live]] = part.solver[live] + len(reports_of)
+        reports_of += part.solvers
+        for local, met in part.singularities.items():
+            if live[local]:
+                singular_of[rows[local]] = met
+        for local in {*part.details, *chosen.notes, *part.remarks}:
+            if live[local]:
+                words = [part.details.get(local), *chosen.notes.get(local, []), part.remarks.get(local)]
+                detail[rows[local]] = " ".join(filter(None, words)) or None
         for table, into in ((chosen.solutions, kept_parts), (chosen.rejected, rejected_parts)):
             table = table.take(np.flatnonzero(live[table.target]))
             table.target = rows[table.target]
             if not part.constrained:
                 table.orientation = np.full(len(table.target), np.nan)
             into.append(table)
-    solvers, solver = _numbered(solver_of)
+    distinct, same = _numbered(reports_of)  # equal reports of different parts are one
+    present, first = np.unique(same[solver_of], return_index=True)
+    by_appearance = present[np.argsort(first)]  # number them by first appearance in target order
+    renumber = np.zeros(len(distinct), dtype=int)
+    renumber[by_appearance] = np.arange(len(by_appearance))
+    solvers, solver = [distinct[i] for i in by_appearance], renumber[same[solver_of]]
     reports, singularities = _numbered_lists(singular_of)
     kept, rejected = _merged(kept_parts, robot.dof), _merged(rejected_parts, robot.dof)
     return IKAnswer(status, detail, solver, solvers, singularities, reports, truncated, trimmed, available, kept,

@@ -28,8 +28,8 @@ import numpy as np
 
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
-from service.kinematics import Robot, forward_kinematics
-from service.kinematics.ik import solve_ik, solve_ik_batch
+from service.kinematics import Limits, Robot, forward_kinematics
+from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, solve_ik, solve_ik_batch
 from service.kinematics.ik._arrays import solve_ik_arrays
 
 from . import anchors
@@ -178,6 +178,24 @@ def bench_robot(report: Report, label: str, robot: Robot, args: argparse.Namespa
             report.rows.append(Row(label, task, name, seconds / count))
 
 
+WHOLE_ANSWER_TASK = "IK answer, catalogue limits, batch of {batch:,}"
+SOLVE_ONLY, WHOLE_ANSWER = "core (solve_ik_arrays, solve only)", "core (answer_ik: solve + select)"
+
+
+def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.Namespace) -> None:
+    """The in-process answer users get (solve + select, the robot's catalogue limits on) beside the solve alone,
+    on targets from joint vectors over the whole ±π range."""
+    T_batch = forward_kinematics(robot, sample_configurations(robot, args.batch, seed=4))
+    targets, options = IKTargets.poses(T_batch), AnswerOptions(limits=Limits.of(robot))
+    tasks = {SOLVE_ONLY: lambda: solve_ik_arrays(robot, T_batch), WHOLE_ANSWER: lambda: answer_ik(robot, targets,
+                                                                                                   options)}
+    for task in tasks.values():  # warm-up: plans built outside the measurement
+        task()
+    task_name = WHOLE_ANSWER_TASK.format(batch=args.batch)
+    for name, seconds in best_of(tasks, args.repeats).items():
+        report.rows.append(Row(label, task_name, name, seconds / args.batch))
+
+
 def _timed_ik(report: Report, label: str, task: str, robot: Robot, tasks: dict[str, Callable[[], list]],
               truth: np.ndarray, repeats: int, to_solutions: Callable[[str, list], list[np.ndarray]]) -> None:
     counts = {}
@@ -238,6 +256,9 @@ def targets(report: Report, batch: int) -> list[str]:
             (f"batch FK per configuration, core / roboticstoolbox ETS.eval ({robot})",
              ratio(robot, f"FK, batch of {batch:,}", "core", "roboticstoolbox"), "<=", 1.0),
         ]
+    whole_task = WHOLE_ANSWER_TASK.format(batch=batch)
+    checks.append(("whole in-process IK answer / solve alone, catalogue limits (PUMA 560)",
+                   ratio("PUMA 560", whole_task, WHOLE_ANSWER, SOLVE_ONLY), "<=", 1.5))
     for name, value, sense, bound in checks:
         if value is None:
             out.append(f"- {name}: not measured (library not installed or arm not supported)")
@@ -271,6 +292,7 @@ def main(argv: list[str] | None = None) -> int:
     report = report_noting_missing_anchors()
     for label in args.robots:
         bench_robot(report, label, catalogue.get(ROBOTS[label]).robot, args)
+    bench_whole_answer(report, "PUMA 560", catalogue.get(ROBOTS["PUMA 560"]).robot, args)
     if args.memory_poses:
         report.memory = peak_memory(catalogue.get(ROBOTS["PUMA 560"]).robot, args.memory_poses)
 

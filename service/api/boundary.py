@@ -31,7 +31,7 @@ from ..kinematics import (
     matrix_from_rpy,
     quaternions_from_matrices,
 )
-from ..kinematics.ik import Ordering, check_ordering
+from ..kinematics.ik import DIRECTION, POSE, POSITION, IKTargets, Ordering, check_ordering
 from ..robots.build import bounds as _bounds
 from .schemas.common import AngleUnit
 from .schemas.ik import Ordering as OrderingOptions
@@ -175,6 +175,48 @@ def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str
     return matrices, constrained
 
 
+def ik_targets_to_core(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str | int,
+                       indexed: bool = True) -> IKTargets:
+    """The core's :class:`IKTargets` from an IK request's targets; errors are located at ``prefix`` (followed by
+    the target's index when ``indexed``). A direction target's matrix holds its position."""
+    def at(index: int):
+        return located(*prefix, index) if indexed else located(*prefix)
+    directions = {}
+    for index, target in enumerate(targets):
+        with at(index):
+            direction = target_direction(target)
+        if direction is not None:
+            directions[index] = direction
+    if not directions and indexed:
+        matrices, constrained = target_matrices(targets, unit, *prefix)
+        return IKTargets(matrices, np.where(constrained, POSE, POSITION))
+    matrices, kinds = np.tile(np.eye(4), (len(targets), 1, 1)), np.full(len(targets), DIRECTION)
+    tool_axes, world_directions = np.zeros((len(targets), 3)), np.zeros((len(targets), 3))
+    for index, target in enumerate(targets):
+        if index in directions:
+            matrices[index, :3, 3], tool_axes[index], world_directions[index] = directions[index]
+            continue
+        with at(index):
+            matrices[index], constrained = target_matrix(target, unit)
+        kinds[index] = POSE if constrained else POSITION
+    return IKTargets(matrices, kinds, tool_axes, world_directions)
+
+
+def free_joints_to_core(robot: Robot, choices: Sequence | None, unit: AngleUnit
+                        ) -> list[tuple[int, list[float] | None, int | None]] | None:
+    """An IK request's free-joint choices as the core's ``(joint, values, samples)`` entries, values in radians /
+    length units (a joint index out of range is left for the core to refuse)."""
+    if choices is None:
+        return None
+    requested = []
+    for choice in choices:
+        values = choice.values
+        if values is not None and 0 <= choice.joint < robot.dof:
+            values = (np.asarray(values, dtype=float) * _unit_scale(robot, unit)[choice.joint]).tolist()
+        requested.append((choice.joint, values, choice.samples))
+    return requested
+
+
 def poses_from_matrices(matrices: np.ndarray) -> list[dict]:
     """Wire poses for a stack of transforms, shape (N, 4, 4)."""
     matrices = np.asarray(matrices, dtype=float)
@@ -241,6 +283,20 @@ def ordering_to_core(robot: Robot, ordering: OrderingOptions, max_solutions: int
         nested = error.location[:1] in (("weights",), ("norm",))
         raise error.relocated(*(("ordering",) if nested else ())) from None
     return core
+
+
+def ik_selection_to_core(robot: Robot, body) -> tuple[np.ndarray | None, Limits, Ordering]:
+    """An IK request's reference, limits and ordering in core units, errors located in the body."""
+    reference = None
+    if body.reference is not None:
+        with located("body", "reference"):
+            reference = joints_to_core(robot, body.reference, body.angle_unit)
+    with located("body", "limits"):
+        limits = limits_to_core(robot, body.limits, body.angle_unit)
+    with located("body"):
+        ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
+                                    body.angle_unit)
+    return reference, limits, ordering
 
 
 def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:

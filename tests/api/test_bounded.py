@@ -113,7 +113,7 @@ def test_a_whole_workspace_batch_is_413_before_solving(client, monkeypatch):
     def never(*args, **kwargs):
         raise AssertionError("the solver ran")
 
-    monkeypatch.setattr(ik_router, "solve_ik_arrays", never)
+    monkeypatch.setattr(ik_router, "answer_ik", never)
     for form in ("objects", "arrays"):
         response = client.post("/v1/robots/ur5/ik/batch", json={"targets": targets, "format": form})
         problem = assert_problem(response, 413, match="KIN_MAX_SOLUTIONS_PER_RESPONSE")

@@ -7,7 +7,9 @@ prismatic joints), and decomposes the problem into geometric subproblems
 back to a bounded numeric search that says it may be incomplete.
 """
 
-from ._arrays import IKArrays, cached_plan, solve_ik_arrays
+from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKAnswer, IKTargets, SolverReport, SolveTiming,
+                      TargetAnswer, UnsupportedTargetError, answer_ik)
+from ._arrays import IKArrays, arrays_from_results, cached_plan, solve_ik_arrays
 from ._direction import solve_direction, target_kinds
 from ._numeric import NumericOptions
 from ._plan import plan_for
@@ -21,6 +23,18 @@ from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
 
 __all__ = [
+    "AnswerOptions",
+    "DIRECTION",
+    "IKAnswer",
+    "IKTargets",
+    "POSE",
+    "POSITION",
+    "SolveTiming",
+    "SolverReport",
+    "TargetAnswer",
+    "UnsupportedTargetError",
+    "answer_ik",
+    "arrays_from_results",
     "FamilyAnswer",
     "FreeJoint",
     "IKArrays",

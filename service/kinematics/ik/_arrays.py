@@ -88,6 +88,47 @@ class IKArrays:
                         singularities, self.structure, self.free_joints, self.complete[rows])
 
 
+def arrays_from_results(robot: Robot, results: list) -> IKArrays:
+    """N :class:`IKResult` records (the fallback's, the position search's) as one :class:`IKArrays`.
+
+    Row i holds result i's solutions in their order, padded to the most
+    solutions of any result; branch labels become codes (names and values in
+    order of first appearance); each result's singularities its row's flags.
+    ``structure`` and ``free_joints`` are the first result's: the records keep
+    their own.
+    """
+    n_targets, width = len(results), max([len(result.solutions) for result in results], default=0)
+    joints = np.zeros((n_targets, width, robot.dof))
+    position, orientation = np.full((n_targets, width), np.inf), np.full((n_targets, width), np.inf)
+    count = np.array([len(result.solutions) for result in results], dtype=int)
+    vocabularies: dict[str, list] = {}
+    for result in results:
+        for solution in result.solutions:
+            for name, value in solution.branch.items():
+                vocabulary = vocabularies.setdefault(name, [])
+                if value not in vocabulary:
+                    vocabulary.append(value)
+    codes = {name: np.full((n_targets, width), -1, dtype=np.int8) for name in vocabularies}
+    singularities = SingularFlags(n_targets)
+    for row, result in enumerate(results):
+        for slot, solution in enumerate(result.solutions):
+            joints[row, slot] = solution.joints
+            position[row, slot], orientation[row, slot] = solution.position_residual, solution.orientation_residual
+            for name, value in solution.branch.items():
+                codes[name][row, slot] = vocabularies[name].index(value)
+        for singularity in result.singularities:
+            mask = np.zeros(n_targets, dtype=bool)
+            mask[row] = True
+            singularities.add(mask, singularity)
+    first = results[0] if results else None
+    return IKArrays(joints=joints, valid=np.arange(width) < count[:, None], count=count, position=position,
+                    orientation=orientation,
+                    labels={name: (tuple(vocabularies[name]), codes[name]) for name in vocabularies},
+                    singularities=singularities, structure=first.structure if first else "general",
+                    free_joints=list(first.free_joints) if first else [],
+                    complete=np.array([result.complete for result in results], dtype=bool))
+
+
 def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     """:func:`plan_for`, built once per robot and kind of target (and values of the free joints).
 

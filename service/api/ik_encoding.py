@@ -1,0 +1,117 @@
+"""The core's :class:`IKAnswer` on the wire, in the request's units: the objects form and the arrays form.
+
+Objects: one dict per target (``status``, ``detail``, ``solutions``,
+``rejected``, ``solver``, …), each solution a dict with its ``violations`` and
+``free_values``. Arrays: the per-target fields and the two solution tables as
+columns, solvers and singularity reports listed once and referred to by index.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..kinematics import Budget, Robot
+from ..kinematics.ik import IKAnswer, SolutionTable
+from .boundary import _unit_scale
+
+
+def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget: Budget) -> list[dict]:
+    """The objects form: one dict per target, in target order."""
+    budget.check("encoding")
+    scale = _unit_scale(robot, unit)
+    solvers = [{"method": s.method, "structure": s.structure, "complete": s.complete,
+                "time_budget_exhausted": s.time_budget_exhausted} for s in answer.solvers]
+    reports = [_report(report) for report in answer.singularity_reports]
+    free_of_target = [list(answer.solvers[index].free_joints) for index in answer.solver.tolist()]
+    kept = _solution_dicts(answer.solutions, answer.solution_violations, answer, scale, free_of_target)
+    rejected = _solution_dicts(answer.rejected, answer.rejected_violations, answer, scale, free_of_target)
+    status, truncated = answer.status.tolist(), answer.truncated.tolist()
+    trimmed, available = answer.trimmed.tolist(), answer.available.tolist()
+    answers = []
+    for row, solver in enumerate(answer.solver.tolist()):
+        if row % 256 == 255:
+            budget.check("encoding")
+        answers.append({
+            "robot_id": robot_id, "status": status[row], "detail": answer.detail[row],
+            "solutions": kept[row], "rejected": rejected[row], "solver": dict(solvers[solver]),
+            "singularities": [dict(reports[i]) for i in answer.singularities[row]],
+            "free_joints": list(free_of_target[row]), "truncated": truncated[row], "trimmed": trimmed[row],
+            "available": available[row], "joint_names": robot.joint_names})
+    return answers
+
+
+def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer, scale: np.ndarray,
+                    free_of_target: list[list[int]]) -> list[list[dict]]:
+    """Each target's rows of ``table`` as solution dicts; ``outside`` (S, n) marks the joints a row violates."""
+    joints = (table.joints / scale).tolist()
+    position = table.position.tolist()
+    orientation = [None if missing else value
+                   for value, missing in zip(table.orientation.tolist(), np.isnan(table.orientation).tolist())]
+    within = table.within_limits.tolist()
+    branch = [(name, np.array([*values, None], dtype=object)[codes].tolist())
+              for name, (values, codes) in table.labels.items()]
+    lower = [None if np.isinf(value) else value for value in (answer.limits.lower / scale).tolist()]
+    upper = [None if np.isinf(value) else value for value in (answer.limits.upper / scale).tolist()]
+    violations: dict[int, list[dict]] = {}
+    for k, j in zip(*np.nonzero(outside)):
+        violations.setdefault(int(k), []).append(
+            {"joint": int(j), "value": joints[k][j], "lower": lower[j], "upper": upper[j]})
+    targets = table.target.tolist()
+    per_target: list[list[dict]] = [[] for _ in free_of_target]
+    for k, target in enumerate(targets):
+        per_target[target].append({
+            "joints": joints[k], "branch": {name: column[k] for name, column in branch if column[k] is not None},
+            "within_limits": within[k], "violations": violations.get(k, []),
+            "residual": {"position": position[k], "orientation": orientation[k]},
+            "free_values": {str(j): joints[k][j] for j in free_of_target[target]}})
+    return per_target
+
+
+def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget: Budget) -> dict:
+    """The arrays form: per-target columns, the two solution tables as columns (numpy arrays, encoded as
+    they stand)."""
+    budget.check("encoding")
+    scale = _unit_scale(robot, unit)
+    solvers = [{"method": s.method, "structure": s.structure, "complete": s.complete,
+                "time_budget_exhausted": s.time_budget_exhausted, "free_joints": list(s.free_joints)}
+               for s in answer.solvers]
+    n_targets = len(answer)
+    return {
+        "robot_id": robot_id,
+        "joint_names": robot.joint_names,
+        "format": "arrays",
+        "solvers": solvers,
+        "singularity_reports": [_report(report) for report in answer.singularity_reports],
+        "targets": {"status": answer.status.tolist(), "detail": answer.detail, "solver": answer.solver,
+                    "singularities": answer.singularities, "truncated": answer.truncated,
+                    "trimmed": answer.trimmed, "available": answer.available,
+                    "solution_count": np.bincount(answer.solutions.target, minlength=n_targets),
+                    "rejected_count": np.bincount(answer.rejected.target, minlength=n_targets)},
+        "solutions": _columns(answer.solutions, scale, answer),
+        "rejected": _columns(answer.rejected, scale, answer),
+    }
+
+
+def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer) -> dict:
+    """One table as columns; ``free_values``: per free joint, each row's value of it, or None where the row's
+    target has no such free joint."""
+    joints = table.joints / scale
+    orientation = table.orientation
+    if np.isnan(orientation).any():
+        orientation = [None if np.isnan(value) else value for value in orientation.tolist()]
+    branch = {name: np.array([*values, None], dtype=object)[codes].tolist()
+              for name, (values, codes) in table.labels.items()}
+    free_values = {}
+    if any(solver.free_joints for solver in answer.solvers):
+        free_of_row = [answer.solvers[index].free_joints for index in answer.solver[table.target].tolist()]
+        rows = joints.tolist()
+        free_values = {str(j): [row[j] if j in free else None for row, free in zip(rows, free_of_row)]
+                       for j in sorted({j for free in free_of_row for j in free})}
+    return {"target": table.target, "joints": joints, "within_limits": table.within_limits,
+            "residual_position": table.position, "residual_orientation": orientation, "branch": branch,
+            "free_values": free_values}
+
+
+def _report(singularity) -> dict:
+    return {"kind": singularity.kind, "joints": list(singularity.joints), "relation": singularity.relation,
+            "detail": singularity.detail}

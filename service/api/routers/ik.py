@@ -29,7 +29,7 @@ from ...kinematics.ik import (
     solve_ik_batch,
     unreachable_details,
 )
-from ...kinematics import Budget
+from ...kinematics import Budget, violations
 from ..boundary import (
     _unit_scale,
     joints_from_core,
@@ -243,26 +243,14 @@ def _solve(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, ta
         chosen = select_arrays(robot, arrays, limits, filter_limits=body.filter_limits, reference=reference,
                                ordering=ordering, max_equivalents=body.max_equivalents, budget=budget)
         budget.check("encoding")
-        kept = chosen.solutions
-        joints = (kept.joints / _unit_scale(robot, body.angle_unit)).tolist()
-        position = kept.position.tolist()
-        orientation = kept.orientation.tolist() if constrained else [None] * len(position)
-        branch = [(name, np.array([*values, None], dtype=object)[codes].tolist())
-                  for name, (values, codes) in kept.labels.items()]
-        starts = np.searchsorted(kept.target, np.arange(len(rows) + 1)).tolist()
+        kept, dropped = (_rows_to_wire(robot, table, limits, body.angle_unit, constrained)
+                         for table in (chosen.solutions, chosen.rejected))
+        kept_starts, dropped_starts = (np.searchsorted(table.target, np.arange(len(rows) + 1)).tolist()
+                                       for table in (chosen.solutions, chosen.rejected))
         for local, (row, result) in enumerate(zip(rows.tolist(), results)):
-            if local % 256 == 255:
-                budget.check("encoding")
-            selection = chosen.selections.get(local)
-            if selection is not None:
-                answers[row] = _to_wire(ref.id, robot, result, selection, body.angle_unit, constrained)
-                continue
-            solutions = [{"joints": joints[k], "branch": {name: column[k] for name, column in branch
-                                                          if column[k] is not None},
-                          "within_limits": True, "violations": [],
-                          "residual": {"position": position[k], "orientation": orientation[k]}}
-                         for k in range(starts[local], starts[local + 1])]
-            answers[row] = _wire(ref.id, result, str(chosen.status[local]), solutions, [],
+            answers[row] = _wire(ref.id, result, str(chosen.status[local]),
+                                 kept[kept_starts[local]:kept_starts[local + 1]],
+                                 dropped[dropped_starts[local]:dropped_starts[local + 1]],
                                  chosen.notes.get(local, []), bool(chosen.truncated[local]),
                                  int(chosen.trimmed[local]), int(chosen.available[local]))
     for row, why in incomplete.items():  # a free value whose locked arm no family covered
@@ -460,6 +448,22 @@ def _solution_to_wire(robot: Robot, entry: Selected, unit: str, constrained: boo
         "residual": {"position": solution.position_residual,
                      "orientation": solution.orientation_residual if constrained else None},
     }
+
+
+def _rows_to_wire(robot: Robot, table: SolutionTable, limits, unit: str, constrained: bool) -> list[dict]:
+    """The wire form of each row of a solution table (core units), violations included."""
+    joints = (table.joints / _unit_scale(robot, unit)).tolist()
+    position = table.position.tolist()
+    orientation = table.orientation.tolist() if constrained else [None] * len(position)
+    branch = [(name, np.array([*values, None], dtype=object)[codes].tolist())
+              for name, (values, codes) in table.labels.items()]
+    within = table.within_limits.tolist()
+    return [{"joints": joints[k], "branch": {name: column[k] for name, column in branch if column[k] is not None},
+             "within_limits": within[k],
+             "violations": [] if within[k] else [violation_to_wire(robot, v, unit)
+                                                 for v in violations(robot, limits, table.joints[k])],
+             "residual": {"position": position[k], "orientation": orientation[k]}}
+            for k in range(len(position))]
 
 
 def _to_wire(robot_id: str, robot: Robot, result: IKResult, selection: Selection, unit: str,

@@ -19,15 +19,11 @@ How each kind of joint is treated:
 
 from __future__ import annotations
 
-import heapq
-import itertools
-import math
 from dataclasses import dataclass
-from typing import Callable, Iterator, Sequence
+from typing import Sequence
 
 import numpy as np
 
-from ._budget import capped_product
 from ._errors import InvalidInputError
 from ._robot import Robot
 
@@ -115,85 +111,41 @@ def violations(robot: Robot, limits: Limits, q: np.ndarray) -> list[Violation]:
             for i in np.flatnonzero(outside)]
 
 
-def _turn_range(lower: float, upper: float, value: float) -> tuple[int, int]:
-    """The whole turns k with ``value + 2kπ`` in [lower, upper] (bounds finite): (first, last), empty if last < first.
+def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The whole turns k that bring each joint of q (shape (..., n)) within its bounds: (first, last), (..., n) each.
 
-    ceil/floor of a rounded quotient can admit a value a few ulps outside: the end values themselves are checked.
+    Joint i may take q_i + 2kπ for every k in [first, last] (none when last < first); the turns are floats, so
+    a joint limited to ±1e6 rad counts its 318,310 equivalents as ``last − first + 1`` without generating them.
+
+    * revolute with both bounds finite: every k inside the bounds (the end values are checked, as the ceil and
+      floor of a rounded quotient can admit a value a few ulps outside);
+    * revolute bounded on one side: the one k inside nearest q_i (0 when q_i fits);
+    * continuous revolute, or prismatic: k = 0 if q_i fits, else none.
+
+    Examples
+    --------
+    A joint limited to ±270° at 100° has turns [−1, 0]: −260° and 100°.
     """
-    first = math.ceil((lower - value) / _TWO_PI)
-    last = math.floor((upper - value) / _TWO_PI)
-    if last >= first and value + _TWO_PI * first < lower:
-        first += 1
-    if last >= first and value + _TWO_PI * last > upper:
-        last -= 1
+    q = np.asarray(q, dtype=float)
+    tolerance = limits.tolerance(robot)
+    lower, upper = limits.lower - tolerance, limits.upper + tolerance
+    both = limits.multi_valued(robot)
+    one_sided = robot.is_revolute & ~both & ~limits.continuous(robot)
+    with np.errstate(invalid="ignore"):
+        first = np.ceil((lower - q) / _TWO_PI)
+        last = np.floor((upper - q) / _TWO_PI)
+        first = first + (q + _TWO_PI * first < lower)
+        last = last - (q + _TWO_PI * last > upper)
+        nearest = np.where(q < lower, first, np.where(q > upper, last, 0.0))
+    inside = np.where(robot.is_revolute & ~both, True, (q >= lower) & (q <= upper))
+    single = np.where(one_sided, nearest, np.where(inside, 0.0, np.nan))
+    first = np.where(both, first, np.where(np.isnan(single), 0.0, single))
+    last = np.where(both, last, np.where(np.isnan(single), -1.0, single))
     return first, last
 
 
-def turn_counts(robot: Robot, limits: Limits, q: np.ndarray) -> list[int]:
-    """How many values :func:`turn_offsets` gives each joint of q (shape (n,)), computed without generating them.
-
-    Examples
-    --------
-    A joint limited to ±1e6 rad has 318,310 equivalents of 0.5 rad; this counts them in constant time.
-    """
-    tolerance = limits.tolerance(robot)
-    counts = []
-    for i in range(robot.dof):
-        lower, upper, value = limits.lower[i] - tolerance[i], limits.upper[i] + tolerance[i], float(q[i])
-        if robot.is_revolute[i] and np.isfinite(lower) and np.isfinite(upper):
-            first, last = _turn_range(lower, upper, value)
-            counts.append(max(0, last - first + 1))
-        elif robot.is_revolute[i] and (value < lower or value > upper):
-            counts.append(1)
-        else:
-            counts.append(1 if lower <= value <= upper else 0)
-    return counts
-
-
-def turn_offsets(robot: Robot, limits: Limits, q: np.ndarray, *, keep: int | None = None,
-                 around: np.ndarray | None = None) -> list[np.ndarray]:
-    """For each joint, the values of q_i that are usable within its bounds, ascending.
-
-    * revolute with both bounds finite: every q_i + 2kπ inside the bounds
-      (empty when none is); with ``keep``, only the ``keep`` of them nearest
-      ``around[i]`` (default q_i), so that a joint limited to ±1e6 rad costs
-      what is kept, not its 318,310 equivalents (:func:`turn_counts` counts
-      them all);
-    * revolute bounded on one side: the one q_i + 2kπ inside, nearest q_i;
-    * continuous revolute, or prismatic: q_i itself, if it fits (a prismatic
-      value outside its bounds gives an empty list).
-
-    Examples
-    --------
-    A joint limited to ±270° has two equivalents of 100°: −260° and 100°.
-    """
-    tolerance = limits.tolerance(robot)
-    options = []
-    for i in range(robot.dof):
-        lower, upper, value = limits.lower[i] - tolerance[i], limits.upper[i] + tolerance[i], float(q[i])
-        if robot.is_revolute[i] and np.isfinite(lower) and np.isfinite(upper):
-            first, last = _turn_range(lower, upper, value)
-            if keep is not None and last - first + 1 > keep + 2:
-                # the keep values nearest the centre are consecutive turns: a window of keep + 2 around it holds
-                # them (one spare turn each side), slid inwards where it meets a bound
-                centre = value if around is None else float(around[i])
-                nearest = min(max(round((centre - value) / _TWO_PI), first), last)
-                low = min(max(first, nearest - keep // 2 - 1), last - keep - 1)
-                first, last = low, low + keep + 1
-            turns = np.arange(first, last + 1, dtype=float) if last >= first else np.zeros(0)
-            candidates = value + _TWO_PI * turns
-            options.append(candidates[(candidates >= lower) & (candidates <= upper)])
-        elif robot.is_revolute[i] and value < lower:
-            options.append(np.array([value + _TWO_PI * np.ceil((lower - value) / _TWO_PI)]))
-        elif robot.is_revolute[i] and value > upper:
-            options.append(np.array([value - _TWO_PI * np.ceil((value - upper) / _TWO_PI)]))
-        else:
-            options.append(np.array([value]) if lower <= value <= upper else np.zeros(0))
-    return options
-
-
 def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray:
-    """The 2π-equivalent of q (shape (n,)) that is as close to the limits as whole turns can bring it.
+    """The 2π-equivalent of each row of q (shape (..., n)) that is as close to the limits as whole turns bring it.
 
     Each revolute joint that has an equivalent inside its bounds takes the one
     nearest its value; one that has none takes the equivalent nearest its
@@ -201,16 +153,14 @@ def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarra
     joints that still violate a bound are exactly those no whole turn can fix.
     """
     q = np.asarray(q, dtype=float)
-    closest = q.copy()
-    for i, options in enumerate(turn_offsets(robot, limits, q, keep=1)):
-        if len(options):
-            closest[i] = options[np.argmin(np.abs(options - q[i]))]
-        elif robot.is_revolute[i]:
-            lower, upper = limits.lower[i], limits.upper[i]
-            below = lower - np.mod(lower - q[i], _TWO_PI)  # largest equivalent ≤ lower
-            above = upper + np.mod(q[i] - upper, _TWO_PI)  # smallest equivalent ≥ upper
-            closest[i] = below if lower - below < above - upper else above
-    return closest
+    first, last = turn_ranges(robot, limits, q)
+    with np.errstate(invalid="ignore"):
+        below = np.floor((limits.lower - q) / _TWO_PI)  # the turn of the largest equivalent ≤ lower
+        short = limits.lower - (q + _TWO_PI * below)
+        over = q + _TWO_PI * (below + 1.0) - limits.upper
+    outside = np.where(limits.multi_valued(robot), np.where(short < over, below, below + 1.0), 0.0)
+    turns = np.where(last >= first, np.clip(0.0, first, last), outside)
+    return q + _TWO_PI * turns
 
 
 def nearest_fitting_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray | None:
@@ -226,71 +176,3 @@ def nearest_fitting_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> n
     """
     closest = closest_equivalent(robot, limits, q)
     return closest if within(robot, limits, closest) else None
-
-
-def count_combinations(options: Sequence[np.ndarray]) -> int:
-    """Number of vectors in the product of per-joint options, at most :data:`._budget.COUNT_CAP`."""
-    return capped_product(len(o) for o in options)
-
-
-def combinations_by_cost(costs: Sequence[np.ndarray],
-                         combine: Callable[[list[float]], float]) -> Iterator[tuple[float, tuple[int, ...]]]:
-    """Every combination of per-joint options, cheapest first, generated lazily.
-
-    Parameters
-    ----------
-    costs : sequence of ndarray
-        For each joint, the cost of each of its options, sorted ascending.
-    combine : callable
-        Total cost of one per-joint cost list; must not decrease when any one
-        cost increases (max, a sum, the square root of a sum of squares).
-
-    Yields
-    ------
-    (cost, indices) in ascending (cost, indices) order, where ``indices`` picks
-    one option per joint. Stopping early costs only what was generated, so a
-    product with billions of combinations can be cut at the cheapest thousand.
-
-    Each combination other than all-zeros has exactly one parent (its last
-    non-zero index decremented), which costs no more; a heap over (cost,
-    indices) therefore pops in order without a visited set.
-    """
-    if any(len(c) == 0 for c in costs):
-        return
-    n = len(costs)
-    start = (0,) * n
-    heap = [(combine([c[0] for c in costs]), start, 0)]
-    while heap:
-        cost, indices, last = heapq.heappop(heap)
-        yield cost, indices
-        for j in range(last, n):
-            if indices[j] + 1 < len(costs[j]):
-                child = indices[:j] + (indices[j] + 1,) + indices[j + 1:]
-                heapq.heappush(heap, (combine([costs[k][child[k]] for k in range(n)]), child, j))
-
-
-def fitting_equivalents(robot: Robot, limits: Limits, q: np.ndarray, cap: int) -> tuple[np.ndarray, bool]:
-    """Every 2π-equivalent of q (shape (n,)) that is inside the limits, fewest turns first, at most ``cap``.
-
-    Returns
-    -------
-    equivalents : ndarray, shape (m, n)
-        Ordered by the total turning Σ|q'_i − q_i|; empty when none fits.
-    truncated : bool
-        True when more than ``cap`` equivalents fit and the list was cut.
-
-    Examples
-    --------
-    A joint limited to ±270° has two equivalents of 100°: 100° and −260°, in
-    that order.
-    """
-    q = np.asarray(q, dtype=float)
-    # the cap cheapest combinations use at most the cap cheapest values of each joint
-    options = [o[np.argsort(np.abs(o - value), kind="stable")]
-               for o, value in zip(turn_offsets(robot, limits, q, keep=cap), q)]
-    costs = [np.abs(o - value) for o, value in zip(options, q)]
-    picked = [indices for _, indices in itertools.islice(combinations_by_cost(costs, math.fsum), cap)]
-    if not picked:
-        return np.zeros((0, robot.dof)), False
-    equivalents = np.array([[options[j][k] for j, k in enumerate(indices)] for indices in picked])
-    return equivalents, capped_product(turn_counts(robot, limits, q)) > cap

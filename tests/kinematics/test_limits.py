@@ -1,8 +1,7 @@
-"""Joint limits in the core: bounds, 2π-equivalents, the cheapest-first enumeration, and selection of IK answers."""
+"""Joint limits in the core: bounds, 2π-equivalents and selection of IK answers."""
 
 from __future__ import annotations
 
-import itertools
 import math
 
 import numpy as np
@@ -15,10 +14,8 @@ from service.kinematics import (
     Limits,
     Robot,
     closest_equivalent,
-    combinations_by_cost,
-    fitting_equivalents,
     nearest_fitting_equivalent,
-    turn_offsets,
+    turn_ranges,
     violations,
     within,
 )
@@ -38,20 +35,30 @@ MIXED = arm(("revolute", -270 * DEG, 270 * DEG), ("prismatic", 0.1, 1.0), ("revo
             ("revolute", 0.0, math.inf), ("revolute", -100 * DEG, 100 * DEG))
 
 
-def test_turn_offsets_per_kind_of_joint():
+def test_turn_ranges_per_kind_of_joint():
     q = np.array([100 * DEG, 0.5, 3.0, -10 * DEG, 120 * DEG])
-    options = turn_offsets(MIXED, Limits.of(MIXED), q)
-    np.testing.assert_allclose(options[0], [-260 * DEG, 100 * DEG])  # both equivalents within ±270°
-    np.testing.assert_array_equal(options[1], [0.5])                   # a slide keeps its value
-    np.testing.assert_array_equal(options[2], [3.0])                   # continuous: never expanded
-    np.testing.assert_allclose(options[3], [350 * DEG])                # one side only: the nearest that fits
-    assert len(options[4]) == 0                                        # 120° has no equivalent in ±100°
+    first, last = turn_ranges(MIXED, Limits.of(MIXED), q)
+    np.testing.assert_array_equal(first[:4], [-1, 0, 0, 1])
+    np.testing.assert_array_equal(last[:4], [0, 0, 0, 1])
+    # −260° and 100° within ±270°; a slide keeps its value; continuous: never expanded; one side only: the
+    # nearest that fits, 350°
+    np.testing.assert_allclose(q[3] + 2 * np.pi * first[3], 350 * DEG)
+    assert last[4] < first[4]  # 120° has no equivalent in ±100°
+
+
+def test_turn_ranges_count_huge_limits_without_generating_them():
+    wide = arm(("revolute", -1e6, 1e6))
+    first, last = turn_ranges(wide, Limits.of(wide), np.array([0.5]))
+    # 0.5 + 2kπ ∈ [−1e6, 1e6] for k from ceil((−1e6 − 0.5)/2π) to floor((1e6 − 0.5)/2π)
+    assert (first[0], last[0]) == (math.ceil((-1e6 - 0.5) / (2 * math.pi)), math.floor((1e6 - 0.5) / (2 * math.pi)))
+    assert last[0] - first[0] + 1 == 318310
 
 
 def test_a_prismatic_joint_is_never_wrapped():
     """d = 1.0 + 2π is out of [0.1, 1.0]; its value minus 2π would fit, but a slide has no turns."""
     q = np.array([0.0, 0.5 + 2 * np.pi, 0.0, 0.0, 0.0])
-    assert len(turn_offsets(MIXED, Limits.of(MIXED), q)[1]) == 0
+    first, last = turn_ranges(MIXED, Limits.of(MIXED), q)
+    assert last[1] < first[1]
     assert nearest_fitting_equivalent(MIXED, Limits.of(MIXED), q) is None
     np.testing.assert_array_equal(closest_equivalent(MIXED, Limits.of(MIXED), q)[1], q[1])
 
@@ -100,35 +107,19 @@ def test_checked_limits_name_the_joint():
     assert within(MIXED, locked, np.full(5, 0.5))
 
 
-def test_fitting_equivalents_fewest_turns_first_and_capped():
+def test_without_a_reference_fewest_turns_first_and_capped():
     two = arm(("revolute", -2 * np.pi, 2 * np.pi), ("revolute", -2 * np.pi, 2 * np.pi))
-    equivalents, truncated = fitting_equivalents(two, Limits.of(two), np.array([1.0, -2.0]), cap=10)
-    np.testing.assert_allclose(equivalents, [[1.0, -2.0], [1.0, -2.0 + 2 * np.pi], [1.0 - 2 * np.pi, -2.0],
-                                             [1.0 - 2 * np.pi, -2.0 + 2 * np.pi]])
-    assert not truncated
-    capped, truncated = fitting_equivalents(two, Limits.of(two), np.array([1.0, -2.0]), cap=3)
-    np.testing.assert_allclose(capped, equivalents[:3])
-    assert truncated
-
-
-@pytest.mark.parametrize("combine", [max, math.fsum, lambda c: math.sqrt(math.fsum(x * x for x in c))])
-def test_combinations_by_cost_is_the_sorted_product(combine):
-    """Lazily generated, cheapest first: the same sequence as sorting the whole product, ties by indices."""
-    rng = np.random.default_rng(3)
-    for trial in range(40):
-        sizes = rng.integers(1, 5, rng.integers(1, 5))
-        # integer costs make ties common; sorted per joint as the function requires
-        costs = [np.sort(rng.integers(0, 4, size).astype(float)) for size in sizes]
-        everything = sorted((combine([costs[j][k] for j, k in enumerate(indices)]), indices)
-                            for indices in itertools.product(*[range(s) for s in sizes]))
-        assert list(combinations_by_cost(costs, combine)) == everything, trial
-
-
-def test_combinations_by_cost_stops_early_on_a_huge_product():
-    costs = [np.arange(1000, dtype=float)] * 8  # 10^24 combinations
-    first = list(itertools.islice(combinations_by_cost(costs, max), 5))
-    assert first[0] == (0.0, (0,) * 8)
-    assert [cost for cost, _ in first] == [0.0, 1.0, 1.0, 1.0, 1.0]
+    result = IKResult("ok", [Solution(np.array([1.0, -2.0]), {}, 0.0, 0.0)], "analytic", "test", True)
+    every = select(two, result, Limits.of(two), max_equivalents=10)
+    # turns: q1 = 1 takes k ∈ {−1, 0}, q2 = −2 takes k ∈ {0, 1}; by Σ|k|, ties by the lower value first
+    np.testing.assert_allclose([e.solution.joints for e in every.solutions],
+                               [[1.0, -2.0], [1.0, -2.0 + 2 * np.pi], [1.0 - 2 * np.pi, -2.0],
+                                [1.0 - 2 * np.pi, -2.0 + 2 * np.pi]])
+    assert not every.expansion_truncated
+    capped = select(two, result, Limits.of(two), max_equivalents=3)
+    np.testing.assert_allclose([e.solution.joints for e in capped.solutions],
+                               [e.solution.joints for e in every.solutions[:3]])
+    assert capped.expansion_truncated and capped.available == 4
 
 
 # --- selection of IK answers -------------------------------------------------------------------------------

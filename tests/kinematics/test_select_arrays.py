@@ -11,9 +11,8 @@ import pytest
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Limits, forward_kinematics
-from service.kinematics.ik import Ordering, select
+from service.kinematics.ik import Ordering, select, select_arrays
 from service.kinematics.ik._arrays import solve_ik_arrays
-from service.kinematics.ik._select_arrays import select_arrays
 from service.kinematics.ik._solve import results_from_arrays
 
 CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
@@ -64,7 +63,3 @@ def test_select_arrays_matches_select(case):
                 assert table.within_limits[k] == entry.within_limits
                 assert {name: values[codes[k]] for name, (values, codes) in table.labels.items() if codes[k] >= 0} == \
                     entry.solution.branch
-    if case.startswith("no limits"):
-        assert chosen.vectorised == len(results)  # one value per joint everywhere: the array path for every target
-    if case.startswith("one-sided"):
-        assert chosen.vectorised > len(results) // 2  # all but targets with a solution outside the narrow limits

@@ -1,12 +1,13 @@
-"""From verified solutions to the answer: joint limits, 2π-equivalents, ordering and trimming.
+"""From verified solutions to the answer: joint limits, 2π-equivalents, ordering and trimming, for N targets at once.
 
 * A solution fits when every joint has a value within its bounds among its
-  2π-equivalents (:func:`.._limits.turn_offsets`). Each combination of those
+  2π-equivalents (:func:`.._limits.turn_ranges`). Each combination of those
   values is a solution of its own: a ±360° joint doubles most solutions.
 * ``filter_limits`` moves solutions that do not fit to ``rejected``. They are
   shown as close to the limits as whole turns bring them
   (:func:`.._limits.closest_equivalent`), so their violations name exactly the
-  joints no turn can fix.
+  joints no turn can fix. With ``filter_limits`` false they stay among the
+  solutions at that closest equivalent, flagged.
 * With a reference, solutions come nearest first. Per joint the distance is
   the actual travel |q_i − r_i| (radians or length units), except for a
   continuous joint, whose distance is taken across the 2π wrap; per-joint
@@ -14,40 +15,51 @@
   norm (``l2``). ``max_joint_move`` keeps the solutions whose every joint
   travels at most its bound; ``max_solutions`` the nearest k.
 * Without a reference, each solution first appears as it needs the fewest
-  turns; the further equivalents follow, one round per solution at a time.
-* ``max_equivalents`` caps the list. The equivalents are generated lazily,
-  cheapest first, so the cap keeps the nearest (with a reference) or the
-  least-turned (without), however many fit.
+  whole turns (Σ|k_i| for the equivalent q_i + 2k_iπ, an exact count); the
+  further equivalents follow, one round per solution at a time.
+* ``max_equivalents`` caps the list: it keeps the nearest (with a reference)
+  or the least-turned (without), however many fit.
+* Ties: equal costs keep the solution order; within one solution, the
+  combination whose per-joint ranks come first lexicographically, a joint's
+  values being ranked by cost and, at equal cost, by value (the lower first).
+  Distances are float64 (the l2 norm summed in joint order), so two values
+  equally far from the reference in exact arithmetic may differ in the last bit.
+
+How the work stays bounded: a joint's usable values are the whole turns k of
+an interval (its limits, narrowed by ``max_joint_move``), ranked by cost
+outwards from the cheapest. A combination among the first L of a solution
+(L = the most that can be returned of it) has ranks (r_1 … r_n) with
+∏(r_j + 1) ≤ L, since every combination with smaller or equal ranks costs no
+more and comes first. Only those rank tuples are enumerated and costed, in
+chunks of targets of at most about :data:`_CHUNK_ROWS` combinations, with
+``budget`` checked between chunks; the counts (``available``, ``trimmed``) are
+products of interval lengths, capped at :data:`.._budget.COUNT_CAP`.
 """
 
 from __future__ import annotations
 
-import heapq
-import itertools
-import math
+import functools
 from dataclasses import dataclass, field
-from typing import Callable, Iterable, Iterator, Literal
+from typing import Literal
 
 import numpy as np
 
-from .._budget import COUNT_CAP, UNLIMITED, Budget, capped_product, capped_sum
+from .._budget import COUNT_CAP, UNLIMITED, Budget
 from .._errors import InvalidInputError
-from .._limits import (
-    Limits,
-    Violation,
-    closest_equivalent,
-    combinations_by_cost,
-    turn_counts,
-    turn_offsets,
-    violations,
-)
+from .._limits import Limits, Violation, closest_equivalent, turn_ranges, violations
 from .._robot import Robot
+from ._arrays import IKArrays
 from ._types import IKResult, Solution
 
 Norm = Literal["linf", "l2"]
 
 #: Default cap on the number of solutions after 2π expansion.
 MAX_EQUIVALENTS = 1024
+
+#: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
+_CHUNK_ROWS = 1 << 18
+
+_TWO_PI = 2.0 * np.pi
 
 
 @dataclass(frozen=True)
@@ -151,21 +163,84 @@ def check_ordering(robot: Robot, ordering: Ordering, reference: np.ndarray | Non
 
 
 @dataclass
-class _Candidate:
-    """One IK solution on its way out: the per-joint values it may take, cheapest first, and their costs."""
+class SolutionTable:
+    """Solutions of many targets, one row each, grouped by target in output order.
 
-    index: int
-    solution: Solution
-    fits: bool
-    options: list[np.ndarray]  # at most the values that can be picked: the cheapest few when a joint has many
-    costs: list[np.ndarray]
-    counts: list[int]  # how many values each joint has in all (≥ len(options[j]))
+    ``target`` (S,) is the row's target index (non-decreasing); ``joints``
+    (S, n); ``within_limits`` (S,); ``position``, ``orientation`` (S,)
+    residuals; ``labels`` name → (values, codes (S,)).
+    """
+
+    target: np.ndarray
+    joints: np.ndarray
+    within_limits: np.ndarray
+    position: np.ndarray
+    orientation: np.ndarray
+    labels: dict[str, tuple[tuple, np.ndarray]]
+
+    def take(self, index: np.ndarray) -> "SolutionTable":
+        return SolutionTable(self.target[index], self.joints[index], self.within_limits[index],
+                             self.position[index], self.orientation[index],
+                             {name: (values, codes[index]) for name, (values, codes) in self.labels.items()})
+
+    @classmethod
+    def concatenate(cls, tables: list["SolutionTable"], n: int) -> "SolutionTable":
+        names: dict[str, tuple] = {}
+        for table in tables:
+            for name, (values, _) in table.labels.items():
+                names.setdefault(name, values)
+        total = sum(len(t.target) for t in tables)
+        labels = {}
+        for name, values in names.items():
+            labels[name] = (values, np.concatenate(
+                [t.labels[name][1] if name in t.labels else np.full(len(t.target), -1, dtype=np.int8)
+                 for t in tables]) if tables else np.zeros(0, dtype=np.int8))
+        if not tables:
+            return cls(np.zeros(0, int), np.zeros((0, n)), np.zeros(0, bool), np.zeros(0), np.zeros(0), labels)
+        table = cls(np.concatenate([t.target for t in tables]), np.concatenate([t.joints for t in tables]),
+                    np.concatenate([t.within_limits for t in tables]), np.concatenate([t.position for t in tables]),
+                    np.concatenate([t.orientation for t in tables]), labels)
+        assert len(table.target) == total
+        return table
+
+
+@dataclass
+class BatchSelection:
+    """The selection for N targets: per-target fields (N,) and the two solution tables."""
+
+    status: np.ndarray  # (N,) object: "ok", "unreachable", "no_solution_within_limits"
+    truncated: np.ndarray  # (N,) bool
+    trimmed: np.ndarray  # (N,) int
+    available: np.ndarray  # (N,) int
+    notes: dict[int, list[str]]
+    solutions: SolutionTable
+    rejected: SolutionTable
+
+
+def select_arrays(robot: Robot, arrays: IKArrays, limits: Limits, *, filter_limits: bool = True,
+                  reference: np.ndarray | None = None, ordering: Ordering = Ordering(),
+                  max_equivalents: int = MAX_EQUIVALENTS, budget: Budget = UNLIMITED) -> BatchSelection:
+    """Apply limits, expand 2π-equivalents, order and trim every target's solutions (see the module docstring).
+
+    The options are those of :func:`select`; ``budget`` is checked between chunks of targets.
+    """
+    _check_options(robot, ordering, reference, max_equivalents)
+    chosen = _choose(robot, limits, arrays.joints, arrays.valid, arrays.count > 0, filter_limits, reference,
+                     ordering, max_equivalents, budget)
+
+    def table(target: np.ndarray, slot: np.ndarray, joints: np.ndarray, within: np.ndarray) -> SolutionTable:
+        return SolutionTable(target, joints, within, arrays.position[target, slot], arrays.orientation[target, slot],
+                             {name: (values, codes[target, slot]) for name, (values, codes) in arrays.labels.items()})
+
+    return BatchSelection(chosen.status, chosen.truncated, chosen.trimmed, chosen.available, chosen.notes,
+                          table(*chosen.kept), table(*chosen.rejected))
 
 
 def select(robot: Robot, result: IKResult, limits: Limits, *, filter_limits: bool = True,
            reference: np.ndarray | None = None, ordering: Ordering = Ordering(),
            max_equivalents: int = MAX_EQUIVALENTS, budget: Budget = UNLIMITED) -> Selection:
-    """Apply limits, expand 2π-equivalents, order and trim the solutions of one IK result.
+    """Apply limits, expand 2π-equivalents, order and trim the solutions of one IK result (:func:`select_arrays`
+    with one target).
 
     Parameters
     ----------
@@ -179,186 +254,311 @@ def select(robot: Robot, result: IKResult, limits: Limits, *, filter_limits: boo
         ``ordering.max_solutions``, ``ordering.max_joint_move`` and
         ``ordering.weights``.
     max_equivalents : int
-        Most solutions returned after expansion (≥ 1). Only the values that
-        can be among them are generated (at most this many per joint); the
-        counts (``available``, ``trimmed``) are computed without generating
-        the rest and stop at :data:`.._budget.COUNT_CAP`.
+        Most solutions returned after expansion (≥ 1). The counts
+        (``available``, ``trimmed``) are computed without generating the rest
+        and stop at :data:`.._budget.COUNT_CAP`.
     budget : Budget
-        Checked between solutions and every few hundred picks.
+        Checked between chunks of the work.
     """
+    _check_options(robot, ordering, reference, max_equivalents)
+    solutions = result.solutions if result.status != "unreachable" else []
+    joints = np.array([s.joints for s in solutions], dtype=float).reshape(1, len(solutions), robot.dof)
+    chosen = _choose(robot, limits, joints, np.ones((1, len(solutions)), dtype=bool),
+                     np.array([result.status != "unreachable"]), filter_limits, reference, ordering, max_equivalents,
+                     budget)
+
+    def entries(slots: np.ndarray, values: np.ndarray, within: np.ndarray) -> list[Selected]:
+        return [Selected(Solution(q, solutions[s].branch, solutions[s].position_residual,
+                                  solutions[s].orientation_residual), fits,
+                         [] if fits else violations(robot, limits, q))
+                for s, q, fits in zip(slots.tolist(), values, within.tolist())]
+
+    return Selection(str(chosen.status[0]), entries(*chosen.kept[1:]), entries(*chosen.rejected[1:]),
+                     bool(chosen.truncated[0]), int(chosen.trimmed[0]), int(chosen.available[0]),
+                     chosen.notes.get(0, []))
+
+
+def _check_options(robot: Robot, ordering: Ordering, reference: np.ndarray | None, max_equivalents: int) -> None:
     check_ordering(robot, ordering, reference)
     if max_equivalents < 1:
         raise InvalidInputError("max_equivalents must be ≥ 1", location=("max_equivalents",))
-    if result.status == "unreachable":
-        return Selection("unreachable", [], [])
-    limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
-    all_counts = [turn_counts(robot, limits, solution.joints) for solution in result.solutions]
-    # Values each joint may need: with a reference any one solution may give all `limit` answers; without, the
-    # answers go round the solutions one at a time, so none gives more than the rounds needed to reach `limit`.
-    combinations = [capped_product(counts) if all(counts) else 1 for counts in all_counts
-                    if all(counts) or not filter_limits]
-    keep = limit if reference is not None else _rounds_needed(combinations, limit)
-    candidates, rejected = [], []
-    for index, (solution, counts) in enumerate(zip(result.solutions, all_counts)):
-        budget.check("selection")
-        fits = all(counts)
-        if not fits:
-            closest = closest_equivalent(robot, limits, solution.joints)
-            if filter_limits:
-                rejected.append(Selected(_with_joints(solution, closest), False, violations(robot, limits, closest)))
-                continue
-            options, counts = [np.array([value]) for value in closest], [1] * robot.dof
-        else:
-            options = turn_offsets(robot, limits, solution.joints, keep=keep, around=reference)
-        candidates.append(_costed(robot, limits, index, solution, fits, options, counts, reference, ordering))
-    with_all_moves = capped_sum(capped_product(c.counts) for c in candidates)
+
+
+@dataclass
+class _Choice:
+    """The selection of N targets: per-target fields (N,), and the kept and rejected rows in answer order.
+
+    ``kept`` and ``rejected`` are (target, slot, joints (K, n), within_limits), grouped by target.
+    """
+
+    status: np.ndarray
+    truncated: np.ndarray
+    trimmed: np.ndarray
+    available: np.ndarray
+    notes: dict[int, list[str]]
+    kept: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+    rejected: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray, reachable: np.ndarray,
+            filter_limits: bool, reference: np.ndarray | None, ordering: Ordering, max_equivalents: int,
+            budget: Budget) -> _Choice:
+    """The selection engine: ``joints`` (N, m, n) with ``valid`` (N, m) slots, ``reachable`` (N,)."""
+    budget.check("selection")
+    n_targets, _, n = joints.shape
+    target, slot = np.nonzero(valid & reachable[:, None])
+    q = joints[target, slot]
+    first, last = turn_ranges(robot, limits, q)
+    fits = np.all(last >= first, axis=1)
+    closest = closest_equivalent(robot, limits, q[~fits])
+    candidate = fits | (not filter_limits)
+    # a solution that does not fit and stays among the candidates has one value: its closest equivalent
+    turns = np.round((closest - q[~fits]) / _TWO_PI)
+    first[~fits], last[~fits] = turns, turns
+    c_target, c_q, c_first, c_last = target[candidate], q[candidate], first[candidate], last[candidate]
+    with_all_moves = _capped_sums(c_target, _capped_products(c_last - c_first + 1.0), n_targets)
     if reference is not None and ordering.max_joint_move is not None:
-        candidates = [_within_move(robot, limits, c, reference, ordering.max_joint_move) for c in candidates]
-    available = capped_sum(capped_product(c.counts) for c in candidates)
+        c_first, c_last = _within_move(robot, limits, c_q, c_first, c_last, reference, ordering.max_joint_move)
+    counts = np.maximum(c_last - c_first + 1.0, 0.0)
+    available = _capped_sums(c_target, _capped_products(counts), n_targets)
 
-    picked = []
-    for pick in itertools.islice(_merged(candidates, reference, ordering), limit):
-        picked.append(pick)
-        if len(picked) % 256 == 0:
-            budget.check("selection")
-    kept = [_selected(robot, limits, candidates[c], indices) for c, indices in picked]
-    capped_by_max_solutions = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
-    truncated = available > len(kept) and not capped_by_max_solutions
-    trimmed = min(with_all_moves - available + (available - len(kept) if capped_by_max_solutions else 0), COUNT_CAP)
+    limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
+    if reference is not None:
+        row_limit = np.full(len(c_target), limit, dtype=np.int64)
+    else:  # round robin: no solution gives more than the rounds needed to reach the limit
+        row_limit = _rounds_needed(c_target, _capped_products(counts), n_targets, limit)[c_target]
+    kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
+                                      reference, ordering, budget)
+    rows = np.flatnonzero(candidate)[kept_rows]
+    kept = (target[rows], slot[rows], kept_values, fits[rows])
 
-    if reference is not None and rejected:
-        distance = travel(robot, limits, np.array([e.solution.joints for e in rejected]), reference, ordering)
-        rejected = [rejected[i] for i in np.argsort(distance, kind="stable")]
-    status = "no_solution_within_limits" if filter_limits and not candidates and rejected else "ok"
-    selection = Selection(status, kept, rejected, truncated, trimmed, available)
-    selection.notes.extend(_notes(selection, with_all_moves, max_equivalents, reference is not None))
-    return selection
+    dropped = np.flatnonzero(~candidate)
+    dropped_values = closest if filter_limits else closest[:0]
+    if reference is not None and len(dropped):
+        order = np.lexsort((travel(robot, limits, dropped_values, reference, ordering), target[dropped]))
+        dropped, dropped_values = dropped[order], dropped_values[order]
+    rejected = (target[dropped], slot[dropped], dropped_values, np.zeros(len(dropped), dtype=bool))
+
+    n_kept = np.bincount(kept[0], minlength=n_targets)
+    n_rejected = np.bincount(rejected[0], minlength=n_targets)
+    outside = np.bincount(kept[0][~kept[3]], minlength=n_targets)
+    no_fit = filter_limits & (np.bincount(c_target, minlength=n_targets) == 0) & (n_rejected > 0)
+    status = np.where(~reachable, "unreachable", np.where(no_fit, "no_solution_within_limits", "ok")).astype(object)
+    capped = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
+    truncated = (available > n_kept) & (not capped)
+    trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
+    noted = no_fit | (outside > 0) | truncated | ((status == "ok") & (n_kept == 0) & (with_all_moves > 0))
+    notes = {row: _notes(str(status[row]), int(n_rejected[row]), int(outside[row]), bool(truncated[row]),
+                         int(available[row]), int(n_kept[row]), int(with_all_moves[row]), max_equivalents,
+                         reference is not None) for row in np.flatnonzero(noted).tolist()}
+    return _Choice(status, truncated, trimmed, available, notes, kept, rejected)
 
 
-def _rounds_needed(combinations: list[int], limit: int) -> int:
-    """Rounds of a round robin over streams of these lengths that yield ``limit`` items (all, if fewer), ≥ 1.
+def _within_move(robot: Robot, limits: Limits, q: np.ndarray, first: np.ndarray, last: np.ndarray,
+                 reference: np.ndarray, max_joint_move: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The turns (first, last), shape (S, n) each, narrowed to values within reference ± max_joint_move.
 
-    >>> _rounds_needed([1, 1, 1, 10**30], 1024)   # three streams end after round 1: the fourth gives 1,021
-    1021
+    A joint with both bounds finite is never continuous: its travel is |q + 2kπ − r|, so its turns stay an
+    interval. Every other joint has one value, kept if its travel is within the bound (tolerance included).
     """
-    remaining, previous, streams = limit, 0, len(combinations)
-    for position, length in enumerate(sorted(combinations)):
-        active = streams - position
-        if (length - previous) * active >= remaining:
-            return max(1, previous + -(-remaining // active))
-        remaining -= (length - previous) * active
-        previous = length
-    return max(1, previous)
+    reach = max_joint_move + limits.tolerance(robot)
+    low, high = reference - reach, reference + reach
+    with np.errstate(invalid="ignore"):
+        near_first = np.ceil((low - q) / _TWO_PI)
+        near_last = np.floor((high - q) / _TWO_PI)
+        near_first = near_first + (q + _TWO_PI * near_first < low)
+        near_last = near_last - (q + _TWO_PI * near_last > high)
+    single_near = _travel(np.abs(q + _TWO_PI * first - reference), limits.continuous(robot)) <= reach
+    multi = limits.multi_valued(robot)
+    return (np.where(multi, np.maximum(first, near_first), first),
+            np.where(multi, np.minimum(last, near_last), np.where(single_near, last, first - 1.0)))
 
 
-def _costed(robot: Robot, limits: Limits, index: int, solution: Solution, fits: bool, options: list[np.ndarray],
-            counts: list[int], reference: np.ndarray | None, ordering: Ordering) -> _Candidate:
-    """Sort each joint's options by cost: weighted travel from the reference, or turning from the solution."""
-    costs = []
-    for j, values in enumerate(options):
+def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, first: np.ndarray, last: np.ndarray,
+             counts: np.ndarray, row_limit: np.ndarray, limit: int, reference: np.ndarray | None,
+             ordering: Ordering, budget: Budget) -> tuple[np.ndarray, np.ndarray]:
+    """The kept combinations of the candidate rows, in answer order: (row (K,), joint values (K, n)).
+
+    ``target`` (S,) is non-decreasing; ``q``, ``first``, ``last``, ``counts`` (S, n) are the rows' values,
+    usable turns and their numbers; ``row_limit`` (S,) the most combinations a row may give.
+    """
+    n = q.shape[1]
+    weights = np.ones(n) if reference is None or ordering.weights is None else np.asarray(ordering.weights, float)
+    if reference is None:  # turns ranked by |k| itself: exact, so equal turning ties exactly
+        cheapest, direction, ahead, behind = _ranked_turns(np.zeros_like(q), first, last, np.zeros_like(q), weights)
+    else:
+        cheapest, direction, ahead, behind = _ranked_turns(q, first, last, np.broadcast_to(reference, q.shape),
+                                                           weights)
+    ranks_cap = np.minimum(counts, row_limit[:, None]).astype(np.int64)
+    limits_met, which = np.unique(row_limit, return_inverse=True)
+    down_sets = np.array([min(_down_set_size(n, int(b)), COUNT_CAP) for b in limits_met.tolist()], dtype=np.int64)
+    bound = np.minimum(_capped_products(ranks_cap), down_sets[which.ravel()])
+    per_target = np.bincount(target, weights=bound.astype(float), minlength=int(target[-1]) + 1 if len(target) else 0)
+    chunk_of_target = (np.cumsum(per_target) - per_target) // _CHUNK_ROWS
+    chunk = chunk_of_target[target]
+    edges = np.flatnonzero(np.r_[True, chunk[1:] != chunk[:-1], True]) if len(target) else np.zeros(1, int)
+    kept_rows, kept_values = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))]
+    for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
+        budget.check("selection")
+        owner, ranks = _rank_tuples(ranks_cap[start:stop], row_limit[start:stop])
+        owner += start
+        turns = cheapest[owner] + _rank_offsets(ranks, direction[owner], ahead[owner], behind[owner])
+        values = q[owner] + _TWO_PI * turns
         if reference is None:
-            cost = np.abs(values - solution.joints[j])
+            cost = np.sum(np.abs(turns), axis=1)
+            by_stream = np.lexsort((cost, owner))  # each row's combinations cheapest first, ties by rank tuple
+            owner, values = owner[by_stream], values[by_stream]
+            stream = _position_in_group(owner)
+            early = stream < row_limit[owner]
+            owner, values, stream = owner[early], values[early], stream[early]
+            order = np.lexsort((owner, stream, target[owner]))
         else:
-            cost = _joint_travel(robot, limits, j, values, reference[j])
-            if ordering.weights is not None:
-                cost = cost * ordering.weights[j]
-        order = np.argsort(cost, kind="stable")
-        options[j], cost = values[order], cost[order]
-        costs.append(cost)
-    return _Candidate(index, solution, fits, options, costs, counts)
+            distance = _travel(np.abs(values - reference), limits.continuous(robot)) * weights
+            cost = distance.max(axis=1) if ordering.norm == "linf" else np.sqrt(np.sum(distance ** 2, axis=1))
+            order = np.lexsort((cost, target[owner]))  # stable: ties by row, then rank tuple
+        owner, values = owner[order], values[order]
+        first_few = _position_in_group(target[owner]) < limit
+        kept_rows.append(owner[first_few])
+        kept_values.append(values[first_few])
+    return np.concatenate(kept_rows), np.concatenate(kept_values)
 
 
-def _joint_travel(robot: Robot, limits: Limits, joint: int, values: np.ndarray, reference: float) -> np.ndarray:
-    """:func:`joint_travel` for the options of one joint, shape (m,)."""
-    return _travel(np.abs(values - reference), limits.continuous(robot)[joint])
+def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, centre: np.ndarray,
+                  weights: np.ndarray) -> tuple[np.ndarray, ...]:
+    """How each joint's usable turns rank by cost |q + 2kπ − centre|·w (ties: the lower value first).
 
-
-def _within_move(robot: Robot, limits: Limits, candidate: _Candidate, reference: np.ndarray,
-                 max_joint_move: np.ndarray) -> _Candidate:
-    """Drop the per-joint options that travel further than the joint's bound (tolerance included).
-
-    A joint whose options were cut to the cheapest few is counted again over the bounds narrowed to
-    reference ± bound (its travel is |q − r| there: a joint with both bounds finite is never continuous).
+    Returns, shape (S, n) each: the cheapest turn, the direction (±1) of the second cheapest, and how many
+    turns lie beyond the cheapest in that direction and in the other. The cost grows outwards from the
+    cheapest, so the ranks alternate between the two sides until one runs out (:func:`_rank_offsets`).
     """
-    tolerance = limits.tolerance(robot)
-    options, costs, counts = [], [], []
-    for j, (values, cost, count) in enumerate(zip(candidate.options, candidate.costs, candidate.counts)):
-        near = _joint_travel(robot, limits, j, values, reference[j]) <= max_joint_move[j] + tolerance[j]
-        options.append(values[near])
-        costs.append(cost[near])
-        if count > len(values):
-            narrowed = Limits(limits.lower.copy(), limits.upper.copy())
-            narrowed.lower[j] = max(limits.lower[j], reference[j] - max_joint_move[j])
-            narrowed.upper[j] = min(limits.upper[j], reference[j] + max_joint_move[j])
-            count = turn_counts(robot, narrowed, candidate.solution.joints)[j] if narrowed.lower[j] <= \
-                narrowed.upper[j] else 0
-        else:
-            count = int(near.sum())
-        counts.append(count)
-    return _Candidate(candidate.index, candidate.solution, candidate.fits, options, costs, counts)
+    def cost(k):
+        return np.abs(q + _TWO_PI * k - centre) * weights
+
+    below = np.floor((centre - q) / _TWO_PI)
+    lower_costs_more = cost(below + 1.0) < cost(below)
+    cheapest = np.where(lower_costs_more, below + 1.0, below)
+    direction = np.where(lower_costs_more | (cost(below - 1.0) <= cost(below + 1.0)), -1.0, 1.0)
+    indifferent = weights == 0  # every value costs 0: ascending values
+    cheapest, direction = np.where(indifferent, first, cheapest), np.where(indifferent, 1.0, direction)
+    direction = np.where(cheapest < first, 1.0, np.where(cheapest > last, -1.0, direction))
+    cheapest = np.minimum(np.maximum(cheapest, first), last)
+    ahead = np.where(direction > 0, last - cheapest, cheapest - first)
+    return cheapest, direction, ahead, (last - first) - ahead
 
 
-def _merged(candidates: list[_Candidate], reference: np.ndarray | None,
-            ordering: Ordering) -> Iterator[tuple[int, tuple[int, ...]]]:
-    """(candidate position, option indices) in answer order, generated lazily."""
-    if reference is None:
-        return _round_robin([_stream(c, candidate.costs, math.fsum) for c, candidate in enumerate(candidates)])
-    combine: Callable[[list[float]], float] = max if ordering.norm == "linf" else _euclidean
-    merged = heapq.merge(*[_stream(c, candidate.costs, combine) for c, candidate in enumerate(candidates)])
-    return ((c, indices) for _, c, indices in merged)
+def _rank_offsets(ranks: np.ndarray, direction: np.ndarray, ahead: np.ndarray, behind: np.ndarray) -> np.ndarray:
+    """The turn, relative to the cheapest, of each joint's value of rank r (shape (C, n), see :func:`_ranked_turns`).
+
+    Ranks 1, 2, 3, 4, … go +1, −1, +2, −2, … in ``direction`` while both sides have turns left, then on along the
+    side that has.
+    """
+    r = ranks.astype(float)
+    alternating = np.where(np.mod(r, 2.0) == 1.0, direction * (r + 1.0) / 2.0, -direction * r / 2.0)
+    one_side = np.where(ahead <= behind, -direction * (r - ahead), direction * (r - behind))
+    return np.where(r <= 2.0 * np.minimum(ahead, behind), alternating, one_side)
 
 
-def _stream(position: int, costs: list[np.ndarray],
-            combine: Callable[[list[float]], float]) -> Iterator[tuple[float, int, tuple[int, ...]]]:
-    """One candidate's combinations, cheapest first, tagged with its position: (cost, position, indices)."""
-    for cost, indices in combinations_by_cost(costs, combine):
-        yield cost, position, indices
+def _rank_tuples(ranks_cap: np.ndarray, row_limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Every rank tuple r of each row with r_j < ranks_cap[row, j] and ∏(r_j + 1) ≤ row_limit[row].
+
+    Returns (row (C,), ranks (C, n)), rows ascending and each row's tuples in lexicographic order.
+    """
+    rows, n = ranks_cap.shape
+    owner = np.flatnonzero(np.all(ranks_cap > 0, axis=1) & (row_limit > 0))
+    product = np.ones(len(owner), dtype=np.int64)
+    ranks = np.zeros((len(owner), 0), dtype=np.int64)
+    for j in range(n):
+        children = np.minimum(ranks_cap[owner, j], row_limit[owner] // product)
+        parent = np.repeat(np.arange(len(owner)), children)
+        rank = np.arange(len(parent)) - (np.cumsum(children) - children)[parent]
+        owner, product = owner[parent], product[parent] * (rank + 1)
+        ranks = np.concatenate([ranks[parent], rank[:, None]], axis=1)
+    return owner, ranks
 
 
-def _euclidean(costs: list[float]) -> float:
-    return math.sqrt(math.fsum(c * c for c in costs))
+@functools.lru_cache(maxsize=None)
+def _down_set_size(n: int, limit: int) -> int:
+    """How many rank tuples of n joints have ∏(r_j + 1) ≤ limit.
+
+    >>> _down_set_size(2, 4)   # (0,0) (0,1) (0,2) (0,3) (1,0) (1,1) (2,0) (3,0)
+    8
+    """
+    if limit < 1:
+        return 0
+    if n == 0:
+        return 1
+    total, factor = 0, 1
+    while factor <= limit:
+        quotient = limit // factor
+        same = limit // quotient  # every factor up to this one leaves the same quotient
+        total += (same - factor + 1) * _down_set_size(n - 1, quotient)
+        factor = same + 1
+    return total
 
 
-def _round_robin(streams: Iterable[Iterator]) -> Iterator[tuple[int, tuple[int, ...]]]:
-    """The first item of each stream, then the second of each, and so on: (position, indices)."""
-    active = list(streams)
-    while active:
-        still = []
-        for stream in active:
-            item = next(stream, None)
-            if item is not None:
-                yield item[1], item[2]
-                still.append(stream)
-        active = still
+def _position_in_group(keys: np.ndarray) -> np.ndarray:
+    """0, 1, 2, … within each run of equal values of sorted ``keys``."""
+    if len(keys) == 0:
+        return np.zeros(0, dtype=np.int64)
+    starts = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]])
+    return np.arange(len(keys)) - np.repeat(starts, np.diff(np.r_[starts, len(keys)]))
 
 
-def _selected(robot: Robot, limits: Limits, candidate: _Candidate, indices: tuple[int, ...]) -> Selected:
-    q = np.array([candidate.options[j][k] for j, k in enumerate(indices)])
-    if candidate.fits:
-        return Selected(_with_joints(candidate.solution, q), True, [])
-    return Selected(_with_joints(candidate.solution, q), False, violations(robot, limits, q))
+def _capped_products(counts: np.ndarray) -> np.ndarray:
+    """∏_j counts[:, j] per row (counts ≥ 0, shape (S, n)), capped at :data:`COUNT_CAP` without overflow, (S,)."""
+    factors = np.minimum(counts, COUNT_CAP).astype(np.int64)
+    product = np.ones(len(factors), dtype=np.int64)
+    for factor in factors.T:
+        over = product > COUNT_CAP // np.maximum(factor, 1)
+        product = np.where(over, COUNT_CAP, product * np.where(over, 1, factor))
+    return product
 
 
-def _with_joints(solution: Solution, q: np.ndarray) -> Solution:
-    return Solution(q, solution.branch, solution.position_residual, solution.orientation_residual, solution.singular)
+def _capped_sums(target: np.ndarray, values: np.ndarray, n_targets: int) -> np.ndarray:
+    """Σ values per target (values ≤ COUNT_CAP), capped at :data:`COUNT_CAP`, shape (N,).
+
+    The float sum is exact while it stays below 2**53 (non-negative integers); at or above it the cap applies.
+    """
+    total = np.bincount(target, weights=values.astype(float), minlength=n_targets)
+    return np.where(total >= 2.0 ** 53, COUNT_CAP, total).astype(np.int64)
 
 
-def _notes(selection: Selection, with_all_moves: int, max_equivalents: int, has_reference: bool) -> list[str]:
+def _rounds_needed(target: np.ndarray, lengths: np.ndarray, n_targets: int, limit: int) -> np.ndarray:
+    """Per target, the rounds of a round robin over its rows' streams (``lengths`` (S,)) that yield ``limit``
+    items (all, if fewer), ≥ 1, shape (N,).
+
+    Rounds R yield Σ min(length, R) items: the smallest R reaching ``limit`` is found by bisection.
+    """
+    position = _position_in_group(target)
+    streams = np.zeros((n_targets, int(position.max()) + 1 if len(position) else 1), dtype=np.int64)
+    streams[target, position] = lengths
+
+    def yielded(rounds):
+        return np.minimum(streams, rounds[:, None]).sum(axis=1)
+
+    low, high = np.ones(n_targets, dtype=np.int64), np.full(n_targets, limit, dtype=np.int64)
+    enough = yielded(high) >= limit
+    while np.any(low < high):
+        middle = (low + high) // 2
+        reached = yielded(middle) >= limit
+        low, high = np.where(reached, low, middle + 1), np.where(reached, middle, high)
+    return np.where(enough, low, np.maximum(1, streams.max(axis=1)))
+
+
+def _notes(status: str, rejected: int, outside: int, truncated: bool, available: int, kept: int,
+           with_all_moves: int, max_equivalents: int, has_reference: bool) -> list[str]:
     notes = []
-    if selection.status == "no_solution_within_limits":
-        notes.append(f"All {len(selection.rejected)} solutions violate a joint limit, whatever whole turns the "
+    if status == "no_solution_within_limits":
+        notes.append(f"All {rejected} solutions violate a joint limit, whatever whole turns the "
                      f"revolute joints make; they are listed in 'rejected'.")
-    outside = sum(not e.within_limits for e in selection.solutions)
     if outside:
         notes.append(f"{outside} of the solutions violate a joint limit (filter_limits is false); "
                      f"each is flagged with its violations.")
-    if selection.expansion_truncated:
+    if truncated:
         which = "nearest" if has_reference else "least-turned"
-        fit = (f"At least {COUNT_CAP} (2**53 − 1, the count's cap)" if selection.available >= COUNT_CAP
-               else f"{selection.available}")
-        notes.append(f"{fit} solutions fit; max_equivalents = {max_equivalents} kept the "
-                     f"{which} {len(selection.solutions)}.")
-    if selection.status == "ok" and not selection.solutions and with_all_moves:
+        fit = f"At least {COUNT_CAP} (2**53 − 1, the count's cap)" if available >= COUNT_CAP else f"{available}"
+        notes.append(f"{fit} solutions fit; max_equivalents = {max_equivalents} kept the {which} {kept}.")
+    if status == "ok" and not kept and with_all_moves:
         notes.append(f"{with_all_moves} solutions fit the limits, but none is within max_joint_move / "
                      f"max_solutions of the reference.")
     return notes

@@ -1,0 +1,213 @@
+"""Selection against a brute-force oracle: every 2π-equivalent enumerated explicitly, filtered, sorted, cut.
+
+The oracle follows the rules of :mod:`service.kinematics.ik._select`'s docstring with its own loops.
+"""
+
+from __future__ import annotations
+
+import itertools
+import time
+import tracemalloc
+
+import numpy as np
+import pytest
+
+from service.kinematics import COUNT_CAP, LIMIT_TOLERANCE, Joint, Limits, Robot, forward_kinematics
+from service.kinematics.ik import IKResult, Ordering, Solution, select, select_arrays, solve_ik_arrays
+from service.robots.catalogue import load_catalogue
+from service.config import Settings
+
+INF = np.inf
+TWO_PI = 2 * np.pi
+KINDS = [(-np.pi, np.pi), (-TWO_PI, TWO_PI), (-3 * np.pi, 3 * np.pi), (-INF, INF), (0.0, INF), (-INF, 1.0),
+         (-1.5, 2.0), (-20.0, 3.0)]
+
+
+def random_case(rng):
+    n = int(rng.integers(1, 5))
+    joints = []
+    for i in range(n):
+        if rng.random() < 0.15:
+            lower, upper = sorted(rng.uniform(-1, 2, 2))
+            joints.append(Joint(f"q{i}", "prismatic", 0.5, 0.0, 0.0, 0.0, lower, upper))
+        else:
+            lower, upper = KINDS[rng.integers(len(KINDS))]
+            joints.append(Joint(f"q{i}", "revolute", 0.5, 0.0, 0.0, 0.0, lower, upper))
+    robot = Robot(joints, name="random arm")
+    solutions = [Solution(rng.uniform(-np.pi, np.pi, n), {"slot": str(s)}, 0.0, 0.0)
+                 for s in range(int(rng.integers(1, 5)))]
+    options = {"filter_limits": bool(rng.random() < 0.6), "max_equivalents": int(rng.integers(1, 30))}
+    if rng.random() < 0.7:
+        options["reference"] = rng.uniform(-4, 4, n)
+        options["ordering"] = Ordering(
+            str(rng.choice(["linf", "l2"])), rng.uniform(0, 2, n) if rng.random() < 0.4 else None,
+            int(rng.integers(0, 20)) if rng.random() < 0.4 else None,
+            np.where(rng.random(n) < 0.5, rng.uniform(0, 6, n), INF) if rng.random() < 0.4 else None)
+    return robot, IKResult("ok", solutions, "analytic", "test", True), options
+
+
+def oracle(robot, result, options):
+    """(kept rows [(joints, within, cost)], rejected joints, available, with_all_moves) by explicit enumeration."""
+    lower, upper = robot.lower, robot.upper
+    tolerance = np.where(robot.is_revolute, LIMIT_TOLERANCE, LIMIT_TOLERANCE * robot.characteristic_length)
+    reference, ordering = options.get("reference"), options.get("ordering", Ordering())
+    weights = np.ones(robot.dof) if ordering.weights is None else ordering.weights
+    move = np.full(robot.dof, INF) if ordering.max_joint_move is None else ordering.max_joint_move
+    continuous = robot.is_revolute & np.isinf(lower) & np.isinf(upper)
+
+    def inside(j, value):
+        return lower[j] - tolerance[j] <= value <= upper[j] + tolerance[j]
+
+    def turns_of(j, value):  # every usable k, explicitly
+        if not robot.is_revolute[j]:
+            return [0] if inside(j, value) else []
+        fitting = [k for k in range(-12, 13) if inside(j, value + TWO_PI * k)]
+        if np.isfinite(lower[j]) and np.isfinite(upper[j]):
+            return fitting
+        return [min(fitting, key=abs)]  # one side or none: the one nearest the value
+
+    def distance(j, value):
+        d = abs(value - reference[j])
+        return (min(d % TWO_PI, TWO_PI - d % TWO_PI) if continuous[j] else d) * weights[j]
+
+    def closest_turn(j, value):
+        fitting = turns_of(j, value)
+        if fitting:
+            return min(fitting, key=lambda k: (abs(k), k))
+        if not robot.is_revolute[j]:
+            return 0
+        return min(range(-12, 13), key=lambda k: max(lower[j] - value - TWO_PI * k, value + TWO_PI * k - upper[j]))
+
+    streams, rejected, with_all_moves = [], [], 0
+    for index, solution in enumerate(result.solutions):
+        q = solution.joints
+        per_joint = [turns_of(j, q[j]) for j in range(robot.dof)]
+        fits = all(per_joint)
+        if not fits:
+            closest = q + TWO_PI * np.array([closest_turn(j, q[j]) for j in range(robot.dof)])
+            if options["filter_limits"]:
+                rejected.append(closest)
+                continue
+            per_joint = [[closest_turn(j, q[j])] for j in range(robot.dof)]
+        combos = [np.array(k, dtype=float) for k in itertools.product(*per_joint)]
+        with_all_moves += len(combos)
+        rows = []
+        for k in combos:
+            values = q + TWO_PI * k
+            if reference is not None:
+                if any(abs(values[j] - reference[j]) > move[j] + tolerance[j] if not continuous[j] else
+                       distance(j, values[j]) / (weights[j] or 1) > move[j] + tolerance[j]
+                       for j in range(robot.dof)):
+                    continue
+                d = [distance(j, values[j]) for j in range(robot.dof)]
+                cost = max(d) if ordering.norm == "linf" else float(np.sqrt(np.sum(np.square(d))))
+            else:
+                cost = float(np.sum(np.abs(k)))
+            ranks = tuple(sorted(per_joint[j], key=lambda t: (abs(t), t)).index(k[j]) for j in range(robot.dof))
+            rows.append((values, fits, cost, ranks))
+        streams.append(rows)
+    available = sum(len(rows) for rows in streams)
+    limit = options["max_equivalents"] if ordering.max_solutions is None else min(options["max_equivalents"],
+                                                                                 ordering.max_solutions)
+    if reference is not None:
+        every = sorted(((row, s) for s, rows in enumerate(streams) for row in rows), key=lambda e: e[0][2])
+        kept = [row for row, _ in every[:limit]]
+        rejected.sort(key=lambda r: (max if ordering.norm == "linf" else np.linalg.norm)(
+            [distance(j, r[j]) for j in range(robot.dof)]))
+    else:
+        # each stream by (Σ|k|, ranks lexicographically), a joint's values ranked by (|k|, k)
+        ranked = [sorted(rows, key=lambda r: (r[2], r[3])) for rows in streams]
+        kept = [rows[i] for i in range(max(map(len, ranked), default=0)) for rows in ranked if i < len(rows)][:limit]
+    return kept, rejected, available, with_all_moves, [row for rows in streams for row in rows]
+
+
+def cost(robot, values, options):
+    """The documented distance of one joint vector from the reference (per-joint travel, weights, norm)."""
+    reference, ordering = options["reference"], options.get("ordering", Ordering())
+    continuous = robot.is_revolute & np.isinf(robot.lower) & np.isinf(robot.upper)
+    d = np.abs(values - reference)
+    d = np.where(continuous, np.minimum(d % TWO_PI, TWO_PI - d % TWO_PI), d)
+    d = d * (1.0 if ordering.weights is None else ordering.weights)
+    return float(d.max() if ordering.norm == "linf" else np.sqrt(np.sum(d ** 2)))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_select_matches_the_brute_force_oracle(seed):
+    rng = np.random.default_rng(seed)
+    for trial in range(60):
+        robot, result, options = random_case(rng)
+        selection = select(robot, result, Limits.of(robot), **options)
+        kept, rejected, available, with_all_moves, everything = oracle(robot, result, options)
+        context = (seed, trial, options)
+        assert selection.available == available, context
+        assert len(selection.solutions) == len(kept), context
+        ordering = options.get("ordering", Ordering())
+        capped = ordering.max_solutions is not None and ordering.max_solutions <= options["max_equivalents"]
+        assert selection.expansion_truncated == (available > len(kept) and not capped), context
+        assert selection.trimmed == with_all_moves - available + (available - len(kept) if capped else 0), context
+        got = np.array([e.solution.joints for e in selection.solutions]).reshape(-1, robot.dof)
+        if "reference" in options:  # the same costs in order (ties may swap rows), each row one the oracle has
+            np.testing.assert_allclose([cost(robot, row, options) for row in got], [r[2] for r in kept], atol=1e-9,
+                                       err_msg=str(context))
+            assert all(any(np.allclose(row, r[0], atol=1e-12) for r in everything) for row in got), context
+        else:
+            np.testing.assert_allclose(got, np.array([r[0] for r in kept]).reshape(-1, robot.dof), atol=1e-12,
+                                       err_msg=str(context))
+        assert [e.within_limits for e in selection.solutions] == [bool(r[1]) for r in kept], context
+        np.testing.assert_allclose(np.array([e.solution.joints for e in selection.rejected]).reshape(-1, robot.dof),
+                                   np.array(rejected).reshape(-1, robot.dof), atol=1e-9, err_msg=str(context))
+        for entry in selection.solutions + selection.rejected:
+            outside = (entry.solution.joints < robot.lower - 1e-9) | (entry.solution.joints > robot.upper + 1e-9)
+            assert [v.joint for v in entry.violations] == np.flatnonzero(outside).tolist(), context
+
+
+CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+
+
+@pytest.mark.parametrize("robot_id", ["puma560_standard", "ur5", "spong_ex3_5_stanford"])
+def test_one_target_select_is_the_row_of_select_arrays(robot_id):
+    robot = CATALOGUE.get(robot_id).robot
+    rng = np.random.default_rng(1)
+    q = rng.uniform(-np.pi, np.pi, (20, robot.dof))
+    q[:, ~robot.is_revolute] = 0.5
+    targets = forward_kinematics(robot, q)
+    reference = np.zeros(robot.dof)
+    for options in ({}, {"reference": reference, "ordering": Ordering("l2")},
+                    {"filter_limits": False, "reference": reference, "max_equivalents": 5}):
+        arrays = solve_ik_arrays(robot, targets)
+        chosen = select_arrays(robot, arrays, Limits.of(robot), **options)
+        for row in range(len(targets)):
+            solutions = [Solution(arrays.joints[row, s], {}, float(arrays.position[row, s]),
+                                  float(arrays.orientation[row, s])) for s in range(arrays.count[row])]
+            one = select(robot, IKResult("ok" if solutions else "unreachable", solutions, "analytic", "x", True),
+                         Limits.of(robot), **options)
+            assert (one.status, one.expansion_truncated, one.trimmed, one.available, one.notes) == (
+                chosen.status[row], chosen.truncated[row], chosen.trimmed[row], chosen.available[row],
+                chosen.notes.get(row, []))
+            for table, entries in ((chosen.solutions, one.solutions), (chosen.rejected, one.rejected)):
+                mine = np.flatnonzero(table.target == row)
+                np.testing.assert_array_equal(table.joints[mine],
+                                              np.array([e.solution.joints for e in entries]).reshape(-1, robot.dof))
+                assert table.within_limits[mine].tolist() == [e.within_limits for e in entries]
+
+
+def test_huge_limits_are_answered_bounded_with_exact_counts():
+    wide = Robot([Joint(f"q{i}", "revolute", 0.5, 0.0, 0.0, 0.0, -1e6, 1e6) for i in range(3)], name="wide")
+    result = IKResult("ok", [Solution(np.array([0.5, -1.0, 2.0]), {}, 0.0, 0.0),
+                             Solution(np.array([-0.5, 1.0, -2.0]), {}, 0.0, 0.0)], "analytic", "test", True)
+    per_joint = [int(np.floor((1e6 - v) / TWO_PI) - np.ceil((-1e6 - v) / TWO_PI) + 1) for v in (0.5, -1.0, 2.0)]
+    tracemalloc.start()
+    started = time.perf_counter()
+    selection = select(wide, result, Limits.of(wide), reference=np.zeros(3), max_equivalents=64)
+    elapsed = time.perf_counter() - started
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert elapsed < 5.0 and peak < 200e6
+    assert selection.available == min(2 * int(np.prod(per_joint, dtype=object)), COUNT_CAP)
+    assert len(selection.solutions) == 64 and selection.expansion_truncated
+    costs = [np.max(np.abs(e.solution.joints)) for e in selection.solutions]
+    assert costs == sorted(costs) and costs[0] == pytest.approx(2.0)  # the solutions themselves come first
+    six = Robot([Joint(f"q{i}", "revolute", 0.5, 0.0, 0.0, 0.0, -1e6, 1e6) for i in range(6)], name="wide six")
+    capped = select(six, IKResult("ok", [Solution(np.full(6, 0.5), {}, 0.0, 0.0)], "analytic", "x", True),
+                    Limits.of(six), max_equivalents=8)
+    assert capped.available == COUNT_CAP and len(capped.solutions) == 8 and "the count's cap" in capped.notes[0]

@@ -25,7 +25,7 @@ from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
 from ._plan import Plan, plan_for
 from ._types import LabelCodes, SingularFlags
-from ._verify import distance_to_reference, polish, residual_arrays, wrap_revolute
+from ._verify import accepted, distance_to_reference, polish, residual_arrays, wrap_revolute
 from ._structure import arm_size
 
 
@@ -236,9 +236,7 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
     position, orientation = residual_arrays(robot, joints, targets)
     _polish_near(robot, joints, targets, position, orientation, candidates.valid, constrain_orientation)
-    ok = candidates.valid & (position <= ACCEPT_RESIDUAL * arm_size(robot))
-    if constrain_orientation:
-        ok &= orientation <= ACCEPT_RESIDUAL
+    ok = candidates.valid & accepted(robot, position, orientation, constrain_orientation)
     kept = _first_of_each(robot, joints, ok)
     labels = plan.label_codes_one(joints, kept) if one_pose else None
     if labels is None:

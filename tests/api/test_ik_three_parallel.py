@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from tests.ik_helpers import find, fk_inline, joints_of
-from tests.kinematics.test_ik_three_parallel_families import CASES, random_arm
+from tests.kinematics.ik.test_three_parallel import CASES, random_arm
 
 
 def _description(robot) -> dict:

@@ -23,10 +23,9 @@ from .._budget import UNLIMITED, Budget
 from .._cache import memo
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
-from ._lean import lean_candidates, lean_label_codes
 from ._plan import Plan, plan_for
 from ._types import LabelCodes, SingularFlags
-from ._verify import distance_to_reference, polish, residual_arrays, wrap_revolute
+from ._verify import accepted, distance_to_reference, polish, residual_arrays, wrap_revolute
 from ._structure import arm_size
 
 
@@ -200,14 +199,15 @@ def solve_ik_arrays(robot: Robot, world_T_targets: np.ndarray, *, constrain_orie
                 parts = list(pool.map(solve, chunks))
         else:
             parts = [solve(chunk) for chunk in chunks]
-        return _concatenated(parts)
+        return concatenated(parts)
     budget.check("the analytic solve")
     return _solve_chunk(robot, targets, constrain_orientation, reference, plan)
 
 
-def _concatenated(parts: list[IKArrays]) -> IKArrays:
-    """One IKArrays from the answers for consecutive chunks of targets (padded to the widest chunk's slots: a
-    solver may give each chunk only as many slots as it needs, as the general 6R solver does)."""
+def concatenated(parts: list[IKArrays]) -> IKArrays:
+    """One IKArrays holding the rows of ``parts`` in turn (consecutive chunks of targets, or several answers for
+    one target), padded to the widest part's slots (a solver may give each part only as many slots as it needs, as
+    the general 6R solver does); labels joined by :func:`joined_label_codes`."""
     width = max(p.joints.shape[1] for p in parts)
     parts = [_padded(p, width) for p in parts]
     singularities = SingularFlags(sum(len(p.count) for p in parts))
@@ -223,10 +223,31 @@ def _concatenated(parts: list[IKArrays]) -> IKArrays:
         joints=np.concatenate([p.joints for p in parts]), valid=np.concatenate([p.valid for p in parts]),
         count=np.concatenate([p.count for p in parts]), position=np.concatenate([p.position for p in parts]),
         orientation=np.concatenate([p.orientation for p in parts]),
-        labels={name: (values, np.concatenate([p.labels[name][1] for p in parts]))
-                for name, (values, _) in first.labels.items()},
+        labels=joined_label_codes([p.labels for p in parts], [p.valid.shape for p in parts]),
         singularities=singularities, structure=first.structure, free_joints=first.free_joints,
         complete=np.concatenate([p.complete for p in parts]))
+
+
+def joined_label_codes(pieces: list[LabelCodes], shapes: list[tuple[int, ...]]) -> LabelCodes:
+    """The label codes of several pieces laid end to end (along axis 0). A name's values are those of the first
+    piece that has it, the others' codes mapped onto them; −1 where a piece lacks the name (its codes' shape
+    in ``shapes``) or the value."""
+    names: dict[str, tuple] = {}
+    for piece in pieces:
+        for name, (values, _) in piece.items():
+            names.setdefault(name, values)
+    joined: LabelCodes = {}
+    for name, values in names.items():
+        columns = []
+        for piece, shape in zip(pieces, shapes):
+            if name in piece:
+                own, codes = piece[name]
+                remap = np.array([values.index(v) if v in values else -1 for v in own] + [-1], dtype=np.int8)
+                columns.append(remap[codes])
+            else:
+                columns.append(np.full(shape, -1, dtype=np.int8))
+        joined[name] = (values, np.concatenate(columns))
+    return joined
 
 
 def _padded(part: IKArrays, width: int) -> IKArrays:
@@ -246,20 +267,19 @@ def _padded(part: IKArrays, width: int) -> IKArrays:
 
 def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
                  plan: Plan) -> IKArrays:
-    # one pose: the scalar candidates when the pose is clearly generic (see _lean), else the array solver's
-    candidates = lean_candidates(plan, targets[0], reference) if len(targets) == 1 else None
-    lean = candidates is not None
-    if not lean:
+    # one pose: the family's scalar path (Plan.solve_one) when it has one and the pose is clearly generic
+    solve_one = getattr(plan, "solve_one", None) if len(targets) == 1 else None
+    candidates = solve_one(targets[0]) if solve_one is not None else None
+    one_pose = candidates is not None
+    if not one_pose:
         candidates = plan.solve(targets, reference)
     n_targets, m, n = candidates.joints.shape
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
     position, orientation = residual_arrays(robot, joints, targets)
     _polish_near(robot, joints, targets, position, orientation, candidates.valid, constrain_orientation)
-    ok = candidates.valid & (position <= ACCEPT_RESIDUAL * arm_size(robot))
-    if constrain_orientation:
-        ok &= orientation <= ACCEPT_RESIDUAL
+    ok = candidates.valid & accepted(robot, position, orientation, constrain_orientation)
     kept = _first_of_each(robot, joints, ok)
-    labels = lean_label_codes(plan, joints, kept) if lean else None
+    labels = plan.label_codes_one(joints, kept) if one_pose else None
     if labels is None:
         labels = plan.label_codes(joints.reshape(-1, n))
     # output order: kept slots first, nearest to the reference first, else in slot order (stable)

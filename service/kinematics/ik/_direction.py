@@ -32,7 +32,7 @@ from .._cache import memo
 from .._errors import InvalidInputError
 from .._forward import forward_kinematics, geometric_jacobian
 from .._robot import Robot
-from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE
 from ._arrays import IKArrays, _first_of_each
 from ._plan import Plan, geometry_of, plan_for_geometry
 from ._structure import Geometry

@@ -56,7 +56,7 @@ import numpy as np
 
 from ._screws import invert
 from ._structure import Geometry
-from ._types import Branch, Candidates, LabelCodes, SingularFlags
+from ._types import Candidates, LabelCodes, SingularFlags
 
 #: A complex root whose angle's imaginary part is within this many times its error bound of the real axis
 #: (a pair about to become two real roots, or two real roots split by rounding) is ambiguous.
@@ -489,11 +489,7 @@ class General6RPlan:
         beyond = np.einsum("ni,ni->n", offset, offset) > (self.reach * (1.0 + 1e-9)) ** 2
         valid[beyond] = False
         complete[beyond] = True
-        return Candidates(joints, valid, [], SingularFlags(n), complete=complete, promise_needs_every_slot=True)
-
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        """A general 6R arm has no textbook branch names: no labels."""
-        return [{} for _ in range(len(joints))]
+        return Candidates(joints, valid, SingularFlags(n), complete=complete, promise_needs_every_slot=True)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return {}

@@ -54,7 +54,7 @@ from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL
 from ._screws import chain_motion
 from ._structure import arm_size
-from ._types import Branch, Candidates, LabelCodes
+from ._types import Candidates, LabelCodes
 from ._verify import polish, residual_arrays, wrap_revolute
 
 #: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
@@ -151,7 +151,7 @@ class IdealisedPlan:
         for mask, _ in ideal.singularities.entries:
             singular |= mask
         complete = converged & distinct & ~near_miss & ~singular
-        return Candidates(joints, accepted, [], ideal.singularities, complete=complete)
+        return Candidates(joints, accepted, ideal.singularities, complete=complete)
 
     def _stalled_apart(self, joints: np.ndarray, world_T_targets: np.ndarray, missed: np.ndarray,
                        after: np.ndarray) -> np.ndarray:
@@ -198,9 +198,6 @@ class IdealisedPlan:
     def _size(self, position: np.ndarray, orientation: np.ndarray) -> np.ndarray:
         size = position / self.size
         return np.maximum(size, orientation) if self.constrain_orientation else size
-
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        return self.inner.labels(joints)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return self.inner.label_codes(joints)

@@ -25,18 +25,20 @@ from ._slide_after_wrist import SlideAfterSphericalWrist
 from ._structure import Geometry, canonical_model, idealised
 from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
 from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
-from ._types import Branch, Candidates, LabelCodes
+from ._types import Candidates, LabelCodes
 from ._wrist import Roll, SphericalWrist
 
 
 class Plan(Protocol):
+    """A family's solver for one robot. A family with a scalar path for one pose also has
+    ``solve_one(world_T_target) -> Candidates | None`` and ``label_codes_one(joints, valid) -> LabelCodes | None``
+    (:mod:`._scalar`); None sends the pose to ``solve`` and ``label_codes``."""
+
     structure: str
     generic_count: int
     free_joints: list[int]
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates: ...
-
-    def labels(self, joints: np.ndarray) -> list[Branch]: ...
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes: ...
 

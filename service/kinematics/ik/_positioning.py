@@ -28,7 +28,7 @@ from ._subproblems import (
     subproblem_5,
     subproblem_5_prismatic,
 )
-from ._types import Branch, LabelCodes, SingularFlags, Singularity, branches_from_codes
+from ._types import LabelCodes, SingularFlags, Singularity
 
 
 @dataclass
@@ -48,18 +48,13 @@ def _unit(v: np.ndarray) -> np.ndarray | None:
     return v / norm if norm > 1e-9 else None
 
 
-def side_labels(key: str, side: np.ndarray, size: np.ndarray, positive, negative) -> list[Branch]:
-    """One label per row from the sign of ``side`` (M,): ``positive`` when above 0, else ``negative``.
+def side_codes(side: np.ndarray, size: np.ndarray) -> np.ndarray:
+    """One label code per row (M,) from the sign of ``side`` (M,): 0 (the label's first value) when above 0, else 1.
 
     Where ``|side| <= DUPLICATE_TOLERANCE * size`` the row sits where its two
     branches meet (a stretched or folded elbow, aligned Assur links, a wrist
-    point at the shoulder's boundary): the label does not apply and is left out.
+    point at the shoulder's boundary): the label does not apply (−1).
     """
-    return branches_from_codes({key: ((positive, negative), side_codes(side, size))}, len(side))
-
-
-def side_codes(side: np.ndarray, size: np.ndarray) -> np.ndarray:
-    """:func:`side_labels` as codes (M,): 0 for ``positive``, 1 for ``negative``, −1 where the label is left out."""
     codes = np.where(side > 0, 0, 1).astype(np.int8)
     codes[np.abs(side) <= DUPLICATE_TOLERANCE * size] = -1
     return codes
@@ -85,10 +80,6 @@ class Positioner:
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         raise NotImplementedError
-
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        """Branch labels of full joint vectors (M, n), one dict per row."""
-        return branches_from_codes(self.label_codes(joints), len(joints))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """The same labels as arrays: name → (values, codes (M,), −1 where the label is left out)."""
@@ -248,7 +239,7 @@ class IntersectingShoulder(Positioner):
         return normal if normal is not None else self.point - self.centre
 
     @cached_property
-    def _label_constants(self) -> tuple[np.ndarray, bool, np.ndarray]:
+    def label_constants(self) -> tuple[np.ndarray, bool, np.ndarray]:
         """What :meth:`label_codes` needs of the geometry alone, computed once per plan: link 1's forward
         direction at q = 0, whether axes 2 and 3 are parallel, and the up-pointing axis 1."""
         g, (i, j, k) = self.geometry, self.joints
@@ -263,7 +254,7 @@ class IntersectingShoulder(Positioner):
         the front configuration's limit is used (textbook §3.2: front, θ3 < 0 is up: the elbow behind).
         """
         g, (i, j, k) = self.geometry, self.joints
-        forward_home, in_plane, up = self._label_constants
+        forward_home, in_plane, up = self.label_constants
         forward = rotate_about(g.direction(i), joints[:, i], forward_home)
         point = self._moved(joints, k + 1, self.point)
         reach = point - self.centre

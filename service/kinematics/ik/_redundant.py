@@ -32,7 +32,7 @@ complete for every free value it lists.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -40,8 +40,7 @@ from .._cache import memo
 from .._errors import InvalidInputError
 from .._robot import Robot
 from .._tolerances import DUPLICATE_TOLERANCE
-from ._arrays import IKArrays, solve_ik_arrays
-from ._lean import lean_candidates, lean_label_codes
+from ._arrays import IKArrays, concatenated, joined_label_codes, solve_ik_arrays
 from ._plan import Plan, geometry_of, plan_for_geometry
 from ._screws import joint_motion
 from ._structure import Geometry
@@ -264,7 +263,8 @@ class _RowsPlan:
             parts = []
             for row, plan in enumerate(self.plans):
                 if plan is not None:  # one pose per plan: the scalar candidates when the pose is clearly generic
-                    part = lean_candidates(plan, world_T_targets[row], locked_reference)
+                    solve_one = getattr(plan, "solve_one", None)
+                    part = solve_one(world_T_targets[row]) if solve_one is not None else None
                     if part is None:
                         part = plan.solve(world_T_targets[row:row + 1], locked_reference)
                     parts.append((np.array([row]), part))
@@ -287,12 +287,7 @@ class _RowsPlan:
                 singular.add(full, Singularity(flag.kind, tuple(int(kept[i]) for i in flag.joints), flag.relation,
                                                flag.detail))
         self._valid = valid
-        return Candidates(joints, valid, [], singular)
-
-    def labels(self, joints: np.ndarray):
-        from ._types import branches_from_codes
-
-        return branches_from_codes(self.label_codes(joints), len(joints))
+        return Candidates(joints, valid, singular)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """Branch labels of full joint vectors (S·m, n), row-major over (row, slot): the locked family's."""
@@ -307,27 +302,12 @@ class _RowsPlan:
             part = locked[row * m:(row + 1) * m]
             piece = {}
             if plan is not None:
-                if valid is not None and valid.shape == (len(self.plans), m):
-                    piece = lean_label_codes(plan, part[None], valid[row:row + 1])
+                if valid is not None and valid.shape == (len(self.plans), m) and hasattr(plan, "label_codes_one"):
+                    piece = plan.label_codes_one(part[None], valid[row:row + 1])
                 if not piece:
                     piece = plan.label_codes(part)
             pieces.append(piece)
-        names: dict[str, tuple] = {}
-        for piece in pieces:
-            for name, (values, _) in piece.items():
-                names.setdefault(name, values)
-        result: LabelCodes = {}
-        for name, values in names.items():
-            columns = []
-            for piece in pieces:
-                if name in piece:
-                    own, code = piece[name]
-                    remap = np.array([values.index(v) if v in values else -1 for v in own] + [-1], dtype=np.int8)
-                    columns.append(remap[code])
-                else:
-                    columns.append(np.full(m, -1, dtype=np.int8))
-            result[name] = (values, np.concatenate(columns) if columns else np.zeros(0, dtype=np.int8))
-        return result
+        return joined_label_codes(pieces, [(m,)] * len(pieces))
 
 
 @dataclass(frozen=True)
@@ -379,7 +359,7 @@ def solve_free_joint_family(robot: Robot, world_T_targets: np.ndarray, free: lis
         extra = None
         if reference is not None and len(family.free) == 1:
             extra = _refine_nearest(robot, family, target, values, grid, reference, minima, rounds)
-        answers.append(grid if extra is None else _stacked([grid, extra]))
+        answers.append(grid if extra is None else concatenated([grid, extra]))
         refined.append(0 if extra is None else len(extra.count))
     missing = sum(plan is None for plan in rows_plan.plans) if not family.ends_only else 0
     merged = _merged_rows(robot, answers, reference)
@@ -550,46 +530,6 @@ def _solve_at(robot: Robot, family: FreeJointFamily, target: np.ndarray, points:
     """Every solution at each single free value in ``points`` (K,), one row each."""
     values = points[:, None]
     return _solve_rows(robot, family, family.rows_plan(values), target, values, reference)
-
-
-def _stacked(parts: list[IKArrays]) -> IKArrays:
-    """Rows of several answers for the same target, padded to the widest slot count."""
-    m = max(p.joints.shape[1] for p in parts)
-
-    def pad(a: np.ndarray, fill) -> np.ndarray:
-        width = [(0, 0)] * a.ndim
-        width[1] = (0, m - a.shape[1])
-        return np.pad(a, width, constant_values=fill)
-
-    names: dict[str, tuple] = {}
-    for p in parts:
-        for name, (values, _) in p.labels.items():
-            names.setdefault(name, values)
-    labels = {}
-    for name, values in names.items():
-        columns = []
-        for p in parts:
-            if name in p.labels:
-                own, codes = p.labels[name]
-                remap = np.array([values.index(v) if v in values else -1 for v in own] + [-1], dtype=np.int8)
-                columns.append(pad(remap[codes], -1))
-            else:
-                columns.append(np.full(p.valid.shape[:1] + (m,), -1, dtype=np.int8))
-        labels[name] = (values, np.concatenate(columns))
-    singular = SingularFlags(sum(len(p.count) for p in parts))
-    offset = 0
-    for p in parts:
-        for mask, flag in p.singularities.entries:
-            full = np.zeros(singular.count, dtype=bool)
-            full[offset:offset + len(mask)] = mask
-            singular.add(full, flag)
-        offset += len(p.count)
-    return IKArrays(np.concatenate([pad(p.joints, 0.0) for p in parts]),
-                    np.concatenate([pad(p.valid, False) for p in parts]),
-                    np.concatenate([p.count for p in parts]),
-                    np.concatenate([pad(p.position, np.inf) for p in parts]),
-                    np.concatenate([pad(p.orientation, np.inf) for p in parts]),
-                    labels, singular, parts[0].structure, parts[0].free_joints)
 
 
 def _merged_rows(robot: Robot, answers: list[IKArrays], reference: np.ndarray | None) -> IKArrays:

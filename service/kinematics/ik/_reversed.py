@@ -19,7 +19,7 @@ from .._forward import ScrewModel
 from ._decoupled import DecoupledPlan
 from ._screws import invert
 from ._structure import Geometry
-from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 
 
 def reversed_geometry(geometry: Geometry) -> Geometry:
@@ -59,7 +59,7 @@ class ReversedPlan:
         singular = SingularFlags(inner.singularities.count)
         for mask, flag in inner.singularities.entries:
             singular.add(mask, self._renumbered(flag))
-        return Candidates(inner.joints[..., ::-1].copy(), inner.valid, [], singular)
+        return Candidates(inner.joints[..., ::-1].copy(), inner.valid, singular)
 
     def _renumbered(self, flag: Singularity) -> Singularity:
         """The inverse chain's singularity with the chain's joint numbers (0-based in ``joints``, 1-based in text)."""
@@ -74,9 +74,6 @@ class ReversedPlan:
         detail = re.sub(r"\baxes (\d+)–(\d+)", span, flag.detail)
         detail = re.sub(r"(\bq|\bjoints? |\baxis )(\d+)", one_based, detail)
         return Singularity(flag.kind, tuple(sorted(n - 1 - j for j in flag.joints)), flag.relation, detail)
-
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        return branches_from_codes(self.label_codes(joints), len(joints))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """The inverse chain's labels (its wrist flip and its positioner's branches) of joint vectors (M, n)."""

@@ -17,7 +17,7 @@ import numpy as np
 from ._screws import apply, chain_rotation, invert
 from ._structure import Geometry
 from ._subproblems import subproblem_5_prismatic
-from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 from ._wrist import SphericalWrist
 
 
@@ -76,10 +76,7 @@ class SlideAfterSphericalWrist:
                                              "and the slide meet: the wrist centre's line touches its workspace"))
         for mask, flag in wrist.singularities.entries:
             singular.add((mask.reshape(n_targets, 4) & arm_ok).any(axis=1), flag)
-        return Candidates(joints.reshape(n_targets, -1, 6), valid.reshape(n_targets, -1), [], singular)
-
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        return branches_from_codes(self.label_codes(joints), len(joints))
+        return Candidates(joints.reshape(n_targets, -1, 6), valid.reshape(n_targets, -1), singular)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return self.wrist.label_codes(joints)

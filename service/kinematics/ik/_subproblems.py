@@ -199,7 +199,7 @@ def _distances(d: ArrayLike, name: str) -> np.ndarray:
     return d
 
 
-def _frame(k: np.ndarray) -> np.ndarray:
+def axis_frame(k: np.ndarray) -> np.ndarray:
     """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``, remembered by value
     (read-only) as :func:`_unit` remembers the axes."""
     key = tuple(k.tolist())
@@ -218,7 +218,7 @@ _FRAMES: dict[tuple, np.ndarray] = {}
 def _build_frame(k: np.ndarray) -> np.ndarray:
     """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``.
 
-    ``p @ _frame(k)`` gives the coordinates ``(x, y, z)`` of ``p``, where ``z = k.p``
+    ``p @ axis_frame(k)`` gives the coordinates ``(x, y, z)`` of ``p``, where ``z = k.p``
     is the height along the axis. A rotation about ``k`` turns ``(x, y)`` like a
     plane rotation: ``R(k, theta) p`` has ``(x cos - y sin, x sin + y cos, z)``.
     """
@@ -284,7 +284,7 @@ def _rotate_onto(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Subproblem 1 core: ``(theta, exact, degenerate)`` for ``R(k, theta) p = q``.
 
-    ``frame`` is ``_frame(k)``. ``scale`` defaults to ``max(||p||, ||q||)``.
+    ``frame`` is ``axis_frame(k)``. ``scale`` defaults to ``max(||p||, ||q||)``.
     """
     px, py, pz = _coords(p, frame)
     qx, qy, qz = _coords(q, frame)
@@ -383,7 +383,7 @@ def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike) -> AngleSolutions:
     k = _unit(k, "k")
     p = _points(p, "p")
     q = _points(q, "q")
-    theta, exact, degenerate = _rotate_onto(_frame(k), p, q)  # all of the batch shape
+    theta, exact, degenerate = _rotate_onto(axis_frame(k), p, q)  # all of the batch shape
     return AngleSolutions(
         theta=theta[..., None],
         valid=np.ones(theta.shape + (1,), dtype=bool),
@@ -537,8 +537,8 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
     if degenerate.any():
         scale_b = np.broadcast_to(scale, degenerate.shape)
         # theta1 free: R(k2, theta2) q = p.  theta2 free: R(k1, theta1) p = q.
-        free_t2, exact2, _ = _rotate_onto(_frame(k2), q, p, scale_b)
-        free_t1, exact1, _ = _rotate_onto(_frame(k1), p, q, scale_b)
+        free_t2, exact2, _ = _rotate_onto(axis_frame(k2), q, p, scale_b)
+        free_t1, exact1, _ = _rotate_onto(axis_frame(k1), p, q, scale_b)
         first1 = np.where(free1, 0.0, np.where(free2, free_t1, first1))
         first2 = np.where(free1, free_t2, np.where(free2, 0.0, first2))
         exact_first = np.where(free1, exact2, np.where(free2, exact1, exact_first))
@@ -649,7 +649,7 @@ def subproblem_3(k: ArrayLike, p: ArrayLike, q: ArrayLike, delta: ArrayLike) -> 
     p = _points(p, "p")
     q = _points(q, "q")
     delta = _distances(delta, "delta")
-    frame = _frame(k)
+    frame = axis_frame(k)
     px, py, pz = _coords(p, frame)
     qx, qy, qz = _coords(q, frame)
     rp2 = px * px + py * py
@@ -878,7 +878,7 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
     theta3 = _wrap(np.where(by_theta1[..., None], theta_s, theta_t))
     L = p0[..., None, :] + _rotate_points(k1, theta1, p1[..., None, :])
     M = p2[..., None, :] + _rotate_points(k3, theta3, p3[..., None, :])
-    theta2, _, _ = _rotate_onto(_frame(k2), np.nan_to_num(M), np.nan_to_num(L), S[..., None])
+    theta2, _, _ = _rotate_onto(axis_frame(k2), np.nan_to_num(M), np.nan_to_num(L), S[..., None])
     miss = _norm(L - _rotate_points(k2, theta2, M))
     # the same root twice (a tangent root): keep the first
     merged = np.zeros(shape, dtype=bool)
@@ -1004,7 +1004,7 @@ def prismatic_to_distance(p: ArrayLike, v: ArrayLike, q: ArrayLike, delta: Array
     v = _unit(v, "v")
     q = _points(q, "q")
     delta = _distances(delta, "delta")
-    wx, wy, b = _coords(p - q, _frame(v))  # b = v.(p - q)
+    wx, wy, b = _coords(p - q, axis_frame(v))  # b = v.(p - q)
     e = _hypot(wx, wy)
     scale = _hypot(e, b) + delta
     tol = GEOMETRY_TOLERANCE * scale
@@ -1108,7 +1108,7 @@ _EXACT_PAIR = 10 * GEOMETRY_TOLERANCE  # relative residual of an exact root: New
 
 def _term_coefficients(k: np.ndarray, h: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``h.R(k, theta) p = a cos(theta) + b sin(theta) + e``: the coefficients (a, b, e), each of the batch shape."""
-    frame = _frame(k)
+    frame = axis_frame(k)
     hx, hy, hz = _coords(h, frame)
     px, py, pz = _coords(p, frame)
     return hx * px + hy * py, hy * px - hx * py, hz * pz
@@ -1548,7 +1548,7 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
         slide = s[..., None] * v[..., None, :]
         turned, onto = (L + slide, np.broadcast_to(p2[..., None, :], L.shape)) if slide_turns \
             else (L, p2[..., None, :] + slide)
-        phi, _, phi_free = _rotate_onto(_frame(k2), np.nan_to_num(turned), np.nan_to_num(onto),
+        phi, _, phi_free = _rotate_onto(axis_frame(k2), np.nan_to_num(turned), np.nan_to_num(onto),
                                         np.ones(shape)[..., None])
         miss = _norm(onto - _rotate_points(k2, phi, turned))
     nan = np.nan

@@ -23,13 +23,17 @@ are one subproblem 6 in (q_1, q_5); steps 3–5 are the same.
 
 from __future__ import annotations
 
+import math
+from functools import cached_property
+
 import numpy as np
 
+from . import _scalar as scalar
 from ._positioning import _flag_rows, _unit, side_codes
 from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_4, subproblem_6
-from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 from ._wrist import _perpendicular_unit, wrist_codes
 
 
@@ -63,7 +67,6 @@ class _AxesTwoToFourParallel:
     def _shoulder_and_wrist(self, A: np.ndarray, singular: SingularFlags,
                             reference: np.ndarray | None) -> tuple[np.ndarray, ...]:
         raise NotImplementedError
-
 
     def _complete(self, A: np.ndarray, q1: np.ndarray, q5: np.ndarray, valid15: np.ndarray,
                   singular: SingularFlags, reference: np.ndarray | None) -> Candidates:
@@ -117,16 +120,13 @@ class _AxesTwoToFourParallel:
             stretched = np.cos(q3[..., 0][np.arange(n), first]) > 0
             for kind, mask in (("stretched", merged_rows & stretched), ("folded", merged_rows & ~stretched)):
                 singular.add(mask, Singularity("elbow", (2,), kind, f"the arm is fully {kind}"))
-        return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), [], singular)
-
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        return branches_from_codes(self.label_codes(joints), len(joints))
+        return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), singular)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """Shoulder left/right: the sign of the reach to axis 4 along link 1's forward direction. Elbow up/down:
         the side of the line from axis 2 to axis 4 that axis 3 lies on, along the robot's up direction, measured
         in the plane normal to the parallel axes (so the points the description puts on them do not matter).
-        Wrist: the sign of sin q5 (:func:`wrist_labels`)."""
+        Wrist: the sign of sin q5 (:func:`wrist_codes`)."""
         g, m = self.geometry, self.model
         def moved(upto: int, x: np.ndarray) -> np.ndarray:
             return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x)
@@ -188,6 +188,23 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
         return (np.broadcast_to(q1[:, :, None], (n, 2, 2)).reshape(n, 4), wrist.theta.reshape(n, 4),
                 valid.reshape(n, 4))
 
+    def solve_one(self, world_T_target: np.ndarray) -> Candidates | None:
+        """:meth:`solve` of one target (4, 4) in scalar arithmetic (:mod:`._scalar`), or None when the pose is not
+        clearly generic (then :meth:`solve` decides). The one exception to "generic": the elbow may be clearly out
+        of reach for some shoulder and wrist roots, which gives a least-squares slot and an empty one, as in
+        :meth:`solve`."""
+        return scalar.one_pose_candidates(self._one_pose.solve, world_T_target)
+
+    def label_codes_one(self, joints: np.ndarray, valid: np.ndarray) -> LabelCodes | None:
+        """:meth:`label_codes` of one pose's slots (1, m, n) where ``valid`` (1, m), in scalar arithmetic, or
+        None (then :meth:`label_codes` decides)."""
+        return scalar.one_pose_label_codes(self._one_pose, joints, valid)
+
+    @cached_property
+    def _one_pose(self) -> "_ThreeParallelOnePose":
+        return _ThreeParallelOnePose(self)
+
+
 class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
     """Axes 2 ∥ 3 ∥ 4 with axes 5 and 6 skew (no common point): steps 1 and 2 become one subproblem 6.
 
@@ -241,3 +258,84 @@ def _split_double_root(elbow: np.ndarray, valid: np.ndarray) -> np.ndarray:
     """Where the two elbow roots (..., 2) are both valid and a split double root apart."""
     gap = np.abs(np.angle(np.exp(1j * (elbow[..., 0] - elbow[..., 1]))))
     return valid[..., 0] & valid[..., 1] & (np.nan_to_num(gap, nan=np.inf) <= SPLIT_DOUBLE_ROOT)
+
+
+class _ThreeParallelOnePose:
+    """:class:`ThreeParallelPlan` (the UR5 type), step for step."""
+
+    def __init__(self, plan: ThreeParallelPlan) -> None:
+        model = plan.model
+        self.directions = [scalar.vector_of(d) for d in model.directions]
+        self.points = [scalar.vector_of(p) for p in model.points]
+        self.frames = [scalar.plane_axes(direction) for direction in self.directions]
+        self.centre = scalar.vector_of(plan.centre)
+        self.home_inverse = scalar.matrix_of(plan.home_inverse[:3, :3]), scalar.vector_of(plan.home_inverse[:3, 3])
+        self.omega_p, self.normal_p = scalar.vector_of(plan.omega_p), scalar.vector_of(plan.normal_p)
+        self.frame_p = scalar.plane_axes(self.omega_p)
+        self.signs = [float(s) for s in plan.signs]
+        self.height = scalar.dot(self.omega_p, scalar.sub(self.centre, self.points[0]))
+        self.forward = scalar.vector_of(plan.forward)
+        self.up = scalar.vector_of(plan.geometry.upward(plan.geometry.direction(0)))
+
+    names = ("shoulder", "elbow", "wrist")
+    values = (("left", "right"), ("up", "down"), ("no_flip", "flip"))
+
+    def codes(self, q: list[float]) -> tuple[int, int, int]:
+        """:meth:`ThreeParallelPlan.label_codes` for one joint vector."""
+        d, p = self.directions, self.points
+        forward = scalar.rotate(d[0], q[0], self.forward)
+        wrist_point = scalar.moved(d, p, q, 3, p[3])
+        to_wrist = scalar.sub(wrist_point, p[0])
+        shoulder = scalar.side_code(scalar.dot(to_wrist, forward), scalar.norm(to_wrist))
+        shoulder_point = scalar.moved(d, p, q, 1, p[1])
+        normal = scalar.rotate(d[0], q[0], self.omega_p)  # the parallel axes, after joint 1
+        elbow = scalar.reject(scalar.sub(scalar.moved(d, p, q, 2, p[2]), shoulder_point), normal)
+        reach = scalar.reject(scalar.sub(wrist_point, shoulder_point), normal)
+        length = scalar.norm(reach)
+        if length <= 1e-300:
+            raise scalar.NotGeneric
+        line = (reach[0] / length, reach[1] / length, reach[2] / length)
+        side = scalar.dot(scalar.reject(elbow, line), self.up)
+        return shoulder, scalar.side_code(side, scalar.norm(elbow)), scalar.wrist_code(q[4])
+
+    def solve(self, T: np.ndarray) -> list[list[float]]:
+        (R_T0, R_T1, R_T2, t_T) = T[:3].T.tolist()
+        R_T = tuple(zip(R_T0, R_T1, R_T2))
+        H, h = self.home_inverse
+        R_A = scalar.mm(R_T, H)
+        t_A = scalar.add(scalar.mv(R_T, h), tuple(t_T))
+        d, p, w_p = self.directions, self.points, self.omega_p
+        c_world = scalar.add(scalar.mv(R_A, self.centre), t_A)
+        s2, s3, s4 = self.signs
+        joints: list[list[float]] = []
+        for theta1 in scalar.subproblem_4(w_p, d[0], scalar.sub(c_world, p[0]), self.height):
+            q1 = -theta1
+            R1 = scalar.rotation(d[0], q1)
+            R_rest = scalar.mtm(R1, R_A)
+            wrist = scalar.subproblem_4(w_p, d[4], d[5], scalar.dot(w_p, scalar.mv(R_rest, d[5])))
+            wanted_p = scalar.mtv(R_rest, w_p)
+            for q5 in wrist:
+                q6 = -scalar.subproblem_1(d[5], self.frames[5], scalar.rotate(d[4], -q5, w_p), wanted_p)
+                R5, R6 = scalar.rotation(d[4], q5), scalar.rotation(d[5], q6)
+                # R234 = R_rest R6ᵀ R5ᵀ, applied to the normal of ω_p
+                R234_normal = scalar.mv(R_rest, scalar.mtv(R6, scalar.mtv(R5, self.normal_p)))
+                angle_sum = scalar.subproblem_1(w_p, self.frame_p, self.normal_p, R234_normal)
+                # the point on axis 4: G_5⁻¹ then G_6⁻¹ (turns about axes through p5, p6), then A, then G_1⁻¹
+                y = scalar.add(p[4], scalar.mtv(R5, scalar.sub(p[3], p[4])))
+                y = scalar.add(p[5], scalar.mtv(R6, scalar.sub(y, p[5])))
+                p4_world = scalar.add(scalar.mv(R_A, y), t_A)
+                z = scalar.add(p[0], scalar.mtv(R1, scalar.sub(p4_world, p[0])))
+                z1 = scalar.sub(z, p[1])
+                # this shoulder and wrist may leave the point out of the elbow's reach: a least-squares root
+                # (then rejected by the FK check) and an empty slot, as in the array solver
+                elbow = scalar.subproblem_3(d[2], self.frames[2], scalar.sub(p[3], p[2]), scalar.sub(p[1], p[2]), scalar.norm(z1),
+                                      out_of_reach=True)
+                for q3 in elbow:
+                    if math.isnan(q3):
+                        joints.append([q1, math.nan, math.nan, math.nan, q5, q6])
+                        continue
+                    moved = scalar.add(p[2], scalar.rotate(d[2], q3, scalar.sub(p[3], p[2])))
+                    q2 = scalar.subproblem_1(d[1], self.frames[1], scalar.sub(moved, p[1]), z1)
+                    q4 = s4 * (angle_sum - s2 * q2 - s3 * q3)
+                    joints.append([q1, q2, q3, q4, q5, q6])
+        return joints

@@ -28,7 +28,7 @@ from ._positioning import side_codes
 from ._screws import apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_3, subproblem_6
-from ._types import Branch, Candidates, LabelCodes, SingularFlags, Singularity, branches_from_codes
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 from ._three_parallel import _split_double_root
 from ._wrist import _perpendicular_unit
 
@@ -124,7 +124,7 @@ class ThreeParallelAtEndPlan:
             stretched = np.cos(bend) > 0
             for kind, mask in (("stretched", merged_rows & stretched), ("folded", merged_rows & ~stretched)):
                 singular.add(mask, Singularity("elbow", (4,), kind, f"axes 4–6 are {kind} in line"))
-        return Candidates(joints.reshape(n, 8, 6), valid.reshape(n, 8), [], singular)
+        return Candidates(joints.reshape(n, 8, 6), valid.reshape(n, 8), singular)
 
     def _free_base(self, A: np.ndarray, v: np.ndarray, q3: np.ndarray, R3w: np.ndarray,
                    reference: np.ndarray | None) -> np.ndarray:
@@ -148,9 +148,6 @@ class ThreeParallelAtEndPlan:
         target = 0.0 if reference is None else float(reference[0])
         near = np.argmin(np.abs(np.angle(np.exp(1j * (np.nan_to_num(roots.theta, nan=1e9) - target)))), axis=-1)
         return np.take_along_axis(roots.theta, near[..., None], -1)[..., 0]
-
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        return branches_from_codes(self.label_codes(joints), len(joints))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return {"elbow": parallel_elbow_codes(self.geometry, joints, 3)}

@@ -15,16 +15,6 @@ Status = Literal["ok", "unreachable"]
 LabelCodes = dict[str, tuple[tuple[str | int, ...], np.ndarray]]
 
 
-def branches_from_codes(codes: LabelCodes, count: int) -> list[Branch]:
-    """One label dict per row from :data:`LabelCodes` (the object form of the same labels)."""
-    branches: list[Branch] = [{} for _ in range(count)]
-    for name, (values, index) in codes.items():
-        for branch, code in zip(branches, index.tolist()):
-            if code >= 0:  # −1: the label does not apply to this row
-                branch[name] = values[code]
-    return branches
-
-
 @dataclass(frozen=True)
 class Singularity:
     """A singular condition met by a target.
@@ -91,10 +81,9 @@ class Candidates:
     """Joint vectors proposed by a solver for a batch of targets.
 
     ``joints`` has shape (N, m, n): m candidate slots for each of N targets;
-    ``valid`` (N, m) says which slots hold a candidate. ``branches`` gives
-    the labels of each slot, per target: a list of N lists of m dicts (built
-    lazily by the family's labeller). ``singularities`` gives, per target, the
-    singular conditions met.
+    ``valid`` (N, m) says which slots hold a candidate. ``singularities``
+    gives, per target, the singular conditions met (the family's
+    ``label_codes`` labels the slots).
 
     ``complete`` (N,), when a solver gives it, says which targets it can
     promise every solution for; None means every target is complete, as for
@@ -108,7 +97,6 @@ class Candidates:
 
     joints: np.ndarray
     valid: np.ndarray
-    branches: list[list[Branch]]
     singularities: SingularFlags
     complete: np.ndarray | None = None
     promise_needs_every_slot: bool = False

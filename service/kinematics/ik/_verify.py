@@ -29,7 +29,8 @@ def joint_difference(robot: Robot, q: np.ndarray, reference: np.ndarray) -> np.n
 
 
 def residuals(robot: Robot, q: np.ndarray, world_T_target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Position error (length units) and orientation error (radians) of FK(q) against the target.
+    """Position error (length units) and orientation error (radians) of FK(q) against the target: k candidates
+    for one target, or one candidate per target (:func:`residual_arrays`, the one formula).
 
     Parameters
     ----------
@@ -40,14 +41,12 @@ def residuals(robot: Robot, q: np.ndarray, world_T_target: np.ndarray) -> tuple[
     -------
     position, orientation : ndarrays, shape (k,)
     """
-    world_T_tool = forward_kinematics(robot, q)
-    position = np.linalg.norm(world_T_tool[..., :3, 3] - world_T_target[..., :3, 3], axis=-1)
-    relative = np.swapaxes(world_T_target[..., :3, :3], -1, -2) @ world_T_tool[..., :3, :3]
-    skew = relative - np.swapaxes(relative, -1, -2)
-    sine = 0.5 * np.linalg.norm(np.stack([skew[..., 2, 1], skew[..., 0, 2], skew[..., 1, 0]], axis=-1), axis=-1)
-    cosine = 0.5 * (np.trace(relative, axis1=-2, axis2=-1) - 1.0)
-    orientation = np.arctan2(sine, cosine)
-    return position, orientation
+    q, world_T_target = np.asarray(q, dtype=float), np.asarray(world_T_target, dtype=float)
+    if world_T_target.ndim == 2:
+        position, orientation = residual_arrays(robot, q[None], world_T_target[None])
+        return position[0], orientation[0]
+    position, orientation = residual_arrays(robot, q[:, None], world_T_target)
+    return position[:, 0], orientation[:, 0]
 
 
 def residual_arrays(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -16,7 +16,7 @@ from .._tolerances import GEOMETRY_TOLERANCE
 from ._screws import rotate_about
 from ._structure import Geometry
 from ._subproblems import subproblem_1, subproblem_2_chain
-from ._types import Branch, LabelCodes, SingularFlags, Singularity, branches_from_codes
+from ._types import LabelCodes, SingularFlags, Singularity
 
 
 @dataclass
@@ -34,19 +34,15 @@ def _perpendicular_unit(axis: np.ndarray) -> np.ndarray:
     return u / np.linalg.norm(u)
 
 
-def wrist_labels(middle: np.ndarray) -> list[Branch]:
-    """Wrist labels from the middle wrist joint's angles (M,): ``no_flip`` when its sine is positive.
+def wrist_codes(middle: np.ndarray) -> LabelCodes:
+    """Wrist label codes from the middle wrist joint's angles (M,): 0 ``no_flip`` when its sine is positive, else
+    1 ``flip``.
 
     The flip is (q_a + π, −q_b, q_c + π) (textbook §2.3, §3.2). When the sine is
     zero (within the tolerance at which subproblem 2 finds the first joint free)
     the outer axes are aligned, the two branches are one family and no wrist
-    label applies.
+    label applies (−1).
     """
-    return branches_from_codes(wrist_codes(middle), len(middle))
-
-
-def wrist_codes(middle: np.ndarray) -> LabelCodes:
-    """:func:`wrist_labels` as codes: 0 ``no_flip``, 1 ``flip``, −1 where no wrist label applies."""
     sine = np.sin(middle)
     codes = np.where(sine > 0, 0, 1).astype(np.int8)
     codes[np.abs(sine) <= 10 * GEOMETRY_TOLERANCE] = -1
@@ -62,7 +58,7 @@ class SphericalWrist:
     outer axes), only q_a ± q_c is determined: q_a takes the reference value
     (or 0) and the singularity is reported.
 
-    Labels: see :func:`wrist_labels`.
+    Labels: see :func:`wrist_codes`.
     """
 
     name = "spherical_wrist"
@@ -104,9 +100,6 @@ class SphericalWrist:
                     f"q{self.joints[0] + 1} is set to the reference value (or 0)"))
         return WristResult(joints, valid, singular)
 
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        return wrist_labels(joints[:, self.joints[1]])
-
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return wrist_codes(joints[:, self.joints[1]])
 
@@ -127,9 +120,6 @@ class Roll:
         wanted = np.einsum("...ij,j->...i", R_w, self.normal)
         q = subproblem_1(self.axis, self.normal, wanted).theta  # (..., 1)
         return WristResult(q[..., None], np.ones(q.shape, dtype=bool), SingularFlags(len(R_w)))
-
-    def labels(self, joints: np.ndarray) -> list[Branch]:
-        return [{} for _ in range(len(joints))]
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return {}

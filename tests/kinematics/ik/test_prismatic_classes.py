@@ -1,6 +1,6 @@
 """Positioners with one slide and skew axes (RRP, RPR, PRR) in closed form: random arms, alone and with a wrist.
 
-Each class is drawn as seeded random standard DH tables (as in :mod:`test_ik_spherical_wrist_classes`: the same
+Each class is drawn as seeded random standard DH tables (as in :mod:`test_spherical_wrist_classes`: the same
 three conventions, base and tool, reversed axes), its joints 1–3 placing a point (3-DOF, position targets) and
 then again carrying a spherical wrist (6-DOF, pose targets), or with the wrist at the base. Recall 100 %,
 0 wrong solutions (FK computed here), nothing unreachable, the same solution sets in every statement; singular
@@ -17,7 +17,7 @@ from service.kinematics._forward import forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik._arrays import cached_plan
 from service.kinematics.ik._subproblems import subproblem_5_prismatic
-from tests.kinematics.test_ik_spherical_wrist_classes import (
+from tests.kinematics.ik.test_spherical_wrist_classes import (
     _positioner_singular_configurations,
     _random_rigid,
     _reverse_axis,
@@ -297,7 +297,7 @@ def test_slide_after_the_wrist_singular_poses_report_a_singularity():
     Jacobian [ω1 × (c − o1), ω2 × (c − o2), v6] at the current wrist centre c vanishes, found by bisection on
     q2) report the merged positioner roots; the wrist's aligned pose reports the wrist. Never unreachable or
     wrong; the generating vector found to 1e-5 (a double root)."""
-    from tests.kinematics.test_ik_spherical_wrist_classes import _aligning_value, _positioner_determinant
+    from tests.kinematics.ik.test_spherical_wrist_classes import _aligning_value, _positioner_determinant
 
     kind = "rr+wrist+slide"
     robot = statements(kind, seed=list(CLASSES).index(kind))[0]

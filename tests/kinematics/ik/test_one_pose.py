@@ -1,4 +1,5 @@
-"""The scalar single-pose candidates (ik/_lean.py) against the array solvers they stand in for."""
+"""The families' scalar paths for one pose (``solve_one``, ``label_codes_one``: ik/_scalar.py) against their
+array solvers, and the one-pose duplicate scan against the array scan."""
 
 import numpy as np
 import pytest
@@ -8,7 +9,6 @@ from service.config import Settings
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import _arrays, joint_difference, solve_ik
 from service.kinematics.ik._arrays import cached_plan
-from service.kinematics.ik._lean import lean_candidates, lean_label_codes
 from service.kinematics.ik._verify import accepted, residual_arrays, wrap_revolute
 
 from tests.ik_helpers import random_configurations
@@ -16,9 +16,9 @@ from tests.ik_helpers import random_configurations
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 _PLANS = {entry.description.id: (entry.robot, cached_plan(entry.robot, constrain_orientation=True, reference=None))
           for entry in _CATALOGUE.entries()}
-# Robots without an analytic plan (the 7-joint arms: numeric fallback) have no lean path either.
-LEAN_ROBOTS = sorted(robot_id for robot_id, (robot, plan) in _PLANS.items() if plan is not None
-                     and lean_candidates(plan, forward_kinematics(robot, np.full(robot.dof, 0.3)), None) is not None)
+# Robots without an analytic plan (the 7-joint arms: numeric fallback) have no scalar path either.
+ONE_POSE_ROBOTS = sorted(robot_id for robot_id, (robot, plan) in _PLANS.items() if hasattr(plan, "solve_one")
+                         and plan.solve_one(forward_kinematics(robot, np.full(robot.dof, 0.3))) is not None)
 
 
 def _poses(robot, count: int, seed: int) -> np.ndarray:
@@ -37,11 +37,11 @@ def _poses(robot, count: int, seed: int) -> np.ndarray:
 
 def test_the_two_hot_families_are_covered():
     structures = {cached_plan(_CATALOGUE.get(rid).robot, constrain_orientation=True, reference=None).structure
-                  for rid in LEAN_ROBOTS}
+                  for rid in ONE_POSE_ROBOTS}
     assert structures == {"intersecting_shoulder+spherical_wrist", "three_parallel"}
 
 
-@pytest.mark.parametrize("robot_id", LEAN_ROBOTS)
+@pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)
 def test_scalar_candidates_are_the_array_candidates(robot_id):
     """Same slots, same valid slots and joints, and no singularity, wherever the scalar path answers; the
     same branch labels wherever its labeller answers."""
@@ -49,21 +49,21 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     answered = labelled = 0
     for T in _poses(robot, 400, seed=11):
-        lean = lean_candidates(plan, T, None)
-        if lean is None:
+        one_pose = plan.solve_one(T)
+        if one_pose is None:
             continue
         answered += 1
         array = plan.solve(T[None], None)
-        assert (lean.valid == array.valid).all()
+        assert (one_pose.valid == array.valid).all()
         assert not array.singularities.entries
         valid = array.valid[0]
-        assert np.abs(joint_difference(robot, lean.joints[0, valid], array.joints[0, valid])).max() <= 1e-9
-        assert np.isnan(lean.joints[0, ~valid]).any(axis=-1).all()
-        joints = wrap_revolute(robot, np.nan_to_num(lean.joints))
+        assert np.abs(joint_difference(robot, one_pose.joints[0, valid], array.joints[0, valid])).max() <= 1e-9
+        assert np.isnan(one_pose.joints[0, ~valid]).any(axis=-1).all()
+        joints = wrap_revolute(robot, np.nan_to_num(one_pose.joints))
         # as solve_ik: label the slots the FK check keeps (not the least-squares ones it rejects)
         position, orientation = residual_arrays(robot, joints, T[None])
-        valid = lean.valid[0] & accepted(robot, position[0], orientation[0], True)
-        labels = lean_label_codes(plan, joints, valid[None])
+        valid = one_pose.valid[0] & accepted(robot, position[0], orientation[0], True)
+        labels = plan.label_codes_one(joints, valid[None])
         if labels is not None:
             labelled += 1
             expected = plan.label_codes(joints[0])
@@ -75,7 +75,7 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
     assert labelled >= 0.9 * answered
 
 
-@pytest.mark.parametrize("robot_id", LEAN_ROBOTS)
+@pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)
 def test_single_pose_answers_do_not_depend_on_the_path(robot_id, monkeypatch):
     """solve_ik with and without the scalar candidates: the same solutions with the same labels, residuals and
     singularities, for random, singular and unreachable poses; in the same order without a reference, and
@@ -84,9 +84,10 @@ def test_single_pose_answers_do_not_depend_on_the_path(robot_id, monkeypatch):
     robot = _CATALOGUE.get(robot_id).robot
     poses = _poses(robot, 200, seed=12)
     references = [None, random_configurations(robot, 1, seed=13)[0]]
-    lean = [solve_ik(robot, T, reference=references[i % 2]) for i, T in enumerate(poses)]
-    monkeypatch.setattr(_arrays, "lean_candidates", lambda *args: None)
-    for i, (T, fast) in enumerate(zip(poses, lean)):
+    one_pose = [solve_ik(robot, T, reference=references[i % 2]) for i, T in enumerate(poses)]
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    monkeypatch.setattr(type(plan), "solve_one", lambda self, world_T_target: None)
+    for i, (T, fast) in enumerate(zip(poses, one_pose)):
         reference = references[i % 2]
         slow = solve_ik(robot, T, reference=reference)
         assert (fast.status, fast.structure, fast.singularities, fast.free_joints, fast.detail) == \

@@ -15,7 +15,7 @@ from service.kinematics import forward_kinematics
 from service.kinematics.ik import solve_direction, target_kinds
 from service.kinematics.ik._direction import rotations_to
 from tests.ik_helpers import find
-from tests.kinematics.test_ik_redundant import arm
+from tests.kinematics.ik.test_redundant import arm
 
 AXES = {"roll axis z": [0.0, 0.0, 1.0], "jaw axis y": [0.0, 1.0, 0.0], "side axis x": [1.0, 0.0, 0.0],
         "oblique": [0.3, -0.5, 0.8]}

@@ -213,7 +213,7 @@ def test_branch_labels_mean_the_same_in_every_convention(case):
         assert {row["elbow"] for row in labels[0]} == {"up", "down"}
 
 
-UR_TABLES = json.loads((Path(__file__).resolve().parents[1] / "data" / "ur_dh_tables.json").read_text())
+UR_TABLES = json.loads((Path(__file__).resolve().parents[2] / "data" / "ur_dh_tables.json").read_text())
 
 
 @pytest.mark.parametrize("name", sorted(UR_TABLES["arms"]))

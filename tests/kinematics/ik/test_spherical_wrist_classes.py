@@ -25,7 +25,7 @@ from service.kinematics.ik._subproblems import subproblem_1
 
 DEG = np.pi / 180
 POSES = 400  # per statement; three statements (conventions) per class
-DATA = json.loads((Path(__file__).parents[1] / "data" / "opw_arms.json").read_text())
+DATA = json.loads((Path(__file__).parents[2] / "data" / "opw_arms.json").read_text())
 
 
 # --- building arms -------------------------------------------------------------------------------------------

@@ -21,7 +21,7 @@ from service.kinematics.ik import FreeJoint, distance_to_reference, free_joints_
 from service.kinematics.ik._redundant import beyond_reach, default_free_joints, family_for, sample_values
 from tests.ik_helpers import find
 
-ARMS = json.loads((Path(__file__).parents[1] / "data" / "redundant_and_deficient_arms.json").read_text())
+ARMS = json.loads((Path(__file__).parents[2] / "data" / "redundant_and_deficient_arms.json").read_text())
 
 
 def arm(name: str):

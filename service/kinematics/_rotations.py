@@ -37,6 +37,8 @@ from numpy.typing import ArrayLike
 from ._errors import InvalidInputError
 from ._tolerances import ORTHONORMAL_TOLERANCE, SINGULARITY_TOLERANCE
 
+_TWO_PI = 2.0 * np.pi
+
 __all__ = [
     "check_rotation",
     "check_transform",
@@ -708,11 +710,13 @@ def rpy_from_matrix(R: ArrayLike, *, free_angle: float = 0.0) -> tuple[np.ndarra
 # ---------------------------------------------------------------------------
 
 
-def wrap_angle(x: ArrayLike) -> float | np.ndarray:
-    """Wrap angles to ``(-pi, pi]``.
+def wrap_angle(x: ArrayLike) -> np.float64 | np.ndarray:
+    """Wrap angles to ``(-pi, pi]``: the one angle wrap of the core.
 
     Values already in ``(-pi, pi]`` are returned unchanged, bit for bit.
-    ``-pi`` maps to ``pi``. NaN stays NaN; infinities become NaN.
+    ``-pi`` maps to ``pi``. NaN stays NaN; infinities become NaN. Angles within
+    one turn of the range (``|x| < 3 pi``, what sums of two wrapped angles give)
+    take one exact add or subtract of ``2 pi``; only others pay for a modulo.
 
     Parameters
     ----------
@@ -721,18 +725,21 @@ def wrap_angle(x: ArrayLike) -> float | np.ndarray:
 
     Returns
     -------
-    float, or ndarray of the same shape
+    numpy.float64 (a float) for a scalar, or ndarray of the same shape
 
     Examples
     --------
-    >>> wrap_angle(3 * np.pi / 2) == -np.pi / 2
+    >>> float(wrap_angle(3 * np.pi / 2)) == -np.pi / 2
     True
-    >>> wrap_angle([-np.pi, 0.5]).tolist() == [np.pi, 0.5]
+    >>> wrap_angle([-np.pi, 0.5, 100.0]).round(6).tolist() == [round(np.pi, 6), 0.5, round(100.0 - 32 * np.pi, 6)]
     True
     """
     a = np.asarray(x, dtype=np.float64)
-    with np.errstate(invalid="ignore"):
-        outside = (a <= -np.pi) | (a > np.pi) | np.isinf(a)
-        wrapped = np.where(outside, np.pi - np.mod(np.pi - a, 2.0 * np.pi), a)
-        wrapped = np.where(wrapped <= -np.pi, wrapped + 2.0 * np.pi, wrapped)
-    return float(wrapped) if wrapped.ndim == 0 else wrapped
+    # For |a| <= 3π (3π is exact in floating point) a ∓ 2π is exact (Sterbenz), so it lands in (−π, π].
+    wrapped = a - (_TWO_PI * (a > np.pi) - _TWO_PI * (a <= -np.pi))  # a − 0.0 keeps a −0.0
+    far = np.abs(a) >= 3.0 * np.pi  # infinities too
+    if far.any():
+        # np.mod is exact here, and its remainder a multiple of ulp(2π), so it never rounds up to a full turn.
+        with np.errstate(invalid="ignore"):
+            wrapped = np.where(far, np.pi - np.mod(np.pi - a, _TWO_PI), wrapped)
+    return wrapped[()]  # a 0-d result as a numpy float, as numpy's own functions return it

@@ -396,15 +396,20 @@ def test_wrap_angle_values():
     assert wrap_angle(-PI) == PI
     assert wrap_angle(PI) == PI
     assert wrap_angle(-3 * PI) == PI
-    # one ulp above pi: the modulo rounds to exactly -pi, which must still come back as +pi
-    assert wrap_angle(np.nextafter(PI, 4.0)) == PI
+    # one ulp above pi: one turn down is exact, just above -pi (pi's float is below the true pi)
+    assert wrap_angle(np.nextafter(PI, 4.0)) == np.nextafter(PI, 4.0) - 2 * PI > -PI
+    # far angles go through the modulo, which must not round up to a full turn
+    assert wrap_angle(np.nextafter(5 * PI, 0.0)) == pytest.approx(PI, abs=1e-14)
+    assert wrap_angle(-5 * PI) == PI
+    assert wrap_angle(np.nextafter(5 * PI, 6 * PI)) == pytest.approx(-PI, abs=1e-14)
+    assert np.isnan(wrap_angle([np.inf, -np.inf, np.nan])).all()
     assert wrap_angle(0.1) == 0.1
     assert wrap_angle(100.0) == pytest.approx(100.0 - 32 * PI, abs=1e-13)
     assert isinstance(wrap_angle(1.0), float)
 
 
 def test_wrap_angle_is_vectorized_and_in_range(rng):
-    x = rng.uniform(-50, 50, (10, 100))
+    x = np.concatenate([rng.uniform(-50, 50, (10, 100)), rng.uniform(-3 * PI, 3 * PI, (10, 100))])
     wrapped = wrap_angle(x)
     assert wrapped.shape == x.shape
     assert np.all((wrapped > -PI) & (wrapped <= PI))

@@ -17,7 +17,7 @@ from ..robots.catalogue import load_catalogue
 from ..config import Settings
 from ..kinematics import BudgetExhausted
 from .budget import TIMEOUT_HEADER, InFlight, WorkLimits, budget_exhausted
-from .limits import BodySizeLimit
+from .body_size import BodySizeLimit
 from .robot_cache import RobotCache
 from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
 from .examples import add_examples

@@ -20,6 +20,7 @@ from ..kinematics import (
     Limits,
     Violation,
     KinematicsError,
+    LimitOrderError,
     Robot,
     check_joint_values,
     check_rotation,
@@ -242,13 +243,15 @@ def limits_to_core(robot: Robot, overrides: Sequence | None, unit: AngleUnit) ->
     if len(overrides) != robot.dof:
         raise InvalidInputError(f"expected limits for {robot.dof} joints, one entry (or null) per joint, "
                                 f"got {len(overrides)}")
-    for index, (override, name) in enumerate(zip(overrides, robot.joint_names)):
-        if override is not None and override.lower is not None and override.upper is not None \
-                and override.lower > override.upper:
-            raise InvalidInputError(f"joint {index} ({name}): lower limit {override.lower:g} is greater than "
-                                    f"upper limit {override.upper:g}", location=(index,))
-    bounds = [_bounds(o, factor) for o, factor in zip(overrides, _unit_scale(robot, unit))]
-    return Limits.checked(robot, [b[0] for b in bounds], [b[1] for b in bounds])
+    scale = _unit_scale(robot, unit)
+    bounds = [_bounds(o, factor) for o, factor in zip(overrides, scale)]
+    try:
+        return Limits.checked(robot, [b[0] for b in bounds], [b[1] for b in bounds])
+    except LimitOrderError as error:  # the core checks the order; quote its bounds in the request's unit
+        index = error.location[0]
+        raise InvalidInputError(f"joint {index} ({robot.joint_names[index]}): lower limit "
+                                f"{error.lower / scale[index]:g} is greater than upper limit "
+                                f"{error.upper / scale[index]:g}", location=error.location) from None
 
 
 def ordering_to_core(robot: Robot, ordering: OrderingOptions, max_solutions: int | None,

@@ -6,7 +6,7 @@ homogeneous transform named by the frames it relates (``world_T_tool``).
 
 from ._budget import COUNT_CAP, UNLIMITED, Budget, BudgetExhausted
 from ._conventions import CONVENTIONS, Convention, craig_row_from_khalil, link_transforms
-from ._errors import InvalidInputError, KinematicsError
+from ._errors import InvalidInputError, KinematicsError, LimitOrderError
 from ._forward import (
     JointScrews,
     ScrewModel,
@@ -63,6 +63,7 @@ __all__ = [
     "violations",
     "within",
     "KinematicsError",
+    "LimitOrderError",
     "RATE_SINGULARITY_TOLERANCE",
     "Robot",
     "ScrewJoint",

@@ -55,6 +55,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._errors import InvalidInputError
+from ._rotations import wrap_angle
 from ._tolerances import GEOMETRY_TOLERANCE, SINGULARITY_TOLERANCE
 
 __all__ = [
@@ -121,11 +122,6 @@ def _check_tolerance(value, name: str) -> float:
     if not np.isfinite(tolerance) or tolerance < 0.0:
         raise InvalidInputError(f"{name} must be a non-negative number, got {value!r}", location=(name,))
     return tolerance
-
-
-def _wrap_to_pi(angle: np.ndarray) -> np.ndarray:
-    """Wrap angles to (-π, π]."""
-    return np.pi - np.mod(np.pi - angle, 2.0 * np.pi)
 
 
 # --------------------------------------------------------------------------
@@ -796,7 +792,7 @@ def assur_scara_inverse(
         theta1=group.phi,
         theta1d=group.phid,
         theta1dd=group.phidd,
-        theta2=_wrap_to_pi(group.phi - theta_BC),
+        theta2=wrap_angle(group.phi - theta_BC),
         theta2d=group.phid - theta_BCd,
         theta2dd=group.phidd - theta_BCdd,
         l3=l_OA - D[..., 2],

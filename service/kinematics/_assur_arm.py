@@ -45,6 +45,7 @@ import numpy as np
 from ._assur import AssurScaraSolution, assur_scara_inverse
 from ._forward import screw_model
 from ._robot import Robot
+from ._rotations import wrap_angle
 from ._tolerances import GEOMETRY_TOLERANCE, SINGULARITY_TOLERANCE
 
 __all__ = ["AssurScara", "AssurScaraRates", "assur_scara_of"]
@@ -155,5 +156,5 @@ def assur_scara_of(robot: Robot) -> AssurScara | None:
     signs = np.array([np.sign(d @ z) for d in (d1, d2, d3)])
     c1 = _angle(elbow)
     c2 = _angle(tool[:2] - elbow) - c1
-    c2 = float(np.pi - np.mod(np.pi - c2, 2 * np.pi))
+    c2 = wrap_angle(c2)
     return AssurScara(origin, world_R_paper, float(tool[2]), l_AB, l_BC, signs, c1, c2)

@@ -6,6 +6,9 @@ exception handler in the API layer turns them into RFC 9457 problem documents.
 
 from __future__ import annotations
 
+import copy
+import math
+
 Location = tuple[str | int, ...]
 
 
@@ -29,8 +32,24 @@ class KinematicsError(ValueError):
 
     def relocated(self, *prefix: str | int) -> "KinematicsError":
         """Return a copy of this error whose location starts with ``prefix``."""
-        return type(self)(self.message, location=(*prefix, *self.location))
+        moved = copy.copy(self)
+        moved.location = (*prefix, *self.location)
+        return moved
 
 
 class InvalidInputError(KinematicsError):
     """A value has the wrong shape, is not finite, or breaks a stated invariant."""
+
+
+class LimitOrderError(InvalidInputError):
+    """A joint's lower limit is above its upper one.
+
+    ``lower`` and ``upper`` are the bounds in core units (radians or length units), so that a boundary can
+    quote them in the units it was given them in.
+    """
+
+    def __init__(self, message: str, *, location: Location = (), lower: float = math.nan,
+                 upper: float = math.nan) -> None:
+        super().__init__(message, location=location)
+        self.lower = lower
+        self.upper = upper

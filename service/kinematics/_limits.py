@@ -25,7 +25,7 @@ from typing import Sequence
 import numpy as np
 
 from ._errors import InvalidInputError
-from ._robot import Robot
+from ._robot import Robot, check_limit_pair
 
 #: Inclusive-bound tolerance: radians for revolute joints; times the robot's
 #: characteristic length for prismatic joints.
@@ -60,12 +60,7 @@ class Limits:
         if lower.shape != (robot.dof,) or upper.shape != (robot.dof,):
             raise InvalidInputError(f"expected limits for {robot.dof} joints, got {lower.size} and {upper.size}")
         for index, name in enumerate(robot.joint_names):
-            if np.isnan(lower[index]) or np.isnan(upper[index]):
-                raise InvalidInputError(f"joint {index} ({name}): limits must be numbers, not NaN",
-                                        location=(index,))
-            if lower[index] > upper[index]:
-                raise InvalidInputError(f"joint {index} ({name}): lower limit {lower[index]:g} is greater than "
-                                        f"upper limit {upper[index]:g}", location=(index,))
+            check_limit_pair(lower[index], upper[index], location=(index,), joint=f"joint {index} ({name}): ")
         return cls(lower, upper)
 
     def tolerance(self, robot: Robot) -> np.ndarray:

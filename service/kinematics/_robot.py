@@ -22,7 +22,7 @@ import numpy as np
 
 from ._cache import bounded_memo, memo
 from ._conventions import CONVENTIONS, Convention
-from ._errors import InvalidInputError
+from ._errors import InvalidInputError, LimitOrderError
 
 #: Robots with other base/tool frames kept on their parent by :meth:`Robot.with_frames`.
 FRAMED_ROBOTS_KEPT = 16
@@ -299,13 +299,21 @@ def _inverse(T: np.ndarray) -> np.ndarray:
     return inverse
 
 
+def check_limit_pair(lower: float, upper: float, *, location: tuple = (), joint: str = "") -> None:
+    """The one check of a joint's bounds: numbers, not NaN, and lower <= upper (equal locks the joint).
+
+    ``joint`` (such as ``"joint 2 (elbow): "``) starts the message. Raises :class:`InvalidInputError`, or
+    :class:`LimitOrderError` for bounds out of order, at ``location``.
+    """
+    if math.isnan(lower) or math.isnan(upper):
+        raise InvalidInputError(f"{joint}limits must be numbers, not NaN", location=location)
+    if lower > upper:
+        raise LimitOrderError(f"{joint}lower limit {lower:g} is greater than upper limit {upper:g}",
+                              location=location, lower=float(lower), upper=float(upper))
+
+
 def _check_limits(joint, where: tuple) -> None:
-    if math.isnan(joint.lower) or math.isnan(joint.upper):
-        raise InvalidInputError("joint limits must be numbers, not NaN", location=(*where, "limits"))
-    if joint.lower > joint.upper:
-        raise InvalidInputError(
-            f"lower limit {joint.lower:g} is greater than upper limit {joint.upper:g}", location=(*where, "limits")
-        )
+    check_limit_pair(joint.lower, joint.upper, location=(*where, "limits"))
 
 
 def _checked_transform(T: np.ndarray | None, field: str) -> np.ndarray:

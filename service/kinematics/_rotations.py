@@ -3,7 +3,7 @@
 Conventions
 -----------
 * Angles are radians. Units other than radians exist only at the API boundary,
-  where :func:`to_radians` and :func:`from_radians` convert them once.
+  which converts them once.
 * A rotation matrix ``a_R_b``, shape (3, 3), maps coordinates in frame b to
   coordinates in frame a; its columns are the axes of b expressed in a.
   A homogeneous transform ``a_T_b``, shape (4, 4), is ``[[a_R_b, a_p_b], [0 0 0 1]]``.
@@ -23,8 +23,8 @@ representation validates its input the same way, so a matrix that is not a
 rotation can never be converted silently. Failures raise
 :class:`InvalidInputError`. Its ``location`` is relative to the value given:
 ``(1, 2)`` is entry (1, 2) of a matrix, ``(4,)`` row 4 of a batch, and ``()``
-the value as a whole. Functions with several array arguments put the
-argument's name first, for example ``("p", 2)`` in :func:`transform_from`.
+the value as a whole. Functions with several arguments put the argument's
+name first, for example ``("theta",)`` in :func:`matrix_from_euler_zyz`.
 """
 
 from __future__ import annotations
@@ -37,34 +37,24 @@ from numpy.typing import ArrayLike
 from ._errors import InvalidInputError
 from ._tolerances import ORTHONORMAL_TOLERANCE, SINGULARITY_TOLERANCE
 
+_TWO_PI = 2.0 * np.pi
+
 __all__ = [
     "check_rotation",
     "check_transform",
     "check_transforms",
     "check_unit_quaternion",
     "euler_zyz_from_matrix",
-    "from_radians",
-    "invert_transform",
-    "matrices_from_quaternions",
-    "matrix_from_axis_angle",
     "matrix_from_euler_zyz",
     "matrix_from_quaternion",
     "matrix_from_rpy",
-    "quaternion_from_matrix",
     "quaternions_from_matrices",
     "rot_x",
     "rot_y",
     "rot_z",
-    "rotation_angle_between",
     "rpy_from_matrix",
-    "to_radians",
-    "transform_from",
     "wrap_angle",
 ]
-
-# Radians per unit, for every angle unit the service accepts.
-_RADIANS_PER_UNIT = {"rad": 1.0, "deg": math.pi / 180.0}
-
 
 # ---------------------------------------------------------------------------
 # Validation helpers (private). They work on stacks of shape (..., m, n) so the
@@ -172,9 +162,9 @@ def _checked_transforms(T: ArrayLike, tolerance: float, batch: bool) -> np.ndarr
     return T
 
 
-def _checked_quaternions(wxyz: ArrayLike, tolerance: float, batch: bool) -> np.ndarray:
+def _checked_quaternion(wxyz: ArrayLike, tolerance: float) -> np.ndarray:
     q = _as_float_array(wxyz, "quaternion")
-    _check_shape(q, (4,), batch, "quaternion")
+    _check_shape(q, (4,), False, "quaternion")
     _check_finite(q, "quaternion")
     norm = np.linalg.norm(q, axis=-1)
     not_unit = np.abs(norm - 1.0) > tolerance
@@ -298,11 +288,11 @@ def check_unit_quaternion(wxyz: ArrayLike, *, tolerance: float = ORTHONORMAL_TOL
     >>> check_unit_quaternion([1, 0, 0, 0]).tolist()
     [1.0, 0.0, 0.0, 0.0]
     """
-    return _checked_quaternions(wxyz, tolerance, batch=False)
+    return _checked_quaternion(wxyz, tolerance)
 
 
 # ---------------------------------------------------------------------------
-# Elementary rotations and axis-angle
+# Elementary rotations
 # ---------------------------------------------------------------------------
 
 
@@ -379,57 +369,6 @@ def rot_z(angle: ArrayLike) -> np.ndarray:
     (2, 3, 3)
     """
     return _elementary(angle, 2, "angle")
-
-
-def matrix_from_axis_angle(axis: ArrayLike, angle: ArrayLike) -> np.ndarray:
-    """Rotation by ``angle`` about the unit vector ``axis`` (Rodrigues' formula).
-
-    ``R = cos(angle) I + sin(angle) [axis]x + (1 - cos(angle)) axis axis^T``.
-
-    Parameters
-    ----------
-    axis : array_like, shape (3,)
-        Unit vector (norm within ``ORTHONORMAL_TOLERANCE`` of 1; it is
-        re-normalised).
-    angle : float or array_like, shape (N,)
-        Radians, right-handed about ``axis``.
-
-    Returns
-    -------
-    R : ndarray, shape (3, 3) or (N, 3, 3)
-
-    Raises
-    ------
-    InvalidInputError
-        Locations start with ``"axis"`` or ``"angle"``.
-
-    Examples
-    --------
-    >>> axis = np.array([1.0, 1.0, 1.0]) / np.sqrt(3.0)
-    >>> (matrix_from_axis_angle(axis, 2 * np.pi / 3) @ [1.0, 0.0, 0.0]).round(12).tolist()
-    [0.0, 1.0, 0.0]
-    """
-    try:
-        axis = _as_float_array(axis, "axis")
-        _check_shape(axis, (3,), False, "axis")
-        _check_finite(axis, "axis")
-        norm = float(np.linalg.norm(axis))
-        if abs(norm - 1.0) > ORTHONORMAL_TOLERANCE:
-            raise InvalidInputError(
-                f"axis must be a unit vector, but its norm is {norm:.9g} "
-                f"(off by {abs(norm - 1.0):.3g}, tolerance {ORTHONORMAL_TOLERANCE:g})"
-            )
-    except InvalidInputError as error:
-        raise error.relocated("axis") from None
-    try:
-        angle = _checked_angles(angle, "angle")
-    except InvalidInputError as error:
-        raise error.relocated("angle") from None
-    n = axis / norm
-    cross = np.array([[0.0, -n[2], n[1]], [n[2], 0.0, -n[0]], [-n[1], n[0], 0.0]])
-    c = np.cos(angle)[..., None, None]
-    s = np.sin(angle)[..., None, None]
-    return c * np.eye(3) + s * cross + (1.0 - c) * np.outer(n, n)
 
 
 # ---------------------------------------------------------------------------
@@ -518,61 +457,11 @@ def matrix_from_quaternion(wxyz: ArrayLike) -> np.ndarray:
     return _matrices_from_quaternions(check_unit_quaternion(wxyz))
 
 
-def matrices_from_quaternions(wxyz: ArrayLike) -> np.ndarray:
-    """Batch version of :func:`matrix_from_quaternion`.
-
-    Parameters
-    ----------
-    wxyz : array_like, shape (N, 4)
-        Unit quaternions ``(w, x, y, z)``, one per row.
-
-    Returns
-    -------
-    R : ndarray, shape (N, 3, 3)
-
-    Raises
-    ------
-    InvalidInputError
-        Location ``(i,)`` for a row whose norm is not 1, ``(i, j)`` for a NaN or
-        infinite entry.
-
-    Examples
-    --------
-    >>> matrices_from_quaternions([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]).round(12).tolist()[1]
-    [[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]]
-    """
-    return _matrices_from_quaternions(_checked_quaternions(wxyz, ORTHONORMAL_TOLERANCE, batch=True))
-
-
-def quaternion_from_matrix(R: ArrayLike) -> np.ndarray:
-    """Unit quaternion of a rotation matrix, with the canonical sign.
+def quaternions_from_matrices(R: ArrayLike) -> np.ndarray:
+    """Unit quaternions of rotation matrices, with the canonical sign.
 
     Uses Shepperd's largest-diagonal method, accurate for every rotation
     including those near 180 degrees (trace near -1).
-
-    Parameters
-    ----------
-    R : array_like, shape (3, 3)
-        Rotation matrix, validated by :func:`check_rotation`.
-
-    Returns
-    -------
-    wxyz : ndarray, shape (4,)
-        ``(w, x, y, z)`` with ``w >= 0``; when ``w == 0`` (a half turn), the first
-        nonzero of ``(x, y, z)`` is positive.
-
-    Examples
-    --------
-    >>> quaternion_from_matrix(rot_z(np.pi / 2)).round(6).tolist()
-    [0.707107, 0.0, 0.0, 0.707107]
-    >>> quaternion_from_matrix(np.diag([-1.0, 1.0, -1.0])).tolist()
-    [0.0, 0.0, 1.0, 0.0]
-    """
-    return _quaternions_from_matrices(check_rotation(R))
-
-
-def quaternions_from_matrices(R: ArrayLike) -> np.ndarray:
-    """Batch version of :func:`quaternion_from_matrix`.
 
     Parameters
     ----------
@@ -582,7 +471,8 @@ def quaternions_from_matrices(R: ArrayLike) -> np.ndarray:
     Returns
     -------
     wxyz : ndarray, shape (N, 4)
-        Canonical unit quaternions ``(w, x, y, z)``, one per matrix.
+        Canonical unit quaternions ``(w, x, y, z)``, one per matrix: ``w >= 0``;
+        when ``w == 0`` (a half turn), the first nonzero of ``(x, y, z)`` is positive.
 
     Raises
     ------
@@ -594,6 +484,10 @@ def quaternions_from_matrices(R: ArrayLike) -> np.ndarray:
     --------
     >>> quaternions_from_matrices(np.stack([np.eye(3), rot_x(np.pi)])).round(12).tolist()
     [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]]
+    >>> quaternions_from_matrices(rot_z([np.pi / 2])).round(6).tolist()
+    [[0.707107, 0.0, 0.0, 0.707107]]
+    >>> quaternions_from_matrices(np.diag([-1.0, 1.0, -1.0])[None]).tolist()
+    [[0.0, 0.0, 1.0, 0.0]]
     """
     return _quaternions_from_matrices(_checked_rotations(R, ORTHONORMAL_TOLERANCE, batch=True))
 
@@ -812,137 +706,17 @@ def rpy_from_matrix(R: ArrayLike, *, free_angle: float = 0.0) -> tuple[np.ndarra
 
 
 # ---------------------------------------------------------------------------
-# Distances, transforms, angles and units
+# Angles
 # ---------------------------------------------------------------------------
 
 
-def rotation_angle_between(R_a: ArrayLike, R_b: ArrayLike) -> float | np.ndarray:
-    """Geodesic angle between two orientations: the rotation angle of ``R_a^T R_b``.
-
-    With ``R_a = w_R_a`` and ``R_b = w_R_b`` this is the angle of ``a_R_b``, in
-    ``[0, pi]``. It is computed as ``2 atan2(|(x, y, z)|, w)`` from the
-    quaternion of ``R_a^T R_b``, which stays accurate near 0 and near pi, where
-    ``arccos((trace - 1) / 2)`` loses half the digits.
-
-    Parameters
-    ----------
-    R_a, R_b : array_like, shape (3, 3) or (N, 3, 3)
-        Rotation matrices; a single matrix broadcasts against a batch.
-
-    Returns
-    -------
-    angle : float, or ndarray of shape (N,)
-        Radians in ``[0, pi]``.
-
-    Raises
-    ------
-    InvalidInputError
-        Locations start with ``"R_a"`` or ``"R_b"``.
-
-    Examples
-    --------
-    >>> round(rotation_angle_between(np.eye(3), rot_x(0.25)), 12)
-    0.25
-    """
-    checked = []
-    for name, R in (("R_a", R_a), ("R_b", R_b)):
-        try:
-            R = _as_float_array(R, name)
-            _check_shape(R, (3, 3), R.ndim == 3, name)
-            _check_finite(R, name)
-            _check_rotation_stack(R, ORTHONORMAL_TOLERANCE, name)
-        except InvalidInputError as error:
-            raise error.relocated(name) from None
-        checked.append(R)
-    R_a, R_b = checked
-    try:
-        np.broadcast_shapes(R_a.shape, R_b.shape)
-    except ValueError:
-        raise InvalidInputError(
-            f"R_a and R_b must hold the same number of matrices, got shapes {R_a.shape} and {R_b.shape}"
-        ) from None
-    q = _quaternions_from_matrices(np.swapaxes(R_a, -1, -2) @ R_b)
-    angle = 2.0 * np.arctan2(np.linalg.norm(q[..., 1:], axis=-1), q[..., 0])
-    return float(angle) if angle.ndim == 0 else angle
-
-
-def transform_from(R: ArrayLike, p: ArrayLike) -> np.ndarray:
-    """Homogeneous transform ``a_T_b`` from rotation ``a_R_b`` and translation ``a_p_b``.
-
-    Parameters
-    ----------
-    R : array_like, shape (3, 3)
-        Rotation, validated by :func:`check_rotation`.
-    p : array_like, shape (3,)
-        Position of b's origin in a (length unit of the robot).
-
-    Returns
-    -------
-    T : ndarray, shape (4, 4)
-        ``[[R, p], [0, 0, 0, 1]]``.
-
-    Raises
-    ------
-    InvalidInputError
-        Locations start with ``"R"`` or ``"p"``.
-
-    Examples
-    --------
-    >>> transform_from(np.eye(3), [1.0, 2.0, 3.0])[:, 3].tolist()
-    [1.0, 2.0, 3.0, 1.0]
-    """
-    try:
-        R = check_rotation(R)
-    except InvalidInputError as error:
-        raise error.relocated("R") from None
-    try:
-        p = _as_float_array(p, "position")
-        _check_shape(p, (3,), False, "position")
-        _check_finite(p, "position")
-    except InvalidInputError as error:
-        raise error.relocated("p") from None
-    T = np.eye(4)
-    T[:3, :3] = R
-    T[:3, 3] = p
-    return T
-
-
-def invert_transform(T: ArrayLike) -> np.ndarray:
-    """Inverse of a homogeneous transform: ``b_T_a`` from ``a_T_b``.
-
-    Uses ``[[R^T, -R^T p], [0, 0, 0, 1]]`` rather than a general matrix inverse.
-
-    Parameters
-    ----------
-    T : array_like, shape (4, 4) or (N, 4, 4)
-        Transforms, validated as in :func:`check_transform` (for a batch, the
-        location starts with the row index).
-
-    Returns
-    -------
-    T_inv : ndarray, same shape as ``T``
-
-    Examples
-    --------
-    >>> T = transform_from(rot_z(np.pi / 2), [1.0, 2.0, 3.0])
-    >>> invert_transform(T)[:3, 3].round(12).tolist()
-    [-2.0, 1.0, -3.0]
-    """
-    T = _as_float_array(T, "transform")
-    T = _checked_transforms(T, ORTHONORMAL_TOLERANCE, batch=T.ndim == 3)
-    R_inv = np.swapaxes(T[..., :3, :3], -1, -2)
-    T_inv = np.zeros_like(T)
-    T_inv[..., :3, :3] = R_inv
-    T_inv[..., :3, 3] = -(R_inv @ T[..., :3, 3, None])[..., 0]
-    T_inv[..., 3, 3] = 1.0
-    return T_inv
-
-
-def wrap_angle(x: ArrayLike) -> float | np.ndarray:
-    """Wrap angles to ``(-pi, pi]``.
+def wrap_angle(x: ArrayLike) -> np.float64 | np.ndarray:
+    """Wrap angles to ``(-pi, pi]``: the one angle wrap of the core.
 
     Values already in ``(-pi, pi]`` are returned unchanged, bit for bit.
-    ``-pi`` maps to ``pi``. NaN stays NaN; infinities become NaN.
+    ``-pi`` maps to ``pi``. NaN stays NaN; infinities become NaN. Angles within
+    one turn of the range (``|x| < 3 pi``, what sums of two wrapped angles give)
+    take one exact add or subtract of ``2 pi``; only others pay for a modulo.
 
     Parameters
     ----------
@@ -951,91 +725,21 @@ def wrap_angle(x: ArrayLike) -> float | np.ndarray:
 
     Returns
     -------
-    float, or ndarray of the same shape
+    numpy.float64 (a float) for a scalar, or ndarray of the same shape
 
     Examples
     --------
-    >>> wrap_angle(3 * np.pi / 2) == -np.pi / 2
+    >>> float(wrap_angle(3 * np.pi / 2)) == -np.pi / 2
     True
-    >>> wrap_angle([-np.pi, 0.5]).tolist() == [np.pi, 0.5]
+    >>> wrap_angle([-np.pi, 0.5, 100.0]).round(6).tolist() == [round(np.pi, 6), 0.5, round(100.0 - 32 * np.pi, 6)]
     True
     """
     a = np.asarray(x, dtype=np.float64)
-    with np.errstate(invalid="ignore"):
-        outside = (a <= -np.pi) | (a > np.pi) | np.isinf(a)
-        wrapped = np.where(outside, np.pi - np.mod(np.pi - a, 2.0 * np.pi), a)
-        wrapped = np.where(wrapped <= -np.pi, wrapped + 2.0 * np.pi, wrapped)
-    return float(wrapped) if wrapped.ndim == 0 else wrapped
-
-
-def _radians_per(unit: str) -> float:
-    if not isinstance(unit, str) or unit not in _RADIANS_PER_UNIT:
-        raise InvalidInputError(
-            f"unknown angle unit {unit!r}; use one of {', '.join(map(repr, _RADIANS_PER_UNIT))}",
-            location=("unit",),
-        )
-    return _RADIANS_PER_UNIT[unit]
-
-
-def _angle_values(values: ArrayLike) -> np.ndarray:
-    try:
-        return _as_float_array(values, "angle values")
-    except InvalidInputError as error:
-        raise error.relocated("values") from None
-
-
-def to_radians(values: ArrayLike, unit: str) -> float | np.ndarray:
-    """Convert angles given in ``unit`` to radians.
-
-    The API layer calls this once, at the boundary; the core works in radians.
-
-    Parameters
-    ----------
-    values : float or array_like
-        Angles in ``unit``, any shape. Infinities pass through (an open limit).
-    unit : {"rad", "deg"}
-
-    Returns
-    -------
-    float, or ndarray of the same shape
-
-    Raises
-    ------
-    InvalidInputError
-        An unknown unit (location ``("unit",)``) or non-numeric values
-        (location ``("values",)``).
-
-    Examples
-    --------
-    >>> to_radians(180.0, "deg") == np.pi
-    True
-    >>> to_radians([0.5, 1.0], "rad").tolist()
-    [0.5, 1.0]
-    """
-    scale = _radians_per(unit)
-    converted = _angle_values(values) * scale
-    return float(converted) if converted.ndim == 0 else converted
-
-
-def from_radians(values: ArrayLike, unit: str) -> float | np.ndarray:
-    """Convert angles in radians to ``unit``; the inverse of :func:`to_radians`.
-
-    Parameters
-    ----------
-    values : float or array_like
-        Radians, any shape.
-    unit : {"rad", "deg"}
-
-    Returns
-    -------
-    float, or ndarray of the same shape
-
-    Examples
-    --------
-    >>> from_radians(np.pi / 2, "deg")
-    90.0
-    """
-    scale = _radians_per(unit)
-    converted = _angle_values(values) / scale
-    return float(converted) if converted.ndim == 0 else converted
-
+    # For |a| <= 3π (3π is exact in floating point) a ∓ 2π is exact (Sterbenz), so it lands in (−π, π].
+    wrapped = a - (_TWO_PI * (a > np.pi) - _TWO_PI * (a <= -np.pi))  # a − 0.0 keeps a −0.0
+    far = np.abs(a) >= 3.0 * np.pi  # infinities too
+    if far.any():
+        # np.mod is exact here, and its remainder a multiple of ulp(2π), so it never rounds up to a full turn.
+        with np.errstate(invalid="ignore"):
+            wrapped = np.where(far, np.pi - np.mod(np.pi - a, _TWO_PI), wrapped)
+    return wrapped[()]  # a 0-d result as a numpy float, as numpy's own functions return it

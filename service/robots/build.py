@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from ..kinematics import InvalidInputError, Joint, Robot, ScrewJoint, craig_row_from_khalil
+from ..kinematics import InvalidInputError, Joint, LimitOrderError, Robot, ScrewJoint, craig_row_from_khalil
 from .schemas import AnyRobotDescription, KhalilRobot, ScrewsRobot, URDFRobot
 from .urdf import parse_urdf
 
@@ -30,6 +30,18 @@ def robot_from_description(description: AnyRobotDescription, *, max_joints: int)
                                  name=description.name or chain.robot_name or description.id)
     _check_joint_count(len(description.joints), max_joints)
     angle = _DEGREE if description.angle_unit == "deg" else 1.0
+    try:
+        return _robot_from_rows(description, angle, base, tool, name)
+    except LimitOrderError as error:  # the core checks the order; quote its bounds in the description's unit
+        index = error.location[1]
+        scale = angle if description.joints[index].type == "revolute" else 1.0
+        raise InvalidInputError(f"lower limit {error.lower / scale:g} is greater than upper limit "
+                                f"{error.upper / scale:g}", location=error.location) from None
+
+
+def _robot_from_rows(description: AnyRobotDescription, angle: float, base: np.ndarray | None,
+                     tool: np.ndarray | None, name: str) -> Robot:
+    """The core robot of a DH, Khalil or screws description; ``angle`` is radians per description unit."""
     if isinstance(description, ScrewsRobot):
         joints = []
         for index, row in enumerate(description.joints):

@@ -49,12 +49,6 @@ class JointLimits(ApiModel):
     lower: Number | None = Field(description="lowest value of q; null: open below")
     upper: Number | None = Field(description="highest value of q; null: open above")
 
-    @model_validator(mode="after")
-    def _ordered(self) -> "JointLimits":
-        if self.lower is not None and self.upper is not None and self.lower > self.upper:
-            raise ValueError(f"lower limit {self.lower:g} is greater than upper limit {self.upper:g}")
-        return self
-
 
 class DHJoint(ApiModel):
     """One row of a standard (Spong) or modified (Craig) DH table.

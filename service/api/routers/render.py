@@ -10,6 +10,7 @@ from fastapi.responses import Response
 
 from ...drawing import arm_poses, render_svg
 from ...kinematics import InvalidInputError, Robot
+from ...kinematics.ik import wrap_revolute
 from ..boundary import joints_to_core, located, _unit_scale
 from ..deps import RobotRef, catalogue_robot, inline_robot, with_request_frames
 from ..problems import problem_responses
@@ -78,7 +79,7 @@ def ik_picture(robot: Robot, robot_id: str, answer: dict, unit: str, view: str, 
     for kind in ("solutions", "rejected"):
         for solution in answer[kind]:
             q = np.asarray(solution["joints"], dtype=float) * scale
-            wrapped = np.where(robot.is_revolute, np.angle(np.exp(1j * q)), q)
+            wrapped = wrap_revolute(robot, q)
             key = (kind, tuple(np.round(wrapped, 6).tolist()), tuple(sorted(solution["branch"].items())))
             group = groups.setdefault(key, {"q": q, "solution": solution, "count": 0, "kind": kind})
             group["count"] += 1

@@ -25,8 +25,7 @@ from ._arrays import IKArrays, arrays_from_results, solve_ik_arrays
 from ._direction import solve_direction
 from ._position_search import search_position
 from ._redundant import FreeJoint, beyond_reach, free_joints_for, no_solution_detail, solve_free_joint_family
-from ._select import MAX_EQUIVALENTS, Ordering
-from ._select_arrays import BatchSelection, SolutionTable, select_arrays
+from ._select import MAX_EQUIVALENTS, BatchSelection, Ordering, SolutionTable, select_arrays
 from ._solve import IKOptions, solve_ik_batch, unreachable_details
 from ._types import IKResult, Singularity
 

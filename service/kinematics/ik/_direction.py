@@ -32,6 +32,7 @@ from .._cache import memo
 from .._errors import InvalidInputError
 from .._forward import forward_kinematics, geometric_jacobian
 from .._robot import Robot
+from .._rotations import wrap_angle
 from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE
 from ._arrays import IKArrays, _first_of_each
 from ._plan import Plan, geometry_of, plan_for_geometry
@@ -190,7 +191,7 @@ def solve_direction(robot: Robot, positions: np.ndarray, world_directions: np.nd
     full = np.nan_to_num(candidates.joints)  # (N, m, n + 1)
     valid = candidates.valid.copy()
     if plan.roll_joint is not None:  # the arm's own pose problem: the virtual joint must stay at 0
-        virtual = np.abs(np.angle(np.exp(1j * full[..., n])))
+        virtual = np.abs(wrap_angle(full[..., n]))
         valid &= virtual <= VIRTUAL_AT_ZERO
     joints = wrap_revolute(robot, full[..., :n].copy())
     if valid.any():

@@ -54,6 +54,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._rotations import wrap_angle
 from ._screws import invert
 from ._structure import Geometry
 from ._types import Candidates, LabelCodes, SingularFlags
@@ -454,7 +455,7 @@ class General6RPlan:
                 roots = _solve_arrangement(arrangement, A)
                 if not roots.conditioned.all():
                     continue
-                gap = np.abs(np.angle(np.exp(1j * (roots.joints - q[:, None, :])))).max(axis=-1)
+                gap = np.abs(wrap_angle(roots.joints - q[:, None, :])).max(axis=-1)
                 gap = np.where(roots.valid, gap, np.inf)
                 error = float(gap.min(axis=1).max())
                 if error < best_error:

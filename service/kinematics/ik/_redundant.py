@@ -39,6 +39,7 @@ import numpy as np
 from .._cache import memo
 from .._errors import InvalidInputError
 from .._robot import Robot
+from .._rotations import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE
 from ._arrays import IKArrays, concatenated, joined_label_codes, solve_ik_arrays
 from ._plan import Plan, geometry_of, plan_for_geometry
@@ -478,7 +479,7 @@ def _on_branch(robot: Robot, family: FreeJointFamily, target: np.ndarray, values
     joint vectors (K, n) and which rows have a solution (K,)."""
     answer = _solve_at(robot, family, target, values, reference)
     same = (_branch_keys(answer) == keys[:, None]) & answer.valid
-    gap = np.abs(np.angle(np.exp(1j * (answer.joints - seeds[:, None, :])))).max(axis=-1)
+    gap = np.abs(wrap_angle(answer.joints - seeds[:, None, :])).max(axis=-1)
     gap = np.where(answer.valid, gap, np.inf)
     slot = np.where(same.any(axis=1), np.argmax(same, axis=1), gap.argmin(axis=1))
     rows = np.arange(len(values))
@@ -519,7 +520,7 @@ def _track_branch(robot: Robot, family: FreeJointFamily, target: np.ndarray, see
 
 def _wrapped(robot: Robot, joint: int, values: np.ndarray) -> np.ndarray:
     if robot.is_revolute[joint]:
-        wrapped = np.mod(values + np.pi, 2 * np.pi) - np.pi
+        wrapped = wrap_angle(values)
         inside = (values >= robot.lower[joint]) & (values <= robot.upper[joint])
         return np.where(inside, values, wrapped)
     return values

@@ -72,6 +72,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._errors import InvalidInputError
+from .._rotations import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
 
 __all__ = [
@@ -143,7 +144,6 @@ _MERGE_RESIDUAL = DUPLICATE_TOLERANCE**2
 # Two roots phi ± half of rho cos(theta - phi) = c are one when half < DUPLICATE_TOLERANCE / 2, that is when
 # rho - |c| < rho (1 - cos(DUPLICATE_TOLERANCE / 2)): an angle criterion, independent of the problem's scale.
 _MERGE_COS_GAP = 1.0 - math.cos(DUPLICATE_TOLERANCE / 2.0)
-_TWO_PI = 2.0 * math.pi
 
 
 # ---------------------------------------------------------------------------
@@ -266,11 +266,6 @@ def _norm(a: np.ndarray) -> np.ndarray:
     return np.sqrt(_dot(a, a))
 
 
-def _wrap(theta: np.ndarray) -> np.ndarray:
-    """Wrap angles in (-3 pi, 3 pi] to (-pi, pi], leaving angles already there untouched. NaN stays NaN."""
-    return theta - _TWO_PI * (theta > np.pi) + _TWO_PI * (theta <= -np.pi)
-
-
 def _pair(shape: tuple[int, ...], first: ArrayLike, second: ArrayLike, dtype: type) -> np.ndarray:
     """Candidates of shape ``shape + (2,)`` from the two slots (cheaper than ``np.stack`` for one row)."""
     out = np.empty(shape + (2,), dtype=dtype)
@@ -297,7 +292,7 @@ def _rotate_onto(
     tol = GEOMETRY_TOLERANCE * scale
     exact = (np.abs(radius_p - radius_q) <= tol) & (np.abs(pz - qz) <= tol)
     degenerate = (radius_p <= tol) | (radius_q <= tol)
-    return np.where(degenerate, 0.0, _wrap(theta)), exact, degenerate
+    return np.where(degenerate, 0.0, wrap_angle(theta)), exact, degenerate
 
 
 def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> AngleSolutions:
@@ -328,8 +323,8 @@ def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> Ang
     root = np.sqrt(np.maximum(-excess, 0.0) * (rho + abs_c))  # sqrt(rho**2 - c**2) without cancellation
     half = np.arctan2(root * two, c)  # 0 or pi unless there are two roots
     phi = np.arctan2(b, a)
-    first = np.where(degenerate, 0.0, _wrap(phi + half))
-    second = np.where(two, _wrap(phi - half), np.nan)
+    first = np.where(degenerate, 0.0, wrap_angle(phi + half))
+    second = np.where(two, wrap_angle(phi - half), np.nan)
     exact_first = regular | (degenerate & (np.abs(a - c) <= tol))
     return AngleSolutions(
         theta=_pair(shape, first, second, float),
@@ -516,10 +511,10 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
     #   (k2 x q).x = alpha qn - sign gamma e2,   (k2 x q).(k2 x x) = alpha e2 + sign gamma qn.
     s1, c1, t1, u1 = -beta * pn, beta * d1, gamma * d1, gamma * pn
     s2, c2, t2, u2 = alpha * qn, alpha * e2, gamma * e2, gamma * qn
-    first1 = _wrap(np.arctan2(s1 + t1, c1 + u1))
-    first2 = _wrap(np.arctan2(s2 - t2, c2 + u2))
-    second1 = np.where(two, _wrap(np.arctan2(s1 - t1, c1 - u1)), np.nan)
-    second2 = np.where(two, _wrap(np.arctan2(s2 + t2, c2 - u2)), np.nan)
+    first1 = wrap_angle(np.arctan2(s1 + t1, c1 + u1))
+    first2 = wrap_angle(np.arctan2(s2 - t2, c2 + u2))
+    second1 = np.where(two, wrap_angle(np.arctan2(s1 - t1, c1 - u1)), np.nan)
+    second2 = np.where(two, wrap_angle(np.arctan2(s2 + t2, c2 - u2)), np.nan)
 
     touch = meet & close
     if not meet.all():
@@ -593,7 +588,7 @@ def subproblem_2_chain(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike)
     ([-90.0, 90.0], [-90.0, 90.0])
     """
     sol = subproblem_2(k1, k2, q, p)
-    return sol._replace(theta1=_wrap(-sol.theta1))
+    return sol._replace(theta1=wrap_angle(-sol.theta1))
 
 
 def subproblem_3(k: ArrayLike, p: ArrayLike, q: ArrayLike, delta: ArrayLike) -> AngleSolutions:
@@ -874,8 +869,8 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
         u_t = np.stack([np.cos(theta_t), np.sin(theta_t)], axis=-1)
         u_s = f[..., None, :] + np.einsum("...ij,...mj->...mi", G, u_t)
         theta_s = np.arctan2(u_s[..., 1], u_s[..., 0])
-    theta1 = _wrap(np.where(by_theta1[..., None], theta_t, theta_s))
-    theta3 = _wrap(np.where(by_theta1[..., None], theta_s, theta_t))
+    theta1 = wrap_angle(np.where(by_theta1[..., None], theta_t, theta_s))
+    theta3 = wrap_angle(np.where(by_theta1[..., None], theta_s, theta_t))
     L = p0[..., None, :] + _rotate_points(k1, theta1, p1[..., None, :])
     M = p2[..., None, :] + _rotate_points(k3, theta3, p3[..., None, :])
     theta2, _, _ = _rotate_onto(axis_frame(k2), np.nan_to_num(M), np.nan_to_num(L), S[..., None])
@@ -884,7 +879,7 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
     merged = np.zeros(shape, dtype=bool)
     for later in range(1, 4):
         for earlier in range(later):
-            gap = np.abs(_wrap(theta_t[..., later] - theta_t[..., earlier]))
+            gap = np.abs(wrap_angle(theta_t[..., later] - theta_t[..., earlier]))
             same = valid[..., later] & valid[..., earlier] & (gap <= DUPLICATE_TOLERANCE)
             merged |= same
             valid[..., later] &= ~same
@@ -1152,7 +1147,7 @@ def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2):
         theta[..., 2:] = np.where(~quartic[..., None], theta[..., :1], theta[..., 2:])
         found[..., :2] = np.where(~quartic[..., None], two, found[..., :2])
         double = ~quartic & harmonic.merged
-    return _wrap(np.nan_to_num(theta)), found, double
+    return wrap_angle(np.nan_to_num(theta)), found, double
 
 
 def subproblem_6(
@@ -1319,8 +1314,8 @@ def subproblem_6(
     keep[none, nearest[none]] = True
 
     # merge equal roots (a double root appears twice), keep distinct ones first
-    gap1 = np.abs(_wrap(theta1[..., :, None] - theta1[..., None, :]))
-    gap2 = np.abs(_wrap(theta2[..., :, None] - theta2[..., None, :]))
+    gap1 = np.abs(wrap_angle(theta1[..., :, None] - theta1[..., None, :]))
+    gap2 = np.abs(wrap_angle(theta2[..., :, None] - theta2[..., None, :]))
     same = (np.nan_to_num(gap1, nan=np.inf) <= DUPLICATE_TOLERANCE) & (np.nan_to_num(gap2, nan=np.inf)
                                                                          <= DUPLICATE_TOLERANCE)
     earlier = np.tril(np.ones((4, 4), dtype=bool), -1)
@@ -1330,8 +1325,8 @@ def subproblem_6(
     order = np.argsort(~keep, axis=-1, kind="stable")
     keep = np.take_along_axis(keep, order, -1)
     exact = np.take_along_axis(exact, order, -1) & keep
-    theta1 = np.where(keep, np.take_along_axis(_wrap(theta1), order, -1), np.nan)
-    theta2 = np.where(keep, np.take_along_axis(_wrap(theta2), order, -1), np.nan)
+    theta1 = np.where(keep, np.take_along_axis(wrap_angle(theta1), order, -1), np.nan)
+    theta2 = np.where(keep, np.take_along_axis(wrap_angle(theta2), order, -1), np.nan)
     decoupled_free = rank_one & ~identically
     if decoupled_free.any():
         theta1[..., 0] = np.where(decoupled_free, np.where(one.degenerate, 0.0, one.theta[..., 0]), theta1[..., 0])
@@ -1520,14 +1515,14 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
                 valid = np.where(rows[..., None], split_valid, valid)
                 merged = np.where(rows, split_merged, merged)
                 degenerate = np.where(rows, split_degenerate, degenerate)
-        theta = _wrap(np.where(valid, theta, np.nan))
+        theta = wrap_angle(np.where(valid, theta, np.nan))
         s = np.where(valid, s, np.nan)
         # the same root twice (a tangent root): keep one, at the midpoint of the pair. A double root that
         # rounding splits along the circle splits symmetrically, so the midpoint is nearer than either half
         for later in range(1, 4):
             for earlier in range(later):
-                gap = _wrap(theta[..., later] - theta[..., earlier])
-                middle = _wrap(theta[..., earlier] + gap / 2)
+                gap = wrap_angle(theta[..., later] - theta[..., earlier])
+                middle = wrap_angle(theta[..., earlier] + gap / 2)
                 same = valid[..., later] & valid[..., earlier] & (np.abs(gap) <= DUPLICATE_TOLERANCE) \
                     & (np.abs(s[..., later] - s[..., earlier]) <= DUPLICATE_TOLERANCE)
                 if quartic is not None:  # or a pair whose midpoint solves the quartic (a badly split double root)

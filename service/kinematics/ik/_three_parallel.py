@@ -29,6 +29,7 @@ from functools import cached_property
 import numpy as np
 
 from . import _scalar as scalar
+from .._rotations import wrap_angle
 from ._positioning import _flag_rows, _unit, side_codes
 from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
@@ -256,7 +257,7 @@ SPLIT_DOUBLE_ROOT = 1e-4
 
 def _split_double_root(elbow: np.ndarray, valid: np.ndarray) -> np.ndarray:
     """Where the two elbow roots (..., 2) are both valid and a split double root apart."""
-    gap = np.abs(np.angle(np.exp(1j * (elbow[..., 0] - elbow[..., 1]))))
+    gap = np.abs(wrap_angle(elbow[..., 0] - elbow[..., 1]))
     return valid[..., 0] & valid[..., 1] & (np.nan_to_num(gap, nan=np.inf) <= SPLIT_DOUBLE_ROOT)
 
 

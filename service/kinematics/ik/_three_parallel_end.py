@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._rotations import wrap_angle
 from ._positioning import side_codes
 from ._screws import apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
@@ -146,7 +147,7 @@ class ThreeParallelAtEndPlan:
         low, high = np.maximum(near, self.reach[0]), np.minimum(far, self.reach[1])
         roots = subproblem_3(-h1, tip, y - p1, 0.5 * (low + np.maximum(low, high)))
         target = 0.0 if reference is None else float(reference[0])
-        near = np.argmin(np.abs(np.angle(np.exp(1j * (np.nan_to_num(roots.theta, nan=1e9) - target)))), axis=-1)
+        near = np.argmin(np.abs(wrap_angle(np.nan_to_num(roots.theta, nan=1e9) - target)), axis=-1)
         return np.take_along_axis(roots.theta, near[..., None], -1)[..., 0]
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:

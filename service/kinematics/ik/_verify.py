@@ -13,14 +13,14 @@ import numpy as np
 from .._budget import UNLIMITED, Budget
 from .._forward import forward_kinematics, tool_columns, tool_columns_scalar
 from .._robot import Robot
+from .._rotations import wrap_angle
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE
 from ._structure import arm_size
 
 
 def wrap_revolute(robot: Robot, q: np.ndarray) -> np.ndarray:
     """Revolute joint values wrapped to (−π, π]; prismatic values unchanged. Shape (..., n)."""
-    wrapped = np.pi - np.mod(np.pi - q, 2 * np.pi)
-    return np.where(robot.is_revolute, wrapped, q)
+    return np.where(robot.is_revolute, wrap_angle(q), q)
 
 
 def joint_difference(robot: Robot, q: np.ndarray, reference: np.ndarray) -> np.ndarray:

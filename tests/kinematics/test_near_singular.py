@@ -170,3 +170,30 @@ def test_zero_length_links_report_every_free_shoulder_joint():
         assert any(s.kind == "shoulder" and tuple(s.joints) == (0, 1) for s in result.singularities)
         solutions = np.array([s.joints for s in result.solutions])
         assert np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= 1e-7
+
+
+def test_coincident_first_axes_are_not_taken_for_a_spherical_wrist():
+    """Joints 1 and 2 on one line (α1 = 0, a1 = 0) turn the tool about that line together: only q1 + q2 counts.
+    The three axes through one point were taken for a spherical wrist at the base, which cannot reach an FK
+    pose of this arm: ``unreachable`` with ``complete: true``. Now no closed form claims it; the answer holds the
+    generating configuration up to the split of q1 + q2 and does not promise completeness."""
+    from service.robots.build import robot_from_description
+    from service.robots.schemas import DHRobot
+
+    half = np.pi / 2
+    robot = robot_from_description(DHRobot.model_validate({"id": "coaxial", "convention": "standard", "joints": [
+        {"a": 0, "alpha": 0, "d": 0.3}, {"a": 0, "alpha": half, "d": 0.1}, {"a": 0.4, "alpha": 0, "d": 0},
+        {"a": 0.05, "alpha": half, "d": 0.35}, {"a": 0, "alpha": -half, "d": 0}, {"a": 0, "alpha": 0, "d": 0.1}]}),
+        max_joints=32)
+    q = np.random.default_rng(1).uniform(-np.pi, np.pi, 6)
+    target = forward_kinematics(robot, q)
+    for constrain_orientation in (True, False):
+        result = solve_ik(robot, target, constrain_orientation=constrain_orientation, reference=q)
+        assert result.status == "ok" and not result.complete
+        solutions = np.array([s.joints for s in result.solutions])
+        d = joint_difference(robot, solutions, q)
+        same_sum = np.abs(_wrapped(d[:, 0] + d[:, 1])) <= 1e-7
+        others = np.abs(d[:, 2:]).max(axis=1) <= 1e-7 if constrain_orientation else np.ones(len(d), bool)
+        assert np.any(same_sum & others)
+        np.testing.assert_allclose([forward_kinematics(robot, s)[:3, 3] for s in solutions],
+                                   np.broadcast_to(target[:3, 3], (len(solutions), 3)), atol=1e-9)

@@ -55,7 +55,7 @@ class Settings(BaseSettings):
     header_timeout_s: float = Field(10.0, gt=0, description="a connection must send its request head within this")
     body_timeout_s: float = Field(30.0, gt=0, description="a request body must arrive within this")
     max_connections: int = Field(
-        900, ge=1, description="most open connections per worker (uvicorn's limit_concurrency); keep it below "
+        900, ge=1, description="most open connections per worker (past it a 503 problem at once); keep it below "
                                "the descriptor limit")
     max_robot_file_bytes: int = Field(1024 * 1024, ge=1024, description="largest robot file the catalogue loads")
 

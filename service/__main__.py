@@ -36,7 +36,7 @@ def main() -> None:
             access_log=False,  # the service writes its own JSON access log, with the request id
             http=WatchedProtocol,  # head and body deadlines for slow clients (service/server.py)
             timeout_keep_alive=settings.timeout_keep_alive_s,
-            limit_concurrency=settings.max_connections,
+            # KIN_MAX_CONNECTIONS is enforced by WatchedProtocol (a problem+json 503, not uvicorn's text/plain one)
             h11_max_incomplete_event_size=64 * 1024,  # a request head larger than this is refused
             # Every request ends by its deadline (a 503 problem past it), so waiting that long on SIGTERM lets each
             # in-flight request finish or refuse cleanly instead of being cut off with a text/plain 500.

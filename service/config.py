@@ -55,7 +55,7 @@ class Settings(BaseSettings):
     header_timeout_s: float = Field(10.0, gt=0, description="a connection must send its request head within this")
     body_timeout_s: float = Field(30.0, gt=0, description="a request body must arrive within this")
     max_connections: int = Field(
-        900, ge=1, description="most open connections per worker (uvicorn's limit_concurrency); keep it below "
+        900, ge=1, description="most open connections per worker (past it a 503 problem at once); keep it below "
                                "the descriptor limit")
     robot_cache_size: int = Field(
         64, ge=0, le=100_000, description="most inline robot descriptions (and robots with a request's own "

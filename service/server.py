@@ -9,9 +9,10 @@ adds both, on uvicorn's own HTTP protocol classes:
   previous response;
 * **body**: a request's body must arrive within ``KIN_BODY_TIMEOUT_S`` of its head.
 
-Each closes the connection and logs one warning line naming the client. ``KIN_MAX_CONNECTIONS`` is uvicorn's
-``limit_concurrency``: past it uvicorn answers 503 at once instead of letting descriptors run out (logged here by
-:class:`_Watchdog` too). The settings are read from the environment in each worker process, since workers are
+Each closes the connection and logs one warning line naming the client. ``KIN_MAX_CONNECTIONS`` caps the open
+connections per worker: a connection opened past it is answered 503 at once (a problem+json with ``Retry-After``
+and ``Connection: close``, logged) instead of letting descriptors run out. :class:`_Watchdog` enforces it itself
+rather than through uvicorn's ``limit_concurrency``, whose 503 is text/plain. The settings are read from the environment in each worker process, since workers are
 spawned and do not share the parent's objects.
 """
 
@@ -21,6 +22,8 @@ import asyncio
 import logging
 from typing import Any
 
+from .api.budget import RETRY_AFTER_SECONDS
+from .api.problems import problem_response
 from .config import Settings
 
 logger = logging.getLogger("service.server")
@@ -46,9 +49,14 @@ class _Watchdog:
         self._seen_cycle = None
         self._cycle_since = 0.0
         self._watch_timer = loop.call_later(_CHECK_EVERY_S, self._watch)
-        if len(self.connections) > 0.9 * self._limits().max_connections:  # type: ignore[attr-defined]
+        open_connections, cap = len(self.connections), self._limits().max_connections  # type: ignore[attr-defined]
+        if open_connections > cap:  # (this one included) every request on it gets the 503 problem
+            self.app = _over_connection_cap  # type: ignore[attr-defined]
+            logger.warning("refused: %d open connections (KIN_MAX_CONNECTIONS)", open_connections,
+                           extra={"fields": {"connections": open_connections, "cap": cap}})
+        elif open_connections > 0.9 * cap:
             logger.warning("open connections near the cap", extra={"fields": {
-                "connections": len(self.connections), "cap": self._limits().max_connections}})  # type: ignore
+                "connections": open_connections, "cap": cap}})
 
     def on_response_complete(self) -> None:
         self._waiting_since = asyncio.get_running_loop().time()
@@ -86,6 +94,17 @@ class _Watchdog:
                        extra={"fields": {"client": f"{client[0]}:{client[1]}" if client else None,
                                          "timeout_s": seconds, "setting": setting}})
         self.transport.close()  # type: ignore[attr-defined]
+
+
+async def _over_connection_cap(scope: dict, receive: Any, send: Any) -> None:
+    """The ASGI answer on a connection past ``KIN_MAX_CONNECTIONS``: a 503 problem that closes the connection."""
+    cap = _Watchdog._limits().max_connections
+    response = problem_response(
+        503, "overloaded", "Too many open connections",
+        f"The service holds its limit of {cap} open connections per worker (KIN_MAX_CONNECTIONS); retry after "
+        f"{RETRY_AFTER_SECONDS} s.", instance=scope.get("path"),
+        headers={"Retry-After": str(RETRY_AFTER_SECONDS), "Connection": "close"})
+    await response(scope, receive, send)
 
 
 def _protocol_class() -> type:

@@ -184,3 +184,28 @@ def test_sigterm_during_a_request_finishes_or_refuses_it_cleanly(tmp_path):
     assert code in (0, -signal.SIGTERM)
     for line in server.lines():
         json.loads(line)
+
+
+def test_a_connection_over_the_cap_gets_a_problem_and_is_logged(tmp_path):
+    """KIN_MAX_CONNECTIONS = 3: with three connections open, a fourth is answered 503 application/problem+json
+    with Retry-After and closed (uvicorn's own limit answered text/plain); once one closes, requests pass again."""
+    server = Server(tmp_path, KIN_MAX_CONNECTIONS="3", KIN_HEADER_TIMEOUT_S="30")
+    held = [socket.create_connection(("127.0.0.1", server.port)) for _ in range(3)]
+    try:
+        time.sleep(0.3)  # the server has taken all three
+        response = httpx.get(f"{server.url}/healthz", timeout=5)
+        assert response.status_code == 503
+        assert response.headers["content-type"].startswith("application/problem+json")
+        assert response.headers["retry-after"] == "1" and response.headers["connection"] == "close"
+        problem = response.json()
+        assert problem["status"] == 503 and problem["type"].endswith("/overloaded") and problem["title"]
+        assert "KIN_MAX_CONNECTIONS" in problem["detail"] and "3" in problem["detail"]
+        held.pop().close()
+        time.sleep(0.3)
+        assert httpx.get(f"{server.url}/healthz", timeout=5).status_code == 200
+    finally:
+        for connection in held:
+            connection.close()
+        server.stop()
+    records = [json.loads(line) for line in server.lines()]
+    assert any("KIN_MAX_CONNECTIONS" in record["msg"] for record in records)

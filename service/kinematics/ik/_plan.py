@@ -145,8 +145,8 @@ def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
         wrist_joints = tuple(range(k, n))
         if len(wrist_joints) == 3:
             point = geometry.common_point(wrist_joints)
-            if point is None:
-                continue
+            if point is None or geometry.parallel(k, k + 1) or geometry.parallel(k + 1, k + 2):
+                continue  # consecutive coincident axes turn the tool about one line: not a 3-DOF wrist
             wrist = SphericalWrist(geometry, wrist_joints)
         elif len(wrist_joints) == 1:
             if not model.is_revolute[k]:

@@ -37,7 +37,10 @@ Conventions
     grows with the square of the distance from it. So this merges roots
     closer than about ``DUPLICATE_TOLERANCE`` (radians, or a fraction of the
     scale for prismatic joints), the project's test for "the same solution".
-    It also merges a double root that rounding has split.
+    It also merges a double root that rounding has split. Subproblem 2 bounds the
+    two angles themselves (both within ``DUPLICATE_TOLERANCE``) or, on small
+    circles, the crossing gap's rounding error: its midpoint residual alone
+    would merge roots ``1e-6 / sqrt(radius)`` apart.
 
 Results
 -------
@@ -144,6 +147,12 @@ _MERGE_RESIDUAL = DUPLICATE_TOLERANCE**2
 # Two roots phi ± half of rho cos(theta - phi) = c are one when half < DUPLICATE_TOLERANCE / 2, that is when
 # rho - |c| < rho (1 - cos(DUPLICATE_TOLERANCE / 2)): an angle criterion, independent of the problem's scale.
 _MERGE_COS_GAP = 1.0 - math.cos(DUPLICATE_TOLERANCE / 2.0)
+# The same angle criterion for two crossings of circles of radius rho, half an angle asin(sqrt(g) / rho) apart:
+# g < rho**2 sin(DUPLICATE_TOLERANCE / 2)**2.
+_MERGE_SIN_SQUARED = math.sin(DUPLICATE_TOLERANCE / 2.0) ** 2
+# Rounding error of that g relative to rho: exact tangencies give |g| up to 86 ulps of rho (tests/kinematics/
+# test_subproblems.py's tangent cones); this bound keeps a factor 3 above it.
+_GAP_ROUNDING = 256 * np.finfo(float).eps
 
 
 # ---------------------------------------------------------------------------
@@ -500,9 +509,13 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
     beta = (h2 - cos * h1) / sin2
     g = _crossing_gap(rho1, rho2, alpha * sin, beta * sin)
     meet = g >= 0.0
-    # With gamma = 0 each angle turns its vector to the arc midpoint between the
-    # two crossings, a sagitta of at most g / rho from x0: the residual is at most g (1/rho1 + 1/rho2).
-    close = g * (rho1 + rho2) <= _MERGE_RESIDUAL * rho1 * rho2
+    # The crossings x0 +/- gamma n lie on the circles of radius rho1 and rho2, half an angle asin(sqrt(g) / rho)
+    # apart about each axis: they are one root when both angles are within DUPLICATE_TOLERANCE (the smaller
+    # radius turns the more), or when g is within its rounding error (about a hundred ulps of rho: a tangency
+    # that rounding split). A test on the midpoint's residual, g (1/rho1 + 1/rho2) <= 1e-12, merged roots
+    # 1e-6 / sqrt(rho) apart instead: the Stanford shoulder at theta2 = 6e-7 came back 1.5e-6 off.
+    rho = np.minimum(rho1, rho2)
+    close = g <= np.maximum(_MERGE_SIN_SQUARED * rho, _GAP_ROUNDING) * rho
     two = meet & ~close & ~degenerate
     gamma = np.sqrt(np.maximum(g, 0.0)) * two / sin
 

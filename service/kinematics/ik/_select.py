@@ -310,7 +310,7 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     q = joints[target, slot]
     first, last = turn_ranges(robot, limits, q)
     fits = np.all(last >= first, axis=1)
-    closest = closest_equivalent(robot, limits, q[~fits])
+    closest = closest_equivalent(robot, limits, q[~fits], (first[~fits], last[~fits]))
     candidate = fits | (not filter_limits)
     # a solution that does not fit and stays among the candidates has one value: its closest equivalent
     turns = np.round((closest - q[~fits]) / _TWO_PI)
@@ -348,9 +348,10 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     truncated = (available > n_kept) & (not capped)
     trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
     noted = no_fit | (outside > 0) | truncated | ((status == "ok") & (n_kept == 0) & (with_all_moves > 0))
-    notes = {row: _notes(str(status[row]), int(n_rejected[row]), int(outside[row]), bool(truncated[row]),
-                         int(available[row]), int(n_kept[row]), int(with_all_moves[row]), max_equivalents,
-                         reference is not None) for row in np.flatnonzero(noted).tolist()}
+    rows = np.flatnonzero(noted)
+    notes = dict(zip(rows.tolist(), (_notes(*fields, max_equivalents, reference is not None) for fields in zip(
+        status[rows].tolist(), *(column[rows].tolist() for column in (n_rejected, outside, truncated, available,
+                                                                        n_kept, with_all_moves))))))
     return _Choice(status, truncated, trimmed, available, notes, kept, rejected)
 
 

@@ -401,9 +401,16 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     kept_rows, kept_values = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))]
     for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
         budget.check("selection")
-        owner, ranks = _rank_tuples(ranks_cap[start:stop], row_limit[start:stop])
+        caps = ranks_cap[start:stop]
+        owner, ranks = _rank_tuples(caps, row_limit[start:stop])
+        # each (row, joint, rank) turn once (no more of them than combinations), then looked up per combination
+        table_start = (np.cumsum(caps.ravel()) - caps.ravel()).reshape(caps.shape)
+        entry = np.repeat(np.arange(caps.size), caps.ravel())
+        rank = np.arange(len(entry)) - table_start.ravel()[entry]
+        table = [a[start:stop].ravel()[entry] for a in (cheapest, direction, ahead, behind)]
+        table = table[0] + _rank_offsets(rank, *table[1:])
+        turns = table[table_start[owner] + ranks]
         owner += start
-        turns = cheapest[owner] + _rank_offsets(ranks, direction[owner], ahead[owner], behind[owner])
         values = q[owner] + _TWO_PI * turns
         if reference is None:
             cost = np.sum(np.abs(turns), axis=1)
@@ -448,7 +455,7 @@ def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, centre: np
 
 
 def _rank_offsets(ranks: np.ndarray, direction: np.ndarray, ahead: np.ndarray, behind: np.ndarray) -> np.ndarray:
-    """The turn, relative to the cheapest, of each joint's value of rank r (shape (C, n), see :func:`_ranked_turns`).
+    """The turn, relative to the cheapest, of a joint's value of rank r (arrays of one shape, see :func:`_ranked_turns`).
 
     Ranks 1, 2, 3, 4, … go +1, −1, +2, −2, … in ``direction`` while both sides have turns left, then on along the
     side that has.

@@ -474,13 +474,19 @@ def _rank_tuples(ranks_cap: np.ndarray, row_limit: np.ndarray) -> tuple[np.ndarr
     rows, n = ranks_cap.shape
     owner = np.flatnonzero(np.all(ranks_cap > 0, axis=1) & (row_limit > 0))
     product = np.ones(len(owner), dtype=np.int64)
-    ranks = np.zeros((len(owner), 0), dtype=np.int64)
+    levels = []  # per joint: each partial tuple's parent and its rank there
     for j in range(n):
         children = np.minimum(ranks_cap[owner, j], row_limit[owner] // product)
         parent = np.repeat(np.arange(len(owner)), children)
         rank = np.arange(len(parent)) - (np.cumsum(children) - children)[parent]
         owner, product = owner[parent], product[parent] * (rank + 1)
-        ranks = np.concatenate([ranks[parent], rank[:, None]], axis=1)
+        levels.append((parent, rank))
+    ranks = np.zeros((len(owner), n), dtype=np.int64)
+    index = np.arange(len(owner))
+    for j in range(n - 1, -1, -1):  # back along the parents
+        parent, rank = levels[j]
+        ranks[:, j] = rank[index]
+        index = parent[index]
     return owner, ranks
 
 

@@ -124,31 +124,39 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     q = np.asarray(q, dtype=float)
     tolerance = limits.tolerance(robot)
     lower, upper = limits.lower - tolerance, limits.upper + tolerance
-    both = limits.multi_valued(robot)
-    one_sided = robot.is_revolute & ~both & ~limits.continuous(robot)
-    with np.errstate(invalid="ignore"):
-        first = np.ceil((lower - q) / _TWO_PI)
-        last = np.floor((upper - q) / _TWO_PI)
-        first = first + (q + _TWO_PI * first < lower)
-        last = last - (q + _TWO_PI * last > upper)
-        nearest = np.where(q < lower, first, np.where(q > upper, last, 0.0))
-    inside = np.where(robot.is_revolute & ~both, True, (q >= lower) & (q <= upper))
-    single = np.where(one_sided, nearest, np.where(inside, 0.0, np.nan))
-    first = np.where(both, first, np.where(np.isnan(single), 0.0, single))
-    last = np.where(both, last, np.where(np.isnan(single), -1.0, single))
+    both, continuous = limits.multi_valued(robot), limits.continuous(robot)
+    first, last = np.zeros_like(q), np.zeros_like(q)
+    for j in range(robot.dof):  # one kind of joint per column
+        value = q[..., j]
+        if both[j]:
+            low = np.ceil((lower[j] - value) / _TWO_PI)
+            high = np.floor((upper[j] - value) / _TWO_PI)
+            first[..., j] = low + (value + _TWO_PI * low < lower[j])
+            last[..., j] = high - (value + _TWO_PI * high > upper[j])
+        elif robot.is_revolute[j] and not continuous[j]:
+            below = value < lower[j]
+            above = value > upper[j]
+            turn = np.where(below, np.ceil((lower[j] - value) / _TWO_PI) if np.isfinite(lower[j]) else 0.0,
+                            np.where(above, np.floor((upper[j] - value) / _TWO_PI) if np.isfinite(upper[j]) else 0.0,
+                                     0.0))
+            first[..., j] = last[..., j] = turn
+        else:
+            last[..., j] = np.where((value >= lower[j]) & (value <= upper[j]), 0.0, -1.0)
     return first, last
 
 
-def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray:
+def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray,
+                       turns: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """The 2π-equivalent of each row of q (shape (..., n)) that is as close to the limits as whole turns bring it.
 
     Each revolute joint that has an equivalent inside its bounds takes the one
     nearest its value; one that has none takes the equivalent nearest its
     range (the smallest violation). Prismatic joints keep their values. The
-    joints that still violate a bound are exactly those no whole turn can fix.
+    joints that still violate a bound are exactly those no whole turn can fix. ``turns`` are q's
+    :func:`turn_ranges`, when the caller has them.
     """
     q = np.asarray(q, dtype=float)
-    first, last = turn_ranges(robot, limits, q)
+    first, last = turn_ranges(robot, limits, q) if turns is None else turns
     with np.errstate(invalid="ignore"):
         below = np.floor((limits.lower - q) / _TWO_PI)  # the turn of the largest equivalent ≤ lower
         short = limits.lower - (q + _TWO_PI * below)

@@ -310,7 +310,7 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     q = joints[target, slot]
     first, last = turn_ranges(robot, limits, q)
     fits = np.all(last >= first, axis=1)
-    closest = closest_equivalent(robot, limits, q[~fits])
+    closest = closest_equivalent(robot, limits, q[~fits], (first[~fits], last[~fits]))
     candidate = fits | (not filter_limits)
     # a solution that does not fit and stays among the candidates has one value: its closest equivalent
     turns = np.round((closest - q[~fits]) / _TWO_PI)
@@ -348,9 +348,10 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     truncated = (available > n_kept) & (not capped)
     trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
     noted = no_fit | (outside > 0) | truncated | ((status == "ok") & (n_kept == 0) & (with_all_moves > 0))
-    notes = {row: _notes(str(status[row]), int(n_rejected[row]), int(outside[row]), bool(truncated[row]),
-                         int(available[row]), int(n_kept[row]), int(with_all_moves[row]), max_equivalents,
-                         reference is not None) for row in np.flatnonzero(noted).tolist()}
+    rows = np.flatnonzero(noted)
+    notes = dict(zip(rows.tolist(), (_notes(*fields, max_equivalents, reference is not None) for fields in zip(
+        status[rows].tolist(), *(column[rows].tolist() for column in (n_rejected, outside, truncated, available,
+                                                                        n_kept, with_all_moves))))))
     return _Choice(status, truncated, trimmed, available, notes, kept, rejected)
 
 
@@ -400,9 +401,16 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     kept_rows, kept_values = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))]
     for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
         budget.check("selection")
-        owner, ranks = _rank_tuples(ranks_cap[start:stop], row_limit[start:stop])
+        caps = ranks_cap[start:stop]
+        owner, ranks = _rank_tuples(caps, row_limit[start:stop])
+        # each (row, joint, rank) turn once (no more of them than combinations), then looked up per combination
+        table_start = (np.cumsum(caps.ravel()) - caps.ravel()).reshape(caps.shape)
+        entry = np.repeat(np.arange(caps.size), caps.ravel())
+        rank = np.arange(len(entry)) - table_start.ravel()[entry]
+        table = [a[start:stop].ravel()[entry] for a in (cheapest, direction, ahead, behind)]
+        table = table[0] + _rank_offsets(rank, *table[1:])
+        turns = table[table_start[owner] + ranks]
         owner += start
-        turns = cheapest[owner] + _rank_offsets(ranks, direction[owner], ahead[owner], behind[owner])
         values = q[owner] + _TWO_PI * turns
         if reference is None:
             cost = np.sum(np.abs(turns), axis=1)
@@ -447,7 +455,7 @@ def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, centre: np
 
 
 def _rank_offsets(ranks: np.ndarray, direction: np.ndarray, ahead: np.ndarray, behind: np.ndarray) -> np.ndarray:
-    """The turn, relative to the cheapest, of each joint's value of rank r (shape (C, n), see :func:`_ranked_turns`).
+    """The turn, relative to the cheapest, of a joint's value of rank r (arrays of one shape, see :func:`_ranked_turns`).
 
     Ranks 1, 2, 3, 4, … go +1, −1, +2, −2, … in ``direction`` while both sides have turns left, then on along the
     side that has.
@@ -466,13 +474,19 @@ def _rank_tuples(ranks_cap: np.ndarray, row_limit: np.ndarray) -> tuple[np.ndarr
     rows, n = ranks_cap.shape
     owner = np.flatnonzero(np.all(ranks_cap > 0, axis=1) & (row_limit > 0))
     product = np.ones(len(owner), dtype=np.int64)
-    ranks = np.zeros((len(owner), 0), dtype=np.int64)
+    levels = []  # per joint: each partial tuple's parent and its rank there
     for j in range(n):
         children = np.minimum(ranks_cap[owner, j], row_limit[owner] // product)
         parent = np.repeat(np.arange(len(owner)), children)
         rank = np.arange(len(parent)) - (np.cumsum(children) - children)[parent]
         owner, product = owner[parent], product[parent] * (rank + 1)
-        ranks = np.concatenate([ranks[parent], rank[:, None]], axis=1)
+        levels.append((parent, rank))
+    ranks = np.zeros((len(owner), n), dtype=np.int64)
+    index = np.arange(len(owner))
+    for j in range(n - 1, -1, -1):  # back along the parents
+        parent, rank = levels[j]
+        ranks[:, j] = rank[index]
+        index = parent[index]
     return owner, ranks
 
 

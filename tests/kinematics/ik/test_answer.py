@@ -8,7 +8,7 @@ from service.config import Settings
 from service.kinematics import Limits, forward_kinematics
 from service.kinematics.ik import DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, answer_ik
 from service.robots.catalogue import load_catalogue
-from tests.kinematics.test_ik_redundant import arm
+from tests.kinematics.ik.test_redundant import arm
 
 PUMA = load_catalogue([Settings().builtin_robots_dir], max_joints=32).get("puma560_standard").robot
 TOOL_AXIS = np.array([0.0, 1.0, 0.0])

@@ -24,6 +24,7 @@ from fastapi.responses import JSONResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from ..config import Settings
+from ..kinematics.ik import MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit
 from ..kinematics import UNLIMITED, Budget, BudgetExhausted, Limits, Robot
 from .problems import PROBLEM_MEDIA_TYPE, PROBLEM_TYPE_BASE, ProblemError, problem_response
 
@@ -240,6 +241,14 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: 
                            f"{settings.max_numeric_starts:,}. Send fewer targets or fewer numeric.starts.")
     kept = max_equivalents if max_solutions is None else min(max_equivalents, max_solutions)
     equivalents = equivalents_per_solution(robot, limits)
+    if combinations_to_rank(robot.dof, kept, equivalents) > MAX_COMBINATIONS_PER_SOLUTION:
+        most = enumerable_limit(robot.dof)
+        raise ProblemError(413, "too-much-work", "Too much work",
+                           f"Keeping the nearest {kept:,} of up to {equivalents:,} 2π-equivalents per solution would "
+                           f"rank {combinations_to_rank(robot.dof, kept, equivalents):,} combinations of this "
+                           f"{robot.dof}-joint arm's turns per solution, more than the "
+                           f"{MAX_COMBINATIONS_PER_SOLUTION:,} one answer may. Ask for at most {most:,} "
+                           f"(max_equivalents or max_solutions), or narrow multi-turn limits.")
     per_target, rejected = worst_answer_per_target(solutions_per_target, equivalents, kept)
     check_answer_size(settings, robot, targets=targets, per_target=per_target, form=form,
                       what=f"{targets:,} targets × up to {per_target:,} each: {solutions_per_target} solutions "

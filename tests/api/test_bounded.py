@@ -98,10 +98,38 @@ def test_max_equivalents_beyond_the_solution_cap_is_413_before_solving():
     with TestClient(create_app(Settings(_env_file=None))) as client:
         body = {"target": _ur5_target(client), "limits": _limits(300.0), "max_equivalents": 100_000}
         client.app.state.settings.max_solutions_per_response = 100_000
+        # ranking the nearest 100,000 of so many equivalents is itself too much work for one answer
+        problem = assert_problem(client.post("/v1/robots/ur5/ik", json=body), 413, match="Ask for at most 1,455")
+        assert problem["type"].endswith("/too-much-work")
+        # within the ranking bound, the answer's worst case: one solution fills the 1,400 kept, 7 are rejected
+        client.app.state.settings.max_solutions_per_response = 1_000
+        body["max_equivalents"] = 1_400
         problem = assert_problem(client.post("/v1/robots/ur5/ik", json=body), 413,
-                                 match="KIN_MAX_SOLUTIONS_PER_RESPONSE = 100,000")
-        # the worst case: one solution fits and fills the 100,000 kept, the other 7 are rejected
-        assert "100,007 solutions" in problem["detail"] and "7 of them are rejected" in problem["detail"]
+                                 match="KIN_MAX_SOLUTIONS_PER_RESPONSE = 1,000")
+        assert "1,407 solutions" in problem["detail"] and "7 of them are rejected" in problem["detail"]
+
+
+def test_the_ranking_work_per_solution_is_bounded_whatever_the_joint_count():
+    """An 8-joint arm with ±1e6 rad limits: 318,310 values per joint. The default 1,024 kept would rank 2.6
+    million turn combinations per solution; the core keeps the nearest it can rank exactly, and says so."""
+    from service.kinematics import Joint, Limits, Robot
+    from service.kinematics.ik import MAX_COMBINATIONS_PER_SOLUTION, Selection, enumerable_limit, select
+    from service.kinematics.ik._select import _down_set_size
+    from service.kinematics.ik._types import IKResult, Solution
+
+    robot = Robot([Joint(f"q{j + 1}", "revolute", 0.1, 0.3, 0.0, 0.0) for j in range(8)], convention="standard")
+    limits = Limits(np.full(8, -1e6), np.full(8, 1e6))
+    assert _down_set_size(8, 1024) > MAX_COMBINATIONS_PER_SOLUTION >= _down_set_size(8, enumerable_limit(8))
+    result = IKResult("ok", [Solution(np.full(8, 0.25), {}, 0.0, 0.0)], "analytic", "test", True)
+    started = time.perf_counter()
+    selection: Selection = select(robot, result, limits, reference=np.zeros(8))
+    assert time.perf_counter() - started < 20.0
+    kept = np.array([entry.solution.joints for entry in selection.solutions])
+    assert len(kept) == enumerable_limit(8) == 599 and selection.expansion_truncated
+    assert any("At most 599 are listed for a 8-joint arm" in note for note in selection.notes)
+    # nearest first, and the nearest are the ones with the smallest largest |q_j| (every joint at 0.25 + 2kπ)
+    cost = np.abs(kept).max(axis=1)
+    assert np.all(np.diff(cost) >= -1e-12) and np.isclose(cost[0], 0.25)
 
 
 def test_a_whole_workspace_batch_is_413_before_solving(client, monkeypatch):

@@ -16,13 +16,17 @@ from ._plan import plan_for
 from ._position_search import search_position
 from ._redundant import (MAX_FREE_VALUES, FamilyAnswer, FreeJoint, beyond_reach, follow_free_joints, free_joints_for,
                          no_solution_detail, solve_free_joint_family)
-from ._select import (MAX_EQUIVALENTS, Ordering, Selected, Selection, SolutionTable, check_ordering, joint_travel,
-                      select, select_arrays, travel)
+from ._select import (MAX_COMBINATIONS_PER_SOLUTION, MAX_EQUIVALENTS, Ordering, Selected, Selection, SolutionTable,
+                      check_ordering, combinations_to_rank, enumerable_limit, joint_travel, select, select_arrays,
+                      travel)
 from ._solve import IKOptions, results_from_arrays, solve_ik, solve_ik_batch, unreachable_details
 from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
 
 __all__ = [
+    "MAX_COMBINATIONS_PER_SOLUTION",
+    "combinations_to_rank",
+    "enumerable_limit",
     "AnswerOptions",
     "DIRECTION",
     "IKAnswer",

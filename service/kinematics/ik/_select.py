@@ -58,6 +58,10 @@ MAX_EQUIVALENTS = 1024
 
 #: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
 _CHUNK_ROWS = 1 << 18
+#: Most rank tuples one solution may enumerate (:func:`_nearest`). Past it the number kept per target is lowered
+#: to :func:`enumerable_limit` (said in the target's notes), so the work per solution stays bounded whatever the
+#: limits, ``max_equivalents`` and the joint count; the boundary refuses such requests before solving.
+MAX_COMBINATIONS_PER_SOLUTION = 1 << 20
 
 _TWO_PI = 2.0 * np.pi
 
@@ -323,6 +327,9 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     available = _capped_sums(c_target, _capped_products(counts), n_targets)
 
     limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
+    lowered = limit > enumerable_limit(n) and bool(np.any(_capped_products(counts) > MAX_COMBINATIONS_PER_SOLUTION))
+    if lowered:
+        limit = enumerable_limit(n)
     if reference is not None:
         row_limit = np.full(len(c_target), limit, dtype=np.int64)
     else:  # round robin: no solution gives more than the rounds needed to reach the limit
@@ -352,7 +359,31 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     notes = dict(zip(rows.tolist(), (_notes(*fields, max_equivalents, reference is not None) for fields in zip(
         status[rows].tolist(), *(column[rows].tolist() for column in (n_rejected, outside, truncated, available,
                                                                         n_kept, with_all_moves))))))
+    if lowered:
+        for row in np.flatnonzero(truncated).tolist():
+            notes.setdefault(row, []).append(
+                f"At most {limit} are listed for a {n}-joint arm whatever max_equivalents asks: ranking more of "
+                f"so many equivalents would take more work than one answer may.")
     return _Choice(status, truncated, trimmed, available, notes, kept, rejected)
+
+
+def combinations_to_rank(n: int, limit: int, equivalents: int) -> int:
+    """The most rank tuples one solution of an n-joint arm with ``equivalents`` 2π-equivalents enumerates to keep
+    ``limit`` (see :func:`_nearest`): min(equivalents, |{r : ∏(r_j + 1) ≤ min(limit, equivalents)}|)."""
+    return min(equivalents, _down_set_size(n, min(limit, equivalents)))
+
+
+@functools.lru_cache(maxsize=None)
+def enumerable_limit(n: int) -> int:
+    """The largest number kept per target whose rank tuples for n joints fit MAX_COMBINATIONS_PER_SOLUTION."""
+    low, high = 1, MAX_COMBINATIONS_PER_SOLUTION  # _down_set_size(n, 1) = 1 fits; the high end never does for n ≥ 2
+    while low < high:
+        middle = (low + high + 1) // 2
+        if _down_set_size(n, middle) <= MAX_COMBINATIONS_PER_SOLUTION:
+            low = middle
+        else:
+            high = middle - 1
+    return low
 
 
 def _within_move(robot: Robot, limits: Limits, q: np.ndarray, first: np.ndarray, last: np.ndarray,

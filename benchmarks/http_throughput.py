@@ -7,11 +7,20 @@ It starts the service (one uvicorn worker, as ``python -m service`` does) on a
 free loopback port, and drives it with wrk (Debian package ``wrk``; the POST
 bodies go in through a Lua script):
 
-* requests/s and p50/p99 latency for single FK and single IK (PUMA 560), beside
-  ``GET /healthz`` of the same server as the framework's ceiling;
+* requests/s and p50/p99 latency for single FK (PUMA 560), single IK on catalogue
+  robots of three families (PUMA 560, UR5, KUKA KR 6 R900-2) and on an inline robot
+  (the PUMA's description sent in the body), beside ``GET /healthz`` of the same
+  server as the framework's ceiling, each as a share of it;
+* the same single IK against two worker processes (``KIN_WORKERS=2``), for the
+  scale-out ratio;
 * poses/s for one IK batch of N targets (``format: arrays``, and the default
   objects form for comparison), against the core's own time for the same batch
-  measured in this process (``solve_ik_arrays``).
+  measured in this process (``solve_ik_arrays``);
+* the workload a reachability study sends: the same N targets (drawn over the
+  whole ±π joint range) with the robot's catalogue limits in force, the whole
+  answer (solve, limits, 2π-equivalents, encoding) over HTTP, per pose, against
+  EAIK's batched in-process solve of the same poses (``IK_batched``, when EAIK is
+  installed).
 
 Traffic goes only to 127.0.0.1, each wrk run is bounded in time, and the
 server is stopped at the end.
@@ -45,6 +54,8 @@ from .core import machine, sample_configurations
 
 ROOT = Path(__file__).resolve().parent.parent
 ROBOT = "puma560_standard"
+#: single-pose IK rows: the PUMA and UR5 families and one of the offset-shoulder (OPW) arms
+SINGLE_IK_ROBOTS = ("puma560_standard", "ur5", "kuka_kr6_r900_2")
 
 
 @dataclass
@@ -62,9 +73,11 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def start_server(port: int, max_batch: int, max_body: int) -> subprocess.Popen:
-    env = {**os.environ, "HOST": "127.0.0.1", "PORT": str(port), "KIN_LOG_LEVEL": "warning", "KIN_WORKERS": "1",
-           "KIN_MAX_BATCH": str(max_batch), "KIN_MAX_BODY_BYTES": str(max_body)}
+def start_server(port: int, max_batch: int, max_body: int, workers: int = 1) -> subprocess.Popen:
+    env = {**os.environ, "HOST": "127.0.0.1", "PORT": str(port), "KIN_LOG_LEVEL": "warning",
+           "KIN_WORKERS": str(workers), "KIN_MAX_BATCH": str(max_batch), "KIN_MAX_BODY_BYTES": str(max_body),
+           "KIN_REQUEST_TIMEOUT_MS": "300000"}  # a reachability-study batch may take longer than the default 5 s
+    env.pop("PROMETHEUS_MULTIPROC_DIR", None)
     server = subprocess.Popen([sys.executable, "-m", "service"], cwd=ROOT, env=env, start_new_session=True)
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:
@@ -127,7 +140,7 @@ def run_wrk(name: str, url: str, script: Path, *, seconds: float, connections: i
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.http_throughput", description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10, help="length of each wrk run (default 10)")
-    parser.add_argument("--connections", type=int, default=8, help="open connections for the single calls")
+    parser.add_argument("--connections", type=int, default=16, help="open connections for the single calls")
     parser.add_argument("--batch", type=int, default=10_000, help="targets in the batch request (default 10,000)")
     parser.add_argument("--quick", action="store_true", help="1-second runs and a batch of 20: a smoke run")
     args = parser.parse_args(argv)
@@ -137,67 +150,128 @@ def main(argv: list[str] | None = None) -> int:
         print("wrk is not installed (Debian: apt-get install wrk); skipped")
         return 0
 
-    robot = load_catalogue([Settings().builtin_robots_dir], max_joints=32).get(ROBOT).robot
+    catalogue = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+    robot = catalogue.get(ROBOT).robot
     q = sample_configurations(robot, args.batch, seed=4)
     T = forward_kinematics(robot, q)
     unlimited = [None] * robot.dof  # the mathematical solution set, as the core call below computes it
     bodies = {
         "fk": json.dumps({"joints": q[0].tolist()}).encode(),
-        "ik": json.dumps({"target": {"matrix": T[0].tolist()}, "limits": unlimited}).encode(),
         "batch_arrays": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "limits": unlimited,
                                     "format": "arrays"}).encode(),
         "batch_objects": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "limits": unlimited}).encode(),
+        # no "limits": the catalogue's limits apply, as they do for a user who sends none
+        "batch_limited": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "format": "arrays"}).encode(),
     }
+    for robot_id in SINGLE_IK_ROBOTS:  # one pose each from the arm's own FK, with its catalogue limits
+        arm = catalogue.get(robot_id).robot
+        pose = forward_kinematics(arm, sample_configurations(arm, 1, seed=5)[0])
+        bodies[f"ik_{robot_id}"] = json.dumps({"target": {"matrix": pose.tolist()}}).encode()
+    description = json.loads(catalogue.get(ROBOT).description.model_dump_json(exclude_none=True))
+    bodies["ik_inline"] = json.dumps({"robot": description, "target": {"matrix": T[0].tolist()}}).encode()
 
     # the core's own time for the same batch, in this process, before the server starts
     solve_ik_arrays(robot, T[:10])
     core = min(_timed(lambda: solve_ik_arrays(robot, T)) for _ in range(3))
+    eaik = _eaik_batch_seconds(robot, T)
 
-    port = free_port()
-    base = f"http://127.0.0.1:{port}"
-    server = start_server(port, max_batch=max(args.batch, 10_000), max_body=max(64 << 20, 2 * len(bodies["batch_objects"])))
+    max_body = max(64 << 20, 2 * len(bodies["batch_objects"]))
     loads: list[Load] = []
-    try:
-        with tempfile.TemporaryDirectory() as folder:
-            folder = Path(folder)
-            scripts = {name: _lua(folder / f"{name}.json", body) for name, body in bodies.items()}
-            scripts["healthz"] = _lua(folder / "healthz.json", None)
-            single = dict(seconds=args.seconds, connections=args.connections, timeout=10)
+    with tempfile.TemporaryDirectory() as folder:
+        folder = Path(folder)
+        scripts = {name: _lua(folder / f"{name}.json", body) for name, body in bodies.items()}
+        scripts["healthz"] = _lua(folder / "healthz.json", None)
+        single = dict(seconds=args.seconds, connections=args.connections, timeout=10)
+        port = free_port()
+        base = f"http://127.0.0.1:{port}"
+        server = start_server(port, max_batch=max(args.batch, 10_000), max_body=max_body)
+        try:
             loads.append(run_wrk("GET /healthz (framework ceiling)", f"{base}/healthz", scripts["healthz"], **single))
-            loads.append(run_wrk("POST fk, one configuration", f"{base}/v1/robots/{ROBOT}/fk", scripts["fk"], **single))
-            loads.append(run_wrk("POST ik, one pose", f"{base}/v1/robots/{ROBOT}/ik", scripts["ik"], **single))
-            for form in ("arrays", "objects"):
+            loads.append(run_wrk("POST fk, one configuration", f"{base}/v1/robots/{ROBOT}/fk", scripts["fk"],
+                                 **single))
+            for robot_id in SINGLE_IK_ROBOTS:
+                loads.append(run_wrk(f"POST ik, one pose, {robot_id}", f"{base}/v1/robots/{robot_id}/ik",
+                                     scripts[f"ik_{robot_id}"], **single))
+            loads.append(run_wrk(f"POST /v1/ik, one pose, inline {ROBOT}", f"{base}/v1/ik", scripts["ik_inline"],
+                                 **single))
+            for form, what in (("arrays", "format arrays"), ("objects", "format objects"),
+                               ("limited", "format arrays, catalogue limits")):
                 # one request first (warm-up), so that the run is long enough for several requests of this size
                 once = _post(f"{base}/v1/robots/{ROBOT}/ik/batch", bodies[f"batch_{form}"])
                 seconds = min(max(args.seconds, 2, 4 * once + 1), 120)
-                loads.append(run_wrk(f"POST ik/batch, {args.batch:,} targets, format {form}",
+                loads.append(run_wrk(f"POST ik/batch, {args.batch:,} targets, {what}",
                                      f"{base}/v1/robots/{ROBOT}/ik/batch", scripts[f"batch_{form}"],
                                      seconds=seconds, connections=1, timeout=120))
-    finally:
-        stop_server(server)
+        finally:
+            stop_server(server)
+        # the same single IK against two worker processes, for the scale-out ratio
+        port = free_port()
+        server = start_server(port, max_batch=10_000, max_body=max_body, workers=2)
+        try:
+            two_workers = run_wrk(f"POST ik, one pose, {ROBOT}, 2 workers",
+                                  f"http://127.0.0.1:{port}/v1/robots/{ROBOT}/ik", scripts[f"ik_{ROBOT}"], **single)
+        finally:
+            stop_server(server)
+    loads.append(two_workers)
 
     print(f"machine: {machine()}")
-    print(f"server: python -m service (uvicorn, 1 worker) on 127.0.0.1; wrk 1 thread, {args.connections} connections "
-          f"for the single calls, 1 for the batches; {args.seconds:g} s per run; robot {ROBOT}\n")
-    print("| endpoint | requests/s | p50 ms | p99 ms | requests | poses/s |")
-    print("|---|---:|---:|---:|---:|---:|")
+    print(f"server: python -m service (uvicorn, 1 worker unless said) on 127.0.0.1; wrk 1 thread on the same machine, "
+          f"{args.connections} connections for the single calls, 1 for the batches; {args.seconds:g} s per run; "
+          f"batches on {ROBOT}\n")
+    ceiling = loads[0]
+    print("| endpoint | requests/s | share of /healthz | p50 ms | p99 ms | requests | poses/s |")
+    print("|---|---:|---:|---:|---:|---:|---:|")
     for load in loads:
         poses = load.requests_per_second * args.batch if "batch" in load.name else None
-        print(f"| {load.name} | {load.requests_per_second:,.1f} | {load.p50_ms:.2f} | {load.p99_ms:.2f} | "
-              f"{load.requests:,} | {'' if poses is None else f'{poses:,.0f}'} |")
-    print(f"| core solve_ik_arrays, same {args.batch:,} targets, in process | {1 / core:,.1f} | {core * 1e3:.2f} | "
-          f" | | {args.batch / core:,.0f} |")
-    ceiling, fk, ik, arrays, objects = loads
-    print("\ntargets (ratios from this run):")
-    share = ik.requests_per_second / ceiling.requests_per_second
-    print(f"- single-IK throughput / trivial endpoint: {share:.2f} (target >= 0.60: {'met' if share >= 0.6 else 'NOT met'})")
-    print(f"- single-FK throughput / trivial endpoint: {fk.requests_per_second / ceiling.requests_per_second:.2f}")
-    ratio = (arrays.p50_ms / 1e3) / core
-    print(f"- {args.batch:,}-target batch over HTTP (arrays form, p50) / core batch time: {ratio:.2f} "
-          f"(target <= 3: {'met' if ratio <= 3 else 'NOT met'})")
+        print(f"| {load.name} | {load.requests_per_second:,.1f} | "
+              f"{load.requests_per_second / ceiling.requests_per_second:.2f} | {load.p50_ms:.2f} | "
+              f"{load.p99_ms:.2f} | {load.requests:,} | {'' if poses is None else f'{poses:,.0f}'} |")
+    print(f"| core solve_ik_arrays, same {args.batch:,} targets, in process | {1 / core:,.1f} | | "
+          f"{core * 1e3:.2f} | | | {args.batch / core:,.0f} |")
+    if eaik is not None:
+        print(f"| EAIK IK_batched, same {args.batch:,} targets, in process | {1 / eaik:,.1f} | | {eaik * 1e3:.2f} | "
+              f"| | {args.batch / eaik:,.0f} |")
+    by_name = {load.name: load for load in loads}
+    fk = by_name["POST fk, one configuration"]
+    ik = by_name[f"POST ik, one pose, {ROBOT}"]
+    inline = by_name[f"POST /v1/ik, one pose, inline {ROBOT}"]
+    arrays, objects, limited = (by_name[f"POST ik/batch, {args.batch:,} targets, {what}"] for what in
+                                ("format arrays", "format objects", "format arrays, catalogue limits"))
+
+    def goal(text: str, value: float, target: float, at_least: bool = True) -> None:
+        met = value >= target if at_least else value <= target
+        print(f"- {text}: {value:.2f} (goal {'>=' if at_least else '<='} {target:g}: {'met' if met else 'NOT met'})")
+
+    print("\ngoals (ratios from this run):")
+    best_ik = max(by_name[f"POST ik, one pose, {r}"].requests_per_second for r in ("puma560_standard", "ur5"))
+    goal("single IK on the PUMA or UR5 / GET /healthz", best_ik / ceiling.requests_per_second, 0.5)
+    goal("inline-robot IK / GET /healthz", inline.requests_per_second / ceiling.requests_per_second, 0.4)
+    goal("single FK / GET /healthz", fk.requests_per_second / ceiling.requests_per_second, 0.7)
+    goal("2 workers / 1 worker, single IK (wrk shares the 2 cores)",
+         two_workers.requests_per_second / ik.requests_per_second, 1.7)
+    goal(f"{args.batch:,}-target batch over HTTP (arrays form, p50) / core batch time", (arrays.p50_ms / 1e3) / core,
+         3, at_least=False)
     print(f"- {args.batch:,}-target batch over HTTP (objects form, p50) / core batch time: "
           f"{(objects.p50_ms / 1e3) / core:.2f}")
+    if eaik is None:
+        print("- EAIK is not installed (pip install -e '.[bench]'): the limits-on batch has no anchor in this run")
+    else:
+        goal(f"{args.batch:,}-target batch over HTTP with the catalogue limits (p50) / EAIK's batched in-process "
+             f"solve, per pose", (limited.p50_ms / 1e3) / eaik, 8, at_least=False)
     return 0
+
+
+def _eaik_batch_seconds(robot, T: np.ndarray) -> float | None:
+    """EAIK's best-of-three time for ``IK_batched`` on the poses T (N, 4, 4), or None without EAIK."""
+    from . import anchors
+
+    if not anchors.installed("EAIK"):
+        return None
+    anchor = anchors.eaik(robot)
+    if isinstance(anchor, str):
+        return None
+    anchor.ik_batch(T[:10])
+    return min(_timed(lambda: anchor.ik_batch(T)) for _ in range(3))
 
 
 def _post(url: str, body: bytes) -> float:

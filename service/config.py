@@ -42,7 +42,7 @@ class Settings(BaseSettings):
         5000, ge=1, le=3_600_000,
         description="deadline for a whole request (solve, select, encode); past it: 503 with Retry-After")
     max_solutions_per_response: int = Field(
-        100_000, ge=1, description="most solutions (kept plus rejected) one answer may hold, estimated before "
+        200_000, ge=1, description="most solutions (kept plus rejected) one answer may hold, estimated before "
                                    "solving; more is refused with 413")
     max_response_bytes: int = Field(
         64 * 1024 * 1024, ge=1024, description="largest estimated answer in bytes; more is refused with 413")
@@ -57,6 +57,10 @@ class Settings(BaseSettings):
     max_connections: int = Field(
         900, ge=1, description="most open connections per worker (uvicorn's limit_concurrency); keep it below "
                                "the descriptor limit")
+    robot_cache_size: int = Field(
+        64, ge=0, le=100_000, description="most inline robot descriptions (and robots with a request's own "
+                                          "base/tool) kept built with their IK plans, least recently used "
+                                          "dropped first; 0 turns the cache off")
     max_robot_file_bytes: int = Field(1024 * 1024, ge=1024, description="largest robot file the catalogue loads")
 
     @field_validator("cors_origins", mode="before")

@@ -44,7 +44,11 @@ def test_http_benchmark_runs_with_tiny_sizes(capsys):
     assert http_throughput.main(["--quick"]) == 0
     out = capsys.readouterr().out
     assert "| GET /healthz (framework ceiling) |" in out
-    assert "single-IK throughput / trivial endpoint" in out
+    assert "single IK on the PUMA or UR5 / GET /healthz" in out
+    for row in ("POST ik, one pose, kuka_kr6_r900_2", "POST /v1/ik, one pose, inline puma560_standard",
+                "POST ik, one pose, puma560_standard, 2 workers"):
+        assert f"| {row} |" in out
+    assert "targets, format arrays, catalogue limits |" in out
 
 
 def test_http_benchmark_says_when_wrk_is_missing(capsys, monkeypatch):

@@ -18,6 +18,7 @@ from ..config import Settings
 from ..kinematics import BudgetExhausted
 from .budget import TIMEOUT_HEADER, InFlight, WorkLimits, budget_exhausted
 from .body_size import BodySizeLimit
+from .robot_cache import RobotCache
 from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
 from .examples import add_examples
 from .pages import install_pages
@@ -83,6 +84,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.settings = settings
     app.state.catalogue = None
     app.state.in_flight = InFlight(settings.max_in_flight)
+    app.state.inline_robots = RobotCache("inline", settings.robot_cache_size)
     configure_logging(settings.log_level)
     install_problem_handlers(app)
     app.add_exception_handler(BudgetExhausted, budget_exhausted)

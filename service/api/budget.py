@@ -240,8 +240,30 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: 
                            f"{settings.max_numeric_starts:,}. Send fewer targets or fewer numeric.starts.")
     kept = max_equivalents if max_solutions is None else min(max_equivalents, max_solutions)
     equivalents = equivalents_per_solution(robot, limits)
-    per_target = min(kept, solutions_per_target * equivalents) + solutions_per_target  # kept + rejected
+    per_target, rejected = worst_answer_per_target(solutions_per_target, equivalents, kept)
     check_answer_size(settings, robot, targets=targets, per_target=per_target, form=form,
                       what=f"{targets:,} targets × up to {per_target:,} each: {solutions_per_target} solutions "
-                           f"× {equivalents:,} 2π-equivalents with at most {kept:,} kept, and up to "
-                           f"{solutions_per_target} rejected")
+                           f"× {equivalents:,} 2π-equivalents with at most {kept:,} kept"
+                           + (f", when {rejected} of them are rejected" if rejected else ""))
+
+
+def worst_answer_per_target(solutions: int, equivalents: int, kept: int) -> tuple[int, int]:
+    """The most rows (kept plus rejected) one target's answer can hold, and how many of them are then rejected.
+
+    A solution either fits, and gives up to ``equivalents`` rows of which at most ``kept`` in all are kept, or
+    does not, and gives one rejected row (or one flagged row when filter_limits is false). With r rejected the
+    answer holds min(kept, (solutions − r) × equivalents) + r rows: growing in r while the fitting ones still
+    fill ``kept``, shrinking after, so the most is at the r where they just fill it (or at r = 0).
+
+    >>> worst_answer_per_target(8, 2, 1024)   # a PUMA with its limits: every solution fits, twice
+    (16, 0)
+    >>> worst_answer_per_target(8, 10**30, 1000)   # one fitting solution fills the cap; the other 7 are rejected
+    (1007, 7)
+    """
+    def rows(rejected: int) -> int:
+        return min(kept, (solutions - rejected) * equivalents) + rejected
+
+    filling = solutions - -(-kept // equivalents)  # the most rejected while the others still fill `kept`
+    candidates = {0, solutions, max(0, filling), min(solutions, max(0, filling + 1))}
+    rejected = max(sorted(candidates), key=rows)
+    return rows(rejected), rejected

@@ -77,8 +77,14 @@ def nearest_ids(wanted: str, ids: list[str], limit: int = 5) -> list[str]:
 
 
 def inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef:
-    with located("body", "robot"):
-        robot = robot_from_description(description, max_joints=settings_of(request).max_joints)
+    """The robot a request describes, built once per canonical description (see :mod:`.robot_cache`)."""
+    max_joints = settings_of(request).max_joints
+
+    def build() -> Robot:
+        with located("body", "robot"):
+            return robot_from_description(description, max_joints=max_joints)
+
+    robot = request.app.state.inline_robots.get((description.model_dump_json(), max_joints), build)
     return RobotRef(description.id, robot)
 
 

@@ -7,6 +7,7 @@ The memo lives on the robot object itself and goes away with it.
 
 from __future__ import annotations
 
+from collections import OrderedDict
 from typing import Any, Callable, Hashable, TypeVar
 
 T = TypeVar("T")
@@ -24,3 +25,17 @@ def memo(robot: Any, key: Hashable, build: Callable[[], T]) -> T:
     except KeyError:
         value = store[key] = build()
         return value
+
+
+def bounded_memo(robot: Any, namespace: str, key: Hashable, build: Callable[[], T], capacity: int) -> T:
+    """:func:`memo` for a family of keys of which at most ``capacity`` are kept, least recently used dropped."""
+    store = memo(robot, namespace, OrderedDict)
+    try:
+        value = store[key]
+    except KeyError:
+        value = store[key] = build()
+        while len(store) > capacity:
+            store.popitem(last=False)
+        return value
+    store.move_to_end(key)
+    return value

@@ -20,10 +20,13 @@ from typing import Literal, Sequence
 
 import numpy as np
 
-from ._cache import memo
+from ._cache import bounded_memo, memo
 from ._conventions import CONVENTIONS, Convention
 from ._errors import InvalidInputError, LimitOrderError
 from ._tolerances import GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
+
+#: Robots with other base/tool frames kept on their parent by :meth:`Robot.with_frames`.
+FRAMED_ROBOTS_KEPT = 16
 
 JointKind = Literal["revolute", "prismatic"]
 JOINT_KINDS: tuple[JointKind, ...] = ("revolute", "prismatic")
@@ -197,15 +200,24 @@ class Robot:
                     flange_T_tool: np.ndarray | None = None) -> "Robot":
         """The same arm with another ``world_T_base`` and/or ``flange_T_tool`` (None keeps the robot's own).
 
-        A new object, so nothing derived from the old frames (plans, screw models) is carried over.
+        Another object, so nothing derived from the old frames (plans, screw models) is carried over; the
+        last :data:`FRAMED_ROBOTS_KEPT` of them are kept on this robot, so asking again for the same frames
+        returns the same object, with what it has derived since.
         """
-        other = Robot.__new__(Robot)
-        other.__dict__.update({key: value for key, value in self.__dict__.items() if key != "_derived"})
-        if world_T_base is not None:
-            other.world_T_base = _checked_transform(world_T_base, "base")
-        if flange_T_tool is not None:
-            other.flange_T_tool = _checked_transform(flange_T_tool, "tool")
-        return other
+        base = None if world_T_base is None else _checked_transform(world_T_base, "base")
+        tool = None if flange_T_tool is None else _checked_transform(flange_T_tool, "tool")
+
+        def build() -> "Robot":
+            other = Robot.__new__(Robot)
+            other.__dict__.update({key: value for key, value in self.__dict__.items() if key != "_derived"})
+            if base is not None:
+                other.world_T_base = base
+            if tool is not None:
+                other.flange_T_tool = tool
+            return other
+
+        key = (None if base is None else base.tobytes(), None if tool is None else tool.tobytes())
+        return bounded_memo(self, "with_frames", key, build, FRAMED_ROBOTS_KEPT)
 
     @property
     def dof(self) -> int:

@@ -19,7 +19,7 @@ from service.api.app import create_app
 from service.api.budget import InFlight, WorkLimits, budget_of
 from service.api.routers import health
 from service.config import Settings
-from service.kinematics import COUNT_CAP, Budget, BudgetExhausted
+from service.kinematics import COUNT_CAP, Budget, BudgetExhausted, Limits
 from tests.conftest import assert_problem
 
 UR5_Q = [0.3, -1.0, 1.2, 0.4, 0.5, 0.6]
@@ -97,9 +97,11 @@ def test_max_equivalents_beyond_the_solution_cap_is_413_before_solving():
     """max_equivalents 100000 turned a 534-byte request into 30.6 MB; it is refused, and by how much is said."""
     with TestClient(create_app(Settings(_env_file=None))) as client:
         body = {"target": _ur5_target(client), "limits": _limits(300.0), "max_equivalents": 100_000}
+        client.app.state.settings.max_solutions_per_response = 100_000
         problem = assert_problem(client.post("/v1/robots/ur5/ik", json=body), 413,
                                  match="KIN_MAX_SOLUTIONS_PER_RESPONSE = 100,000")
-        assert "8 more than" in problem["detail"]  # 100,000 kept + 8 rejected
+        # the worst case: one solution fits and fills the 100,000 kept, the other 7 are rejected
+        assert "100,007 solutions" in problem["detail"] and "7 of them are rejected" in problem["detail"]
 
 
 def test_a_whole_workspace_batch_is_413_before_solving(client, monkeypatch):
@@ -115,7 +117,33 @@ def test_a_whole_workspace_batch_is_413_before_solving(client, monkeypatch):
     for form in ("objects", "arrays"):
         response = client.post("/v1/robots/ur5/ik/batch", json={"targets": targets, "format": form})
         problem = assert_problem(response, 413, match="KIN_MAX_SOLUTIONS_PER_RESPONSE")
-        assert "5,200,000 solutions" in problem["detail"]  # 10,000 × (8 × 2⁶ kept + 8 rejected)
+        assert "5,120,000 solutions" in problem["detail"]  # 10,000 × 8 × 2⁶ kept
+
+
+def test_the_worst_answer_per_target_is_the_most_over_every_number_rejected():
+    """Independent count: every number r of rejected solutions, min(kept, (S − r) × E) + r rows."""
+    import itertools
+
+    from service.api.budget import worst_answer_per_target
+
+    for solutions, equivalents, kept in itertools.product(range(12), (1, 2, 3, 64, 2**53 - 1), (1, 2, 5, 16, 1024)):
+        rows, rejected = worst_answer_per_target(solutions, equivalents, kept)
+        brute = [min(kept, (solutions - r) * equivalents) + r for r in range(solutions + 1)]
+        assert rows == max(brute) and brute[rejected] == rows
+
+
+def test_a_puma_reachability_batch_with_its_catalogue_limits_fits_the_default_caps(client):
+    """10,000 targets on the PUMA with its limits: up to 8 solutions × 2 equivalents each, 160,000 in all."""
+    from service.api.budget import check_ik_cost
+
+    robot = client.app.state.catalogue.get("puma560_standard").robot
+    settings = Settings(_env_file=None)
+    check_ik_cost(settings, robot, Limits.of(robot), targets=10_000, solutions_per_target=8, max_equivalents=1024,
+                  max_solutions=None, form="arrays")
+    with pytest.raises(Exception, match="160,000 solutions"):
+        check_ik_cost(Settings(_env_file=None, max_solutions_per_response=150_000), robot, Limits.of(robot),
+                      targets=10_000, solutions_per_target=8, max_equivalents=1024, max_solutions=None,
+                      form="arrays")
 
 
 def test_the_response_byte_cap_is_checked_too():

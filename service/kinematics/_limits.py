@@ -26,10 +26,7 @@ import numpy as np
 
 from ._errors import InvalidInputError
 from ._robot import Robot, check_limit_pair
-
-#: Inclusive-bound tolerance: radians for revolute joints; times the robot's
-#: characteristic length for prismatic joints.
-LIMIT_TOLERANCE = 1e-9
+from ._tolerances import LIMIT_TOLERANCE
 
 _TWO_PI = 2.0 * np.pi
 

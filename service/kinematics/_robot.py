@@ -23,6 +23,7 @@ import numpy as np
 from ._cache import bounded_memo, memo
 from ._conventions import CONVENTIONS, Convention
 from ._errors import InvalidInputError, LimitOrderError
+from ._tolerances import GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
 
 #: Robots with other base/tool frames kept on their parent by :meth:`Robot.with_frames`.
 FRAMED_ROBOTS_KEPT = 16
@@ -276,10 +277,11 @@ def _joint_frame(joint: ScrewJoint, index: int) -> np.ndarray:
     if point.shape != (3,) or not np.all(np.isfinite(point)):
         raise InvalidInputError("point must be 3 finite numbers", location=(*where, "point"))
     norm = float(np.linalg.norm(axis))
-    if norm < 1e-9:
+    if norm < GEOMETRY_TOLERANCE:
         raise InvalidInputError("axis must not be the zero vector", location=(*where, "axis"))
-    if abs(norm - 1.0) > 1e-6:
-        raise InvalidInputError(f"axis must be a unit vector (within 1e-6), its length is {norm:.9g}",
+    if abs(norm - 1.0) > ORTHONORMAL_TOLERANCE:
+        raise InvalidInputError(f"axis must be a unit vector (within {ORTHONORMAL_TOLERANCE:g}), "
+                                f"its length is {norm:.9g}",
                                 location=(*where, "axis"))
     _check_limits(joint, where)
     z = axis / norm

@@ -39,6 +39,10 @@ POLISH_RESIDUAL = 1e-4
 #: length for prismatic joints) are the same solution.
 DUPLICATE_TOLERANCE = 1e-6
 
+#: Inclusive-bound tolerance of joint limits: radians for revolute joints; times the robot's
+#: characteristic length for prismatic joints.
+LIMIT_TOLERANCE = 1e-9
+
 #: A configuration is reported as singular when the relevant quantity (a sine,
 #: a normalised distance) is smaller than this.
 SINGULARITY_TOLERANCE = 1e-7

@@ -45,7 +45,7 @@ class PositionerResult:
 
 def _unit(v: np.ndarray) -> np.ndarray | None:
     norm = np.linalg.norm(v)
-    return v / norm if norm > 1e-9 else None
+    return v / norm if norm > GEOMETRY_TOLERANCE else None
 
 
 def side_codes(side: np.ndarray, size: np.ndarray) -> np.ndarray:
@@ -205,9 +205,10 @@ class IntersectingShoulder(Positioner):
         """
         g, (_, j, k) = self.geometry, self.joints
         axis = g.direction(j)
-        constant = g.parallel(j, k) if g.model.is_revolute[k] else abs(float(g.direction(k) @ axis)) <= 1e-9
+        constant = g.parallel(j, k) if g.model.is_revolute[k] \
+            else abs(float(g.direction(k) @ axis)) <= GEOMETRY_TOLERANCE
         along = float((self.point - self.centre) @ axis)
-        if not constant or abs(along) <= 1e-9 * g.length_scale:
+        if not constant or abs(along) <= GEOMETRY_TOLERANCE * g.length_scale:
             return None
         return along * axis
 
@@ -329,12 +330,12 @@ class OffsetShoulderParallelElbow(Positioner):
         if geometry.model.is_revolute[k]:
             if not geometry.parallel(j, k) or geometry.on_axis(k, np.asarray(point, dtype=float)):
                 return None
-        elif abs(float(geometry.direction(k) @ u)) > 1e-9:
+        elif abs(float(geometry.direction(k) @ u)) > GEOMETRY_TOLERANCE:
             return None
         if geometry.model.is_revolute[i]:
             if geometry.parallel(i, j):
                 return None
-        elif abs(float(geometry.direction(i) @ u)) <= 1e-9:
+        elif abs(float(geometry.direction(i) @ u)) <= GEOMETRY_TOLERANCE:
             return None
         solver = cls(geometry, joints, point)
         if geometry.model.is_revolute[i]:
@@ -468,7 +469,7 @@ class OffsetShoulderIntersectingElbow(Positioner):
         i, j, k = joints
         centre = geometry.intersection(j, k)
         point = np.asarray(point, dtype=float)
-        if centre is None or np.linalg.norm(point - centre) <= 1e-9 * geometry.length_scale:
+        if centre is None or np.linalg.norm(point - centre) <= GEOMETRY_TOLERANCE * geometry.length_scale:
             return None
         if geometry.model.is_revolute[i] and geometry.on_axis(i, centre):
             return None  # all three axes through one point: it cannot place a point
@@ -656,7 +657,7 @@ class PlanarTwoLink(Positioner):
         u = g.direction(i)
         radial = targets - g.point(i)
         reach = np.linalg.norm(radial - np.outer(radial @ u, u), axis=-1)
-        in_plane = np.abs((targets - self.point) @ u) <= 1e-9 * g.length_scale
+        in_plane = np.abs((targets - self.point) @ u) <= GEOMETRY_TOLERANCE * g.length_scale
         in_plane_projector = np.eye(3) - np.outer(u, u)
         elbow = subproblem_3(g.direction(j), in_plane_projector @ (self.point - g.point(j)),
                              in_plane_projector @ (g.point(i) - g.point(j)), reach)
@@ -707,7 +708,7 @@ class OneRevoluteTwoPrismatic(Positioner):
         solver.slides = tuple(joint for joint in joints if joint != solver.revolute)
         omega = geometry.direction(solver.revolute)
         axial = np.array([omega @ geometry.direction(s) for s in solver.slides])
-        if np.abs(axial).max() <= 1e-9:
+        if np.abs(axial).max() <= GEOMETRY_TOLERANCE:
             return None  # no slide along the axis: the height equation does not fix them
         return solver
 
@@ -766,7 +767,7 @@ class Cartesian(Positioner):
         if len(joints) != 3 or geometry.kinds(joints) != "PPP":
             return None
         V = np.stack([geometry.direction(j) for j in joints], axis=1)
-        if abs(np.linalg.det(V)) < 1e-9:
+        if abs(np.linalg.det(V)) < GEOMETRY_TOLERANCE:
             return None
         solver = cls(geometry, joints, point)
         solver.inverse = np.linalg.inv(V)
@@ -820,11 +821,12 @@ class SkewAxesWithSlide(Positioner):
             if geometry.on_axis(circle, point):
                 return None  # the circle is a point: joint b does not move it
         along = abs(float(geometry.direction(eliminated) @ geometry.direction(slide)))
-        normal = along <= 1e-9
+        normal = along <= GEOMETRY_TOLERANCE
         if normal and geometry.parallel(eliminated, circle):
             return None  # planar: the height along the parallel axes never changes
         turn = float(np.linalg.norm(np.cross(geometry.direction(eliminated), geometry.direction(circle))))
-        if 1e-9 < along <= RECOGNITION_TOLERANCE or 10 * GEOMETRY_TOLERANCE < turn <= RECOGNITION_TOLERANCE:
+        if GEOMETRY_TOLERANCE < along <= RECOGNITION_TOLERANCE \
+                or 10 * GEOMETRY_TOLERANCE < turn <= RECOGNITION_TOLERANCE:
             return None  # nearly special (a rounded SCARA): the idealised family answers, refined on this arm
         solver = cls(geometry, joints, point)
         solver.kinds, solver.slide, solver.revolute = kinds, slide, tuple(revolute)

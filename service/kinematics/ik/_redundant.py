@@ -143,7 +143,8 @@ class FreeJointFamily:
         answer = solve_ik_arrays(robot, forward_kinematics(robot, q)[None], constrain_orientation=True,
                                  reference=None, plan=rows)
         found = answer.joints[0, :answer.count[0]]
-        return bool(len(found)) and bool((np.abs(wrap_revolute(robot, found - q)).max(axis=1) < 1e-6).any())
+        gap = np.abs(wrap_revolute(robot, found - q)).max(axis=1)
+        return bool(len(found)) and bool((gap < DUPLICATE_TOLERANCE).any())
 
     def _plan_locked_at(self, locked: dict[int, float]) -> Plan | None:
         return plan_for_geometry(locked_geometry(self.geometry, locked), constrain_orientation=True,

@@ -100,7 +100,7 @@ def _closest_common_point(points: list[np.ndarray], directions: list[np.ndarray]
         projector = np.eye(3) - np.outer(k, k)
         A += projector
         b += projector @ p
-    if np.linalg.matrix_rank(A, tol=1e-9) < 3:
+    if np.linalg.matrix_rank(A, tol=GEOMETRY_TOLERANCE) < 3:
         return None
     x = np.linalg.solve(A, b)
     for p, k in zip(points, directions):

@@ -5,12 +5,13 @@ from __future__ import annotations
 import math
 import os
 import shutil
+import sys
 import tempfile
 
 import uvicorn
 
 from .config import Settings
-from .server import WatchedProtocol, log_config
+from .server import ClosingMultiprocess, WatchedProtocol, log_config
 
 MULTIPROC_ENV = "PROMETHEUS_MULTIPROC_DIR"
 
@@ -25,7 +26,7 @@ def main() -> None:
         own_metrics_dir = tempfile.mkdtemp(prefix="kin-metrics-")
         os.environ[MULTIPROC_ENV] = own_metrics_dir
     try:
-        uvicorn.run(
+        config = uvicorn.Config(
             "service.api.app:create_app",
             factory=True,
             host=settings.host,
@@ -42,6 +43,13 @@ def main() -> None:
             # in-flight request finish or refuse cleanly instead of being cut off with a text/plain 500.
             timeout_graceful_shutdown=math.ceil(settings.request_timeout_ms / 1000.0) + 2,
         )
+        if settings.workers > 1:  # the parent holds the listening socket: it closes it first on SIGTERM
+            ClosingMultiprocess(config, sockets=[config.bind_socket()]).run()
+        else:
+            server = uvicorn.Server(config)
+            server.run()
+            if not server.started:
+                sys.exit(3)  # uvicorn's start-up failure code
     finally:
         if own_metrics_dir is not None:
             shutil.rmtree(own_metrics_dir, ignore_errors=True)

@@ -12,8 +12,9 @@ adds both, on uvicorn's own HTTP protocol classes:
 Each closes the connection and logs one warning line naming the client. ``KIN_MAX_CONNECTIONS`` caps the open
 connections per worker: a connection opened past it is answered 503 at once (a problem+json with ``Retry-After``
 and ``Connection: close``, logged) instead of letting descriptors run out. :class:`_Watchdog` enforces it itself
-rather than through uvicorn's ``limit_concurrency``, whose 503 is text/plain. The settings are read from the environment in each worker process, since workers are
-spawned and do not share the parent's objects.
+rather than through uvicorn's ``limit_concurrency``, whose 503 is text/plain. The settings are read from the
+environment in each worker process, since workers are spawned and do not share the parent's objects. With several
+workers, :class:`ClosingMultiprocess` closes the shared listening socket on SIGTERM.
 """
 
 from __future__ import annotations
@@ -21,6 +22,8 @@ from __future__ import annotations
 import asyncio
 import logging
 from typing import Any
+
+from uvicorn.supervisors.multiprocess import Multiprocess
 
 from .api.budget import RETRY_AFTER_SECONDS
 from .api.problems import problem_response
@@ -121,6 +124,28 @@ def _protocol_class() -> type:
 #: The HTTP protocol ``python -m service`` runs (module-level so that spawned workers import it by name).
 WatchedProtocol = _protocol_class()
 globals()[WatchedProtocol.__name__] = WatchedProtocol
+
+
+class ClosingMultiprocess(Multiprocess):
+    """uvicorn's supervisor of several workers, closing its listening socket as soon as SIGTERM or SIGINT arrives.
+
+    The workers share the parent's socket. uvicorn's parent keeps it open until every worker has finished its
+    graceful shutdown, so the kernel went on accepting connections that no one served: they hung for up to
+    ``KIN_REQUEST_TIMEOUT_MS`` + 2 s and were then reset. Closed at once (and by each worker as it stops), a new
+    connection is refused, as with one worker.
+    """
+
+    def _close_sockets(self) -> None:
+        for sock in self.sockets:
+            sock.close()
+
+    def handle_term(self) -> None:
+        self._close_sockets()
+        super().handle_term()
+
+    def handle_int(self) -> None:
+        self._close_sockets()
+        super().handle_int()
 
 
 def log_config(level: str) -> dict[str, Any]:

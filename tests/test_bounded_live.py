@@ -209,3 +209,31 @@ def test_a_connection_over_the_cap_gets_a_problem_and_is_logged(tmp_path):
         server.stop()
     records = [json.loads(line) for line in server.lines()]
     assert any("KIN_MAX_CONNECTIONS" in record["msg"] for record in records)
+
+
+def test_with_two_workers_a_new_connection_during_shutdown_is_refused_at_once(tmp_path):
+    """SIGTERM to the parent of two workers while one still holds a connection (a request whose body has not
+    arrived): uvicorn's parent kept the shared listening socket open until every worker had finished, so the
+    kernel accepted new connections that no one served (they hung for the whole graceful shutdown, then were
+    reset). Now the parent closes it at once: a new connection is refused or answered, never left hanging."""
+    server = Server(tmp_path, KIN_WORKERS="2", KIN_BODY_TIMEOUT_S="8", KIN_REQUEST_TIMEOUT_MS="4000")
+    held = socket.create_connection(("127.0.0.1", server.port))
+    try:
+        held.sendall(b"POST /v1/robots/ur5/fk HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"
+                     b"Content-Length: 100\r\n\r\n{")
+        time.sleep(0.5)
+        server.process.send_signal(signal.SIGTERM)
+        time.sleep(1.5)  # the supervisor polls its signals every 0.5 s; the workers start their shutdown
+        assert server.process.poll() is None  # still waiting for the held connection
+        started = time.perf_counter()
+        try:
+            answered = httpx.get(f"{server.url}/healthz", timeout=5).status_code
+        except httpx.ConnectError:
+            answered = None  # refused: the socket is closed
+        assert time.perf_counter() - started < 1.0, answered
+    finally:
+        held.close()
+        code = server.stop()
+    assert code in (0, -signal.SIGTERM)
+    for line in server.lines():
+        json.loads(line)

@@ -110,7 +110,6 @@ class Solution:
     branch: Branch
     position_residual: float
     orientation_residual: float
-    singular: bool = False
 
 
 @dataclass

@@ -241,11 +241,12 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: 
                            f"{settings.max_numeric_starts:,}. Send fewer targets or fewer numeric.starts.")
     kept = max_equivalents if max_solutions is None else min(max_equivalents, max_solutions)
     equivalents = equivalents_per_solution(robot, limits)
-    if combinations_to_rank(robot.dof, kept, equivalents) > MAX_COMBINATIONS_PER_SOLUTION:
+    ranked = combinations_to_rank(robot.dof, kept, equivalents)
+    if ranked > MAX_COMBINATIONS_PER_SOLUTION:
         most = enumerable_limit(robot.dof)
         raise ProblemError(413, "too-much-work", "Too much work",
                            f"Keeping the nearest {kept:,} of up to {equivalents:,} 2π-equivalents per solution would "
-                           f"rank {combinations_to_rank(robot.dof, kept, equivalents):,} combinations of this "
+                           f"rank {ranked:,} combinations of this "
                            f"{robot.dof}-joint arm's turns per solution, more than the "
                            f"{MAX_COMBINATIONS_PER_SOLUTION:,} one answer may. Ask for at most {most:,} "
                            f"(max_equivalents or max_solutions), or narrow multi-turn limits.")

@@ -324,16 +324,17 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     if reference is not None and ordering.max_joint_move is not None:
         c_first, c_last = _within_move(robot, limits, c_q, c_first, c_last, reference, ordering.max_joint_move)
     counts = np.maximum(c_last - c_first + 1.0, 0.0)
-    available = _capped_sums(c_target, _capped_products(counts), n_targets)
+    combinations = _capped_products(counts)  # (C,) each candidate's usable combinations
+    available = _capped_sums(c_target, combinations, n_targets)
 
     limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
-    lowered = limit > enumerable_limit(n) and bool(np.any(_capped_products(counts) > MAX_COMBINATIONS_PER_SOLUTION))
+    lowered = limit > enumerable_limit(n) and bool(np.any(combinations > MAX_COMBINATIONS_PER_SOLUTION))
     if lowered:
         limit = enumerable_limit(n)
     if reference is not None:
         row_limit = np.full(len(c_target), limit, dtype=np.int64)
     else:  # round robin: no solution gives more than the rounds needed to reach the limit
-        row_limit = _rounds_needed(c_target, _capped_products(counts), n_targets, limit)[c_target]
+        row_limit = _rounds_needed(c_target, combinations, n_targets, limit)[c_target]
     kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
                                       reference, ordering, budget)
     rows = np.flatnonzero(candidate)[kept_rows]

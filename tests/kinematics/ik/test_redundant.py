@@ -40,9 +40,6 @@ def assert_fk_verified(robot, solutions: np.ndarray, target: np.ndarray) -> None
     assert np.abs(reached[:, :3, :3] - target[:3, :3]).max() <= 1e-8
 
 
-PANDA_SOLVABLE = family_for(arm("panda"), (6,)).available
-needs_general_6r = pytest.mark.xfail(not PANDA_SOLVABLE, strict=True,
-                                     reason="a Panda with q7 locked needs the general 6R solver (issue 10)")
 
 
 def test_default_free_joint_is_an_end_joint_whose_locking_leaves_a_family():
@@ -61,7 +58,7 @@ def test_a_locked_class_that_is_degenerate_is_not_chosen():
 
 
 @pytest.mark.parametrize("name, joint", [("iiwa14", 2), ("iiwa14", 0), ("gen3", 2), ("gen3", 0),
-                                         pytest.param("panda", 6, marks=needs_general_6r)])
+                                         ("panda", 6)])
 def test_generating_vector_comes_back_and_every_solution_is_verified(name, joint):
     robot = arm(name)
     rng = np.random.default_rng(14)
@@ -94,7 +91,7 @@ def test_each_value_is_solved_completely():
 
 
 @pytest.mark.parametrize("name, joint", [("iiwa14", 0), ("iiwa14", 2), ("gen3", 0),
-                                         pytest.param("panda", 6, marks=needs_general_6r)])
+                                         ("panda", 6)])
 def test_nearest_to_reference_is_at_least_as_near_as_a_dense_grid(name, joint):
     robot = arm(name)
     rng = np.random.default_rng(3)

@@ -37,12 +37,13 @@ def catalogue_of(request: Request) -> Catalogue:
     return catalogue
 
 
-def catalogue_robot(
+async def catalogue_robot(
     request: Request,
     robot_id: str = Path(pattern=r"^[A-Za-z0-9][A-Za-z0-9_-]{0,63}$",
                          description="catalogue id, see GET /v1/robots; ids are lower case and matched "
                                      "case-insensitively (UR5 is ur5)"),
 ) -> RobotRef:
+    """The catalogue robot the path names (a dictionary look-up: async, so FastAPI calls it without a thread)."""
     catalogue = catalogue_of(request)
     entry = catalogue.get(robot_id.lower())
     if entry is None:

@@ -141,3 +141,37 @@ def test_objects_form_is_what_its_model_says(client, case):
     assert response.status_code == 200
     body = response.json()
     assert IKBatchResponse.model_validate(body).model_dump(mode="json") == body
+
+
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_single_answer_is_what_its_model_says(client, case):
+    """A single IK answer is encoded without passing through IKResponse either: it must already be it, and be the
+    batch's answer for the same target."""
+    from service.api.schemas.ik import IKResponse
+
+    robot_id, options, position_only = CASES[case]
+    targets = _targets(client, robot_id, 3, seed=sorted(CASES).index(case), position_only=position_only)
+    batch = client.post(f"/v1/robots/{robot_id}/ik/batch", json={"targets": targets, **options}).json()["results"]
+    for target, expected in zip(targets, batch):
+        response = client.post(f"/v1/robots/{robot_id}/ik", json={"target": target, **options})
+        assert response.status_code == 200
+        body = response.json()
+        assert IKResponse.model_validate(body).model_dump(mode="json") == body
+        _assert_same_answer(body, expected)
+
+
+def _assert_same_answer(a, b, where: str = "") -> None:
+    """Equal, but for the last bits of floats (the single pose takes the family's scalar path, a batch the
+    array path)."""
+    if isinstance(a, float) or isinstance(b, float):
+        assert abs(a - b) <= 1e-9, where
+    elif isinstance(a, dict):
+        assert list(a) == list(b), where
+        for key in a:
+            _assert_same_answer(a[key], b[key], f"{where}.{key}")
+    elif isinstance(a, list):
+        assert len(a) == len(b), where
+        for k, (x, y) in enumerate(zip(a, b)):
+            _assert_same_answer(x, y, f"{where}[{k}]")
+    else:
+        assert a == b, where

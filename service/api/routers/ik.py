@@ -79,7 +79,7 @@ def _answer_or_picture(request: Request, ref: RobotRef, body: IKRequest, render:
     answer = ik_objects(ref.id, ref.robot, _answer(request, ref, body, "objects"), body.angle_unit,
                         budget_of(request))[0]
     if render is None and not wants_svg(request):
-        return answer
+        return FastJSONResponse(answer)  # built to IKResponse field by field (a test validates it), as it stands
     return ik_picture(ref.robot, ref.id, answer, body.angle_unit, render or "iso", body.reference is not None)
 
 

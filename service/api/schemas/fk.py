@@ -2,9 +2,12 @@
 
 from __future__ import annotations
 
+from typing import Annotated
+
 from pydantic import Field
 
-from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames, RobotId
+from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames,
+                     RobotId)
 from .poses import NamedPose, Pose
 from ...robots.schemas import RobotDescription
 
@@ -37,7 +40,7 @@ class FKResponse(ApiModel):
 class FKBatchRequest(RequestFrames):
     """Many joint vectors, one tool pose each (vectorised)."""
 
-    joints: list[list[Number]] = Field(min_length=1, description="one row of joint values per configuration")
+    joints: Annotated[list[list[Number]], IN_PIECES] = Field(min_length=1, description="one row of joint values per configuration")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
 
 

@@ -8,7 +8,8 @@ from typing import Annotated, Literal
 from pydantic import Field, model_serializer, model_validator
 
 from ...kinematics.ik import MAX_EQUIVALENTS, MAX_FREE_VALUES
-from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames, RobotId
+from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames,
+                     RobotId)
 from .limits import JointLimitsOverride, LimitViolation
 from .poses import PoseTarget
 from ...robots.schemas import RobotDescription
@@ -97,7 +98,7 @@ class _Target(ApiModel):
 
 
 class _Targets(ApiModel):
-    targets: list[PoseTarget] = Field(min_length=1, description="the tool poses to reach, world frame; each is "
+    targets: Annotated[list[PoseTarget], IN_PIECES] = Field(min_length=1, description="the tool poses to reach, world frame; each is "
                                                                 "solved as an IKRequest target")
 
 

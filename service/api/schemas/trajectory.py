@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import Field, model_validator
 
 from ...kinematics import RATE_SINGULARITY_TOLERANCE
-from .common import ANGLE_UNIT_FIELD, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId, Vector3
+from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId,
+                     Vector3)
 from .ik import Branch, SingularityReport
 from .limits import LimitViolation
 from .poses import PoseTarget
@@ -54,7 +55,7 @@ class TrajectorySample(ApiModel):
 class TrajectoryRequest(RequestFrames):
     """Sampled tool poses to follow on one consistent branch, with joint velocities and accelerations."""
 
-    samples: list[TrajectorySample] = Field(
+    samples: Annotated[list[TrajectorySample], IN_PIECES] = Field(
         min_length=1, description="every pose the same kind: all with an orientation (or matrix), or all "
                                   "position-only")
     branch: Branch | None = Field(

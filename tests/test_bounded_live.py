@@ -237,3 +237,31 @@ def test_with_two_workers_a_new_connection_during_shutdown_is_refused_at_once(tm
     assert code in (0, -signal.SIGTERM)
     for line in server.lines():
         json.loads(line)
+
+
+def test_a_single_ik_is_not_queued_behind_long_requests(server):
+    """Long requests (a 2,000-sample unreachable trajectory on the numeric arm, each until its 4 s deadline) fill
+    more requests than there are cores; a single IK sent after them is answered while they still run. With one
+    work loop per core it waited for one of them to end, and in the soak went past its own deadline."""
+    fk = httpx.post(f"{server.url}/v1/robots/ur5/fk", json={"joints": UR5_Q}).json()
+    far = {"position": [5.0, 5.0, 5.0], "orientation": {"type": "rpy", "angles": [0, 0, 0]}}
+    long_body = {"robot": NUMERIC_ARM, "samples": [{"time": 0.01 * k, "pose": far} for k in range(2000)]}
+    ended: list[float] = []
+
+    def long_request() -> None:
+        with httpx.Client(timeout=60) as client:
+            response = client.post(f"{server.url}/v1/ik/trajectory", json=long_body)
+            assert response.status_code in (200, 503)
+            ended.append(time.monotonic())
+
+    long_ones = [threading.Thread(target=long_request) for _ in range(2 * (os.cpu_count() or 1) + 1)]
+    for thread in long_ones:
+        thread.start()
+    time.sleep(0.5)  # they have started computing
+    with httpx.Client(timeout=60) as client:
+        response = client.post(f"{server.url}/v1/robots/ur5/ik", json={"target": {"matrix": fk["pose"]["matrix"]}})
+    answered = time.monotonic()
+    for thread in long_ones:
+        thread.join()
+    assert response.status_code == 200 and response.json()["status"] == "ok"
+    assert answered < min(ended), (answered, sorted(ended))

@@ -27,6 +27,7 @@ from ..config import Settings
 from ..kinematics.ik import MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit
 from ..kinematics import UNLIMITED, Budget, BudgetExhausted, Limits, Robot
 from .problems import PROBLEM_MEDIA_TYPE, PROBLEM_TYPE_BASE, ProblemError, problem_response
+from .routing import CORE_TURNS
 
 logger = logging.getLogger("service.budget")
 
@@ -89,7 +90,7 @@ class WorkLimits:
                                 f"(KIN_MAX_IN_FLIGHT = {self.in_flight.capacity}); retry after "
                                 f"{RETRY_AFTER_SECONDS} s.", scope, retry_after=True)
             return
-        budget = Budget(timeout)
+        budget = Budget(timeout, between_chunks=CORE_TURNS.pass_on)
         scope.setdefault("state", {})[BUDGET_STATE_KEY] = budget
         disconnected = asyncio.Event()
         body_done = False
@@ -226,11 +227,13 @@ def check_answer_size(settings: Settings, robot: Robot, *, targets: int, per_tar
 
 def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: int, solutions_per_target: int,
                   max_equivalents: int, max_solutions: int | None, form: str = "objects",
-                  numeric_starts: int | None = None) -> None:
+                  numeric_starts: int | None = None, kept_asked: bool = True) -> None:
     """The IK cost model, before any solving: turns per joint, the numeric work, then the worst-case answer size.
 
     ``solutions_per_target`` is the family's generic count (8 for a PUMA) or, for the numeric search, its starts
-    (``numeric_starts``, which also count as work).
+    (``numeric_starts``, which also count as work). ``kept_asked``: the client chose ``max_equivalents`` or
+    ``max_solutions``; a default too large to rank exactly is lowered by the core (and said in the notes) rather
+    than refused.
     """
     check_turns(settings, robot, limits, ("body", "limits"))
     if numeric_starts is not None and targets * numeric_starts > settings.max_numeric_starts:
@@ -242,7 +245,9 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: 
     kept = max_equivalents if max_solutions is None else min(max_equivalents, max_solutions)
     equivalents = equivalents_per_solution(robot, limits)
     ranked = combinations_to_rank(robot.dof, kept, equivalents)
-    if ranked > MAX_COMBINATIONS_PER_SOLUTION:
+    if ranked > MAX_COMBINATIONS_PER_SOLUTION and not kept_asked:
+        kept = enumerable_limit(robot.dof)
+    elif ranked > MAX_COMBINATIONS_PER_SOLUTION:
         most = enumerable_limit(robot.dof)
         raise ProblemError(413, "too-much-work", "Too much work",
                            f"Keeping the nearest {kept:,} of up to {equivalents:,} 2π-equivalents per solution would "

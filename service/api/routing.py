@@ -8,25 +8,28 @@
 * **Off the server's loop.** FastAPI parses and validates a body on the event loop: a 10,000-target batch holds it
   for about half a second, and a body at KIN_MAX_BODY_BYTES for seconds, during which ``/healthz`` could not
   answer. A :class:`FastJSONRoute` reads the body on the server's loop, then hands FastAPI's whole handler (parse,
-  validate, the endpoint, encoding) to one of :data:`SOLVER_THREADS` work loops, each an event loop in a thread
-  of its own, and awaits the finished response. The server's loop keeps only the I/O, the middleware and the
-  async health routes.
+  validate, the endpoint, encoding) to a work loop, an event loop in a thread of its own (:class:`WorkLoops`),
+  and awaits the finished response. The server's loop keeps only the I/O, the middleware and the async health
+  routes.
 * **One hop each way.** The endpoints are plain (sync) functions that compute; FastAPI would send each one on to
-  a thread pool, a second hand-over between threads per request. A work loop exists to be blocked by its
-  request, so :class:`FastJSONRoute` runs the endpoint inline on it instead. A request goes to the work loop with
-  the fewest requests on hand, so one long batch does not hold up the small requests behind it while another
-  loop is free.
+  a thread pool, a second hand-over between threads per request. A work loop exists to be blocked by its one
+  request, so :class:`FastJSONRoute` runs the endpoint inline on it instead.
+* **Turns.** A request computes only in its turn (:class:`CoreTurns`): as many at once as there are cores, the
+  others waiting in order, a long request letting a waiting one go first between its chunks of work.
 """
 
 from __future__ import annotations
 
 import asyncio
+import collections
 import contextvars
 import functools
 import inspect
+import itertools
 import json
 import os
 import threading
+import time
 from typing import Any, Callable, Coroutine
 
 import orjson
@@ -52,43 +55,106 @@ class _OrjsonRequest(Request):
         return self._json
 
 
-#: Work loops, each in a thread of its own. The solvers are CPU-bound: more threads than cores only share the
-#: cores and the GIL, and every one of them delays the server's loop (and /healthz) at each GIL hand-over.
-SOLVER_THREADS = max(2, os.cpu_count() or 1)
+class CoreTurns:
+    """At most ``cores`` requests compute at once; the others wait, in arrival order, without asking for the GIL.
+
+    Every thread that asks for the GIL gets it in turn, one switch interval (5 ms) each: with one thread per
+    request, the server's loop waited its turn behind every computing request and ``/healthz`` took 300 ms in the
+    soak. A request takes a turn before its handler runs and gives it back at the end; at each of its budget's
+    checks (between chunks of work) it gives it to the first waiting request once it has held it for
+    :data:`TURN_SECONDS`, and queues again. So a single IK that arrives while long batches run waits for the next
+    chunk boundary, not for a batch to end.
+    """
+
+    def __init__(self, cores: int) -> None:
+        self._lock = threading.Lock()
+        self._free = cores
+        self._waiting: collections.deque[threading.Event] = collections.deque()
+        self._held_since = threading.local()
+
+    def take(self) -> None:
+        """Wait (blocking this thread) for a turn."""
+        with self._lock:
+            if self._free and not self._waiting:
+                self._free -= 1
+                turn = None
+            else:
+                turn = threading.Event()
+                self._waiting.append(turn)
+        if turn is not None:
+            turn.wait()
+        self._held_since.value = time.monotonic()
+
+    def give_back(self) -> None:
+        """End this thread's turn: to the first waiting request, if any."""
+        self._held_since.value = None
+        with self._lock:
+            if self._waiting:
+                self._waiting.popleft().set()
+            else:
+                self._free += 1
+
+    def pass_on(self) -> None:
+        """Between chunks: after :data:`TURN_SECONDS` of computing, let the first waiting request have the turn."""
+        since = getattr(self._held_since, "value", None)  # None: this thread holds no turn
+        if since is not None and self._waiting and time.monotonic() - since > TURN_SECONDS:
+            self.give_back()
+            self.take()
+
+
+#: How long a request computes before it lets a waiting one have its turn (at its next chunk boundary).
+TURN_SECONDS = 0.02
+#: The turns of this process: one per core.
+CORE_TURNS = CoreTurns(os.cpu_count() or 1)
 
 
 class WorkLoop:
-    """An event loop in a daemon thread; ``on_hand`` counts the requests given to it and not yet answered (read
-    and written on the server's loop only)."""
+    """An event loop in a daemon thread of its own."""
 
     def __init__(self, name: str) -> None:
         self.loop = _new_loop()
-        self.on_hand = 0
         threading.Thread(target=self.loop.run_forever, name=name, daemon=True).start()
 
 
-_work_loops: list[WorkLoop] = []
-_work_loops_lock = threading.Lock()
+class WorkLoops:
+    """The work loops of this process, one per request being handled: an idle one is reused, else one more is
+    started (``list.pop`` and ``append`` are atomic, so several servers in one process, as tests run them, may
+    share them).
+
+    A request never waits for another's loop: with a fixed number of loops, a single IK that arrived while long
+    batches ran waited for a batch to end (past its own deadline, in the soak). Who computes when is
+    :class:`CoreTurns`'. How many loops there are at once is bounded by KIN_MAX_IN_FLIGHT (the middleware refuses
+    requests beyond it).
+    """
+
+    def __init__(self) -> None:
+        self.idle: list[WorkLoop] = []
+        self._numbers = itertools.count(1)
+
+    def take(self) -> WorkLoop:
+        try:
+            return self.idle.pop()
+        except IndexError:
+            return WorkLoop(f"kin-work-{next(self._numbers)}")
+
+    def give_back(self, worker: WorkLoop) -> None:
+        self.idle.append(worker)
 
 
-def work_loops() -> list[WorkLoop]:
-    """The process's :data:`SOLVER_THREADS` work loops, started on first use."""
-    with _work_loops_lock:
-        if not _work_loops:
-            _work_loops.extend(WorkLoop(f"kin-work-{i}") for i in range(SOLVER_THREADS))
-        return _work_loops
+_work_loops = WorkLoops()
 
 
 async def _on_work_loop(make: Callable[[], Coroutine[Any, Any, Response]]) -> Response:
-    """Run ``make()`` on the least busy work loop, in the caller's context (request id), and await it here."""
+    """Run ``make()`` on a work loop of its own, in the caller's context (request id), and await it here."""
     here = asyncio.get_running_loop()
-    worker = min(work_loops(), key=lambda w: w.on_hand)
+    worker = _work_loops.take()
     done: asyncio.Future = here.create_future()
     context = contextvars.copy_context()
     tasks: list[asyncio.Task] = []
 
     def settle(task: asyncio.Task) -> None:
         def apply() -> None:
+            _work_loops.give_back(worker)
             if done.done():
                 return
             if task.cancelled():
@@ -99,20 +165,24 @@ async def _on_work_loop(make: Callable[[], Coroutine[Any, Any, Response]]) -> Re
                 done.set_result(task.result())
         here.call_soon_threadsafe(apply)
 
+    async def in_turn() -> Response:
+        CORE_TURNS.take()
+        try:
+            return await make()
+        finally:
+            CORE_TURNS.give_back()
+
     def start() -> None:
-        task = worker.loop.create_task(make(), context=context)
+        task = worker.loop.create_task(in_turn(), context=context)
         tasks.append(task)
         task.add_done_callback(settle)
 
-    worker.on_hand += 1
     worker.loop.call_soon_threadsafe(start)
     try:
         return await done
     except asyncio.CancelledError:  # the server gave up on the request (shutdown): stop the work too
         worker.loop.call_soon_threadsafe(lambda: [task.cancel() for task in tasks])
         raise
-    finally:
-        worker.on_hand -= 1
 
 
 def _inline(endpoint: Callable[..., Any]) -> Callable[..., Any]:

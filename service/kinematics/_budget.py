@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Iterable
+from typing import Callable, Iterable
 
 #: Largest count reported exactly: 2**53 − 1, the largest integer a JSON client holding numbers as doubles reads
 #: exactly. A count at this value means "at least this many".
@@ -52,12 +52,15 @@ class Budget:
     True
     """
 
-    __slots__ = ("timeout_seconds", "deadline", "_cancelled")
+    __slots__ = ("timeout_seconds", "deadline", "_cancelled", "between_chunks")
 
-    def __init__(self, timeout_seconds: float | None = None) -> None:
+    def __init__(self, timeout_seconds: float | None = None,
+                 between_chunks: Callable[[], None] | None = None) -> None:
         self.timeout_seconds = timeout_seconds
         self.deadline = None if timeout_seconds is None else time.monotonic() + timeout_seconds
         self._cancelled = threading.Event()
+        #: called at every check, before it: a server lets the requests waiting for a core take their turn there
+        self.between_chunks = between_chunks
 
     def cancel(self) -> None:
         """Stop the work at its next check (thread-safe: called from the server's event loop)."""
@@ -79,11 +82,13 @@ class Budget:
         part = Budget(timeout_seconds)
         if self.deadline is not None and self.deadline < part.deadline:
             part.deadline, part.timeout_seconds = self.deadline, self.timeout_seconds
-        part._cancelled = self._cancelled
+        part._cancelled, part.between_chunks = self._cancelled, self.between_chunks
         return part
 
     def check(self, stage: str) -> None:
         """Raise :class:`BudgetExhausted` when cancelled or past the deadline; ``stage`` names the work."""
+        if self.between_chunks is not None:
+            self.between_chunks()
         if self._cancelled.is_set():
             raise BudgetExhausted("cancelled", stage, self.timeout_seconds)
         if self.deadline is not None and time.monotonic() > self.deadline:

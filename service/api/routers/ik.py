@@ -38,7 +38,8 @@ def _answer(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, f
     per_target = max(body.numeric.starts if plan is None else plan.generic_count for plan in plans)
     check_ik_cost(settings_of(request), robot, limits, targets=len(targets.kinds), solutions_per_target=per_target,
                   max_equivalents=body.max_equivalents, max_solutions=body.max_solutions, form=form,
-                  numeric_starts=body.numeric.starts if any(plan is None for plan in plans) else None)
+                  numeric_starts=body.numeric.starts if any(plan is None for plan in plans) else None,
+                  kept_asked=bool({"max_equivalents", "max_solutions"} & body.model_fields_set))
     # the numeric search's time cap: time_budget_ms per target, at most KIN_MAX_IK_TIME_MS per request
     cap_ms = settings_of(request).max_ik_time_ms
     if body.numeric.time_budget_ms is not None:

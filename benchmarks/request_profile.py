@@ -1,0 +1,153 @@
+"""Where the time of one single-IK request goes, stage by stage, in process.
+
+    python -m benchmarks.request_profile                      # PUMA 560, 500 requests per row
+    python -m benchmarks.request_profile --robot ur5 --requests 200
+
+The whole request goes through the ASGI application as uvicorn calls it (middleware, routing, the hand-over to a
+work loop, validation, the endpoint, encoding), one request at a time, with no network: beside ``GET /healthz``
+through the same application, it is the framework's share that wrk cannot separate from the server's. The stages
+of the IK request are then timed alone on the same body: the JSON parse and body validation, the boundary's
+conversion to core arrays and the cost model, the core's answer (and within it the solve alone), and the
+encoding. What the stages do not account for is the framework and the hand-over. Best of three rounds per row;
+read the shares, the absolute times move with the machine's load.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import time
+from typing import Callable
+
+import numpy as np
+import orjson
+
+from service.api.app import create_app
+from service.api.boundary import free_joints_to_core, ik_selection_to_core, ik_targets_to_core
+from service.api.budget import check_ik_cost
+from service.api.ik_encoding import ik_objects
+from service.api.schemas.fk import FKRequest
+from service.api.schemas.ik import IKRequest
+from service.config import Settings
+from service.kinematics import UNLIMITED, forward_kinematics
+from service.kinematics.ik import AnswerOptions, IKOptions, NumericOptions, answer_ik, cached_plan, solve_ik
+
+from .core import machine, sample_configurations
+
+
+def _asgi_seconds(app, method: str, path: str, body: bytes, count: int) -> float:
+    """Seconds per request through the application, one at a time (best of three rounds)."""
+    async def once() -> None:
+        sent: list[dict] = []
+
+        async def receive() -> dict:
+            return {"type": "http.request", "body": body, "more_body": False}
+
+        async def send(message: dict) -> None:
+            sent.append(message)
+
+        scope = {"type": "http", "asgi": {"version": "3.0"}, "http_version": "1.1", "method": method,
+                 "scheme": "http", "path": path, "raw_path": path.encode(), "query_string": b"", "root_path": "",
+                 "headers": [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())],
+                 "client": ("127.0.0.1", 1), "server": ("127.0.0.1", 80)}
+        await app(scope, receive, send)
+        assert sent[0]["status"] == 200, sent
+
+    async def rounds() -> float:
+        async with app.router.lifespan_context(app):
+            for _ in range(min(50, count)):
+                await once()
+            best = float("inf")
+            for _ in range(3):
+                started = time.perf_counter()
+                for _ in range(count):
+                    await once()
+                best = min(best, (time.perf_counter() - started) / count)
+            return best
+
+    return asyncio.run(rounds())
+
+
+def _seconds(function: Callable[[], object], count: int) -> float:
+    for _ in range(min(50, count)):
+        function()
+    best = float("inf")
+    for _ in range(3):
+        started = time.perf_counter()
+        for _ in range(count):
+            function()
+        best = min(best, (time.perf_counter() - started) / count)
+    return best
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks.request_profile", description=__doc__.splitlines()[0])
+    parser.add_argument("--robot", default="puma560_standard", help="catalogue id (default puma560_standard)")
+    parser.add_argument("--requests", type=int, default=500, help="requests per row and round (default 500)")
+    args = parser.parse_args(argv)
+
+    settings = Settings(log_level="warning")
+    app = create_app(settings)
+    from service.robots.catalogue import load_catalogue
+    robot = load_catalogue([settings.builtin_robots_dir], max_joints=settings.max_joints).get(args.robot).robot
+    q = sample_configurations(robot, 1, seed=5)[0]
+    T = forward_kinematics(robot, q)
+    ik_body = orjson.dumps({"target": {"matrix": T.tolist()}})
+    fk_body = orjson.dumps({"joints": q.tolist()})
+    count = args.requests
+
+    healthz = _asgi_seconds(app, "GET", "/healthz", b"", count)
+    fk = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/fk", fk_body, count)
+    ik = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/ik", ik_body, count)
+
+    # the IK request's stages, alone, on the same body (as the router runs them)
+    body = IKRequest.model_validate(orjson.loads(ik_body))
+    targets = ik_targets_to_core([body.target], body.angle_unit, "body", "target", indexed=False)
+    reference, limits, ordering = ik_selection_to_core(robot, body)
+    options = AnswerOptions(reference, limits, body.filter_limits, ordering, body.max_equivalents,
+                            IKOptions(NumericOptions(starts=body.numeric.starts,
+                                                     max_iterations=body.numeric.iterations), budget=UNLIMITED),
+                            free_joints_to_core(robot, body.free_joints, body.angle_unit), UNLIMITED)
+    answer = answer_ik(robot, targets, options)
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+
+    def boundary() -> None:
+        ik_targets_to_core([body.target], body.angle_unit, "body", "target", indexed=False)
+        ik_selection_to_core(robot, body)
+        check_ik_cost(settings, robot, limits, targets=1, solutions_per_target=plan.generic_count,
+                      max_equivalents=body.max_equivalents, max_solutions=body.max_solutions)
+
+    stages = {
+        "parse + validate the body": _seconds(lambda: IKRequest.model_validate(orjson.loads(ik_body)), count),
+        "boundary: units, targets, limits, cost model": _seconds(boundary, count),
+        "core answer (answer_ik)": _seconds(lambda: answer_ik(robot, targets, options), count),
+        "encode (ik_objects + orjson)": _seconds(
+            lambda: orjson.dumps(ik_objects(args.robot, robot, answer, "rad", UNLIMITED)[0]), count),
+    }
+    solve = _seconds(lambda: solve_ik(robot, T), count)
+    fk_core = _seconds(lambda: forward_kinematics(robot, q), count)
+    fk_validate = _seconds(lambda: FKRequest.model_validate(orjson.loads(fk_body)), count)
+
+    print(f"machine: {machine()}")
+    print(f"robot {args.robot}, {count} requests per row, best of 3 rounds, in process (no network)\n")
+    print("| what | µs | share of the IK request |")
+    print("|---|---:|---:|")
+    print(f"| GET /healthz through the application | {healthz * 1e6:,.1f} | {healthz / ik:.2f} |")
+    print(f"| POST fk, whole request | {fk * 1e6:,.1f} | {fk / ik:.2f} |")
+    print(f"|   of which FK in the core | {fk_core * 1e6:,.1f} | |")
+    print(f"|   of which parse + validate the body | {fk_validate * 1e6:,.1f} | |")
+    print(f"| POST ik, whole request | {ik * 1e6:,.1f} | 1.00 |")
+    for name, seconds in stages.items():
+        print(f"|   {name} | {seconds * 1e6:,.1f} | {seconds / ik:.2f} |")
+        if name.startswith("core"):
+            print(f"|     of which the solve alone (solve_ik) | {solve * 1e6:,.1f} | {solve / ik:.2f} |")
+    rest = ik - sum(stages.values())
+    print(f"|   framework, middleware, hand-over (the rest) | {rest * 1e6:,.1f} | {rest / ik:.2f} |")
+    print(f"\n- whole IK request / GET /healthz, in process: {ik / healthz:.1f} (wrk's share of /healthz is bounded by "
+          f"its inverse, {healthz / ik:.2f}, before the network)")
+    print(f"- whole FK request / GET /healthz, in process: {fk / healthz:.1f} (bound {healthz / fk:.2f})")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

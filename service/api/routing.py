@@ -58,12 +58,12 @@ class _OrjsonRequest(Request):
 class CoreTurns:
     """At most ``cores`` requests compute at once; the others wait, in arrival order, without asking for the GIL.
 
-    Every thread that asks for the GIL gets it in turn, one switch interval (5 ms) each: with one thread per
-    request, the server's loop waited its turn behind every computing request and ``/healthz`` took 300 ms in the
-    soak. A request takes a turn before its handler runs and gives it back at the end; at each of its budget's
-    checks (between chunks of work) it gives it to the first waiting request once it has held it for
-    :data:`TURN_SECONDS`, and queues again. So a single IK that arrives while long batches run waits for the next
-    chunk boundary, not for a batch to end.
+    With a thread per request, every computing thread would ask for the GIL, and the server's loop shares it with
+    all of them (each holds it for a switch interval, 5 ms, before it is handed on); their working arrays would
+    add up too. So a request takes a turn before its handler runs (parse, validation, the endpoint, encoding) and
+    gives it back at the end; at each of its budget's checks (between chunks of work) it gives it to the first
+    waiting request once it has held it for :data:`TURN_SECONDS`, and queues again. A single IK that arrives
+    while long batches run waits for their next chunk boundary, not for a batch to end.
     """
 
     def __init__(self, cores: int) -> None:

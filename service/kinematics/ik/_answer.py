@@ -12,8 +12,11 @@ are numbered by first appearance in target order.
 
 from __future__ import annotations
 
+import operator
 import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -98,6 +101,33 @@ class SolveTiming:
     solutions_per_target: list[int]
 
 
+class PerTarget(Sequence):
+    """A per-target column of Python values (N,), each made when read by ``entry(index)``: a batch has
+    thousands of targets, and most readers look at a few (``list(column)`` makes them all)."""
+
+    def __init__(self, length: int, entry: Callable[[int], Any]) -> None:
+        self._length, self._entry = length, entry
+
+    def __len__(self) -> int:
+        return self._length
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self._entry(i) for i in range(*index.indices(self._length))]
+        index = operator.index(index)
+        if not -self._length <= index < self._length:
+            raise IndexError(index)
+        return self._entry(index % self._length)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Sequence) and list(self) == list(other)
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        return f"PerTarget({list(self)!r})"
+
+
 @dataclass
 class TargetAnswer:
     """One target's answer (a view of :class:`IKAnswer`): its fields and its rows of the two tables."""
@@ -118,9 +148,9 @@ class IKAnswer:
     """The answer for N targets, as columns.
 
     Per target (N,): ``status`` (object: "ok", "unreachable",
-    "no_solution_within_limits"), ``detail`` (list of str or None),
-    ``solver`` (index into ``solvers``), ``singularities`` (list of lists of
-    indices into ``singularity_reports``), ``truncated``, ``trimmed``,
+    "no_solution_within_limits"), ``detail`` (str or None, worded when
+    read), ``solver`` (index into ``solvers``), ``singularities`` (lists of
+    indices into ``singularity_reports``, made when read), ``truncated``, ``trimmed``,
     ``available``. ``solutions`` and ``rejected`` hold the rows grouped by
     target, joints in radians / length units; a position-only target's
     orientation residuals are NaN. ``solution_violations`` (S, n) and
@@ -129,10 +159,10 @@ class IKAnswer:
     """
 
     status: np.ndarray
-    detail: list[str | None]
+    detail: PerTarget  # of str | None
     solver: np.ndarray
     solvers: list[SolverReport]
-    singularities: list[list[int]]
+    singularities: PerTarget  # of list[int]
     singularity_reports: list[Singularity]
     truncated: np.ndarray
     trimmed: np.ndarray
@@ -321,15 +351,14 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
     part's rows replace an earlier part's answer for the same targets (the position search after an unreachable
     held-joint solve)."""
     status = np.empty(n_targets, dtype=object)
-    detail: list[str | None] = [None] * n_targets
     solver_of, reports_of = np.zeros(n_targets, dtype=int), []  # index into every part's solvers, in part order
-    singular_of: list[list[Singularity]] = [[] for _ in range(n_targets)]
+    singular_of: dict[int, list[Singularity]] = {}
     truncated, trimmed = np.zeros(n_targets, dtype=bool), np.zeros(n_targets, dtype=int)
     available = np.zeros(n_targets, dtype=int)
     kept_parts, rejected_parts = [], []
-    owner = np.full(n_targets, -1)
+    owner, local_of = np.full(n_targets, -1), np.zeros(n_targets, dtype=int)
     for number, part in enumerate(parts):
-        owner[part.rows] = number
+        owner[part.rows], local_of[part.rows] = number, np.arange(len(part.rows))
     for number, part in enumerate(parts):
         live = owner[part.rows] == number
         if not live.any():
@@ -346,16 +375,13 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
         reports_of += part.solvers
         for local, met in part.singularities.items():
             if live[local]:
-                singular_of[rows[local]] = met
-        for local in {*part.details, *chosen.notes, *part.remarks}:
-            if live[local]:
-                words = [part.details.get(local), *chosen.notes.get(local, []), part.remarks.get(local)]
-                detail[rows[local]] = " ".join(filter(None, words)) or None
+                singular_of[int(rows[local])] = met
         for table, into in ((chosen.solutions, kept_parts), (chosen.rejected, rejected_parts)):
-            table = table.take(np.flatnonzero(live[table.target]))
-            table.target = rows[table.target]
-            if not part.constrained:
-                table.orientation = np.full(len(table.target), np.nan)
+            if not live.all():
+                table = table.take(np.flatnonzero(live[table.target]))
+            table = SolutionTable(rows[table.target], table.joints, table.within_limits, table.position,
+                                  table.orientation if part.constrained else np.full(len(table.target), np.nan),
+                                  table.labels)
             into.append(table)
     distinct, same = _numbered(reports_of)  # equal reports of different parts are one
     present, first = np.unique(same[solver_of], return_index=True)
@@ -363,10 +389,20 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
     renumber = np.zeros(len(distinct), dtype=int)
     renumber[by_appearance] = np.arange(len(by_appearance))
     solvers, solver = [distinct[i] for i in by_appearance], renumber[same[solver_of]]
-    reports, singularities = _numbered_lists(singular_of)
+    reports, numbered = _numbered_lists([singular_of[row] for row in sorted(singular_of)])
+    numbered_of = dict(zip(sorted(singular_of), numbered))
+    singularities = PerTarget(n_targets, lambda row: list(numbered_of.get(row, ())))
+    detail = PerTarget(n_targets, lambda row: None if owner[row] < 0 else _worded(parts[int(owner[row])],
+                                                                                     int(local_of[row])))
     kept, rejected = _merged(kept_parts, robot.dof), _merged(rejected_parts, robot.dof)
     return IKAnswer(status, detail, solver, solvers, singularities, reports, truncated, trimmed, available, kept,
                     rejected, _violations(robot, limits, kept), _violations(robot, limits, rejected), limits, timings)
+
+
+def _worded(part: _Solved, local: int) -> str | None:
+    """The detail of a part's row ``local``: the solver's detail, the selection's notes, the remarks."""
+    words = [part.details.get(local), *part.chosen.notes.get(local, []), part.remarks.get(local)]
+    return " ".join(filter(None, words)) or None
 
 
 def _numbered(items: list) -> tuple[list, np.ndarray]:
@@ -410,5 +446,7 @@ def _merged(tables: list[SolutionTable], dof: int) -> SolutionTable:
             labels[name] = (tuple(vocabulary), lookup[codes])
         remapped.append(SolutionTable(table.target, table.joints, table.within_limits, table.position,
                                       table.orientation, labels))
+    if len(remapped) == 1:
+        return remapped[0]
     merged = SolutionTable.concatenate(remapped, dof)
-    return merged.take(np.argsort(merged.target, kind="stable")) if len(remapped) > 1 else merged
+    return merged.take(np.argsort(merged.target, kind="stable"))

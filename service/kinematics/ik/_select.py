@@ -39,6 +39,7 @@ products of interval lengths, capped at :data:`.._budget.COUNT_CAP`.
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -46,7 +47,7 @@ import numpy as np
 
 from .._budget import COUNT_CAP, UNLIMITED, Budget
 from .._errors import InvalidInputError
-from .._limits import Limits, Violation, closest_equivalent, turn_ranges, violations
+from .._limits import Limits, Violation, closest_turns, turn_ranges, violations
 from .._robot import Robot
 from ._arrays import IKArrays
 from ._types import IKResult, Solution
@@ -216,7 +217,7 @@ class BatchSelection:
     truncated: np.ndarray  # (N,) bool
     trimmed: np.ndarray  # (N,) int
     available: np.ndarray  # (N,) int
-    notes: dict[int, list[str]]
+    notes: "TargetNotes"
     solutions: SolutionTable
     rejected: SolutionTable
 
@@ -299,7 +300,7 @@ class _Choice:
     truncated: np.ndarray
     trimmed: np.ndarray
     available: np.ndarray
-    notes: dict[int, list[str]]
+    notes: "TargetNotes"
     kept: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
     rejected: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -314,12 +315,16 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     q = joints[target, slot]
     first, last = turn_ranges(robot, limits, q)
     fits = np.all(last >= first, axis=1)
-    closest = closest_equivalent(robot, limits, q[~fits], (first[~fits], last[~fits]))
-    candidate = fits | (not filter_limits)
-    # a solution that does not fit and stays among the candidates has one value: its closest equivalent
-    turns = np.round((closest - q[~fits]) / _TWO_PI)
-    first[~fits], last[~fits] = turns, turns
-    c_target, c_q, c_first, c_last = target[candidate], q[candidate], first[candidate], last[candidate]
+    misfits = np.flatnonzero(~fits)
+    misfit_q = q[misfits]
+    misfit_turns = closest_turns(robot, limits, misfit_q, first[misfits], last[misfits])
+    if filter_limits:  # the rows that fit are the candidates; the others are rejected at their closest equivalent
+        candidate = fits
+        c_target, c_q, c_first, c_last = target[fits], q[fits], first[fits], last[fits]
+    else:  # a solution that does not fit stays among the candidates with one value: its closest equivalent
+        candidate = np.ones(len(target), dtype=bool)
+        first[misfits], last[misfits] = misfit_turns, misfit_turns
+        c_target, c_q, c_first, c_last = target, q, first, last
     with_all_moves = _capped_sums(c_target, _capped_products(c_last - c_first + 1.0), n_targets)
     if reference is not None and ordering.max_joint_move is not None:
         c_first, c_last = _within_move(robot, limits, c_q, c_first, c_last, reference, ordering.max_joint_move)
@@ -340,8 +345,7 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     rows = np.flatnonzero(candidate)[kept_rows]
     kept = (target[rows], slot[rows], kept_values, fits[rows])
 
-    dropped = np.flatnonzero(~candidate)
-    dropped_values = closest if filter_limits else closest[:0]
+    dropped, dropped_values = (misfits, misfit_q + _TWO_PI * misfit_turns) if filter_limits else (misfits[:0], q[:0])
     if reference is not None and len(dropped):
         order = np.lexsort((travel(robot, limits, dropped_values, reference, ordering), target[dropped]))
         dropped, dropped_values = dropped[order], dropped_values[order]
@@ -356,15 +360,8 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     truncated = (available > n_kept) & (not capped)
     trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
     noted = no_fit | (outside > 0) | truncated | ((status == "ok") & (n_kept == 0) & (with_all_moves > 0))
-    rows = np.flatnonzero(noted)
-    notes = dict(zip(rows.tolist(), (_notes(*fields, max_equivalents, reference is not None) for fields in zip(
-        status[rows].tolist(), *(column[rows].tolist() for column in (n_rejected, outside, truncated, available,
-                                                                        n_kept, with_all_moves))))))
-    if lowered:
-        for row in np.flatnonzero(truncated).tolist():
-            notes.setdefault(row, []).append(
-                f"At most {limit} are listed for a {n}-joint arm whatever max_equivalents asks: ranking more of "
-                f"so many equivalents would take more work than one answer may.")
+    notes = TargetNotes(np.flatnonzero(noted), status, n_rejected, outside, truncated, available, n_kept,
+                        with_all_moves, max_equivalents, reference is not None, limit if lowered else None, n)
     return _Choice(status, truncated, trimmed, available, notes, kept, rejected)
 
 
@@ -591,20 +588,57 @@ def _rounds_needed(target: np.ndarray, lengths: np.ndarray, n_targets: int, limi
     return np.where(enough, low, np.maximum(1, streams.max(axis=1)))
 
 
-def _notes(status: str, rejected: int, outside: int, truncated: bool, available: int, kept: int,
-           with_all_moves: int, max_equivalents: int, has_reference: bool) -> list[str]:
-    notes = []
-    if status == "no_solution_within_limits":
-        notes.append(f"All {rejected} solutions violate a joint limit, whatever whole turns the "
-                     f"revolute joints make; they are listed in 'rejected'.")
-    if outside:
-        notes.append(f"{outside} of the solutions violate a joint limit (filter_limits is false); "
-                     f"each is flagged with its violations.")
-    if truncated:
-        which = "nearest" if has_reference else "least-turned"
-        fit = f"At least {COUNT_CAP} (2**53 − 1, the count's cap)" if available >= COUNT_CAP else f"{available}"
-        notes.append(f"{fit} solutions fit; max_equivalents = {max_equivalents} kept the {which} {kept}.")
-    if status == "ok" and not kept and with_all_moves:
-        notes.append(f"{with_all_moves} solutions fit the limits, but none is within max_joint_move / "
-                     f"max_solutions of the reference.")
-    return notes
+class TargetNotes(Mapping):
+    """The selection's notes: target index → its notes (list of str), for the targets that have any, each
+    worded only when read (a batch has thousands; most readers look at a few).
+
+    ``rows`` (k,) ascending are the noted targets; the other arrays (N,) are the per-target counts the notes
+    quote: status, rejected, flagged outside the limits, truncated, available, kept, and fitting before
+    ``max_joint_move``. ``lowered_to`` is the per-target limit :func:`enumerable_limit` imposed, if any.
+    """
+
+    def __init__(self, rows: np.ndarray, status: np.ndarray, rejected: np.ndarray, outside: np.ndarray,
+                 truncated: np.ndarray, available: np.ndarray, kept: np.ndarray, with_all_moves: np.ndarray,
+                 max_equivalents: int, has_reference: bool, lowered_to: int | None, dof: int) -> None:
+        self.rows = rows
+        self._columns = (status, rejected, outside, truncated, available, kept, with_all_moves)
+        self._max_equivalents, self._has_reference = max_equivalents, has_reference
+        self._lowered_to, self._dof = lowered_to, dof
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __iter__(self):
+        return iter(self.rows.tolist())
+
+    def __contains__(self, row: object) -> bool:
+        if not isinstance(row, (int, np.integer)):
+            return False
+        at = int(np.searchsorted(self.rows, row))
+        return at < len(self.rows) and self.rows[at] == row
+
+    def __getitem__(self, row: int) -> list[str]:
+        if row not in self:
+            raise KeyError(row)
+        status, *counts = self._columns
+        status, (rejected, outside, truncated, available, kept, with_all_moves) = (
+            status[row], (column[row].item() for column in counts))
+        notes = []
+        if status == "no_solution_within_limits":
+            notes.append(f"All {rejected} solutions violate a joint limit, whatever whole turns the "
+                         f"revolute joints make; they are listed in 'rejected'.")
+        if outside:
+            notes.append(f"{outside} of the solutions violate a joint limit (filter_limits is false); "
+                         f"each is flagged with its violations.")
+        if truncated:
+            which = "nearest" if self._has_reference else "least-turned"
+            fit = f"At least {COUNT_CAP} (2**53 − 1, the count's cap)" if available >= COUNT_CAP else f"{available}"
+            notes.append(f"{fit} solutions fit; max_equivalents = {self._max_equivalents} kept the {which} {kept}.")
+        if status == "ok" and not kept and with_all_moves:
+            notes.append(f"{with_all_moves} solutions fit the limits, but none is within max_joint_move / "
+                         f"max_solutions of the reference.")
+        if truncated and self._lowered_to is not None:
+            notes.append(f"At most {self._lowered_to} are listed for a {self._dof}-joint arm whatever "
+                         f"max_equivalents asks: ranking more of so many equivalents would take more work than "
+                         f"one answer may.")
+        return notes

@@ -414,11 +414,6 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     """
     n = q.shape[1]
     weights = np.ones(n) if reference is None or ordering.weights is None else np.asarray(ordering.weights, float)
-    if reference is None:  # turns ranked by |k| itself: exact, so equal turning ties exactly
-        cheapest, direction, ahead, behind = _ranked_turns(np.zeros_like(q), first, last, np.zeros_like(q), weights)
-    else:
-        cheapest, direction, ahead, behind = _ranked_turns(q, first, last, np.broadcast_to(reference, q.shape),
-                                                           weights)
     ranks_cap = np.minimum(counts, row_limit[:, None]).astype(np.int64)
     limits_met, which = np.unique(row_limit, return_inverse=True)
     down_sets = np.array([min(_down_set_size(n, int(b)), COUNT_CAP) for b in limits_met.tolist()], dtype=np.int64)
@@ -430,15 +425,8 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     kept_rows, kept_values = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))]
     for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
         budget.check("selection")
-        caps = ranks_cap[start:stop]
-        owner, ranks = _rank_tuples(caps, row_limit[start:stop])
-        # each (row, joint, rank) turn once (no more of them than combinations), then looked up per combination
-        table_start = (np.cumsum(caps.ravel()) - caps.ravel()).reshape(caps.shape)
-        entry = np.repeat(np.arange(caps.size), caps.ravel())
-        rank = np.arange(len(entry)) - table_start.ravel()[entry]
-        table = [a[start:stop].ravel()[entry] for a in (cheapest, direction, ahead, behind)]
-        table = table[0] + _rank_offsets(rank, *table[1:])
-        turns = table[table_start[owner] + ranks]
+        owner, turns = _combination_turns(q[start:stop], first[start:stop], last[start:stop], ranks_cap[start:stop],
+                                          row_limit[start:stop], reference, weights)
         owner += start
         values = q[owner] + _TWO_PI * turns
         if reference is None:
@@ -458,6 +446,47 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
         kept_rows.append(owner[first_few])
         kept_values.append(values[first_few])
     return np.concatenate(kept_rows), np.concatenate(kept_values)
+
+
+def _combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_cap: np.ndarray,
+                       row_limit: np.ndarray, reference: np.ndarray | None,
+                       weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The turns of every combination of rows (S,) among each row's first ``row_limit`` in cost order: (row (C,)
+    ascending, turns (C, n)), each row's combinations in lexicographic order of their rank tuples.
+
+    ``q``, ``first``, ``last`` (S, n) are the rows' values and usable turns, ``ranks_cap`` (S, n) the most
+    ranks of each joint worth enumerating. A row with one usable turn per joint (limits under a whole turn,
+    the usual case) has one combination, its ``first`` turns, and is not ranked at all.
+    """
+    single = np.all(first == last, axis=1) & (row_limit > 0)
+    multi = np.flatnonzero(~single)
+    if not len(multi):
+        return np.arange(len(q)), first
+    caps = ranks_cap[multi]
+    if reference is None:  # turns ranked by |k| itself: exact, so equal turning ties exactly
+        zeros = np.zeros((len(multi), q.shape[1]))
+        cheapest, direction, ahead, behind = _ranked_turns(zeros, first[multi], last[multi], zeros, weights)
+    else:
+        cheapest, direction, ahead, behind = _ranked_turns(q[multi], first[multi], last[multi],
+                                                           np.broadcast_to(reference, caps.shape), weights)
+    owner, ranks = _rank_tuples(caps, row_limit[multi])
+    # each (row, joint, rank) turn once (no more of them than combinations), then looked up per combination
+    table_start = (np.cumsum(caps.ravel()) - caps.ravel()).reshape(caps.shape)
+    entry = np.repeat(np.arange(caps.size), caps.ravel())
+    rank = np.arange(len(entry)) - table_start.ravel()[entry]
+    table = [a.ravel()[entry] for a in (cheapest, direction, ahead, behind)]
+    table = table[0] + _rank_offsets(rank, *table[1:])
+    multi_turns = table[table_start[owner] + ranks]
+    if len(multi) == len(q):
+        return owner, multi_turns
+    per_row = np.ones(len(q), dtype=np.int64)  # each row's combinations, placed in row order
+    per_row[multi] = np.bincount(owner, minlength=len(multi))
+    offset = np.cumsum(per_row) - per_row
+    turns = np.empty((int(per_row.sum()), q.shape[1]))
+    singles = np.flatnonzero(single)
+    turns[offset[singles]] = first[singles]
+    turns[offset[multi][owner] + _position_in_group(owner)] = multi_turns
+    return np.repeat(np.arange(len(q)), per_row), turns
 
 
 def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, centre: np.ndarray,

@@ -421,6 +421,8 @@ def _numbered_lists(lists: list[list]) -> tuple[list, list[list[int]]]:
 
 def _violations(robot: Robot, limits: Limits, table: SolutionTable) -> np.ndarray:
     """Which joints (S, n) of each row outside the limits break them (tolerance included); False elsewhere."""
+    if table.within_limits.all():  # the usual kept table: nothing to compare
+        return np.zeros(table.joints.shape, dtype=bool)
     tolerance = limits.tolerance(robot)
     outside = (table.joints < limits.lower - tolerance) | (table.joints > limits.upper + tolerance)
     return outside & ~table.within_limits[:, None]

@@ -605,16 +605,20 @@ def _rounds_needed(target: np.ndarray, lengths: np.ndarray, n_targets: int, limi
     streams = np.zeros((n_targets, int(position.max()) + 1 if len(position) else 1), dtype=np.int64)
     streams[target, position] = lengths
 
+    rounds = np.maximum(1, streams.max(axis=1))  # a target whose streams yield fewer than ``limit``: all of them
+    enough = np.flatnonzero(np.minimum(streams, limit).sum(axis=1) >= limit)
+    streams = streams[enough]  # only these need the bisection
+
     def yielded(rounds):
         return np.minimum(streams, rounds[:, None]).sum(axis=1)
 
-    low, high = np.ones(n_targets, dtype=np.int64), np.full(n_targets, limit, dtype=np.int64)
-    enough = yielded(high) >= limit
+    low, high = np.ones(len(enough), dtype=np.int64), np.full(len(enough), limit, dtype=np.int64)
     while np.any(low < high):
         middle = (low + high) // 2
         reached = yielded(middle) >= limit
         low, high = np.where(reached, low, middle + 1), np.where(reached, middle, high)
-    return np.where(enough, low, np.maximum(1, streams.max(axis=1)))
+    rounds[enough] = low
+    return rounds
 
 
 class TargetNotes(Mapping):

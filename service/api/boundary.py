@@ -302,6 +302,21 @@ def ik_selection_to_core(robot: Robot, body) -> tuple[np.ndarray | None, Limits,
     return reference, limits, ordering
 
 
+#: The selection's notes as the wire words them, naming the request's options (the core's
+#: :data:`~service.kinematics.ik.NOTE_WORDING`, same keys and fields).
+WIRE_NOTES = {
+    "no_fit": "All {rejected} solutions violate a joint limit, whatever whole turns the revolute joints make; they "
+              "are listed in 'rejected'.",
+    "flagged": "{outside} of the solutions violate a joint limit (filter_limits is false); each is flagged with its "
+               "violations.",
+    "capped": "{fit} solutions fit; max_equivalents = {cap} kept the {which} {kept}.",
+    "none_near": "{fit} solutions fit the limits, but none is within max_joint_move / max_solutions of the "
+                 "reference.",
+    "lowered": "At most {limit} are listed for a {dof}-joint arm whatever max_equivalents asks: ranking more of so "
+               "many equivalents would take more work than one answer may.",
+}
+
+
 def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:
     """A violation in the request's units; an open side of the range is null."""
     scale = float(_unit_scale(robot, unit)[violation.joint])

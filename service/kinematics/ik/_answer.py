@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import operator
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,7 +28,7 @@ from ._arrays import IKArrays, arrays_from_results, solve_ik_arrays
 from ._direction import solve_direction
 from ._position_search import search_position
 from ._redundant import FreeJoint, beyond_reach, free_joints_for, no_solution_detail, solve_free_joint_family
-from ._select import MAX_EQUIVALENTS, BatchSelection, Ordering, SolutionTable, select_arrays
+from ._select import MAX_EQUIVALENTS, NOTE_WORDING, BatchSelection, Ordering, SolutionTable, select_arrays
 from ._solve import IKOptions, solve_ik_batch, unreachable_details
 from ._types import IKResult, Singularity
 
@@ -173,9 +173,16 @@ class IKAnswer:
     rejected_violations: np.ndarray
     limits: Limits
     timings: list[SolveTiming]
+    detail_of: Callable[[int, Mapping[str, str]], str | None] = field(default=lambda row, wording: None,
+                                                                      repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.status)
+
+    def details(self, wording: Mapping[str, str] = NOTE_WORDING) -> PerTarget:
+        """Each target's detail (str or None), the selection's notes in ``wording``: the keys and fields of
+        :data:`NOTE_WORDING`, a boundary's words for the options (``detail`` reads in the core's)."""
+        return PerTarget(len(self), lambda row: self.detail_of(row, wording))
 
     def target(self, index: int) -> TargetAnswer:
         """Target ``index``'s answer as one object (its table rows sliced out, nothing recomputed)."""
@@ -392,16 +399,20 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
     reports, numbered = _numbered_lists([singular_of[row] for row in sorted(singular_of)])
     numbered_of = dict(zip(sorted(singular_of), numbered))
     singularities = PerTarget(n_targets, lambda row: list(numbered_of.get(row, ())))
-    detail = PerTarget(n_targets, lambda row: None if owner[row] < 0 else _worded(parts[int(owner[row])],
-                                                                                     int(local_of[row])))
+    def detail_of(row: int, wording: Mapping[str, str]) -> str | None:
+        return None if owner[row] < 0 else _worded(parts[int(owner[row])], int(local_of[row]), wording)
+
     kept, rejected = _merged(kept_parts, robot.dof), _merged(rejected_parts, robot.dof)
-    return IKAnswer(status, detail, solver, solvers, singularities, reports, truncated, trimmed, available, kept,
-                    rejected, _violations(robot, limits, kept), _violations(robot, limits, rejected), limits, timings)
+    return IKAnswer(status, PerTarget(n_targets, lambda row: detail_of(row, NOTE_WORDING)), solver, solvers,
+                    singularities, reports, truncated, trimmed, available, kept, rejected,
+                    _violations(robot, limits, kept), _violations(robot, limits, rejected), limits, timings, detail_of)
 
 
-def _worded(part: _Solved, local: int) -> str | None:
-    """The detail of a part's row ``local``: the solver's detail, the selection's notes, the remarks."""
-    words = [part.details.get(local), *part.chosen.notes.get(local, []), part.remarks.get(local)]
+def _worded(part: _Solved, local: int, wording: Mapping[str, str]) -> str | None:
+    """The detail of a part's row ``local``: the solver's detail, the selection's notes in ``wording``, the
+    remarks."""
+    notes = part.chosen.notes.worded(local, wording) if local in part.chosen.notes else []
+    words = [part.details.get(local), *notes, part.remarks.get(local)]
     return " ".join(filter(None, words)) or None
 
 

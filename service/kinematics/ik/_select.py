@@ -57,6 +57,21 @@ Norm = Literal["linf", "l2"]
 #: Default cap on the number of solutions after 2π expansion.
 MAX_EQUIVALENTS = 1024
 
+#: How the selection's notes read, in the core's terms, by kind. A boundary that names the options otherwise
+#: words them itself: :meth:`TargetNotes.worded` and :meth:`.IKAnswer.details` take a mapping with these keys,
+#: whose texts use the same fields.
+NOTE_WORDING = {
+    "no_fit": "All {rejected} solutions violate a joint limit, whatever whole turns the revolute joints make; they "
+              "are listed in 'rejected'.",
+    "flagged": "{outside} of the solutions violate a joint limit (the limits flag rather than filter them); each is "
+               "flagged with its violations.",
+    "capped": "{fit} solutions fit; the cap of {cap} on 2π-equivalents kept the {which} {kept}.",
+    "none_near": "{fit} solutions fit the limits, but none is within the joint move or among the solutions allowed "
+                 "near the reference.",
+    "lowered": "At most {limit} are listed for a {dof}-joint arm whatever cap on 2π-equivalents is asked: ranking "
+               "more of so many equivalents would take more work than one answer may.",
+}
+
 #: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
 _CHUNK_ROWS = 1 << 18
 #: Most rank tuples one solution may enumerate (:func:`_nearest`). Past it the number kept per target is lowered
@@ -651,6 +666,10 @@ class TargetNotes(Mapping):
         return at < len(self.rows) and self.rows[at] == row
 
     def __getitem__(self, row: int) -> list[str]:
+        return self.worded(row, NOTE_WORDING)
+
+    def worded(self, row: int, wording: Mapping[str, str]) -> list[str]:
+        """Target ``row``'s notes in ``wording`` (the keys and fields of :data:`NOTE_WORDING`)."""
         if row not in self:
             raise KeyError(row)
         status, *counts = self._columns
@@ -658,20 +677,15 @@ class TargetNotes(Mapping):
             status[row], (column[row].item() for column in counts))
         notes = []
         if status == "no_solution_within_limits":
-            notes.append(f"All {rejected} solutions violate a joint limit, whatever whole turns the "
-                         f"revolute joints make; they are listed in 'rejected'.")
+            notes.append(wording["no_fit"].format(rejected=rejected))
         if outside:
-            notes.append(f"{outside} of the solutions violate a joint limit (filter_limits is false); "
-                         f"each is flagged with its violations.")
+            notes.append(wording["flagged"].format(outside=outside))
         if truncated:
-            which = "nearest" if self._has_reference else "least-turned"
             fit = f"At least {COUNT_CAP} (2**53 − 1, the count's cap)" if available >= COUNT_CAP else f"{available}"
-            notes.append(f"{fit} solutions fit; max_equivalents = {self._max_equivalents} kept the {which} {kept}.")
+            notes.append(wording["capped"].format(fit=fit, cap=self._max_equivalents, kept=kept,
+                                                  which="nearest" if self._has_reference else "least-turned"))
         if status == "ok" and not kept and with_all_moves:
-            notes.append(f"{with_all_moves} solutions fit the limits, but none is within max_joint_move / "
-                         f"max_solutions of the reference.")
+            notes.append(wording["none_near"].format(fit=with_all_moves))
         if truncated and self._lowered_to is not None:
-            notes.append(f"At most {self._lowered_to} are listed for a {self._dof}-joint arm whatever "
-                         f"max_equivalents asks: ranking more of so many equivalents would take more work than "
-                         f"one answer may.")
+            notes.append(wording["lowered"].format(limit=self._lowered_to, dof=self._dof))
         return notes

@@ -211,3 +211,12 @@ def test_huge_limits_are_answered_bounded_with_exact_counts():
     capped = select(six, IKResult("ok", [Solution(np.full(6, 0.5), {}, 0.0, 0.0)], "analytic", "x", True),
                     Limits.of(six), max_equivalents=8)
     assert capped.available == COUNT_CAP and len(capped.solutions) == 8 and "the count's cap" in capped.notes[0]
+
+
+def test_the_core_notes_name_no_option_of_the_wire():
+    """The core words its notes in its own terms; the boundary words them for the wire (tests/api)."""
+    from service.kinematics.ik import NOTE_WORDING
+
+    for text in NOTE_WORDING.values():
+        for wire_name in ("max_equivalents", "filter_limits", "max_joint_move", "max_solutions", "free_joints"):
+            assert wire_name not in text

@@ -14,8 +14,8 @@ from ._direction import solve_direction, target_kinds
 from ._numeric import NumericOptions
 from ._plan import plan_for
 from ._position_search import search_position
-from ._redundant import (MAX_FREE_VALUES, FamilyAnswer, FreeJoint, beyond_reach, follow_free_joints, free_joints_for,
-                         no_solution_detail, solve_free_joint_family)
+from ._redundant import (MAX_FREE_VALUES, FamilyAnswer, FreeJoint, NotRedundantError, beyond_reach, follow_free_joints,
+                         free_joints_for, no_solution_detail, solve_free_joint_family)
 from ._select import (MAX_COMBINATIONS_PER_SOLUTION, MAX_EQUIVALENTS, NOTE_WORDING, Ordering, Selected, Selection,
                       SolutionTable, check_ordering, combinations_to_rank, enumerable_limit, joint_travel, select,
                       select_arrays, travel)
@@ -41,6 +41,7 @@ __all__ = [
     "arrays_from_results",
     "FamilyAnswer",
     "FreeJoint",
+    "NotRedundantError",
     "IKArrays",
     "MAX_EQUIVALENTS",
     "NOTE_WORDING",

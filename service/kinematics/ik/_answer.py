@@ -14,14 +14,15 @@ from __future__ import annotations
 
 import operator
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from .._budget import UNLIMITED, Budget
-from .._errors import KinematicsError
+from .._errors import InvalidInputError, KinematicsError
 from .._limits import Limits
 from .._robot import Robot
 from ._arrays import IKArrays, arrays_from_results, solve_ik_arrays
@@ -218,7 +219,8 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
     limits = Limits.of(robot) if options.limits is None else options.limits
     free = None
     if options.free_joints is not None or robot.dof > 6:
-        free = free_joints_for(robot, options.free_joints)
+        with _at_free_joints():
+            free = free_joints_for(robot, options.free_joints)
     timings: list[SolveTiming] = []
     solved = [*_solved_directions(robot, targets, options, timings),
               *_solved_poses(robot, matrices, kinds, free, options, timings)]
@@ -232,6 +234,15 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
         solved.append(_from_results(robot, np.array(retry), results, False))
         answer = _selected(robot, len(matrices), solved, limits, options, timings)
     return answer
+
+
+@contextmanager
+def _at_free_joints() -> Iterator[None]:
+    """Locate the errors about the free joints at the option that asks for them (``free_joints``)."""
+    try:
+        yield
+    except InvalidInputError as error:
+        raise error.relocated("free_joints") from None
 
 
 def _solved_directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timings: list[SolveTiming]):
@@ -273,7 +284,8 @@ def _solved_poses(robot: Robot, matrices: np.ndarray, kinds: np.ndarray, free: l
         constrained = kind == POSE
         started = time.perf_counter()
         if constrained and free is not None:  # a redundant arm: the family over the free joints' values
-            family = solve_free_joint_family(robot, matrices[rows], free, reference)
+            with _at_free_joints():
+                family = solve_free_joint_family(robot, matrices[rows], free, reference)
             if family is None:
                 yield _numeric(robot, matrices, rows, True, options, timings, started, free)
                 continue

@@ -31,8 +31,8 @@ outwards from the cheapest. A combination among the first L of a solution
 (L = the most that can be returned of it) has ranks (r_1 … r_n) with
 ∏(r_j + 1) ≤ L, since every combination with smaller or equal ranks costs no
 more and comes first. Only those rank tuples are enumerated and costed, in
-chunks of targets of at most about :data:`_CHUNK_ROWS` combinations, with
-``budget`` checked between chunks; the counts (``available``, ``trimmed``) are
+chunks of whole solutions of at most about :data:`_CHUNK_ROWS` combinations
+(one target's may span several), with ``budget`` checked between chunks; the counts (``available``, ``trimmed``) are
 products of interval lengths, capped at :data:`.._budget.COUNT_CAP`.
 """
 
@@ -432,12 +432,12 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     ranks_cap = np.minimum(counts, row_limit[:, None]).astype(np.int64)
     limits_met, which = np.unique(row_limit, return_inverse=True)
     down_sets = np.array([min(_down_set_size(n, int(b)), COUNT_CAP) for b in limits_met.tolist()], dtype=np.int64)
-    bound = np.minimum(_capped_products(ranks_cap), down_sets[which.ravel()])
-    per_target = np.bincount(target, weights=bound.astype(float), minlength=int(target[-1]) + 1 if len(target) else 0)
-    chunk_of_target = (np.cumsum(per_target) - per_target) // _CHUNK_ROWS
-    chunk = chunk_of_target[target]
+    bound = np.minimum(_capped_products(ranks_cap), down_sets[which.ravel()]).astype(float)
+    # chunks of whole rows: a row's combinations are at most MAX_COMBINATIONS_PER_SOLUTION, but one target's rows
+    # (16 solutions, or 32 samples of a free joint times 8) may hold millions, so a target may span chunks
+    chunk = (np.cumsum(bound) - bound) // _CHUNK_ROWS
     edges = np.flatnonzero(np.r_[True, chunk[1:] != chunk[:-1], True]) if len(target) else np.zeros(1, int)
-    kept_rows, kept_values = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))]
+    kept_rows, kept_values, kept_keys = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))], [np.zeros(0)]
     for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
         budget.check("selection")
         owner, turns = _combination_turns(q[start:stop], first[start:stop], last[start:stop], ranks_cap[start:stop],
@@ -448,19 +448,28 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
             cost = np.sum(np.abs(turns), axis=1)
             by_stream = np.lexsort((cost, owner))  # each row's combinations cheapest first, ties by rank tuple
             owner, values = owner[by_stream], values[by_stream]
-            stream = _position_in_group(owner)
-            early = stream < row_limit[owner]
-            owner, values, stream = owner[early], values[early], stream[early]
-            order = np.lexsort((owner, stream, target[owner]))
+            key = _position_in_group(owner)  # the row's stream position: the targets take turns between rows
+            early = key < row_limit[owner]
+            owner, values, key = owner[early], values[early], key[early]
+            order = np.lexsort((owner, key, target[owner]))
         else:
             distance = _travel(np.abs(values - reference), limits.continuous(robot)) * weights
-            cost = distance.max(axis=1) if ordering.norm == "linf" else np.sqrt(np.sum(distance ** 2, axis=1))
-            order = np.lexsort((cost, target[owner]))  # stable: ties by row, then rank tuple
-        owner, values = owner[order], values[order]
+            key = distance.max(axis=1) if ordering.norm == "linf" else np.sqrt(np.sum(distance ** 2, axis=1))
+            order = np.lexsort((key, target[owner]))  # stable: ties by row, then rank tuple
+        owner, values, key = owner[order], values[order], key[order]
         first_few = _position_in_group(target[owner]) < limit
         kept_rows.append(owner[first_few])
         kept_values.append(values[first_few])
-    return np.concatenate(kept_rows), np.concatenate(kept_values)
+        kept_keys.append(key[first_few])
+    rows, values, keys = np.concatenate(kept_rows), np.concatenate(kept_values), np.concatenate(kept_keys)
+    if len(edges) > 2 and (target[edges[1:-1]] == target[edges[1:-1] - 1]).any():
+        # a target over several chunks: its kept combinations from each, ordered again as one chunk orders them
+        # (each chunk's come in row order, so the stable sorts break ties as one chunk would)
+        order = np.lexsort((rows, keys, target[rows])) if reference is None else np.lexsort((keys, target[rows]))
+        rows, values = rows[order], values[order]
+        first_few = _position_in_group(target[rows]) < limit
+        rows, values = rows[first_few], values[first_few]
+    return rows, values
 
 
 def _combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_cap: np.ndarray,

@@ -32,7 +32,7 @@ from ..kinematics import (
     matrix_from_rpy,
     quaternions_from_matrices,
 )
-from ..kinematics.ik import DIRECTION, POSE, POSITION, IKTargets, Ordering, check_ordering
+from ..kinematics.ik import DIRECTION, POSE, POSITION, IKTargets, NotRedundantError, Ordering, check_ordering
 from ..robots.build import bounds as _bounds
 from .schemas.common import AngleUnit
 from .schemas.ik import Ordering as OrderingOptions
@@ -50,11 +50,22 @@ _DEGREE = math.pi / 180.0
 
 @contextmanager
 def located(*prefix: str | int) -> Iterator[None]:
-    """Prefix the location of any core error raised inside the block."""
+    """Prefix the location of any core error raised inside the block, worded for the wire where the core's words
+    differ (:func:`wire_worded`)."""
     try:
         yield
     except KinematicsError as error:
-        raise error.relocated(*prefix) from None
+        raise wire_worded(error).relocated(*prefix) from None
+
+
+def wire_worded(error: KinematicsError) -> KinematicsError:
+    """A core error as the wire words it: the core speaks of free joints, the request of ``free_joints``."""
+    if isinstance(error, NotRedundantError):
+        worded = error.relocated()
+        worded.message = f"free_joints applies to arms with more than 6 joints; this one has {error.dof}"
+        worded.args = (worded.message,)
+        return worded
+    return error
 
 
 def _unit_scale(robot: Robot, unit: AngleUnit) -> np.ndarray:
@@ -300,6 +311,21 @@ def ik_selection_to_core(robot: Robot, body) -> tuple[np.ndarray | None, Limits,
         ordering = ordering_to_core(robot, body.ordering, body.max_solutions, body.max_joint_move, reference,
                                     body.angle_unit)
     return reference, limits, ordering
+
+
+#: The selection's notes as the wire words them, naming the request's options (the core's
+#: :data:`~service.kinematics.ik.NOTE_WORDING`, same keys and fields).
+WIRE_NOTES = {
+    "no_fit": "All {rejected} solutions violate a joint limit, whatever whole turns the revolute joints make; they "
+              "are listed in 'rejected'.",
+    "flagged": "{outside} of the solutions violate a joint limit (filter_limits is false); each is flagged with its "
+               "violations.",
+    "capped": "{fit} solutions fit; max_equivalents = {cap} kept the {which} {kept}.",
+    "none_near": "{fit} solutions fit the limits, but none is within max_joint_move / max_solutions of the "
+                 "reference.",
+    "lowered": "At most {limit} are listed for a {dof}-joint arm whatever max_equivalents asks: ranking more of so "
+               "many equivalents would take more work than one answer may.",
+}
 
 
 def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:

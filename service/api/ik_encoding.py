@@ -12,7 +12,7 @@ import numpy as np
 
 from ..kinematics import Budget, Robot
 from ..kinematics.ik import IKAnswer, SolutionTable
-from .boundary import _unit_scale
+from .boundary import WIRE_NOTES, _unit_scale
 
 
 def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget: Budget) -> list[dict]:
@@ -25,14 +25,14 @@ def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
     free_of_target = [list(answer.solvers[index].free_joints) for index in answer.solver.tolist()]
     kept = _solution_dicts(answer.solutions, answer.solution_violations, answer, scale, free_of_target)
     rejected = _solution_dicts(answer.rejected, answer.rejected_violations, answer, scale, free_of_target)
-    status, truncated = answer.status.tolist(), answer.truncated.tolist()
+    status, truncated, detail = answer.status.tolist(), answer.truncated.tolist(), answer.details(WIRE_NOTES)
     trimmed, available = answer.trimmed.tolist(), answer.available.tolist()
     answers = []
     for row, solver in enumerate(answer.solver.tolist()):
         if row % 256 == 255:
             budget.check("encoding")
         answers.append({
-            "robot_id": robot_id, "status": status[row], "detail": answer.detail[row],
+            "robot_id": robot_id, "status": status[row], "detail": detail[row],
             "solutions": kept[row], "rejected": rejected[row], "solver": dict(solvers[solver]),
             "singularities": [dict(reports[i]) for i in answer.singularities[row]],
             "free_joints": list(free_of_target[row]), "truncated": truncated[row], "trimmed": trimmed[row],
@@ -82,8 +82,9 @@ def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
         "format": "arrays",
         "solvers": solvers,
         "singularity_reports": [_report(report) for report in answer.singularity_reports],
-        "targets": {"status": answer.status.tolist(), "detail": answer.detail, "solver": answer.solver,
-                    "singularities": answer.singularities, "truncated": answer.truncated,
+        "targets": {"status": answer.status.tolist(), "detail": list(answer.details(WIRE_NOTES)),
+                    "solver": answer.solver,
+                    "singularities": list(answer.singularities), "truncated": answer.truncated,
                     "trimmed": answer.trimmed, "available": answer.available,
                     "solution_count": np.bincount(answer.solutions.target, minlength=n_targets),
                     "rejected_count": np.bincount(answer.rejected.target, minlength=n_targets)},

@@ -154,13 +154,32 @@ def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray,
     """
     q = np.asarray(q, dtype=float)
     first, last = turn_ranges(robot, limits, q) if turns is None else turns
-    with np.errstate(invalid="ignore"):
-        below = np.floor((limits.lower - q) / _TWO_PI)  # the turn of the largest equivalent ≤ lower
-        short = limits.lower - (q + _TWO_PI * below)
-        over = q + _TWO_PI * (below + 1.0) - limits.upper
-    outside = np.where(limits.multi_valued(robot), np.where(short < over, below, below + 1.0), 0.0)
-    turns = np.where(last >= first, np.clip(0.0, first, last), outside)
-    return q + _TWO_PI * turns
+    return q + _TWO_PI * closest_turns(robot, limits, q, first, last)
+
+
+def closest_turns(robot: Robot, limits: Limits, q: np.ndarray, first: np.ndarray, last: np.ndarray) -> np.ndarray:
+    """The whole turns k (shape (..., n)) of :func:`closest_equivalent`: q + 2kπ, from q's :func:`turn_ranges`.
+
+    A joint with turns inside its bounds takes the one nearest 0. A both-bounded revolute joint without one
+    has ``last = first − 1``: q + 2π·last is the largest equivalent below the range and q + 2π·first the
+    smallest above it, and the nearer to its bound is taken (the upper one on a tie). Every other joint
+    without one (continuous or prismatic, out of range) keeps its value (``first`` is 0 there).
+
+    Examples
+    --------
+    A joint limited to [10°, 20°] at 200°: turns [0, −1], so 200° (180° above) and −160° (170° below):
+    −1 turn, to −160°.
+    """
+    turns = np.minimum(np.maximum(first, 0.0), last)
+    outside = np.flatnonzero(last < first)  # usually few joints: only these need the nearer side worked out
+    if len(outside):
+        joint = outside % q.shape[-1]
+        value, below, above = (np.take(a, outside) for a in (q, last, first))
+        with np.errstate(invalid="ignore"):
+            below_by = limits.lower[joint] - (value + _TWO_PI * below)
+            above_by = (value + _TWO_PI * above) - limits.upper[joint]
+        np.put(turns, outside, np.where(limits.multi_valued(robot)[joint] & (below_by < above_by), below, above))
+    return turns
 
 
 def nearest_fitting_equivalent(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray | None:

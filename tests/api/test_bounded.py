@@ -152,7 +152,8 @@ def test_the_ranking_work_per_solution_is_bounded_whatever_the_joint_count():
     assert time.perf_counter() - started < 20.0
     kept = np.array([entry.solution.joints for entry in selection.solutions])
     assert len(kept) == enumerable_limit(8) == 89 and selection.expansion_truncated
-    assert any("At most 89 are listed for a 8-joint arm" in note for note in selection.notes)
+    assert any("At most 89 are listed for a 8-joint arm whatever cap on 2π-equivalents is asked" in note
+               for note in selection.notes)
     # nearest first, and the nearest are the ones with the smallest largest |q_j| (every joint at 0.25 + 2kπ)
     cost = np.abs(kept).max(axis=1)
     assert np.all(np.diff(cost) >= -1e-12) and np.isclose(cost[0], 0.25)

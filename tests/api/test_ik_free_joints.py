@@ -100,3 +100,12 @@ def test_a_locking_no_family_covers_falls_back_to_the_numeric_search_and_says_so
                                          "free_joints": [{"joint": 3, "values": [Q[3]]}]}).json()
     assert answer["solver"]["method"] == "numeric" and answer["solver"]["complete"] is False
     assert "q4 locked" in answer["detail"]
+
+
+def test_free_joint_errors_read_as_before_on_the_wire(client):
+    """The core speaks of free joints; the boundary words its errors with the request's field, as always."""
+    pose = client.post("/v1/robots/ur5/fk", json={"joints": [0.1] * 6}).json()["pose"]["matrix"]
+    body = assert_problem(client.post("/v1/robots/ur5/ik", json={"target": {"matrix": pose},
+                                                                 "free_joints": [{"joint": 2, "values": [0]}]}), 422)
+    assert body["errors"] == [{"loc": ["body", "free_joints"], "type": "value_error",
+                               "msg": "free_joints applies to arms with more than 6 joints; this one has 6"}]

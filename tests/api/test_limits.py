@@ -562,3 +562,16 @@ def test_catalogue_states_where_every_limit_comes_from(client):
                   for j in description["joints"]]
         if robot_id in PUBLISHED:
             assert served == PUBLISHED[robot_id], robot_id
+
+
+def test_the_wire_words_every_note_of_the_core_with_the_same_fields():
+    import string
+
+    from service.api.boundary import WIRE_NOTES
+    from service.kinematics.ik import NOTE_WORDING
+
+    def fields(text):
+        return {name for _, name, _, _ in string.Formatter().parse(text) if name}
+
+    assert WIRE_NOTES.keys() == NOTE_WORDING.keys()
+    assert all(fields(WIRE_NOTES[kind]) == fields(NOTE_WORDING[kind]) for kind in NOTE_WORDING)

@@ -169,7 +169,7 @@ def test_cap_keeps_the_nearest_with_a_reference():
     assert capped.expansion_truncated and capped.available == 12 and capped.trimmed == 0
     np.testing.assert_array_equal([s.solution.joints for s in capped.solutions],
                                   [s.solution.joints for s in full.solutions[:5]])
-    assert "12 solutions fit; max_equivalents = 5 kept the nearest 5" in capped.notes[0]
+    assert "12 solutions fit; the cap of 5 on 2π-equivalents kept the nearest 5" in capped.notes[0]
 
 
 def test_cap_without_reference_keeps_every_branch_before_any_second_turn():
@@ -195,7 +195,7 @@ def test_max_solutions_and_max_joint_move_are_counted_as_trimmed():
     nothing = select(TWO_TURN, result, Limits.of(TWO_TURN), reference=reference,
                      ordering=Ordering(max_joint_move=np.zeros(2)))
     assert nothing.status == "ok" and nothing.solutions == [] and nothing.trimmed == 12
-    assert "none is within max_joint_move" in nothing.notes[0]
+    assert "none is within the joint move or among the solutions allowed near the reference" in nothing.notes[0]
 
 
 def test_continuous_joints_are_measured_across_the_wrap():

@@ -815,12 +815,17 @@ def test_sp5_infeasible_degenerate_and_inseparable(rng):
 def test_sp5_quartic_that_drops_to_a_quadratic():
     """||f + G u||² = 1 with G a scaled rotation has no 2θ terms: the leading coefficient vanishes and the
     harmonic equation 2 g·u + c0 = 0 is what is left (here 0.6 cos θ + 0.8 sin θ = 0.25)."""
-    theta, valid, free = _subproblems._unit_circle_roots(
-        np.array([0.0 + 0.0j]), np.array([0.3 - 0.4j]), np.array([-0.25 + 0.0j]), np.array([1.0]))
+    theta, valid, double = _subproblems._trig_quartic_roots(
+        np.array([-0.25]), np.array([0.6]), np.array([0.8]), np.array([0.0]), np.array([0.0]))
     phi, half = np.arctan2(0.8, 0.6), np.arccos(0.25)
-    assert valid.sum() == 2 and not free[0]
+    assert valid.sum() == 2 and not double[0]
     assert np.allclose(np.sort(theta[valid]), np.sort(np.angle(np.exp(1j * np.array([phi + half, phi - half])))))
     # and the constant left when g vanishes too: identically zero (free) or never
-    _, valid, free = _subproblems._unit_circle_roots(np.zeros(2, complex), np.zeros(2, complex),
-                                                     np.array([0.0, 0.5 + 0j]), np.ones(2))
-    assert free.tolist() == [True, False] and not valid.any()
+    zeros = np.zeros(2)
+    theta, valid, _ = _subproblems._trig_quartic_roots(np.array([0.0, 0.5]), zeros, zeros, zeros, zeros)
+    free = _subproblems._vanishes(np.array([0.0, 0.5]), zeros, zeros, zeros, zeros, np.ones(2))
+    assert free.tolist() == [True, False] and not valid[1].any()
+    # every angle solves 0 = 0: the root finder gives one representative, angle 0 (the caller marks it free)
+    assert valid[0].tolist() == [True, False, False, False] and theta[0, 0] == 0.0
+
+

@@ -7,18 +7,18 @@ prismatic joints), and decomposes the problem into geometric subproblems
 back to a bounded numeric search that says it may be incomplete.
 """
 
-from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKAnswer, IKTargets, SolverReport, SolveTiming,
-                      TargetAnswer, UnsupportedTargetError, answer_ik)
+from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKAnswer, IKTargets, PerTarget, SolverReport,
+                      SolveTiming, TargetAnswer, UnsupportedTargetError, answer_ik)
 from ._arrays import IKArrays, arrays_from_results, cached_plan, solve_ik_arrays
 from ._direction import solve_direction, target_kinds
 from ._numeric import NumericOptions
 from ._plan import plan_for
 from ._position_search import search_position
-from ._redundant import (MAX_FREE_VALUES, FamilyAnswer, FreeJoint, beyond_reach, follow_free_joints, free_joints_for,
-                         no_solution_detail, solve_free_joint_family)
-from ._select import (MAX_COMBINATIONS_PER_SOLUTION, MAX_EQUIVALENTS, Ordering, Selected, Selection, SolutionTable,
-                      check_ordering, combinations_to_rank, enumerable_limit, joint_travel, select, select_arrays,
-                      travel)
+from ._redundant import (MAX_FREE_VALUES, FamilyAnswer, FreeJoint, NotRedundantError, beyond_reach, follow_free_joints,
+                         free_joints_for, no_solution_detail, solve_free_joint_family)
+from ._select import (MAX_COMBINATIONS_PER_SOLUTION, MAX_EQUIVALENTS, NOTE_WORDING, Ordering, Selected, Selection,
+                      SolutionTable, check_ordering, combinations_to_rank, enumerable_limit, joint_travel, select,
+                      select_arrays, travel)
 from ._solve import IKOptions, results_from_arrays, solve_ik, solve_ik_batch, unreachable_details
 from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
@@ -41,8 +41,11 @@ __all__ = [
     "arrays_from_results",
     "FamilyAnswer",
     "FreeJoint",
+    "NotRedundantError",
     "IKArrays",
     "MAX_EQUIVALENTS",
+    "NOTE_WORDING",
+    "PerTarget",
     "MAX_FREE_VALUES",
     "IKOptions",
     "IKResult",

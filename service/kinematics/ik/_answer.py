@@ -12,20 +12,24 @@ are numbered by first appearance in target order.
 
 from __future__ import annotations
 
+import operator
 import time
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from .._budget import UNLIMITED, Budget
-from .._errors import KinematicsError
+from .._errors import InvalidInputError, KinematicsError
 from .._limits import Limits
 from .._robot import Robot
 from ._arrays import IKArrays, arrays_from_results, solve_ik_arrays
 from ._direction import solve_direction
 from ._position_search import search_position
 from ._redundant import FreeJoint, beyond_reach, free_joints_for, no_solution_detail, solve_free_joint_family
-from ._select import MAX_EQUIVALENTS, BatchSelection, Ordering, SolutionTable, select_arrays
+from ._select import MAX_EQUIVALENTS, NOTE_WORDING, BatchSelection, Ordering, SolutionTable, select_arrays
 from ._solve import IKOptions, solve_ik_batch, unreachable_details
 from ._types import IKResult, Singularity
 
@@ -98,6 +102,33 @@ class SolveTiming:
     solutions_per_target: list[int]
 
 
+class PerTarget(Sequence):
+    """A per-target column of Python values (N,), each made when read by ``entry(index)``: a batch has
+    thousands of targets, and most readers look at a few (``list(column)`` makes them all)."""
+
+    def __init__(self, length: int, entry: Callable[[int], Any]) -> None:
+        self._length, self._entry = length, entry
+
+    def __len__(self) -> int:
+        return self._length
+
+    def __getitem__(self, index):
+        if isinstance(index, slice):
+            return [self._entry(i) for i in range(*index.indices(self._length))]
+        index = operator.index(index)
+        if not -self._length <= index < self._length:
+            raise IndexError(index)
+        return self._entry(index % self._length)
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Sequence) and list(self) == list(other)
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        return f"PerTarget({list(self)!r})"
+
+
 @dataclass
 class TargetAnswer:
     """One target's answer (a view of :class:`IKAnswer`): its fields and its rows of the two tables."""
@@ -118,9 +149,9 @@ class IKAnswer:
     """The answer for N targets, as columns.
 
     Per target (N,): ``status`` (object: "ok", "unreachable",
-    "no_solution_within_limits"), ``detail`` (list of str or None),
-    ``solver`` (index into ``solvers``), ``singularities`` (list of lists of
-    indices into ``singularity_reports``), ``truncated``, ``trimmed``,
+    "no_solution_within_limits"), ``detail`` (str or None, worded when
+    read), ``solver`` (index into ``solvers``), ``singularities`` (lists of
+    indices into ``singularity_reports``, made when read), ``truncated``, ``trimmed``,
     ``available``. ``solutions`` and ``rejected`` hold the rows grouped by
     target, joints in radians / length units; a position-only target's
     orientation residuals are NaN. ``solution_violations`` (S, n) and
@@ -129,10 +160,10 @@ class IKAnswer:
     """
 
     status: np.ndarray
-    detail: list[str | None]
+    detail: PerTarget  # of str | None
     solver: np.ndarray
     solvers: list[SolverReport]
-    singularities: list[list[int]]
+    singularities: PerTarget  # of list[int]
     singularity_reports: list[Singularity]
     truncated: np.ndarray
     trimmed: np.ndarray
@@ -143,9 +174,16 @@ class IKAnswer:
     rejected_violations: np.ndarray
     limits: Limits
     timings: list[SolveTiming]
+    detail_of: Callable[[int, Mapping[str, str]], str | None] = field(default=lambda row, wording: None,
+                                                                      repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.status)
+
+    def details(self, wording: Mapping[str, str] = NOTE_WORDING) -> PerTarget:
+        """Each target's detail (str or None), the selection's notes in ``wording``: the keys and fields of
+        :data:`NOTE_WORDING`, a boundary's words for the options (``detail`` reads in the core's)."""
+        return PerTarget(len(self), lambda row: self.detail_of(row, wording))
 
     def target(self, index: int) -> TargetAnswer:
         """Target ``index``'s answer as one object (its table rows sliced out, nothing recomputed)."""
@@ -181,7 +219,8 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
     limits = Limits.of(robot) if options.limits is None else options.limits
     free = None
     if options.free_joints is not None or robot.dof > 6:
-        free = free_joints_for(robot, options.free_joints)
+        with _at_free_joints():
+            free = free_joints_for(robot, options.free_joints)
     timings: list[SolveTiming] = []
     solved = [*_solved_directions(robot, targets, options, timings),
               *_solved_poses(robot, matrices, kinds, free, options, timings)]
@@ -195,6 +234,15 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
         solved.append(_from_results(robot, np.array(retry), results, False))
         answer = _selected(robot, len(matrices), solved, limits, options, timings)
     return answer
+
+
+@contextmanager
+def _at_free_joints() -> Iterator[None]:
+    """Locate the errors about the free joints at the option that asks for them (``free_joints``)."""
+    try:
+        yield
+    except InvalidInputError as error:
+        raise error.relocated("free_joints") from None
 
 
 def _solved_directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timings: list[SolveTiming]):
@@ -236,7 +284,8 @@ def _solved_poses(robot: Robot, matrices: np.ndarray, kinds: np.ndarray, free: l
         constrained = kind == POSE
         started = time.perf_counter()
         if constrained and free is not None:  # a redundant arm: the family over the free joints' values
-            family = solve_free_joint_family(robot, matrices[rows], free, reference)
+            with _at_free_joints():
+                family = solve_free_joint_family(robot, matrices[rows], free, reference)
             if family is None:
                 yield _numeric(robot, matrices, rows, True, options, timings, started, free)
                 continue
@@ -321,15 +370,14 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
     part's rows replace an earlier part's answer for the same targets (the position search after an unreachable
     held-joint solve)."""
     status = np.empty(n_targets, dtype=object)
-    detail: list[str | None] = [None] * n_targets
     solver_of, reports_of = np.zeros(n_targets, dtype=int), []  # index into every part's solvers, in part order
-    singular_of: list[list[Singularity]] = [[] for _ in range(n_targets)]
+    singular_of: dict[int, list[Singularity]] = {}
     truncated, trimmed = np.zeros(n_targets, dtype=bool), np.zeros(n_targets, dtype=int)
     available = np.zeros(n_targets, dtype=int)
     kept_parts, rejected_parts = [], []
-    owner = np.full(n_targets, -1)
+    owner, local_of = np.full(n_targets, -1), np.zeros(n_targets, dtype=int)
     for number, part in enumerate(parts):
-        owner[part.rows] = number
+        owner[part.rows], local_of[part.rows] = number, np.arange(len(part.rows))
     for number, part in enumerate(parts):
         live = owner[part.rows] == number
         if not live.any():
@@ -346,16 +394,13 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
         reports_of += part.solvers
         for local, met in part.singularities.items():
             if live[local]:
-                singular_of[rows[local]] = met
-        for local in {*part.details, *chosen.notes, *part.remarks}:
-            if live[local]:
-                words = [part.details.get(local), *chosen.notes.get(local, []), part.remarks.get(local)]
-                detail[rows[local]] = " ".join(filter(None, words)) or None
+                singular_of[int(rows[local])] = met
         for table, into in ((chosen.solutions, kept_parts), (chosen.rejected, rejected_parts)):
-            table = table.take(np.flatnonzero(live[table.target]))
-            table.target = rows[table.target]
-            if not part.constrained:
-                table.orientation = np.full(len(table.target), np.nan)
+            if not live.all():
+                table = table.take(np.flatnonzero(live[table.target]))
+            table = SolutionTable(rows[table.target], table.joints, table.within_limits, table.position,
+                                  table.orientation if part.constrained else np.full(len(table.target), np.nan),
+                                  table.labels)
             into.append(table)
     distinct, same = _numbered(reports_of)  # equal reports of different parts are one
     present, first = np.unique(same[solver_of], return_index=True)
@@ -363,10 +408,24 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
     renumber = np.zeros(len(distinct), dtype=int)
     renumber[by_appearance] = np.arange(len(by_appearance))
     solvers, solver = [distinct[i] for i in by_appearance], renumber[same[solver_of]]
-    reports, singularities = _numbered_lists(singular_of)
+    reports, numbered = _numbered_lists([singular_of[row] for row in sorted(singular_of)])
+    numbered_of = dict(zip(sorted(singular_of), numbered))
+    singularities = PerTarget(n_targets, lambda row: list(numbered_of.get(row, ())))
+    def detail_of(row: int, wording: Mapping[str, str]) -> str | None:
+        return None if owner[row] < 0 else _worded(parts[int(owner[row])], int(local_of[row]), wording)
+
     kept, rejected = _merged(kept_parts, robot.dof), _merged(rejected_parts, robot.dof)
-    return IKAnswer(status, detail, solver, solvers, singularities, reports, truncated, trimmed, available, kept,
-                    rejected, _violations(robot, limits, kept), _violations(robot, limits, rejected), limits, timings)
+    return IKAnswer(status, PerTarget(n_targets, lambda row: detail_of(row, NOTE_WORDING)), solver, solvers,
+                    singularities, reports, truncated, trimmed, available, kept, rejected,
+                    _violations(robot, limits, kept), _violations(robot, limits, rejected), limits, timings, detail_of)
+
+
+def _worded(part: _Solved, local: int, wording: Mapping[str, str]) -> str | None:
+    """The detail of a part's row ``local``: the solver's detail, the selection's notes in ``wording``, the
+    remarks."""
+    notes = part.chosen.notes.worded(local, wording) if local in part.chosen.notes else []
+    words = [part.details.get(local), *notes, part.remarks.get(local)]
+    return " ".join(filter(None, words)) or None
 
 
 def _numbered(items: list) -> tuple[list, np.ndarray]:
@@ -385,6 +444,8 @@ def _numbered_lists(lists: list[list]) -> tuple[list, list[list[int]]]:
 
 def _violations(robot: Robot, limits: Limits, table: SolutionTable) -> np.ndarray:
     """Which joints (S, n) of each row outside the limits break them (tolerance included); False elsewhere."""
+    if table.within_limits.all():  # the usual kept table: nothing to compare
+        return np.zeros(table.joints.shape, dtype=bool)
     tolerance = limits.tolerance(robot)
     outside = (table.joints < limits.lower - tolerance) | (table.joints > limits.upper + tolerance)
     return outside & ~table.within_limits[:, None]
@@ -410,5 +471,7 @@ def _merged(tables: list[SolutionTable], dof: int) -> SolutionTable:
             labels[name] = (tuple(vocabulary), lookup[codes])
         remapped.append(SolutionTable(table.target, table.joints, table.within_limits, table.position,
                                       table.orientation, labels))
+    if len(remapped) == 1:
+        return remapped[0]
     merged = SolutionTable.concatenate(remapped, dof)
-    return merged.take(np.argsort(merged.target, kind="stable")) if len(remapped) > 1 else merged
+    return merged.take(np.argsort(merged.target, kind="stable"))

@@ -166,6 +166,14 @@ def family_for(robot: Robot, free: tuple[int, ...]) -> FreeJointFamily:
     return memo(robot, ("free_joint_family", free), lambda: FreeJointFamily(robot, free))
 
 
+class NotRedundantError(InvalidInputError):
+    """Free joints were asked of an arm with 6 joints or fewer (``dof``): it has none to free."""
+
+    def __init__(self, message: str, *, dof: int = 0) -> None:
+        super().__init__(message)
+        self.dof = dof
+
+
 def default_free_joints(robot: Robot) -> tuple[int, ...] | None:
     """The free joint(s) whose locking leaves a closed-form 6-DOF class, or None when no choice does.
 
@@ -212,8 +220,7 @@ def sample_values(robot: Robot, joint: int, samples: int) -> np.ndarray:
         if not (np.isfinite(lower) and np.isfinite(upper)) or upper - lower >= 2 * np.pi:
             return -np.pi + 2 * np.pi * np.arange(samples) / samples
     elif not (np.isfinite(lower) and np.isfinite(upper)):
-        raise InvalidInputError(f"joint {joint} is prismatic without limits: give its free values as 'values'",
-                                location=("free_joints",))
+        raise InvalidInputError(f"joint {joint} is prismatic without limits: give its free values as 'values'")
     return np.linspace(lower, upper, samples) if samples > 1 else np.array([(lower + upper) / 2])
 
 
@@ -347,12 +354,11 @@ def solve_free_joint_family(robot: Robot, world_T_targets: np.ndarray, free: lis
     grids = np.meshgrid(*(by_joint[j] for j in family.free), indexing="ij")
     values = np.stack([g.ravel() for g in grids], axis=-1)  # (S, f)
     if len(values) > MAX_FREE_VALUES:
-        raise InvalidInputError(f"{len(values)} free values requested; at most {MAX_FREE_VALUES} per target",
-                                location=("free_joints",))
+        raise InvalidInputError(f"{len(values)} free values requested; at most {MAX_FREE_VALUES} per target")
     if not family.ends_only and len(values) > MAX_PLANNED_VALUES:
         raise InvalidInputError(
             f"{len(values)} free values requested; a free joint inside the chain needs one plan per value, so at "
-            f"most {MAX_PLANNED_VALUES} (an end joint takes up to {MAX_FREE_VALUES})", location=("free_joints",))
+            f"most {MAX_PLANNED_VALUES} (an end joint takes up to {MAX_FREE_VALUES})")
     targets = np.asarray(world_T_targets, dtype=float)
     rows_plan = _cached_rows_plan(family, values)
     answers, refined = [], []
@@ -588,7 +594,9 @@ def free_joints_for(robot: Robot, requested: list[tuple[int, list[float] | None,
     length units) or, when there are none, the default choice sampled :data:`DEFAULT_SAMPLES` times.
 
     Returns None when the request names none and no locking leaves a family. Raises
-    :class:`InvalidInputError` for a request that does not name exactly n − 6 distinct joints of the arm.
+    :class:`InvalidInputError` for a request that does not name exactly n − 6 distinct joints of the arm
+    (:class:`NotRedundantError` for an arm of 6 joints or fewer), located in ``requested``: ``()`` for the
+    whole list, ``(index, "joint")`` or ``(index, "values")`` for one entry.
     """
     extra = robot.dof - 6
     if not requested:
@@ -597,24 +605,24 @@ def free_joints_for(robot: Robot, requested: list[tuple[int, list[float] | None,
             return None
         return [FreeJoint(j, sample_values(robot, j, DEFAULT_SAMPLES)) for j in chosen]
     if extra < 1:
-        raise InvalidInputError(f"free_joints applies to arms with more than 6 joints; this one has {robot.dof}",
-                                location=("free_joints",))
+        raise NotRedundantError(f"free joints apply to arms with more than 6 joints; this one has {robot.dof}",
+                                dof=robot.dof)
     if len(requested) != extra:
         raise InvalidInputError(f"an arm with {robot.dof} joints has {extra} free joint(s) for a full pose; "
-                                f"{len(requested)} given", location=("free_joints",))
+                                f"{len(requested)} given")
     joints = [joint for joint, _, _ in requested]
     for index, joint in enumerate(joints):
         if not 0 <= joint < robot.dof:
             raise InvalidInputError(f"joint index must be 0…{robot.dof - 1}, not {joint}",
-                                    location=("free_joints", index, "joint"))
+                                    location=(index, "joint"))
         if joints.index(joint) != index:
-            raise InvalidInputError(f"joint {joint} is named twice", location=("free_joints", index, "joint"))
+            raise InvalidInputError(f"joint {joint} is named twice", location=(index, "joint"))
     free = []
     for index, (joint, values, samples) in enumerate(requested):
         if values is not None:
             array = np.asarray(values, dtype=float)
             if not np.isfinite(array).all():
-                raise InvalidInputError("free values must be finite", location=("free_joints", index, "values"))
+                raise InvalidInputError("free values must be finite", location=(index, "values"))
         else:
             array = sample_values(robot, joint, int(samples))
         free.append(FreeJoint(joint, array))

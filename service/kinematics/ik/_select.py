@@ -31,14 +31,15 @@ outwards from the cheapest. A combination among the first L of a solution
 (L = the most that can be returned of it) has ranks (r_1 … r_n) with
 ∏(r_j + 1) ≤ L, since every combination with smaller or equal ranks costs no
 more and comes first. Only those rank tuples are enumerated and costed, in
-chunks of targets of at most about :data:`_CHUNK_ROWS` combinations, with
-``budget`` checked between chunks; the counts (``available``, ``trimmed``) are
+chunks of whole solutions of at most about :data:`_CHUNK_ROWS` combinations
+(one target's may span several), with ``budget`` checked between chunks; the counts (``available``, ``trimmed``) are
 products of interval lengths, capped at :data:`.._budget.COUNT_CAP`.
 """
 
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -46,7 +47,7 @@ import numpy as np
 
 from .._budget import COUNT_CAP, UNLIMITED, Budget
 from .._errors import InvalidInputError
-from .._limits import Limits, Violation, closest_equivalent, turn_ranges, violations
+from .._limits import Limits, Violation, closest_turns, turn_ranges, violations
 from .._robot import Robot
 from ._arrays import IKArrays
 from ._types import IKResult, Solution
@@ -55,6 +56,21 @@ Norm = Literal["linf", "l2"]
 
 #: Default cap on the number of solutions after 2π expansion.
 MAX_EQUIVALENTS = 1024
+
+#: How the selection's notes read, in the core's terms, by kind. A boundary that names the options otherwise
+#: words them itself: :meth:`TargetNotes.worded` and :meth:`.IKAnswer.details` take a mapping with these keys,
+#: whose texts use the same fields.
+NOTE_WORDING = {
+    "no_fit": "All {rejected} solutions violate a joint limit, whatever whole turns the revolute joints make; they "
+              "are listed in 'rejected'.",
+    "flagged": "{outside} of the solutions violate a joint limit (the limits flag rather than filter them); each is "
+               "flagged with its violations.",
+    "capped": "{fit} solutions fit; the cap of {cap} on 2π-equivalents kept the {which} {kept}.",
+    "none_near": "{fit} solutions fit the limits, but none is within the joint move or among the solutions allowed "
+                 "near the reference.",
+    "lowered": "At most {limit} are listed for a {dof}-joint arm whatever cap on 2π-equivalents is asked: ranking "
+               "more of so many equivalents would take more work than one answer may.",
+}
 
 #: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
 _CHUNK_ROWS = 1 << 18
@@ -218,7 +234,7 @@ class BatchSelection:
     truncated: np.ndarray  # (N,) bool
     trimmed: np.ndarray  # (N,) int
     available: np.ndarray  # (N,) int
-    notes: dict[int, list[str]]
+    notes: "TargetNotes"
     solutions: SolutionTable
     rejected: SolutionTable
 
@@ -301,7 +317,7 @@ class _Choice:
     truncated: np.ndarray
     trimmed: np.ndarray
     available: np.ndarray
-    notes: dict[int, list[str]]
+    notes: "TargetNotes"
     kept: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
     rejected: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
@@ -316,12 +332,16 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     q = joints[target, slot]
     first, last = turn_ranges(robot, limits, q)
     fits = np.all(last >= first, axis=1)
-    closest = closest_equivalent(robot, limits, q[~fits], (first[~fits], last[~fits]))
-    candidate = fits | (not filter_limits)
-    # a solution that does not fit and stays among the candidates has one value: its closest equivalent
-    turns = np.round((closest - q[~fits]) / _TWO_PI)
-    first[~fits], last[~fits] = turns, turns
-    c_target, c_q, c_first, c_last = target[candidate], q[candidate], first[candidate], last[candidate]
+    misfits = np.flatnonzero(~fits)
+    misfit_q = q[misfits]
+    misfit_turns = closest_turns(robot, limits, misfit_q, first[misfits], last[misfits])
+    if filter_limits:  # the rows that fit are the candidates; the others are rejected at their closest equivalent
+        candidate = fits
+        c_target, c_q, c_first, c_last = target[fits], q[fits], first[fits], last[fits]
+    else:  # a solution that does not fit stays among the candidates with one value: its closest equivalent
+        candidate = np.ones(len(target), dtype=bool)
+        first[misfits], last[misfits] = misfit_turns, misfit_turns
+        c_target, c_q, c_first, c_last = target, q, first, last
     with_all_moves = _capped_sums(c_target, _capped_products(c_last - c_first + 1.0), n_targets)
     if reference is not None and ordering.max_joint_move is not None:
         c_first, c_last = _within_move(robot, limits, c_q, c_first, c_last, reference, ordering.max_joint_move)
@@ -342,8 +362,7 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     rows = np.flatnonzero(candidate)[kept_rows]
     kept = (target[rows], slot[rows], kept_values, fits[rows])
 
-    dropped = np.flatnonzero(~candidate)
-    dropped_values = closest if filter_limits else closest[:0]
+    dropped, dropped_values = (misfits, misfit_q + _TWO_PI * misfit_turns) if filter_limits else (misfits[:0], q[:0])
     if reference is not None and len(dropped):
         order = np.lexsort((travel(robot, limits, dropped_values, reference, ordering), target[dropped]))
         dropped, dropped_values = dropped[order], dropped_values[order]
@@ -358,15 +377,8 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     truncated = (available > n_kept) & (not capped)
     trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
     noted = no_fit | (outside > 0) | truncated | ((status == "ok") & (n_kept == 0) & (with_all_moves > 0))
-    rows = np.flatnonzero(noted)
-    notes = dict(zip(rows.tolist(), (_notes(*fields, max_equivalents, reference is not None) for fields in zip(
-        status[rows].tolist(), *(column[rows].tolist() for column in (n_rejected, outside, truncated, available,
-                                                                        n_kept, with_all_moves))))))
-    if lowered:
-        for row in np.flatnonzero(truncated).tolist():
-            notes.setdefault(row, []).append(
-                f"At most {limit} are listed for a {n}-joint arm whatever max_equivalents asks: ranking more of "
-                f"so many equivalents would take more work than one answer may.")
+    notes = TargetNotes(np.flatnonzero(noted), status, n_rejected, outside, truncated, available, n_kept,
+                        with_all_moves, max_equivalents, reference is not None, limit if lowered else None, n)
     return _Choice(status, truncated, trimmed, available, notes, kept, rejected)
 
 
@@ -419,50 +431,88 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     """
     n = q.shape[1]
     weights = np.ones(n) if reference is None or ordering.weights is None else np.asarray(ordering.weights, float)
-    if reference is None:  # turns ranked by |k| itself: exact, so equal turning ties exactly
-        cheapest, direction, ahead, behind = _ranked_turns(np.zeros_like(q), first, last, np.zeros_like(q), weights)
-    else:
-        cheapest, direction, ahead, behind = _ranked_turns(q, first, last, np.broadcast_to(reference, q.shape),
-                                                           weights)
     ranks_cap = np.minimum(counts, row_limit[:, None]).astype(np.int64)
     limits_met, which = np.unique(row_limit, return_inverse=True)
     down_sets = np.array([min(_down_set_size(n, int(b)), COUNT_CAP) for b in limits_met.tolist()], dtype=np.int64)
-    bound = np.minimum(_capped_products(ranks_cap), down_sets[which.ravel()])
-    per_target = np.bincount(target, weights=bound.astype(float), minlength=int(target[-1]) + 1 if len(target) else 0)
-    chunk_of_target = (np.cumsum(per_target) - per_target) // _CHUNK_ROWS
-    chunk = chunk_of_target[target]
+    bound = np.minimum(_capped_products(ranks_cap), down_sets[which.ravel()]).astype(float)
+    # chunks of whole rows: a row's combinations are at most MAX_COMBINATIONS_PER_SOLUTION, but one target's rows
+    # (16 solutions, or 32 samples of a free joint times 8) may hold millions, so a target may span chunks
+    chunk = (np.cumsum(bound) - bound) // _CHUNK_ROWS
     edges = np.flatnonzero(np.r_[True, chunk[1:] != chunk[:-1], True]) if len(target) else np.zeros(1, int)
-    kept_rows, kept_values = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))]
+    kept_rows, kept_values, kept_keys = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))], [np.zeros(0)]
     for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
         budget.check("selection")
-        caps = ranks_cap[start:stop]
-        owner, ranks = _rank_tuples(caps, row_limit[start:stop])
-        # each (row, joint, rank) turn once (no more of them than combinations), then looked up per combination
-        table_start = (np.cumsum(caps.ravel()) - caps.ravel()).reshape(caps.shape)
-        entry = np.repeat(np.arange(caps.size), caps.ravel())
-        rank = np.arange(len(entry)) - table_start.ravel()[entry]
-        table = [a[start:stop].ravel()[entry] for a in (cheapest, direction, ahead, behind)]
-        table = table[0] + _rank_offsets(rank, *table[1:])
-        turns = table[table_start[owner] + ranks]
+        owner, turns = _combination_turns(q[start:stop], first[start:stop], last[start:stop], ranks_cap[start:stop],
+                                          row_limit[start:stop], reference, weights)
         owner += start
         values = q[owner] + _TWO_PI * turns
         if reference is None:
             cost = np.sum(np.abs(turns), axis=1)
             by_stream = np.lexsort((cost, owner))  # each row's combinations cheapest first, ties by rank tuple
             owner, values = owner[by_stream], values[by_stream]
-            stream = _position_in_group(owner)
-            early = stream < row_limit[owner]
-            owner, values, stream = owner[early], values[early], stream[early]
-            order = np.lexsort((owner, stream, target[owner]))
+            key = _position_in_group(owner)  # the row's stream position: the targets take turns between rows
+            early = key < row_limit[owner]
+            owner, values, key = owner[early], values[early], key[early]
+            order = np.lexsort((owner, key, target[owner]))
         else:
             distance = _travel(np.abs(values - reference), limits.continuous(robot)) * weights
-            cost = distance.max(axis=1) if ordering.norm == "linf" else np.sqrt(np.sum(distance ** 2, axis=1))
-            order = np.lexsort((cost, target[owner]))  # stable: ties by row, then rank tuple
-        owner, values = owner[order], values[order]
+            key = distance.max(axis=1) if ordering.norm == "linf" else np.sqrt(np.sum(distance ** 2, axis=1))
+            order = np.lexsort((key, target[owner]))  # stable: ties by row, then rank tuple
+        owner, values, key = owner[order], values[order], key[order]
         first_few = _position_in_group(target[owner]) < limit
         kept_rows.append(owner[first_few])
         kept_values.append(values[first_few])
-    return np.concatenate(kept_rows), np.concatenate(kept_values)
+        kept_keys.append(key[first_few])
+    rows, values, keys = np.concatenate(kept_rows), np.concatenate(kept_values), np.concatenate(kept_keys)
+    if len(edges) > 2 and (target[edges[1:-1]] == target[edges[1:-1] - 1]).any():
+        # a target over several chunks: its kept combinations from each, ordered again as one chunk orders them
+        # (each chunk's come in row order, so the stable sorts break ties as one chunk would)
+        order = np.lexsort((rows, keys, target[rows])) if reference is None else np.lexsort((keys, target[rows]))
+        rows, values = rows[order], values[order]
+        first_few = _position_in_group(target[rows]) < limit
+        rows, values = rows[first_few], values[first_few]
+    return rows, values
+
+
+def _combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_cap: np.ndarray,
+                       row_limit: np.ndarray, reference: np.ndarray | None,
+                       weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The turns of every combination of rows (S,) among each row's first ``row_limit`` in cost order: (row (C,)
+    ascending, turns (C, n)), each row's combinations in lexicographic order of their rank tuples.
+
+    ``q``, ``first``, ``last`` (S, n) are the rows' values and usable turns, ``ranks_cap`` (S, n) the most
+    ranks of each joint worth enumerating. A row with one usable turn per joint (limits under a whole turn,
+    the usual case) has one combination, its ``first`` turns, and is not ranked at all.
+    """
+    single = np.all(first == last, axis=1) & (row_limit > 0)
+    multi = np.flatnonzero(~single)
+    if not len(multi):
+        return np.arange(len(q)), first
+    caps = ranks_cap[multi]
+    if reference is None:  # turns ranked by |k| itself: exact, so equal turning ties exactly
+        zeros = np.zeros((len(multi), q.shape[1]))
+        cheapest, direction, ahead, behind = _ranked_turns(zeros, first[multi], last[multi], zeros, weights)
+    else:
+        cheapest, direction, ahead, behind = _ranked_turns(q[multi], first[multi], last[multi],
+                                                           np.broadcast_to(reference, caps.shape), weights)
+    owner, ranks = _rank_tuples(caps, row_limit[multi])
+    # each (row, joint, rank) turn once (no more of them than combinations), then looked up per combination
+    table_start = (np.cumsum(caps.ravel()) - caps.ravel()).reshape(caps.shape)
+    entry = np.repeat(np.arange(caps.size), caps.ravel())
+    rank = np.arange(len(entry)) - table_start.ravel()[entry]
+    table = [a.ravel()[entry] for a in (cheapest, direction, ahead, behind)]
+    table = table[0] + _rank_offsets(rank, *table[1:])
+    multi_turns = table[table_start[owner] + ranks]
+    if len(multi) == len(q):
+        return owner, multi_turns
+    per_row = np.ones(len(q), dtype=np.int64)  # each row's combinations, placed in row order
+    per_row[multi] = np.bincount(owner, minlength=len(multi))
+    offset = np.cumsum(per_row) - per_row
+    turns = np.empty((int(per_row.sum()), q.shape[1]))
+    singles = np.flatnonzero(single)
+    turns[offset[singles]] = first[singles]
+    turns[offset[multi][owner] + _position_in_group(owner)] = multi_turns
+    return np.repeat(np.arange(len(q)), per_row), turns
 
 
 def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, centre: np.ndarray,
@@ -581,32 +631,72 @@ def _rounds_needed(target: np.ndarray, lengths: np.ndarray, n_targets: int, limi
     streams = np.zeros((n_targets, int(position.max()) + 1 if len(position) else 1), dtype=np.int64)
     streams[target, position] = lengths
 
+    rounds = np.maximum(1, streams.max(axis=1))  # a target whose streams yield fewer than ``limit``: all of them
+    enough = np.flatnonzero(np.minimum(streams, limit).sum(axis=1) >= limit)
+    streams = streams[enough]  # only these need the bisection
+
     def yielded(rounds):
         return np.minimum(streams, rounds[:, None]).sum(axis=1)
 
-    low, high = np.ones(n_targets, dtype=np.int64), np.full(n_targets, limit, dtype=np.int64)
-    enough = yielded(high) >= limit
+    low, high = np.ones(len(enough), dtype=np.int64), np.full(len(enough), limit, dtype=np.int64)
     while np.any(low < high):
         middle = (low + high) // 2
         reached = yielded(middle) >= limit
         low, high = np.where(reached, low, middle + 1), np.where(reached, middle, high)
-    return np.where(enough, low, np.maximum(1, streams.max(axis=1)))
+    rounds[enough] = low
+    return rounds
 
 
-def _notes(status: str, rejected: int, outside: int, truncated: bool, available: int, kept: int,
-           with_all_moves: int, max_equivalents: int, has_reference: bool) -> list[str]:
-    notes = []
-    if status == "no_solution_within_limits":
-        notes.append(f"All {rejected} solutions violate a joint limit, whatever whole turns the "
-                     f"revolute joints make; they are listed in 'rejected'.")
-    if outside:
-        notes.append(f"{outside} of the solutions violate a joint limit (filter_limits is false); "
-                     f"each is flagged with its violations.")
-    if truncated:
-        which = "nearest" if has_reference else "least-turned"
-        fit = f"At least {COUNT_CAP} (2**53 − 1, the count's cap)" if available >= COUNT_CAP else f"{available}"
-        notes.append(f"{fit} solutions fit; max_equivalents = {max_equivalents} kept the {which} {kept}.")
-    if status == "ok" and not kept and with_all_moves:
-        notes.append(f"{with_all_moves} solutions fit the limits, but none is within max_joint_move / "
-                     f"max_solutions of the reference.")
-    return notes
+class TargetNotes(Mapping):
+    """The selection's notes: target index → its notes (list of str), for the targets that have any, each
+    worded only when read (a batch has thousands; most readers look at a few).
+
+    ``rows`` (k,) ascending are the noted targets; the other arrays (N,) are the per-target counts the notes
+    quote: status, rejected, flagged outside the limits, truncated, available, kept, and fitting before
+    ``max_joint_move``. ``lowered_to`` is the per-target limit :func:`enumerable_limit` imposed, if any.
+    """
+
+    def __init__(self, rows: np.ndarray, status: np.ndarray, rejected: np.ndarray, outside: np.ndarray,
+                 truncated: np.ndarray, available: np.ndarray, kept: np.ndarray, with_all_moves: np.ndarray,
+                 max_equivalents: int, has_reference: bool, lowered_to: int | None, dof: int) -> None:
+        self.rows = rows
+        self._columns = (status, rejected, outside, truncated, available, kept, with_all_moves)
+        self._max_equivalents, self._has_reference = max_equivalents, has_reference
+        self._lowered_to, self._dof = lowered_to, dof
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def __iter__(self):
+        return iter(self.rows.tolist())
+
+    def __contains__(self, row: object) -> bool:
+        if not isinstance(row, (int, np.integer)):
+            return False
+        at = int(np.searchsorted(self.rows, row))
+        return at < len(self.rows) and self.rows[at] == row
+
+    def __getitem__(self, row: int) -> list[str]:
+        return self.worded(row, NOTE_WORDING)
+
+    def worded(self, row: int, wording: Mapping[str, str]) -> list[str]:
+        """Target ``row``'s notes in ``wording`` (the keys and fields of :data:`NOTE_WORDING`)."""
+        if row not in self:
+            raise KeyError(row)
+        status, *counts = self._columns
+        status, (rejected, outside, truncated, available, kept, with_all_moves) = (
+            status[row], (column[row].item() for column in counts))
+        notes = []
+        if status == "no_solution_within_limits":
+            notes.append(wording["no_fit"].format(rejected=rejected))
+        if outside:
+            notes.append(wording["flagged"].format(outside=outside))
+        if truncated:
+            fit = f"At least {COUNT_CAP} (2**53 − 1, the count's cap)" if available >= COUNT_CAP else f"{available}"
+            notes.append(wording["capped"].format(fit=fit, cap=self._max_equivalents, kept=kept,
+                                                  which="nearest" if self._has_reference else "least-turned"))
+        if status == "ok" and not kept and with_all_moves:
+            notes.append(wording["none_near"].format(fit=with_all_moves))
+        if truncated and self._lowered_to is not None:
+            notes.append(wording["lowered"].format(limit=self._lowered_to, dof=self._dof))
+        return notes

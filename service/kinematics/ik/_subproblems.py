@@ -724,10 +724,18 @@ def subproblem_4(h: ArrayLike, k: ArrayLike, p: ArrayLike, delta: ArrayLike) -> 
     return _harmonic(a, b, c, scale)
 
 
-# Roots of subproblem 5's quartic count as on the unit circle (real angles) within this radial distance.
-# Roots off the circle come in pairs (z, 1 / conj(z)); a tangent (double) root that rounding splits
-# lies about sqrt(eps) off it. A root accepted here that is not a solution fails the FK check.
-_SP5_ROOT_RADIUS = 1e-5
+# A root z of a trigonometric quartic (:func:`_trig_quartic_roots`) counts as a real angle when | |z| - 1 | is at
+# most this. Real roots lie on the unit circle and the others come in pairs (z, 1 / conj(z)); a double root (a
+# tangent case) that rounding splits lies about sqrt(eps) ~ 1.5e-8 off it, some 600 times inside. A root accepted
+# here that solves nothing fails the caller's residual test after its Newton steps.
+_ON_UNIT_CIRCLE = 1e-5
+# The degree-2 terms of a trigonometric quartic count as absent below this fraction of its coefficients' size: the
+# companion matrix would carry entries of 1 / this and more, while the harmonic equation left is off by at most
+# this (the callers' Newton steps remove it).
+_LEADING_NEGLIGIBLE = 1e-8
+# A trigonometric quartic vanishes identically (every angle solves it) when each coefficient is at most this
+# fraction of the problem's scale.
+_VANISHING = 1e-12
 
 
 def _rotation_parts(k: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -746,32 +754,69 @@ def _inverse_2x2(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return adjugate / det[..., None, None], det
 
 
-def _unit_circle_roots(c2: np.ndarray, c1: np.ndarray, c0: np.ndarray, scale: np.ndarray
-                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Angles of the roots on the unit circle of ``c2 z⁴ + c1 z³ + c0 z² + conj(c1) z + conj(c2)``.
+def _trig_quartic_roots(alpha0: np.ndarray, alpha1: np.ndarray, beta1: np.ndarray, alpha2: np.ndarray,
+                        beta2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The real roots of ``alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t = 0``: four slots.
 
-    Returns ``(theta (..., 4), valid (..., 4), identically_zero (...,))``. Rows whose leading
-    coefficient vanishes (relative to ``scale``) are solved as the quadratic left.
+    Times ``z**2`` with ``z = exp(i t)`` the equation is the quartic
+    ``c4 z**4 + c3 z**3 + alpha0 z**2 + conj(c3) z + conj(c4)`` with ``c4 = (alpha2 - i beta2) / 2`` and
+    ``c3 = (alpha1 - i beta1) / 2``, whose roots on the unit circle are the real angles (no tangent half-angle,
+    so ``t = pi`` is an ordinary root). The roots are the eigenvalues of its companion matrices, one batched
+    ``eigvals``. Where the degree-2 part is negligible (``|c4|`` at most :data:`_LEADING_NEGLIGIBLE` of the
+    coefficients' size) the harmonic equation ``alpha1 cos t + beta1 sin t = -alpha0`` is solved instead: two
+    slots, the other two copies of the first, not on the circle.
+
+    The coefficients are arrays of one shape (...). Returns ``(theta, on_circle, double)``: ``theta``
+    (..., 4) radians in (-pi, pi], each root's angle (off the circle too: the nearest angle for a row without
+    a real root); ``on_circle`` (..., 4) where the root is real (within :data:`_ON_UNIT_CIRCLE` radially, or an
+    exact root of the harmonic equation); ``double`` (...,) where the harmonic equation's two roots are one.
+    Whether the quartic vanishes identically is the caller's to judge (:func:`_vanishes`).
+
+    Examples
+    --------
+    ``cos 2t = 0``: t = +/-pi/4 and +/-3pi/4.
+
+    >>> theta, on_circle, _ = _trig_quartic_roots(*np.array([[0.0], [0.0], [0.0], [1.0], [0.0]]))
+    >>> np.sort(np.degrees(theta[on_circle])).round(9).tolist()
+    [-135.0, -45.0, 45.0, 135.0]
     """
-    shape = c0.shape
-    z = np.full(shape + (4,), np.nan + 0j)
-    tol = 1e-12 * scale
-    quartic = np.abs(c2) > tol
+    shape = np.shape(alpha0)
+    c4 = 0.5 * (alpha2 - 1j * beta2)
+    c3 = 0.5 * (alpha1 - 1j * beta1)
+    size = np.maximum.reduce([np.abs(alpha0), np.abs(alpha1) + np.abs(beta1), np.abs(alpha2) + np.abs(beta2)])
+    size = np.where(size > 0.0, size, 1.0)
+    quartic = np.abs(c4) > _LEADING_NEGLIGIBLE * size
+    theta = np.full(shape + (4,), np.nan)
+    on_circle = np.zeros(shape + (4,), dtype=bool)
+    double = np.zeros(shape, dtype=bool)
     if quartic.any():
-        a = np.stack([c1, c0, np.conj(c1), np.conj(c2)], axis=-1)[quartic] / c2[quartic][:, None]
-        companion = np.zeros(a.shape[:1] + (4, 4), dtype=complex)
-        companion[:, 0, :] = -a
-        companion[:, 1, 0] = companion[:, 2, 1] = companion[:, 3, 2] = 1.0
-        z[quartic] = np.linalg.eigvals(companion)
-    quadratic = ~quartic & (np.abs(c1) > tol)
-    if quadratic.any():
-        A, B, C = c1[quadratic], c0[quadratic], np.conj(c1[quadratic])
-        root = np.sqrt(B * B - 4 * A * C)
-        z[quadratic, 0] = (-B + root) / (2 * A)
-        z[quadratic, 1] = (-B - root) / (2 * A)
-    identically_zero = ~quartic & ~quadratic & (np.abs(c0) <= tol)
-    valid = np.abs(np.abs(z) - 1.0) <= _SP5_ROOT_RADIUS
-    return np.where(valid, np.angle(z), np.nan), valid, identically_zero
+        lead = np.where(quartic, c4, 1.0)
+        companion = np.zeros(shape + (4, 4), dtype=complex)
+        companion[..., 1, 0] = companion[..., 2, 1] = companion[..., 3, 2] = 1.0
+        companion[..., 0, 0] = -c3 / lead
+        companion[..., 0, 1] = -alpha0 / lead
+        companion[..., 0, 2] = -np.conj(c3) / lead
+        companion[..., 0, 3] = -np.conj(c4) / lead
+        companion[~quartic] = np.eye(4) * 2.0  # placeholder rows: roots off the circle, overwritten below
+        z = np.linalg.eigvals(companion)
+        on_circle = quartic[..., None] & (np.abs(np.abs(z) - 1.0) <= _ON_UNIT_CIRCLE)
+        theta = np.angle(z)
+    if not quartic.all():
+        harmonic = _harmonic(alpha1, beta1, -alpha0, size)
+        two = harmonic.valid & harmonic.exact
+        theta[..., :2] = np.where(~quartic[..., None], np.nan_to_num(harmonic.theta), theta[..., :2])
+        theta[..., 2:] = np.where(~quartic[..., None], theta[..., :1], theta[..., 2:])
+        on_circle[..., :2] = np.where(~quartic[..., None], two, on_circle[..., :2])
+        double = ~quartic & harmonic.merged
+    return wrap_angle(np.nan_to_num(theta)), on_circle, double
+
+
+def _vanishes(alpha0: np.ndarray, alpha1: np.ndarray, beta1: np.ndarray, alpha2: np.ndarray, beta2: np.ndarray,
+              scale: np.ndarray) -> np.ndarray:
+    """Whether the trigonometric quartic of :func:`_trig_quartic_roots` is 0 for every angle (...,): each of its
+    complex coefficients at most :data:`_VANISHING` times ``scale`` (...,)."""
+    largest = np.maximum.reduce([np.abs(alpha0), 0.5 * _hypot(alpha1, beta1), 0.5 * _hypot(alpha2, beta2)])
+    return largest <= _VANISHING * scale
 
 
 def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1: ArrayLike, p2: ArrayLike,
@@ -806,7 +851,7 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
     Notes
     -----
     Unlike subproblems 1–4 there is no least-squares candidate: a row whose quartic has no root
-    on the unit circle (within ``1e-5`` radially) has no valid slot. Roots closer than
+    on the unit circle (within :data:`_ON_UNIT_CIRCLE` radially) has no valid slot. Roots closer than
     ``DUPLICATE_TOLERANCE`` (a tangent root, the edge of the workspace) are reported once with
     ``merged`` set. Scale: ``S = ||p0|| + ||p1|| + ||p2|| + ||p3||``; a candidate is ``exact``
     when the vector equation holds to ``GEOMETRY_TOLERANCE * S``. Near a tangent root a root
@@ -862,14 +907,15 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
     Q = np.swapaxes(G, -1, -2) @ G
     g = np.einsum("...ji,...j->...i", G, f)
     h = _dot(f, f) - 1.0
-    c2 = (Q[..., 0, 0] - Q[..., 1, 1]) / 4 - 0.5j * Q[..., 0, 1]
-    c1 = g[..., 0] - 1j * g[..., 1]
-    c0 = (Q[..., 0, 0] + Q[..., 1, 1]) / 2 + h
+    # F(t) = u Q u + 2 g u + h as alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t
+    coefficients = ((Q[..., 0, 0] + Q[..., 1, 1]) / 2 + h, 2 * g[..., 0], 2 * g[..., 1],
+                    (Q[..., 0, 0] - Q[..., 1, 1]) / 2, Q[..., 0, 1])
     scale = 1.0 + Q[..., 0, 0] + Q[..., 1, 1] + _dot(f, f)
     with np.errstate(invalid="ignore"):
-        theta_t, valid, free = _unit_circle_roots(c2, c1, c0, np.where(separable, scale, np.inf))
-        free &= separable
-        valid &= separable[..., None]
+        theta_t, valid, double = _trig_quartic_roots(*coefficients)
+        free = separable & _vanishes(*coefficients, scale)
+        valid &= (separable & ~free)[..., None]
+        theta_t = np.where(valid, theta_t, np.nan)
         theta_t[free, 0], valid[free, 0] = 0.0, True
         for _ in range(2):  # Newton on F(t) = u Q u + 2 g u + h, u = (cos t, sin t)
             u = np.stack([np.cos(theta_t), np.sin(theta_t)], axis=-1)
@@ -889,7 +935,7 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
     theta2, _, _ = _rotate_onto(axis_frame(k2), np.nan_to_num(M), np.nan_to_num(L), S[..., None])
     miss = _norm(L - _rotate_points(k2, theta2, M))
     # the same root twice (a tangent root): keep the first
-    merged = np.zeros(shape, dtype=bool)
+    merged = double & separable & ~free  # a tangent root of the harmonic equation, already reported once
     for later in range(1, 4):
         for earlier in range(later):
             gap = np.abs(wrap_angle(theta_t[..., later] - theta_t[..., earlier]))
@@ -1107,9 +1153,6 @@ class AngleQuadSolutions(NamedTuple):
     merged: np.ndarray  #: (...,) bool
 
 
-# A root z of the quartic counts as a real angle when | |z| - 1 | is below this before polishing: generous, since
-# a double root splits by about sqrt(eps); polishing and the residual test below decide.
-_ON_CIRCLE = 1e-3
 _NEWTON_STEPS = 2  # on the pair of equations, after the quartic's roots
 _EXACT_PAIR = 10 * GEOMETRY_TOLERANCE  # relative residual of an exact root: Newton-polished roots reach ~1e-15
 
@@ -1120,47 +1163,6 @@ def _term_coefficients(k: np.ndarray, h: np.ndarray, p: np.ndarray) -> tuple[np.
     hx, hy, hz = _coords(h, frame)
     px, py, pz = _coords(p, frame)
     return hx * px + hy * py, hy * px - hx * py, hz * pz
-
-
-def _trig_quartic_roots(alpha0, alpha1, beta1, alpha2, beta2):
-    """The real roots of ``alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t = 0``, four slots.
-
-    With ``z = exp(i t)`` the equation times ``z**2`` is a quartic in z whose roots on the unit circle are the
-    real angles. Its roots come from the eigenvalues of the companion matrices, one batched ``eigvals``.
-    Returns ``(theta, found, double)``: ``theta`` and ``found`` (..., 4), ``found`` where a root lies on the
-    circle (``theta`` elsewhere holds the angle of a root off it); ``double`` as below. When the
-    degree-2 part vanishes (``|alpha2| + |beta2|`` about 0) the equation is harmonic, with two roots, and
-    ``double`` (...,) marks where they are one.
-    """
-    shape = np.shape(alpha0)
-    c4 = 0.5 * (alpha2 - 1j * beta2)
-    c3 = 0.5 * (alpha1 - 1j * beta1)
-    size = np.maximum.reduce([np.abs(alpha0), np.abs(alpha1) + np.abs(beta1), np.abs(alpha2) + np.abs(beta2)])
-    size = np.where(size > 0.0, size, 1.0)
-    quartic = np.abs(c4) > 1e-8 * size
-    theta = np.full(shape + (4,), np.nan)
-    found = np.zeros(shape + (4,), dtype=bool)
-    double = np.zeros(shape, dtype=bool)
-    if quartic.any():
-        lead = np.where(quartic, c4, 1.0)
-        companion = np.zeros(shape + (4, 4), dtype=complex)
-        companion[..., 1, 0] = companion[..., 2, 1] = companion[..., 3, 2] = 1.0
-        companion[..., 0, 0] = -c3 / lead
-        companion[..., 0, 1] = -alpha0 / lead
-        companion[..., 0, 2] = -np.conj(c3) / lead
-        companion[..., 0, 3] = -np.conj(c4) / lead
-        companion[~quartic] = np.eye(4) * 2.0  # placeholder rows: roots off the circle, overwritten below
-        z = np.linalg.eigvals(companion)
-        found = quartic[..., None] & (np.abs(np.abs(z) - 1.0) <= _ON_CIRCLE)
-        theta = np.angle(z)  # off the circle too: the nearest angle serves a row without a root
-    if not quartic.all():
-        harmonic = _harmonic(alpha1, beta1, -alpha0, size)
-        two = harmonic.valid & harmonic.exact
-        theta[..., :2] = np.where(~quartic[..., None], np.nan_to_num(harmonic.theta), theta[..., :2])
-        theta[..., 2:] = np.where(~quartic[..., None], theta[..., :1], theta[..., 2:])
-        found[..., :2] = np.where(~quartic[..., None], two, found[..., :2])
-        double = ~quartic & harmonic.merged
-    return wrap_angle(np.nan_to_num(theta)), found, double
 
 
 def subproblem_6(
@@ -1492,9 +1494,11 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
             F = bq * bq * np.pad(A2, [(0, 0)] * len(shape) + [(0, 2)]) - bq * _trig_product(A1, B2) \
                 + c * _trig_product(A1, A1)
             scale = 1.0 + np.abs(F).sum(axis=-1)
-            c2 = (F[..., 3] - 1j * F[..., 4]) / 2
-            c1 = (F[..., 1] - 1j * F[..., 2]) / 2
-            theta, valid, degenerate = _unit_circle_roots(c2, c1, F[..., 0] + 0j, scale)
+            coefficients = tuple(np.moveaxis(F, -1, 0))
+            theta, valid, double = _trig_quartic_roots(*coefficients)
+            degenerate = _vanishes(*coefficients, scale)
+            valid &= ~degenerate[..., None]
+            theta = np.where(valid, theta, np.nan)
             theta[degenerate, 0], valid[degenerate, 0] = 0.0, True
             for _ in range(2):  # Newton on F(theta)
                 value, slope = _trig_value(F, theta)
@@ -1502,7 +1506,7 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
                                 0.0)
                 theta = np.where(degenerate[..., None] | (np.abs(step) > 1e-3), theta, theta - step)
             s = -_trig_value(A1, theta)[0] / bq
-            merged = np.zeros(shape, dtype=bool)
+            merged = double & ~degenerate  # a tangent root of the harmonic equation left, reported once
             quartic, quartic_scale = F, np.where(by_quartic, scale, -1.0)  # no residual merging elsewhere
         if not by_quartic.all():
             first = _harmonic(A1[..., 1], A1[..., 2], -A1[..., 0], np.ones(shape))

@@ -16,7 +16,7 @@ from pydantic import TypeAdapter
 
 from service.robots import robot_from_description
 from service.robots.schemas import RobotDescription
-from service.kinematics import forward_kinematics
+from service.kinematics import InvalidInputError, forward_kinematics
 from service.kinematics.ik import FreeJoint, distance_to_reference, free_joints_for, solve_free_joint_family
 from service.kinematics.ik._redundant import beyond_reach, default_free_joints, family_for, sample_values
 from tests.ik_helpers import find
@@ -180,3 +180,27 @@ def test_values_whose_locked_arm_has_no_plan_are_counted(monkeypatch):
     answer = solve_free_joint_family(robot, forward_kinematics(robot, q)[None], [FreeJoint(2, values)], None)
     assert answer.missing.tolist() == [2]
     assert find(robot, solutions_of(answer), q) is not None
+
+
+def test_free_joint_errors_are_located_in_the_request_and_worded_in_the_core_terms():
+    """Locations are relative to the entries given (the boundary prefixes the request's path); the words name
+    free joints, not a wire field."""
+    from service.config import Settings
+    from service.kinematics.ik import AnswerOptions, IKTargets, NotRedundantError, answer_ik
+    from service.robots.catalogue import load_catalogue
+
+    robot = arm("iiwa14")
+    with pytest.raises(InvalidInputError) as caught:
+        free_joints_for(robot, [(9, [0.0], None)])
+    assert caught.value.location == (0, "joint")
+    with pytest.raises(InvalidInputError) as caught:
+        free_joints_for(robot, [(2, [0.0, np.nan], None)])
+    assert caught.value.location == (0, "values")
+    with pytest.raises(NotRedundantError) as caught:
+        ur5 = load_catalogue([Settings().builtin_robots_dir], max_joints=32).get("ur5").robot
+        free_joints_for(ur5, [(2, [0.0], None)])
+    assert caught.value.location == () and caught.value.dof == 6 and "free_joints" not in caught.value.message
+    target = IKTargets.poses(forward_kinematics(robot, np.zeros((1, 7))))
+    with pytest.raises(InvalidInputError) as caught:  # answer_ik puts them at its option
+        answer_ik(robot, target, AnswerOptions(free_joints=[(9, [0.0], None)]))
+    assert caught.value.location == ("free_joints", 0, "joint")

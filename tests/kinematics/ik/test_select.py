@@ -161,6 +161,32 @@ def test_select_matches_the_brute_force_oracle(seed):
             assert [v.joint for v in entry.violations] == np.flatnonzero(outside).tolist(), context
 
 
+@pytest.mark.parametrize("seed", range(6, 9))
+def test_select_matches_the_oracle_when_a_target_spans_many_chunks(seed, monkeypatch):
+    """Chunks of whole solutions, three combinations at most: every target with several solutions, or one with
+    several equivalents, is ranked over several chunks and its kept ones ordered again as one."""
+    from service.kinematics.ik import _select
+    monkeypatch.setattr(_select, "_CHUNK_ROWS", 3)
+    test_select_matches_the_brute_force_oracle(seed)
+
+
+def test_a_batch_answers_the_same_in_small_chunks(monkeypatch):
+    """The UR5 (±360°: up to 64 equivalents a solution) over 40 targets, with and without a reference: the same
+    rows in the same order whether a chunk holds every target or a few of one target's solutions."""
+    from service.kinematics.ik import _select
+    robot = CATALOGUE.get("ur5").robot
+    q = np.random.default_rng(3).uniform(-np.pi, np.pi, (40, 6))
+    arrays = solve_ik_arrays(robot, forward_kinematics(robot, q))
+    for options in ({"max_equivalents": 50}, {"reference": q[0], "max_equivalents": 20},
+                    {"reference": q[1], "ordering": Ordering("l2", weights=np.linspace(0.5, 2, 6))}):
+        whole = select_arrays(robot, arrays, Limits.of(robot), **options)
+        monkeypatch.setattr(_select, "_CHUNK_ROWS", 40)
+        small = select_arrays(robot, arrays, Limits.of(robot), **options)
+        monkeypatch.undo()
+        np.testing.assert_array_equal(small.solutions.target, whole.solutions.target)
+        np.testing.assert_array_equal(small.solutions.joints, whole.solutions.joints)
+
+
 CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 
 
@@ -211,3 +237,12 @@ def test_huge_limits_are_answered_bounded_with_exact_counts():
     capped = select(six, IKResult("ok", [Solution(np.full(6, 0.5), {}, 0.0, 0.0)], "analytic", "x", True),
                     Limits.of(six), max_equivalents=8)
     assert capped.available == COUNT_CAP and len(capped.solutions) == 8 and "the count's cap" in capped.notes[0]
+
+
+def test_the_core_notes_name_no_option_of_the_wire():
+    """The core words its notes in its own terms; the boundary words them for the wire (tests/api)."""
+    from service.kinematics.ik import NOTE_WORDING
+
+    for text in NOTE_WORDING.values():
+        for wire_name in ("max_equivalents", "filter_limits", "max_joint_move", "max_solutions", "free_joints"):
+            assert wire_name not in text

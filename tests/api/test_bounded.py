@@ -347,3 +347,25 @@ def test_budget_within_shares_the_cancellation_and_keeps_the_earlier_deadline():
     request.cancel()
     with pytest.raises(BudgetExhausted, match="cancelled"):
         part.check("part")
+
+
+def test_a_redundant_arm_with_many_turn_limits_and_a_reference_stays_bounded():
+    """kuka_iiwa14 with ±300 rad on every joint (48 turns, within KIN_MAX_TURNS_PER_JOINT) and a reference: 32
+    samples of the free joint × 8 solutions, each ranking up to 2^15 turn combinations. One target's solutions
+    were ranked in one chunk: 2.6 GB and 30 s, the deadline never checked. Now in chunks of whole solutions:
+    bounded memory, and the deadline holds (answered, or a 503 problem at it)."""
+    import tracemalloc
+
+    with TestClient(create_app(Settings(_env_file=None))) as client:
+        fk = client.post("/v1/robots/kuka_iiwa14/fk", json={"joints": [0.3] * 7}).json()
+        body = {"target": {"matrix": fk["pose"]["matrix"]}, "limits": [{"lower": -300, "upper": 300}] * 7,
+                "reference": [0.0] * 7}
+        tracemalloc.start()
+        started = time.perf_counter()
+        response = client.post("/v1/robots/kuka_iiwa14/ik", json=body, headers={"X-Request-Timeout-Ms": "2000"})
+        seconds, (_, peak) = time.perf_counter() - started, tracemalloc.get_traced_memory()
+        tracemalloc.stop()
+    assert response.status_code in (200, 503), response.text
+    if response.status_code == 503:
+        assert response.json()["type"].endswith("/deadline-exceeded")
+    assert seconds < 2.0 + 4.0 and peak < 400 * 2**20, (seconds, peak)

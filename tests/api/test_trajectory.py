@@ -26,7 +26,17 @@ ASSUR = "assur001_scara_rrp"
 def post(client, robot_id: str, body: dict, status: int = 200):
     response = client.post(f"/v1/robots/{robot_id}/ik/trajectory", json=body)
     assert response.status_code == status, response.text
-    return response.json()
+    answer = response.json()
+    if status == 200:
+        assert_is_its_model(answer)
+    return answer
+
+
+def assert_is_its_model(answer: dict) -> None:
+    """A trajectory answer is encoded without passing through TrajectoryResponse: it must already be it."""
+    from service.api.schemas.trajectory import TrajectoryResponse
+
+    assert TrajectoryResponse.model_validate(answer).model_dump(mode="json") == answer
 
 
 def spiral_samples(t, *, twist=True, acceleration=True) -> list[dict]:
@@ -113,6 +123,7 @@ def test_inline_twin_answers_as_the_catalogue_robot(client):
     body = {"samples": spiral_samples(np.arange(9.0)), "branch": {"assembly_mode": 1}}
     inline = client.post("/v1/ik/trajectory", json={**body, "robot": robot})
     assert inline.status_code == 200, inline.text
+    assert_is_its_model(inline.json())
     catalogue = post(client, ASSUR, body)
     assert inline.json()["samples"] == catalogue["samples"]
 
@@ -172,6 +183,7 @@ def test_coincident_group_with_equal_arms_inline(client):
                                                       "reference": [1.8, 2.7, 90.0]})
     assert response.status_code == 200, response.text
     body = response.json()
+    assert_is_its_model(body)
     at = body["samples"][2]
     assert [(s["kind"], s["relation"]) for s in at["singularities"]] == [("assur_group", "coincident"),
                                                                         ("jacobian", "near_singular")]

@@ -7,13 +7,14 @@ import math
 import numpy as np
 from fastapi import APIRouter, Depends, Request
 
-from ...kinematics import InvalidInputError, Robot
+from ...kinematics import Budget, InvalidInputError, Robot
 from ...kinematics import TrajectoryOptions, TrajectoryResult, follow_trajectory
 from ...kinematics.ik import IKOptions
 from ..budget import budget_of
 from ..boundary import joints_from_core, joints_to_core, located, target_matrix, violation_to_wire
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
 from ..problems import problem_responses
+from ..responses import FastJSONResponse
 from ..routing import FastJSONRoute
 from ..schemas.trajectory import TrajectoryInlineRequest, TrajectoryRequest, TrajectoryResponse
 
@@ -34,7 +35,10 @@ def _follow(request: Request, ref: RobotRef, body: TrajectoryRequest) -> dict:
     ref = with_request_frames(ref, body)
     robot = ref.robot
     matrices, constrained = [], []
+    budget = budget_of(request)
     for k, sample in enumerate(body.samples):
+        if k % 256 == 255:
+            budget.check("reading the samples")
         with located("body", "samples", k, "pose"):
             matrix, flag = target_matrix(sample.pose, body.angle_unit)
         matrices.append(matrix)
@@ -57,8 +61,7 @@ def _follow(request: Request, ref: RobotRef, body: TrajectoryRequest) -> dict:
             twists=np.array([_cartesian(s.twist, angle) for s in body.samples]),
             accelerations=np.array([_cartesian(s.acceleration, angle) for s in body.samples]),
             options=options)
-    budget_of(request).check("encoding")
-    return _to_wire(ref.id, robot, result, body)
+    return _to_wire(ref.id, robot, result, body, budget)
 
 
 def _vector(robot: Robot, values: np.ndarray | None, unit: str, scale: np.ndarray | None = None) -> list | None:
@@ -67,11 +70,15 @@ def _vector(robot: Robot, values: np.ndarray | None, unit: str, scale: np.ndarra
     return (joints_from_core(robot, values, unit) if scale is None else values / scale).tolist()
 
 
-def _to_wire(robot_id: str, robot: Robot, result: TrajectoryResult, body: TrajectoryRequest) -> dict:
+def _to_wire(robot_id: str, robot: Robot, result: TrajectoryResult, body: TrajectoryRequest,
+             budget: Budget) -> dict:
+    """The answer as TrajectoryResponse's fields, built field by field (a test validates it against the model)."""
     unit = body.angle_unit
     paper_scale = np.array([math.pi / 180.0, math.pi / 180.0, 1.0]) if unit == "deg" else np.ones(3)
     samples = []
-    for s in result.samples:
+    for k, s in enumerate(result.samples):
+        if k % 256 == 0:
+            budget.check("encoding")
         samples.append({
             "time": s.time,
             "status": s.status,
@@ -120,13 +127,13 @@ def _to_wire(robot_id: str, robot: Robot, result: TrajectoryResult, body: Trajec
 @router.post("/robots/{robot_id}/ik/trajectory", operation_id="inverse_kinematics_trajectory",
              response_model=TrajectoryResponse, responses=problem_responses(404, 413, 422))
 def inverse_kinematics_trajectory(request: Request, body: TrajectoryRequest,
-                                  ref: RobotRef = Depends(catalogue_robot)) -> dict:
+                                  ref: RobotRef = Depends(catalogue_robot)) -> FastJSONResponse:
     """Joint positions, velocities and accelerations on one branch along sampled poses, with singularity flags."""
-    return _follow(request, ref, body)
+    return FastJSONResponse(_follow(request, ref, body))
 
 
 @router.post("/ik/trajectory", operation_id="inverse_kinematics_trajectory_inline",
              response_model=TrajectoryResponse, responses=problem_responses(413, 422))
-def inverse_kinematics_trajectory_inline(request: Request, body: TrajectoryInlineRequest) -> dict:
+def inverse_kinematics_trajectory_inline(request: Request, body: TrajectoryInlineRequest) -> FastJSONResponse:
     """Trajectory IK for a robot described in the request body."""
-    return _follow(request, inline_robot(request, body.robot), body)
+    return FastJSONResponse(_follow(request, inline_robot(request, body.robot), body))

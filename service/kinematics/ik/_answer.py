@@ -285,7 +285,7 @@ def _solved_poses(robot: Robot, matrices: np.ndarray, kinds: np.ndarray, free: l
         started = time.perf_counter()
         if constrained and free is not None:  # a redundant arm: the family over the free joints' values
             with _at_free_joints():
-                family = solve_free_joint_family(robot, matrices[rows], free, reference)
+                family = solve_free_joint_family(robot, matrices[rows], free, reference, budget=options.budget)
             if family is None:
                 yield _numeric(robot, matrices, rows, True, options, timings, started, free)
                 continue

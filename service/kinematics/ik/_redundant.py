@@ -36,6 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._budget import UNLIMITED, Budget
 from .._cache import memo
 from .._errors import InvalidInputError
 from .._robot import Robot
@@ -338,14 +339,14 @@ class FamilyAnswer:
 
 def solve_free_joint_family(robot: Robot, world_T_targets: np.ndarray, free: list[FreeJoint],
                             reference: np.ndarray | None, *, minima: int = REFINED_MINIMA,
-                            rounds: int = REFINE_ROUNDS) -> FamilyAnswer | None:
+                            rounds: int = REFINE_ROUNDS, budget: Budget = UNLIMITED) -> FamilyAnswer | None:
     """Every solution of each target (N, 4, 4) at each combination of the free joints' values.
 
     ``free`` names the free joints and their values (the grid is their
     product). With a reference, ``minima`` local minima of the distance are
     refined by ``rounds`` rounds of :func:`_refine_nearest` each. Returns None when locking
     them leaves no analytic family (the caller then falls back to the numeric
-    search).
+    search). ``budget`` is checked before each target and within its solves.
     """
     family = family_for(robot, tuple(sorted(f.joint for f in free)))
     if not family.available:
@@ -363,7 +364,8 @@ def solve_free_joint_family(robot: Robot, world_T_targets: np.ndarray, free: lis
     rows_plan = _cached_rows_plan(family, values)
     answers, refined = [], []
     for target in targets:
-        grid = _solve_rows(robot, family, rows_plan, target, values, reference)
+        budget.check("the free-joint family")
+        grid = _solve_rows(robot, family, rows_plan, target, values, reference, budget)
         extra = None
         if reference is not None and len(family.free) == 1:
             extra = _refine_nearest(robot, family, target, values, grid, reference, minima, rounds)
@@ -387,9 +389,10 @@ def _cached_rows_plan(family: FreeJointFamily, values: np.ndarray) -> _RowsPlan:
 
 
 def _solve_rows(robot: Robot, family: FreeJointFamily, rows_plan: _RowsPlan, target: np.ndarray,
-                values: np.ndarray, reference: np.ndarray | None) -> IKArrays:
+                values: np.ndarray, reference: np.ndarray | None, budget: Budget = UNLIMITED) -> IKArrays:
     targets = np.broadcast_to(target, (len(values), 4, 4))
-    return solve_ik_arrays(robot, targets, constrain_orientation=True, reference=reference, plan=rows_plan)
+    return solve_ik_arrays(robot, targets, constrain_orientation=True, reference=reference, plan=rows_plan,
+                           budget=budget)
 
 
 def _branch_keys(arrays: IKArrays) -> np.ndarray:

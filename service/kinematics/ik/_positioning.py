@@ -816,6 +816,63 @@ class PlanarTwoLink(Positioner):
         return {"elbow": (("up", "down"), side_codes(side, np.linalg.norm(point, axis=-1) * np.linalg.norm(elbow, axis=-1)))}
 
 
+class IntersectingPair(Positioner):
+    """Two revolute joints whose axes meet at a point c (not parallel), placing a point on a sphere about c.
+
+    ``R(ω₁, q₁) R(ω₂, q₂)(w − c) = x − c`` is subproblem 2: two solutions. The pair places the point
+    only on the sphere of radius ``‖w − c‖``: another target is unreachable. The positioner of an arm
+    with one joint fewer than six, such as a six-joint arm with two coaxial joints once one of them is
+    held (:mod:`._coaxial`). Joint 1 is free when the target is on axis 1, joint 2 when the point is on
+    axis 2, both when the point is c. No textbook names its branches, so it gives no labels.
+    """
+
+    name = "intersecting_pair"
+    generic_count = 2
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "IntersectingPair | None":
+        if len(joints) != 2 or geometry.kinds(joints) != "RR":
+            return None
+        centre = geometry.intersection(*joints)
+        if centre is None:
+            return None
+        solver = cls(geometry, joints, point)
+        solver.centre = centre
+        return solver
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        g, (i, j) = self.geometry, self.joints
+        c, n_targets = self.centre, len(targets)
+        pair = subproblem_2_chain(g.direction(i), g.direction(j), self.point - c, targets - c)
+        q1, q2 = pair.theta1, pair.theta2  # (N, 2)
+        start = {i: 0.0 if reference is None else float(reference[i]), j: 0.0 if reference is None
+                 else float(reference[j])}
+        # the chain form's theta1 is free with the target on axis 1, theta2 with the point on axis 2
+        on_axis_1 = np.linalg.norm(np.cross(g.direction(i), targets - c), axis=-1) <= GEOMETRY_TOLERANCE * g.length_scale
+        on_axis_2 = pair.degenerate & ~on_axis_1
+        both = on_axis_1 & (np.linalg.norm(self.point - c) <= GEOMETRY_TOLERANCE * g.length_scale)
+        if pair.degenerate.any():
+            q1 = np.where(on_axis_1[:, None], start[i], q1)
+            second = subproblem_1(g.direction(j), self.point - c, rotate_about(g.direction(i), -start[i], targets - c))
+            q2 = np.where(on_axis_1[:, None], np.where(both, start[j], second.theta[..., 0])[:, None], q2)
+            q2 = np.where(on_axis_2[:, None], start[j], q2)
+            if on_axis_2.any():
+                first = subproblem_1(g.direction(i), rotate_about(g.direction(j), start[j], self.point - c),
+                                     targets - c)
+                q1 = np.where(on_axis_2[:, None], first.theta, q1)
+        joints = np.stack([q1, q2], axis=-1)
+        valid = pair.valid & pair.exact
+        singular = SingularFlags(n_targets)
+        _flag_rows(both, Singularity("shoulder", (i, j), "free", "the point is at the axes' crossing; joints "
+                                     f"{i + 1} and {j + 1} are set to the reference values (or 0)"), singular)
+        _flag_rows(on_axis_1 & ~both, Singularity("shoulder", (i,), "free", f"the point is on axis {i + 1}; joint "
+                                                  f"{i + 1} is set to the reference value (or 0)"), singular)
+        _flag_rows(on_axis_2, Singularity("shoulder", (j,), "free", f"the point is on axis {j + 1}; joint {j + 1} is "
+                                          "set to the reference value (or 0)"), singular)
+        _flag_rows(pair.merged, Singularity("shoulder", (i, j), "boundary", "the two solutions meet"), singular)
+        return PositionerResult(joints, valid, singular)
+
+
 class OneRevoluteTwoPrismatic(Positioner):
     """One revolute and two prismatic joints in any order (cylindrical RPP, PRP).
 
@@ -1035,6 +1092,7 @@ def _quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale:
 
 
 POSITIONERS = (IntersectingShoulder, ParallelShoulder, OneRevoluteTwoPrismatic, Cartesian, PlanarTwoLink,
+               IntersectingPair,
                OffsetShoulderParallelElbow, OffsetShoulderIntersectingElbow, SkewAxes, SkewAxesWithSlide)
 
 

@@ -243,9 +243,8 @@ def test_coincident_first_axes_are_not_taken_for_a_spherical_wrist():
     """Joints 1 and 2 on one line (α1 = 0, a1 = 0) turn the tool about that line together: only q1 + q2 counts.
     The three axes through one point were taken for a spherical wrist at the base, which cannot reach an FK
     pose of this arm: ``unreachable`` with ``complete: true``. Now every answer reports the relation (q1 + q2
-    fixed, q2 free at the reference) and holds the generating configuration up to the split. A position target
-    is solved by the intersecting shoulder of the arm without joint 2, complete up to the relation; for the pose
-    that arm (five joints, no spherical wrist) has no closed form, and the numeric answer promises nothing."""
+    fixed, q2 free at the reference) and holds the generating configuration up to the split, complete: the arm
+    without joint 2 is an intersecting shoulder (position targets) with a two-axis wrist (poses)."""
     from service.robots.build import robot_from_description
     from service.robots.schemas import DHRobot
 
@@ -258,7 +257,7 @@ def test_coincident_first_axes_are_not_taken_for_a_spherical_wrist():
     target = forward_kinematics(robot, q)
     for constrain_orientation in (True, False):
         result = solve_ik(robot, target, constrain_orientation=constrain_orientation, reference=q)
-        assert result.status == "ok" and result.complete == (not constrain_orientation)
+        assert result.status == "ok" and result.complete and result.method == "analytic"
         assert any(s.kind == "coaxial" and s.joints == (0, 1) and s.relation == "sum" for s in result.singularities)
         assert 1 in result.free_joints
         solutions = np.array([s.joints for s in result.solutions])

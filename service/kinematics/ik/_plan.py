@@ -27,7 +27,7 @@ from ._structure import Geometry, canonical_model, idealised
 from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
 from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
 from ._types import Candidates, LabelCodes
-from ._wrist import Roll, SphericalWrist
+from ._wrist import Roll, SphericalWrist, TwoAxisWrist
 
 
 class Plan(Protocol):
@@ -159,11 +159,16 @@ def _reversed_three_parallel_plan(geometry: Geometry, reverse: Geometry, n: int)
 
 def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
     model = geometry.model
-    for k in (n - 3, n - 1, n):
+    for k in (n - 3, n - 1, n, n - 2):
         if k < 0:
             continue
         wrist_joints = tuple(range(k, n))
-        if len(wrist_joints) == 3:
+        if len(wrist_joints) == 2:  # one joint fewer than six: two axes meeting place the orientation
+            point = geometry.common_point(wrist_joints)
+            if n != 5 or point is None:
+                continue
+            wrist = TwoAxisWrist(geometry, wrist_joints)
+        elif len(wrist_joints) == 3:
             point = geometry.common_point(wrist_joints)
             if point is None or geometry.parallel(k, k + 1) or geometry.parallel(k + 1, k + 2):
                 continue  # consecutive coincident axes turn the tool about one line: not a 3-DOF wrist

@@ -3,8 +3,9 @@
 PUMA-like arms with random lengths, made coaxial at one pair of consecutive joints (a_i = 0 and α_i = 0, or
 α_i = π for reversed axes), checked against the arm's own FK: the target fixes only q_i + q_j (q_i − q_j when
 reversed), every answer says so, joint j is listed free and takes the reference value, and with the generating
-configuration as reference it comes back whole. Where the arm without joint j is a closed-form family
-(coaxial pairs among joints 1–4 here) the answer is complete up to that relation.
+configuration as reference it comes back whole. The arm without joint j is a closed-form family (a planar
+two-link or intersecting pair with a spherical wrist, or the shoulder with a two-axis wrist), so the answer
+is complete up to that relation.
 """
 
 from __future__ import annotations
@@ -42,7 +43,6 @@ def test_coaxial_pairs_report_the_relation_and_return_the_generating_configurati
     first, second = pair_start, pair_start + 1
     relation = "difference" if reversed_axes else "sum"
     sign = -1.0 if reversed_axes else 1.0
-    closed_form = pair_start <= 2  # the arm without joint j: planar two-link or intersecting pair + wrist
     for arm in range(3):
         robot = _coaxial_puma(rng, pair_start, reversed_axes)
         for trial in range(4):
@@ -51,7 +51,7 @@ def test_coaxial_pairs_report_the_relation_and_return_the_generating_configurati
             for reference in (q, None):
                 result = solve_ik(robot, target, reference=reference)
                 assert result.status == "ok", (arm, trial)
-                assert result.complete == closed_form, (arm, trial, result.structure)
+                assert result.complete and result.method == "analytic", (arm, trial, result.structure)
                 assert second in result.free_joints
                 assert any(s.kind == "coaxial" and s.joints == (first, second) and s.relation == relation
                            for s in result.singularities)
@@ -86,4 +86,25 @@ def test_position_targets_of_a_coaxial_shoulder_are_complete():
         assert result.status == "ok" and result.complete and result.method == "analytic"
         assert any(s.kind == "coaxial" and s.joints == (0, 1) for s in result.singularities)
         solutions = np.array([s.joints for s in result.solutions])
+        assert np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= 1e-7
+
+
+def test_five_joint_arm_poses_by_a_two_axis_wrist():
+    """The SO-101 (five joints, its last two axes meeting): full poses from its own FK are answered by the
+    offset shoulder with a two-axis wrist, complete, the generating configuration among them (it was the
+    numeric search, complete: false)."""
+    from service.config import BUILTIN_ROBOTS_DIR
+    from service.robots.catalogue import load_catalogue
+
+    robot = load_catalogue([BUILTIN_ROBOTS_DIR], max_joints=32).get("so101").robot
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        q = rng.uniform(-np.pi, np.pi, robot.dof)
+        target = forward_kinematics(robot, q)
+        result = solve_ik(robot, target)
+        assert result.status == "ok" and result.complete and result.structure.endswith("two_axis_wrist")
+        solutions = np.array([s.joints for s in result.solutions])
+        reached = forward_kinematics(robot, solutions)
+        assert np.abs(reached[:, :3, 3] - target[:3, 3]).max() <= 1e-9 * robot.characteristic_length
+        assert np.abs(reached[:, :3, :3] - target[:3, :3]).max() <= 1e-9
         assert np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= 1e-7

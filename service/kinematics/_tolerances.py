@@ -43,6 +43,12 @@ DUPLICATE_TOLERANCE = 1e-6
 #: characteristic length for prismatic joints.
 LIMIT_TOLERANCE = 1e-9
 
+#: Relative rounding error of a target pose computed by FK, and of quantities formed from it in a few
+#: operations (64 ulps). At a fold of a positioner (two solutions meeting) a coordinate of the solution is
+#: seen only through a square: a target rounded to this fraction of its size leaves it undetermined within
+#: a band, and the solver takes the reference's value when it lies in that band (see
+#: ``IntersectingShoulder`` with a slide through axis 2).
+ROUNDING_TOLERANCE = 64 * float(np.finfo(float).eps)
 #: A configuration is reported as singular when the relevant quantity (a sine,
 #: a normalised distance) is smaller than this.
 SINGULARITY_TOLERANCE = 1e-7

@@ -64,8 +64,9 @@ REDUNDANT = {"franka_panda": "spherical_wrist+intersecting_shoulder with q7 free
              "ufactory_xarm7": "general_6r with q7 free",
              "kinova_gen3": "intersecting_shoulder+spherical_wrist with q1 free"}
 #: Answered elsewhere: the xArm 6 (no spherical wrist, a5 = 76 mm) by the general 6R solver
-#: (tests/kinematics/ik/test_general_6r.py), the 5-joint SO-101's full poses by the numeric search (its targets are
-#: position + direction, tests/api/test_ik_direction.py).
+#: (tests/kinematics/ik/test_general_6r.py), the 5-joint SO-101 (its targets are position + direction,
+#: tests/api/test_ik_direction.py; its full poses: an offset shoulder with a two-axis wrist, tests/kinematics/ik/
+#: test_coaxial.py).
 ELSEWHERE = {"so101", "ufactory_xarm6"}
 
 

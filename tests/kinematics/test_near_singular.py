@@ -121,11 +121,7 @@ def test_every_joint_near_zero_returns_the_generating_configuration(catalogue, r
     assert not failures, failures
 
 
-@pytest.mark.parametrize("joint", [1, pytest.param(2, marks=pytest.mark.xfail(strict=True, reason=(
-    "known, not fixed: d3 in [1e-9, 1e-7] of the arm's size gives unreachable + complete: true (1e-5…1e-6: "
-    "θ2 off by 1e-6…5e-5). prismatic_to_distance merges the slide's roots ±d3 (seen only through reach − d2 ~ "
-    "d3²) into d3 = 0, where the point lies on axis 2 and the shoulder can no longer tilt it by d3 / d2 towards "
-    "the target; the slide needs solving with the shoulder, not from the reach alone")))])
+@pytest.mark.parametrize("joint", [1])  # the slide d3 near 0: test_slides_near_zero_… below
 def test_stanford_shoulder_and_slide_near_their_fold_return_the_generating_configuration(catalogue, joint):
     """θ2 → 0 (the wrist centre as near axis 1 as the offset d2 allows) and d3 → 0 (the slide at its nearest
     reach) are folds: two solutions ``~eps`` apart meet. Each answer holds the generating configuration to 1e-7,
@@ -148,6 +144,77 @@ def test_stanford_shoulder_and_slide_near_their_fold_return_the_generating_confi
             met = any(s.relation == "boundary" for s in result.singularities)
             if not (distance <= 1e-7 or (met and distance <= DUPLICATE_TOLERANCE)) or not result.complete:
                 failures.append((eps, trial, len(solutions), float(distance), met))
+    assert not failures, failures
+
+
+#: robot id → whether its sweep targets are poses (else points): every catalogue arm with a slide among its
+#: positioning joints, swept near the slide's zero (where the Stanford and polar arms put the point on axis 2
+#: or at the shoulder's centre, and the cylindrical arms on axis 1)
+SLIDE_SWEEPS = {"spong_ex3_5_stanford": True, "spong_sec4_3_spherical_arm_rrp": False,
+                "spong_sec4_3_spherical_arm_table3_4_frames": False, "ex004_2_polar_rrp": False,
+                "ex004_4_polar_offset_rrp": False, "ex004_1_prp": False, "ex004_3_spherical_rrpr": False,
+                "spong_ex3_2_cylindrical_rpp": False, "spong_ex3_4_cylindrical_with_wrist": True,
+                "spong_ex3_6_scara_rrpr": False, "assur001_scara_rrp": False}
+SLIDE_EPSILONS = (1e-3, 1e-5, 1e-6, 1e-7, 3e-8, 1e-8, 1e-9, 1e-10, 1e-12, 0.0)
+
+
+@pytest.mark.parametrize("robot_id", sorted(SLIDE_SWEEPS))
+def test_slides_near_zero_return_the_generating_configuration(catalogue, robot_id):
+    """Each slide at ±eps of the arm's size, eps from 1e-3 down to 1e-12 and 0: never ``unreachable``, always
+    complete, every solution on the target, and the generating configuration back.
+
+    With the generating configuration as reference it comes back to 1e-7 (or, where a fold is reported, to
+    ``DUPLICATE_TOLERANCE``). Without one, near the Stanford arm's d3 = 0 the pose itself does not tell it
+    apart from its neighbours: joint 2 moves the point by ``d3 · δ`` and the shoulder's fold shows ``d3`` only
+    through its square, so at d3 = 1e-6 of the arm's size q2 ± 1e-4 reproduces the pose to rounding. The
+    answer then holds the generating configuration to 1e-7, or one whose FK is the target to 1e-13 of the
+    arm's size (the pose cannot tell them apart), or reports joints free and holds every other one to 1e-7
+    (a point within ``GEOMETRY_TOLERANCE`` of the cylindrical arm's axis: joint 1 is free, set to 0). Before, d3 in [1e-9, 1e-7] came back ``unreachable`` with ``complete: true``: the
+    slide was solved from the reach alone (``‖y‖² = d2² + d3²``), its roots ±d3 merged into 0, which puts the
+    point on axis 2 where the shoulder cannot tilt it back by d3 / d2.
+    """
+    robot = catalogue.get(robot_id).robot
+    pose = SLIDE_SWEEPS[robot_id]
+    size = robot.characteristic_length
+    compared = slice(None) if pose else slice(0, 3)  # position targets fix the positioning joints only
+    rng = np.random.default_rng(6)
+    failures, count = [], 0
+    for joint in np.flatnonzero(~robot.is_revolute):
+        for eps in SLIDE_EPSILONS:
+            for trial in range(8):
+                q = rng.uniform(-np.pi, np.pi, robot.dof)
+                q[~robot.is_revolute] = rng.uniform(0.2, 1.0, (~robot.is_revolute).sum()) * size
+                q[joint] = (eps if trial % 2 else -eps) * size
+                reference = q if trial % 4 else None
+                target = forward_kinematics(robot, q)
+                result = solve_ik(robot, target, constrain_orientation=pose, reference=reference)
+                count += 1
+                solutions = np.array([s.joints for s in result.solutions]).reshape(-1, robot.dof)
+                if result.status != "ok" or not result.complete:
+                    failures.append((int(joint), eps, trial, result.status, result.complete))
+                    continue
+                reached = forward_kinematics(robot, solutions)
+                off = np.abs(reached[:, :3, 3] - target[:3, 3]).max() / size
+                if pose:
+                    off = max(off, np.abs(reached[:, :3, :3] - target[:3, :3]).max())
+                assert off <= 1e-9, (joint, eps, trial, off)
+                scaled = joint_difference(robot, solutions, q) / np.where(robot.is_revolute, 1.0, size)
+                distance = np.abs(scaled[:, compared]).max(axis=1)
+                if distance.min() <= 1e-7:
+                    continue
+                if reference is not None:
+                    met = any(s.relation == "boundary" for s in result.singularities)
+                    if not (met and distance.min() <= DUPLICATE_TOLERANCE):
+                        failures.append((int(joint), eps, trial, "reference", float(distance.min())))
+                    continue
+                apart = np.abs(reached[:, :3, 3] - target[:3, 3]).max(axis=-1) / size
+                if pose:
+                    apart = np.maximum(apart, np.abs(reached[:, :3, :3] - target[:3, :3]).max(axis=(1, 2)))
+                free = [j for s in result.singularities if s.relation == "free" for j in s.joints]
+                fixed = np.delete(np.abs(scaled[:, compared]), free, axis=1).max(axis=1, initial=0.0)
+                if apart.min() > 1e-13 and not (free and fixed.min() <= 1e-7):
+                    failures.append((int(joint), eps, trial, "no reference", float(distance.min()), float(apart.min())))
+    assert count >= 80
     assert not failures, failures
 
 
@@ -175,8 +242,9 @@ def test_zero_length_links_report_every_free_shoulder_joint():
 def test_coincident_first_axes_are_not_taken_for_a_spherical_wrist():
     """Joints 1 and 2 on one line (α1 = 0, a1 = 0) turn the tool about that line together: only q1 + q2 counts.
     The three axes through one point were taken for a spherical wrist at the base, which cannot reach an FK
-    pose of this arm: ``unreachable`` with ``complete: true``. Now no closed form claims it; the answer holds the
-    generating configuration up to the split of q1 + q2 and does not promise completeness."""
+    pose of this arm: ``unreachable`` with ``complete: true``. Now every answer reports the relation (q1 + q2
+    fixed, q2 free at the reference) and holds the generating configuration up to the split, complete: the arm
+    without joint 2 is an intersecting shoulder (position targets) with a two-axis wrist (poses)."""
     from service.robots.build import robot_from_description
     from service.robots.schemas import DHRobot
 
@@ -189,7 +257,9 @@ def test_coincident_first_axes_are_not_taken_for_a_spherical_wrist():
     target = forward_kinematics(robot, q)
     for constrain_orientation in (True, False):
         result = solve_ik(robot, target, constrain_orientation=constrain_orientation, reference=q)
-        assert result.status == "ok" and not result.complete
+        assert result.status == "ok" and result.complete and result.method == "analytic"
+        assert any(s.kind == "coaxial" and s.joints == (0, 1) and s.relation == "sum" for s in result.singularities)
+        assert 1 in result.free_joints
         solutions = np.array([s.joints for s in result.solutions])
         d = joint_difference(robot, solutions, q)
         same_sum = np.abs(_wrapped(d[:, 0] + d[:, 1])) <= 1e-7

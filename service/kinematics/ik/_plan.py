@@ -15,6 +15,7 @@ import numpy as np
 from .._cache import memo
 from .._forward import link_frames, screw_model
 from .._robot import Robot
+from ._coaxial import CoaxialPlan, coaxial_pair, without_joint
 from ._decoupled import DecoupledPlan
 from ._general_6r import General6RPlan
 from ._idealised import IdealisedPlan
@@ -26,7 +27,7 @@ from ._structure import Geometry, canonical_model, idealised
 from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
 from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
 from ._types import Candidates, LabelCodes
-from ._wrist import Roll, SphericalWrist
+from ._wrist import Roll, SphericalWrist, TwoAxisWrist
 
 
 class Plan(Protocol):
@@ -64,7 +65,8 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
     to the general 6R solver, last, because a rounded Pieper arm is nearly degenerate for its elimination.
     """
     geometry = geometry_of(robot)
-    plan = _family_plan(geometry, constrain_orientation, reference)
+    plan = _coaxial_plan(geometry, constrain_orientation, reference) or \
+        _family_plan(geometry, constrain_orientation, reference)
     if plan is not None:
         return plan
     ideal = idealised(geometry)
@@ -79,10 +81,28 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
 def plan_for_geometry(geometry: Geometry, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     """:func:`plan_for` on a screw model directly, exact recognition only (the idealised retry needs the robot):
     also for arms that exist only as models, such as a redundant arm with joints locked (see ``_redundant``)."""
-    plan = _family_plan(geometry, constrain_orientation, reference)
+    plan = _coaxial_plan(geometry, constrain_orientation, reference) or \
+        _family_plan(geometry, constrain_orientation, reference)
     if plan is None and constrain_orientation:
         plan = General6RPlan.match(geometry)
     return plan
+
+
+def _coaxial_plan(geometry: Geometry, constrain_orientation: bool, reference: np.ndarray | None
+                  ) -> CoaxialPlan | None:
+    """Two consecutive coaxial revolute joints: the plan of the arm without the second (see :mod:`._coaxial`),
+    or None when there are none or no family covers that arm."""
+    pair = coaxial_pair(geometry)
+    if pair is None:
+        return None
+    first, second, relation = pair
+    if reference is not None:  # the locked arm's: joint i carries q_i ± q_j
+        full = np.asarray(reference, dtype=float)
+        reference = np.delete(full, second)
+        reference[first] = full[first] + (1.0 if relation == "sum" else -1.0) * full[second]
+    inner = plan_for_geometry(without_joint(geometry, second), constrain_orientation=constrain_orientation,
+                              reference=reference)
+    return None if inner is None else CoaxialPlan(inner, pair, geometry.dof)
 
 
 def _family_plan(geometry: Geometry, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
@@ -139,11 +159,16 @@ def _reversed_three_parallel_plan(geometry: Geometry, reverse: Geometry, n: int)
 
 def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
     model = geometry.model
-    for k in (n - 3, n - 1, n):
+    for k in (n - 3, n - 1, n, n - 2):
         if k < 0:
             continue
         wrist_joints = tuple(range(k, n))
-        if len(wrist_joints) == 3:
+        if len(wrist_joints) == 2:  # one joint fewer than six: two axes meeting place the orientation
+            point = geometry.common_point(wrist_joints)
+            if n != 5 or point is None:
+                continue
+            wrist = TwoAxisWrist(geometry, wrist_joints)
+        elif len(wrist_joints) == 3:
             point = geometry.common_point(wrist_joints)
             if point is None or geometry.parallel(k, k + 1) or geometry.parallel(k + 1, k + 2):
                 continue  # consecutive coincident axes turn the tool about one line: not a 3-DOF wrist

@@ -15,7 +15,8 @@ from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, SINGULARITY_TOLERANCE
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, ROUNDING_TOLERANCE
+from .._rotations import wrap_angle
 from ._screws import chain_motion, chain_rotation, move_point, rotate_about
 from ._structure import Geometry
 from ._subproblems import (
@@ -96,6 +97,47 @@ class Positioner:
         return chain_motion(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], q[..., :upto])
 
 
+@dataclass(frozen=True)
+class SlideThroughAxis2:
+    """The frame of an intersecting shoulder whose third joint slides normal to axis 2 along a line crossing it.
+
+    With c the shoulder's centre, k1 and k2 its axes (angle α between them) and v the slide (world
+    frame, q = 0), the point ``w + s v`` is ``c + h k2 + t v`` with ``t = s − foot``. Joint 2 keeps
+    ``h k2`` and turns v in the plane normal to k2, spanned by ``n1`` (k1's part in it, unit) and
+    ``n2 = k2 × n1``: ``R(k2, q2) v = cos ψ n1 + sin ψ n2`` with ``ψ = q2 + psi0``. Only ``n1`` has a
+    part along k1 (``sin α``), so a target y (from c) has ``k1·y = h cos α + t sin α cos ψ`` and
+    ``‖y‖² = h² + t²``. The Stanford arm (h = d2, α = 90°) and the polar arms (h = 0).
+    """
+
+    height: float  #: h, the crossing's distance from c along k2 (signed)
+    foot: float  #: the slide's value at the crossing
+    n1: np.ndarray  #: (3,)
+    n2: np.ndarray  #: (3,)
+    psi0: float  #: ψ at q2 = 0, radians
+    cos_alpha: float
+    sin_alpha: float
+
+    @classmethod
+    def of(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray
+           ) -> "SlideThroughAxis2 | None":
+        """The frame when joints (i, j, k) are that shoulder and slide and ``point`` (3,) is on the slide's line."""
+        i, j, k = joints
+        if geometry.model.is_revolute[k]:
+            return None
+        k1, k2, v = geometry.direction(i), geometry.direction(j), geometry.direction(k)
+        offset = point - centre
+        crossing_miss = abs(float(offset @ np.cross(k2, v)))
+        if abs(float(v @ k2)) > GEOMETRY_TOLERANCE or crossing_miss > GEOMETRY_TOLERANCE * geometry.length_scale:
+            return None
+        cos_alpha = float(k1 @ k2)
+        n1 = k1 - cos_alpha * k2
+        sin_alpha = float(np.linalg.norm(n1))
+        n1 = n1 / sin_alpha
+        n2 = np.cross(k2, n1)
+        return cls(float(offset @ k2), -float(offset @ v), n1, n2, float(np.arctan2(v @ n2, v @ n1)), cos_alpha,
+                   sin_alpha)
+
+
 class IntersectingShoulder(Positioner):
     """Revolute joints 1 and 2 with intersecting axes, then a revolute or prismatic joint 3.
 
@@ -111,6 +153,10 @@ class IntersectingShoulder(Positioner):
     every target: q_3 does not change ‖w_3 − c‖, the target does not determine
     it, and it is a free joint (reference value or 0); 2 solutions remain.
 
+    A slide normal to axis 2 whose line crosses it (the Stanford and polar arms) is solved together with
+    the shoulder instead (:meth:`_solve_slide_through_axis_2`): from the reach alone its value near the
+    crossing is known only to the square root of the target's rounding, and without its sign.
+
     Labels: ``shoulder`` left/right is the sign of the arm's reach along the
     forward direction of link 1 (the textbook's left/right arm; "front" is left);
     ``elbow`` up/down (revolute joint 3) is the side of the shoulder–point line
@@ -119,6 +165,8 @@ class IntersectingShoulder(Positioner):
 
     name = "intersecting_shoulder"
     generic_count = 4
+    #: the frame of a slide normal to axis 2 through it (the Stanford and polar arms), else None
+    slide_through_axis_2: SlideThroughAxis2 | None = None
 
     @classmethod
     def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "IntersectingShoulder | None":
@@ -134,10 +182,13 @@ class IntersectingShoulder(Positioner):
         if geometry.model.is_revolute[k] and (geometry.on_axis(k, solver.point) or geometry.on_axis(k, centre)):
             solver.free_joints = (k,)  # subproblem 3 is degenerate for every target
             solver.generic_count = 2
+        solver.slide_through_axis_2 = SlideThroughAxis2.of(geometry, joints, solver.point, centre)
         return solver
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, (i, j, k) = self.geometry, self.joints
+        if self.slide_through_axis_2 is not None:
+            return self._solve_slide_through_axis_2(targets, reference)
         c, w = self.centre, self.point
         n_targets = len(targets)
         reach = np.linalg.norm(targets - c, axis=-1)
@@ -188,6 +239,85 @@ class IntersectingShoulder(Positioner):
         elif not g.model.is_revolute[k]:
             _flag_rows(third.merged, Singularity("reach", (k,), "boundary",
                                                  "the point is at the nearest reach of the prismatic joint"), singular)
+        return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
+
+    def _solve_slide_through_axis_2(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        """The Stanford and polar arms: a slide normal to axis 2 whose line crosses axis 2 (see
+        :class:`SlideThroughAxis2` for the frame and the equations).
+
+        ``targets`` (N, 3) in the world frame. The slide's displacement from the crossing, ``t u`` with
+        ``u = R(k2, q2) v``, is ``B n1 + a n2``: ``B`` follows from the target's height along axis 1 (first
+        order in t), ``a`` only through ``a² = ‖y‖² − h² − B²`` (the fold where the two shoulder solutions
+        ±a meet). Then ``q2 = atan2(a, B) − ψ0`` with ``t = +‖(B, a)‖``, or ``q2 + π`` with ``−t``, and q1
+        turns ``h k2 + t u`` onto the target (subproblem 1). Solving t from the reach alone, as the
+        general slide does, loses the sign of t and every digit of it below ``√ε`` of the arm's size;
+        this keeps B to the target's rounding, and the target does not determine a or B better than
+        their rounding bands: where the reference's values lie in those bands they are taken (the
+        representative nearest the reference), and where the whole displacement is within them the point
+        is on axis 2 and joint 2 is free (reference value or 0).
+        """
+        g, (i, j, k) = self.geometry, self.joints
+        frame = self.slide_through_axis_2
+        k1, n_targets = g.direction(i), len(targets)
+        y = targets - self.centre  # (N, 3)
+        height = y @ k1
+        radius = np.linalg.norm(y - height[:, None] * k1, axis=-1)  # from axis 1
+        h = frame.height
+        along = (height - h * frame.cos_alpha) / frame.sin_alpha  # B (N,)
+        # a² = ‖y‖² − h² − B² = radius² − (h sin α − B cos α)²: a difference only where ±a meet
+        inner = np.abs(h * frame.sin_alpha - along * frame.cos_alpha)
+        across_squared = (radius - inner) * (radius + inner)  # (N,)
+        # the target's coordinates carry rounding relative to their size and the arm's
+        rounding = ROUNDING_TOLERANCE * (g.length_scale + np.linalg.norm(targets, axis=-1))
+        band_along = rounding / frame.sin_alpha
+        band_squared = 2 * rounding * (radius + inner + band_along)
+        met = across_squared <= band_squared  # the two shoulder solutions ±a meet: a = 0 represents them
+        free = met & (np.abs(along) <= band_along)  # the point on axis 2: joint 2 does not move it
+        across = np.where(met, 0.0, np.sqrt(np.maximum(across_squared, 0.0)))
+        first_sign = np.ones(n_targets)
+        free_angle = frame.psi0 + (0.0 if reference is None else reference[j])
+        if reference is not None:
+            t_ref = reference[k] - frame.foot
+            along_ref, across_ref = t_ref * np.cos(free_angle), t_ref * np.sin(free_angle)
+            along = np.where(np.abs(along - along_ref) <= band_along, along_ref, along)
+            in_band = np.abs(across_ref * across_ref - across_squared) <= band_squared
+            across = np.where(in_band, abs(across_ref), across)
+            first_sign = np.where(in_band & (across_ref < 0), -1.0, 1.0)
+        across_pair = np.stack([first_sign * across, -first_sign * across], axis=-1)  # (N, 2)
+        psi = np.where(free[:, None], free_angle, np.arctan2(across_pair, along[:, None]))  # (N, 2)
+        t = along[:, None] * np.cos(psi) + across_pair * np.sin(psi)  # the displacement along u(ψ)
+        psi = np.stack([psi, psi + np.pi], axis=-1)  # (N, 2 shoulder, 2 slide signs)
+        t = np.stack([t, -t], axis=-1)
+        turned = h * g.direction(j) + t[..., None] * (np.cos(psi)[..., None] * frame.n1
+                                                      + np.sin(psi)[..., None] * frame.n2)
+        first = subproblem_1(k1, turned, y[:, None, None, :], free_below=rounding[:, None, None])
+        q1 = first.theta[..., 0]
+        free_first = first.degenerate  # the target on axis 1 (a polar arm without offset)
+        if reference is not None:  # an azimuth seen on a radius r is known to rounding / r
+            band_first = rounding[:, None, None] / np.maximum(radius[:, None, None], 1e-300)
+            q1 = np.where(free_first | (np.abs(wrap_angle(q1 - reference[i])) <= band_first), reference[i], q1)
+        else:
+            q1 = np.where(free_first, 0.0, q1)
+        joints = np.stack([q1, wrap_angle(psi - frame.psi0), frame.foot + t], axis=-1)
+        # exact to the arm's size (subproblem 1 measures against the point's own, tiny near the centre)
+        miss = np.linalg.norm(rotate_about(k1, q1, turned) - y[:, None, None, :], axis=-1)
+        valid = miss <= GEOMETRY_TOLERANCE * g.length_scale
+        valid[:, 1, :] &= ~met[:, None]  # −a is +a
+        valid[..., 1] &= ~free[:, None]  # −t with ψ + π is t with ψ when joint 2 is free
+        singular = SingularFlags(n_targets)
+        both = free & free_first.any(axis=(1, 2))
+        _flag_rows(both, Singularity("shoulder", (i, j), "free", "the point is at the shoulder's centre; joints "
+                                     "1 and 2 are set to the reference values (or 0)"), singular)
+        _flag_rows(free & ~both, Singularity("shoulder", (j,), "free", "the point is on axis 2 (the slide at "
+                                             "its nearest reach); joint 2 is set to the reference value (or 0)"),
+                   singular)
+        _flag_rows(free_first.any(axis=(1, 2)) & ~both, Singularity(
+            "shoulder", (i,), "free", "the point is on the first joint's axis; joint 1 is set to the reference "
+                                      "value (or 0)"), singular)
+        _flag_rows(met & ~free, Singularity("shoulder", (i, j), "boundary", "the two shoulder solutions meet: the "
+                                            "point is as near axis 1 as the shoulder allows"), singular)
+        _flag_rows(free, Singularity("reach", (k,), "boundary",
+                                     "the point is at the nearest reach of the prismatic joint"), singular)
         return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
 
     def _stretched(self, q3: np.ndarray, w: np.ndarray, c: np.ndarray) -> np.ndarray:
@@ -686,6 +816,63 @@ class PlanarTwoLink(Positioner):
         return {"elbow": (("up", "down"), side_codes(side, np.linalg.norm(point, axis=-1) * np.linalg.norm(elbow, axis=-1)))}
 
 
+class IntersectingPair(Positioner):
+    """Two revolute joints whose axes meet at a point c (not parallel), placing a point on a sphere about c.
+
+    ``R(ω₁, q₁) R(ω₂, q₂)(w − c) = x − c`` is subproblem 2: two solutions. The pair places the point
+    only on the sphere of radius ``‖w − c‖``: another target is unreachable. The positioner of an arm
+    with one joint fewer than six, such as a six-joint arm with two coaxial joints once one of them is
+    held (:mod:`._coaxial`). Joint 1 is free when the target is on axis 1, joint 2 when the point is on
+    axis 2, both when the point is c. No textbook names its branches, so it gives no labels.
+    """
+
+    name = "intersecting_pair"
+    generic_count = 2
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "IntersectingPair | None":
+        if len(joints) != 2 or geometry.kinds(joints) != "RR":
+            return None
+        centre = geometry.intersection(*joints)
+        if centre is None:
+            return None
+        solver = cls(geometry, joints, point)
+        solver.centre = centre
+        return solver
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        g, (i, j) = self.geometry, self.joints
+        c, n_targets = self.centre, len(targets)
+        pair = subproblem_2_chain(g.direction(i), g.direction(j), self.point - c, targets - c)
+        q1, q2 = pair.theta1, pair.theta2  # (N, 2)
+        start = {i: 0.0 if reference is None else float(reference[i]), j: 0.0 if reference is None
+                 else float(reference[j])}
+        # the chain form's theta1 is free with the target on axis 1, theta2 with the point on axis 2
+        on_axis_1 = np.linalg.norm(np.cross(g.direction(i), targets - c), axis=-1) <= GEOMETRY_TOLERANCE * g.length_scale
+        on_axis_2 = pair.degenerate & ~on_axis_1
+        both = on_axis_1 & (np.linalg.norm(self.point - c) <= GEOMETRY_TOLERANCE * g.length_scale)
+        if pair.degenerate.any():
+            q1 = np.where(on_axis_1[:, None], start[i], q1)
+            second = subproblem_1(g.direction(j), self.point - c, rotate_about(g.direction(i), -start[i], targets - c))
+            q2 = np.where(on_axis_1[:, None], np.where(both, start[j], second.theta[..., 0])[:, None], q2)
+            q2 = np.where(on_axis_2[:, None], start[j], q2)
+            if on_axis_2.any():
+                first = subproblem_1(g.direction(i), rotate_about(g.direction(j), start[j], self.point - c),
+                                     targets - c)
+                q1 = np.where(on_axis_2[:, None], first.theta, q1)
+        joints = np.stack([q1, q2], axis=-1)
+        valid = pair.valid & pair.exact
+        singular = SingularFlags(n_targets)
+        _flag_rows(both, Singularity("shoulder", (i, j), "free", "the point is at the axes' crossing; joints "
+                                     f"{i + 1} and {j + 1} are set to the reference values (or 0)"), singular)
+        _flag_rows(on_axis_1 & ~both, Singularity("shoulder", (i,), "free", f"the point is on axis {i + 1}; joint "
+                                                  f"{i + 1} is set to the reference value (or 0)"), singular)
+        _flag_rows(on_axis_2, Singularity("shoulder", (j,), "free", f"the point is on axis {j + 1}; joint {j + 1} is "
+                                          "set to the reference value (or 0)"), singular)
+        _flag_rows(pair.merged, Singularity("shoulder", (i, j), "boundary", "the two solutions meet"), singular)
+        return PositionerResult(joints, valid, singular)
+
+
 class OneRevoluteTwoPrismatic(Positioner):
     """One revolute and two prismatic joints in any order (cylindrical RPP, PRP).
 
@@ -737,11 +924,17 @@ class OneRevoluteTwoPrismatic(Positioner):
         slides = s0[:, None, :] + t[..., None] * nullspace  # (N, 2, 2)
         body = self.point - p + slides @ V_post.T
         world = targets[:, None, :] - p - slides @ V_pre.T
-        turn = subproblem_1(omega, body, world)
+        # an azimuth seen on a radius is known to the target's rounding / radius: free only within rounding
+        band = ROUNDING_TOLERANCE * (g.length_scale + np.linalg.norm(targets, axis=-1))[:, None]
+        turn = subproblem_1(omega, body, world, free_below=band)
         theta = turn.theta[..., 0]
         free = turn.degenerate
-        if free.any():
-            theta = np.where(free, 0.0 if reference is None else reference[r], theta)
+        if reference is not None:
+            radius = np.linalg.norm(world @ perp, axis=-1)
+            free_or_in_band = free | (np.abs(wrap_angle(theta - reference[r])) * radius <= band)
+            theta = np.where(free_or_in_band, reference[r], theta)
+        elif free.any():
+            theta = np.where(free, 0.0, theta)
         joints = np.zeros(slides.shape[:2] + (3,))
         order = list(self.joints)
         joints[..., order.index(r)] = theta
@@ -884,9 +1077,12 @@ def _quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale:
         valid[linear, 0] = np.abs(B[linear]) > 1e-12
         quad = ~linear
         discriminant = B[quad] ** 2 - 4 * A[quad] * C[quad]
-        tolerance = SINGULARITY_TOLERANCE * (B[quad] ** 2 + np.abs(4 * A[quad] * C[quad]) + scale ** 2 * 1e-12)
+        # the discriminant's rounding: a double root only within it. (SINGULARITY_TOLERANCE here merged roots
+        # ±1e-10 of the scale apart and kept the + one: the cylindrical arm's radial slide at −1e-10 came back
+        # at +1e-10 with joint 1 turned by π.)
+        tolerance = ROUNDING_TOLERANCE * (B[quad] ** 2 + np.abs(4 * A[quad] * C[quad]) + scale ** 2 * 1e-12)
         touching = np.abs(discriminant) <= tolerance
-        root = np.sqrt(np.maximum(discriminant, 0.0))
+        root = np.sqrt(np.maximum(discriminant, 0.0)) * ~touching  # a double root: the midpoint
         roots[quad, 0] = (-B[quad] + root) / (2 * A[quad])
         roots[quad, 1] = (-B[quad] - root) / (2 * A[quad])
         valid[quad, 0] = discriminant >= -tolerance
@@ -896,6 +1092,7 @@ def _quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale:
 
 
 POSITIONERS = (IntersectingShoulder, ParallelShoulder, OneRevoluteTwoPrismatic, Cartesian, PlanarTwoLink,
+               IntersectingPair,
                OffsetShoulderParallelElbow, OffsetShoulderIntersectingElbow, SkewAxes, SkewAxesWithSlide)
 
 

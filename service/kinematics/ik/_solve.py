@@ -10,6 +10,7 @@ from .._budget import UNLIMITED, Budget
 from .._robot import Robot
 from ._numeric import NumericOptions, solve_numeric
 from ._arrays import IKArrays, solve_ik_arrays
+from ._coaxial import coaxial_pair, coaxial_report, held_split
 from ._plan import geometry_of
 from ._types import IKResult, Solution
 from ._verify import accepted, distance_to_reference, distinct, polish, residuals, wrap_revolute
@@ -184,9 +185,12 @@ def _numeric(robot: Robot, target: np.ndarray, constrain_orientation: bool, refe
     if seeds is not None and len(seeds):
         joints = np.concatenate([seeds, joints.reshape(-1, robot.dof)])
     solutions: list[Solution] = []
+    coaxial = coaxial_pair(geometry_of(robot))
     if len(joints):
         targets = np.broadcast_to(target, (len(joints), 4, 4))
         joints = wrap_revolute(robot, polish(robot, joints, targets, constrain_orientation))
+        if coaxial is not None:  # one representative per sum (difference) of the coaxial pair: see _coaxial
+            joints = wrap_revolute(robot, held_split(joints, coaxial, reference))
         position, orientation = residuals(robot, joints, target)
         ok = np.flatnonzero(accepted(robot, position, orientation, constrain_orientation))
         options.budget.check("polishing the numeric solutions")
@@ -200,4 +204,6 @@ def _numeric(robot: Robot, target: np.ndarray, constrain_orientation: bool, refe
             f"The iteration cap ({options.numeric.max_iterations}) stopped some starts before they converged.")
     return IKResult(status="ok" if solutions else "unreachable", solutions=_ordered(robot, solutions, reference),
                     method="numeric", structure="general", complete=False, detail=detail,
+                    singularities=[coaxial_report(coaxial)] if coaxial is not None and solutions else [],
+                    free_joints=[coaxial[1]] if coaxial is not None else [],
                     search_exhausted_budget=outcome.budget_exhausted)

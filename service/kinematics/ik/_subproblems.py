@@ -284,11 +284,13 @@ def _pair(shape: tuple[int, ...], first: ArrayLike, second: ArrayLike, dtype: ty
 
 
 def _rotate_onto(
-    frame: np.ndarray, p: np.ndarray, q: np.ndarray, scale: np.ndarray | None = None
+    frame: np.ndarray, p: np.ndarray, q: np.ndarray, scale: np.ndarray | None = None,
+    free_below: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Subproblem 1 core: ``(theta, exact, degenerate)`` for ``R(k, theta) p = q``.
 
-    ``frame`` is ``axis_frame(k)``. ``scale`` defaults to ``max(||p||, ||q||)``.
+    ``frame`` is ``axis_frame(k)``. ``scale`` defaults to ``max(||p||, ||q||)``. ``free_below``, the radius
+    at or below which ``p`` or ``q`` counts as on the axis, defaults to ``GEOMETRY_TOLERANCE * scale``.
     """
     px, py, pz = _coords(p, frame)
     qx, qy, qz = _coords(q, frame)
@@ -300,7 +302,8 @@ def _rotate_onto(
         scale = np.maximum(_hypot(radius_p, pz), _hypot(radius_q, qz))
     tol = GEOMETRY_TOLERANCE * scale
     exact = (np.abs(radius_p - radius_q) <= tol) & (np.abs(pz - qz) <= tol)
-    degenerate = (radius_p <= tol) | (radius_q <= tol)
+    free_below = tol if free_below is None else free_below
+    degenerate = (radius_p <= free_below) | (radius_q <= free_below)
     return np.where(degenerate, 0.0, wrap_angle(theta)), exact, degenerate
 
 
@@ -349,7 +352,7 @@ def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> Ang
 # ---------------------------------------------------------------------------
 
 
-def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike) -> AngleSolutions:
+def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike, free_below: ArrayLike | None = None) -> AngleSolutions:
     """Paden-Kahan 1: solve ``R(k, theta) p = q``; else minimise ``||R(k, theta) p - q||``.
 
     An exact solution needs ``||p_perp|| = ||q_perp||`` and ``k.p = k.q``. The
@@ -363,6 +366,10 @@ def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike) -> AngleSolutions:
         Unit rotation axis through the origin.
     p, q : array_like, shape (..., 3)
         Points before and after the rotation.
+    free_below : array_like, shape (...), optional
+        The radius from the axis at or below which a point counts as on it (``degenerate``); by default
+        ``GEOMETRY_TOLERANCE * L``. A caller that knows the target's rounding passes it: a point further
+        out still fixes the angle, to rounding / radius.
 
     Returns
     -------
@@ -387,7 +394,8 @@ def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike) -> AngleSolutions:
     k = _unit(k, "k")
     p = _points(p, "p")
     q = _points(q, "q")
-    theta, exact, degenerate = _rotate_onto(axis_frame(k), p, q)  # all of the batch shape
+    free_below = None if free_below is None else np.asarray(free_below, dtype=float)
+    theta, exact, degenerate = _rotate_onto(axis_frame(k), p, q, free_below=free_below)  # all of the batch shape
     return AngleSolutions(
         theta=theta[..., None],
         valid=np.ones(theta.shape + (1,), dtype=bool),

@@ -3,7 +3,9 @@
 Given ``R_w``, the rotation the wrist joints must produce (the positioning
 joints' motion already removed), these solve
 ``R(ω_a, q_a) R(ω_b, q_b) R(ω_c, q_c) = R_w`` (spherical wrist) or
-``R(ω, q) = R_w`` (a final roll). Axes are the home axes of the screw model.
+``R(ω_a, q_a) R(ω_b, q_b) = R_w`` (two axes meeting: an arm with one joint fewer than six, such as
+one with two coaxial joints) or ``R(ω, q) = R_w`` (a final roll). Axes are the home axes of the screw
+model.
 """
 
 from __future__ import annotations
@@ -120,6 +122,37 @@ class Roll:
         wanted = np.einsum("...ij,j->...i", R_w, self.normal)
         q = subproblem_1(self.axis, self.normal, wanted).theta  # (..., 1)
         return WristResult(q[..., None], np.ones(q.shape, dtype=bool), SingularFlags(len(R_w)))
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        return {}
+
+
+class TwoAxisWrist:
+    """Two revolute joints whose axes meet at the wrist centre (not parallel): ``R(ω_a, q_a) R(ω_b, q_b) = R_w``.
+
+    ``R(ω_b, q_b)`` keeps ω_b, so ``R(ω_a, q_a) ω_b = R_w ω_b`` (subproblem 1) gives q_a, and q_b follows by
+    subproblem 1 on a vector normal to ω_b. One solution; only a rotation of that two-parameter form is
+    reachable (``valid`` where the first subproblem is exact; the FK check decides the rest). The wrist of a
+    five-joint arm placing a full pose, for instance a six-joint arm with two coaxial wrist joints once one is
+    held (:mod:`._coaxial`).
+    """
+
+    name = "two_axis_wrist"
+    generic_count = 1
+
+    def __init__(self, geometry: Geometry, joints: tuple[int, int]) -> None:
+        self.geometry = geometry
+        self.joints = joints
+        self.axes = [geometry.direction(j) for j in joints]
+        self.normal = _perpendicular_unit(self.axes[1])
+
+    def solve(self, R_w: np.ndarray, reference: np.ndarray | None) -> WristResult:
+        a, b = self.axes
+        first = subproblem_1(a, b, np.einsum("...ij,j->...i", R_w, b))  # theta (..., 1)
+        qa = first.theta
+        wanted = np.einsum("...ij,j->...i", R_w, self.normal)[..., None, :]  # (..., 1, 3)
+        qb = subproblem_1(b, self.normal, rotate_about(a, -qa, wanted)).theta[..., 0]
+        return WristResult(np.stack([qa, qb], axis=-1), first.exact.copy(), SingularFlags(len(R_w)))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return {}

@@ -224,7 +224,9 @@ class SolverInfo(ApiModel):
 class SingularityReport(ApiModel):
     """A singular condition the target meets, and how the joints it frees are coupled."""
 
-    kind: str = Field(description="wrist, shoulder, elbow, reach or assur_group")
+    kind: str = Field(description="wrist, shoulder, elbow, base, positioner, reach, coaxial (two consecutive "
+                                  "joints on one line: only their sum or difference is fixed), assur_group, or "
+                                  "jacobian (trajectory rates)")
     joints: list[int] = Field(description="0-based joint indices involved")
     relation: str = Field(description="sum, difference, signed_sum, free, stretched, folded, aligned, coincident, "
                                       "boundary")

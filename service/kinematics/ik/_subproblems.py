@@ -1446,12 +1446,16 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
     ``A1``, ``A2`` and (inside) ``B2 = 2 v.L`` are trigonometric polynomials of degree 1 in theta
     (``||L||**2 = ||p0||**2 + ||p1||**2 + 2 p0.R(k, theta) p1``), ``c = -1`` outside and ``+1`` inside.
 
-    * ``b = ±k2.v ≠ 0``: ``s = -A1 / b``, and ``b**2 A2 - b A1 B2 + c A1**2 = 0`` is a trigonometric
+    * ``|b| = |k2.v| > 6e-6``: ``s = -A1 / b``, and ``b**2 A2 - b A1 B2 + c A1**2 = 0`` is a trigonometric
       quartic in theta (degree 2 in ``cos``, ``sin``). Its roots are those on the unit circle of a
       degree-4 polynomial in ``z = exp(i theta)`` (the companion matrix of subproblem 5), each refined
       by two Newton steps. With ``k ∥ k2`` the quartic drops to a quadratic: 2 roots.
-    * ``b = 0`` (the slide normal to ``k2``, decided by the caller from the geometry): ``A1(theta) = 0``
-      is a harmonic equation (two roots), and for each E2 is a quadratic in s (two roots): 4 in all.
+    * ``|b| <= 6e-6`` (the slide normal, or nearly, to ``k2``): as if b were 0, ``A1(theta) = 0`` is a
+      harmonic equation (two roots), and for each E2 is a quadratic in s (two roots): 4 in all.
+
+    Every candidate then takes a few Newton steps on E1 and E2 themselves: as b -> 0 the quartic's
+    roots pair up (near-double roots) and ``s = -A1 / b`` misses by about ``eps / b**2``, the split by
+    about ``|b|``; the pair's Jacobian stays regular (see ``_SLIDE_NEARLY_NORMAL``).
 
     ``phi`` then follows by subproblem 1. This is the positioning problem of an RRP, RPR or PRR arm
     with skew axes: the slide is a line where subproblem 5 has a circle.
@@ -1478,8 +1482,8 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
     a candidate is ``exact`` when the vector equation holds to ``GEOMETRY_TOLERANCE * S``. Two roots
     are reported once, at their midpoint, with ``merged`` set (a tangent root, the edge of the
     workspace) when they are closer than ``DUPLICATE_TOLERANCE`` (in theta and in ``s / S``), or,
-    for the quartic, closer than 1e-3 rad with the midpoint solving it to ``DUPLICATE_TOLERANCE**2``
-    of its coefficients: near a triple root rounding splits a double root by far more than √ε. ``degenerate``: E1 and E2 do not depend on theta (``p1`` on ``k``, with the target
+    for the quartic, closer than 1e-3 rad with the midpoint solving E2 (the quartic over ``b**2``) to
+    ``DUPLICATE_TOLERANCE**2`` of the quartic's coefficients: near a triple root rounding splits a double root by far more than √ε. ``degenerate``: E1 and E2 do not depend on theta (``p1`` on ``k``, with the target
     reachable); the representative has ``theta = 0``. ``phi_free`` marks slots whose turned vector
     lies on ``k2`` (phi is then 0).
 

@@ -1400,6 +1400,46 @@ def _trig_value(f: np.ndarray, theta: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return value, slope
 
 
+# The slide within this cosine of normal to k2 (|b| at most this) is solved by the split (b taken as 0), else by
+# the quartic; :func:`_refine_turn_slide` then finishes either. The quartic ``b**2 A2 - b A1 B2 + c A1**2`` tends
+# to ``c A1**2`` as b -> 0: its roots pair up about |b| apart around the zeros of A1 (near-double roots, found to
+# about eps / |b|), and ``s = -A1 / b`` divides that again by b, so s misses by about eps / b**2. The split misses
+# by about |b|. The two meet at |b| = eps**(1/3), about 6e-6, where both miss by about 6e-6: well inside the
+# reach of Newton's steps (a few, of at most 1e-3 each) on the undivided equations.
+_SLIDE_NEARLY_NORMAL = 6e-6
+_REFINE_STEPS, _REFINE_STEP = 4, 1e-3
+
+
+def _refine_turn_slide(A1: np.ndarray, A2: np.ndarray, B2: np.ndarray, b: np.ndarray, c: float,
+                       theta: np.ndarray, s: np.ndarray, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Newton steps on the undivided pair ``E1 = A1(theta) + b s``, ``E2 = A2(theta) + B2(theta) s + c s**2``.
+
+    ``theta``, ``s`` and ``active`` are (..., 4); the coefficients (..., 3), ``b`` (...). The Jacobian
+    ``[[A1', b], [A2' + B2' s, B2 + 2 c s]]`` stays regular as b -> 0 (it is singular only where two
+    solutions meet), unlike the quartic's ``s = -A1 / b``. A step is taken only where it lowers ``|E1| + |E2|``
+    and moves at most ``_REFINE_STEP`` (in theta and in s / S): a candidate that solves neither stays as it was.
+    """
+    def residual(t, x):
+        (a1, a1_slope), (a2, a2_slope), (b2, b2_slope) = (_trig_value(f, t) for f in (A1, A2, B2))
+        e1, e2 = a1 + b[..., None] * x, a2 + b2 * x + c * x * x
+        return e1, e2, a1_slope, a2_slope + b2_slope * x, b2 + 2 * c * x
+
+    bb = b[..., None]
+    for _ in range(_REFINE_STEPS):
+        e1, e2, j11, j21, j22 = residual(theta, s)
+        det = j11 * j22 - bb * j21
+        regular = np.abs(det) > 1e-9 * (np.abs(j11 * j22) + np.abs(bb * j21))
+        safe = np.where(regular, det, 1.0)
+        d_theta = (j22 * e1 - bb * e2) / safe
+        d_s = (j11 * e2 - j21 * e1) / safe
+        new_theta, new_s = theta - d_theta, s - d_s
+        n1, n2 = residual(new_theta, new_s)[:2]
+        better = active & regular & (np.abs(d_theta) <= _REFINE_STEP) & (np.abs(d_s) <= _REFINE_STEP) \
+            & (np.abs(n1) + np.abs(n2) < np.abs(e1) + np.abs(e2))
+        theta, s = np.where(better, new_theta, theta), np.where(better, new_s, s)
+    return theta, s
+
+
 def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: ArrayLike, p2: ArrayLike,
                            v: ArrayLike, slide_turns: bool) -> TurnSlideSolutions:
     """Subproblem 5 with one rotation replaced by a slide; up to 4 solutions ``(phi, theta, s)``.
@@ -1416,12 +1456,16 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
     ``A1``, ``A2`` and (inside) ``B2 = 2 v.L`` are trigonometric polynomials of degree 1 in theta
     (``||L||**2 = ||p0||**2 + ||p1||**2 + 2 p0.R(k, theta) p1``), ``c = -1`` outside and ``+1`` inside.
 
-    * ``b = ±k2.v ≠ 0``: ``s = -A1 / b``, and ``b**2 A2 - b A1 B2 + c A1**2 = 0`` is a trigonometric
+    * ``|b| = |k2.v| > 6e-6``: ``s = -A1 / b``, and ``b**2 A2 - b A1 B2 + c A1**2 = 0`` is a trigonometric
       quartic in theta (degree 2 in ``cos``, ``sin``). Its roots are those on the unit circle of a
       degree-4 polynomial in ``z = exp(i theta)`` (the companion matrix of subproblem 5), each refined
       by two Newton steps. With ``k ∥ k2`` the quartic drops to a quadratic: 2 roots.
-    * ``b = 0`` (the slide normal to ``k2``, decided by the caller from the geometry): ``A1(theta) = 0``
-      is a harmonic equation (two roots), and for each E2 is a quadratic in s (two roots): 4 in all.
+    * ``|b| <= 6e-6`` (the slide normal, or nearly, to ``k2``): as if b were 0, ``A1(theta) = 0`` is a
+      harmonic equation (two roots), and for each E2 is a quadratic in s (two roots): 4 in all.
+
+    Every candidate then takes a few Newton steps on E1 and E2 themselves: as b -> 0 the quartic's
+    roots pair up (near-double roots) and ``s = -A1 / b`` misses by about ``eps / b**2``, the split by
+    about ``|b|``; the pair's Jacobian stays regular (see ``_SLIDE_NEARLY_NORMAL``).
 
     ``phi`` then follows by subproblem 1. This is the positioning problem of an RRP, RPR or PRR arm
     with skew axes: the slide is a line where subproblem 5 has a circle.
@@ -1448,8 +1492,8 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
     a candidate is ``exact`` when the vector equation holds to ``GEOMETRY_TOLERANCE * S``. Two roots
     are reported once, at their midpoint, with ``merged`` set (a tangent root, the edge of the
     workspace) when they are closer than ``DUPLICATE_TOLERANCE`` (in theta and in ``s / S``), or,
-    for the quartic, closer than 1e-3 rad with the midpoint solving it to ``DUPLICATE_TOLERANCE**2``
-    of its coefficients: near a triple root rounding splits a double root by far more than √ε. ``degenerate``: E1 and E2 do not depend on theta (``p1`` on ``k``, with the target
+    for the quartic, closer than 1e-3 rad with the midpoint solving E2 (the quartic over ``b**2``) to
+    ``DUPLICATE_TOLERANCE**2`` of the quartic's coefficients: near a triple root rounding splits a double root by far more than √ε. ``degenerate``: E1 and E2 do not depend on theta (``p1`` on ``k``, with the target
     reachable); the representative has ``theta = 0``. ``phi_free`` marks slots whose turned vector
     lies on ``k2`` (phi is then 0).
 
@@ -1494,7 +1538,7 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
         B2 = np.zeros(shape + (3,))
         B2[..., 0] = -2 * _dot(p2, v)
         c = -1.0
-    by_quartic = np.abs(b) > GEOMETRY_TOLERANCE  # (...): else the slide is normal to k2
+    by_quartic = np.abs(b) > _SLIDE_NEARLY_NORMAL  # (...): else the slide is (nearly) normal to k2
     with np.errstate(invalid="ignore", divide="ignore"):
         quartic, quartic_scale = None, None
         if by_quartic.any():
@@ -1515,7 +1559,8 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
                 theta = np.where(degenerate[..., None] | (np.abs(step) > 1e-3), theta, theta - step)
             s = -_trig_value(A1, theta)[0] / bq
             merged = double & ~degenerate  # a tangent root of the harmonic equation left, reported once
-            quartic, quartic_scale = F, np.where(by_quartic, scale, -1.0)  # no residual merging elsewhere
+            # F = b**2 E2 with s = -A1 / b: the midpoint test below asks E2 (the length) to hold, not F
+            quartic, quartic_scale = F, np.where(by_quartic, scale * b * b, -1.0)  # no residual merging elsewhere
         if not by_quartic.all():
             first = _harmonic(A1[..., 1], A1[..., 2], -A1[..., 0], np.ones(shape))
             split_degenerate = first.degenerate & first.exact[..., 0]
@@ -1540,6 +1585,8 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
                 valid = np.where(rows[..., None], split_valid, valid)
                 merged = np.where(rows, split_merged, merged)
                 degenerate = np.where(rows, split_degenerate, degenerate)
+        # both eliminations lose digits as b -> 0 (the quartic's s, the split's b = 0): refine on E1, E2
+        theta, s = _refine_turn_slide(A1, A2, B2, b, c, theta, s, valid & ~np.asarray(degenerate)[..., None])
         theta = wrap_angle(np.where(valid, theta, np.nan))
         s = np.where(valid, s, np.nan)
         # the same root twice (a tangent root): keep one, at the midpoint of the pair. A double root that

@@ -12,7 +12,7 @@ from ._numeric import NumericOptions, solve_numeric
 from ._arrays import IKArrays, solve_ik_arrays
 from ._plan import geometry_of
 from ._types import IKResult, Solution
-from ._verify import accepted, distance_to_reference, distinct, polish, residuals, wrap_revolute
+from ._verify import accepted, distance_to_reference, first_of_each, polish, residuals, wrap_revolute
 
 
 @dataclass(frozen=True)
@@ -190,7 +190,7 @@ def _numeric(robot: Robot, target: np.ndarray, constrain_orientation: bool, refe
         position, orientation = residuals(robot, joints, target)
         ok = np.flatnonzero(accepted(robot, position, orientation, constrain_orientation))
         options.budget.check("polishing the numeric solutions")
-        kept = ok[distinct(robot, joints[ok], options.budget)] if len(ok) else ok
+        kept = ok[first_of_each(robot, joints[ok][None], np.ones((1, len(ok)), dtype=bool))[0]]
         solutions = [Solution(joints[i], {}, float(position[i]), float(orientation[i])) for i in kept]
     detail = "" if solutions else (
         "No solution was found by the numeric search; the target may be outside the workspace "

@@ -270,9 +270,9 @@ def _padded(part: IKArrays, width: int) -> IKArrays:
 def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
                  plan: Plan) -> IKArrays:
     if len(targets) == 1:  # one pose: the family's scalar path when it has one and the pose is clearly generic
-        answer = _solve_one_pose(robot, targets[0], constrain_orientation, reference, plan)
+        answer = solve_one_pose(robot, targets[0], constrain_orientation, reference, plan)
         if answer is not None:
-            return answer
+            return answer.arrays()
     candidates = plan.solve(targets, reference)
     n_targets, m, n = candidates.joints.shape
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
@@ -303,8 +303,36 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
         complete=complete)
 
 
-def _solve_one_pose(robot: Robot, target: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
-                    plan: Plan) -> IKArrays | None:
+class OnePoseAnswer:
+    """:func:`_solve_chunk`'s answer for one target, from :func:`solve_one_pose`, as lists in output order.
+
+    ``rows`` holds the m slots' joint vectors, the ``count`` solutions first;
+    ``position`` and ``orientation`` their FK residuals; ``codes`` one list of
+    label codes per name of ``names`` (values ``values``), −1 past ``count``.
+    :meth:`arrays` is the :class:`IKArrays` of it; the object API reads the
+    lists directly.
+    """
+
+    __slots__ = ("rows", "count", "position", "orientation", "names", "values", "codes", "plan", "singularities")
+
+    def __init__(self, rows, count, position, orientation, names, values, codes, plan, singularities) -> None:
+        self.rows, self.count, self.position, self.orientation = rows, count, position, orientation
+        self.names, self.values, self.codes, self.plan, self.singularities = names, values, codes, plan, singularities
+
+    def arrays(self) -> IKArrays:
+        valid = np.zeros((1, len(self.rows)), dtype=bool)
+        valid[0, :self.count] = True
+        residuals = np.array([self.position, self.orientation])
+        codes = np.array(self.codes, dtype=np.int8).reshape(len(self.names), 1, -1)
+        return IKArrays(joints=np.array(self.rows)[None], valid=valid, count=np.array([self.count]),
+                        position=residuals[:1], orientation=residuals[1:],
+                        labels={name: (values, column) for name, values, column in zip(self.names, self.values, codes)},
+                        singularities=self.singularities, structure=self.plan.structure,
+                        free_joints=list(self.plan.free_joints), complete=np.ones(1, dtype=bool))
+
+
+def solve_one_pose(robot: Robot, target: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
+                   plan: Plan) -> OnePoseAnswer | None:
     """:func:`_solve_chunk` for one target (4, 4) on the family's scalar path (``plan.solve_one``, which labels
     its slots as it solves), in plain floats: the same FK check (:func:`residuals_of_rows`), duplicate scan
     (:func:`first_of_each_one`) and order. None, for the array path to decide, when the family has no scalar
@@ -327,8 +355,8 @@ def _solve_one_pose(robot: Robot, target: np.ndarray, constrain_orientation: boo
         orientation.append(o)
     rows = [q if q is not None else [0.0] * robot.dof for q in rows]
     kept = first_of_each_one(robot, rows, ok)
-    labels = one_pose.label_codes(kept)
-    if labels is None:
+    codes = one_pose.code_lists(kept)
+    if codes is None:
         return None
     # output order: kept slots first, nearest to the reference first, else in slot order (stable)
     slots = range(len(rows))
@@ -337,15 +365,10 @@ def _solve_one_pose(robot: Robot, target: np.ndarray, constrain_orientation: boo
         distance = np.abs(difference).max(axis=1).tolist()
         order = sorted(slots, key=lambda s: distance[s] if kept[s] else math.inf)
     else:
-        order = sorted(slots, key=lambda s: not kept[s])
-    count = sum(kept)
-    return IKArrays(
-        joints=np.array([[rows[s] for s in order]]), valid=np.array([[kept[s] for s in order]]),
-        count=np.array([count]), position=np.array([[position[s] for s in order]]),
-        orientation=np.array([[orientation[s] for s in order]]),
-        labels={name: (values, codes[order][None]) for name, (values, codes) in labels.items()},
-        singularities=one_pose.singularities, structure=plan.structure, free_joints=list(plan.free_joints),
-        complete=np.ones(1, dtype=bool))
+        order = [s for s in slots if kept[s]] + [s for s in slots if not kept[s]]
+    return OnePoseAnswer([rows[s] for s in order], sum(kept), [position[s] for s in order],
+                         [orientation[s] for s in order], one_pose.names, one_pose.values,
+                         [[column[s] for s in order] for column in codes], plan, one_pose.singularities)
 
 
 #: Candidates with errors above this (and up to ``POLISH_RESIDUAL``) get Gauss–Newton steps (:func:`_polish_near`).

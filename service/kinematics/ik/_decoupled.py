@@ -10,6 +10,7 @@ is the motion left to the wrist, whose rotation it solves.
 
 from __future__ import annotations
 
+import math
 from functools import cached_property
 
 import numpy as np
@@ -178,11 +179,11 @@ class _ShoulderWristOnePose:
             R_3 = scalar.rotation(d[2], q3)
             # the wrist point from the centre with joint 3 turned (joints 1 and 2 turn it about the centre)
             reach_local = scalar.add(scalar.mv(R_3, self.point_from_3), self.centre_to_3)
+            elbow_side = self._elbow_side(reach_local)
             for q1, q2 in shoulder.angles(shoulder.start(reach_local), goal):
-                R_1 = scalar.rotation(d[0], q1)
-                R_12 = scalar.mm(R_1, scalar.rotation(d[1], q2))
-                R_G = scalar.mm(R_12, R_3)
-                shoulder_code, elbow_code = self._arm_codes(R_1, R_12, reach_local)
+                R_1, R_2 = scalar.rotation(d[0], q1), scalar.rotation(d[1], q2)
+                R_G = scalar.mm(scalar.mm(R_1, R_2), R_3)
+                shoulder_code, elbow_code = self._arm_codes(R_2, reach_local, elbow_side)
                 # what is left to the wrist, R_Gᵀ · R_target, applied to its last axis and normal
                 wanted = scalar.mtv(R_G, normal)
                 a, b = self.wrist_axes
@@ -193,18 +194,22 @@ class _ShoulderWristOnePose:
                     codes.append((shoulder_code, elbow_code, scalar.wrist_code(qb)))
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
-    def _arm_codes(self, R_1: scalar.Matrix, R_12: scalar.Matrix,
-                   reach_local: scalar.Vector) -> tuple[int | None, int | None]:
-        """:meth:`IntersectingShoulder.label_codes` of one arm branch: joints 1 and 2 (R_1, R_12 = R_1 R_2) turn
-        the centre-to-point vector ``reach_local`` and the elbow about the centre, so the elbow's side is taken
-        before they turn it, against the up direction turned back."""
-        reach = scalar.mv(R_12, reach_local)
-        if scalar.norm(scalar.reject(reach, self.directions[0])) <= scalar.MARGIN * self.on_axis:
-            return None, None  # the point near axis 1: the array labeller decides
-        shoulder = scalar.side_code(scalar.dot(reach, scalar.mv(R_1, self.forward)), scalar.norm(reach))
+    def _elbow_side(self, reach_local: scalar.Vector) -> scalar.Vector:
+        """The elbow's offset from the centre–point line (in the arm's plane when axes 2 ∥ 3), before joints 1
+        and 2 turn the arm: :meth:`IntersectingShoulder.label_codes` measures it along the up direction."""
         if self.in_plane:
             reach_local = scalar.reject(reach_local, self.directions[1])
         length = scalar.norm(reach_local)
-        line = (reach_local[0] / length, reach_local[1] / length, reach_local[2] / length)
-        side = scalar.dot(scalar.reject(self.elbow, line), scalar.mtv(R_12, self.up))
-        return shoulder, scalar.side_code(side, self.elbow_length)
+        return scalar.reject(self.elbow, (reach_local[0] / length, reach_local[1] / length, reach_local[2] / length))
+
+    def _arm_codes(self, R_2: scalar.Matrix, reach_local: scalar.Vector,
+                   elbow_side: scalar.Vector) -> tuple[int | None, int | None]:
+        """:meth:`IntersectingShoulder.label_codes` of one arm branch. Joint 1 turns about axis 1, which is the up
+        direction and carries the forward one with it, so only joint 2's turn R_2 matters."""
+        reach = scalar.mv(R_2, reach_local)
+        length = math.sqrt(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2])
+        if scalar.norm(scalar.reject(reach, self.directions[0])) <= scalar.MARGIN * self.on_axis:
+            return None, None  # the point near axis 1: the array labeller decides
+        return (scalar.side_code(scalar.dot(reach, self.forward), length),
+                scalar.side_code(scalar.dot(scalar.mv(R_2, elbow_side), self.up), self.elbow_length))
+

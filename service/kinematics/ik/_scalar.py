@@ -72,6 +72,14 @@ class OnePose:
 
     def label_codes(self, kept: list[bool]) -> LabelCodes | None:
         """Label codes (m,) of the ``kept`` slots (the others −1), or None when one of them is not clear."""
+        table = self.code_lists(kept)
+        if table is None:
+            return None
+        return {name: (values, np.array(column, dtype=np.int8))
+                for name, values, column in zip(self.names, self.values, table)}
+
+    def code_lists(self, kept: list[bool]) -> list[list[int]] | None:
+        """:meth:`label_codes` as lists, one per name."""
         table = [[-1] * len(kept) for _ in self.names]
         for slot, (keep, codes) in enumerate(zip(kept, self.codes)):
             if keep:
@@ -79,8 +87,7 @@ class OnePose:
                     if code is None:
                         return None
                     column[slot] = code
-        return {name: (values, np.array(column, dtype=np.int8))
-                for name, values, column in zip(self.names, self.values, table)}
+        return table
 
 
 def side_code(side: float, size: float) -> int | None:

@@ -311,7 +311,6 @@ class _ThreeParallelOnePose:
         for theta1 in self.shoulder.angles(self.shoulder.of(scalar.sub(c_world, p[0])), self.height):
             q1 = -theta1
             R1 = scalar.rotation(d[0], q1)
-            up = scalar.mtv(R1, self.up)  # the up direction before joint 1 turns the arm
             R_rest = scalar.mtm(R1, R_A)
             wanted_p = self.sixth.coordinates(scalar.mtv(R_rest, w_p))
             for q5 in scalar.Height.angles(self.wrist, scalar.dot(w_p, scalar.mv(R_rest, d[5]))):
@@ -326,7 +325,7 @@ class _ThreeParallelOnePose:
                 p4_world = scalar.add(scalar.mv(R_A, y), t_A)
                 to_point = scalar.mtv(R1, scalar.sub(p4_world, p[0]))
                 z1 = scalar.sub(scalar.add(p[0], to_point), p[1])
-                # labels: joint 1 turns the arm about axis 1, so they are taken before it turns it
+                # labels: joint 1 turns the arm about axis 1 (the up direction), so they are taken before it does
                 shoulder = scalar.side_code(scalar.dot(to_point, self.forward), scalar.norm(to_point))
                 reach = scalar.reject(z1, w_p)
                 length = scalar.norm(reach)
@@ -346,6 +345,6 @@ class _ThreeParallelOnePose:
                     q4 = s4 * (angle_sum - s2 * q2 - s3 * q3)
                     rows.append([wrap(q1), q2, q3, wrap(q4), q5, q6])
                     side = None if line is None else scalar.side_code(
-                        scalar.dot(scalar.reject(scalar.rotate(d[1], q2, self.elbow), line), up), self.elbow_length)
+                        scalar.dot(scalar.reject(scalar.rotate(d[1], q2, self.elbow), line), self.up), self.elbow_length)
                     codes.append((shoulder, side, wrist_code))
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)

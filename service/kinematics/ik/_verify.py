@@ -175,10 +175,8 @@ def first_of_each_one(robot: Robot, joints: list[list[float]], ok: list[bool]) -
             for other in first:
                 for a, b, (turn, tolerance) in zip(q, other, rule):
                     gap = abs(a - b)
-                    if turn and two_pi - gap < gap:
-                        gap = two_pi - gap
-                    if not gap <= tolerance:
-                        break
+                    if not (gap <= tolerance or turn and two_pi - gap <= tolerance):
+                        break  # this joint differs (modulo 2π for a revolute one)
                 else:  # every joint within tolerance: the same solution
                     good = False
                     break

@@ -8,7 +8,9 @@ like a standard DH frame it carries the axis of joint i + 1 as its z axis, and
 frame n is the flange (see :meth:`Robot.from_screws`).
 
 Every function takes joint values ``q`` with shape (n,) or a batch (N, n) and
-vectorises over N: there is no Python loop over configurations.
+vectorises over N: there is no Python loop over configurations. The one
+exception is :func:`tool_columns_scalar_rows`, the same chain on a few joint
+vectors in plain floats, for which array operations cost more than they save.
 """
 
 from __future__ import annotations

@@ -180,14 +180,24 @@ class _ShoulderWristOnePose:
             # the wrist point from the centre with joint 3 turned (joints 1 and 2 turn it about the centre)
             reach_local = scalar.add(scalar.mv(R_3, self.point_from_3), self.centre_to_3)
             elbow_side = self._elbow_side(reach_local)
-            for q1, q2 in shoulder.angles(shoulder.start(reach_local), goal):
+            for pair in shoulder.angles(shoulder.start(reach_local), goal):
+                if pair is None:  # no arm branch here: its wrist slots are empty too
+                    rows += [None, None]
+                    codes += [(None, None, None)] * 2
+                    continue
+                q1, q2 = pair
                 R_1, R_2 = scalar.rotation(d[0], q1), scalar.rotation(d[1], q2)
                 R_G = scalar.mm(scalar.mm(R_1, R_2), R_3)
                 shoulder_code, elbow_code = self._arm_codes(R_2, reach_local, elbow_side)
                 # what is left to the wrist, R_Gᵀ · R_target, applied to its last axis and normal
                 wanted = scalar.mtv(R_G, normal)
                 a, b = self.wrist_axes
-                for qa, qb in wrist.angles(self.wrist_start, wrist.goal(scalar.mtv(R_G, axis_c))):
+                for roots in wrist.angles(self.wrist_start, wrist.goal(scalar.mtv(R_G, axis_c))):
+                    if roots is None:
+                        rows.append(None)
+                        codes.append((None, None, None))
+                        continue
+                    qa, qb = roots
                     unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
                     qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))
                     rows.append([q1, q2, q3, qa, qb, qc])

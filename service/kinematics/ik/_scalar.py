@@ -5,15 +5,19 @@ operations, each with a fixed overhead far larger than its arithmetic. The two
 hot 6R families (:class:`~._decoupled.DecoupledPlan` with an intersecting
 shoulder and a spherical wrist, the PUMA type, and
 :class:`~._three_parallel.ThreeParallelPlan`, the UR5 type) therefore also
-solve one pose with ``math`` on floats (their ``solve_one`` and
-``label_codes_one``), from these pieces.
+solve one pose with ``math`` on floats (their ``solve_one``, which also labels
+the slots from the quantities it has: :class:`OnePose`), from these pieces,
+with the plan's fixed vectors reduced once when the plan is built
+(:class:`Turn`, :class:`Height`, :class:`TwoTurns`).
 
 Generic case only: every subproblem has two distinct, exact, non-degenerate
-roots, each clearly (by :data:`MARGIN` times the tolerance) away from the
-threshold where the array solver would decide otherwise. Anything else raises
-:class:`NotGeneric` and the pose takes the array path, which is the reference
-(``tests/kinematics/ik/test_one_pose.py`` holds these paths to it). The
-formulas are those of :mod:`._subproblems` (same slot order, same roots).
+roots, or clearly none (then, as the array solver, the least-squares one and
+an empty slot), each clearly (by :data:`MARGIN` times the tolerance) away from
+the threshold where the array solver would decide otherwise. Anything else
+raises :class:`NotGeneric` and the pose takes the array path, which is the
+reference (``tests/kinematics/ik/test_one_pose.py`` and
+``test_one_pose_families.py`` hold these paths to it). The formulas are those
+of :mod:`._subproblems` (same slot order, same roots).
 """
 
 from __future__ import annotations
@@ -110,13 +114,6 @@ def wrap_any(theta: float) -> float:
     if -_THREE_PI < theta < _THREE_PI:
         return wrap(theta)
     return _PI - (_PI - theta) % _TWO_PI
-
-
-def moved(directions: list[Vector], points: list[Vector], q: list[float], upto: int, x: Vector) -> Vector:
-    """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) x for revolute joints (as :func:`._screws.move_point`)."""
-    for i in reversed(range(upto)):
-        x = add(points[i], rotate(directions[i], q[i], sub(x, points[i])))
-    return x
 
 
 def reject(v: Vector, unit: Vector) -> Vector:
@@ -285,8 +282,9 @@ class Height:
 
     @staticmethod
     def angles(p: tuple[float, float, float, float], delta: float) -> tuple[float, float]:
+        """The two roots; where δ is clearly out of reach, the least-squares root and NaN (as the array solver)."""
         a, b, along, length = p
-        return harmonic(a, b, delta - along, length + abs(delta))
+        return harmonic(a, b, delta - along, length + abs(delta), out_of_reach=True)
 
 
 class TwoTurns:
@@ -316,7 +314,9 @@ class TwoTurns:
         radius = math.sqrt(across * across + e2 * e2) / self.sin
         return along2, across, e2, radius, math.sqrt(along2 * along2 + radius * radius)
 
-    def angles(self, start: tuple[float, ...], goal: tuple[float, ...]) -> tuple[tuple[float, float], ...]:
+    def angles(self, start: tuple[float, ...], goal: tuple[float, ...]) -> tuple[tuple[float, float] | None, ...]:
+        """The two pairs, the +γ crossing first; where the cones clearly miss, the least-squares pair (as the
+        array solver gives it, for the FK check to reject) and None for the empty slot."""
         p1, pn, d1, radius_p, norm_p = goal
         q2, qn, e2, radius_q, norm_q = start
         tol = GEOMETRY_TOLERANCE * (norm_p if norm_p > norm_q else norm_q)
@@ -331,11 +331,14 @@ class TwoTurns:
             g = (rho1 - abs(beta * sin)) * (rho1 + abs(beta * sin))
         else:
             g = (rho2 - abs(alpha * sin)) * (rho2 + abs(alpha * sin))
-        if not g * (rho1 + rho2) > MARGIN * _MERGE_RESIDUAL * rho1 * rho2:
+        atan2 = math.atan2
+        s1, c1, s2, c2 = -beta * pn, beta * d1, alpha * qn, alpha * e2
+        margin = MARGIN * _MERGE_RESIDUAL * rho1 * rho2
+        if not g * (rho1 + rho2) > margin:
+            if g * (rho1 + rho2) < -margin:  # the cones clearly miss: the least-squares pair and an empty slot
+                return (wrap(-wrap(atan2(s1, c1))), wrap(atan2(s2, c2))), None
             raise NotGeneric
         gamma = math.sqrt(g) / sin
-        s1, c1, t1, u1 = -beta * pn, beta * d1, gamma * d1, gamma * pn
-        s2, c2, t2, u2 = alpha * qn, alpha * e2, gamma * e2, gamma * qn
-        atan2 = math.atan2
+        t1, u1, t2, u2 = gamma * d1, gamma * pn, gamma * e2, gamma * qn
         return ((wrap(-wrap(atan2(s1 + t1, c1 + u1))), wrap(atan2(s2 - t2, c2 + u2))),
                 (wrap(-wrap(atan2(s1 - t1, c1 - u1))), wrap(atan2(s2 + t2, c2 - u2))))

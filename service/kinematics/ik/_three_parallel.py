@@ -309,11 +309,19 @@ class _ThreeParallelOnePose:
         rows: list[list[float] | None] = []
         codes: list[tuple[int | None, ...]] = []
         for theta1 in self.shoulder.angles(self.shoulder.of(scalar.sub(c_world, p[0])), self.height):
+            if math.isnan(theta1):  # the shoulder's second root where it has only a least-squares one
+                rows += [None] * 4
+                codes += [(None, None, None)] * 4
+                continue
             q1 = -theta1
             R1 = scalar.rotation(d[0], q1)
             R_rest = scalar.mtm(R1, R_A)
             wanted_p = self.sixth.coordinates(scalar.mtv(R_rest, w_p))
             for q5 in scalar.Height.angles(self.wrist, scalar.dot(w_p, scalar.mv(R_rest, d[5]))):
+                if math.isnan(q5):
+                    rows += [None] * 2
+                    codes += [(None, None, None)] * 2
+                    continue
                 q6 = -Turn.angle(self.sixth.coordinates(scalar.rotate(d[4], -q5, w_p)), wanted_p)
                 R5, R6 = scalar.rotation(d[4], q5), scalar.rotation(d[5], q6)
                 # R234 = R_rest R6ᵀ R5ᵀ, applied to the normal of ω_p

@@ -8,7 +8,9 @@ like a standard DH frame it carries the axis of joint i + 1 as its z axis, and
 frame n is the flange (see :meth:`Robot.from_screws`).
 
 Every function takes joint values ``q`` with shape (n,) or a batch (N, n) and
-vectorises over N: there is no Python loop over configurations.
+vectorises over N: there is no Python loop over configurations. The one
+exception is :func:`tool_columns_scalar_rows`, the same chain on a few joint
+vectors in plain floats, for which array operations cost more than they save.
 """
 
 from __future__ import annotations
@@ -134,14 +136,78 @@ def _chain_steps(robot: Robot) -> tuple[_Step, ...]:
     return tuple(steps)
 
 
-def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """``world_T_tool`` for a batch of joint vectors, as its four columns.
+# The operations of a chain program (:func:`_chain_program`); each acts on the frame's columns x, y, z, p.
+_TURN = 0  # a turn about z by a joint's angle: (_TURN, joint, constant angle)
+_SLIDE = 1  # a move along z by a joint's value: (_SLIDE, joint, constant offset)
+_MOVE_Z = 2  # a fixed move along z: (_MOVE_Z, -1, distance)
+_MOVE_X = 3  # a fixed move along x: (_MOVE_X, -1, distance)
+_TWIST = 4  # a fixed turn about x: (_TWIST, -1, (cos, sin))
+_FIXED = 5  # a fixed rigid motion: (_FIXED, -1, its columns x, y, z, t flattened (12 floats))
+_TURN_BY = 6  # a fixed turn about z (a prismatic joint's theta): (_TURN_BY, -1, (cos, sin))
+_QUARTER = 7  # a fixed turn about x by ±90°: (_QUARTER, -1, ±1.0), a _TWIST with cos 0 and sin ±1
 
-    The chain is multiplied out column by column: post-multiplying by Rz(θ)
-    mixes the x and y columns, by Rx(α) the y and z columns, and a
-    translation adds a multiple of one column to the position. Each step is
-    a few elementwise operations over the whole batch, and terms that are
-    zero for this robot (a = 0, d = 0, α = 0) are skipped.
+
+class ChainProgram(NamedTuple):
+    """``world_T_tool`` as a start frame and the column operations that follow, built once per robot.
+
+    Post-multiplying a frame by Rz(θ) mixes its x and y columns, by Rx(α) its
+    y and z columns, and a translation adds multiples of its columns to the
+    position; terms that are zero for this robot (a = 0, d = 0, α = 0, an
+    identity tool) are left out. :func:`tool_columns` runs it on a batch,
+    :func:`tool_columns_scalar` on one joint vector: the same operations.
+    """
+
+    start: tuple[float, ...]  # world_T_base (· F_0 for a screws robot): columns x, y, z, p flattened
+    operations: tuple[tuple[int, int, object], ...]
+    joint_steps: tuple[int, ...]  # per joint, the index of the operation that reads its value
+
+
+def chain_program(robot: Robot) -> ChainProgram:
+    """The robot's :class:`ChainProgram` (memoised on the robot)."""
+    return memo(robot, "chain_program", lambda: _chain_program(robot))
+
+
+def _columns(T: np.ndarray) -> tuple[float, ...]:
+    return tuple(T[:3, :].T.ravel().tolist())
+
+
+def _chain_program(robot: Robot) -> ChainProgram:
+    operations: list[tuple[int, int, object]] = []
+    tool = robot.flange_T_tool
+    if robot.chain_transforms is not None:  # base · F_0, then per joint its motion about local z and F_i
+        chain = robot.chain_transforms
+        for i in range(robot.dof):
+            operations.append((_TURN, i, 0.0) if robot.is_revolute[i] else (_SLIDE, i, 0.0))
+            fixed = chain[i + 1] @ tool if i == robot.dof - 1 else chain[i + 1]
+            operations.append((_FIXED, -1, _columns(fixed)))
+        return _program(_columns(robot.world_T_base @ chain[0]), operations)
+    standard = robot.convention == "standard"
+    for i, step in enumerate(_chain_steps(robot)):
+        if step.revolute:
+            about_z = [(_TURN, i, step.theta)] + ([(_MOVE_Z, -1, step.d)] if step.d != 0.0 else [])
+        else:
+            about_z = [(_SLIDE, i, step.d)]
+            if step.theta != 0.0:
+                about_z.append((_TURN_BY, -1, (math.cos(step.theta), math.sin(step.theta))))
+        about_x = [(_MOVE_X, -1, step.a)] if step.a != 0.0 else []
+        if step.twisted:
+            about_x.append((_QUARTER, -1, step.sin_alpha) if step.cos_alpha == 0.0 and abs(step.sin_alpha) == 1.0
+                           else (_TWIST, -1, (step.cos_alpha, step.sin_alpha)))
+        # standard DH: A = Rz(θ) Tz(d) Tx(a) Rx(α); Craig and Khalil: T = Rx(α) Tx(a) Rz(θ) Tz(d)
+        operations += about_z + about_x if standard else about_x + about_z
+    if not np.array_equal(tool, _IDENTITY):
+        operations.append((_FIXED, -1, _columns(tool)))
+    return _program(_columns(robot.world_T_base), operations)
+
+
+def _program(start: tuple[float, ...], operations: list[tuple[int, int, object]]) -> ChainProgram:
+    joint_steps = tuple(i for i, (kind, _, _) in enumerate(operations) if kind in (_TURN, _SLIDE))
+    return ChainProgram(start, tuple(operations), joint_steps)
+
+
+def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``world_T_tool`` for a batch of joint vectors, as its four columns (:class:`ChainProgram`, each operation
+    a few elementwise operations over the whole batch).
 
     Parameters
     ----------
@@ -152,159 +218,119 @@ def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     x, y, z, p : ndarrays, shape (3, N)
         The rotation's columns and the position of the tool, in the world frame.
     """
-    if robot.chain_transforms is not None:
-        return _screw_chain_columns(robot, np.asarray(q, dtype=float))
-    steps = memo(robot, "chain_steps", lambda: _chain_steps(robot))
+    program = chain_program(robot)
     qt = np.asarray(q, dtype=float).T  # (n, N)
-    angles = np.array([s.theta for s in steps])[:, None] + np.where(robot.is_revolute[:, None], qt, 0.0)
-    cos, sin = np.cos(angles), np.sin(angles)
-    base = robot.world_T_base
     count = qt.shape[1]
-    x, y, z = (np.repeat(base[:3, k:k + 1], count, axis=1) for k in range(3))
-    p = np.repeat(base[:3, 3:4], count, axis=1)
-    standard = robot.convention == "standard"
-    for i, step in enumerate(steps):
-        c, s = cos[i], sin[i]
-        if standard:  # A = Rz(θ) Tz(d) Tx(a) Rx(α)
-            d = step.d if step.revolute else step.d + qt[i]
-            if step.revolute and d != 0.0 or not step.revolute:
-                p = p + z * d
+    start = np.array(program.start).reshape(4, 3, 1)
+    x, y, z, p = (np.repeat(column, count, axis=1) for column in start)
+    for kind, joint, value in program.operations:
+        if kind == _TURN:
+            angle = qt[joint] + value if value != 0.0 else qt[joint]
+            c, s = np.cos(angle), np.sin(angle)
             x, y = x * c + y * s, y * c - x * s
-            if step.a != 0.0:
-                p = p + x * step.a
-            if step.twisted:
-                y, z = y * step.cos_alpha + z * step.sin_alpha, z * step.cos_alpha - y * step.sin_alpha
-        else:  # T = Rx(α) Tx(a) Rz(θ) Tz(d)
-            if step.a != 0.0:
-                p = p + x * step.a
-            if step.twisted:
-                y, z = y * step.cos_alpha + z * step.sin_alpha, z * step.cos_alpha - y * step.sin_alpha
+        elif kind == _SLIDE:
+            p = p + z * (qt[joint] + value)
+        elif kind == _MOVE_Z:
+            p = p + z * value
+        elif kind == _MOVE_X:
+            p = p + x * value
+        elif kind == _TWIST:
+            c, s = value
+            y, z = y * c + z * s, z * c - y * s
+        elif kind == _QUARTER:
+            y, z = (z, -y) if value > 0 else (-z, y)
+        elif kind == _TURN_BY:
+            c, s = value
             x, y = x * c + y * s, y * c - x * s
-            d = step.d if step.revolute else step.d + qt[i]
-            if step.revolute and d != 0.0 or not step.revolute:
-                p = p + z * d
-    tool = robot.flange_T_tool
-    if not np.array_equal(tool, _IDENTITY):
-        R, t = tool[:3, :3], tool[:3, 3]
-        p = p + x * t[0] + y * t[1] + z * t[2]
-        x, y, z = (x * R[0, k] + y * R[1, k] + z * R[2, k] for k in range(3))
+        else:
+            a0, a1, a2, b0, b1, b2, c0, c1, c2, t0, t1, t2 = value
+            p = p + x * t0 + y * t1 + z * t2
+            x, y, z = x * a0 + y * a1 + z * a2, x * b0 + y * b1 + z * b2, x * c0 + y * c1 + z * c2
     return x, y, z, p
 
 
 _IDENTITY = np.eye(4)
 
 
-def _apply_columns(x, y, z, p, T: np.ndarray):
-    """Columns of frame · T for a fixed rigid T, shape (4, 4); works on arrays and on scalars alike."""
-    R, t = T[:3, :3], T[:3, 3]
-    p = p + x * t[0] + y * t[1] + z * t[2]
-    return (*(x * R[0, k] + y * R[1, k] + z * R[2, k] for k in range(3)), p)
+def tool_columns_scalar(robot: Robot, q: list[float]) -> tuple[tuple[float, float, float], ...]:
+    """:func:`tool_columns` for one joint vector (a list of floats), in scalar arithmetic: the columns x, y, z, p
+    of ``world_T_tool`` as tuples of three floats (:func:`tool_columns_scalar_rows` of one row)."""
+    return tool_columns_scalar_rows(robot, [q])[0]
 
 
-def _screw_chain_columns(robot: Robot, q: np.ndarray):
-    """:func:`tool_columns` of a screws robot: base · F_0, then per joint its motion about local z and F_i."""
-    chain = robot.chain_transforms
-    qt = q.T
-    count = qt.shape[1]
-    base = robot.world_T_base @ chain[0]
-    x, y, z = (np.repeat(base[:3, k:k + 1], count, axis=1) for k in range(3))
-    p = np.repeat(base[:3, 3:4], count, axis=1)
-    cos, sin = np.cos(qt), np.sin(qt)
-    for i in range(robot.dof):
-        if robot.is_revolute[i]:
-            c, s = cos[i], sin[i]
-            x, y = x * c + y * s, y * c - x * s
+def tool_columns_scalar_rows(robot: Robot, rows: list[list[float]]) -> list[tuple[tuple[float, float, float], ...]]:
+    """:func:`tool_columns` for a few joint vectors (lists of floats), in scalar arithmetic: the same
+    :class:`ChainProgram`, without the fixed cost of array operations. A row that shares its first joints' values
+    with the row before it (as the IK solutions of one branch of the arm do) starts from the frame those joints
+    gave it: the same operations on the same numbers, done once.
+
+    Returns, per row, the columns x, y, z, p of ``world_T_tool`` as tuples of three floats.
+    """
+    program = chain_program(robot)
+    operations, joint_steps = program.operations, program.joint_steps
+    cos, sin = math.cos, math.sin
+    frames: list[tuple[float, ...]] = []  # frames[j]: the frame before the operations of joint j, last row
+    previous: list[float] = []
+    out = []
+    for q in rows:
+        shared = 0
+        for a, b in zip(q, previous):
+            if a != b:
+                break
+            shared += 1
+        if shared < len(frames):
+            x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frames[shared]
+            del frames[shared:]
+            first = joint_steps[shared]
         else:
-            p = p + z * qt[i]
-        x, y, z, p = _apply_columns(x, y, z, p, chain[i + 1] @ robot.flange_T_tool if i == robot.dof - 1
-                                    else chain[i + 1])
-    return x, y, z, p
-
-
-def _screw_chain_scalar(robot: Robot, q: list[float]):
-    """:func:`_screw_chain_columns` for one joint vector, in scalar arithmetic (unrolled, no array overhead)."""
-    def build():
-        fixed = [robot.world_T_base @ robot.chain_transforms[0], *robot.chain_transforms[1:-1],
-                 robot.chain_transforms[-1] @ robot.flange_T_tool]
-        return [tuple(T[:3, :].T.ravel().tolist()) for T in fixed]  # x, y, z, p columns, flattened
-
-    fixed = memo(robot, "screw_chain_scalar", build)
-    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = fixed[0]
-    for revolute, value, F in zip(robot.is_revolute.tolist(), q, fixed[1:]):
-        if revolute:
-            c, s = math.cos(value), math.sin(value)
-            x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
-                                      y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
-        else:
-            p0, p1, p2 = p0 + z0 * value, p1 + z1 * value, p2 + z2 * value
-        a0, a1, a2, b0, b1, b2, c0, c1, c2, t0, t1, t2 = F
-        p0, p1, p2 = (p0 + x0 * t0 + y0 * t1 + z0 * t2, p1 + x1 * t0 + y1 * t1 + z1 * t2,
-                      p2 + x2 * t0 + y2 * t1 + z2 * t2)
-        x0, x1, x2, y0, y1, y2, z0, z1, z2 = (
-            x0 * a0 + y0 * a1 + z0 * a2, x1 * a0 + y1 * a1 + z1 * a2, x2 * a0 + y2 * a1 + z2 * a2,
-            x0 * b0 + y0 * b1 + z0 * b2, x1 * b0 + y1 * b1 + z1 * b2, x2 * b0 + y2 * b1 + z2 * b2,
-            x0 * c0 + y0 * c1 + z0 * c2, x1 * c0 + y1 * c1 + z1 * c2, x2 * c0 + y2 * c1 + z2 * c2)
-    return (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)
+            x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = program.start
+            frames.clear()
+            first = 0
+        for kind, joint, value in operations[first:]:
+            if kind == _TURN:
+                frames.append((x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2))
+                angle = q[joint] + value
+                c, s = cos(angle), sin(angle)
+                x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
+                                          y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
+            elif kind == _QUARTER:  # a twist of ±90°: the y and z columns swap (a sign changes)
+                if value > 0:
+                    y0, y1, y2, z0, z1, z2 = z0, z1, z2, -y0, -y1, -y2
+                else:
+                    y0, y1, y2, z0, z1, z2 = -z0, -z1, -z2, y0, y1, y2
+            elif kind == _MOVE_X:
+                p0, p1, p2 = p0 + x0 * value, p1 + x1 * value, p2 + x2 * value
+            elif kind == _MOVE_Z:
+                p0, p1, p2 = p0 + z0 * value, p1 + z1 * value, p2 + z2 * value
+            elif kind == _TWIST:
+                c, s = value
+                y0, y1, y2, z0, z1, z2 = (y0 * c + z0 * s, y1 * c + z1 * s, y2 * c + z2 * s,
+                                          z0 * c - y0 * s, z1 * c - y1 * s, z2 * c - y2 * s)
+            elif kind == _SLIDE:
+                frames.append((x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2))
+                d = q[joint] + value
+                p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
+            elif kind == _TURN_BY:
+                c, s = value
+                x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
+                                          y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
+            else:
+                a0, a1, a2, b0, b1, b2, c0, c1, c2, t0, t1, t2 = value
+                p0, p1, p2 = (p0 + x0 * t0 + y0 * t1 + z0 * t2, p1 + x1 * t0 + y1 * t1 + z1 * t2,
+                              p2 + x2 * t0 + y2 * t1 + z2 * t2)
+                x0, x1, x2, y0, y1, y2, z0, z1, z2 = (
+                    x0 * a0 + y0 * a1 + z0 * a2, x1 * a0 + y1 * a1 + z1 * a2, x2 * a0 + y2 * a1 + z2 * a2,
+                    x0 * b0 + y0 * b1 + z0 * b2, x1 * b0 + y1 * b1 + z1 * b2, x2 * b0 + y2 * b1 + z2 * b2,
+                    x0 * c0 + y0 * c1 + z0 * c2, x1 * c0 + y1 * c1 + z1 * c2, x2 * c0 + y2 * c1 + z2 * c2)
+        out.append(((x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)))
+        previous = q
+    return out
 
 
 def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:
     """``world_T_tool`` for one joint vector: :func:`tool_columns` in scalar arithmetic (no array overhead)."""
     (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = tool_columns_scalar(robot, q)
     return np.array([[x0, y0, z0, p0], [x1, y1, z1, p1], [x2, y2, z2, p2], [0.0, 0.0, 0.0, 1.0]])
-
-
-def _screw_z(frame: tuple, c: float, s: float, d: float) -> tuple:
-    """A frame (x, y, z, p columns, flattened) moved by Rot_z(theta)·Trans_z(d), given c, s of theta (they commute)."""
-    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frame
-    if d:
-        p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
-    return (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s, y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s,
-            z0, z1, z2, p0, p1, p2)
-
-
-def _screw_x(frame: tuple, step) -> tuple:
-    """A frame moved by Trans_x(a)·Rot_x(alpha) of a chain step (they commute); zero terms are skipped."""
-    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frame
-    if step.a:
-        p0, p1, p2 = p0 + x0 * step.a, p1 + x1 * step.a, p2 + x2 * step.a
-    if step.twisted:
-        ca, sa = step.cos_alpha, step.sin_alpha
-        y0, y1, y2, z0, z1, z2 = (y0 * ca + z0 * sa, y1 * ca + z1 * sa, y2 * ca + z2 * sa,
-                                  z0 * ca - y0 * sa, z1 * ca - y1 * sa, z2 * ca - y2 * sa)
-    return x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2
-
-
-def tool_columns_scalar(robot: Robot, q: list[float]) -> tuple[tuple[float, float, float], ...]:
-    """:func:`tool_columns` for one joint vector (a list of floats), in scalar arithmetic: the columns x, y, z, p
-    of ``world_T_tool`` as tuples of three floats."""
-    if robot.chain_transforms is not None:
-        return _screw_chain_scalar(robot, q)
-    steps = memo(robot, "chain_steps", lambda: _chain_steps(robot))
-    start = memo(robot, "base_columns", lambda: robot.world_T_base[:3].T.tolist())
-    (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = start
-    frame = (x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2)
-    standard = robot.convention == "standard"
-    for step, value in zip(steps, q):
-        if step.revolute:
-            angle, d = step.theta + value, step.d
-        else:
-            angle, d = step.theta, step.d + value
-        # Standard DH is a screw about z (theta, d) then about x (a, alpha); Craig and Khalil the other way round.
-        if standard:
-            frame = _screw_x(_screw_z(frame, math.cos(angle), math.sin(angle), d), step)
-        else:
-            frame = _screw_z(_screw_x(frame, step), math.cos(angle), math.sin(angle), d)
-    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frame
-    x, y, z, p = (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)
-    tool = memo(robot, "tool_scalar", lambda: None if np.array_equal(robot.flange_T_tool, _IDENTITY)
-                else robot.flange_T_tool[:3].T.tolist())
-    if tool is None:
-        return x, y, z, p
-    # as in tool_columns: p += R_flange t, then each column of R_flange · R_tool
-    (r0, r1, r2, t) = tool
-    p = tuple(p[a] + x[a] * t[0] + y[a] * t[1] + z[a] * t[2] for a in range(3))
-    x, y, z = (tuple(x[a] * r[0] + y[a] * r[1] + z[a] * r[2] for a in range(3)) for r in (r0, r1, r2))
-    return x, y, z, p
 
 
 class JointScrews(NamedTuple):

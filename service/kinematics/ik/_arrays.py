@@ -13,6 +13,7 @@ slots past ``count[i]`` hold no solution.
 
 from __future__ import annotations
 
+import math
 import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
@@ -22,10 +23,11 @@ import numpy as np
 from .._budget import UNLIMITED, Budget
 from .._cache import memo
 from .._robot import Robot
-from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
+from .._tolerances import ACCEPT_RESIDUAL, POLISH_RESIDUAL
 from ._plan import Plan, plan_for
 from ._types import LabelCodes, SingularFlags
-from ._verify import accepted, distance_to_reference, polish, residual_arrays, wrap_revolute
+from ._verify import (accepted, distance_to_reference, first_of_each, first_of_each_one, polish, residual_arrays,
+                      residuals_of_rows, wrap_revolute)
 from ._structure import arm_size
 
 
@@ -267,21 +269,18 @@ def _padded(part: IKArrays, width: int) -> IKArrays:
 
 def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
                  plan: Plan) -> IKArrays:
-    # one pose: the family's scalar path (Plan.solve_one) when it has one and the pose is clearly generic
-    solve_one = getattr(plan, "solve_one", None) if len(targets) == 1 else None
-    candidates = solve_one(targets[0]) if solve_one is not None else None
-    one_pose = candidates is not None
-    if not one_pose:
-        candidates = plan.solve(targets, reference)
+    if len(targets) == 1:  # one pose: the family's scalar path when it has one and the pose is clearly generic
+        answer = solve_one_pose(robot, targets[0], constrain_orientation, reference, plan)
+        if answer is not None:
+            return answer.arrays()
+    candidates = plan.solve(targets, reference)
     n_targets, m, n = candidates.joints.shape
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
     position, orientation = residual_arrays(robot, joints, targets)
     _polish_near(robot, joints, targets, position, orientation, candidates.valid, constrain_orientation)
     ok = candidates.valid & accepted(robot, position, orientation, constrain_orientation)
-    kept = _first_of_each(robot, joints, ok)
-    labels = plan.label_codes_one(joints, kept) if one_pose else None
-    if labels is None:
-        labels = plan.label_codes(joints.reshape(-1, n))
+    kept = first_of_each(robot, joints, ok)
+    labels = plan.label_codes(joints.reshape(-1, n))
     # output order: kept slots first, nearest to the reference first, else in slot order (stable)
     if reference is not None:
         key = np.where(kept, distance_to_reference(robot, joints, reference), np.inf)
@@ -302,6 +301,78 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
         labels={name: (values, codes.reshape(n_targets, m)[take]) for name, (values, codes) in labels.items()},
         singularities=candidates.singularities, structure=plan.structure, free_joints=list(plan.free_joints),
         complete=complete)
+
+
+class OnePoseAnswer:
+    """:func:`_solve_chunk`'s answer for one target, from :func:`solve_one_pose`, as lists in output order.
+
+    ``rows`` holds the m slots' joint vectors, the ``count`` solutions first;
+    ``position`` and ``orientation`` their FK residuals; ``codes`` one list of
+    label codes per name of ``names`` (values ``values``), −1 past ``count``.
+    :meth:`arrays` is the :class:`IKArrays` of it; the object API reads the
+    lists directly.
+    """
+
+    __slots__ = ("rows", "count", "position", "orientation", "names", "values", "codes", "plan", "singularities")
+
+    def __init__(self, rows, count, position, orientation, names, values, codes, plan, singularities) -> None:
+        self.rows, self.count, self.position, self.orientation = rows, count, position, orientation
+        self.names, self.values, self.codes, self.plan, self.singularities = names, values, codes, plan, singularities
+
+    def arrays(self) -> IKArrays:
+        valid = np.zeros((1, len(self.rows)), dtype=bool)
+        valid[0, :self.count] = True
+        residuals = np.array([self.position, self.orientation])
+        codes = np.array(self.codes, dtype=np.int8).reshape(len(self.names), 1, -1)
+        return IKArrays(joints=np.array(self.rows)[None], valid=valid, count=np.array([self.count]),
+                        position=residuals[:1], orientation=residuals[1:],
+                        labels={name: (values, column) for name, values, column in zip(self.names, self.values, codes)},
+                        singularities=self.singularities, structure=self.plan.structure,
+                        free_joints=list(self.plan.free_joints), complete=np.ones(1, dtype=bool))
+
+
+def solve_one_pose(robot: Robot, target: np.ndarray, constrain_orientation: bool, reference: np.ndarray | None,
+                   plan: Plan) -> OnePoseAnswer | None:
+    """:func:`_solve_chunk` for one target (4, 4) on the family's scalar path (``plan.solve_one``, which labels
+    its slots as it solves), in plain floats: the same FK check (:func:`residuals_of_rows`), duplicate scan
+    (:func:`first_of_each_one`) and order. None, for the array path to decide, when the family has no scalar
+    path, the pose is not clearly generic, a candidate would be polished, or a kept slot's label is not clear."""
+    solve_one = getattr(plan, "solve_one", None)
+    one_pose = solve_one(target) if solve_one is not None else None
+    if one_pose is None:
+        return None
+    size = arm_size(robot)
+    rows = one_pose.rows
+    verified = iter(residuals_of_rows(robot, [q for q in rows if q is not None], target[:3].tolist()))
+    ok, position, orientation = [], [], []
+    for q in rows:
+        p, o = next(verified) if q is not None else (math.inf, math.inf)
+        error = max(p / size, o) if constrain_orientation else p / size
+        if q is not None and _POLISH_FROM < error <= POLISH_RESIDUAL:  # the array path polishes it
+            return None
+        ok.append(p <= ACCEPT_RESIDUAL * size and (o <= ACCEPT_RESIDUAL or not constrain_orientation))  # accepted()
+        position.append(p)
+        orientation.append(o)
+    rows = [q if q is not None else [0.0] * robot.dof for q in rows]
+    kept = first_of_each_one(robot, rows, ok)
+    codes = one_pose.code_lists(kept)
+    if codes is None:
+        return None
+    # output order: kept slots first, nearest to the reference first, else in slot order (stable)
+    slots = range(len(rows))
+    if reference is not None:
+        difference = wrap_revolute(robot, np.array(rows) - reference)
+        distance = np.abs(difference).max(axis=1).tolist()
+        order = sorted(slots, key=lambda s: distance[s] if kept[s] else math.inf)
+    else:
+        order = [s for s in slots if kept[s]] + [s for s in slots if not kept[s]]
+    return OnePoseAnswer([rows[s] for s in order], sum(kept), [position[s] for s in order],
+                         [orientation[s] for s in order], one_pose.names, one_pose.values,
+                         [[column[s] for s in order] for column in codes], plan, one_pose.singularities)
+
+
+#: Candidates with errors above this (and up to ``POLISH_RESIDUAL``) get Gauss–Newton steps (:func:`_polish_near`).
+_POLISH_FROM = ACCEPT_RESIDUAL * 1e-3
 
 
 #: Singular relations under which a family's "no solution" is not a proof: it set a joint it found undetermined to
@@ -330,7 +401,7 @@ def _polish_near(robot: Robot, joints: np.ndarray, targets: np.ndarray, position
                  orientation: np.ndarray, valid: np.ndarray, constrain_orientation: bool) -> None:
     """Refine, in place, candidates close to their target but outside the acceptance tolerance."""
     size = np.maximum(position / arm_size(robot), orientation if constrain_orientation else 0.0)
-    near = valid & (size > ACCEPT_RESIDUAL * 1e-3) & (size <= POLISH_RESIDUAL)
+    near = valid & (size > _POLISH_FROM) & (size <= POLISH_RESIDUAL)
     if not near.any():
         return
     rows, slots = np.nonzero(near)
@@ -338,74 +409,3 @@ def _polish_near(robot: Robot, joints: np.ndarray, targets: np.ndarray, position
     joints[rows, slots] = refined
     p, o = residual_arrays(robot, refined[:, None, :], targets[rows])
     position[rows, slots], orientation[rows, slots] = p[:, 0], o[:, 0]
-
-
-def _slot_pairs(m: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every pair of slots (earlier, later), grouped by the later slot: (0, 1), (0, 2), (1, 2), (0, 3), …"""
-    pairs = _PAIRS.get(m)
-    if pairs is None:
-        later, earlier = np.tril_indices(m, -1)
-        pairs = _PAIRS[m] = (earlier, later)
-    return pairs
-
-
-_PAIRS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-
-
-def _first_of_each_scalar(joints: np.ndarray, ok: np.ndarray, revolute: list[bool],
-                          tolerance: list[float]) -> np.ndarray:
-    """:func:`_first_of_each` by a plain scan (the same rule), for a few slots."""
-    kept = np.zeros_like(ok)
-    two_pi = 2 * np.pi
-    for row, (slots, usable) in enumerate(zip(joints.tolist(), ok.tolist())):
-        first: list[list[float]] = []
-        for slot, (q, good) in enumerate(zip(slots, usable)):
-            if not good:
-                continue
-            for other in first:
-                for a, b, turn, tol in zip(q, other, revolute, tolerance):
-                    gap = abs(a - b)
-                    if turn and two_pi - gap < gap:
-                        gap = two_pi - gap
-                    if not gap <= tol:
-                        break
-                else:  # every joint within tolerance: the same solution
-                    break
-            else:
-                first.append(q)
-                kept[row, slot] = True
-    return kept
-
-
-def _first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Which slots (N, m) hold the first occurrence of a distinct solution among the ``ok`` ones.
-
-    Revolute joints are compared modulo 2π. A slot is dropped when it equals
-    a slot kept before it, exactly as a sequential scan would: the loop runs
-    over the m slots, each step vectorised over the targets.
-    """
-    m = joints.shape[1]
-    if m == 1:
-        return ok.copy()
-    revolute = robot.is_revolute
-    all_revolute = bool(revolute.all())
-    tolerance = memo(robot, "duplicate_tolerance", lambda: np.where(
-        revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot)))
-    if joints.size <= 16 * len(revolute):  # one pose's slots: a scan in Python is cheaper than the array ops
-        return _first_of_each_scalar(joints, ok, revolute.tolist(), tolerance.tolist())
-    # every pair (earlier slot, later slot) at once; joints are wrapped to (−π, π], so a revolute difference d
-    # lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
-    earlier, later = _slot_pairs(m)
-    gap = np.abs(joints[:, later, :] - joints[:, earlier, :])  # (N, pairs, n)
-    if all_revolute:
-        np.minimum(gap, 2 * np.pi - gap, out=gap)
-    elif revolute.any():
-        gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
-    same = (gap <= tolerance).all(axis=-1)  # (N, pairs)
-    # then the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
-    kept = ok.copy()
-    start = 0
-    for slot in range(1, m):
-        kept[:, slot] &= ~np.any(same[:, start:start + slot] & kept[:, :slot], axis=1)
-        start += slot
-    return kept

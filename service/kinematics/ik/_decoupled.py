@@ -10,6 +10,7 @@ is the motion left to the wrist, whose rotation it solves.
 
 from __future__ import annotations
 
+import math
 from functools import cached_property
 
 import numpy as np
@@ -97,17 +98,17 @@ class DecoupledPlan:
                 codes.update(part.label_codes(joints))
         return codes
 
-    def solve_one(self, world_T_target: np.ndarray) -> Candidates | None:
-        """:meth:`solve` of one target (4, 4) in scalar arithmetic (:mod:`._scalar`), or None when the plan is
-        not the PUMA type or the pose is not clearly generic (then :meth:`solve` decides)."""
+    def solve_one(self, world_T_target: np.ndarray) -> scalar.OnePose | None:
+        """:meth:`solve` of one target (4, 4) in scalar arithmetic (:mod:`._scalar`), with the slots' branch
+        labels (:meth:`label_codes`) from the same quantities, or None when the plan is not the PUMA type or the
+        pose is not clearly generic (then :meth:`solve` and :meth:`label_codes` decide)."""
         one_pose = self._one_pose
-        return None if one_pose is None else scalar.one_pose_candidates(one_pose.solve, world_T_target)
-
-    def label_codes_one(self, joints: np.ndarray, valid: np.ndarray) -> LabelCodes | None:
-        """:meth:`label_codes` of one pose's slots (1, m, n) where ``valid`` (1, m), in scalar arithmetic, or
-        None (then :meth:`label_codes` decides)."""
-        one_pose = self._one_pose
-        return None if one_pose is None else scalar.one_pose_label_codes(one_pose, joints, valid)
+        if one_pose is None:
+            return None
+        try:
+            return one_pose.solve(world_T_target)
+        except scalar.NotGeneric:
+            return None
 
     @cached_property
     def _one_pose(self) -> "_ShoulderWristOnePose | None":
@@ -122,69 +123,103 @@ class DecoupledPlan:
 
 
 class _ShoulderWristOnePose:
-    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` (revolute joint 3) and a spherical wrist."""
-
-    def __init__(self, plan: DecoupledPlan) -> None:
-        positioner, wrist, model = plan.positioner, plan.wrist, plan.positioner.model
-        self.directions = [scalar.vector_of(d) for d in model.directions]
-        self.points = [scalar.vector_of(p) for p in model.points]
-        self.frame_3 = scalar.plane_axes(self.directions[2])
-        self.centre, self.point = scalar.vector_of(positioner.centre), scalar.vector_of(plan.point)
-        self.home_inverse = scalar.matrix_of(plan.home_inverse[:3, :3]), scalar.vector_of(plan.home_inverse[:3, 3])
-        self.axes = [scalar.vector_of(a) for a in wrist.axes]
-        self.normal = scalar.vector_of(wrist.normal)
-        self.frame_c = scalar.plane_axes(self.axes[2])
-        forward, in_plane, up = positioner.label_constants
-        self.forward, self.in_plane, self.up = scalar.vector_of(forward), in_plane, scalar.vector_of(up)
-        self.on_axis = GEOMETRY_TOLERANCE * 10 * positioner.geometry.length_scale
+    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` (revolute joint 3) and a spherical wrist, step
+    for step, with the plan's constants as floats (built once per plan)."""
 
     names = ("shoulder", "elbow", "wrist")
     values = (("left", "right"), ("up", "down"), ("no_flip", "flip"))
 
-    def codes(self, q: list[float]) -> tuple[int, int, int]:
-        """:meth:`IntersectingShoulder.label_codes` and :func:`wrist_codes` for one joint vector."""
-        d, p, c = self.directions, self.points, self.centre
-        forward = scalar.rotate(d[0], q[0], self.forward)
-        reach = scalar.sub(scalar.moved(d, p, q, 3, self.point), c)
-        if scalar.norm(scalar.reject(reach, d[0])) <= scalar.MARGIN * self.on_axis:  # the point near axis 1
-            raise scalar.NotGeneric
-        shoulder = scalar.side_code(scalar.dot(reach, forward), scalar.norm(reach))
-        elbow = scalar.sub(scalar.moved(d, p, q, 2, p[2]), c)
-        if self.in_plane:  # in the arm's plane, normal to axis 2
-            normal = scalar.rotate(d[0], q[0], d[1])
-            elbow, reach = scalar.reject(elbow, normal), scalar.reject(reach, normal)
-        length = scalar.norm(reach)
-        line = (reach[0] / length, reach[1] / length, reach[2] / length)
-        side = scalar.dot(scalar.reject(elbow, line), self.up)
-        return shoulder, scalar.side_code(side, scalar.norm(elbow)), scalar.wrist_code(q[4])
+    def __init__(self, plan: DecoupledPlan) -> None:
+        positioner, wrist, model = plan.positioner, plan.wrist, plan.positioner.model
+        d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
+        p2 = scalar.vector_of(model.points[2])
+        c, w = scalar.vector_of(positioner.centre), scalar.vector_of(plan.point)
+        self.centre = c
+        home_inverse = plan.home_inverse
+        a, b, axis_c = (scalar.vector_of(axis) for axis in wrist.axes)
+        # the wrist point, and the wrist's last axis and its normal, at home: home⁻¹ applied once here
+        self.point_home = scalar.vector_of(home_inverse[:3, :3] @ plan.point + home_inverse[:3, 3])
+        self.axis_c_home = scalar.vector_of(home_inverse[:3, :3] @ wrist.axes[2])
+        self.normal_home = scalar.vector_of(home_inverse[:3, :3] @ wrist.normal)
+        # subproblem 3 about axis 3 (the wrist point's distance from the centre), 2 about axes 1 and 2 (where the
+        # arm turns it), 2 about the wrist's first two axes and 1 about its last (the normal)
+        self.elbow_turn = scalar.Turn(d[2])
+        self.point_from_3 = scalar.sub(w, p2)
+        self.elbow_coordinates = (self.elbow_turn.coordinates(self.point_from_3),
+                                  self.elbow_turn.coordinates(scalar.sub(c, p2)))
+        self.centre_to_3 = scalar.sub(p2, c)
+        self.shoulder = scalar.TwoTurns(d[0], d[1])
+        self.wrist, self.wrist_axes = scalar.TwoTurns(a, b), (a, b)
+        self.wrist_start = self.wrist.start(axis_c)
+        self.last_turn = scalar.Turn(axis_c)
+        self.last_normal = self.last_turn.coordinates(scalar.vector_of(wrist.normal))
+        # the labels' constants
+        forward, self.in_plane, up = positioner.label_constants
+        self.forward, self.up = scalar.vector_of(forward), scalar.vector_of(up)
+        self.on_axis = GEOMETRY_TOLERANCE * 10 * positioner.geometry.length_scale
+        # the elbow (point on axis 3) from the centre before joints 1 and 2 turn it, in the arm's plane if the
+        # labels work there (axes 2 ∥ 3), and its length
+        elbow = scalar.sub(p2, c)
+        self.elbow = scalar.reject(elbow, d[1]) if self.in_plane else elbow
+        self.elbow_length = scalar.norm(self.elbow)
+        self.dof = plan.dof
 
-    def solve(self, T: np.ndarray) -> list[list[float]]:
-        (R_T0, R_T1, R_T2, t_T) = T[:3].T.tolist()  # the target's columns
-        R_T = tuple(zip(R_T0, R_T1, R_T2))  # rows
-        H, h = self.home_inverse
-        R_target = scalar.mm(R_T, H)
-        # the wrist point: (T · home⁻¹) · point
-        translation = scalar.add(scalar.mv(R_T, h), tuple(t_T))
-        point_world = scalar.add(scalar.mv(R_target, self.point), translation)
-        d, p, c, w = self.directions, self.points, self.centre, self.point
+    def solve(self, T: np.ndarray) -> scalar.OnePose:
+        """The eight slots for a target (4, 4), or NotGeneric."""
+        top = T[:3].tolist()
+        R_T = (top[0][:3], top[1][:3], top[2][:3])
+        # the wrist point (T · home⁻¹ · point), and the wrist's last axis and normal as the target turns them
+        point_world = scalar.add(scalar.mv(R_T, self.point_home), (top[0][3], top[1][3], top[2][3]))
+        axis_c, normal = scalar.mv(R_T, self.axis_c_home), scalar.mv(R_T, self.normal_home)
+        d, c, shoulder, wrist = self.directions, self.centre, self.shoulder, self.wrist
         target = scalar.sub(point_world, c)
-        third = scalar.subproblem_3(d[2], self.frame_3, scalar.sub(w, p[2]), scalar.sub(c, p[2]), scalar.norm(target))
-        joints = []
-        for q3 in third:
-            w3 = scalar.add(p[2], scalar.rotate(d[2], q3, scalar.sub(w, p[2])))
-            for q1, q2 in scalar.subproblem_2_chain(d[0], d[1], scalar.sub(w3, c), target):
-                R_G = scalar.mm(scalar.mm(scalar.rotation(d[0], q1), scalar.rotation(d[1], q2)), scalar.rotation(d[2], q3))
-                R_H = scalar.mtm(R_G, R_target)
-                for qa, qb, qc in self._wrist(R_H):
-                    joints.append([q1, q2, q3, qa, qb, qc])
-        return joints
+        goal = shoulder.goal(target)
+        rows, codes = [], []
+        for q3 in self.elbow_turn.angles_at_distance(*self.elbow_coordinates, scalar.norm(target)):
+            R_3 = scalar.rotation(d[2], q3)
+            # the wrist point from the centre with joint 3 turned (joints 1 and 2 turn it about the centre)
+            reach_local = scalar.add(scalar.mv(R_3, self.point_from_3), self.centre_to_3)
+            elbow_side = self._elbow_side(reach_local)
+            for pair in shoulder.angles(shoulder.start(reach_local), goal):
+                if pair is None:  # no arm branch here: its wrist slots are empty too
+                    rows += [None, None]
+                    codes += [(None, None, None)] * 2
+                    continue
+                q1, q2 = pair
+                R_1, R_2 = scalar.rotation(d[0], q1), scalar.rotation(d[1], q2)
+                R_G = scalar.mm(scalar.mm(R_1, R_2), R_3)
+                shoulder_code, elbow_code = self._arm_codes(R_2, reach_local, elbow_side)
+                # what is left to the wrist, R_Gᵀ · R_target, applied to its last axis and normal
+                wanted = scalar.mtv(R_G, normal)
+                a, b = self.wrist_axes
+                for roots in wrist.angles(self.wrist_start, wrist.goal(scalar.mtv(R_G, axis_c))):
+                    if roots is None:
+                        rows.append(None)
+                        codes.append((None, None, None))
+                        continue
+                    qa, qb = roots
+                    unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
+                    qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))
+                    rows.append([q1, q2, q3, qa, qb, qc])
+                    codes.append((shoulder_code, elbow_code, scalar.wrist_code(qb)))
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
-    def _wrist(self, R_w: scalar.Matrix) -> list[tuple[float, float, float]]:
-        a, b, c = self.axes
-        target_axis = scalar.mv(R_w, c)
-        wanted = scalar.mv(R_w, self.normal)
-        roots = []
-        for qa, qb in scalar.subproblem_2_chain(a, b, c, target_axis):
-            unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
-            roots.append((qa, qb, scalar.subproblem_1(c, self.frame_c, self.normal, unwound)))
-        return roots
+    def _elbow_side(self, reach_local: scalar.Vector) -> scalar.Vector:
+        """The elbow's offset from the centre–point line (in the arm's plane when axes 2 ∥ 3), before joints 1
+        and 2 turn the arm: :meth:`IntersectingShoulder.label_codes` measures it along the up direction."""
+        if self.in_plane:
+            reach_local = scalar.reject(reach_local, self.directions[1])
+        length = scalar.norm(reach_local)
+        return scalar.reject(self.elbow, (reach_local[0] / length, reach_local[1] / length, reach_local[2] / length))
+
+    def _arm_codes(self, R_2: scalar.Matrix, reach_local: scalar.Vector,
+                   elbow_side: scalar.Vector) -> tuple[int | None, int | None]:
+        """:meth:`IntersectingShoulder.label_codes` of one arm branch. Joint 1 turns about axis 1, which is the up
+        direction and carries the forward one with it, so only joint 2's turn R_2 matters."""
+        reach = scalar.mv(R_2, reach_local)
+        length = math.sqrt(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2])
+        if scalar.norm(scalar.reject(reach, self.directions[0])) <= scalar.MARGIN * self.on_axis:
+            return None, None  # the point near axis 1: the array labeller decides
+        return (scalar.side_code(scalar.dot(reach, self.forward), length),
+                scalar.side_code(scalar.dot(scalar.mv(R_2, elbow_side), self.up), self.elbow_length))
+

@@ -34,11 +34,11 @@ from .._forward import forward_kinematics, geometric_jacobian
 from .._robot import Robot
 from .._rotations import wrap_angle
 from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE
-from ._arrays import IKArrays, _first_of_each
+from ._arrays import IKArrays
 from ._plan import Plan, geometry_of, plan_for_geometry
 from ._structure import Geometry
 from ._types import SingularFlags, Singularity
-from ._verify import distance_to_reference, wrap_revolute
+from ._verify import distance_to_reference, first_of_each, wrap_revolute
 
 #: The virtual joint's value (rad) within which a 6-joint solution is one of the 5-joint arm (the roll case).
 VIRTUAL_AT_ZERO = 1e-6
@@ -202,7 +202,7 @@ def solve_direction(robot: Robot, positions: np.ndarray, world_directions: np.nd
         joints[..., plan.roll_joint] = 0.0 if reference is None else reference[plan.roll_joint]
     position, angle = direction_residuals(robot, joints, positions, directions, plan.tool_axis)
     ok = valid & (position <= ACCEPT_RESIDUAL * robot.characteristic_length) & (angle <= ACCEPT_RESIDUAL)
-    kept = _first_of_each(robot, joints, ok)
+    kept = first_of_each(robot, joints, ok)
     labels = plan.plan.label_codes(full.reshape(-1, n + 1))
     m = joints.shape[1]
     if reference is not None:

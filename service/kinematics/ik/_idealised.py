@@ -55,7 +55,7 @@ from .._tolerances import ACCEPT_RESIDUAL
 from ._screws import chain_motion
 from ._structure import arm_size
 from ._types import Candidates, LabelCodes
-from ._verify import polish, residual_arrays, wrap_revolute
+from ._verify import first_of_each, polish, residual_arrays, wrap_revolute
 
 #: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
 #: the idealisation's deviation marks the row incomplete: the perturbation moves the tool by at most a few δ
@@ -205,6 +205,4 @@ class IdealisedPlan:
 
 def _distinct_counts(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """How many distinct joint vectors (revolute joints modulo 2π, within 1e-6) each row's ``ok`` slots hold."""
-    from ._arrays import _first_of_each
-
-    return _first_of_each(robot, joints, ok).sum(axis=1)
+    return first_of_each(robot, joints, ok).sum(axis=1)

@@ -32,8 +32,8 @@ from ._wrist import Roll, SphericalWrist, TwoAxisWrist
 
 class Plan(Protocol):
     """A family's solver for one robot. A family with a scalar path for one pose also has
-    ``solve_one(world_T_target) -> Candidates | None`` and ``label_codes_one(joints, valid) -> LabelCodes | None``
-    (:mod:`._scalar`); None sends the pose to ``solve`` and ``label_codes``."""
+    ``solve_one(world_T_target) -> OnePose | None`` (:mod:`._scalar`: the candidates with their labels); None
+    sends the pose to ``solve`` and ``label_codes``."""
 
     structure: str
     generic_count: int

@@ -271,12 +271,15 @@ class _RowsPlan:
             parts = [(np.arange(n_rows), family.plan.solve(self._moved_targets(world_T_targets), locked_reference))]
         else:
             parts = []
+            self._one_pose = {}  # row → the scalar path's candidates, which carry their labels
             for row, plan in enumerate(self.plans):
                 if plan is not None:  # one pose per plan: the scalar candidates when the pose is clearly generic
                     solve_one = getattr(plan, "solve_one", None)
                     part = solve_one(world_T_targets[row]) if solve_one is not None else None
                     if part is None:
                         part = plan.solve(world_T_targets[row:row + 1], locked_reference)
+                    else:
+                        self._one_pose[row] = part
                     parts.append((np.array([row]), part))
         m = max([self._m, *(part.joints.shape[1] for _, part in parts)])
         self._m = m
@@ -308,12 +311,13 @@ class _RowsPlan:
         m = len(joints) // max(len(self.plans), 1)
         pieces = []
         valid = getattr(self, "_valid", None)
+        one_pose = getattr(self, "_one_pose", {})
         for row, plan in enumerate(self.plans):
             part = locked[row * m:(row + 1) * m]
             piece = {}
             if plan is not None:
-                if valid is not None and valid.shape == (len(self.plans), m) and hasattr(plan, "label_codes_one"):
-                    piece = plan.label_codes_one(part[None], valid[row:row + 1])
+                if valid is not None and valid.shape == (len(self.plans), m) and row in one_pose:
+                    piece = one_pose[row].label_codes(valid[row].tolist())
                 if not piece:
                     piece = plan.label_codes(part)
             pieces.append(piece)

@@ -5,15 +5,19 @@ operations, each with a fixed overhead far larger than its arithmetic. The two
 hot 6R families (:class:`~._decoupled.DecoupledPlan` with an intersecting
 shoulder and a spherical wrist, the PUMA type, and
 :class:`~._three_parallel.ThreeParallelPlan`, the UR5 type) therefore also
-solve one pose with ``math`` on floats (their ``solve_one`` and
-``label_codes_one``), from these pieces.
+solve one pose with ``math`` on floats (their ``solve_one``, which also labels
+the slots from the quantities it has: :class:`OnePose`), from these pieces,
+with the plan's fixed vectors reduced once when the plan is built
+(:class:`Turn`, :class:`Height`, :class:`TwoTurns`).
 
 Generic case only: every subproblem has two distinct, exact, non-degenerate
-roots, each clearly (by :data:`MARGIN` times the tolerance) away from the
-threshold where the array solver would decide otherwise. Anything else raises
-:class:`NotGeneric` and the pose takes the array path, which is the reference
-(``tests/kinematics/ik/test_one_pose.py`` holds these paths to it). The
-formulas are those of :mod:`._subproblems` (same slot order, same roots).
+roots, or clearly none (then, as the array solver, the least-squares one and
+an empty slot), each clearly (by :data:`MARGIN` times the tolerance) away from
+the threshold where the array solver would decide otherwise. Anything else
+raises :class:`NotGeneric` and the pose takes the array path, which is the
+reference (``tests/kinematics/ik/test_one_pose.py`` and
+``test_one_pose_families.py`` hold these paths to it). The formulas are those
+of :mod:`._subproblems` (same slot order, same roots).
 """
 
 from __future__ import annotations
@@ -24,13 +28,13 @@ import numpy as np
 
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._subproblems import axis_frame
-from ._types import Candidates, LabelCodes, SingularFlags
+from ._types import LabelCodes, SingularFlags
 
 #: How far (as a multiple of each tolerance) a quantity must be from the array solver's threshold for the
 #: scalar path to decide the pose; closer than that, the array path decides.
 MARGIN = 10.0
 
-_PI, _TWO_PI = math.pi, 2.0 * math.pi
+_PI, _TWO_PI, _THREE_PI = math.pi, 2.0 * math.pi, 3.0 * math.pi
 _MERGE_RESIDUAL = DUPLICATE_TOLERANCE ** 2
 _MERGE_COS_GAP = 1.0 - math.cos(DUPLICATE_TOLERANCE / 2.0)
 
@@ -42,53 +46,74 @@ class NotGeneric(Exception):
     """The pose is not clearly generic: leave it to the array path."""
 
 
-def one_pose_candidates(solve, world_T_target: np.ndarray) -> Candidates | None:
-    """Candidates (1, m, n) from ``solve(world_T_target)`` (the m joint vectors as lists), or None when the
-    pose is not clearly generic."""
-    try:
-        joints = solve(world_T_target)
-    except NotGeneric:
-        return None
-    joints = np.array(joints)[None]  # (1, m, n)
-    return Candidates(joints, ~np.isnan(joints).any(axis=-1), SingularFlags(1))
+class OnePose:
+    """One pose's candidates from a family's scalar path, with their branch labels.
+
+    ``rows`` holds the m slots' joint vectors (lists of floats, revolute joints
+    wrapped to (−π, π]), None for an empty slot; ``codes`` one tuple per slot,
+    a label code per name of ``names`` (values ``values``), each None where the
+    label quantity is within :data:`MARGIN` times the tolerance of where the
+    label flips or is left out (then the array labeller decides). ``joints``
+    (1, m, n), ``valid`` (1, m) and ``singularities`` (none: the pose is
+    generic) read it as :class:`Candidates`.
+    """
+
+    def __init__(self, rows: list[list[float] | None], codes: list[tuple[int | None, ...]],
+                 names: tuple[str, ...], values: tuple[tuple[str, ...], ...], dof: int) -> None:
+        self.rows, self.codes, self.names, self.values, self.dof = rows, codes, names, values, dof
+        self.singularities = SingularFlags(1)
+        self.complete = None
+        self.promise_needs_every_slot = False
+
+    @property
+    def joints(self) -> np.ndarray:
+        nan = [math.nan] * self.dof
+        return np.array([nan if q is None else q for q in self.rows])[None]
+
+    @property
+    def valid(self) -> np.ndarray:
+        return np.array([q is not None for q in self.rows])[None]
+
+    def label_codes(self, kept: list[bool]) -> LabelCodes | None:
+        """Label codes (m,) of the ``kept`` slots (the others −1), or None when one of them is not clear."""
+        table = self.code_lists(kept)
+        if table is None:
+            return None
+        return {name: (values, np.array(column, dtype=np.int8))
+                for name, values, column in zip(self.names, self.values, table)}
+
+    def code_lists(self, kept: list[bool]) -> list[list[int]] | None:
+        """:meth:`label_codes` as lists, one per name."""
+        table = [[-1] * len(kept) for _ in self.names]
+        for slot, (keep, codes) in enumerate(zip(kept, self.codes)):
+            if keep:
+                for column, code in zip(table, codes):
+                    if code is None:
+                        return None
+                    column[slot] = code
+        return table
 
 
-def one_pose_label_codes(labeller, joints: np.ndarray, valid: np.ndarray) -> LabelCodes | None:
-    """Label codes of one pose's slots (1, m, n) for the valid ones (the others get −1), from ``labeller``: its
-    ``names``, their ``values`` and ``codes(q)`` (one code per name for a joint vector), or None when a slot's label quantity is within :data:`MARGIN` times the tolerance of
-    the value where the label flips or is left out: the array labeller then decides."""
-    names = labeller.names
-    table = {name: [-1] * len(valid[0]) for name in names}
-    try:
-        for slot, (q, ok) in enumerate(zip(joints[0].tolist(), valid[0].tolist())):
-            if ok:
-                for name, code in zip(names, labeller.codes(q)):
-                    table[name][slot] = code
-    except NotGeneric:
-        return None
-    return {name: (labels, np.array(table[name], dtype=np.int8)) for name, labels in zip(names, labeller.values)}
-
-
-def side_code(side: float, size: float) -> int:
-    """:func:`._positioning.side_codes` for one value, clear of its thresholds."""
+def side_code(side: float, size: float) -> int | None:
+    """:func:`._positioning.side_codes` for one value, None unless clear of its thresholds."""
     if abs(side) <= MARGIN * DUPLICATE_TOLERANCE * size:
-        raise NotGeneric
+        return None
     return 0 if side > 0 else 1
 
 
-def wrist_code(middle: float) -> int:
-    """:func:`._wrist.wrist_codes` for one value, clear of its thresholds."""
+def wrist_code(middle: float) -> int | None:
+    """:func:`._wrist.wrist_codes` for one value, None unless clear of its thresholds."""
     sine = math.sin(middle)
     if abs(sine) <= MARGIN * 10 * GEOMETRY_TOLERANCE:
-        raise NotGeneric
+        return None
     return 0 if sine > 0 else 1
 
 
-def moved(directions: list[Vector], points: list[Vector], q: list[float], upto: int, x: Vector) -> Vector:
-    """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) x for revolute joints (as :func:`._screws.move_point`)."""
-    for i in reversed(range(upto)):
-        x = add(points[i], rotate(directions[i], q[i], sub(x, points[i])))
-    return x
+def wrap_any(theta: float) -> float:
+    """:func:`~service.kinematics._rotations.wrap_angle` of one float: (−π, π], −π to π."""
+    if -_THREE_PI < theta < _THREE_PI:
+        return wrap(theta)
+    return _PI - (_PI - theta) % _TWO_PI
 
 
 def reject(v: Vector, unit: Vector) -> Vector:
@@ -203,62 +228,117 @@ def harmonic(a: float, b: float, c: float, scale: float, out_of_reach: bool = Fa
     return wrap(phi + half), wrap(phi - half)
 
 
-def subproblem_1(k: Vector, frame: tuple[Vector, Vector], p: Vector, q: Vector) -> float:
-    """θ with R(k, θ) p = q (least squares), non-degenerate only."""
-    e1, e2 = frame
-    px, py, pz = dot(p, e1), dot(p, e2), dot(p, k)
-    qx, qy, qz = dot(q, e1), dot(q, e2), dot(q, k)
-    radius_p, radius_q = math.sqrt(px * px + py * py), math.sqrt(qx * qx + qy * qy)
-    tol = GEOMETRY_TOLERANCE * max(math.sqrt(radius_p ** 2 + pz * pz), math.sqrt(radius_q ** 2 + qz * qz))
-    if not (radius_p > MARGIN * tol and radius_q > MARGIN * tol):
-        raise NotGeneric
-    return wrap(math.atan2(px * qy - py * qx, px * qx + py * qy))
+class Turn:
+    """Turns about one axis k (a unit vector), with the frame e1, e2, k of :func:`plane_axes`: subproblems 1 and 3,
+    on vectors given by their :meth:`coordinates` (those of fixed vectors computed once per plan)."""
+
+    def __init__(self, k: Vector) -> None:
+        self.k = k
+        self.e1, self.e2 = plane_axes(k)
+
+    def coordinates(self, v: Vector) -> tuple[float, float, float, float, float]:
+        """v's components along e1, e2 and k, its distance from the axis and its length."""
+        (e0, e1, e2), (f0, f1, f2), (k0, k1, k2) = self.e1, self.e2, self.k
+        x, y, z = v[0] * e0 + v[1] * e1 + v[2] * e2, v[0] * f0 + v[1] * f1 + v[2] * f2, v[0] * k0 + v[1] * k1 + v[2] * k2
+        radius = math.sqrt(x * x + y * y)
+        return x, y, z, radius, math.sqrt(radius * radius + z * z)
+
+    @staticmethod
+    def angle(p: tuple[float, ...], q: tuple[float, ...]) -> float:
+        """Subproblem 1: θ with R(k, θ) p = q (least squares), p and q as :meth:`coordinates`; non-degenerate
+        only."""
+        px, py, _, radius_p, length_p = p
+        qx, qy, _, radius_q, length_q = q
+        tol = GEOMETRY_TOLERANCE * (length_p if length_p > length_q else length_q)
+        if not (radius_p > MARGIN * tol and radius_q > MARGIN * tol):
+            raise NotGeneric
+        return wrap(math.atan2(px * qy - py * qx, px * qx + py * qy))
+
+    @staticmethod
+    def angles_at_distance(p: tuple[float, ...], q: tuple[float, ...], delta: float,
+                           out_of_reach: bool = False) -> tuple[float, float]:
+        """Subproblem 3: the two θ with |R(k, θ) p − q| = δ, p and q as :meth:`coordinates` (see :func:`harmonic`
+        for ``out_of_reach``)."""
+        px, py, pz, _, _ = p
+        qx, qy, qz, _, _ = q
+        rp2, rq2, delta2 = px * px + py * py, qx * qx + qy * qy, delta * delta
+        c = 0.5 * (rp2 + rq2 + (pz - qz) ** 2 - delta2)
+        return harmonic(px * qx + py * qy, px * qy - py * qx, c, rp2 + rq2 + pz * pz + qz * qz + delta2,
+                        out_of_reach)
 
 
-def subproblem_3(k: Vector, frame: tuple[Vector, Vector], p: Vector, q: Vector, delta: float,
-                  out_of_reach: bool = False) -> tuple[float, float]:
-    e1, e2 = frame
-    px, py, pz = dot(p, e1), dot(p, e2), dot(p, k)
-    qx, qy, qz = dot(q, e1), dot(q, e2), dot(q, k)
-    rp2, rq2, delta2 = px * px + py * py, qx * qx + qy * qy, delta * delta
-    c = 0.5 * (rp2 + rq2 + (pz - qz) ** 2 - delta2)
-    return harmonic(px * qx + py * qy, px * qy - py * qx, c, rp2 + rq2 + pz * pz + qz * qz + delta2, out_of_reach)
+class Height:
+    """Subproblem 4 for a fixed pair h, k: the two θ with h · R(k, θ) p = δ."""
+
+    def __init__(self, h: Vector, k: Vector) -> None:
+        hk = dot(h, k)
+        self.hk, self.k = hk, k
+        self.h_across = (h[0] - hk * k[0], h[1] - hk * k[1], h[2] - hk * k[2])
+        self.h_cross_k = cross(h, k)
+
+    def of(self, p: Vector) -> tuple[float, float, float, float]:
+        """What the angles need of p (computed once when p is fixed)."""
+        return dot(self.h_across, p), dot(self.h_cross_k, p), self.hk * dot(self.k, p), norm(p)
+
+    @staticmethod
+    def angles(p: tuple[float, float, float, float], delta: float) -> tuple[float, float]:
+        """The two roots; where δ is clearly out of reach, the least-squares root and NaN (as the array solver)."""
+        a, b, along, length = p
+        return harmonic(a, b, delta - along, length + abs(delta), out_of_reach=True)
 
 
-def subproblem_4(h: Vector, k: Vector, p: Vector, delta: float) -> tuple[float, float]:
-    hk = dot(h, k)
-    a = dot((h[0] - hk * k[0], h[1] - hk * k[1], h[2] - hk * k[2]), p)
-    b = dot(cross(h, k), p)
-    return harmonic(a, b, delta - hk * dot(k, p), norm(p) + abs(delta))
+class TwoTurns:
+    """Subproblem 2 as a chain for a fixed pair of axes k1, k2 (not parallel): the two (θ1, θ2) with
+    R(k1, θ1) R(k2, θ2) start = goal, that is :func:`._subproblems.subproblem_2` on (goal, start) with θ1 negated.
+    The vectors enter as :meth:`start` and :meth:`goal` (those of fixed vectors computed once per plan)."""
 
+    def __init__(self, k1: Vector, k2: Vector) -> None:
+        self.k1, self.k2 = k1, k2
+        self.normal = cross(k1, k2)
+        self.sin2 = dot(self.normal, self.normal)
+        self.cos, self.sin = dot(k1, k2), math.sqrt(self.sin2)
 
-def subproblem_2_chain(k1: Vector, k2: Vector, p: Vector, q: Vector) -> tuple[tuple[float, float], ...]:
-    """The two (θ1, θ2) with R(k1, θ1) R(k2, θ2) p = q: :func:`._subproblems.subproblem_2` on (q, p), θ1 negated."""
-    p, q = q, p  # subproblem_2(k1, k2, q, p): R(k1, t1) q = R(k2, t2) p
-    normal = cross(k1, k2)
-    sin2 = dot(normal, normal)
-    cos, sin = dot(k1, k2), math.sqrt(sin2)
-    p1, p2, pn = dot(p, k1), dot(p, k2), dot(p, normal)
-    q1, q2, qn = dot(q, k1), dot(q, k2), dot(q, normal)
-    d1, e2 = p2 - cos * p1, q1 - cos * q2
-    radius_p = math.sqrt(pn * pn + d1 * d1) / sin
-    radius_q = math.sqrt(qn * qn + e2 * e2) / sin
-    norm_p, norm_q = math.sqrt(p1 * p1 + radius_p * radius_p), math.sqrt(q2 * q2 + radius_q * radius_q)
-    tol = GEOMETRY_TOLERANCE * max(norm_p, norm_q)
-    if not (radius_p > MARGIN * tol and radius_q > MARGIN * tol and abs(norm_p - norm_q) * MARGIN <= tol):
-        raise NotGeneric
-    h1, h2 = p1 / norm_p, q2 / norm_q
-    rho1, rho2 = radius_p / norm_p, radius_q / norm_q
-    alpha, beta = (h1 - cos * h2) / sin2, (h2 - cos * h1) / sin2
-    # _subproblems._crossing_gap, in scalar form
-    if rho1 <= rho2:
-        g = (rho1 - abs(beta * sin)) * (rho1 + abs(beta * sin))
-    else:
-        g = (rho2 - abs(alpha * sin)) * (rho2 + abs(alpha * sin))
-    if not g * (rho1 + rho2) > MARGIN * _MERGE_RESIDUAL * rho1 * rho2:
-        raise NotGeneric
-    gamma = math.sqrt(g) / sin
-    s1, c1, t1, u1 = -beta * pn, beta * d1, gamma * d1, gamma * pn
-    s2, c2, t2, u2 = alpha * qn, alpha * e2, gamma * e2, gamma * qn
-    return ((wrap(-wrap(math.atan2(s1 + t1, c1 + u1))), wrap(math.atan2(s2 - t2, c2 + u2))),
-            (wrap(-wrap(math.atan2(s1 - t1, c1 - u1))), wrap(math.atan2(s2 + t2, c2 - u2))))
+    def goal(self, v: Vector) -> tuple[float, float, float, float, float]:
+        (k0, k1, k2), (l0, l1, l2), (n0, n1, n2) = self.k1, self.k2, self.normal
+        v0, v1, v2 = v
+        along1, along2, across = v0 * k0 + v1 * k1 + v2 * k2, v0 * l0 + v1 * l1 + v2 * l2, v0 * n0 + v1 * n1 + v2 * n2
+        d1 = along2 - self.cos * along1
+        radius = math.sqrt(across * across + d1 * d1) / self.sin
+        return along1, across, d1, radius, math.sqrt(along1 * along1 + radius * radius)
+
+    def start(self, v: Vector) -> tuple[float, float, float, float, float]:
+        (k0, k1, k2), (l0, l1, l2), (n0, n1, n2) = self.k1, self.k2, self.normal
+        v0, v1, v2 = v
+        along1, along2, across = v0 * k0 + v1 * k1 + v2 * k2, v0 * l0 + v1 * l1 + v2 * l2, v0 * n0 + v1 * n1 + v2 * n2
+        e2 = along1 - self.cos * along2
+        radius = math.sqrt(across * across + e2 * e2) / self.sin
+        return along2, across, e2, radius, math.sqrt(along2 * along2 + radius * radius)
+
+    def angles(self, start: tuple[float, ...], goal: tuple[float, ...]) -> tuple[tuple[float, float] | None, ...]:
+        """The two pairs, the +γ crossing first; where the cones clearly miss, the least-squares pair (as the
+        array solver gives it, for the FK check to reject) and None for the empty slot."""
+        p1, pn, d1, radius_p, norm_p = goal
+        q2, qn, e2, radius_q, norm_q = start
+        tol = GEOMETRY_TOLERANCE * (norm_p if norm_p > norm_q else norm_q)
+        if not (radius_p > MARGIN * tol and radius_q > MARGIN * tol and abs(norm_p - norm_q) * MARGIN <= tol):
+            raise NotGeneric
+        cos, sin, sin2 = self.cos, self.sin, self.sin2
+        h1, h2 = p1 / norm_p, q2 / norm_q
+        rho1, rho2 = radius_p / norm_p, radius_q / norm_q
+        alpha, beta = (h1 - cos * h2) / sin2, (h2 - cos * h1) / sin2
+        # _subproblems._crossing_gap, in scalar form
+        if rho1 <= rho2:
+            g = (rho1 - abs(beta * sin)) * (rho1 + abs(beta * sin))
+        else:
+            g = (rho2 - abs(alpha * sin)) * (rho2 + abs(alpha * sin))
+        atan2 = math.atan2
+        s1, c1, s2, c2 = -beta * pn, beta * d1, alpha * qn, alpha * e2
+        margin = MARGIN * _MERGE_RESIDUAL * rho1 * rho2
+        if not g * (rho1 + rho2) > margin:
+            if g * (rho1 + rho2) < -margin:  # the cones clearly miss: the least-squares pair and an empty slot
+                return (wrap(-wrap(atan2(s1, c1))), wrap(atan2(s2, c2))), None
+            raise NotGeneric
+        gamma = math.sqrt(g) / sin
+        t1, u1, t2, u2 = gamma * d1, gamma * pn, gamma * e2, gamma * qn
+        return ((wrap(-wrap(atan2(s1 + t1, c1 + u1))), wrap(atan2(s2 - t2, c2 + u2))),
+                (wrap(-wrap(atan2(s1 - t1, c1 - u1))), wrap(atan2(s2 + t2, c2 - u2))))

@@ -9,11 +9,11 @@ import numpy as np
 from .._budget import UNLIMITED, Budget
 from .._robot import Robot
 from ._numeric import NumericOptions, solve_numeric
-from ._arrays import IKArrays, solve_ik_arrays
+from ._arrays import IKArrays, OnePoseAnswer, cached_plan, solve_ik_arrays, solve_one_pose
 from ._coaxial import coaxial_pair, coaxial_report, held_split
 from ._plan import geometry_of
 from ._types import IKResult, Solution
-from ._verify import accepted, distance_to_reference, distinct, polish, residuals, wrap_revolute
+from ._verify import accepted, distance_to_reference, first_of_each, polish, residuals, wrap_revolute
 
 
 @dataclass(frozen=True)
@@ -44,8 +44,30 @@ def solve_ik(robot: Robot, world_T_target: np.ndarray, *, constrain_orientation:
         Every distinct solution that FK verifies, with branch labels, residuals
         and the singularities met.
     """
-    return solve_ik_batch(robot, np.asarray(world_T_target)[None], constrain_orientation=constrain_orientation,
+    target = np.asarray(world_T_target, dtype=float)
+    if constrain_orientation:  # the families with a scalar path for one pose solve pose targets
+        plan = cached_plan(robot, constrain_orientation=True, reference=None)
+        if plan is not None:
+            (options or _DEFAULT_OPTIONS).budget.check("the analytic solve")
+            answer = solve_one_pose(robot, target, True, reference, plan)
+            if answer is not None and answer.count:  # (an unreachable target takes the path that says why)
+                return _one_pose_result(answer)
+    return solve_ik_batch(robot, target[None], constrain_orientation=constrain_orientation,
                           reference=reference, options=options)[0]
+
+
+_DEFAULT_OPTIONS = IKOptions()
+
+
+def _one_pose_result(answer: OnePoseAnswer) -> IKResult:
+    """:func:`results_from_arrays` of a :class:`OnePoseAnswer` with solutions, read from its lists."""
+    joints = np.array(answer.rows[:answer.count])
+    labels = list(zip(answer.names, answer.values, answer.codes))
+    solutions = [Solution(joints[s], {name: values[codes[s]] for name, values, codes in labels if codes[s] >= 0},
+                          answer.position[s], answer.orientation[s]) for s in range(answer.count)]
+    plan = answer.plan
+    return IKResult(status="ok", solutions=solutions, method="analytic", structure=plan.structure, complete=True,
+                    singularities=answer.singularities[0], free_joints=list(plan.free_joints))
 
 
 def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,
@@ -54,7 +76,7 @@ def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orien
 
     The work is :func:`solve_ik_arrays`; this only turns its rows into records.
     """
-    options = options or IKOptions()
+    options = options or _DEFAULT_OPTIONS
     targets = np.asarray(world_T_targets, dtype=float)
     arrays = solve_ik_arrays(robot, targets, constrain_orientation=constrain_orientation, reference=reference,
                              budget=options.budget)
@@ -107,7 +129,7 @@ def _incomplete_row(robot: Robot, target: np.ndarray, known: np.ndarray, structu
 def _closed_form_results(robot: Robot, arrays: IKArrays, targets: np.ndarray, constrain_orientation: bool,
                          reference: np.ndarray | None) -> list[IKResult]:
     counts = arrays.count.tolist()
-    details = unreachable_details(robot, arrays, targets, constrain_orientation, reference)
+    details = unreachable_details(robot, arrays, targets, constrain_orientation, reference) if 0 in counts else {}
     joints, position, orientation = arrays.joints, arrays.position.tolist(), arrays.orientation.tolist()
     labels = [(name, values, codes.tolist()) for name, (values, codes) in arrays.labels.items()]
     free_joints = arrays.free_joints
@@ -194,7 +216,7 @@ def _numeric(robot: Robot, target: np.ndarray, constrain_orientation: bool, refe
         position, orientation = residuals(robot, joints, target)
         ok = np.flatnonzero(accepted(robot, position, orientation, constrain_orientation))
         options.budget.check("polishing the numeric solutions")
-        kept = ok[distinct(robot, joints[ok], options.budget)] if len(ok) else ok
+        kept = ok[first_of_each(robot, joints[ok][None], np.ones((1, len(ok)), dtype=bool))[0]]
         solutions = [Solution(joints[i], {}, float(position[i]), float(orientation[i])) for i in kept]
     detail = "" if solutions else (
         "No solution was found by the numeric search; the target may be outside the workspace "

@@ -189,17 +189,16 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
         return (np.broadcast_to(q1[:, :, None], (n, 2, 2)).reshape(n, 4), wrist.theta.reshape(n, 4),
                 valid.reshape(n, 4))
 
-    def solve_one(self, world_T_target: np.ndarray) -> Candidates | None:
-        """:meth:`solve` of one target (4, 4) in scalar arithmetic (:mod:`._scalar`), or None when the pose is not
-        clearly generic (then :meth:`solve` decides). The one exception to "generic": the elbow may be clearly out
+    def solve_one(self, world_T_target: np.ndarray) -> scalar.OnePose | None:
+        """:meth:`solve` of one target (4, 4) in scalar arithmetic (:mod:`._scalar`), with the slots' branch
+        labels (:meth:`label_codes`) from the same quantities, or None when the pose is not clearly generic (then
+        :meth:`solve` and :meth:`label_codes` decide). The one exception to "generic": the elbow may be clearly out
         of reach for some shoulder and wrist roots, which gives a least-squares slot and an empty one, as in
         :meth:`solve`."""
-        return scalar.one_pose_candidates(self._one_pose.solve, world_T_target)
-
-    def label_codes_one(self, joints: np.ndarray, valid: np.ndarray) -> LabelCodes | None:
-        """:meth:`label_codes` of one pose's slots (1, m, n) where ``valid`` (1, m), in scalar arithmetic, or
-        None (then :meth:`label_codes` decides)."""
-        return scalar.one_pose_label_codes(self._one_pose, joints, valid)
+        try:
+            return self._one_pose.solve(world_T_target)
+        except scalar.NotGeneric:
+            return None
 
     @cached_property
     def _one_pose(self) -> "_ThreeParallelOnePose":
@@ -262,81 +261,98 @@ def _split_double_root(elbow: np.ndarray, valid: np.ndarray) -> np.ndarray:
 
 
 class _ThreeParallelOnePose:
-    """:class:`ThreeParallelPlan` (the UR5 type), step for step."""
-
-    def __init__(self, plan: ThreeParallelPlan) -> None:
-        model = plan.model
-        self.directions = [scalar.vector_of(d) for d in model.directions]
-        self.points = [scalar.vector_of(p) for p in model.points]
-        self.frames = [scalar.plane_axes(direction) for direction in self.directions]
-        self.centre = scalar.vector_of(plan.centre)
-        self.home_inverse = scalar.matrix_of(plan.home_inverse[:3, :3]), scalar.vector_of(plan.home_inverse[:3, 3])
-        self.omega_p, self.normal_p = scalar.vector_of(plan.omega_p), scalar.vector_of(plan.normal_p)
-        self.frame_p = scalar.plane_axes(self.omega_p)
-        self.signs = [float(s) for s in plan.signs]
-        self.height = scalar.dot(self.omega_p, scalar.sub(self.centre, self.points[0]))
-        self.forward = scalar.vector_of(plan.forward)
-        self.up = scalar.vector_of(plan.geometry.upward(plan.geometry.direction(0)))
+    """:class:`ThreeParallelPlan` (the UR5 type), step for step, with the plan's constants as floats (built once
+    per plan)."""
 
     names = ("shoulder", "elbow", "wrist")
     values = (("left", "right"), ("up", "down"), ("no_flip", "flip"))
 
-    def codes(self, q: list[float]) -> tuple[int, int, int]:
-        """:meth:`ThreeParallelPlan.label_codes` for one joint vector."""
-        d, p = self.directions, self.points
-        forward = scalar.rotate(d[0], q[0], self.forward)
-        wrist_point = scalar.moved(d, p, q, 3, p[3])
-        to_wrist = scalar.sub(wrist_point, p[0])
-        shoulder = scalar.side_code(scalar.dot(to_wrist, forward), scalar.norm(to_wrist))
-        shoulder_point = scalar.moved(d, p, q, 1, p[1])
-        normal = scalar.rotate(d[0], q[0], self.omega_p)  # the parallel axes, after joint 1
-        elbow = scalar.reject(scalar.sub(scalar.moved(d, p, q, 2, p[2]), shoulder_point), normal)
-        reach = scalar.reject(scalar.sub(wrist_point, shoulder_point), normal)
-        length = scalar.norm(reach)
-        if length <= 1e-300:
-            raise scalar.NotGeneric
-        line = (reach[0] / length, reach[1] / length, reach[2] / length)
-        side = scalar.dot(scalar.reject(elbow, line), self.up)
-        return shoulder, scalar.side_code(side, scalar.norm(elbow)), scalar.wrist_code(q[4])
+    def __init__(self, plan: ThreeParallelPlan) -> None:
+        model = plan.model
+        d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
+        p = self.points = [scalar.vector_of(point) for point in model.points]
+        self.home_inverse = scalar.matrix_of(plan.home_inverse[:3, :3]), scalar.vector_of(plan.home_inverse[:3, 3])
+        self.centre = scalar.vector_of(plan.centre)
+        w_p = self.omega_p = scalar.vector_of(plan.omega_p)
+        self.normal_p = scalar.vector_of(plan.normal_p)
+        self.signs = [float(s) for s in plan.signs]
+        # the subproblems with their fixed vectors: 4 for the shoulder (the centre's height along ω_p) and the
+        # wrist (axis 6's), 1 for q6, for the sum q2 + q3 + q4 and for q2, 3 for the elbow
+        self.shoulder, self.height = scalar.Height(w_p, d[0]), scalar.dot(w_p, scalar.sub(self.centre, p[0]))
+        self.wrist = scalar.Height(w_p, d[4]).of(d[5])
+        self.sixth, self.second = scalar.Turn(d[5]), scalar.Turn(d[1])
+        self.parallel = scalar.Turn(w_p)
+        self.normal_p_coordinates = self.parallel.coordinates(self.normal_p)
+        self.elbow_turn = scalar.Turn(d[2])
+        self.p4_from_3 = scalar.sub(p[3], p[2])
+        self.elbow_coordinates = (self.elbow_turn.coordinates(self.p4_from_3),
+                                  self.elbow_turn.coordinates(scalar.sub(p[1], p[2])))
+        self.p4_from_5 = scalar.sub(p[3], p[4])
+        # the labels' constants, and the elbow (point on axis 3 from axis 2) in the plane normal to ω_p
+        self.forward = scalar.vector_of(plan.forward)
+        self.up = scalar.vector_of(plan.geometry.upward(plan.geometry.direction(0)))
+        self.elbow = scalar.reject(scalar.sub(p[2], p[1]), w_p)
+        self.elbow_length = scalar.norm(self.elbow)
+        self.dof = plan.geometry.dof
 
-    def solve(self, T: np.ndarray) -> list[list[float]]:
-        (R_T0, R_T1, R_T2, t_T) = T[:3].T.tolist()
-        R_T = tuple(zip(R_T0, R_T1, R_T2))
+    def solve(self, T: np.ndarray) -> scalar.OnePose:
+        """The eight slots for a target (4, 4), or NotGeneric."""
+        top = T[:3].tolist()
+        R_T, t_T = (top[0][:3], top[1][:3], top[2][:3]), (top[0][3], top[1][3], top[2][3])
         H, h = self.home_inverse
         R_A = scalar.mm(R_T, H)
-        t_A = scalar.add(scalar.mv(R_T, h), tuple(t_T))
+        t_A = scalar.add(scalar.mv(R_T, h), t_T)
         d, p, w_p = self.directions, self.points, self.omega_p
-        c_world = scalar.add(scalar.mv(R_A, self.centre), t_A)
+        c_world = scalar.add(scalar.mv(R_A, self.centre), t_A)  # as the array solver: A · centre
         s2, s3, s4 = self.signs
-        joints: list[list[float]] = []
-        for theta1 in scalar.subproblem_4(w_p, d[0], scalar.sub(c_world, p[0]), self.height):
+        wrap, Turn = scalar.wrap_any, scalar.Turn
+        rows: list[list[float] | None] = []
+        codes: list[tuple[int | None, ...]] = []
+        for theta1 in self.shoulder.angles(self.shoulder.of(scalar.sub(c_world, p[0])), self.height):
+            if math.isnan(theta1):  # the shoulder's second root where it has only a least-squares one
+                rows += [None] * 4
+                codes += [(None, None, None)] * 4
+                continue
             q1 = -theta1
             R1 = scalar.rotation(d[0], q1)
             R_rest = scalar.mtm(R1, R_A)
-            wrist = scalar.subproblem_4(w_p, d[4], d[5], scalar.dot(w_p, scalar.mv(R_rest, d[5])))
-            wanted_p = scalar.mtv(R_rest, w_p)
-            for q5 in wrist:
-                q6 = -scalar.subproblem_1(d[5], self.frames[5], scalar.rotate(d[4], -q5, w_p), wanted_p)
+            wanted_p = self.sixth.coordinates(scalar.mtv(R_rest, w_p))
+            for q5 in scalar.Height.angles(self.wrist, scalar.dot(w_p, scalar.mv(R_rest, d[5]))):
+                if math.isnan(q5):
+                    rows += [None] * 2
+                    codes += [(None, None, None)] * 2
+                    continue
+                q6 = -Turn.angle(self.sixth.coordinates(scalar.rotate(d[4], -q5, w_p)), wanted_p)
                 R5, R6 = scalar.rotation(d[4], q5), scalar.rotation(d[5], q6)
                 # R234 = R_rest R6ᵀ R5ᵀ, applied to the normal of ω_p
                 R234_normal = scalar.mv(R_rest, scalar.mtv(R6, scalar.mtv(R5, self.normal_p)))
-                angle_sum = scalar.subproblem_1(w_p, self.frame_p, self.normal_p, R234_normal)
+                angle_sum = Turn.angle(self.normal_p_coordinates, self.parallel.coordinates(R234_normal))
                 # the point on axis 4: G_5⁻¹ then G_6⁻¹ (turns about axes through p5, p6), then A, then G_1⁻¹
-                y = scalar.add(p[4], scalar.mtv(R5, scalar.sub(p[3], p[4])))
+                y = scalar.add(p[4], scalar.mtv(R5, self.p4_from_5))
                 y = scalar.add(p[5], scalar.mtv(R6, scalar.sub(y, p[5])))
                 p4_world = scalar.add(scalar.mv(R_A, y), t_A)
-                z = scalar.add(p[0], scalar.mtv(R1, scalar.sub(p4_world, p[0])))
-                z1 = scalar.sub(z, p[1])
+                to_point = scalar.mtv(R1, scalar.sub(p4_world, p[0]))
+                z1 = scalar.sub(scalar.add(p[0], to_point), p[1])
+                # labels: joint 1 turns the arm about axis 1 (the up direction), so they are taken before it does
+                shoulder = scalar.side_code(scalar.dot(to_point, self.forward), scalar.norm(to_point))
+                reach = scalar.reject(z1, w_p)
+                length = scalar.norm(reach)
+                line = (reach[0] / length, reach[1] / length, reach[2] / length) if length > 1e-300 else None
+                wrist_code = scalar.wrist_code(q5)
+                q5, q6 = wrap(q5), wrap(q6)
                 # this shoulder and wrist may leave the point out of the elbow's reach: a least-squares root
                 # (then rejected by the FK check) and an empty slot, as in the array solver
-                elbow = scalar.subproblem_3(d[2], self.frames[2], scalar.sub(p[3], p[2]), scalar.sub(p[1], p[2]), scalar.norm(z1),
-                                      out_of_reach=True)
-                for q3 in elbow:
+                z1_coordinates = self.second.coordinates(z1)
+                for q3 in Turn.angles_at_distance(*self.elbow_coordinates, scalar.norm(z1), out_of_reach=True):
                     if math.isnan(q3):
-                        joints.append([q1, math.nan, math.nan, math.nan, q5, q6])
+                        rows.append(None)
+                        codes.append((None, None, None))
                         continue
-                    moved = scalar.add(p[2], scalar.rotate(d[2], q3, scalar.sub(p[3], p[2])))
-                    q2 = scalar.subproblem_1(d[1], self.frames[1], scalar.sub(moved, p[1]), z1)
+                    moved = scalar.add(p[2], scalar.rotate(d[2], q3, self.p4_from_3))
+                    q2 = Turn.angle(self.second.coordinates(scalar.sub(moved, p[1])), z1_coordinates)
                     q4 = s4 * (angle_sum - s2 * q2 - s3 * q3)
-                    joints.append([q1, q2, q3, q4, q5, q6])
-        return joints
+                    rows.append([wrap(q1), q2, q3, wrap(q4), q5, q6])
+                    side = None if line is None else scalar.side_code(
+                        scalar.dot(scalar.reject(scalar.rotate(d[1], q2, self.elbow), line), self.up), self.elbow_length)
+                    codes.append((shoulder, side, wrist_code))
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)

@@ -10,8 +10,8 @@ import math
 
 import numpy as np
 
-from .._budget import UNLIMITED, Budget
-from .._forward import forward_kinematics, tool_columns, tool_columns_scalar
+from .._cache import memo
+from .._forward import forward_kinematics, tool_columns, tool_columns_scalar_rows
 from .._robot import Robot
 from .._rotations import wrap_angle
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE
@@ -84,22 +84,31 @@ SCALAR_CANDIDATES = 16
 
 
 def _residuals_scalar(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`residual_arrays` by the scalar FK, candidate by candidate (the same formulas)."""
+    """:func:`residual_arrays` by :func:`residuals_of_rows`, target by target."""
     n_targets, m, _ = q.shape
     position, orientation = np.empty((n_targets, m)), np.empty((n_targets, m))
     for row, (candidates, target) in enumerate(zip(q.tolist(), world_T_targets[:, :3, :].tolist())):
-        (tx0, ty0, tz0, tp0), (tx1, ty1, tz1, tp1), (tx2, ty2, tz2, tp2) = target
-        for slot, joints in enumerate(candidates):
-            (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = tool_columns_scalar(robot, joints)
-            d0, d1, d2 = p0 - tp0, p1 - tp1, p2 - tp2
-            position[row, slot] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            cosine = 0.5 * ((tx0 * x0 + tx1 * x1 + tx2 * x2) + (ty0 * y0 + ty1 * y1 + ty2 * y2)
-                            + (tz0 * z0 + tz1 * z1 + tz2 * z2) - 1.0)
-            sine = 0.5 * math.sqrt(((tz0 * y0 + tz1 * y1 + tz2 * y2) - (ty0 * z0 + ty1 * z1 + ty2 * z2)) ** 2
-                                   + ((tx0 * z0 + tx1 * z1 + tx2 * z2) - (tz0 * x0 + tz1 * x1 + tz2 * x2)) ** 2
-                                   + ((ty0 * x0 + ty1 * x1 + ty2 * x2) - (tx0 * y0 + tx1 * y1 + tx2 * y2)) ** 2)
-            orientation[row, slot] = math.atan2(sine, cosine)
+        position[row], orientation[row] = zip(*residuals_of_rows(robot, candidates, target))
     return position, orientation
+
+
+def residuals_of_rows(robot: Robot, rows: list[list[float]], target: list[list[float]]) -> list[tuple[float, float]]:
+    """:func:`residual_arrays` of a few candidates (lists of n floats) against one target (the top three rows of
+    its matrix, as lists), in scalar arithmetic on the scalar FK
+    (:func:`~service.kinematics._forward.tool_columns_scalar_rows`): the same formulas. Returns (position,
+    orientation) per candidate."""
+    (tx0, ty0, tz0, tp0), (tx1, ty1, tz1, tp1), (tx2, ty2, tz2, tp2) = target
+    sqrt, atan2 = math.sqrt, math.atan2
+    out = []
+    for (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) in tool_columns_scalar_rows(robot, rows):
+        d0, d1, d2 = p0 - tp0, p1 - tp1, p2 - tp2
+        cosine = 0.5 * ((tx0 * x0 + tx1 * x1 + tx2 * x2) + (ty0 * y0 + ty1 * y1 + ty2 * y2)
+                        + (tz0 * z0 + tz1 * z1 + tz2 * z2) - 1.0)
+        sine = 0.5 * sqrt(((tz0 * y0 + tz1 * y1 + tz2 * y2) - (ty0 * z0 + ty1 * z1 + ty2 * z2)) ** 2
+                          + ((tx0 * z0 + tx1 * z1 + tx2 * z2) - (tz0 * x0 + tz1 * x1 + tz2 * x2)) ** 2
+                          + ((ty0 * x0 + ty1 * x1 + ty2 * x2) - (tx0 * y0 + tx1 * y1 + tx2 * y2)) ** 2)
+        out.append((sqrt(d0 * d0 + d1 * d1 + d2 * d2), atan2(sine, cosine)))
+    return out
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -115,19 +124,78 @@ def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constr
     return ok
 
 
-def distinct(robot: Robot, q: np.ndarray, budget: Budget = UNLIMITED) -> np.ndarray:
-    """Indices of the first occurrence of each distinct joint vector, revolute joints compared modulo 2π.
+def duplicate_tolerance(robot: Robot) -> np.ndarray:
+    """Per joint (n,), how close two solutions' values must be to count as one: ``DUPLICATE_TOLERANCE`` radians
+    for a revolute joint, that times the arm's size for a prismatic one."""
+    return memo(robot, "duplicate_tolerance", lambda: np.where(
+        robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot)))
 
-    Each row is compared with every kept row at once; ``budget`` is checked every 64 rows.
+
+def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """Which slots (N, m) hold the first occurrence of a distinct solution among the ``ok`` ones.
+
+    ``joints`` (N, m, n) has its revolute joints wrapped to (−π, π]; they are
+    compared modulo 2π, each joint within :func:`duplicate_tolerance`. A slot
+    is dropped when it equals a slot kept before it, exactly as a sequential
+    scan would (:func:`first_of_each_one` is that scan for one target): the
+    loop runs over the m slots, each step vectorised over the targets.
     """
-    tolerance = np.where(robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot))
-    keep: list[int] = []
-    for i in range(len(q)):
-        if i % 64 == 63:
-            budget.check("merging the numeric solutions")
-        if not keep or not np.any(np.all(np.abs(joint_difference(robot, q[keep], q[i])) <= tolerance, axis=1)):
-            keep.append(i)
-    return np.array(keep, dtype=int)
+    m = joints.shape[1]
+    if m == 1:
+        return ok.copy()
+    revolute = robot.is_revolute
+    # every pair (earlier slot, later slot) at once; joints are wrapped to (−π, π], so a revolute difference d
+    # lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
+    earlier, later = _slot_pairs(m)
+    gap = np.abs(joints[:, later, :] - joints[:, earlier, :])  # (N, pairs, n)
+    if revolute.all():
+        np.minimum(gap, 2 * np.pi - gap, out=gap)
+    elif revolute.any():
+        gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
+    same = (gap <= duplicate_tolerance(robot)).all(axis=-1)  # (N, pairs)
+    # then the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
+    kept = ok.copy()
+    start = 0
+    for slot in range(1, m):
+        kept[:, slot] &= ~np.any(same[:, start:start + slot] & kept[:, :slot], axis=1)
+        start += slot
+    return kept
+
+
+def first_of_each_one(robot: Robot, joints: list[list[float]], ok: list[bool]) -> list[bool]:
+    """:func:`first_of_each` for one target's m slots (lists of floats, revolute joints wrapped), by a plain scan:
+    cheaper than the array operations at that size."""
+    rule = memo(robot, "duplicate_rule", lambda: list(zip(robot.is_revolute.tolist(),
+                                                           duplicate_tolerance(robot).tolist())))
+    two_pi = 2 * math.pi
+    kept: list[bool] = []
+    first: list[list[float]] = []
+    for q, good in zip(joints, ok):
+        if good:
+            for other in first:
+                for a, b, (turn, tolerance) in zip(q, other, rule):
+                    gap = abs(a - b)
+                    if not (gap <= tolerance or turn and two_pi - gap <= tolerance):
+                        break  # this joint differs (modulo 2π for a revolute one)
+                else:  # every joint within tolerance: the same solution
+                    good = False
+                    break
+            if good:
+                first.append(q)
+        kept.append(good)
+    return kept
+
+
+def _slot_pairs(m: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair of slots (earlier, later), grouped by the later slot: (0, 1), (0, 2), (1, 2), (0, 3), …"""
+    pairs = _PAIRS.get(m)
+    if pairs is None:
+        later, earlier = np.tril_indices(m, -1)
+        pairs = _PAIRS[m] = (earlier, later)
+    return pairs
+
+
+_PAIRS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
 
 def distance_to_reference(robot: Robot, q: np.ndarray, reference: np.ndarray, *, norm: str = "linf",

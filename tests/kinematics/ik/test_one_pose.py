@@ -1,4 +1,4 @@
-"""The families' scalar paths for one pose (``solve_one``, ``label_codes_one``: ik/_scalar.py) against their
+"""The families' scalar paths for one pose (``solve_one`` and the labels it gives: ik/_scalar.py) against their
 array solvers, and the one-pose duplicate scan against the array scan."""
 
 import numpy as np
@@ -7,7 +7,7 @@ import pytest
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import forward_kinematics
-from service.kinematics.ik import _arrays, joint_difference, solve_ik
+from service.kinematics.ik import _verify, joint_difference, solve_ik
 from service.kinematics.ik._arrays import cached_plan
 from service.kinematics.ik._verify import accepted, residual_arrays, wrap_revolute
 
@@ -63,7 +63,7 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
         # as solve_ik: label the slots the FK check keeps (not the least-squares ones it rejects)
         position, orientation = residual_arrays(robot, joints, T[None])
         valid = one_pose.valid[0] & accepted(robot, position[0], orientation[0], True)
-        labels = plan.label_codes_one(joints, valid[None])
+        labels = one_pose.label_codes(valid.tolist())
         if labels is not None:
             labelled += 1
             expected = plan.label_codes(joints[0])
@@ -121,6 +121,5 @@ def test_scalar_duplicate_scan_is_the_array_scan(robot_id):
         q[0, copies[:2]] = q[0, copies[2:]] + rng.choice([0.0, 1e-7, 1e-5], (2, 1)) * robot.is_revolute
         q[0, :, robot.is_revolute] = wrap_revolute(robot, q[0])[:, robot.is_revolute].T
         ok = rng.random((1, 8)) < 0.8
-        tolerance = np.where(robot.is_revolute, 1e-6, 1e-6 * robot.characteristic_length)
-        scalar = _arrays._first_of_each_scalar(q, ok, robot.is_revolute.tolist(), tolerance.tolist())
-        assert (scalar == _arrays._first_of_each(robot, np.repeat(q, 3, axis=0), np.repeat(ok, 3, axis=0))[0]).all()
+        scalar = _verify.first_of_each_one(robot, q[0].tolist(), ok[0].tolist())
+        assert (scalar == _verify.first_of_each(robot, np.repeat(q, 3, axis=0), np.repeat(ok, 3, axis=0))[0]).all()

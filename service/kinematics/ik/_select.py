@@ -326,18 +326,19 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     """The selection engine: ``joints`` (N, m, n) with ``valid`` (N, m) slots, ``reachable`` (N,)."""
     budget.check("selection")
     n_targets, _, n = joints.shape
-    target, slot = np.nonzero(valid & reachable[:, None])
-    q = joints[target, slot]
+    occupied = np.flatnonzero(valid & reachable[:, None])  # (S,) flat (target, slot) indices, grouped by target
+    target, slot = np.divmod(occupied, joints.shape[1])
+    q = joints.reshape(-1, n).take(occupied, axis=0)
     first, last = turn_ranges(robot, limits, q)
     fits = np.all(last >= first, axis=1)
     misfits = np.flatnonzero(~fits)
-    misfit_q = q[misfits]
-    misfit_turns = closest_turns(robot, limits, misfit_q, first[misfits], last[misfits])
+    misfit_q = q.take(misfits, axis=0)
+    misfit_turns = closest_turns(robot, limits, misfit_q, first.take(misfits, axis=0), last.take(misfits, axis=0))
     if filter_limits:  # the rows that fit are the candidates; the others are rejected at their closest equivalent
-        candidate = fits
-        c_target, c_q, c_first, c_last = target[fits], q[fits], first[fits], last[fits]
+        candidates = np.flatnonzero(fits)
+        c_target, c_q, c_first, c_last = (a.take(candidates, axis=0) for a in (target, q, first, last))
     else:  # a solution that does not fit stays among the candidates with one value: its closest equivalent
-        candidate = np.ones(len(target), dtype=bool)
+        candidates = np.arange(len(target))
         first[misfits], last[misfits] = misfit_turns, misfit_turns
         c_target, c_q, c_first, c_last = target, q, first, last
     with_all_moves = _capped_sums(c_target, _capped_products(c_last - c_first + 1.0), n_targets)
@@ -357,7 +358,7 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
         row_limit = _rounds_needed(c_target, combinations, n_targets, limit)[c_target]
     kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
                                       reference, ordering, budget)
-    rows = np.flatnonzero(candidate)[kept_rows]
+    rows = candidates[kept_rows]
     kept = (target[rows], slot[rows], kept_values, fits[rows])
 
     dropped, dropped_values = (misfits, misfit_q + _TWO_PI * misfit_turns) if filter_limits else (misfits[:0], q[:0])

@@ -467,8 +467,9 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
 def _combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_cap: np.ndarray,
                        row_limit: np.ndarray, reference: np.ndarray | None,
                        weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The turns of every combination of rows (S,) among each row's first ``row_limit`` in cost order: (row (C,)
-    ascending, turns (C, n)), each row's combinations in lexicographic order of their rank tuples.
+    """The turns of the combinations of rows (S,) worth costing: those whose rank tuples r (r_j < ``ranks_cap``)
+    have ∏(r_j + 1) ≤ ``row_limit`` (:func:`_rank_tuples`). Returns (row (C,) ascending, turns (C, n)), each
+    row's combinations in lexicographic order of their rank tuples.
 
     ``q``, ``first``, ``last`` (S, n) are the rows' values and usable turns, ``ranks_cap`` (S, n) the most
     ranks of each joint worth enumerating. A row with one usable turn per joint (limits under a whole turn,

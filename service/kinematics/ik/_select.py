@@ -444,23 +444,27 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
         owner, turns = _combination_turns(q[start:stop], first[start:stop], last[start:stop], ranks_cap[start:stop],
                                           row_limit[start:stop], reference, weights)
         owner += start
-        values = q[owner] + _TWO_PI * turns
+        # the combinations are put in answer order and cut by an index into them (C,), so the joint values
+        # (C, n) are gathered once, at the end
         if reference is None:
             cost = np.sum(np.abs(turns), axis=1)
-            by_stream = np.lexsort((cost, owner))  # each row's combinations cheapest first, ties by rank tuple
-            owner, values = owner[by_stream], values[by_stream]
-            stream = _position_in_group(owner)
-            early = stream < row_limit[owner]
-            owner, values, stream = owner[early], values[early], stream[early]
-            order = np.lexsort((owner, stream, target[owner]))
+            pick = np.lexsort((cost, owner))  # each row's combinations cheapest first, ties by rank tuple
+            stream = _position_in_group(owner[pick])
+            early = stream < row_limit[owner[pick]]
+            pick, stream = pick[early], stream[early]
+            picked = owner[pick]
+            pick = pick[np.lexsort((picked, stream, target[picked]))]
+            values = None
         else:
+            values = q[owner] + _TWO_PI * turns
             distance = _travel(np.abs(values - reference), limits.continuous(robot)) * weights
             cost = distance.max(axis=1) if ordering.norm == "linf" else np.sqrt(np.sum(distance ** 2, axis=1))
-            order = np.lexsort((cost, target[owner]))  # stable: ties by row, then rank tuple
-        owner, values = owner[order], values[order]
-        first_few = _position_in_group(target[owner]) < limit
-        kept_rows.append(owner[first_few])
-        kept_values.append(values[first_few])
+            pick = np.lexsort((cost, target[owner]))  # stable: ties by row, then rank tuple
+        pick = pick[_position_in_group(target[owner[pick]]) < limit]
+        kept_rows.append(owner[pick])
+        kept_values.append(q[owner[pick]] + _TWO_PI * turns[pick] if values is None else values[pick])
+    if len(kept_rows) == 2:  # one chunk: no copy
+        return kept_rows[1], kept_values[1]
     return np.concatenate(kept_rows), np.concatenate(kept_values)
 
 

@@ -122,15 +122,20 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     tolerance = limits.tolerance(robot)
     lower, upper = limits.lower - tolerance, limits.upper + tolerance
     both, continuous = limits.multi_valued(robot), limits.continuous(robot)
+    if both.any():  # every both-bounded column at once (whole rows: a column alone strides through them all)
+        value, low_bound, high_bound = (q, lower, upper) if both.all() else (q[..., both], lower[both], upper[both])
+        low = np.ceil((low_bound - value) / _TWO_PI)
+        high = np.floor((high_bound - value) / _TWO_PI)
+        low += value + _TWO_PI * low < low_bound
+        high -= value + _TWO_PI * high > high_bound
+        if both.all():
+            return low, high
     first, last = np.zeros_like(q), np.zeros_like(q)
-    for j in range(robot.dof):  # one kind of joint per column
+    if both.any():
+        first[..., both], last[..., both] = low, high
+    for j in np.flatnonzero(~both).tolist():  # one kind of joint per column
         value = q[..., j]
-        if both[j]:
-            low = np.ceil((lower[j] - value) / _TWO_PI)
-            high = np.floor((upper[j] - value) / _TWO_PI)
-            first[..., j] = low + (value + _TWO_PI * low < lower[j])
-            last[..., j] = high - (value + _TWO_PI * high > upper[j])
-        elif robot.is_revolute[j] and not continuous[j]:
+        if robot.is_revolute[j] and not continuous[j]:
             below = value < lower[j]
             above = value > upper[j]
             turn = np.where(below, np.ceil((lower[j] - value) / _TWO_PI) if np.isfinite(lower[j]) else 0.0,

@@ -408,9 +408,11 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
     renumber = np.zeros(len(distinct), dtype=int)
     renumber[by_appearance] = np.arange(len(by_appearance))
     solvers, solver = [distinct[i] for i in by_appearance], renumber[same[solver_of]]
-    reports, numbered = _numbered_lists([singular_of[row] for row in sorted(singular_of)])
-    numbered_of = dict(zip(sorted(singular_of), numbered))
+    singular_rows = sorted(singular_of)  # only the targets that meet a condition, in target order
+    reports, numbered = _numbered_lists([singular_of[row] for row in singular_rows])
+    numbered_of = dict(zip(singular_rows, numbered))
     singularities = PerTarget(n_targets, lambda row: list(numbered_of.get(row, ())))
+
     def detail_of(row: int, wording: Mapping[str, str]) -> str | None:
         return None if owner[row] < 0 else _worded(parts[int(owner[row])], int(local_of[row]), wording)
 

@@ -328,18 +328,19 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     """The selection engine: ``joints`` (N, m, n) with ``valid`` (N, m) slots, ``reachable`` (N,)."""
     budget.check("selection")
     n_targets, _, n = joints.shape
-    target, slot = np.nonzero(valid & reachable[:, None])
-    q = joints[target, slot]
+    occupied = np.flatnonzero(valid & reachable[:, None])  # (S,) flat (target, slot) indices, grouped by target
+    target, slot = np.divmod(occupied, joints.shape[1])
+    q = joints.reshape(-1, n).take(occupied, axis=0)
     first, last = turn_ranges(robot, limits, q)
     fits = np.all(last >= first, axis=1)
     misfits = np.flatnonzero(~fits)
-    misfit_q = q[misfits]
-    misfit_turns = closest_turns(robot, limits, misfit_q, first[misfits], last[misfits])
+    misfit_q = q.take(misfits, axis=0)
+    misfit_turns = closest_turns(robot, limits, misfit_q, first.take(misfits, axis=0), last.take(misfits, axis=0))
     if filter_limits:  # the rows that fit are the candidates; the others are rejected at their closest equivalent
-        candidate = fits
-        c_target, c_q, c_first, c_last = target[fits], q[fits], first[fits], last[fits]
+        candidates = np.flatnonzero(fits)
+        c_target, c_q, c_first, c_last = (a.take(candidates, axis=0) for a in (target, q, first, last))
     else:  # a solution that does not fit stays among the candidates with one value: its closest equivalent
-        candidate = np.ones(len(target), dtype=bool)
+        candidates = np.arange(len(target))
         first[misfits], last[misfits] = misfit_turns, misfit_turns
         c_target, c_q, c_first, c_last = target, q, first, last
     with_all_moves = _capped_sums(c_target, _capped_products(c_last - c_first + 1.0), n_targets)
@@ -359,7 +360,7 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
         row_limit = _rounds_needed(c_target, combinations, n_targets, limit)[c_target]
     kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
                                       reference, ordering, budget)
-    rows = np.flatnonzero(candidate)[kept_rows]
+    rows = candidates[kept_rows]
     kept = (target[rows], slot[rows], kept_values, fits[rows])
 
     dropped, dropped_values = (misfits, misfit_q + _TWO_PI * misfit_turns) if filter_limits else (misfits[:0], q[:0])
@@ -445,26 +446,33 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
         owner, turns = _combination_turns(q[start:stop], first[start:stop], last[start:stop], ranks_cap[start:stop],
                                           row_limit[start:stop], reference, weights)
         owner += start
-        values = q[owner] + _TWO_PI * turns
+        # the combinations are put in answer order and cut by an index into them (C,), so the joint values
+        # (C, n) are gathered once, at the end
         if reference is None:
             cost = np.sum(np.abs(turns), axis=1)
-            by_stream = np.lexsort((cost, owner))  # each row's combinations cheapest first, ties by rank tuple
-            owner, values = owner[by_stream], values[by_stream]
-            key = _position_in_group(owner)  # the row's stream position: the targets take turns between rows
-            early = key < row_limit[owner]
-            owner, values, key = owner[early], values[early], key[early]
-            order = np.lexsort((owner, key, target[owner]))
+            pick = np.lexsort((cost, owner))  # each row's combinations cheapest first, ties by rank tuple
+            key = _position_in_group(owner[pick])  # the row's stream position: the targets take turns between rows
+            early = key < row_limit[owner[pick]]
+            pick, key = pick[early], key[early]
+            picked = owner[pick]
+            order = np.lexsort((picked, key, target[picked]))
+            pick, key = pick[order], key[order]
+            values = None
         else:
+            values = q[owner] + _TWO_PI * turns
             distance = _travel(np.abs(values - reference), limits.continuous(robot)) * weights
-            key = distance.max(axis=1) if ordering.norm == "linf" else np.sqrt(np.sum(distance ** 2, axis=1))
-            order = np.lexsort((key, target[owner]))  # stable: ties by row, then rank tuple
-        owner, values, key = owner[order], values[order], key[order]
-        first_few = _position_in_group(target[owner]) < limit
-        kept_rows.append(owner[first_few])
-        kept_values.append(values[first_few])
-        kept_keys.append(key[first_few])
+            cost = distance.max(axis=1) if ordering.norm == "linf" else np.sqrt(np.sum(distance ** 2, axis=1))
+            pick = np.lexsort((cost, target[owner]))  # stable: ties by row, then rank tuple
+            key = cost[pick]
+        first_few = _position_in_group(target[owner[pick]]) < limit
+        pick, key = pick[first_few], key[first_few]
+        kept_rows.append(owner[pick])
+        kept_values.append(q[owner[pick]] + _TWO_PI * turns[pick] if values is None else values[pick])
+        kept_keys.append(key)
+    if len(kept_rows) == 2:  # one chunk: no copy
+        return kept_rows[1], kept_values[1]
     rows, values, keys = np.concatenate(kept_rows), np.concatenate(kept_values), np.concatenate(kept_keys)
-    if len(edges) > 2 and (target[edges[1:-1]] == target[edges[1:-1] - 1]).any():
+    if (target[edges[1:-1]] == target[edges[1:-1] - 1]).any():
         # a target over several chunks: its kept combinations from each, ordered again as one chunk orders them
         # (each chunk's come in row order, so the stable sorts break ties as one chunk would)
         order = np.lexsort((rows, keys, target[rows])) if reference is None else np.lexsort((keys, target[rows]))
@@ -477,8 +485,9 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
 def _combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_cap: np.ndarray,
                        row_limit: np.ndarray, reference: np.ndarray | None,
                        weights: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The turns of every combination of rows (S,) among each row's first ``row_limit`` in cost order: (row (C,)
-    ascending, turns (C, n)), each row's combinations in lexicographic order of their rank tuples.
+    """The turns of the combinations of rows (S,) worth costing: those whose rank tuples r (r_j < ``ranks_cap``)
+    have ∏(r_j + 1) ≤ ``row_limit`` (:func:`_rank_tuples`). Returns (row (C,) ascending, turns (C, n)), each
+    row's combinations in lexicographic order of their rank tuples.
 
     ``q``, ``first``, ``last`` (S, n) are the rows' values and usable turns, ``ranks_cap`` (S, n) the most
     ranks of each joint worth enumerating. A row with one usable turn per joint (limits under a whole turn,

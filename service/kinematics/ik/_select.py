@@ -612,13 +612,16 @@ def _position_in_group(keys: np.ndarray) -> np.ndarray:
 
 
 def _capped_products(counts: np.ndarray) -> np.ndarray:
-    """∏_j counts[:, j] per row (counts ≥ 0, shape (S, n)), capped at :data:`COUNT_CAP` without overflow, (S,)."""
-    factors = np.minimum(counts, COUNT_CAP).astype(np.int64)
-    product = np.ones(len(factors), dtype=np.int64)
-    for factor in factors.T:
-        over = product > COUNT_CAP // np.maximum(factor, 1)
-        product = np.where(over, COUNT_CAP, product * np.where(over, 1, factor))
-    return product
+    """∏_j counts[:, j] per row (counts ≥ 0, shape (S, n)), capped at :data:`COUNT_CAP` without overflow, (S,).
+
+    The float product is exact below 2**53: without a zero factor every partial product is a whole number no
+    larger than the whole; at or above 2**53 (or past the float range) the cap applies, and a zero factor gives 0.
+    """
+    factors = np.minimum(counts, COUNT_CAP).astype(float)
+    with np.errstate(over="ignore", invalid="ignore"):
+        product = np.prod(factors, axis=1)
+    capped = np.where(product >= 2.0 ** 53, float(COUNT_CAP), product)
+    return np.where((factors == 0).any(axis=1), 0.0, capped).astype(np.int64)
 
 
 def _capped_sums(target: np.ndarray, values: np.ndarray, n_targets: int) -> np.ndarray:

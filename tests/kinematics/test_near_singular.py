@@ -267,3 +267,84 @@ def test_coincident_first_axes_are_not_taken_for_a_spherical_wrist():
         assert np.any(same_sum & others)
         np.testing.assert_allclose([forward_kinematics(robot, s)[:3, 3] for s in solutions],
                                    np.broadcast_to(target[:3, 3], (len(solutions), 3)), atol=1e-9)
+
+
+#: the UR5 and random UR-type arms (axes 2 ∥ 3 ∥ 4, axes 5 and 6 meeting, their twists equal so the wrist can be
+#: singular) in each convention, with random base and tool frames
+UR_TYPE_ARMS = ["ur5"] + [f"{convention}-{seed}" for convention in ("standard", "modified", "khalil")
+                          for seed in (0, 1)]
+UR_TYPE_EPSILONS = (1e-3, 1e-6, 3e-7, 1e-7, 3e-8, 1e-8, 3e-9, 1e-9, 1e-10, 1e-12, 0.0)
+
+
+def _turn_onto(k: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    """The angle about the unit axis k that turns a's part normal to k onto b's direction."""
+    a, b = a - (a @ k) * k, b - (b @ k) * k
+    return float(np.arctan2(k @ np.cross(a, b), a @ b))
+
+
+def _ur_type_singular_values(plan, q: np.ndarray, kind: str) -> tuple[int, float]:
+    """The joint swept and its singular value for q's other joints: θ5 with axis 6 along the parallel axes (the
+    wrist), θ3 with the elbow stretched, θ4 with θ2 + θ3 + θ4 turning axis 5 as near axis 1 as it goes."""
+    from tests.kinematics.ik.test_one_pose_families import _stretched_elbow
+
+    g = plan.geometry
+    w_p = g.direction(1)
+    if kind == "wrist":
+        k, six = g.direction(4), g.direction(5)
+        side = 1.0 if abs(six @ k - w_p @ k) <= abs(six @ k + w_p @ k) else -1.0
+        return 4, _turn_onto(k, six, side * w_p)
+    if kind == "elbow":
+        return 2, _stretched_elbow(None, plan, q)
+    s2, s3, s4 = plan.signs
+    total = _turn_onto(w_p, g.direction(4), g.direction(0))
+    return 3, float(s4 * (total - s2 * q[1] - s3 * q[2]))
+
+
+@pytest.mark.parametrize("kind", ["wrist", "elbow", "alignment"])
+@pytest.mark.parametrize("arm", UR_TYPE_ARMS)
+def test_ur_type_arms_near_their_singularities_return_the_generating_configuration(catalogue, arm, kind):
+    """θ5 at ±eps from the wrist singularity (axis 6 along axes 2–4), θ3 from the stretched elbow, θ2 + θ3 + θ4
+    from axis 5's nearest approach to axis 1, eps from 1e-3 down to 1e-12 and 0, each pose alone (solve_ik, the
+    scalar path where it answers) and all in one batch (solve_ik_arrays): ``complete`` and the generating
+    configuration back, up to the relation a reported wrist singularity leaves free (q2, q3, q4 and q6 along a
+    self-motion; q1 and q5 still hold). Before subproblem 2 gave the wrist, its roots came from the height
+    ω_p·R ω6 = cos q5, which merged ±q5 below 5e-7 into q5 = 0, where q6 was set to 0 whether the elbow reached
+    or not: the UR5 lost a whole shoulder branch (4 of 8 solutions) with ``complete: true``."""
+    from tests.kinematics.ik.test_one_pose_families import random_arm
+    from service.kinematics.ik import solve_ik_arrays
+    from service.kinematics.ik._arrays import cached_plan
+
+    if arm == "ur5":
+        robot = catalogue.get("ur5").robot
+    else:
+        convention, seed = arm.split("-")
+        robot = random_arm("three_parallel", convention, int(seed), wrist_singular=True)
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    assert plan.structure == "three_parallel"
+    rng = np.random.default_rng(7)
+    generating = []
+    for eps in UR_TYPE_EPSILONS:
+        for trial in range(4):
+            q = rng.uniform(-np.pi, np.pi, 6)
+            joint, singular = _ur_type_singular_values(plan, q, kind)
+            q[joint] = singular + (eps if trial % 2 else -eps)
+            generating.append((eps, trial, q))
+    poses = forward_kinematics(robot, np.array([q for _, _, q in generating]))
+    batch = solve_ik_arrays(robot, poses)
+    failures = []
+    for row, ((eps, trial, q), pose) in enumerate(zip(generating, poses)):
+        result = solve_ik(robot, pose)
+        # Near the wrist singularity the pose holds q2, q3, q4 and q6 (the planar self-motion) only to what it can
+        # tell: configurations δ apart along it have poses ~eps·δ apart, so δ up to the FK acceptance (1e-9) over
+        # eps is the generating one (as _recovered above); where the singularity is reported they are free. Near the
+        # elbow fold two roots ~eps apart meet: each is good to about √(rounding) over the arm's conditioning.
+        coupled = np.array([False, True, True, True, False, True]) if kind == "wrist" else np.zeros(6, bool)
+        split = np.inf if any(s.kind == "wrist" for s in result.singularities) else max(1e-6, 1e-9 / max(eps, 1e-300))
+        tolerance = np.where(coupled, split, 1e-5 if kind == "elbow" else 1e-6)
+        for answer, joints in (("alone", np.array([s.joints for s in result.solutions]).reshape(-1, 6)),
+                               ("batch", batch.joints[row, :batch.count[row]])):
+            complete = result.complete if answer == "alone" else bool(batch.complete[row])
+            gaps = (np.abs(joint_difference(robot, joints, q)) / tolerance).max(axis=1) if len(joints) else [9.0]
+            if not complete or np.min(gaps) > 1.0:
+                failures.append((answer, eps, trial, len(joints), complete, float(np.min(gaps))))
+    assert not failures, failures

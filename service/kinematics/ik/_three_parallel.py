@@ -6,11 +6,13 @@ G_1 ⋯ G_6, and c the point where axes 5 and 6 meet:
 1. Turning about axes parallel to ω_p keeps the component along ω_p, and
    G_5, G_6 leave c fixed, so ``ω_p·R(ω_1, −q_1)(A c − p_1) = ω_p·(c − p_1)``:
    subproblem 4, two shoulder roots.
-2. For the rotations, ``ω_pᵀ R_1ᵀ R_A ω_6 = ω_pᵀ R(ω_5, q_5) ω_6``: subproblem 4,
-   two wrist roots.
+2. For the rotations, ``R_1ᵀ R_A ω_6 = R_234 R(ω_5, q_5) ω_6`` with R_234 a turn
+   about ω_p: subproblem 2, two wrist roots (on the whole vector: its height along
+   ω_p alone holds q_5 only to second order near the wrist singularity).
 3. ``R(ω_6, −q_6) R(ω_5, −q_5) ω_p = (R_1ᵀ R_A)ᵀ ω_p``: subproblem 1.
 4. What is left, R_234, is a turn about ω_p by the (signed) sum q_2 + q_3 + q_4:
-   subproblem 1.
+   subproblem 1. Where axis 6 lies along ω_p (the wrist singularity) step 3 leaves
+   q_6 free for the rotation but not for step 5, which needs a q_6 the elbow reaches.
 5. The point p_4 on axis 4 reaches ``G_1⁻¹ A G_6⁻¹ G_5⁻¹ p_4`` through joints 2
    and 3: subproblem 3 for q_3 (two elbow roots), subproblem 1 for q_2, and
    q_4 from the sum.
@@ -30,10 +32,11 @@ import numpy as np
 
 from . import _scalar as scalar
 from .._rotations import wrap_angle
+from .._tolerances import GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
 from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
-from ._subproblems import subproblem_1, subproblem_3, subproblem_4, subproblem_6
+from ._subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 from ._wrist import _perpendicular_unit, wrist_codes
 
@@ -82,10 +85,11 @@ class _AxesTwoToFourParallel:
         sixth = subproblem_1(g.direction(5), p, q)
         q6 = -sixth.theta[..., 0]
         free_six = sixth.degenerate
+        G5 = joint_motion(g.direction(4), g.point(4), True, q5)
         if free_six.any():
             q6 = np.where(free_six, 0.0 if reference is None else reference[5], q6)
+            q6 = self._reachable_sixth(A, R1, G5, q6, free_six)
         # 4. R_234 about ω_p: the signed sum
-        G5 = joint_motion(g.direction(4), g.point(4), True, q5)
         G6 = joint_motion(g.direction(5), g.point(5), True, q6)
         R5, R6 = G5[..., :3, :3], G6[..., :3, :3]
         R234 = R_rest @ np.swapaxes(R6, -1, -2) @ np.swapaxes(R5, -1, -2)
@@ -113,7 +117,8 @@ class _AxesTwoToFourParallel:
         _flag_rows((free_six & valid15).any(axis=1), Singularity("wrist", (1, 2, 3, 5), relation,
                                                    "axis 6 is parallel to axes 2–4: only q2 + q3 + q4 and q6 "
                                                    "together are determined; q6 is set to the reference value "
-                                                   "(or 0)"), singular)
+                                                   "(or 0), or where the elbow cannot reach with it, to the "
+                                                   "nearer of two values it reaches with"), singular)
         merged = (elbow.merged | _split_double_root(q3, valid)) & valid[..., 0]
         merged_rows = merged.any(axis=1)
         if merged_rows.any():
@@ -122,6 +127,33 @@ class _AxesTwoToFourParallel:
             for kind, mask in (("stretched", merged_rows & stretched), ("folded", merged_rows & ~stretched)):
                 singular.add(mask, Singularity("elbow", (2,), kind, f"the arm is fully {kind}"))
         return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), singular)
+
+    def _reachable_sixth(self, A: np.ndarray, R1: np.ndarray, G5: np.ndarray, q6: np.ndarray,
+                         free: np.ndarray) -> np.ndarray:
+        """q6 where axis 6 lies along the parallel axes (``free``): the orientation leaves it free, the position
+        does not. Turning about axis 6 carries the point on axis 4 round axis 6 (the two are apart), so the elbow
+        (step 5) reaches that point only for some values of q6. The value given (the reference, or 0) stays where
+        the elbow reaches; elsewhere q6 becomes the nearer of the two values that put the point in the middle of
+        the distances from axis 2 that both the turn and the elbow can give, so the arm branch keeps its
+        solutions (two elbow roots) instead of a least-squares slot the FK check rejects."""
+        g = self.geometry
+        # the distance step 5 asks of the elbow is |R(ω_6, −q6) u − w|, u and w from a point on axis 6
+        u = apply(invert(G5), g.point(3)) - g.point(5)  # (N, m, 3)
+        w = apply(invert(A)[:, None], apply(R1, g.point(1))) - g.point(5)
+        distance = np.linalg.norm(rotate_about(g.direction(5), -q6, u) - w, axis=-1)
+        low_e, high_e = _distance_range(g.direction(2), g.point(3) - g.point(2), g.point(1) - g.point(2))
+        low_c, high_c = _distance_range(g.direction(5), u, w)
+        low, high = np.maximum(low_e, low_c), np.minimum(high_e, high_c)
+        tol = GEOMETRY_TOLERANCE * (high_e + distance)
+        out = free & ((distance < low_e - tol) | (distance > high_e + tol)) & (low <= high)
+        if not out.any():
+            return q6
+        turn = subproblem_3(g.direction(5), u, w, np.where(out, 0.5 * (low + high), distance))
+        candidates = -turn.theta  # (N, m, 2)
+        gaps = np.abs(wrap_angle(candidates - q6[..., None]))
+        nearer = np.where(np.nan_to_num(gaps[..., 0], nan=np.inf) <= np.nan_to_num(gaps[..., 1], nan=np.inf),
+                          candidates[..., 0], candidates[..., 1])
+        return np.where(out, wrap_angle(nearer), q6)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """Shoulder left/right: the sign of the reach to axis 4 along link 1's forward direction. Elbow up/down:
@@ -178,15 +210,16 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
         q1 = -shoulder.theta  # (N, 2)
         R1 = rotation_about(g.direction(0), q1)  # (N, 2, 3, 3)
         R_rest = np.swapaxes(R1, -1, -2) @ A[:, None, :3, :3]  # (N, 2, 3, 3)
-        # 2. wrist: two roots for q5
-        target_height = np.einsum("i,...ij,j->...", w_p, R_rest, g.direction(5))
-        wrist = subproblem_4(w_p, g.direction(4), g.direction(5), target_height)
+        # 2. wrist: two roots for q5. R_rest ω_6 = R_234 R(ω_5, q5) ω_6 with R_234 a turn about ω_p: subproblem 2
+        # on the whole vector, not subproblem 4 on its height ω_p·R_rest ω_6, which near the wrist singularity
+        # (height cos q5) holds q5 only to second order and merged ±q5 below 5e-7 into q5 = 0.
+        wrist = subproblem_2(w_p, g.direction(4), R_rest @ g.direction(5), g.direction(5))
         _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
                                                     "the wrist point is on the first axis; joint 1 is free"), singular)
         _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",
                                                 "the two shoulder solutions meet"), singular)
         valid = shoulder.valid[:, :, None] & wrist.valid
-        return (np.broadcast_to(q1[:, :, None], (n, 2, 2)).reshape(n, 4), wrist.theta.reshape(n, 4),
+        return (np.broadcast_to(q1[:, :, None], (n, 2, 2)).reshape(n, 4), wrist.theta2.reshape(n, 4),
                 valid.reshape(n, 4))
 
     def solve_one(self, world_T_target: np.ndarray) -> scalar.OnePose | None:
@@ -248,6 +281,14 @@ class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
         return q1, pair.theta2, pair.valid
 
 
+def _distance_range(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The least and greatest of ``||R(k, θ) p − q||`` over θ (k a unit axis through the origin)."""
+    along = (p - q) @ k
+    radius_p = np.linalg.norm(p - (p @ k)[..., None] * k, axis=-1)
+    radius_q = np.linalg.norm(q - (q @ k)[..., None] * k, axis=-1)
+    return np.hypot(radius_p - radius_q, along), np.hypot(radius_p + radius_q, along)
+
+
 #: Two elbow roots closer than this (rad) are one double root split by rounding upstream (a root of
 #: subproblem 6 is good to ~1e-12 in an arm's chain, and a double root to about its square root). Both stay
 #: (each is FK-verified); the target is reported at the stretched or folded boundary.
@@ -276,10 +317,12 @@ class _ThreeParallelOnePose:
         w_p = self.omega_p = scalar.vector_of(plan.omega_p)
         self.normal_p = scalar.vector_of(plan.normal_p)
         self.signs = [float(s) for s in plan.signs]
-        # the subproblems with their fixed vectors: 4 for the shoulder (the centre's height along ω_p) and the
-        # wrist (axis 6's), 1 for q6, for the sum q2 + q3 + q4 and for q2, 3 for the elbow
+        # the subproblems with their fixed vectors: 4 for the shoulder (the centre's height along ω_p), 2 for the
+        # wrist (axis 6 turned about axis 5, then about ω_p), 1 for q6, for the sum q2 + q3 + q4 and for q2, 3 for
+        # the elbow
         self.shoulder, self.height = scalar.Height(w_p, d[0]), scalar.dot(w_p, scalar.sub(self.centre, p[0]))
-        self.wrist = scalar.Height(w_p, d[4]).of(d[5])
+        self.wrist = scalar.TwoTurns(w_p, d[4])
+        self.wrist_start = self.wrist.start(d[5])
         self.sixth, self.second = scalar.Turn(d[5]), scalar.Turn(d[1])
         self.parallel = scalar.Turn(w_p)
         self.normal_p_coordinates = self.parallel.coordinates(self.normal_p)
@@ -317,11 +360,12 @@ class _ThreeParallelOnePose:
             R1 = scalar.rotation(d[0], q1)
             R_rest = scalar.mtm(R1, R_A)
             wanted_p = self.sixth.coordinates(scalar.mtv(R_rest, w_p))
-            for q5 in scalar.Height.angles(self.wrist, scalar.dot(w_p, scalar.mv(R_rest, d[5]))):
-                if math.isnan(q5):
+            for pair in self.wrist.angles(self.wrist_start, self.wrist.goal(scalar.mv(R_rest, d[5]))):
+                if pair is None:  # the second wrist root where the cones miss (a least-squares one)
                     rows += [None] * 2
                     codes += [(None, None, None)] * 2
                     continue
+                q5 = pair[1]
                 q6 = -Turn.angle(self.sixth.coordinates(scalar.rotate(d[4], -q5, w_p)), wanted_p)
                 R5, R6 = scalar.rotation(d[4], q5), scalar.rotation(d[5], q6)
                 # R234 = R_rest R6ᵀ R5ᵀ, applied to the normal of ω_p

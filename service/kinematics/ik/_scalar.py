@@ -299,20 +299,25 @@ class TwoTurns:
         self.cos, self.sin = dot(k1, k2), math.sqrt(self.sin2)
 
     def goal(self, v: Vector) -> tuple[float, float, float, float, float]:
-        (k0, k1, k2), (l0, l1, l2), (n0, n1, n2) = self.k1, self.k2, self.normal
-        v0, v1, v2 = v
-        along1, along2, across = v0 * k0 + v1 * k1 + v2 * k2, v0 * l0 + v1 * l1 + v2 * l2, v0 * n0 + v1 * n1 + v2 * n2
-        d1 = along2 - self.cos * along1
-        radius = math.sqrt(across * across + d1 * d1) / self.sin
-        return along1, across, d1, radius, math.sqrt(along1 * along1 + radius * radius)
+        along1, along2, across = self._projections(v)
+        return self._cone(along1, along2, across)
 
     def start(self, v: Vector) -> tuple[float, float, float, float, float]:
+        along1, along2, across = self._projections(v)
+        return self._cone(along2, along1, across)
+
+    def _projections(self, v: Vector) -> tuple[float, float, float]:
+        """v along k1, along k2 and along their normal."""
         (k0, k1, k2), (l0, l1, l2), (n0, n1, n2) = self.k1, self.k2, self.normal
         v0, v1, v2 = v
-        along1, along2, across = v0 * k0 + v1 * k1 + v2 * k2, v0 * l0 + v1 * l1 + v2 * l2, v0 * n0 + v1 * n1 + v2 * n2
-        e2 = along1 - self.cos * along2
-        radius = math.sqrt(across * across + e2 * e2) / self.sin
-        return along2, across, e2, radius, math.sqrt(along2 * along2 + radius * radius)
+        return v0 * k0 + v1 * k1 + v2 * k2, v0 * l0 + v1 * l1 + v2 * l2, v0 * n0 + v1 * n1 + v2 * n2
+
+    def _cone(self, along: float, other: float, across: float) -> tuple[float, float, float, float, float]:
+        """The cone about the axis v is turned around: v along it, across, the in-plane part, the radius about it
+        and |v| (``along`` on this axis, ``other`` on the other one)."""
+        in_plane = other - self.cos * along
+        radius = math.sqrt(across * across + in_plane * in_plane) / self.sin
+        return along, across, in_plane, radius, math.sqrt(along * along + radius * radius)
 
     def angles(self, start: tuple[float, ...], goal: tuple[float, ...]) -> tuple[tuple[float, float] | None, ...]:
         """The two pairs, the +γ crossing first; where the cones clearly miss, the least-squares pair (as the

@@ -13,17 +13,10 @@ from service.kinematics.ik._arrays import cached_plan
 from service.kinematics.ik._screws import move_point
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
+from tests.kinematics.ik.test_spherical_wrist_classes import _random_rigid
 
 FAMILIES = ("intersecting_shoulder+spherical_wrist", "three_parallel")
 CONVENTIONS = ("standard", "modified", "khalil")
-
-
-def _rigid(rng: np.random.Generator, scale: float) -> np.ndarray:
-    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    T = np.eye(4)
-    T[:3, :3] = q * np.sign(np.linalg.det(q))
-    T[:3, 3] = rng.uniform(-scale, scale, 3)
-    return T
 
 
 def random_arm(family: str, convention: str, seed: int, wrist_singular: bool = False) -> Robot:
@@ -45,7 +38,7 @@ def random_arm(family: str, convention: str, seed: int, wrist_singular: bool = F
         a[4] = 0.0  # axes 5 and 6 meet
         if wrist_singular:
             alpha[4] = abs(alpha[3]) * np.sign(alpha[4])
-    base, tool = _rigid(rng, 0.5), _rigid(rng, 0.2)
+    base, tool = _random_rigid(rng, 0.5), _random_rigid(rng, 0.2)
     if convention == "standard":
         rows = zip(a, alpha, d, theta)
     else:  # Craig's frames; a Khalil row holds the same numbers renamed

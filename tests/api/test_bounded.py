@@ -369,3 +369,20 @@ def test_a_redundant_arm_with_many_turn_limits_and_a_reference_stays_bounded():
     if response.status_code == 503:
         assert response.json()["type"].endswith("/deadline-exceeded")
     assert seconds < 2.0 + 4.0 and peak < 400 * 2**20, (seconds, peak)
+
+
+def test_a_redundant_arm_is_costed_by_its_free_joint_family_not_as_numeric():
+    """kuka_iiwa14 is solved in closed form over 32 samples of its free joint: the cost model took it for the
+    numeric search (48 starts a target) and refused a 500-target batch with KIN_MAX_NUMERIC_STARTS = 20,000. It
+    counts 32 × 8 solutions a target now, and refuses only answers too large, saying so."""
+    with TestClient(create_app(Settings(_env_file=None, max_numeric_starts=100))) as client:
+        q = np.random.default_rng(2).uniform(-1, 1, (10, 7))
+        poses = client.post("/v1/robots/kuka_iiwa14/fk/batch", json={"joints": q.tolist()}).json()["poses"]
+        targets = [{"matrix": pose["matrix"]} for pose in poses]
+        response = client.post("/v1/robots/kuka_iiwa14/ik/batch", json={"targets": targets, "format": "arrays"})
+        assert response.status_code == 200, response.text  # 10 × 48 starts would be over the cap of 100
+        assert set(response.json()["targets"]["status"]) == {"ok"}
+        client.app.state.settings.max_solutions_per_response = 2_000
+        problem = assert_problem(client.post("/v1/robots/kuka_iiwa14/ik/batch", json={"targets": targets}), 413,
+                                 match="KIN_MAX_SOLUTIONS_PER_RESPONSE")
+        assert "2,560 solutions" in problem["detail"]  # 10 targets × 32 samples × 8

@@ -6,6 +6,7 @@ import json
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from tests.conftest import assert_problem
 from tests.ik_helpers import find, fk_inline
@@ -109,3 +110,16 @@ def test_free_joint_errors_read_as_before_on_the_wire(client):
                                                                  "free_joints": [{"joint": 2, "values": [0]}]}), 422)
     assert body["errors"] == [{"loc": ["body", "free_joints"], "type": "value_error",
                                "msg": "free_joints applies to arms with more than 6 joints; this one has 6"}]
+
+
+@pytest.mark.parametrize("robot_id", ["kuka_iiwa14", "franka_panda"])
+def test_a_target_out_of_reach_of_a_urdf_arm_is_unreachable_not_a_500(client, robot_id):
+    """The reach-sphere proof read DH lengths, which a URDF robot does not have: an empty answer of the free-joint
+    family was a 500, in a single request and in a batch."""
+    far = {"matrix": [[1, 0, 0, 5.0], [0, 1, 0, 5.0], [0, 0, 1, 5.0], [0, 0, 0, 1]]}
+    single = client.post(f"/v1/robots/{robot_id}/ik", json={"target": far})
+    assert single.status_code == 200, single.text
+    assert single.json()["status"] == "unreachable" and "outside the workspace" in single.json()["detail"]
+    batch = client.post(f"/v1/robots/{robot_id}/ik/batch", json={"targets": [far, far]})
+    assert batch.status_code == 200, batch.text
+    assert [r["status"] for r in batch.json()["results"]] == ["unreachable", "unreachable"]

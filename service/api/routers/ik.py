@@ -6,7 +6,7 @@ import numpy as np
 from fastapi import APIRouter, Depends, Query, Request
 
 from ...kinematics.ik import (AnswerOptions, IKAnswer, IKOptions, NumericOptions, UnsupportedTargetError, answer_ik,
-                               cached_plan)
+                               solutions_per_target)
 from ..boundary import free_joints_to_core, ik_selection_to_core, ik_targets_to_core, located
 from ..budget import budget_of, check_ik_cost
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, settings_of, with_request_frames
@@ -32,13 +32,13 @@ def _answer(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, f
     targets = ik_targets_to_core([body.target] if single else body.targets, unit, "body",
                                  "target" if single else "targets", indexed=not single)
     reference, limits, ordering = ik_selection_to_core(robot, body)
-    # the kept plans (a position-only plan holding joints at the reference has the same count as the kept one)
-    plans = [cached_plan(robot, constrain_orientation=bool(kind), reference=None)
-             for kind in np.unique(targets.kinds > 0)]
-    per_target = max(body.numeric.starts if plan is None else plan.generic_count for plan in plans)
-    check_ik_cost(settings_of(request), robot, limits, targets=len(targets.kinds), solutions_per_target=per_target,
+    free = free_joints_to_core(robot, body.free_joints, unit)
+    with located("body"):
+        most, numeric = solutions_per_target(robot, targets.kinds, free, refined=reference is not None)
+    check_ik_cost(settings_of(request), robot, limits, targets=len(targets.kinds),
+                  solutions_per_target=max(most, body.numeric.starts if numeric else 0),
                   max_equivalents=body.max_equivalents, max_solutions=body.max_solutions, form=form,
-                  numeric_starts=body.numeric.starts if any(plan is None for plan in plans) else None,
+                  numeric_starts=body.numeric.starts if numeric else None,
                   kept_asked=bool({"max_equivalents", "max_solutions"} & body.model_fields_set))
     # the numeric search's time cap: time_budget_ms per target, at most KIN_MAX_IK_TIME_MS per request
     cap_ms = settings_of(request).max_ik_time_ms
@@ -46,8 +46,8 @@ def _answer(request: Request, ref: RobotRef, body: IKRequest | IKBatchRequest, f
         cap_ms = min(body.numeric.time_budget_ms * len(targets.kinds), cap_ms)
     search = IKOptions(NumericOptions(starts=body.numeric.starts, max_iterations=body.numeric.iterations),
                        budget=budget_of(request).within(cap_ms / 1000.0))
-    options = AnswerOptions(reference, limits, body.filter_limits, ordering, body.max_equivalents, search,
-                            free_joints_to_core(robot, body.free_joints, unit), budget_of(request))
+    options = AnswerOptions(reference, limits, body.filter_limits, ordering, body.max_equivalents, search, free,
+                            budget_of(request))
     try:
         with located("body"):
             answer = answer_ik(robot, targets, options)

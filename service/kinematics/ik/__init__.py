@@ -8,7 +8,7 @@ back to a bounded numeric search that says it may be incomplete.
 """
 
 from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKAnswer, IKTargets, PerTarget, SolverReport,
-                      SolveTiming, TargetAnswer, UnsupportedTargetError, answer_ik)
+                      SolveTiming, TargetAnswer, UnsupportedTargetError, answer_ik, solutions_per_target)
 from ._arrays import IKArrays, arrays_from_results, cached_plan, solve_ik_arrays
 from ._direction import solve_direction, target_kinds
 from ._numeric import NumericOptions
@@ -38,6 +38,7 @@ __all__ = [
     "TargetAnswer",
     "UnsupportedTargetError",
     "answer_ik",
+    "solutions_per_target",
     "arrays_from_results",
     "FamilyAnswer",
     "FreeJoint",

@@ -25,10 +25,11 @@ from .._budget import UNLIMITED, Budget
 from .._errors import InvalidInputError, KinematicsError
 from .._limits import Limits
 from .._robot import Robot
-from ._arrays import IKArrays, arrays_from_results, solve_ik_arrays
+from ._arrays import IKArrays, arrays_from_results, cached_plan, solve_ik_arrays
 from ._direction import solve_direction
 from ._position_search import search_position
-from ._redundant import FreeJoint, beyond_reach, free_joints_for, no_solution_detail, solve_free_joint_family
+from ._redundant import (FreeJoint, beyond_reach, free_joint_solutions, free_joints_for, no_solution_detail,
+                         solve_free_joint_family)
 from ._select import MAX_EQUIVALENTS, NOTE_WORDING, BatchSelection, Ordering, SolutionTable, select_arrays
 from ._solve import IKOptions, solve_ik_batch, unreachable_details
 from ._types import IKResult, Singularity
@@ -234,6 +235,24 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
         solved.append(_from_results(robot, np.array(retry), results, False))
         answer = _selected(robot, len(matrices), solved, limits, options, timings)
     return answer
+
+
+def solutions_per_target(robot: Robot, kinds: np.ndarray, free_joints: list | None, refined: bool
+                         ) -> tuple[int, bool]:
+    """The cost model's count, before any solving: the most solutions a target of ``kinds`` (N,) can have in
+    closed form (its plan's generic count; a redundant arm's over its free values, see
+    :func:`free_joint_solutions`), and whether some kind goes to the numeric search instead (its starts count).
+    ``free_joints`` and ``refined`` (a reference is given) are :class:`AnswerOptions`'."""
+    most, numeric = 0, False
+    for constrained in np.unique(np.asarray(kinds) > 0).tolist():
+        # a position-only plan holding joints at the reference has the generic count of the kept one
+        plan = cached_plan(robot, constrain_orientation=constrained, reference=None)
+        count = None if plan is None else plan.generic_count
+        if plan is None and constrained and robot.dof > 6:
+            with _at_free_joints():
+                count = free_joint_solutions(robot, free_joints, refined)
+        most, numeric = (most, True) if count is None else (max(most, count), numeric)
+    return most, numeric
 
 
 @contextmanager

@@ -636,11 +636,28 @@ def free_joints_for(robot: Robot, requested: list[tuple[int, list[float] | None,
     return free
 
 
+def free_joint_solutions(robot: Robot, requested: list[tuple[int, list[float] | None, int | None]] | None,
+                         refined: bool) -> int | None:
+    """The most solutions one full-pose target of a redundant arm can have over its free joints (``requested`` as
+    for :func:`free_joints_for`): the locked arm's generic count at each free value, and at the
+    :data:`REFINED_MINIMA` values the continuous search adds when ``refined`` (a reference is given). None when
+    no family covers the arm: the numeric search answers."""
+    free = free_joints_for(robot, requested)
+    if free is None:
+        return None
+    family = family_for(robot, tuple(sorted(f.joint for f in free)))
+    if not family.available:
+        return None
+    values = int(np.prod([len(f.values) for f in free]))
+    return (values + (REFINED_MINIMA if refined and len(free) == 1 else 0)) * family.generic_count
+
+
 def beyond_reach(robot: Robot, positions: np.ndarray) -> np.ndarray:
     """Which world positions (..., 3) no joint vector can reach, by the reach sphere: each link moves the next
     frame by at most |a| + |d| (plus a prismatic joint's travel), so the tool stays within the sum of those
-    and the tool offset from the base origin. A proof of unreachability, not a test of reachability."""
-    reach = float(np.sum(np.abs(robot.a)) + np.sum(np.abs(robot.d)) + np.linalg.norm(robot.flange_T_tool[:3, 3]))
+    and the tool offset from the base origin (the robot's characteristic length, which a robot described by
+    joint screws or a URDF measures on its links). A proof of unreachability, not a test of reachability."""
+    reach = robot.characteristic_length
     travel = np.where(robot.is_revolute, 0.0, np.maximum(np.abs(robot.lower), np.abs(robot.upper)))
     reach += float(np.sum(travel))
     distance = np.linalg.norm(np.asarray(positions) - robot.world_T_base[:3, 3], axis=-1)

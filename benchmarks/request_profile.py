@@ -5,7 +5,9 @@
 
 The whole request goes through the ASGI application as uvicorn calls it (middleware, routing, the hand-over to a
 work loop, validation, the endpoint, encoding), one request at a time, with no network: beside ``GET /healthz``
-through the same application, it is the framework's share that wrk cannot separate from the server's. The stages
+through the same application, it is the framework's share that wrk cannot separate from the server's. A bare
+FastAPI application (a GET, and a POST of the FK body validated by a pydantic model) gives the framework's own
+floor. The stages
 of the IK request are then timed alone on the same body: the JSON parse and body validation, the boundary's
 conversion to core arrays and the cost model, the core's answer (and within it the solve alone), and the
 encoding. What the stages do not account for is the framework and the hand-over. Best of three rounds per row;
@@ -21,6 +23,8 @@ from typing import Callable
 
 import numpy as np
 import orjson
+from fastapi import FastAPI
+from pydantic import BaseModel
 
 from service.api.app import create_app
 from service.api.boundary import free_joints_to_core, ik_selection_to_core, ik_targets_to_core
@@ -68,6 +72,26 @@ def _asgi_seconds(app, method: str, path: str, body: bytes, count: int) -> float
     return asyncio.run(rounds())
 
 
+class _Joints(BaseModel):
+    joints: list[float]
+
+
+def _bare_application() -> FastAPI:
+    """A FastAPI application with nothing of this service: the framework's own cost of a GET and of a POST whose
+    body (the FK body) is validated by a pydantic model."""
+    bare = FastAPI()
+
+    @bare.get("/healthz")
+    async def healthz() -> dict:
+        return {"status": "ok"}
+
+    @bare.post("/fk")
+    async def fk(body: _Joints) -> dict:
+        return {"joints": body.joints}
+
+    return bare
+
+
 def _seconds(function: Callable[[], object], count: int) -> float:
     for _ in range(min(50, count)):
         function()
@@ -96,6 +120,9 @@ def main(argv: list[str] | None = None) -> int:
     fk_body = orjson.dumps({"joints": q.tolist()})
     count = args.requests
 
+    bare = _bare_application()
+    bare_get = _asgi_seconds(bare, "GET", "/healthz", b"", count)
+    bare_post = _asgi_seconds(bare, "POST", "/fk", fk_body, count)
     healthz = _asgi_seconds(app, "GET", "/healthz", b"", count)
     fk = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/fk", fk_body, count)
     ik = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/ik", ik_body, count)
@@ -143,7 +170,10 @@ def main(argv: list[str] | None = None) -> int:
             print(f"|     of which the solve alone (solve_ik) | {solve * 1e6:,.1f} | {solve / ik:.2f} |")
     rest = ik - sum(stages.values())
     print(f"|   framework, middleware, hand-over (the rest) | {rest * 1e6:,.1f} | {rest / ik:.2f} |")
-    print(f"\n- whole IK request / GET /healthz, in process: {ik / healthz:.1f} (wrk's share of /healthz is bounded by "
+    print(f"| bare FastAPI: GET | {bare_get * 1e6:,.1f} | |")
+    print(f"| bare FastAPI: POST of the FK body, validated | {bare_post * 1e6:,.1f} | |")
+    print(f"\n- bare FastAPI, POST / GET: {bare_post / bare_get:.1f} (its share of GET is at most {bare_get / bare_post:.2f})")
+    print(f"- whole IK request / GET /healthz, in process: {ik / healthz:.1f} (wrk's share of /healthz is bounded by "
           f"its inverse, {healthz / ik:.2f}, before the network)")
     print(f"- whole FK request / GET /healthz, in process: {fk / healthz:.1f} (bound {healthz / fk:.2f})")
     return 0

@@ -10,7 +10,7 @@ import shutil
 
 import pytest
 
-from benchmarks import anchors, core, http_throughput, slide_classes, wrist_classes
+from benchmarks import anchors, core, http_throughput, request_profile, slide_classes, wrist_classes
 
 
 def test_core_benchmark_runs_with_tiny_sizes(capsys):
@@ -22,6 +22,13 @@ def test_core_benchmark_runs_with_tiny_sizes(capsys):
     for name in anchors.LIBRARIES:
         if not anchors.installed(name):
             assert f"{name}: not installed" in out
+
+
+def test_request_profile_runs_with_tiny_sizes(capsys):
+    assert request_profile.main(["--requests", "3"]) == 0
+    out = capsys.readouterr().out
+    assert "| POST ik, whole request |" in out and "|     of which the solve alone (solve_ik) |" in out
+    assert "| bare FastAPI: POST of the FK body, validated |" in out
 
 
 def test_wrist_classes_benchmark_runs_with_tiny_sizes(capsys):

@@ -414,3 +414,15 @@ def test_more_samples_than_kin_max_batch_is_413():
         assert small.post(f"/v1/robots/{ASSUR}/ik/trajectory", json={"samples": samples[:3]}).status_code == 200
         robot = small.get(f"/v1/robots/{ASSUR}").json()
         assert_problem(small.post("/v1/ik/trajectory", json={"samples": samples, "robot": robot}), 413)
+
+
+def test_a_long_trajectory_stops_while_its_samples_are_read():
+    """The samples were converted to core targets without a budget check, and the answer built without one either:
+    10,000 UR5 samples answered their 503 1.2 s after a 5 s deadline. With a 1 ms deadline, 300 samples now stop
+    while they are read, before any solving."""
+    pose = {"matrix": [[1, 0, 0, 0.4], [0, 1, 0, 0.1], [0, 0, 1, 0.3], [0, 0, 0, 1]]}
+    body = {"samples": [{"time": 0.01 * k, "pose": pose} for k in range(300)]}
+    with TestClient(create_app(Settings())) as client:
+        response = client.post("/v1/robots/ur5/ik/trajectory", json=body, headers={"X-Request-Timeout-Ms": "1"})
+    problem = assert_problem(response, 503)
+    assert "during reading the samples" in problem["detail"]

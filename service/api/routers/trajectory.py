@@ -54,7 +54,7 @@ def _follow(request: Request, ref: RobotRef, body: TrajectoryRequest) -> dict:
     options = TrajectoryOptions(
         branch=None if body.branch is None else body.branch.model_dump(), reference=reference,
         singularity_tolerance=body.singularity_tolerance, damping=body.damping,
-        ik=IKOptions(budget=budget_of(request)))
+        ik=IKOptions(budget=budget))
     with located("body"):
         result = follow_trajectory(
             robot, [s.time for s in body.samples], np.array(matrices), constrain_orientation=constrained[0],

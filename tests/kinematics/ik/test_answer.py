@@ -153,3 +153,20 @@ def test_solvers_and_singularity_reports_are_numbered_by_first_appearance():
                            AnswerOptions(filter_limits=False)).target(0)
         assert answer.target(i).singularities == single.singularities
         assert any(s.joints == (3, 5) and s.relation == "sum" for s in single.singularities)  # only q4 + q6 is fixed
+
+
+def test_a_redundant_arms_family_stops_at_the_requests_budget():
+    """The free-joint family solved every target without the request's budget, so a deadline was first seen at the
+    selection, after all of them (200 xArm 7 targets: a 503 at 8.6 s on a 5 s deadline). A cancelled budget
+    now stops it before its first target."""
+    import pytest
+
+    from service.kinematics import Budget, BudgetExhausted
+
+    robot = load_catalogue([Settings().builtin_robots_dir], max_joints=32).get("kuka_iiwa14").robot
+    targets = _targets(robot, np.full((3, 7), 0.3), [POSE] * 3)
+    budget = Budget(None)
+    budget.cancel()
+    with pytest.raises(BudgetExhausted) as stopped:
+        answer_ik(robot, targets, AnswerOptions(budget=budget))
+    assert stopped.value.stage == "the free-joint family"

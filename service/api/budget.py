@@ -227,8 +227,9 @@ def check_answer_size(settings: Settings, robot: Robot, *, targets: int, per_tar
 
 def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: int, solutions_per_target: int,
                   max_equivalents: int, max_solutions: int | None, form: str = "objects",
-                  numeric_starts: int | None = None, kept_asked: bool = True) -> None:
-    """The IK cost model, before any solving: turns per joint, the numeric work, then the worst-case answer size.
+                  numeric_starts: int | None = None, kept_asked: bool = True) -> int:
+    """The IK cost model, before any solving: turns per joint, the numeric work, then the worst-case answer size,
+    which it returns (the most solutions the answer can hold, rejected ones included).
 
     ``solutions_per_target`` is the family's generic count (8 for a PUMA) or, for the numeric search, its starts
     (``numeric_starts``, which also count as work). ``kept_asked``: the client chose ``max_equivalents`` or
@@ -260,6 +261,7 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: 
                       what=f"{targets:,} targets × up to {per_target:,} each: {solutions_per_target} solutions "
                            f"× {equivalents:,} 2π-equivalents with at most {kept:,} kept"
                            + (f", when {rejected} of them are rejected" if rejected else ""))
+    return targets * per_target
 
 
 def worst_answer_per_target(solutions: int, equivalents: int, kept: int) -> tuple[int, int]:

@@ -16,6 +16,7 @@ from ..robots.build import robot_from_description
 from ..robots.schemas import AnyRobotDescription
 from .boundary import located
 from .problems import ProblemError
+from .routing import hand_over_unless
 
 
 @dataclass(frozen=True)
@@ -85,8 +86,16 @@ def inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef
         with located("body", "robot"):
             return robot_from_description(description, max_joints=max_joints)
 
-    robot = request.app.state.inline_robots.get((description.model_dump_json(), max_joints), build)
+    robot = getattr(request.state, _INLINE_ROBOT, None)  # found before the request started again on a work loop
+    if robot is None:
+        cache, key = request.app.state.inline_robots, (description.model_dump_json(), max_joints)
+        hand_over_unless(key in cache)  # building a robot (a URDF's parse, its chain) is not small work
+        robot = cache.get(key, build)
+        setattr(request.state, _INLINE_ROBOT, robot)
     return RobotRef(description.id, robot)
+
+
+_INLINE_ROBOT = "inline_robot"
 
 
 def with_request_frames(ref: RobotRef, body) -> RobotRef:

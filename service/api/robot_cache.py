@@ -55,5 +55,9 @@ class RobotCache:
                     self._entries.popitem(last=False)
         return robot
 
+    def __contains__(self, key: Hashable) -> bool:
+        """Whether ``key`` is kept (not counted as a look-up)."""
+        return key in self._entries
+
     def __len__(self) -> int:
         return len(self._entries)

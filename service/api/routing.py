@@ -16,6 +16,15 @@
   request, so :class:`FastJSONRoute` runs the endpoint inline on it instead.
 * **Turns.** A request computes only in its turn (:class:`CoreTurns`): as many at once as there are cores, the
   others waiting in order, a long request letting a waiting one go first between its chunks of work.
+* **Small work where it arrives.** The hand-over to a work loop and back costs more than a single FK and about as
+  much as a single IK (two thread wake-ups, a second loop's turn at the GIL). The routes motion planners call one
+  pose at a time (:func:`small_first`) therefore start on the server's loop when their body is small
+  (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes microseconds. Before any work, the endpoint
+  says whether its work is small (:func:`hand_over_unless`): bounded by a few milliseconds whatever the request
+  asks, e.g. a closed-form IK whose worst-case answer is a few hundred rows. If it is not, nothing has been done
+  yet, and the request starts again on a work loop, in its turn. Only while no request computes on a work loop:
+  under mixed load, small requests take their turns like the others, and the server's loop stays free for I/O and
+  the health routes (in the soak, running them where they arrived doubled ``/healthz``'s p99).
 """
 
 from __future__ import annotations
@@ -44,6 +53,31 @@ except ImportError:  # pragma: no cover - platforms without uvloop
     _new_loop = asyncio.new_event_loop
 
 
+#: Bodies up to this size are parsed and validated on the server's loop by the :func:`small_first` routes.
+SMALL_BODY_BYTES = 8192
+
+_on_server_loop: contextvars.ContextVar[bool] = contextvars.ContextVar("on_server_loop", default=False)
+
+
+class _NotSmall(Exception):
+    """Raised by :func:`hand_over_unless` on the server's loop: the request starts again on a work loop."""
+
+
+def hand_over_unless(small: bool) -> None:
+    """Called by an endpoint before it does any work: work that is not ``small`` (bounded by a few milliseconds
+    whatever the request asks) leaves the server's loop for a work loop. Elsewhere (on a work loop, or an
+    endpoint not marked :func:`small_first`) it does nothing."""
+    if not small and _on_server_loop.get():
+        raise _NotSmall
+
+
+def small_first(endpoint: Callable[..., Any]) -> Callable[..., Any]:
+    """Mark an endpoint whose small requests run where they arrive (see the module docstring). Its work must be
+    guarded by :func:`hand_over_unless` wherever it can be more than small."""
+    endpoint.small_first = True  # type: ignore[attr-defined]
+    return endpoint
+
+
 class _OrjsonRequest(Request):
     async def json(self) -> Any:
         if not hasattr(self, "_json"):
@@ -68,9 +102,14 @@ class CoreTurns:
 
     def __init__(self, cores: int) -> None:
         self._lock = threading.Lock()
-        self._free = cores
+        self._cores = self._free = cores
         self._waiting: collections.deque[threading.Event] = collections.deque()
         self._held_since = threading.local()
+
+    @property
+    def idle(self) -> bool:
+        """No request holds or waits for a turn (read without the lock: a hint, not a promise)."""
+        return self._free == self._cores and not self._waiting
 
     def take(self) -> None:
         """Wait (blocking this thread) for a turn."""
@@ -202,6 +241,7 @@ class FastJSONRoute(APIRoute):
 
     def __init__(self, path: str, endpoint: Callable[..., Any], **kwargs: Any) -> None:
         super().__init__(path, _inline(endpoint), **kwargs)
+        self.small_first = getattr(endpoint, "small_first", False)
 
     def get_route_handler(self) -> Callable[[Request], Coroutine[Any, Any, Response]]:
         handler = super().get_route_handler()
@@ -212,6 +252,17 @@ class FastJSONRoute(APIRoute):
             async def replay() -> Message:
                 return {"type": "http.request", "body": body, "more_body": False}
 
-            return await _on_work_loop(lambda: handler(_OrjsonRequest(request.scope, replay)))
+            def make() -> Coroutine[Any, Any, Response]:
+                return handler(_OrjsonRequest(request.scope, replay))
+
+            if self.small_first and len(body) <= SMALL_BODY_BYTES and CORE_TURNS.idle:
+                here = _on_server_loop.set(True)
+                try:
+                    return await make()
+                except _NotSmall:
+                    pass  # nothing was done yet: start again on a work loop
+                finally:
+                    _on_server_loop.reset(here)
+            return await _on_work_loop(make)
 
         return route

@@ -27,6 +27,11 @@ def memo(robot: Any, key: Hashable, build: Callable[[], T]) -> T:
         return value
 
 
+def is_memoised(robot: Any, key: Hashable) -> bool:
+    """Whether :func:`memo` has kept ``key`` for ``robot`` (asking would build nothing)."""
+    return key in robot.__dict__.get(_ATTRIBUTE, ())
+
+
 def bounded_memo(robot: Any, namespace: str, key: Hashable, build: Callable[[], T], capacity: int) -> T:
     """:func:`memo` for a family of keys of which at most ``capacity`` are kept, least recently used dropped."""
     store = memo(robot, namespace, OrderedDict)

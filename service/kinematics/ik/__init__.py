@@ -8,7 +8,8 @@ back to a bounded numeric search that says it may be incomplete.
 """
 
 from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKAnswer, IKTargets, PerTarget, SolverReport,
-                      SolveTiming, TargetAnswer, UnsupportedTargetError, answer_ik, solutions_per_target)
+                      SolveTiming, TargetAnswer, UnsupportedTargetError, answer_ik, plans_are_kept,
+                      solutions_per_target)
 from ._arrays import IKArrays, arrays_from_results, cached_plan, solve_ik_arrays
 from ._direction import solve_direction, target_kinds
 from ._numeric import NumericOptions
@@ -38,6 +39,7 @@ __all__ = [
     "TargetAnswer",
     "UnsupportedTargetError",
     "answer_ik",
+    "plans_are_kept",
     "solutions_per_target",
     "arrays_from_results",
     "FamilyAnswer",

@@ -25,7 +25,7 @@ from .._budget import UNLIMITED, Budget
 from .._errors import InvalidInputError, KinematicsError
 from .._limits import Limits
 from .._robot import Robot
-from ._arrays import IKArrays, arrays_from_results, cached_plan, solve_ik_arrays
+from ._arrays import IKArrays, arrays_from_results, cached_plan, plan_is_kept, solve_ik_arrays
 from ._direction import solve_direction
 from ._position_search import search_position
 from ._redundant import (FreeJoint, beyond_reach, free_joint_solutions, free_joints_for, no_solution_detail,
@@ -253,6 +253,17 @@ def solutions_per_target(robot: Robot, kinds: np.ndarray, free_joints: list | No
                 count = free_joint_solutions(robot, free_joints, refined)
         most, numeric = (most, True) if count is None else (max(most, count), numeric)
     return most, numeric
+
+
+def plans_are_kept(robot: Robot, kinds: np.ndarray, reference: np.ndarray | None) -> bool:
+    """Whether the plans that targets of ``kinds`` (N,) need are already built and kept on the robot, so that
+    neither :func:`solutions_per_target` nor :func:`answer_ik` derives one (False for direction targets, whose
+    families are chosen per tool axis)."""
+    kinds = np.asarray(kinds)
+    if (kinds == DIRECTION).any():
+        return False
+    return all(plan_is_kept(robot, constrain_orientation=constrained, reference=reference)
+               for constrained in np.unique(kinds == POSE).tolist())
 
 
 @contextmanager

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._budget import UNLIMITED, Budget
-from .._cache import memo
+from .._cache import is_memoised, memo
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL, POLISH_RESIDUAL
 from ._plan import Plan, plan_for
@@ -137,13 +137,25 @@ def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndar
     others at the reference values: those plans depend on the values and are
     built each time rather than kept.
     """
+    key = _plan_key(robot, constrain_orientation, reference)
+    if key is None:
+        return plan_for(robot, constrain_orientation=False, reference=reference)
+    return memo(robot, key, lambda: plan_for(robot, constrain_orientation=constrain_orientation, reference=None))
+
+
+def plan_is_kept(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> bool:
+    """Whether :func:`cached_plan` would answer without building a plan."""
+    key = _plan_key(robot, constrain_orientation, reference)
+    return key is not None and is_memoised(robot, key)
+
+
+def _plan_key(robot: Robot, constrain_orientation: bool, reference: np.ndarray | None) -> tuple[str, str] | None:
+    """The memo key of a kept plan; None for a plan built for the reference's values each time."""
     if constrain_orientation:
-        return memo(robot, ("ik_plan", "pose"),
-                    lambda: plan_for(robot, constrain_orientation=True, reference=None))
+        return ("ik_plan", "pose")
     if robot.dof <= 3 or reference is None:
-        return memo(robot, ("ik_plan", "position"),
-                    lambda: plan_for(robot, constrain_orientation=False, reference=None))
-    return plan_for(robot, constrain_orientation=False, reference=reference)
+        return ("ik_plan", "position")
+    return None
 
 
 #: Targets solved together: large enough that per-operation overhead is small, small enough that the

@@ -668,8 +668,9 @@ def _position_in_group(keys: np.ndarray) -> np.ndarray:
     """0, 1, 2, … within each run of equal values of sorted ``keys``."""
     if len(keys) == 0 or keys[0] == keys[-1]:  # one run
         return np.arange(len(keys))
-    starts = np.flatnonzero(np.concatenate(([True], keys[1:] != keys[:-1])))
-    return np.arange(len(keys)) - np.repeat(starts, np.diff(starts, append=len(keys)))
+    index = np.arange(len(keys))
+    run_start = np.where(np.concatenate(([True], keys[1:] != keys[:-1])), index, 0)
+    return index - np.maximum.accumulate(run_start)
 
 
 def _capped_products(counts: np.ndarray) -> np.ndarray:

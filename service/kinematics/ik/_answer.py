@@ -433,8 +433,7 @@ def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits
                                   table.labels)
             into.append(table)
     distinct, same = _numbered(reports_of)  # equal reports of different parts are one
-    present, first = np.unique(same[solver_of], return_index=True)
-    by_appearance = present[np.argsort(first)]  # number them by first appearance in target order
+    by_appearance = list(dict.fromkeys(same[solver_of].tolist()))  # number them by first appearance in target order
     renumber = np.zeros(len(distinct), dtype=int)
     renumber[by_appearance] = np.arange(len(by_appearance))
     solvers, solver = [distinct[i] for i in by_appearance], renumber[same[solver_of]]
@@ -491,6 +490,9 @@ def _merged(tables: list[SolutionTable], dof: int) -> SolutionTable:
         for name, (values, _) in table.labels.items():
             vocabulary = vocabularies.setdefault(name, [])
             vocabulary.extend(value for value in values if value not in vocabulary)
+    if len(tables) == 1 and all(tuple(vocabularies[name]) == values and codes.dtype == np.int8
+                                for name, (values, codes) in tables[0].labels.items()):
+        return tables[0]  # its values are the vocabulary already
     remapped = []
     for table in tables:
         labels = {}

@@ -39,6 +39,7 @@ products of interval lengths, capped at :data:`.._budget.COUNT_CAP`.
 from __future__ import annotations
 
 import functools
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Literal
@@ -82,6 +83,11 @@ _CHUNK_ROWS = 1 << 18
 MAX_COMBINATIONS_PER_SOLUTION = 1 << 15
 
 _TWO_PI = 2.0 * np.pi
+#: Rows (one target's solutions) and rank entries per row (∏ caps × n, bounding the cache's memory) up to which
+#: :func:`_rank_tuples` looks rows up one by one rather than enumerating them all at once; up to these rows and
+#: entries in all, :func:`_combination_turns` works out each combination's turns directly rather than tabling
+#: each joint's ranked turns first.
+_FEW_ROWS, _FEW_RANKS = 32, 1 << 13
 
 
 @dataclass(frozen=True)
@@ -145,6 +151,8 @@ def joint_travel(robot: Robot, limits: Limits, q: np.ndarray, reference: np.ndar
 
 def _travel(difference: np.ndarray, continuous: np.ndarray | bool) -> np.ndarray:
     """|q − r| made wrap-aware where ``continuous``."""
+    if not np.any(continuous):
+        return difference
     return np.where(continuous, np.abs(np.pi - np.mod(np.pi - difference, 2.0 * np.pi)), difference)
 
 
@@ -335,20 +343,26 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     fits = np.all(last >= first, axis=1)
     misfits = np.flatnonzero(~fits)
     misfit_q = q.take(misfits, axis=0)
-    misfit_turns = closest_turns(robot, limits, misfit_q, first.take(misfits, axis=0), last.take(misfits, axis=0))
-    if filter_limits:  # the rows that fit are the candidates; the others are rejected at their closest equivalent
+    misfit_turns = (closest_turns(robot, limits, misfit_q, first.take(misfits, axis=0), last.take(misfits, axis=0))
+                    if len(misfits) else misfit_q)
+    if not len(misfits):
+        candidates = np.arange(len(target))
+        c_target, c_q, c_first, c_last = target, q, first, last
+    elif filter_limits:  # the rows that fit are the candidates; the others are rejected at their closest equivalent
         candidates = np.flatnonzero(fits)
         c_target, c_q, c_first, c_last = (a.take(candidates, axis=0) for a in (target, q, first, last))
     else:  # a solution that does not fit stays among the candidates with one value: its closest equivalent
         candidates = np.arange(len(target))
         first[misfits], last[misfits] = misfit_turns, misfit_turns
         c_target, c_q, c_first, c_last = target, q, first, last
-    with_all_moves = _capped_sums(c_target, _capped_products(c_last - c_first + 1.0), n_targets)
+    counts = c_last - c_first + 1.0  # ≥ 1: every candidate has a usable turn per joint
+    combinations = _capped_products(counts)  # (C,) each candidate's usable combinations
+    with_all_moves = available = _capped_sums(c_target, combinations, n_targets)
     if reference is not None and ordering.max_joint_move is not None:
         c_first, c_last = _within_move(robot, limits, c_q, c_first, c_last, reference, ordering.max_joint_move)
-    counts = np.maximum(c_last - c_first + 1.0, 0.0)
-    combinations = _capped_products(counts)  # (C,) each candidate's usable combinations
-    available = _capped_sums(c_target, combinations, n_targets)
+        counts = np.maximum(c_last - c_first + 1.0, 0.0)
+        combinations = _capped_products(counts)
+        available = _capped_sums(c_target, combinations, n_targets)
 
     limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
     lowered = limit > enumerable_limit(n) and bool(np.any(combinations > MAX_COMBINATIONS_PER_SOLUTION))
@@ -373,7 +387,8 @@ def _choose(robot: Robot, limits: Limits, joints: np.ndarray, valid: np.ndarray,
     n_rejected = np.bincount(rejected[0], minlength=n_targets)
     outside = np.bincount(kept[0][~kept[3]], minlength=n_targets)
     no_fit = filter_limits & (np.bincount(c_target, minlength=n_targets) == 0) & (n_rejected > 0)
-    status = np.where(~reachable, "unreachable", np.where(no_fit, "no_solution_within_limits", "ok")).astype(object)
+    status = np.full(n_targets, "ok", dtype=object)
+    status[no_fit], status[~reachable] = "no_solution_within_limits", "unreachable"
     capped = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
     truncated = (available > n_kept) & (not capped)
     trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
@@ -433,13 +448,22 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     n = q.shape[1]
     weights = np.ones(n) if reference is None or ordering.weights is None else np.asarray(ordering.weights, float)
     ranks_cap = np.minimum(counts, row_limit[:, None]).astype(np.int64)
-    limits_met, which = np.unique(row_limit, return_inverse=True)
-    down_sets = np.array([min(_down_set_size(n, int(b)), COUNT_CAP) for b in limits_met.tolist()], dtype=np.int64)
-    bound = np.minimum(_capped_products(ranks_cap), down_sets[which.ravel()]).astype(float)
+    if len(row_limit) and (row_limit == row_limit[0]).all():  # one limit: one target, or a reference
+        down_sets = min(_down_set_size(n, int(row_limit[0])), COUNT_CAP)
+    else:
+        limits_met, which = np.unique(row_limit, return_inverse=True)
+        down_sets = np.array([min(_down_set_size(n, int(b)), COUNT_CAP) for b in limits_met.tolist()],
+                             dtype=np.int64)[which.ravel()]
+    bound = np.minimum(_capped_products(ranks_cap), down_sets).astype(float)
     # chunks of whole rows: a row's combinations are at most MAX_COMBINATIONS_PER_SOLUTION, but one target's rows
     # (16 solutions, or 32 samples of a free joint times 8) may hold millions, so a target may span chunks
     chunk = (np.cumsum(bound) - bound) // _CHUNK_ROWS
-    edges = np.flatnonzero(np.r_[True, chunk[1:] != chunk[:-1], True]) if len(target) else np.zeros(1, int)
+    if not len(target):
+        edges = np.zeros(1, int)
+    elif chunk[-1] == 0:  # one chunk
+        edges = np.array([0, len(target)])
+    else:
+        edges = np.flatnonzero(np.concatenate(([True], chunk[1:] != chunk[:-1], [True])))
     kept_rows, kept_values, kept_keys = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))], [np.zeros(0)]
     for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
         budget.check("selection")
@@ -491,27 +515,22 @@ def _combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks
 
     ``q``, ``first``, ``last`` (S, n) are the rows' values and usable turns, ``ranks_cap`` (S, n) the most
     ranks of each joint worth enumerating. A row with one usable turn per joint (limits under a whole turn,
-    the usual case) has one combination, its ``first`` turns, and is not ranked at all.
+    the usual case) has one combination, its ``first`` turns (when every row is such, none is ranked).
     """
     single = np.all(first == last, axis=1) & (row_limit > 0)
-    multi = np.flatnonzero(~single)
-    if not len(multi):
+    if single.all():
         return np.arange(len(q)), first
+    if len(q) <= _FEW_ROWS:  # few rows: all ranked, the single ones keeping their ``first`` turns
+        owner, ranks = _rank_tuples(ranks_cap, row_limit)
+        if ranks.size <= _FEW_RANKS:  # and few combinations: each one's turns worked out directly
+            cheapest, direction, ahead, behind = _ranked_turns(q, first, last, reference, weights)
+            turns = cheapest[owner] + _rank_offsets(ranks, direction[owner], ahead[owner], behind[owner])
+            return owner, np.where(single[owner, None], first[owner], turns)
+    multi = np.flatnonzero(~single)
     caps = ranks_cap[multi]
-    if reference is None:  # turns ranked by |k| itself: exact, so equal turning ties exactly
-        zeros = np.zeros((len(multi), q.shape[1]))
-        cheapest, direction, ahead, behind = _ranked_turns(zeros, first[multi], last[multi], zeros, weights)
-    else:
-        cheapest, direction, ahead, behind = _ranked_turns(q[multi], first[multi], last[multi],
-                                                           np.broadcast_to(reference, caps.shape), weights)
+    cheapest, direction, ahead, behind = _ranked_turns(q[multi], first[multi], last[multi], reference, weights)
     owner, ranks = _rank_tuples(caps, row_limit[multi])
-    # each (row, joint, rank) turn once (no more of them than combinations), then looked up per combination
-    table_start = (np.cumsum(caps.ravel()) - caps.ravel()).reshape(caps.shape)
-    entry = np.repeat(np.arange(caps.size), caps.ravel())
-    rank = np.arange(len(entry)) - table_start.ravel()[entry]
-    table = [a.ravel()[entry] for a in (cheapest, direction, ahead, behind)]
-    table = table[0] + _rank_offsets(rank, *table[1:])
-    multi_turns = table[table_start[owner] + ranks]
+    multi_turns = _tabled_turns(caps, owner, ranks, cheapest, direction, ahead, behind)
     if len(multi) == len(q):
         return owner, multi_turns
     per_row = np.ones(len(q), dtype=np.int64)  # each row's combinations, placed in row order
@@ -524,23 +543,45 @@ def _combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks
     return np.repeat(np.arange(len(q)), per_row), turns
 
 
-def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, centre: np.ndarray,
+def _tabled_turns(caps: np.ndarray, owner: np.ndarray, ranks: np.ndarray, cheapest: np.ndarray,
+                  direction: np.ndarray, ahead: np.ndarray, behind: np.ndarray) -> np.ndarray:
+    """The turns (C, n) of the combinations ``ranks`` (C, n) of rows ``owner`` (C,), from the rows' ranked turns
+    (S, n each, :func:`_ranked_turns`) and ``caps`` (S, n): as ``cheapest[owner] + _rank_offsets(ranks, …)``, but
+    each (row, joint, rank) turn is worked out once (no more of them than combinations), then looked up."""
+    table_start = (np.cumsum(caps.ravel()) - caps.ravel()).reshape(caps.shape)
+    entry = np.repeat(np.arange(caps.size), caps.ravel())
+    rank = np.arange(len(entry)) - table_start.ravel()[entry]
+    table = [a.ravel()[entry] for a in (cheapest, direction, ahead, behind)]
+    table = table[0] + _rank_offsets(rank, *table[1:])
+    return table[table_start[owner] + ranks]
+
+
+def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, reference: np.ndarray | None,
                   weights: np.ndarray) -> tuple[np.ndarray, ...]:
-    """How each joint's usable turns rank by cost |q + 2kπ − centre|·w (ties: the lower value first).
+    """How each joint's usable turns rank by cost |q + 2kπ − r|·w for the reference r (shape (n,)); without
+    one, by |k| itself (exact, so equal turning ties exactly). Ties: the lower value first.
 
     Returns, shape (S, n) each: the cheapest turn, the direction (±1) of the second cheapest, and how many
     turns lie beyond the cheapest in that direction and in the other. The cost grows outwards from the
     cheapest, so the ranks alternate between the two sides until one runs out (:func:`_rank_offsets`).
     """
+    if reference is None:
+        q = centre = np.zeros(first.shape)
+    else:
+        centre = reference
+
     def cost(k):
         return np.abs(q + _TWO_PI * k - centre) * weights
 
     below = np.floor((centre - q) / _TWO_PI)
-    lower_costs_more = cost(below + 1.0) < cost(below)
-    cheapest = np.where(lower_costs_more, below + 1.0, below)
-    direction = np.where(lower_costs_more | (cost(below - 1.0) <= cost(below + 1.0)), -1.0, 1.0)
+    above = below + 1.0
+    at_above = cost(above)
+    lower_costs_more = at_above < cost(below)
+    cheapest = np.where(lower_costs_more, above, below)
+    direction = np.where(lower_costs_more | (cost(below - 1.0) <= at_above), -1.0, 1.0)
     indifferent = weights == 0  # every value costs 0: ascending values
-    cheapest, direction = np.where(indifferent, first, cheapest), np.where(indifferent, 1.0, direction)
+    if indifferent.any():
+        cheapest, direction = np.where(indifferent, first, cheapest), np.where(indifferent, 1.0, direction)
     direction = np.where(cheapest < first, 1.0, np.where(cheapest > last, -1.0, direction))
     cheapest = np.minimum(np.maximum(cheapest, first), last)
     ahead = np.where(direction > 0, last - cheapest, cheapest - first)
@@ -562,8 +603,28 @@ def _rank_offsets(ranks: np.ndarray, direction: np.ndarray, ahead: np.ndarray, b
 def _rank_tuples(ranks_cap: np.ndarray, row_limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Every rank tuple r of each row with r_j < ranks_cap[row, j] and ∏(r_j + 1) ≤ row_limit[row].
 
-    Returns (row (C,), ranks (C, n)), rows ascending and each row's tuples in lexicographic order.
+    Returns (row (C,), ranks (C, n)), rows ascending and each row's tuples in lexicographic order. A few rows
+    of few tuples each (one target's) are looked up row by row (:func:`_row_rank_tuples`).
     """
+    if len(ranks_cap) <= _FEW_ROWS:
+        caps, limits = ranks_cap.tolist(), row_limit.tolist()
+        if all(math.prod(row) * len(row) <= _FEW_RANKS for row in caps):
+            per_row = [_row_rank_tuples(tuple(row), limit) for row, limit in zip(caps, limits)]
+            owner = np.repeat(np.arange(len(per_row)), [len(ranks) for ranks in per_row])
+            return owner, np.concatenate(per_row) if per_row else np.zeros(ranks_cap.shape, dtype=np.int64)
+    return _enumerated_rank_tuples(ranks_cap, row_limit)
+
+
+@functools.lru_cache(maxsize=256)
+def _row_rank_tuples(ranks_cap: tuple[int, ...], row_limit: int) -> np.ndarray:
+    """:func:`_rank_tuples` of one row, (C, n), read-only: the same caps and limit recur from target to target."""
+    ranks = _enumerated_rank_tuples(np.array([ranks_cap], dtype=np.int64), np.array([row_limit]))[1]
+    ranks.flags.writeable = False
+    return ranks
+
+
+def _enumerated_rank_tuples(ranks_cap: np.ndarray, row_limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_rank_tuples` for any number of rows at once."""
     rows, n = ranks_cap.shape
     owner = np.flatnonzero(np.all(ranks_cap > 0, axis=1) & (row_limit > 0))
     product = np.ones(len(owner), dtype=np.int64)
@@ -605,10 +666,11 @@ def _down_set_size(n: int, limit: int) -> int:
 
 def _position_in_group(keys: np.ndarray) -> np.ndarray:
     """0, 1, 2, … within each run of equal values of sorted ``keys``."""
-    if len(keys) == 0:
-        return np.zeros(0, dtype=np.int64)
-    starts = np.flatnonzero(np.r_[True, keys[1:] != keys[:-1]])
-    return np.arange(len(keys)) - np.repeat(starts, np.diff(np.r_[starts, len(keys)]))
+    if len(keys) == 0 or keys[0] == keys[-1]:  # one run
+        return np.arange(len(keys))
+    index = np.arange(len(keys))
+    run_start = np.where(np.concatenate(([True], keys[1:] != keys[:-1])), index, 0)
+    return index - np.maximum.accumulate(run_start)
 
 
 def _capped_products(counts: np.ndarray) -> np.ndarray:
@@ -618,6 +680,8 @@ def _capped_products(counts: np.ndarray) -> np.ndarray:
     larger than the whole; at or above 2**53 (or past the float range) the cap applies, and a zero factor gives 0.
     """
     factors = np.minimum(counts, COUNT_CAP).astype(float)
+    if factors.max(initial=1.0) ** factors.shape[1] < 2.0 ** 53:  # the usual few turns: exact, no cap reached
+        return np.prod(factors, axis=1).astype(np.int64)
     with np.errstate(over="ignore", invalid="ignore"):
         product = np.prod(factors, axis=1)
     capped = np.where(product >= 2.0 ** 53, float(COUNT_CAP), product)
@@ -637,25 +701,24 @@ def _rounds_needed(target: np.ndarray, lengths: np.ndarray, n_targets: int, limi
     """Per target, the rounds of a round robin over its rows' streams (``lengths`` (S,)) that yield ``limit``
     items (all, if fewer), ≥ 1, shape (N,).
 
-    Rounds R yield Σ min(length, R) items: the smallest R reaching ``limit`` is found by bisection.
+    Rounds R yield Y(R) = Σ min(length, R) items. With the streams sorted by length s_0 ≤ s_1 ≤ …, for R in
+    (s_{k−1}, s_k] Y(R) = Σ_{i<k} s_i + R·(P − k) (P streams): the smallest R reaching ``limit`` is the smallest
+    over those segments of the first R of each that does. R ≤ ``limit``, so longer streams count as ``limit``.
     """
     position = _position_in_group(target)
     streams = np.zeros((n_targets, int(position.max()) + 1 if len(position) else 1), dtype=np.int64)
     streams[target, position] = lengths
 
     rounds = np.maximum(1, streams.max(axis=1))  # a target whose streams yield fewer than ``limit``: all of them
-    enough = np.flatnonzero(np.minimum(streams, limit).sum(axis=1) >= limit)
-    streams = streams[enough]  # only these need the bisection
-
-    def yielded(rounds):
-        return np.minimum(streams, rounds[:, None]).sum(axis=1)
-
-    low, high = np.ones(len(enough), dtype=np.int64), np.full(len(enough), limit, dtype=np.int64)
-    while np.any(low < high):
-        middle = (low + high) // 2
-        reached = yielded(middle) >= limit
-        low, high = np.where(reached, low, middle + 1), np.where(reached, middle, high)
-    rounds[enough] = low
+    capped = np.minimum(streams, limit)
+    enough = capped.sum(axis=1) >= limit
+    if not enough.any():
+        return rounds
+    s = np.sort(capped[enough], axis=1)
+    shorter = np.cumsum(s, axis=1) - s  # Σ of the streams before each
+    segment_start = np.concatenate((np.zeros((len(s), 1), dtype=np.int64), s[:, :-1]), axis=1) + 1
+    first_reaching = np.maximum(segment_start, -((shorter - limit) // (s.shape[1] - np.arange(s.shape[1]))))
+    rounds[enough] = np.where(first_reaching <= s, first_reaching, limit).min(axis=1)
     return rounds
 
 

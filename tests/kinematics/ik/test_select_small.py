@@ -1,0 +1,153 @@
+"""One target's answer (the few-rows forms of the selection) is the general array path's, field by field.
+
+For one target the selection looks rank tuples up row by row, works out each combination's turns directly and
+skips the bookkeeping of many targets (:mod:`service.kinematics.ik._select`). The general path is forced by
+answering the same target inside a batch of other targets, with those forms switched off: the two answers must
+agree bit for bit, over random catalogue arms, limits (±2π and wider, narrow, one-sided, exactly at a
+solution's joints), references (some exactly between two equivalents) and options.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from service.config import Settings
+from service.kinematics import Limits, forward_kinematics
+from service.kinematics.ik import AnswerOptions, IKTargets, Ordering, answer_ik, select_arrays, solve_ik_arrays
+from service.kinematics.ik._arrays import concatenated
+from service.kinematics.ik import _select
+from service.robots.catalogue import load_catalogue
+
+CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+ROBOTS = ["puma560_standard", "ur5", "kuka_kr6_r900_2", "kuka_kr210_r2700", "abb_irb120", "ur10e"]
+TWO_PI = 2 * np.pi
+
+
+def _random_case(rng):
+    """(robot, target (4, 4), options) with limits and a reference drawn around the target's own solutions."""
+    robot = CATALOGUE.get(ROBOTS[rng.integers(len(ROBOTS))]).robot
+    n = robot.dof
+    target = forward_kinematics(robot, rng.uniform(-np.pi, np.pi, n))
+    arrays = solve_ik_arrays(robot, target[None])
+    solutions = arrays.joints[0][arrays.valid[0]]
+    solution = solutions[rng.integers(len(solutions))]
+    lower, upper = robot.lower.copy(), robot.upper.copy()
+    kind = rng.integers(5)
+    if kind == 1:  # ±π … ±5 turns
+        width = rng.choice([np.pi, TWO_PI, 2.5 * np.pi, 3 * np.pi, 10 * np.pi], n)
+        lower, upper = -width, width
+    elif kind == 2:  # narrow
+        centre, width = rng.uniform(-1, 1, n), rng.uniform(0.2, 2.0, n)
+        lower, upper = centre - width, centre + width
+    elif kind == 3:  # exactly at a solution's joints (or a whole turn away)
+        turns = rng.integers(-1, 2, n)
+        lower = np.where(rng.random(n) < 0.6, solution + TWO_PI * turns, lower)
+        upper = np.where(rng.random(n) < 0.6, solution + TWO_PI * turns + rng.choice([0.0, TWO_PI, 3.0], n), upper)
+        lower, upper = np.minimum(lower, upper), np.maximum(lower, upper)
+    elif kind == 4:  # some one-sided or open
+        width = rng.choice([TWO_PI, 4 * np.pi, np.inf], n)
+        lower, upper = np.where(rng.random(n) < 0.2, -np.inf, -width), width
+    reference, ordering = None, Ordering()
+    draw = rng.random()
+    if draw > 0.3:
+        if draw < 0.55:  # between two equivalents of a solution's joint: a tie in exact arithmetic
+            reference = solution + np.where(rng.random(n) < 0.6, np.pi * rng.choice([-1, 1], n),
+                                            rng.uniform(-0.5, 0.5, n))
+        else:
+            reference = rng.uniform(-4, 4, n)
+        ordering = Ordering(str(rng.choice(["linf", "l2"])),
+                            rng.choice([0.0, 0.5, 1.0, 2.0], n) if rng.random() < 0.4 else None,
+                            int(rng.integers(0, 12)) if rng.random() < 0.4 else None,
+                            np.where(rng.random(n) < 0.5, rng.uniform(0, 6, n), np.inf) if rng.random() < 0.4
+                            else None)
+    options = AnswerOptions(reference=reference, limits=Limits(lower, upper), filter_limits=bool(rng.random() < 0.6),
+                            ordering=ordering, max_equivalents=int(rng.choice([1, 2, 3, 5, 17, 1024])))
+    return robot, target, options
+
+
+def _rows(table, index):
+    mine = np.flatnonzero(table.target == index)
+    labels = [{name: values[codes[k]] for name, (values, codes) in table.labels.items() if codes[k] >= 0}
+              for k in mine.tolist()]
+    return (table.joints[mine].tobytes(), table.within_limits[mine].tolist(), table.position[mine].tobytes(),
+            table.orientation[mine].tobytes(), labels)  # bit for bit
+
+
+def _assert_identical(mine, index, general, general_index) -> None:
+    """Target ``index`` of selection ``mine`` and ``general_index`` of ``general`` agree in every field."""
+    for name in ("status", "truncated", "trimmed", "available"):
+        assert getattr(mine, name)[index] == getattr(general, name)[general_index], name
+    assert mine.notes.get(index, []) == general.notes.get(general_index, [])
+    for kind in ("solutions", "rejected"):
+        assert _rows(getattr(mine, kind), index) == _rows(getattr(general, kind), general_index), kind
+
+
+def _select_both(robot, target, options, rng, monkeypatch):
+    """The target's selection alone, and within a batch of six other targets through the general forms."""
+    reference = options.reference
+    alone = solve_ik_arrays(robot, target[None], reference=reference)
+    others = solve_ik_arrays(robot, forward_kinematics(robot, rng.uniform(-np.pi, np.pi, (6, robot.dof))),
+                             reference=reference)
+    batch = concatenated([others.take(np.arange(3)), alone, others.take(np.arange(3, 6))])
+    arguments = dict(filter_limits=options.filter_limits, reference=reference, ordering=options.ordering,
+                     max_equivalents=options.max_equivalents)
+    mine = select_arrays(robot, alone, options.limits, **arguments)
+    with monkeypatch.context() as forced:  # the general forms only: every row enumerated and tabled at once
+        forced.setattr(_select, "_FEW_ROWS", -1)
+        forced.setattr(_select, "_FEW_RANKS", -1)
+        general = select_arrays(robot, batch, options.limits, **arguments)
+    return mine, general
+
+
+@pytest.fixture
+def calls(monkeypatch):
+    """Counts of the selection's few-rows and general forms, as the cases call them."""
+    counted = {"few rows": 0, "general": 0}
+
+    def counting(function, key):
+        def wrapper(*args, **kwargs):
+            counted[key] += 1
+            return function(*args, **kwargs)
+        return wrapper
+
+    monkeypatch.setattr(_select, "_row_rank_tuples", counting(_select._row_rank_tuples, "few rows"))
+    monkeypatch.setattr(_select, "_tabled_turns", counting(_select._tabled_turns, "general"))
+    return counted
+
+
+def test_one_target_selects_as_the_general_path(monkeypatch, calls):
+    rng = np.random.default_rng(20240611)
+    ranked = kept_many = 0
+    for case in range(250):
+        robot, target, options = _random_case(rng)
+        before = calls["few rows"]
+        mine, general = _select_both(robot, target, options, rng, monkeypatch)
+        ranked += calls["few rows"] > before
+        _assert_identical(mine, 0, general, 3)
+        kept_many += int(np.sum(mine.solutions.target == 0)) > 1
+        # and the answer built on it (one part, one target) keeps it as it is
+        answer = answer_ik(robot, IKTargets.poses(target[None]), options)
+        assert _rows(answer.solutions, 0) == _rows(mine.solutions, 0), case
+        assert _rows(answer.rejected, 0) == _rows(mine.rejected, 0), case
+        assert (answer.status[0], answer.available[0], answer.trimmed[0]) == (
+            mine.status[0], mine.available[0], mine.trimmed[0])
+    # the cases exercise the few-rows forms and the general one, and rank many equivalents
+    assert ranked > 50 and calls["general"] > 50 and kept_many > 100, (ranked, calls, kept_many)
+
+
+def test_joint_exactly_at_its_limits_and_reference_between_equivalents(monkeypatch):
+    """A ±360° arm whose limits pass through a solution's joints, the reference half a turn from each: the
+    single target's selection is the general path's, ties and limit values included."""
+    robot = CATALOGUE.get("ur5").robot
+    target = forward_kinematics(robot, np.array([0.3, -1.1, 1.4, -0.6, 1.2, 2.0]))
+    solution = solve_ik_arrays(robot, target[None]).joints[0, 0]
+    limits = Limits(solution - TWO_PI, solution + TWO_PI)  # each joint's values: exactly both limits, and itself
+    rng = np.random.default_rng(1)
+    for reference in (solution + np.pi, solution - np.pi, None):
+        for filter_limits in (True, False):
+            options = AnswerOptions(reference=reference, limits=limits, filter_limits=filter_limits,
+                                    max_equivalents=7)
+            mine, general = _select_both(robot, target, options, rng, monkeypatch)
+            _assert_identical(mine, 0, general, 3)
+            assert mine.available[0] >= 7 and mine.truncated[0]

@@ -13,6 +13,8 @@ G_1 ⋯ G_6, and c the point where axes 5 and 6 meet:
 4. What is left, R_234, is a turn about ω_p by the (signed) sum q_2 + q_3 + q_4:
    subproblem 1. Where axis 6 lies along ω_p (the wrist singularity) step 3 leaves
    q_6 free for the rotation but not for step 5, which needs a q_6 the elbow reaches.
+   Those values form one arc or two separate ones (two families of solutions); a
+   second arc gets the slot of the other wrist root, which meets the first there.
 5. The point p_4 on axis 4 reaches ``G_1⁻¹ A G_6⁻¹ G_5⁻¹ p_4`` through joints 2
    and 3: subproblem 3 for q_3 (two elbow roots), subproblem 1 for q_2, and
    q_4 from the sum.
@@ -32,7 +34,7 @@ import numpy as np
 
 from . import _scalar as scalar
 from .._rotations import wrap_angle
-from .._tolerances import GEOMETRY_TOLERANCE
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
 from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
@@ -86,9 +88,16 @@ class _AxesTwoToFourParallel:
         q6 = -sixth.theta[..., 0]
         free_six = sixth.degenerate
         G5 = joint_motion(g.direction(4), g.point(4), True, q5)
+        unrepresented = np.zeros(n, dtype=bool)
         if free_six.any():
             q6 = np.where(free_six, 0.0 if reference is None else reference[5], q6)
-            q6 = self._reachable_sixth(A, R1, G5, q6, free_six)
+            q6, other_arc = self._reachable_sixth(A, R1, G5, q6, free_six)
+            if np.isfinite(other_arc).any():
+                q1, q5, q6, valid15, free_six, unrepresented = _second_arc_slots(
+                    q1, q5, q6, valid15, free_six, other_arc)
+                R1 = joint_motion(g.direction(0), g.point(0), True, q1)
+                R_rest = np.swapaxes(R1[..., :3, :3], -1, -2) @ A[:, None, :3, :3]
+                G5 = joint_motion(g.direction(4), g.point(4), True, q5)
         # 4. R_234 about ω_p: the signed sum
         G6 = joint_motion(g.direction(5), g.point(5), True, q6)
         R5, R6 = G5[..., :3, :3], G6[..., :3, :3]
@@ -118,7 +127,12 @@ class _AxesTwoToFourParallel:
                                                    "axis 6 is parallel to axes 2–4: only q2 + q3 + q4 and q6 "
                                                    "together are determined; q6 is set to the reference value "
                                                    "(or 0), or where the elbow cannot reach with it, to the "
-                                                   "nearer of two values it reaches with"), singular)
+                                                   "nearer of two values it reaches with; where the values the "
+                                                   "elbow reaches with form two separate arcs, the other arc is "
+                                                   "represented too, by the other of those two values"), singular)
+        singular.add(unrepresented, Singularity(
+            "wrist", (1, 2, 3, 5), relation, "the values of q6 the elbow reaches with form two separate arcs "
+            "and no candidate slot was left for the second one: its solutions are missing (complete: false)"))
         merged = (elbow.merged | _split_double_root(q3, valid)) & valid[..., 0]
         merged_rows = merged.any(axis=1)
         if merged_rows.any():
@@ -126,16 +140,23 @@ class _AxesTwoToFourParallel:
             stretched = np.cos(q3[..., 0][np.arange(n), first]) > 0
             for kind, mask in (("stretched", merged_rows & stretched), ("folded", merged_rows & ~stretched)):
                 singular.add(mask, Singularity("elbow", (2,), kind, f"the arm is fully {kind}"))
-        return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), singular)
+        return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), singular,
+                          complete=~unrepresented if unrepresented.any() else None)
 
     def _reachable_sixth(self, A: np.ndarray, R1: np.ndarray, G5: np.ndarray, q6: np.ndarray,
-                         free: np.ndarray) -> np.ndarray:
-        """q6 where axis 6 lies along the parallel axes (``free``): the orientation leaves it free, the position
-        does not. Turning about axis 6 carries the point on axis 4 round axis 6 (the two are apart), so the elbow
-        (step 5) reaches that point only for some values of q6. The value given (the reference, or 0) stays where
-        the elbow reaches; elsewhere q6 becomes the nearer of the two values that put the point in the middle of
-        the distances from axis 2 that both the turn and the elbow can give, so the arm branch keeps its
-        solutions (two elbow roots) instead of a least-squares slot the FK check rejects."""
+                         free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """q6 where axis 6 lies along the parallel axes (``free``, (N, m)): the orientation leaves it free, the
+        position does not. Turning about axis 6 carries the point on axis 4 round axis 6 (the two are apart), so
+        the elbow (step 5) reaches that point only for some values of q6. The value given (the reference, or 0)
+        stays where the elbow reaches; elsewhere q6 becomes the nearer of the two values that put the point in the
+        middle of the distances from axis 2 that both the turn and the elbow can give, so the arm branch keeps its
+        solutions (two elbow roots) instead of a least-squares slot the FK check rejects.
+
+        The distance the elbow is asked for sweeps its range up and down once per turn. Where the elbow's band of
+        distances lies strictly inside that range, the values it reaches with form two separate arcs, one where
+        the distance rises and one where it falls, and each is a separate family of solutions: the two middle
+        values lie one on each arc. Returns q6 (N, m) and a value on the other arc than q6's (N, m), NaN where
+        the reachable values are one arc (or none)."""
         g = self.geometry
         # the distance step 5 asks of the elbow is |R(ω_6, −q6) u − w|, u and w from a point on axis 6
         u = apply(invert(G5), g.point(3)) - g.point(5)  # (N, m, 3)
@@ -146,14 +167,23 @@ class _AxesTwoToFourParallel:
         low, high = np.maximum(low_e, low_c), np.minimum(high_e, high_c)
         tol = GEOMETRY_TOLERANCE * (high_e + distance)
         out = free & ((distance < low_e - tol) | (distance > high_e + tol)) & (low <= high)
-        if not out.any():
-            return q6
-        turn = subproblem_3(g.direction(5), u, w, np.where(out, 0.5 * (low + high), distance))
+        two_arcs = free & (low_c < low_e - tol) & (high_e + tol < high_c)
+        if not (out | two_arcs).any():
+            return q6, np.full(q6.shape, np.nan)
+        turn = subproblem_3(g.direction(5), u, w, np.where(out | two_arcs, 0.5 * (low + high), distance))
         candidates = -turn.theta  # (N, m, 2)
         gaps = np.abs(wrap_angle(candidates - q6[..., None]))
         nearer = np.where(np.nan_to_num(gaps[..., 0], nan=np.inf) <= np.nan_to_num(gaps[..., 1], nan=np.inf),
                           candidates[..., 0], candidates[..., 1])
-        return np.where(out, wrap_angle(nearer), q6)
+        q6 = np.where(out, wrap_angle(nearer), q6)
+
+        def rising(sixth: np.ndarray) -> np.ndarray:
+            """Whether the distance grows with q6 there: the sign of its derivative, ω_6 · (R(ω_6, −q6) u × w)."""
+            return np.cross(rotate_about(g.direction(5), -sixth, u), w) @ g.direction(5) > 0
+
+        # the two middle values mirror each other about the distance's extremes: one on each arc
+        other = np.where(rising(q6) == rising(candidates[..., 0]), candidates[..., 1], candidates[..., 0])
+        return q6, np.where(two_arcs, wrap_angle(other), np.nan)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """Shoulder left/right: the sign of the reach to axis 4 along link 1's forward direction. Elbow up/down:
@@ -287,6 +317,35 @@ def _distance_range(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> tuple[np.nda
     radius_p = np.linalg.norm(p - (p @ k)[..., None] * k, axis=-1)
     radius_q = np.linalg.norm(q - (q @ k)[..., None] * k, axis=-1)
     return np.hypot(radius_p - radius_q, along), np.hypot(radius_p + radius_q, along)
+
+
+def _second_arc_slots(q1: np.ndarray, q5: np.ndarray, q6: np.ndarray, valid: np.ndarray, free: np.ndarray,
+                      other_arc: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Each candidate (q1, q5) of shape (N, m) whose free q6 has a second arc (``other_arc`` finite) gets a slot of
+    its own row for that arc's value: the first slot after it (then from the start) that is empty or repeats
+    its (q1, q5) (at the wrist singularity the two wrist roots meet, so the other root's slot is one of those).
+    Returns q1, q5, q6, valid and free with those slots filled, and the rows (N,) where a second arc found no
+    slot."""
+    q1, q5, q6, valid, free = (np.array(x) for x in (q1, q5, q6, valid, free))
+    n, m = q1.shape
+    source = valid & free & np.isfinite(other_arc)
+    taken = np.zeros((n, m), dtype=bool)
+    unrepresented = np.zeros(n, dtype=bool)
+    for slot in range(m):
+        pending = source[:, slot] & ~taken[:, slot]
+        if not pending.any():
+            continue
+        taken[:, slot] |= pending
+        for spare in [*range(slot + 1, m), *range(slot)]:
+            repeats = (valid[:, spare] & free[:, spare]
+                       & (np.abs(wrap_angle(q1[:, spare] - q1[:, slot])) <= DUPLICATE_TOLERANCE)
+                       & (np.abs(wrap_angle(q5[:, spare] - q5[:, slot])) <= DUPLICATE_TOLERANCE))
+            fill = pending & ~taken[:, spare] & (~valid[:, spare] | repeats)
+            q1[fill, spare], q5[fill, spare], q6[fill, spare] = q1[fill, slot], q5[fill, slot], other_arc[fill, slot]
+            valid[fill, spare] = free[fill, spare] = taken[fill, spare] = True
+            pending &= ~fill
+        unrepresented |= pending
+    return q1, q5, q6, valid, free, unrepresented
 
 
 #: Two elbow roots closer than this (rad) are one double root split by rounding upstream (a root of

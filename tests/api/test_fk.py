@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pytest
 
+from service.api.schemas.fk import FKResponse
 from tests.conftest import DATA, assert_problem
 from tests.oracles.closed_forms import CLOSED_FORMS
 
@@ -14,7 +15,10 @@ from tests.oracles.closed_forms import CLOSED_FORMS
 def _fk(client, robot_id, joints, **extra):
     response = client.post(f"/v1/robots/{robot_id}/fk", json={"joints": list(map(float, joints)), **extra})
     assert response.status_code == 200, response.text
-    return response.json()
+    body = response.json()
+    # encoded without the response model: it must be exactly what the model would write
+    assert FKResponse.model_validate(body).model_dump(mode="json", exclude_none=True) == body
+    return body
 
 
 def test_every_textbook_fk_vector(client, textbook_fk_vectors):

@@ -1,4 +1,5 @@
-"""The route class of the work routes: bodies parsed by orjson, and the whole request handled off the server's loop.
+"""The route class of the work routes: bodies parsed by orjson, and the request handled off the server's loop unless
+its work is small.
 
 * **orjson.** FastAPI parses a JSON body with the standard library before validating it. orjson parses the same
   text several times faster, which matters for batch bodies of thousands of targets. orjson rejects the
@@ -21,7 +22,7 @@
   pose at a time (:func:`small_first`) therefore start on the server's loop when their body is small
   (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes microseconds. Before any work, the endpoint
   says whether its work is small (:func:`hand_over_unless`): bounded by a few milliseconds whatever the request
-  asks, e.g. a closed-form IK whose worst-case answer is a few hundred rows. If it is not, nothing has been done
+  asks, e.g. a closed-form IK whose worst-case answer is a few dozen rows. If it is not, nothing has been done
   yet, and the request starts again on a work loop, in its turn. Only while no request computes on a work loop:
   under mixed load, small requests take their turns like the others, and the server's loop stays free for I/O and
   the health routes (in the soak, running them where they arrived doubled ``/healthz``'s p99).

@@ -22,7 +22,9 @@ G_1 ⋯ G_6, and c the point where axes 5 and 6 meet:
 2 × 2 × 2 = 8 solutions in general.
 
 When axes 5 and 6 are skew (:class:`SkewWristThreeParallelPlan`) steps 1 and 2
-are one subproblem 6 in (q_1, q_5); steps 3–5 are the same.
+are one subproblem 6 in (q_1, q_5), whose roots near the wrist singularity are
+refined on the parts of the axes normal to ω_p (two of them meet there); steps
+3–5 are the same.
 """
 
 from __future__ import annotations
@@ -308,7 +310,129 @@ class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
         q1 = pair.theta1
         if pair.degenerate.any():  # the equations do not involve q1 there, so q5 holds for any value of it
             q1 = np.where(pair.degenerate[:, None], 0.0 if reference is None else reference[0], q1)
-        return q1, pair.theta2, pair.valid
+            return q1, pair.theta2, pair.valid
+        return self._refined_pairs(A, q1, pair.theta2, pair.valid)
+
+    def _refined_pairs(self, A: np.ndarray, q1: np.ndarray, q5: np.ndarray,
+                       valid: np.ndarray) -> tuple[np.ndarray, ...]:
+        """Subproblem 6's pairs (q1, q5), shape (N, m), refined, with the root that met a pair's root restored.
+
+        Subproblem 6 equates the heights along ω_p of w = R_1ᵀ R_A ω_6 and u = R(ω_5, q_5) ω_6. At the wrist
+        singularity both are at an extreme (u = ±ω_p): two roots meet and the pair holds them only to the square
+        root of the rounding (q5 ~ 1e-7 instead of 0); step 3 then turns q6 by whatever that error points to,
+        where the elbow may not reach (no solution), and near it the second root is merged away. The same
+        condition on the parts normal to ω_p, ``|w⊥|² = |u⊥|²``, keeps every digit there (1 − h² does not).
+        Each step linearises w⊥ (in q1), u⊥ (in q5) and the position equation and solves the resulting
+        quadratic on the position's line, moving to its root nearer the pair (:func:`_nearer_root_on_line`).
+
+        Where that quadratic's other root lies within :data:`_PARTNER_REACH` and one of the two roots tilts axis 6
+        off ω_p (step 3 fixes q6 there; where neither does, both are the one singular branch, q6 free), the other
+        root is the merged one: it is refined the same way and takes a slot of its own (the pairs widen to make
+        room, with one to spare). Returns q1, q5 and valid, (N, m) or wider."""
+        near = valid & (self._wrist_tilt(np.where(valid, q5, 0.0)) < _REFINE_BELOW)
+        if not near.any():
+            return q1, q5, valid
+        rows, slots = np.nonzero(near)
+        targets = A[rows]  # one per refined pair, each pair (K, 1)
+        root_1, root_5 = self._refined(targets, q1[rows, slots][:, None], q5[rows, slots][:, None])
+        _, (other_1, other_5) = self._quadratic_step(targets, root_1, root_5)
+        q1, q5 = q1.copy(), q5.copy()
+        q1[rows, slots], q5[rows, slots] = wrap_angle(root_1[:, 0]), wrap_angle(root_5[:, 0])
+        partner = (np.nan_to_num(np.hypot(other_1, other_5), nan=np.inf) <= _PARTNER_REACH)[:, 0]
+        if not partner.any():
+            return q1, q5, valid
+        rows, slots, targets = rows[partner], slots[partner], targets[partner]
+        partner_1, partner_5 = self._refined(targets, root_1[partner] + other_1[partner],
+                                             root_5[partner] + other_5[partner])
+        partner_1, partner_5 = wrap_angle(partner_1[:, 0]), wrap_angle(partner_5[:, 0])
+        present = (valid[rows] & (np.abs(wrap_angle(partner_1[:, None] - q1[rows])) <= _SAME_ROOT)
+                   & (np.abs(wrap_angle(partner_5[:, None] - q5[rows])) <= _SAME_ROOT)).any(axis=1)
+        tilted = (self._wrist_tilt(q5[rows, slots]) > GEOMETRY_TOLERANCE) | (self._wrist_tilt(partner_5)
+                                                                           > GEOMETRY_TOLERANCE)
+        kept = tilted & ~present  # present: both roots were apart enough for subproblem 6
+        if not kept.any():
+            return q1, q5, valid
+        rows, partner_1, partner_5 = rows[kept], partner_1[kept], partner_5[kept]
+        # room for every partner and one slot to spare (a second arc of q6, :func:`_second_arc_slots`)
+        extra = np.full((len(q1), int(np.bincount(rows).max()) + 1), np.nan)
+        q1, q5 = np.concatenate([q1, extra], axis=1), np.concatenate([q5, extra], axis=1)
+        valid = np.concatenate([valid, np.zeros(extra.shape, dtype=bool)], axis=1)
+        for row, first, fifth in zip(rows.tolist(), partner_1.tolist(), partner_5.tolist()):
+            spare = int(np.argmin(valid[row]))  # the first empty slot
+            q1[row, spare], q5[row, spare], valid[row, spare] = first, fifth, True
+        return q1, q5, valid
+
+    def _refined(self, targets: np.ndarray, q1: np.ndarray, q5: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """:data:`_REFINE_STEPS` steps of :meth:`_quadratic_step` from pairs (q1, q5) of shape (K, 1) for targets
+        A (K, 4, 4)."""
+        for _ in range(_REFINE_STEPS):
+            (step_1, step_5), _ = self._quadratic_step(targets, q1, q5)
+            q1, q5 = q1 + step_1, q5 + step_5
+        return q1, q5
+
+    def _quadratic_step(self, A: np.ndarray, q1: np.ndarray, q5: np.ndarray) -> tuple[tuple[np.ndarray, ...], ...]:
+        """One step of :meth:`_refined_pairs` at pairs (q1, q5) of shape (N, m) for targets A (N, 4, 4): the step
+        to the nearer root of the linearised equations and the step to the other, each a pair (Δq1, Δq5) of (N, m)."""
+        g, w_p = self.geometry, self.omega_p
+        axis_1, axis_5 = g.direction(0), g.direction(4)
+        wanted = rotate_about(axis_1, -q1, (A[:, :3, :3] @ g.direction(5))[:, None, :])  # w = R_1ᵀ R_A ω_6
+        turned = rotate_about(axis_5, q5, g.direction(5))  # u
+        arm = rotate_about(axis_1, -q1, (apply(A, self.centre) - g.point(0))[:, None, :])
+        offset = rotate_about(axis_5, q5, self.centre - g.point(4))
+        position = arm @ w_p - offset @ w_p - w_p @ (g.point(4) - g.point(0))
+        slope_1, slope_5 = -np.cross(axis_1, arm) @ w_p, -np.cross(axis_5, offset) @ w_p
+        normal = self._normal_part
+        return _nearer_root_on_line(normal(wanted), normal(-np.cross(axis_1, wanted)), normal(turned),
+                                    normal(np.cross(axis_5, turned)), position, slope_1, slope_5)
+
+    def _normal_part(self, v: np.ndarray) -> np.ndarray:
+        """The part of vectors (..., 3) normal to the parallel axes."""
+        return v - (v @ self.omega_p)[..., None] * self.omega_p
+
+    def _wrist_tilt(self, q5: np.ndarray) -> np.ndarray:
+        """|u⊥|, how far joint 5 tilts axis 6 off the parallel axes (q5's shape): at most GEOMETRY_TOLERANCE, step 3
+        leaves q6 free, as :func:`subproblem_1` judges it."""
+        g = self.geometry
+        return np.linalg.norm(self._normal_part(rotate_about(g.direction(4), q5, g.direction(5))), axis=-1)
+
+
+#: Steps of :meth:`SkewWristThreeParallelPlan._refined_pairs` (each converges quadratically, a double root in one)
+_REFINE_STEPS = 3
+#: Pairs that tilt axis 6 off ω_p by less than this are refined: subproblem 6 holds a root to about the rounding
+#: over its distance from the other root, which is about this tilt (further off, its Newton steps suffice)
+_REFINE_BELOW = 1e-2
+#: How far (rad) the other root of the linearised equations may lie for it to be the root merged with a pair's
+#: (the linearisation's error is the square of the step: 1e-4 leaves 1e-8, which the steps then remove)
+_PARTNER_REACH = 1e-4
+#: Refined roots closer than this (rad) are one: they agree to ~1e-15, and two roots that step 3 tells apart (one
+#: tilting axis 6 more than GEOMETRY_TOLERANCE) lie ~1e-9 apart or more
+_SAME_ROOT = 1e-11
+
+
+def _nearer_root_on_line(w: np.ndarray, w_slope: np.ndarray, u: np.ndarray, u_slope: np.ndarray, position: np.ndarray,
+                         slope_1: np.ndarray, slope_5: np.ndarray) -> tuple[tuple[np.ndarray, ...], ...]:
+    """The steps (s1, s5) that solve ``|w + s1 w_slope|² = |u + s5 u_slope|²`` on the line
+    ``position + slope_1 s1 + slope_5 s5 = 0``: the one nearer (0, 0) and the other (NaN where the quadratic has
+    no second root). w, u and the slopes (..., 3); the rest (...). Where the roots are complex (a double root
+    split by rounding) both are its vertex."""
+    norm = np.hypot(slope_1, slope_5)
+    norm = np.where(norm > 0.0, norm, 1.0)
+    foot = -position / norm
+    start_1, start_5 = foot * slope_1 / norm, foot * slope_5 / norm  # the point of the line nearest (0, 0)
+    along_1, along_5 = -slope_5 / norm, slope_1 / norm
+    a, a_slope = w + start_1[..., None] * w_slope, along_1[..., None] * w_slope
+    b, b_slope = u + start_5[..., None] * u_slope, along_5[..., None] * u_slope
+    quadratic = np.einsum("...i,...i", a_slope, a_slope) - np.einsum("...i,...i", b_slope, b_slope)
+    half_linear = np.einsum("...i,...i", a, a_slope) - np.einsum("...i,...i", b, b_slope)
+    constant = np.einsum("...i,...i", a - b, a + b)
+    discriminant = np.maximum(half_linear**2 - quadratic * constant, 0.0)
+    big = -half_linear - np.copysign(np.sqrt(discriminant), half_linear)  # no cancellation
+    with np.errstate(divide="ignore", invalid="ignore"):
+        near = np.where(big != 0.0, constant / big, 0.0)
+        far = np.where(quadratic != 0.0, big / quadratic, np.nan)
+    swap = np.abs(far) < np.abs(near)
+    near, far = np.where(swap, far, near), np.where(swap, near, far)
+    return (start_1 + near * along_1, start_5 + near * along_5), (start_1 + far * along_1, start_5 + far * along_5)
 
 
 def _distance_range(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

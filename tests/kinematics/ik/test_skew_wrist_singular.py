@@ -23,12 +23,12 @@ import pytest
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik._arrays import cached_plan
-from tests.kinematics.ik.test_spherical_wrist_classes import _random_rigid
 from tests.kinematics.ik.test_three_parallel_arcs import (
     RESOLVED,
     arc_holding,
     arcs_of,
     reachable_sixth,
+    ur_type_arm,
 )
 
 WRIST_ANGLES = (0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-6, -1e-6, 1e-3, -1e-3)
@@ -38,29 +38,9 @@ COUPLED = np.array([False, True, True, True, False, True])
 
 
 def skew_wrist_arm(seed: int, convention: str) -> Robot:
-    """A random UR-type arm (standard DH rows a, alpha, d, theta, restated in ``convention``) whose axes 5 and 6 are
-    skew (a5 ≠ 0) and whose axis 6 lies along axes 2–4 at q5 = 0 (the twists of rows 4 and 5 cancel, or add to π),
-    with a random base and tool; the offset d5 long (two arcs of q6 possible) or short, by seed."""
-    rng = np.random.default_rng(seed)
-    upper, fore = rng.uniform(0.3, 0.5) * rng.choice([-1, 1]), rng.uniform(0.1, 0.25) * rng.choice([-1, 1])
-    wrist = rng.uniform(0.3, 0.45) if seed % 2 else rng.uniform(0.02, 0.5 * abs(fore))
-    a = np.array([0.0, upper, fore, 0.0, rng.uniform(0.03, 0.12) * rng.choice([-1, 1]), 0.0])
-    d = np.r_[rng.uniform(0.05, 0.2), rng.uniform(-0.1, 0.1, 2), rng.uniform(0.05, 0.2), wrist * rng.choice([-1, 1]),
-              rng.uniform(0.05, 0.2)]
-    twist = rng.uniform(0.3, 2.8) * rng.choice([-1, 1])
-    alpha = np.array([rng.uniform(0.3, 2.8) * rng.choice([-1, 1]), rng.choice([0.0, np.pi]), rng.choice([0.0, np.pi]),
-                      twist, rng.choice([-twist, np.pi - twist]), rng.uniform(-2.8, 2.8)])
-    theta = rng.uniform(-np.pi, np.pi, 6)
-    theta[4] = 0.0
-    base, tool = _random_rigid(rng, 0.5), _random_rigid(rng, 0.2)
-    if convention == "standard":
-        rows = zip(a, alpha, d, theta)
-    else:  # Craig's frames; the last row's a and alpha go into the tool
-        rows = zip(np.r_[0.0, a[:5]], np.r_[0.0, alpha[:5]], d, theta)
-        c, s = np.cos(alpha[5]), np.sin(alpha[5])
-        tool = np.array([[1, 0, 0, a[5]], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]]) @ tool
-    return Robot([Joint(f"j{i + 1}", "revolute", *row) for i, row in enumerate(rows)], convention=convention,
-                 world_T_base=base, flange_T_tool=tool)
+    """A random UR-type arm whose axes 5 and 6 are skew (a5 ≠ 0), with a random base and tool; the offset d5 long
+    (two arcs of q6 possible) for odd seeds, short for even ones."""
+    return ur_type_arm(seed, convention, two_arcs=bool(seed % 2), skew=True)
 
 
 def ur5_with_skew_wrist() -> Robot:

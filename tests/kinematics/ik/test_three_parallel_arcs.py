@@ -31,15 +31,18 @@ WRIST_OFFSETS = (0.0, 1e-12, -1e-12)
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 
 
-def ur_type_arm(seed: int, convention: str, two_arcs: bool) -> Robot:
+def ur_type_arm(seed: int, convention: str, two_arcs: bool, skew: bool = False) -> Robot:
     """A random UR-type arm (standard DH rows a, alpha, d, theta, restated in ``convention``) whose axis 6 lies
     along axes 2–4 at q5 = 0 exactly (the twists of rows 4 and 5 cancel, or add to π: anti-parallel), with a
     random base and tool. ``two_arcs``: the offset between axes 4 and 6 (d5) longer than the shorter planar link,
-    so that the reachable q6 can form two arcs; else shorter than half of it (the UR5's proportions: one arc)."""
+    so that the reachable q6 can form two arcs; else shorter than half of it (the UR5's proportions: one arc).
+    ``skew``: axes 5 and 6 skew (a5 ≠ 0, the three_parallel_skew_wrist family)."""
     rng = np.random.default_rng(seed)
     upper, fore = rng.uniform(0.3, 0.5) * rng.choice([-1, 1]), rng.uniform(0.1, 0.25) * rng.choice([-1, 1])
     wrist = rng.uniform(0.3, 0.45) if two_arcs else rng.uniform(0.02, 0.5 * abs(fore))
     a = np.array([0.0, upper, fore, 0.0, 0.0, 0.0])
+    if skew:
+        a[4] = rng.uniform(0.03, 0.12) * rng.choice([-1, 1])
     d = np.r_[rng.uniform(0.05, 0.2), rng.uniform(-0.1, 0.1, 2), rng.uniform(0.05, 0.2), wrist * rng.choice([-1, 1]),
               rng.uniform(0.05, 0.2)]
     twist = rng.uniform(0.3, 2.8) * rng.choice([-1, 1])

@@ -240,6 +240,8 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
         # 1. shoulder: two roots for q1
         shoulder = subproblem_4(w_p, g.direction(0), c_world - g.point(0), w_p @ (self.centre - g.point(0)))
         q1 = -shoulder.theta  # (N, 2)
+        if reference is not None:  # the centre on axis 1: any q1 puts it there, so q1 takes the reference value
+            q1 = np.where(shoulder.degenerate[..., None], reference[0], q1)
         R1 = rotation_about(g.direction(0), q1)  # (N, 2, 3, 3)
         R_rest = np.swapaxes(R1, -1, -2) @ A[:, None, :3, :3]  # (N, 2, 3, 3)
         # 2. wrist: two roots for q5. R_rest ω_6 = R_234 R(ω_5, q5) ω_6 with R_234 a turn about ω_p: subproblem 2
@@ -247,7 +249,7 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
         # (height cos q5) holds q5 only to second order and merged ±q5 below 5e-7 into q5 = 0.
         wrist = subproblem_2(w_p, g.direction(4), R_rest @ g.direction(5), g.direction(5))
         _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
-                                                    "the wrist point is on the first axis; joint 1 is free"), singular)
+                                                    "the wrist point is on the first axis; joint 1 is free, set to the reference value (or 0)"), singular)
         _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",
                                                 "the two shoulder solutions meet"), singular)
         valid = shoulder.valid[:, :, None] & wrist.valid

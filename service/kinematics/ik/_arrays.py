@@ -283,8 +283,8 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
                  plan: Plan) -> IKArrays:
     if len(targets) == 1:  # one pose: the family's scalar path when it has one and the pose is clearly generic
         answer = solve_one_pose(robot, targets[0], constrain_orientation, reference, plan)
-        if answer is not None:
-            return answer.arrays()
+        if answer is not None and (answer.count or not answer.singularities.entries):
+            return answer.arrays()  # (no solution at a singular condition: the array path weighs the promise)
     candidates = plan.solve(targets, reference)
     n_targets, m, n = candidates.joints.shape
     joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
@@ -303,7 +303,8 @@ def _solve_chunk(robot: Robot, targets: np.ndarray, constrain_orientation: bool,
     error = position / arm_size(robot)
     if constrain_orientation:
         error = np.maximum(error, orientation)
-    complete = _promised(candidates, count, np.where(candidates.valid, error, np.inf).min(axis=1))
+    complete = _promised(candidates, count, np.where(candidates.valid, error, np.inf).min(axis=1),
+                         constrain_orientation)
     if candidates.promise_needs_every_slot:  # the solver's promise holds only if every valid slot gave a solution
         complete &= count == candidates.valid.sum(axis=1)
     take = (np.arange(n_targets)[:, None], order)
@@ -393,19 +394,25 @@ _FRAGILE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum",
                                 "boundary", "stretched", "folded", "stretched_or_folded"})
 
 
-def _promised(candidates, count: np.ndarray, nearest: np.ndarray) -> np.ndarray:
-    """Which rows (N,) may claim every solution: the family's own word (:attr:`Candidates.complete`), except that
-    a row with no verified solution, where the family set a joint it found free or saw two roots meet, and whose
-    nearest candidate missed by less than ``POLISH_RESIDUAL`` (``nearest`` (N,): fraction of the arm's size, or
-    radians), is not a proof of unreachability: the representative it chose, or the double root, failed
-    narrowly; another value of that joint, or the root pair a rounding error moved off the real line, may not
-    (an arm whose remaining axes are not exactly aligned with the free one, as rounded geometry gives). Those
-    rows go to the fallback."""
+def _promised(candidates, count: np.ndarray, nearest: np.ndarray, constrain_orientation: bool) -> np.ndarray:
+    """Which rows (N,) may claim every solution: the family's own word (:attr:`Candidates.complete`), except for
+    rows with no verified solution where the family set a joint it found free or saw two roots meet:
+
+    * whose nearest candidate missed by less than ``POLISH_RESIDUAL`` (``nearest`` (N,): fraction of the arm's
+      size, or radians): the representative it chose, or the double root, failed narrowly; another value of
+      that joint, or the root pair a rounding error moved off the real line, may not (an arm whose remaining
+      axes are not exactly aligned with the free one, as rounded geometry gives);
+    * on a pose target, a joint left free (relation ``free``) whatever the miss: the position does not fix it,
+      the orientation (or the joints after it) may, and the value the family held it at is one of many.
+
+    Those rows go to the fallback."""
     complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
     narrow = (count == 0) & (nearest <= POLISH_RESIDUAL)
     for mask, flag in candidates.singularities.entries:
         if flag.relation in _FRAGILE_RELATIONS:
             complete &= ~(mask & narrow)
+        if constrain_orientation and flag.relation == "free":
+            complete &= ~(mask & (count == 0))
     return complete
 
 

@@ -18,9 +18,10 @@ import numpy as np
 from .._tolerances import GEOMETRY_TOLERANCE
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, Positioner
-from ._screws import apply, chain_rotation, invert
+from ._screws import apply, chain_rotation, invert, rotation_about
+from ._subproblems import subproblem_1
 from ._types import Candidates, LabelCodes, SingularFlags
-from ._wrist import Roll, SphericalWrist
+from ._wrist import Roll, SphericalWrist, _perpendicular_unit
 
 
 class DecoupledPlan:
@@ -68,11 +69,17 @@ class DecoupledPlan:
         joints[..., :k] = arm_joints
         for index, value in self.fixed.items():
             joints[..., index] = value
-        if self.wrist is None:
+        if self.home_inverse is None:
             return Candidates(joints, arm_valid, singular)
         model = self.positioner.model if self.positioner else None
-        # the wrist's rotation: H = G⁻¹ · world_T_target · home⁻¹, of which only the rotation is needed
+        # the joints' rotation R_1 ⋯ R_n = world_T_target · home⁻¹ (rotation part), shape (N, 3, 3)
         R_target = world_T_targets[:, :3, :3] @ self.home_inverse[:3, :3]
+        if self.positioner is not None:
+            self._turn_free_joints(joints, arm_valid, singular, R_target)
+            arm_joints = joints[..., :k]
+        if self.wrist is None:
+            return Candidates(joints, arm_valid, singular)
+        # the wrist's rotation: H = G⁻¹ · world_T_target · home⁻¹, of which only the rotation is needed
         if self.positioner is not None:
             R_G = chain_rotation(model.directions[:k], model.is_revolute[:k], np.nan_to_num(arm_joints))
             R_H = np.swapaxes(R_G, -1, -2) @ R_target[:, None]
@@ -89,6 +96,65 @@ class DecoupledPlan:
             singular.add((mask.reshape(n_targets, m_arm) & arm_valid).any(axis=1), flag)
         return Candidates(full.reshape(n_targets, m_arm * m_wrist, self.dof), valid.reshape(n_targets, -1),
                           singular)
+
+    def _turn_free_joints(self, joints: np.ndarray, valid: np.ndarray, singular: SingularFlags,
+                          R_target: np.ndarray) -> None:
+        """Set, in place, positioning joints the position leaves free from the target's orientation.
+
+        ``joints`` (N, m, n) with the positioner's values, ``valid`` (N, m), ``singular`` the positioner's flags
+        (N rows), ``R_target`` (N, 3, 3) the joints' rotation R_1 ⋯ R_n the target asks for. Where a flag says
+        revolute joints are free (the point is on their axes: turning them keeps it), the others fixed:
+
+        * one joint j: ``A R(ω_j, θ) B = R_target``, A and B the rotations of the joints before and after it.
+          With no wrist, subproblem 1 turns a vector u normal to ω_j onto ``M u``, ``M = Aᵀ R_target Bᵀ``; with
+          a roll (whose turn keeps its axis ω_r), B ω_r onto ``Aᵀ R_target ω_r``, the roll then following;
+        * two joints i < j, no wrist (the point at their axes' crossing): ``M = R(ω_i, θ_i) C R(ω_j, θ_j)``
+          with C the rotations between them; ``R(ω_j, θ_j)`` keeps ω_j, so subproblem 1 turns C ω_j onto
+          M ω_j for θ_i, and then θ_j as for one joint with ``Cᵀ R(ω_i, θ_i)ᵀ M``.
+
+        Where a subproblem is degenerate (the vector on the axis: only a sum is fixed) the positioner's values
+        stay; with a spherical wrist the wrist absorbs them, so they stay free; with two free joints and a roll,
+        or a two-axis wrist, they stay as the positioner set them (the row is then not promised complete when
+        nothing verifies: ``_promised`` in :mod:`._arrays`).
+        """
+        if self.wrist is not None and not isinstance(self.wrist, Roll):
+            return
+        model, k = self.positioner.model, len(self.positioner.joints)
+        for mask, flag in list(singular.entries):
+            free = flag.joints
+            if (flag.relation != "free" or len(free) > (1 if self.wrist is not None else 2) or max(free) >= k
+                    or not model.is_revolute[list(free)].all()):
+                continue
+            rows = np.flatnonzero(mask)
+            q = np.nan_to_num(joints[rows])  # (r, m, n)
+
+            def turns(start: int, stop: int) -> np.ndarray:
+                """The rotation of joints start … stop − 1 at q, (r, m, 3, 3)."""
+                return chain_rotation(model.directions[start:stop], model.is_revolute[start:stop],
+                                      q[..., start:stop])
+
+            i, j = free[0], free[-1]
+            B = turns(j + 1, k)
+            wanted = np.swapaxes(turns(0, i), -1, -2) @ R_target[rows, None]  # Aᵀ R_target, (r, m, 3, 3)
+            held = ~valid[rows]
+            axis = model.directions[j]
+            if self.wrist is not None:
+                roll = model.directions[self.wrist.joints[0]]
+                last = subproblem_1(axis, B @ roll, wanted @ roll)
+            else:
+                M = wanted @ np.swapaxes(B, -1, -2)
+                if i != j:
+                    C = turns(i + 1, j)
+                    first = subproblem_1(model.directions[i], C @ axis, M @ axis)
+                    held |= first.degenerate
+                    q[..., i] = first.theta[..., 0]
+                    M = np.swapaxes(rotation_about(model.directions[i], q[..., i]) @ C, -1, -2) @ M
+                u = _perpendicular_unit(axis)
+                last = subproblem_1(axis, np.broadcast_to(u, q.shape[:-1] + (3,)), M @ u)
+            held |= last.degenerate
+            q[..., j] = last.theta[..., 0]
+            joints[rows, :, i] = np.where(held, joints[rows, :, i], q[..., i])
+            joints[rows, :, j] = np.where(held, joints[rows, :, j], q[..., j])
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         """Branch labels of full joint vectors (M, n) as arrays: the positioner's, then the wrist's."""

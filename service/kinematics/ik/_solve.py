@@ -96,14 +96,18 @@ def results_from_arrays(robot: Robot, arrays: IKArrays, targets: np.ndarray, con
                         reference: np.ndarray | None, options: IKOptions | None = None) -> list[IKResult]:
     """One :class:`IKResult` per row of :func:`solve_ik_arrays`' answer.
 
-    Rows the closed form could not promise complete (:attr:`IKArrays.complete`, rounded geometry only) are
-    answered by the fallback, keeping the closed form's verified solutions (:func:`_incomplete_row`).
+    Rows the closed form could not promise complete (:attr:`IKArrays.complete`: rounded geometry, or a singular
+    condition it met, see ``_promised`` in :mod:`._arrays`) are answered by the fallback, keeping the closed
+    form's verified solutions (:func:`_incomplete_row`) and reporting the conditions it met.
     """
     results = _closed_form_results(robot, arrays, targets, constrain_orientation, reference)
     for row in np.flatnonzero(~arrays.complete).tolist():
         known = arrays.joints[row, :arrays.count[row]]
         results[row] = _incomplete_row(robot, targets[row], known, arrays.structure, constrain_orientation,
                                        reference, options or IKOptions())
+        # the conditions the closed form met there are why it could not promise the answer: they are reported
+        met = results[row].singularities
+        met.extend(flag for flag in arrays.singularities[row] if flag not in met)
     return results
 
 

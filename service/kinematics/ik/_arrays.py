@@ -402,8 +402,11 @@ def _promised(candidates, count: np.ndarray, nearest: np.ndarray, constrain_orie
       size, or radians): the representative it chose, or the double root, failed narrowly; another value of
       that joint, or the root pair a rounding error moved off the real line, may not (an arm whose remaining
       axes are not exactly aligned with the free one, as rounded geometry gives);
-    * on a pose target, a joint left free (relation ``free``) whatever the miss: the position does not fix it,
-      the orientation (or the joints after it) may, and the value the family held it at is one of many.
+    * on a pose target, a joint left free (relation ``free``) where some candidate reached the position: the
+      position does not fix that joint, the orientation (or the joints after it) may, and the value the family
+      held it at is one of many. Where no candidate was valid, the family found the position out of reach
+      whatever the free joint (a family whose free joint changes the reach says so itself, through
+      :attr:`Candidates.complete`).
 
     Those rows go to the fallback."""
     complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
@@ -412,7 +415,7 @@ def _promised(candidates, count: np.ndarray, nearest: np.ndarray, constrain_orie
         if flag.relation in _FRAGILE_RELATIONS:
             complete &= ~(mask & narrow)
         if constrain_orientation and flag.relation == "free":
-            complete &= ~(mask & (count == 0))
+            complete &= ~(mask & (count == 0) & candidates.valid.any(axis=1))
     return complete
 
 

@@ -142,8 +142,15 @@ class _AxesTwoToFourParallel:
             stretched = np.cos(q3[..., 0][np.arange(n), first]) > 0
             for kind, mask in (("stretched", merged_rows & stretched), ("folded", merged_rows & ~stretched)):
                 singular.add(mask, Singularity("elbow", (2,), kind, f"the arm is fully {kind}"))
+        # a free q1 (the wrist point on axis 1) held where the elbow reaches with no wrist root: another q1 may
+        # reach, so the empty row is no proof (the fallback searches)
+        shoulder_free = np.zeros(n, dtype=bool)
+        for mask, flag in singular.entries:
+            if flag.kind == "shoulder" and flag.relation == "free":
+                shoulder_free |= mask
+        unpromised = unrepresented | (shoulder_free & ~valid.any(axis=(1, 2)))
         return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), singular,
-                          complete=~unrepresented if unrepresented.any() else None)
+                          complete=~unpromised if unpromised.any() else None)
 
     def _reachable_sixth(self, A: np.ndarray, R1: np.ndarray, G5: np.ndarray, q6: np.ndarray,
                          free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

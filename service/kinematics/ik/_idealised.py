@@ -126,18 +126,23 @@ class IdealisedPlan:
         # a row with nothing verified: the closed form's decoupling may amplify δ beyond the near-miss margin
         # where one of its steps is poorly conditioned though the arm is not (an under-determined arm's joint 1
         # from a point close to axis 1, which the orientation fixes): every other candidate is refined too, and
-        # a row answered only that way is not promised complete (the margins of criterion 2 did not hold)
+        # a row answered only that way is not promised complete (the margins of criterion 2 did not hold). The
+        # near misses of criterion 2 stay those of the candidates it speaks of (a refined least-squares answer of
+        # an unreachable target says nothing about the margin)
         rescue = finite & ~tried & ~accepted.any(axis=1)[:, None]
         rescued = np.zeros(len(world_T_targets), dtype=bool)
         rows, slots = np.nonzero(rescue)
         if len(rows):
+            kept = joints.copy()
             refined = polish(robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation,
                              steps=REFINE_STEPS)
             joints[rows, slots] = wrap_revolute(robot, refined)
             position, orientation = residual_arrays(robot, joints, world_T_targets)
-            tried |= rescue
-            accepted = self._accepted(position, orientation) & tried
-            rescued = (accepted & rescue).any(axis=1)
+            reached = self._accepted(position, orientation) & rescue
+            joints = np.where(reached[..., None] | ~rescue[..., None], joints, kept)  # the others as they were
+            position, orientation = residual_arrays(robot, joints, world_T_targets)
+            accepted |= reached
+            rescued = reached.any(axis=1)
         # 2. near misses: a candidate that came within NEAR_MISS δ of the target on the true arm, before or after
         # refinement, without reaching it
         after = self._size(position, orientation)

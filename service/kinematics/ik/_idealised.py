@@ -122,10 +122,27 @@ class IdealisedPlan:
                              steps=REFINE_STEPS)
             joints[rows, slots] = wrap_revolute(robot, refined)
         position, orientation = residual_arrays(robot, joints, world_T_targets)
-        accepted = position <= ACCEPT_RESIDUAL * arm_size(robot)
-        if self.constrain_orientation:
-            accepted &= orientation <= ACCEPT_RESIDUAL
-        accepted &= tried
+        accepted = self._accepted(position, orientation) & tried
+        # a row with nothing verified: the closed form's decoupling may amplify δ beyond the near-miss margin
+        # where one of its steps is poorly conditioned though the arm is not (an under-determined arm's joint 1
+        # from a point close to axis 1, which the orientation fixes): every other candidate is refined too, and
+        # a row answered only that way is not promised complete (the margins of criterion 2 did not hold). The
+        # near misses of criterion 2 stay those of the candidates it speaks of (a refined least-squares answer of
+        # an unreachable target says nothing about the margin)
+        rescue = finite & ~tried & ~accepted.any(axis=1)[:, None]
+        rescued = np.zeros(len(world_T_targets), dtype=bool)
+        rows, slots = np.nonzero(rescue)
+        if len(rows):
+            kept = joints.copy()
+            refined = polish(robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation,
+                             steps=REFINE_STEPS)
+            joints[rows, slots] = wrap_revolute(robot, refined)
+            position, orientation = residual_arrays(robot, joints, world_T_targets)
+            reached = self._accepted(position, orientation) & rescue
+            joints = np.where(reached[..., None] | ~rescue[..., None], joints, kept)  # the others as they were
+            position, orientation = residual_arrays(robot, joints, world_T_targets)
+            accepted |= reached
+            rescued = reached.any(axis=1)
         # 2. near misses: a candidate that came within NEAR_MISS δ of the target on the true arm, before or after
         # refinement, without reaching it
         after = self._size(position, orientation)
@@ -150,8 +167,15 @@ class IdealisedPlan:
             singular[rows[near_singular]] = True
         for mask, _ in ideal.singularities.entries:
             singular |= mask
-        complete = converged & distinct & ~near_miss & ~singular
+        complete = converged & distinct & ~near_miss & ~singular & ~rescued
         return Candidates(joints, accepted, ideal.singularities, complete=complete)
+
+    def _accepted(self, position: np.ndarray, orientation: np.ndarray) -> np.ndarray:
+        """Which slots reach the target on the true arm at the acceptance tolerance."""
+        accepted = position <= ACCEPT_RESIDUAL * arm_size(self.robot)
+        if self.constrain_orientation:
+            accepted &= orientation <= ACCEPT_RESIDUAL
+        return accepted
 
     def _stalled_apart(self, joints: np.ndarray, world_T_targets: np.ndarray, missed: np.ndarray,
                        after: np.ndarray) -> np.ndarray:

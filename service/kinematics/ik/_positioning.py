@@ -273,6 +273,12 @@ class IntersectingShoulder(Positioner):
         band_squared = 2 * rounding * (radius + inner + band_along)
         met = across_squared <= band_squared  # the two shoulder solutions ±a meet: a = 0 represents them
         free = met & (np.abs(along) <= band_along)  # the point on axis 2: joint 2 does not move it
+        # the point within half the acceptance of the centre (an arm without shoulder offset): every q1, q2
+        # reaches it, and the position fixes them only to rounding over that distance, worse than the
+        # acceptance (≥ rounding / 1e-9 > 1e-5 of the arm's size): it is treated as at the centre, both free
+        at_centre = np.linalg.norm(y, axis=-1) <= 0.5 * GEOMETRY_TOLERANCE * g.length_scale
+        met |= at_centre
+        free |= at_centre
         across = np.where(met, 0.0, np.sqrt(np.maximum(across_squared, 0.0)))
         first_sign = np.ones(n_targets)
         free_angle = frame.psi0 + (0.0 if reference is None else reference[j])
@@ -292,7 +298,7 @@ class IntersectingShoulder(Positioner):
                                                       + np.sin(psi)[..., None] * frame.n2)
         first = subproblem_1(k1, turned, y[:, None, None, :], free_below=rounding[:, None, None])
         q1 = first.theta[..., 0]
-        free_first = first.degenerate  # the target on axis 1 (a polar arm without offset)
+        free_first = first.degenerate | at_centre[:, None, None]  # the target on axis 1 (a polar arm without offset)
         if reference is not None:  # an azimuth seen on a radius r is known to rounding / r
             band_first = rounding[:, None, None] / np.maximum(radius[:, None, None], 1e-300)
             q1 = np.where(free_first | (np.abs(wrap_angle(q1 - reference[i])) <= band_first), reference[i], q1)

@@ -27,6 +27,7 @@ from tests.kinematics.ik.test_three_parallel_arcs import (
     RESOLVED,
     arc_holding,
     arcs_of,
+    fk_miss,
     reachable_sixth,
     ur_type_arm,
 )
@@ -75,10 +76,7 @@ def _problem(robot: Robot, q: np.ndarray, arcs: list[np.ndarray], solutions: np.
         return "incomplete"
     if len(solutions) == 0:
         return "no solution"
-    target = forward_kinematics(robot, q)
-    reached = forward_kinematics(robot, solutions)
-    miss = max(np.abs(reached[:, :3, 3] - target[:3, 3]).max() / robot.characteristic_length,
-               np.abs(reached[:, :3, :3] - target[:3, :3]).max())
+    miss = fk_miss(robot, solutions, forward_kinematics(robot, q)).max()
     if miss > 1e-9:
         return f"FK miss {miss:.1e}"
     gaps = np.abs(joint_difference(robot, solutions, q))

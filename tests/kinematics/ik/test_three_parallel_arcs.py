@@ -79,6 +79,14 @@ def reachable_sixth(robot: Robot, q: np.ndarray) -> np.ndarray:
     return (abs(upper - fore) <= reach) & (reach <= upper + fore)
 
 
+def fk_miss(robot: Robot, solutions: np.ndarray, target: np.ndarray) -> np.ndarray:
+    """How far each of the solutions (M, n) misses the target (4, 4) by this test's FK, (M,): the position over the
+    arm's size, or the rotation matrix's largest entry, whichever is larger."""
+    reached = forward_kinematics(robot, solutions)
+    return np.maximum(np.abs(reached[:, :3, 3] - target[:3, 3]).max(axis=1) / robot.characteristic_length,
+                      np.abs(reached[:, :3, :3] - target[:3, :3]).max(axis=(1, 2)))
+
+
 def grid() -> np.ndarray:
     return -np.pi + 2 * np.pi * np.arange(GRID) / GRID
 
@@ -122,10 +130,7 @@ def _check(robot: Robot, q: np.ndarray, arcs: list[np.ndarray], solutions: np.nd
     clearly on an arc; the answer complete; every solution on the target (an FK of this test)."""
     if not complete:
         return "incomplete"
-    target = forward_kinematics(robot, q)
-    reached = forward_kinematics(robot, solutions)
-    miss = max(np.abs(reached[:, :3, 3] - target[:3, 3]).max() / robot.characteristic_length,
-               np.abs(reached[:, :3, :3] - target[:3, :3]).max())
+    miss = fk_miss(robot, solutions, forward_kinematics(robot, q)).max()
     if miss > 1e-9:
         return f"FK miss {miss:.1e}"
     branch = solutions[(np.abs(_wrapped(solutions[:, 0] - q[0])) <= 1e-6)

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import gc
 import time
 from typing import Callable
 
@@ -26,7 +27,8 @@ import orjson
 from fastapi import FastAPI
 from pydantic import BaseModel
 
-from service.api.app import create_app
+from service.api import routing
+from service.api.app import _tune_collector, create_app
 from service.api.boundary import free_joints_to_core, ik_selection_to_core, ik_targets_to_core
 from service.api.budget import check_ik_cost
 from service.api.ik_encoding import ik_objects
@@ -92,6 +94,35 @@ def _bare_application() -> FastAPI:
     return bare
 
 
+def _collector_passes() -> tuple[float, float]:
+    """Seconds of one full collector pass with what start-up built (the application, its catalogue) tracked, and
+    with it frozen as the application's lifespan freezes it (best of three each)."""
+    from service.robots.catalogue import load_catalogue
+    settings = Settings(log_level="warning")
+    # what start-up builds (the application and its catalogue), alive while the passes run
+    started = create_app(settings), load_catalogue([settings.builtin_robots_dir], max_joints=settings.max_joints)
+    thresholds = gc.get_threshold()
+    gc.unfreeze()
+
+    def full_pass() -> float:
+        best = float("inf")
+        for _ in range(3):
+            started = time.perf_counter()
+            gc.collect()
+            best = min(best, time.perf_counter() - started)
+        return best
+
+    tracked = full_pass()
+    _tune_collector()
+    try:
+        frozen = full_pass()
+    finally:
+        gc.unfreeze()
+        gc.set_threshold(*thresholds)
+    del started
+    return tracked, frozen
+
+
 def _seconds(function: Callable[[], object], count: int) -> float:
     for _ in range(min(50, count)):
         function()
@@ -126,6 +157,14 @@ def main(argv: list[str] | None = None) -> int:
     healthz = _asgi_seconds(app, "GET", "/healthz", b"", count)
     fk = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/fk", fk_body, count)
     ik = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/ik", ik_body, count)
+    # the same requests handed to a work loop, as every request was before small work ran where it arrives
+    small_body_bytes, routing.SMALL_BODY_BYTES = routing.SMALL_BODY_BYTES, -1
+    try:
+        fk_handed = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/fk", fk_body, count)
+        ik_handed = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/ik", ik_body, count)
+    finally:
+        routing.SMALL_BODY_BYTES = small_body_bytes
+    tracked_pass, frozen_pass = _collector_passes()
 
     # the IK request's stages, alone, on the same body (as the router runs them)
     body = IKRequest.model_validate(orjson.loads(ik_body))
@@ -170,12 +209,17 @@ def main(argv: list[str] | None = None) -> int:
             print(f"|     of which the solve alone (solve_ik) | {solve * 1e6:,.1f} | {solve / ik:.2f} |")
     rest = ik - sum(stages.values())
     print(f"|   framework, middleware, hand-over (the rest) | {rest * 1e6:,.1f} | {rest / ik:.2f} |")
+    print(f"| POST fk, whole request, handed to a work loop | {fk_handed * 1e6:,.1f} | {fk_handed / ik:.2f} |")
+    print(f"| POST ik, whole request, handed to a work loop | {ik_handed * 1e6:,.1f} | {ik_handed / ik:.2f} |")
     print(f"| bare FastAPI: GET | {bare_get * 1e6:,.1f} | |")
     print(f"| bare FastAPI: POST of the FK body, validated | {bare_post * 1e6:,.1f} | |")
     print(f"\n- bare FastAPI, POST / GET: {bare_post / bare_get:.1f} (its share of GET is at most {bare_get / bare_post:.2f})")
     print(f"- whole IK request / GET /healthz, in process: {ik / healthz:.1f} (wrk's share of /healthz is bounded by "
           f"its inverse, {healthz / ik:.2f}, before the network)")
     print(f"- whole FK request / GET /healthz, in process: {fk / healthz:.1f} (bound {healthz / fk:.2f})")
+    print(f"- handed to a work loop / where it arrives: FK {fk_handed / fk:.2f}, IK {ik_handed / ik:.2f}")
+    print(f"- one full garbage-collector pass in this process: {tracked_pass * 1e3:,.1f} ms with the start-up "
+          f"objects tracked, {frozen_pass * 1e3:,.1f} ms with them frozen (the lifespan's _tune_collector)")
     return 0
 
 

@@ -78,6 +78,10 @@ def nearest_ids(wanted: str, ids: list[str], limit: int = 5) -> list[str]:
     return chosen[:limit]
 
 
+#: Where a request keeps the inline robot it found, so that starting again on a work loop does not look it up twice.
+_INLINE_ROBOT = "inline_robot"
+
+
 def inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef:
     """The robot a request describes, built once per canonical description (see :mod:`.robot_cache`)."""
     max_joints = settings_of(request).max_joints
@@ -93,9 +97,6 @@ def inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef
         robot = cache.get(key, build)
         setattr(request.state, _INLINE_ROBOT, robot)
     return RobotRef(description.id, robot)
-
-
-_INLINE_ROBOT = "inline_robot"
 
 
 def with_request_frames(ref: RobotRef, body) -> RobotRef:

@@ -132,17 +132,16 @@ class IdealisedPlan:
         rescue = finite & ~tried & ~accepted.any(axis=1)[:, None]
         rescued = np.zeros(len(world_T_targets), dtype=bool)
         rows, slots = np.nonzero(rescue)
-        if len(rows):
-            kept = joints.copy()
-            refined = polish(robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation,
-                             steps=REFINE_STEPS)
-            joints[rows, slots] = wrap_revolute(robot, refined)
-            position, orientation = residual_arrays(robot, joints, world_T_targets)
-            reached = self._accepted(position, orientation) & rescue
-            joints = np.where(reached[..., None] | ~rescue[..., None], joints, kept)  # the others as they were
-            position, orientation = residual_arrays(robot, joints, world_T_targets)
-            accepted |= reached
-            rescued = reached.any(axis=1)
+        if len(rows):  # only the refined slots that reach are kept; the others stay as they were
+            refined = wrap_revolute(robot, polish(robot, joints[rows, slots], world_T_targets[rows],
+                                                  self.constrain_orientation, steps=REFINE_STEPS))
+            p, o = residual_arrays(robot, refined[:, None, :], world_T_targets[rows])
+            reached = self._accepted(p[:, 0], o[:, 0])
+            rows, slots = rows[reached], slots[reached]
+            joints[rows, slots] = refined[reached]
+            position[rows, slots], orientation[rows, slots] = p[reached, 0], o[reached, 0]
+            accepted[rows, slots] = True
+            rescued[rows] = True
         # 2. near misses: a candidate that came within NEAR_MISS δ of the target on the true arm, before or after
         # refinement, without reaching it
         after = self._size(position, orientation)

@@ -15,7 +15,8 @@ from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, ROUNDING_TOLERANCE
+from .._tolerances import (ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE,
+                          ROUNDING_TOLERANCE)
 from .._rotations import wrap_angle
 from ._screws import chain_motion, chain_rotation, move_point, rotate_about
 from ._structure import Geometry
@@ -276,7 +277,7 @@ class IntersectingShoulder(Positioner):
         # the point within half the acceptance of the centre (an arm without shoulder offset): every q1, q2
         # reaches it, and the position fixes them only to rounding over that distance, worse than the
         # acceptance (≥ rounding / 1e-9 > 1e-5 of the arm's size): it is treated as at the centre, both free
-        at_centre = np.linalg.norm(y, axis=-1) <= 0.5 * GEOMETRY_TOLERANCE * g.length_scale
+        at_centre = np.linalg.norm(y, axis=-1) <= 0.5 * ACCEPT_RESIDUAL * g.length_scale
         met |= at_centre
         free |= at_centre
         across = np.where(met, 0.0, np.sqrt(np.maximum(across_squared, 0.0)))

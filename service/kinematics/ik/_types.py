@@ -93,6 +93,10 @@ class Candidates:
     slot then verifies as a distinct solution (the verification checks that
     part): the general solver's valid slots are roots, not least-squares
     candidates.
+
+    ``labels`` are the slots' branch labels (name → (values, codes (N, m))), computed by the family from the
+    candidates it proposes, so that nothing about the call stays on the plan. None while a family still labels
+    through its plan's ``label_codes``.
     """
 
     joints: np.ndarray
@@ -100,6 +104,7 @@ class Candidates:
     singularities: SingularFlags
     complete: np.ndarray | None = None
     promise_needs_every_slot: bool = False
+    labels: LabelCodes | None = None
 
 
 @dataclass(frozen=True)

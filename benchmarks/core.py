@@ -30,7 +30,7 @@ from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Limits, Robot, forward_kinematics
 from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, solve_ik, solve_ik_batch
-from service.kinematics.ik._arrays import solve_ik_arrays
+from service.kinematics.ik import solve_ik_arrays
 
 from . import anchors
 

@@ -33,8 +33,9 @@ import numpy as np
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics._forward import screw_model
 from service.kinematics.ik import solve_ik
-from service.kinematics.ik._arrays import solve_ik_arrays
-from service.kinematics.ik._verify import joint_difference, residuals
+from service.kinematics.ik import solve_ik_arrays
+from service.kinematics.ik import joint_difference
+from service.kinematics.ik._verify import residuals
 
 RECALL_TOLERANCE = 1e-6
 ACCEPT = 1e-9

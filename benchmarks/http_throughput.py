@@ -48,7 +48,7 @@ import numpy as np
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import forward_kinematics
-from service.kinematics.ik._arrays import solve_ik_arrays
+from service.kinematics.ik import solve_ik_arrays
 
 from .core import machine, sample_configurations
 

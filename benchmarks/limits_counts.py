@@ -21,7 +21,7 @@ sys.path.insert(0, str(ROOT))
 
 from service.robots.catalogue import load_catalogue  # noqa: E402
 from service.kinematics import Limits, forward_kinematics  # noqa: E402
-from service.kinematics.ik import select, solve_ik_batch  # noqa: E402
+from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, solve_ik_batch  # noqa: E402
 
 ROBOTS = {
     "puma560_standard": "PUMA 560, standard DH (Corke's frames)",
@@ -37,14 +37,11 @@ def counts(robot, poses: int, seed: int) -> tuple[np.ndarray, np.ndarray, np.nda
     q = rng.uniform(robot.lower, robot.upper, (poses, robot.dof))
     targets = np.array([forward_kinematics(robot, row) for row in q])
     results = solve_ik_batch(robot, targets)
-    limits = Limits.of(robot)
-    kept, branches, raw, truncated = [], [], [], 0
-    for result in results:
-        selection = select(robot, result, limits, max_equivalents=100_000)
-        kept.append(len(selection.solutions))
-        branches.append(len(result.solutions) - len(selection.rejected))
-        raw.append(len(result.solutions))
-        truncated += selection.expansion_truncated
+    answer = answer_ik(robot, IKTargets.poses(targets), AnswerOptions(limits=Limits.of(robot), max_equivalents=100_000))
+    kept = answer.solutions.counts(poses).tolist()
+    raw = [len(result.solutions) for result in results]
+    branches = (np.array(raw) - answer.rejected.counts(poses)).tolist()
+    truncated = int(answer.truncated.sum())
     return np.array(kept), np.array(branches), np.array(raw), truncated
 
 

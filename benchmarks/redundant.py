@@ -90,13 +90,13 @@ def main(argv: list[str] | None = None) -> int:
         times, answers = _timed(lambda i: solve_free_joint_family(robot, targets[i:i + 1], one, None), poses)
         medians[(label, None)] = statistics.median(times)
         print(_row(label, f"anchor: full pose, q{joint + 1} at one value", times,
-                   float(np.mean([a.arrays.count[0] for a in answers])), float("nan")))
+                   float(np.mean([len(a.verified.table) for a in answers])), float("nan")))
         for with_reference in (False, True):
             references = q + rng.uniform(-0.3, 0.3, q.shape) if with_reference else [None] * poses
             times, answers = _timed(lambda i: solve_free_joint_family(robot, targets[i:i + 1], free, references[i]),
                                     poses)
-            counts = [int(a.arrays.count[0]) for a in answers]
-            recall = np.mean([_recovered(a.arrays.joints[0, :a.arrays.count[0]], q[i])
+            counts = [len(a.verified.table) for a in answers]
+            recall = np.mean([_recovered(a.verified.table.joints, q[i])
                               for i, a in enumerate(answers)])
             task = (f"full pose, q{joint + 1} sampled {args.samples}×" +
                     (", nearest to a reference (continuous search)" if with_reference else ""))

@@ -36,7 +36,7 @@ from service.api.schemas.fk import FKRequest
 from service.api.schemas.ik import IKRequest
 from service.config import Settings
 from service.kinematics import UNLIMITED, forward_kinematics
-from service.kinematics.ik import AnswerOptions, IKOptions, NumericOptions, answer_ik, cached_plan, solve_ik
+from service.kinematics.ik import AnswerOptions, IKOptions, NumericOptions, answer_ik, cached_plan, estimate, solve_ik
 
 from .core import machine, sample_configurations
 
@@ -180,8 +180,7 @@ def main(argv: list[str] | None = None) -> int:
     def boundary() -> None:
         ik_targets_to_core([body.target], body.angle_unit, "body", "target", indexed=False)
         ik_selection_to_core(robot, body)
-        check_ik_cost(settings, robot, limits, targets=1, solutions_per_target=plan.generic_count,
-                      max_equivalents=body.max_equivalents, max_solutions=body.max_solutions)
+        check_ik_cost(settings, robot, limits, estimate(robot, targets, options))
 
     stages = {
         "parse + validate the body": _seconds(lambda: IKRequest.model_validate(orjson.loads(ik_body)), count),

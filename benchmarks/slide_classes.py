@@ -19,7 +19,7 @@ import numpy as np
 
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import solve_ik
-from service.kinematics.ik._arrays import cached_plan, solve_ik_arrays
+from service.kinematics.ik import cached_plan, solve_ik_arrays
 
 from .core import (Report, Row, best_of, format_report, machine, parse_timing_arguments, recall,
                    sample_configurations, timing_arguments)

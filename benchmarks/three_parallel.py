@@ -21,7 +21,7 @@ from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Robot
 from service.kinematics._robot import Joint
-from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik import cached_plan
 
 from .core import (bench_robot, format_report, machine, parse_timing_arguments,
                    report_noting_missing_anchors, timing_arguments)

@@ -4,8 +4,8 @@
   :class:`~service.kinematics.Budget`: a deadline of ``KIN_REQUEST_TIMEOUT_MS`` (or the lower value of the
   request's ``X-Request-Timeout-Ms`` header), cancelled when the client disconnects. It refuses work beyond
   ``KIN_MAX_IN_FLIGHT`` requests at once with 503 and ``Retry-After``; ``/readyz`` reports the same saturation.
-* The routers call :func:`check_ik_cost` before solving: the worst-case answer,
-  estimated from targets × solutions per target × 2π-equivalents per solution, is held against
+* The routers call :func:`check_ik_cost` before solving: the core's cost estimate (the worst-case answer,
+  targets × solutions per target × 2π-equivalents per solution, and the numeric starts) is held against
   ``KIN_MAX_SOLUTIONS_PER_RESPONSE`` and ``KIN_MAX_RESPONSE_BYTES``, and each joint's limits against
   ``KIN_MAX_TURNS_PER_JOINT``. Over a cap → 413 (422 for the turns) naming the cap and by how much.
 * :class:`~service.kinematics.BudgetExhausted` from the core becomes a 503 problem with ``Retry-After``.
@@ -24,7 +24,7 @@ from fastapi.responses import JSONResponse
 from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from ..config import Settings
-from ..kinematics.ik import MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit
+from ..kinematics.ik import MAX_COMBINATIONS_PER_SOLUTION, Cost, enumerable_limit
 from ..kinematics import UNLIMITED, Budget, BudgetExhausted, Limits, Robot
 from .problems import PROBLEM_MEDIA_TYPE, PROBLEM_TYPE_BASE, ProblemError, problem_response
 from .routing import CORE_TURNS
@@ -170,24 +170,7 @@ async def budget_exhausted(request: Request, exc: BudgetExhausted) -> JSONRespon
                             instance=request.url.path, headers={"Retry-After": str(RETRY_AFTER_SECONDS)})
 
 
-# --------------------------------------------------------------------------- the cost model
-
-
-def equivalents_per_solution(robot: Robot, limits: Limits) -> int:
-    """Most 2π-equivalents one generic solution can have within the limits: Π_j ceil(span_j / 2π) over revolute
-    joints with both bounds finite (1 for every other joint), capped at 2**53 − 1.
-
-    A joint whose span is not a whole number of turns holds at most ceil(span / 2π) values of a 2π-lattice; one
-    more only when a value lands exactly on both bounds. Examples: a ±160° joint 1, a ±360° joint 2 (a UR5 has at
-    most 2⁶ = 64 per solution).
-    """
-    both = robot.is_revolute & np.isfinite(limits.lower) & np.isfinite(limits.upper)
-    spans = np.where(both, limits.upper - limits.lower, 0.0)
-    per_joint = np.where(both, np.maximum(np.ceil(spans / (2 * np.pi)), 1), 1)
-    product = 1
-    for factor in per_joint.tolist():
-        product = min(product * int(factor), 2**53 - 1)
-    return product
+# --------------------------------------------------------------------------- the cost model's caps
 
 
 def check_turns(settings: Settings, robot: Robot, limits: Limits, location: tuple) -> None:
@@ -206,81 +189,44 @@ def check_turns(settings: Settings, robot: Robot, limits: Limits, location: tupl
                                     "type": "value_error"}])
 
 
-def check_answer_size(settings: Settings, robot: Robot, *, targets: int, per_target: int, form: str,
-                      what: str) -> None:
-    """413 when ``targets × per_target`` solutions would exceed KIN_MAX_SOLUTIONS_PER_RESPONSE or the estimated
+def check_answer_size(settings: Settings, robot: Robot, *, rows: int, form: str, what: str) -> None:
+    """413 when an answer of ``rows`` solutions would exceed KIN_MAX_SOLUTIONS_PER_RESPONSE or the estimated
     response bytes KIN_MAX_RESPONSE_BYTES; says which cap, by how much, and what lowers it."""
-    solutions = targets * per_target
     cap = settings.max_solutions_per_response
     remedy = ("Lower max_equivalents or max_solutions (each caps the solutions per target), send fewer targets, "
               "or narrow multi-turn limits.")
-    if solutions > cap:
+    if rows > cap:
         raise ProblemError(413, "answer-too-large", "Answer too large",
-                           f"The answer could hold {solutions:,} solutions ({what}), "
-                           f"{solutions - cap:,} more than KIN_MAX_SOLUTIONS_PER_RESPONSE = {cap:,}. {remedy}")
-    size = solutions * (_SOLUTION_OVERHEAD_BYTES[form] + _BYTES_PER_NUMBER * robot.dof)
+                           f"The answer could hold {rows:,} solutions ({what}), "
+                           f"{rows - cap:,} more than KIN_MAX_SOLUTIONS_PER_RESPONSE = {cap:,}. {remedy}")
+    size = rows * (_SOLUTION_OVERHEAD_BYTES[form] + _BYTES_PER_NUMBER * robot.dof)
     if size > settings.max_response_bytes:
         raise ProblemError(413, "answer-too-large", "Answer too large",
                            f"The answer could take about {size:,} bytes ({what}), {size - settings.max_response_bytes:,} "
                            f"more than KIN_MAX_RESPONSE_BYTES = {settings.max_response_bytes:,}. {remedy}")
 
 
-def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, *, targets: int, solutions_per_target: int,
-                  max_equivalents: int, max_solutions: int | None, form: str = "objects",
-                  numeric_starts: int | None = None, kept_asked: bool = True) -> int:
-    """The IK cost model, before any solving: turns per joint, the numeric work, then the worst-case answer size,
-    which it returns (the most solutions the answer can hold, rejected ones included).
-
-    ``solutions_per_target`` is the family's generic count (8 for a PUMA) or, for the numeric search, its starts
-    (``numeric_starts``, which also count as work). ``kept_asked``: the client chose ``max_equivalents`` or
-    ``max_solutions``; a default too large to rank exactly is lowered by the core (and said in the notes) rather
-    than refused.
-    """
+def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, cost: Cost, *, form: str = "objects") -> None:
+    """The caps on an IK request's cost (:func:`~service.kinematics.ik.estimate`, counted before any solving):
+    turns per joint (422), the numeric search's starts, the combinations ranked per solution and the answer's
+    size (413), each refusal naming the cap, by how much, and what lowers it."""
     check_turns(settings, robot, limits, ("body", "limits"))
-    if numeric_starts is not None and targets * numeric_starts > settings.max_numeric_starts:
-        work = targets * numeric_starts
+    if cost.numeric_starts > settings.max_numeric_starts:
         raise ProblemError(413, "too-much-work", "Too much work",
-                           f"The numeric search would run {work:,} starts ({targets:,} targets × {numeric_starts} "
-                           f"starts), {work - settings.max_numeric_starts:,} more than KIN_MAX_NUMERIC_STARTS = "
-                           f"{settings.max_numeric_starts:,}. Send fewer targets or fewer numeric.starts.")
-    kept = max_equivalents if max_solutions is None else min(max_equivalents, max_solutions)
-    equivalents = equivalents_per_solution(robot, limits)
-    ranked = combinations_to_rank(robot.dof, kept, equivalents)
-    if ranked > MAX_COMBINATIONS_PER_SOLUTION and not kept_asked:
-        kept = enumerable_limit(robot.dof)
-    elif ranked > MAX_COMBINATIONS_PER_SOLUTION:
+                           f"The numeric search would run {cost.numeric_starts:,} starts ({cost.targets:,} targets × "
+                           f"{cost.numeric_starts // max(cost.targets, 1):,} starts each, over every combination of "
+                           f"held free values), {cost.numeric_starts - settings.max_numeric_starts:,} more than "
+                           f"KIN_MAX_NUMERIC_STARTS = {settings.max_numeric_starts:,}. Send fewer targets, fewer "
+                           f"numeric.starts or fewer free values.")
+    if cost.too_many_to_rank:
         most = enumerable_limit(robot.dof)
         raise ProblemError(413, "too-much-work", "Too much work",
-                           f"Keeping the nearest {kept:,} of up to {equivalents:,} 2π-equivalents per solution would "
-                           f"rank {ranked:,} combinations of this "
-                           f"{robot.dof}-joint arm's turns per solution, more than the "
-                           f"{MAX_COMBINATIONS_PER_SOLUTION:,} one answer may. Ask for at most {most:,} "
-                           f"(max_equivalents or max_solutions), or narrow multi-turn limits.")
-    per_target, rejected = worst_answer_per_target(solutions_per_target, equivalents, kept)
-    check_answer_size(settings, robot, targets=targets, per_target=per_target, form=form,
-                      what=f"{targets:,} targets × up to {per_target:,} each: {solutions_per_target} solutions "
-                           f"× {equivalents:,} 2π-equivalents with at most {kept:,} kept"
-                           + (f", when {rejected} of them are rejected" if rejected else ""))
-    return targets * per_target
-
-
-def worst_answer_per_target(solutions: int, equivalents: int, kept: int) -> tuple[int, int]:
-    """The most rows (kept plus rejected) one target's answer can hold, and how many of them are then rejected.
-
-    A solution either fits, and gives up to ``equivalents`` rows of which at most ``kept`` in all are kept, or
-    does not, and gives one rejected row (or one flagged row when filter_limits is false). With r rejected the
-    answer holds min(kept, (solutions − r) × equivalents) + r rows: growing in r while the fitting ones still
-    fill ``kept``, shrinking after, so the most is at the r where they just fill it (or at r = 0).
-
-    >>> worst_answer_per_target(8, 2, 1024)   # a PUMA with its limits: every solution fits, twice
-    (16, 0)
-    >>> worst_answer_per_target(8, 10**30, 1000)   # one fitting solution fills the cap; the other 7 are rejected
-    (1007, 7)
-    """
-    def rows(rejected: int) -> int:
-        return min(kept, (solutions - rejected) * equivalents) + rejected
-
-    filling = solutions - -(-kept // equivalents)  # the most rejected while the others still fill `kept`
-    candidates = {0, solutions, max(0, filling), min(solutions, max(0, filling + 1))}
-    rejected = max(sorted(candidates), key=rows)
-    return rows(rejected), rejected
+                           f"Keeping the nearest {cost.kept:,} of up to {cost.equivalents:,} 2π-equivalents per "
+                           f"solution would rank {cost.ranked:,} combinations of this {robot.dof}-joint arm's turns "
+                           f"per solution, more than the {MAX_COMBINATIONS_PER_SOLUTION:,} one answer may. Ask for "
+                           f"at most {most:,} (max_equivalents or max_solutions), or narrow multi-turn limits.")
+    check_answer_size(settings, robot, rows=cost.rows, form=form,
+                      what=f"{cost.targets:,} targets × up to {cost.rows_per_target:,} each: "
+                           f"{cost.solutions_per_target} solutions × {cost.equivalents:,} 2π-equivalents with at most "
+                           f"{cost.kept:,} kept" + (f", when {cost.rejected_per_target} of them are rejected"
+                                                   if cost.rejected_per_target else ""))

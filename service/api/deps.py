@@ -16,7 +16,6 @@ from ..robots.build import robot_from_description
 from ..robots.schemas import AnyRobotDescription
 from .boundary import located
 from .problems import ProblemError
-from .routing import hand_over_unless
 
 
 @dataclass(frozen=True)
@@ -78,10 +77,6 @@ def nearest_ids(wanted: str, ids: list[str], limit: int = 5) -> list[str]:
     return chosen[:limit]
 
 
-#: Where a request keeps the inline robot it found, so that starting again on a work loop does not look it up twice.
-_INLINE_ROBOT = "inline_robot"
-
-
 def inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef:
     """The robot a request describes, built once per canonical description (see :mod:`.robot_cache`)."""
     max_joints = settings_of(request).max_joints
@@ -90,13 +85,16 @@ def inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef
         with located("body", "robot"):
             return robot_from_description(description, max_joints=max_joints)
 
-    robot = getattr(request.state, _INLINE_ROBOT, None)  # found before the request started again on a work loop
-    if robot is None:
-        cache, key = request.app.state.inline_robots, (description.model_dump_json(), max_joints)
-        hand_over_unless(key in cache)  # building a robot (a URDF's parse, its chain) is not small work
-        robot = cache.get(key, build)
-        setattr(request.state, _INLINE_ROBOT, robot)
-    return RobotRef(description.id, robot)
+    key = (description.model_dump_json(), max_joints)
+    return RobotRef(description.id, request.app.state.inline_robots.get(key, build))
+
+
+def kept_inline_robot(request: Request, description: AnyRobotDescription) -> RobotRef | None:
+    """The robot a request describes if the cache keeps it already, else None: building one (a URDF's parse and
+    its chain) is not small work."""
+    key = (description.model_dump_json(), settings_of(request).max_joints)
+    robot = request.app.state.inline_robots.kept(key)
+    return None if robot is None else RobotRef(description.id, robot)
 
 
 def with_request_frames(ref: RobotRef, body) -> RobotRef:

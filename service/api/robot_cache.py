@@ -55,6 +55,17 @@ class RobotCache:
                     self._entries.popitem(last=False)
         return robot
 
+    def kept(self, key: Hashable) -> Robot | None:
+        """The robot kept under ``key`` (a look-up, counted as a hit), or None without counting a miss: the
+        caller builds it elsewhere, through :meth:`get`."""
+        with self._lock:
+            entry = self._entries.get(key)
+            if entry is not None:
+                self._entries.move_to_end(key)
+        if entry is not None:
+            self._hits.inc()
+        return entry
+
     def __contains__(self, key: Hashable) -> bool:
         """Whether ``key`` is kept (not counted as a look-up)."""
         return key in self._entries

@@ -20,12 +20,13 @@ its work is small.
 * **Small work where it arrives.** The hand-over to a work loop and back costs more than a single FK and about as
   much as a single IK (two thread wake-ups, a second loop's turn at the GIL). The routes motion planners call one
   pose at a time (:func:`small_first`) therefore start on the server's loop when their body is small
-  (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes microseconds. Before any work, the endpoint
-  says whether its work is small (:func:`hand_over_unless`): bounded by a few milliseconds whatever the request
-  asks, e.g. a closed-form IK whose worst-case answer is a few dozen rows. If it is not, nothing has been done
-  yet, and the request starts again on a work loop, in its turn. Only while no request computes on a work loop:
-  under mixed load, small requests take their turns like the others, and the server's loop stays free for I/O and
-  the health routes (in the soak, running them where they arrived doubled ``/healthz``'s p99).
+  (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes microseconds. After validation the endpoint
+  decides, once, whether its work is small (bounded by a few milliseconds whatever the request asks, e.g. a
+  closed-form IK whose worst-case answer is a few dozen rows: :func:`~service.kinematics.ik.estimate`), and hands
+  it to :func:`computed`: small work runs where it is; other work goes to a work loop, in its turn, and the
+  endpoint awaits it. Nothing runs twice. Only while no request computes on a work loop: under mixed load, small
+  requests take their turns like the others, and the server's loop stays free for I/O and the health routes (in
+  the soak, running them where they arrived doubled ``/healthz``'s p99).
 """
 
 from __future__ import annotations
@@ -40,7 +41,7 @@ import json
 import os
 import threading
 import time
-from typing import Any, Callable, Coroutine
+from typing import Any, Callable, Coroutine, TypeVar
 
 import orjson
 from fastapi import Request, Response
@@ -59,22 +60,25 @@ SMALL_BODY_BYTES = 8192
 
 _on_server_loop: contextvars.ContextVar[bool] = contextvars.ContextVar("on_server_loop", default=False)
 
-
-class _NotSmall(Exception):
-    """Raised by :func:`hand_over_unless` on the server's loop: the request starts again on a work loop."""
+T = TypeVar("T")
 
 
-def hand_over_unless(small: bool) -> None:
-    """Called by an endpoint before it does any work: work that is not ``small`` (bounded by a few milliseconds
-    whatever the request asks) leaves the server's loop for a work loop. Elsewhere (on a work loop, or an
-    endpoint not marked :func:`small_first`) it does nothing."""
-    if not small and _on_server_loop.get():
-        raise _NotSmall
+async def computed(work: Callable[[], T], *, small: bool) -> T:
+    """``work()``'s result, computed where the request is when the work is ``small`` (or the request is on a work
+    loop already), else on a work loop in its turn (see the module docstring). Endpoints call it once, after
+    validation."""
+    if small or not _on_server_loop.get():
+        return work()
+
+    async def run() -> T:
+        return work()
+
+    return await _on_work_loop(run)
 
 
 def small_first(endpoint: Callable[..., Any]) -> Callable[..., Any]:
-    """Mark an endpoint whose small requests run where they arrive (see the module docstring). Its work must be
-    guarded by :func:`hand_over_unless` wherever it can be more than small."""
+    """Mark an endpoint whose small requests run where they arrive (see the module docstring). Its work must go
+    through :func:`computed` wherever it can be more than small."""
     endpoint.small_first = True  # type: ignore[attr-defined]
     return endpoint
 
@@ -190,6 +194,7 @@ async def _on_work_loop(make: Callable[[], Coroutine[Any, Any, Response]]) -> Re
     worker = _work_loops.take()
     done: asyncio.Future = here.create_future()
     context = contextvars.copy_context()
+    context.run(_on_server_loop.set, False)  # what runs there is on a work loop, whoever sent it
     tasks: list[asyncio.Task] = []
 
     def settle(task: asyncio.Task) -> None:
@@ -259,9 +264,7 @@ class FastJSONRoute(APIRoute):
             if self.small_first and len(body) <= SMALL_BODY_BYTES and CORE_TURNS.idle:
                 here = _on_server_loop.set(True)
                 try:
-                    return await make()
-                except _NotSmall:
-                    pass  # nothing was done yet: start again on a work loop
+                    return await make()  # its endpoint sends work that is not small on (computed)
                 finally:
                     _on_server_loop.reset(here)
             return await _on_work_loop(make)

@@ -14,13 +14,14 @@ built.
 
 from __future__ import annotations
 
+import copy
 import math
 from dataclasses import dataclass
 from typing import Literal, Sequence
 
 import numpy as np
 
-from ._cache import bounded_memo, memo
+from ._cache import DerivedStore, bounded_memo, memo
 from ._conventions import CONVENTIONS, Convention
 from ._errors import InvalidInputError, LimitOrderError
 from ._tolerances import GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
@@ -126,6 +127,8 @@ class Robot:
         for index, joint in enumerate(joints):
             _check_joint(joint, index)
         self.name = name
+        #: What is derived from this robot alone (plans, screw model), built on first use (:mod:`._cache`).
+        self.derived = DerivedStore()
         self.convention: Convention = convention
         self.joints: tuple[Joint, ...] = joints
         self.world_T_base = _checked_transform(world_T_base, "base")
@@ -177,6 +180,7 @@ class Robot:
         home = _checked_transform(base_T_flange, "home")
         robot = cls.__new__(cls)
         robot.name = name
+        robot.derived = DerivedStore()
         robot.convention = "screws"
         robot.joints = joints
         robot.world_T_base = _checked_transform(world_T_base, "base")
@@ -208,8 +212,8 @@ class Robot:
         tool = None if flange_T_tool is None else _checked_transform(flange_T_tool, "tool")
 
         def build() -> "Robot":
-            other = Robot.__new__(Robot)
-            other.__dict__.update({key: value for key, value in self.__dict__.items() if key != "_derived"})
+            other = copy.copy(self)
+            other.derived = DerivedStore()  # nothing derived from the old frames is carried over
             if base is not None:
                 other.world_T_base = base
             if tool is not None:

@@ -60,15 +60,20 @@ from ._rates import TaskSpace, joint_rates, rate_residuals, task_space
 from ._robot import Robot, check_joint_values
 from ._tolerances import RATE_SINGULARITY_TOLERANCE
 from .ik import (
+    AnswerOptions,
     IKOptions,
     IKResult,
+    IKTargets,
     Singularity,
+    answer_ik,
     distance_to_reference,
+    free_joints_for,
     joint_difference,
-    follow_free_joints,
     plan_for,
+    result_of,
     solve_ik,
     solve_ik_batch,
+    unlimited,
 )
 
 __all__ = [
@@ -146,7 +151,7 @@ class SampleResult:
     """One sample of the trajectory. Arrays have shape (n,); rates are NaN where not computed."""
 
     time: float
-    status: Literal["ok", "unreachable", "branch_unavailable"]
+    status: Literal["ok", "unreachable", "not_found", "branch_unavailable"]
     joints: np.ndarray | None = None
     velocities: np.ndarray | None = None
     accelerations: np.ndarray | None = None
@@ -312,7 +317,8 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
 
     plan = plan_for(robot, constrain_orientation=constrain_orientation, reference=reference)
     # a redundant arm (issue 14): the free joint held continuous along the path, its rate 0
-    family = follow_free_joints(robot, targets, reference) if constrain_orientation and robot.dof > 6 else None
+    family = follow_free_joints(robot, targets, reference, options.ik) \
+        if constrain_orientation and robot.dof > 6 else None
     task = task_space(robot, constrain_orientation=constrain_orientation,
                       free_joints=family[1] if family is not None else
                       plan.free_joints if plan is not None else ())
@@ -340,6 +346,55 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
                             all(r.complete for r in results), "assur_group" if assur else "jacobian", task, assur)
 
 
+#: Along a path, how far (rad or length units) and at how many values a redundant arm's free joint is searched
+#: around the previous sample's value before its whole family is.
+TRACK_WINDOW = 0.25
+TRACK_SAMPLES = 9
+
+
+def follow_free_joints(robot: Robot, world_T_targets: np.ndarray, reference: np.ndarray | None,
+                       ik: IKOptions) -> tuple[list[IKResult], list[int]] | None:
+    """Per-sample IK results of a redundant arm along a path, with the free joint held continuous.
+
+    The first sample takes the family's solution nearest the reference (over the whole family: sampled, then
+    searched continuously) or, without one, the family's first. Each later sample searches the free joint within
+    :data:`TRACK_WINDOW` of the previous sample's value (sampled, then continuously) for the solution nearest the
+    previous sample's joints, so the free parameter moves only as far as the path needs; where that window cannot
+    reach the pose, the whole family is searched. Every sample is answered by :func:`~.ik.answer_ik`, as single IK
+    is. Returns (results, free joints), one :class:`IKResult` per sample (nearest first), or None when the arm has
+    no single free joint a family covers.
+    """
+    free = free_joints_for(robot, None)
+    if free is None or len(free) != 1:
+        return None
+    joint = free[0].joint
+    results = []
+    previous = reference
+    for target in np.asarray(world_T_targets, dtype=float):
+        ik.budget.check("the trajectory")
+        result = None
+        if previous is not None and results:
+            window = np.unique(np.clip(previous[joint] + np.linspace(-TRACK_WINDOW, TRACK_WINDOW, TRACK_SAMPLES),
+                                       robot.lower[joint], robot.upper[joint]))
+            result = _family_result(robot, target, [(joint, window.tolist(), None)], previous, ik)
+        if result is None or not result.solutions:
+            result = _family_result(robot, target, None, previous, ik)
+        if result.solutions:
+            previous = np.asarray(result.solutions[0].joints, dtype=float)
+        results.append(result)
+    return results, [joint]
+
+
+def _family_result(robot: Robot, target: np.ndarray, free_joints: list | None, reference: np.ndarray | None,
+                   ik: IKOptions) -> IKResult:
+    """One pose of a redundant arm answered over its free joint (``free_joints`` as a request gives them, None
+    for the default sampling), nearest the reference first."""
+    answer = answer_ik(robot, IKTargets.poses(target[None]),
+                       AnswerOptions(reference=reference, limits=unlimited(robot), filter_limits=False, search=ik,
+                                     free_joints=free_joints, budget=ik.budget))
+    return result_of(answer, 0)
+
+
 def _has_free_joint(result: IKResult) -> bool:
     return any(s.relation in _FREE_RELATIONS for s in result.singularities)
 
@@ -359,7 +414,8 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
             result = solve_ik(robot, targets[k], constrain_orientation=constrain_orientation, reference=previous_q,
                               options=ik_options)
         if not result.solutions:
-            samples.append(SampleResult(float(times[k]), "unreachable"))
+            # unreachable only where the solver proves it; a search that found nothing says not_found
+            samples.append(SampleResult(float(times[k]), "unreachable" if result.complete else "not_found"))
             continue
         ambiguous = ambiguous_labels(result.singularities)
         matching = [s for s in result.solutions

@@ -139,9 +139,9 @@ def test_the_ranking_work_per_solution_is_bounded_whatever_the_joint_count():
     """An 8-joint arm with ±1e6 rad limits: 318,310 values per joint. The default 1,024 kept would rank 2.6
     million turn combinations per solution; the core keeps the nearest it can rank exactly, and says so."""
     from service.kinematics import Joint, Limits, Robot
-    from service.kinematics.ik import MAX_COMBINATIONS_PER_SOLUTION, Selection, enumerable_limit, select
-    from service.kinematics.ik._select import _down_set_size
-    from service.kinematics.ik._types import IKResult, Solution
+    from service.kinematics.ik import MAX_COMBINATIONS_PER_SOLUTION, IKResult, Solution, enumerable_limit
+    from service.kinematics.ik._equivalents import down_set_size as _down_set_size
+    from tests.selection import OneSelection as Selection, select
 
     robot = Robot([Joint(f"q{j + 1}", "revolute", 0.1, 0.3, 0.0, 0.0) for j in range(8)], convention="standard")
     limits = Limits(np.full(8, -1e6), np.full(8, 1e6))
@@ -161,14 +161,14 @@ def test_the_ranking_work_per_solution_is_bounded_whatever_the_joint_count():
 
 def test_a_whole_workspace_batch_is_413_before_solving(client, monkeypatch):
     """10,000 UR5 targets with ±360° limits: 8.2 GB and 118 s before. Refused before the solver is called."""
-    from service.api.routers import ik as ik_router
+    from service.api import ik_requests
 
     targets = [_ur5_target(client)] * 10_000
 
     def never(*args, **kwargs):
         raise AssertionError("the solver ran")
 
-    monkeypatch.setattr(ik_router, "answer_ik", never)
+    monkeypatch.setattr(ik_requests, "answer_ik", never)
     for form in ("objects", "arrays"):
         response = client.post("/v1/robots/ur5/ik/batch", json={"targets": targets, "format": form})
         problem = assert_problem(response, 413, match="KIN_MAX_SOLUTIONS_PER_RESPONSE")
@@ -179,7 +179,7 @@ def test_the_worst_answer_per_target_is_the_most_over_every_number_rejected():
     """Independent count: every number r of rejected solutions, min(kept, (S − r) × E) + r rows."""
     import itertools
 
-    from service.api.budget import worst_answer_per_target
+    from service.kinematics.ik import worst_answer_per_target
 
     for solutions, equivalents, kept in itertools.product(range(12), (1, 2, 3, 64, 2**53 - 1), (1, 2, 5, 16, 1024)):
         rows, rejected = worst_answer_per_target(solutions, equivalents, kept)
@@ -190,14 +190,15 @@ def test_the_worst_answer_per_target_is_the_most_over_every_number_rejected():
 def test_a_puma_reachability_batch_with_its_catalogue_limits_fits_the_default_caps(client):
     """10,000 targets on the PUMA with its limits: up to 8 solutions × 2 equivalents each, 160,000 in all."""
     from service.api.budget import check_ik_cost
+    from service.kinematics.ik import AnswerOptions, IKTargets, estimate
 
     robot = client.app.state.catalogue.get("puma560_standard").robot
     settings = Settings(_env_file=None)
-    check_ik_cost(settings, robot, Limits.of(robot), targets=10_000, solutions_per_target=8, max_equivalents=1024,
-                  max_solutions=None, form="arrays")
+    cost = estimate(robot, IKTargets.poses(np.broadcast_to(np.eye(4), (10_000, 4, 4))), AnswerOptions(),
+                    kept_asked=False)
+    check_ik_cost(settings, robot, Limits.of(robot), cost, form="arrays")
     with pytest.raises(Exception, match="160,000 solutions"):
-        check_ik_cost(Settings(_env_file=None, max_solutions_per_response=150_000), robot, Limits.of(robot),
-                      targets=10_000, solutions_per_target=8, max_equivalents=1024, max_solutions=None,
+        check_ik_cost(Settings(_env_file=None, max_solutions_per_response=150_000), robot, Limits.of(robot), cost,
                       form="arrays")
 
 

@@ -88,4 +88,4 @@ def test_with_frames_returns_the_kept_robot_for_the_same_frames(client):
         other[0, 3] = 0.01 * (k + 1)
         robot.with_frames(None, other)
     assert robot.with_frames(None, tool) is not framed
-    assert len(robot.__dict__["_derived"]["with_frames"]) == FRAMED_ROBOTS_KEPT
+    assert robot.derived.namespace_size("with_frames") == FRAMED_ROBOTS_KEPT

@@ -12,7 +12,7 @@ from fastapi.testclient import TestClient
 
 from service.api import routing
 from service.api.app import create_app
-from service.api.routers import ik as ik_router
+from service.api import ik_requests
 from service.config import Settings
 from service.kinematics import forward_kinematics
 
@@ -30,13 +30,13 @@ def fresh():
 def where(monkeypatch) -> list[str]:
     """Where each IK answer was computed: 'work' on a work loop's thread, 'here' on the server's loop."""
     places: list[str] = []
-    answer_ik = ik_router.answer_ik
+    answer_ik = ik_requests.answer_ik
 
     def recorded(*args, **kwargs):
         places.append("work" if threading.current_thread().name.startswith("kin-work") else "here")
         return answer_ik(*args, **kwargs)
 
-    monkeypatch.setattr(ik_router, "answer_ik", recorded)
+    monkeypatch.setattr(ik_requests, "answer_ik", recorded)
     return places
 
 

@@ -185,7 +185,7 @@ def test_ragged_batch_rows_are_named():
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 def test_scalar_residuals_of_a_few_candidates_equal_the_array_ones(convention, monkeypatch):
     """One pose's candidates are verified by the scalar FK; it must give the array path's residuals."""
-    from service.kinematics.ik import _verify
+    from service.kinematics.ik import _goals, _verify
 
     rng = np.random.default_rng(3)
     tool = _trans("z", 0.2) @ _rot("y", -0.4)
@@ -194,7 +194,7 @@ def test_scalar_residuals_of_a_few_candidates_equal_the_array_ones(convention, m
     q = rng.uniform(-np.pi, np.pi, (2, 8, 6))
     targets = forward_kinematics(robot, q[:, 0] + rng.normal(0, 1e-3, (2, 6)))
     scalar = _verify.residual_arrays(robot, q, targets)
-    monkeypatch.setattr(_verify, "SCALAR_CANDIDATES", 0)
+    monkeypatch.setattr(_goals, "SCALAR_CANDIDATES", 0)
     arrays = _verify.residual_arrays(robot, q, targets)
     for a, b in zip(scalar, arrays):
         np.testing.assert_allclose(a, b, rtol=0, atol=1e-13)

@@ -19,7 +19,8 @@ from service.kinematics import (
     violations,
     within,
 )
-from service.kinematics.ik import IKResult, Ordering, Solution, select
+from service.kinematics.ik import IKResult, Ordering, Solution
+from tests.selection import select
 
 DEG = math.pi / 180
 

@@ -312,7 +312,7 @@ def test_ur_type_arms_near_their_singularities_return_the_generating_configurati
     or not: the UR5 lost a whole shoulder branch (4 of 8 solutions) with ``complete: true``."""
     from tests.kinematics.ik.test_one_pose_families import random_arm
     from service.kinematics.ik import solve_ik_arrays
-    from service.kinematics.ik._arrays import cached_plan
+    from service.kinematics.ik import cached_plan
 
     if arm == "ur5":
         robot = catalogue.get("ur5").robot

@@ -6,10 +6,10 @@ from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import forward_kinematics, link_frames
 from ..boundary import joints_to_core, located, pose_from_matrix, poses_from_matrices
-from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
+from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, kept_inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..responses import FastJSONResponse
-from ..routing import FastJSONRoute, small_first
+from ..routing import FastJSONRoute, computed, small_first
 from ..schemas.fk import FKBatchRequest, FKBatchResponse, FKInlineRequest, FKRequest, FKResponse
 
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["forward kinematics"])
@@ -45,10 +45,13 @@ def forward_kinematics_catalogue(body: FKRequest, ref: RobotRef = Depends(catalo
 
 @router.post("/fk", operation_id="forward_kinematics_inline", response_model=FKResponse,
              response_model_exclude_none=True, responses=problem_responses(422))
-@small_first  # small once the robot is built (inline_robot hands a build over)
-def forward_kinematics_inline(request: Request, body: FKInlineRequest):
+@small_first  # small once the robot is built
+async def forward_kinematics_inline(request: Request, body: FKInlineRequest):
     """Forward kinematics for a robot described in the request body."""
-    return _forward(inline_robot(request, body.robot), body)
+    ref = kept_inline_robot(request, body.robot)
+    if ref is not None:
+        return _forward(ref, body)
+    return await computed(lambda: _forward(inline_robot(request, body.robot), body), small=False)
 
 
 @router.post("/robots/{robot_id}/fk/batch", operation_id="forward_kinematics_batch", response_model=FKBatchResponse,

@@ -61,10 +61,13 @@ class SolverMethod(str, Enum):
 
 
 class IKStatus(str, Enum):
-    """ok: at least one solution; unreachable: none exists; no_solution_within_limits: all are in `rejected`."""
+    """ok: at least one solution; unreachable: none exists (proved by a closed form or a reach bound);
+    not_found: a search that cannot promise completeness (solver.complete false) found none, and the target may
+    still be reachable; no_solution_within_limits: all are in `rejected`."""
 
     ok = "ok"
     unreachable = "unreachable"
+    not_found = "not_found"
     no_solution_within_limits = "no_solution_within_limits"
 
 
@@ -238,7 +241,8 @@ class IKResponse(ApiModel):
 
     robot_id: RobotId = Field(description="the catalogue id, or the inline robot's id")
     joint_names: list[str] = JOINT_NAMES_FIELD
-    status: IKStatus = Field(description="ok, unreachable, or no_solution_within_limits")
+    status: IKStatus = Field(description="ok, unreachable (proved), not_found (a search that cannot promise "
+                                         "completeness found none), or no_solution_within_limits")
     detail: str | None = Field(None, description="why a target is unreachable, and notes on caps and trims")
     solutions: list[IKSolution] = Field(description="every distinct solution; nearest the reference first when "
                                                     "one is given")

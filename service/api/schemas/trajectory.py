@@ -105,9 +105,11 @@ class TrajectorySampleResult(ApiModel):
     """The joint solution at one sample, on the branch being followed."""
 
     time: float = Field(description="the sample's time, seconds")
-    status: Literal["ok", "unreachable", "branch_unavailable"] = Field(
-        description="unreachable: no solution (joints null); branch_unavailable: no solution on the requested "
-                    "branch, the sample continues on the nearest one")
+    status: Literal["ok", "unreachable", "not_found", "branch_unavailable"] = Field(
+        description="unreachable: no solution exists (proved: joints null); not_found: a search that cannot "
+                    "promise completeness found none (joints null; the pose may be reachable); "
+                    "branch_unavailable: no solution on the requested branch, the sample continues on the nearest "
+                    "one")
     joints: list[float] | None = Field(description="joint values, request's angle unit; null when unreachable")
     velocities: list[float] | None = Field(description="null without a twist, or at a singular sample without "
                                                        "damping")

@@ -1,13 +1,17 @@
-"""One IK answer for a batch of targets of any kinds, built once: solve, fall back, select, as columns.
+"""One IK answer for a batch of targets of any kinds: solve, fall back, select, as columns.
 
-:func:`answer_ik` splits the targets by kind (full pose, position only,
-position + tool direction), solves each kind with its closed form (the free
-joints of a redundant arm over their values), sends the targets no closed form
-covers or promises to the numeric search, and retries position-only targets
-that joints held at the reference could not reach. Every row, analytic or
-numeric, then goes through :func:`select_arrays` into the same two tables.
-The answer's per-target fields are arrays (N,); solver and singularity reports
-are numbered by first appearance in target order.
+:func:`answer_ik` splits the targets by kind (full pose, position only, position + tool direction) and answers
+each with one solver: the arm's closed form (a redundant arm's family over its free joints), or the numeric
+search where no closed form covers the arm or promises a target. Every solver's candidates are verified into
+one :class:`~._table.SolutionTable` (:func:`~._verify.verify`); every target is answered by exactly one part,
+so the parts' tables are laid end to end and selected once (:func:`~._select.select`).
+
+The shapes an answer takes: candidates (N, m, n) → verified table → selected tables → :class:`IKAnswer` (the
+tables and per-target columns) → the wire, encoded from the tables as they stand.
+
+A target's status: ``ok`` with solutions; ``no_solution_within_limits`` when every solution breaks a limit;
+``unreachable`` only where the solver proves there is none (a complete closed form, a reach bound);
+``not_found`` where a search that cannot promise completeness found none.
 """
 
 from __future__ import annotations
@@ -25,14 +29,17 @@ from .._budget import UNLIMITED, Budget
 from .._errors import InvalidInputError, KinematicsError
 from .._limits import Limits
 from .._robot import Robot
-from ._arrays import IKArrays, arrays_from_results, cached_plan, plan_is_kept, solve_ik_arrays
-from ._direction import solve_direction
-from ._position_search import search_position
-from ._redundant import (FreeJoint, beyond_reach, free_joint_solutions, free_joints_for, no_solution_detail,
-                         solve_free_joint_family)
-from ._select import MAX_EQUIVALENTS, NOTE_WORDING, BatchSelection, Ordering, SolutionTable, select_arrays
-from ._solve import IKOptions, solve_ik_batch, unreachable_details
-from ._types import IKResult, Singularity
+from ._closed_form import cached_plan, solve_closed_form
+from ._direction import direction_candidates, direction_plan, tool_roll
+from ._goals import DirectionGoal, PoseGoal
+from ._idealised import IdealisedPlan
+from ._numeric import NumericOptions, search
+from ._plan import geometry_of
+from ._redundant import (FreeJoint, beyond_reach, family_for, free_joints_for, no_solution_detail, solve_family)
+from ._select import MAX_EQUIVALENTS, NOTE_WORDING, Ordering, Selection, check_options, select
+from ._table import SolutionTable
+from ._types import Singularity
+from ._verify import Verified, verify
 
 #: Target kinds (:attr:`IKTargets.kinds`).
 POSITION, POSE, DIRECTION = 0, 1, 2
@@ -46,12 +53,10 @@ class UnsupportedTargetError(KinematicsError):
 class IKTargets:
     """N targets in the world frame.
 
-    ``matrices`` (N, 4, 4) ``world_T_tool``: for a position-only or a
-    direction target only the position (last column) counts. ``kinds`` (N,)
-    int: :data:`POSE`, :data:`POSITION` or :data:`DIRECTION`. For direction
-    rows, ``tool_axes`` (N, 3) is the unit tool axis (tool frame) and
-    ``world_directions`` (N, 3) the unit direction it must point along (world
-    frame); other rows of them are ignored.
+    ``matrices`` (N, 4, 4) ``world_T_tool``: for a position-only or a direction target only the position (last
+    column) counts. ``kinds`` (N,) int: :data:`POSE`, :data:`POSITION` or :data:`DIRECTION`. For direction rows,
+    ``tool_axes`` (N, 3) is the unit tool axis (tool frame) and ``world_directions`` (N, 3) the unit direction it
+    must point along (world frame); other rows of them are ignored.
     """
 
     matrices: np.ndarray
@@ -67,10 +72,18 @@ class IKTargets:
 
 
 @dataclass(frozen=True)
+class IKOptions:
+    """How to search: the numeric search's bounds, and its own budget (the request's, or a tighter time cap)."""
+
+    numeric: NumericOptions = field(default_factory=NumericOptions)
+    budget: Budget = UNLIMITED
+
+
+@dataclass(frozen=True)
 class AnswerOptions:
     """How to answer: reference (n,) and limits in radians / length units, the selection's options, the
     requested free joints of a redundant arm (``(joint, values or None, samples or None)`` entries, see
-    :func:`free_joints_for`), the numeric search's bounds and the request's budget."""
+    :func:`~._redundant.free_joints_for`), the numeric search's bounds and the request's budget."""
 
     reference: np.ndarray | None = None
     limits: Limits | None = None  # default: the robot's own
@@ -149,15 +162,13 @@ class TargetAnswer:
 class IKAnswer:
     """The answer for N targets, as columns.
 
-    Per target (N,): ``status`` (object: "ok", "unreachable",
-    "no_solution_within_limits"), ``detail`` (str or None, worded when
-    read), ``solver`` (index into ``solvers``), ``singularities`` (lists of
-    indices into ``singularity_reports``, made when read), ``truncated``, ``trimmed``,
-    ``available``. ``solutions`` and ``rejected`` hold the rows grouped by
-    target, joints in radians / length units; a position-only target's
-    orientation residuals are NaN. ``solution_violations`` (S, n) and
-    ``rejected_violations`` (R, n) say which joints of a row outside the
-    ``limits`` break them. ``timings`` lists the solver calls.
+    Per target (N,): ``status`` (object: "ok", "unreachable", "not_found", "no_solution_within_limits"),
+    ``detail`` (str or None, worded when read), ``solver`` (index into ``solvers``), ``singularities`` (lists
+    of indices into ``singularity_reports``, made when read), ``truncated``, ``trimmed``, ``available``.
+    ``solutions`` and ``rejected`` hold the rows grouped by target, joints in radians / length units; a
+    position-only target's orientation residuals are NaN. ``solution_violations`` (S, n) and
+    ``rejected_violations`` (R, n) say which joints of a row outside the ``limits`` break them. ``timings``
+    lists the solver calls.
     """
 
     status: np.ndarray
@@ -198,72 +209,37 @@ class IKAnswer:
 
 
 @dataclass
-class _Solved:
-    """Solved rows of one kind: ``rows`` (k,) target indices and their solutions; ``solver`` (k,) indexes
-    ``solvers``. Only the rows that have them appear in ``details`` (put before the selection's notes),
-    ``remarks`` (after them) and ``singularities`` (local row → its singular conditions)."""
+class _Part:
+    """Targets ``rows`` (k,) answered by one solver: their verified solutions (``verified``, k targets), the
+    solver, and per local row the words before the selection's notes (``details``) and after them
+    (``remarks``). ``reported`` (k,) says where the solver's singular conditions are reported (default: the rows
+    with a solution); ``unfinished`` (k,) where the numeric search's iteration cap stopped starts."""
 
     rows: np.ndarray
-    arrays: IKArrays
-    solvers: list[SolverReport]
-    solver: np.ndarray
-    details: dict[int, str]
-    singularities: dict[int, list[Singularity]]
-    constrained: bool  # whether the orientation residual means something (pose and direction rows)
+    verified: Verified
+    method: str
+    structure: str
+    free_joints: tuple[int, ...]
+    details: dict[int, str] = field(default_factory=dict)
     remarks: dict[int, str] = field(default_factory=dict)
-    chosen: BatchSelection | None = None  # the selection of its rows, once made
+    reported: np.ndarray | None = None
+    unfinished: np.ndarray | None = None
 
 
 def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerOptions()) -> IKAnswer:
     """Every solution of each target, selected against the limits (see the module docstring)."""
     matrices, kinds = np.asarray(targets.matrices, dtype=float), np.asarray(targets.kinds)
     limits = Limits.of(robot) if options.limits is None else options.limits
-    free = None
-    if options.free_joints is not None or robot.dof > 6:
-        with _at_free_joints():
-            free = free_joints_for(robot, options.free_joints)
+    check_options(robot, options.ordering, options.reference, options.max_equivalents)
     timings: list[SolveTiming] = []
-    solved = [*_solved_directions(robot, targets, options, timings),
-              *_solved_poses(robot, matrices, kinds, free, options, timings)]
-    answer = _selected(robot, len(matrices), solved, limits, options, timings)
-    retry = [row for row in np.flatnonzero((kinds == POSITION) & (answer.status == "unreachable")).tolist()
-             if answer.solvers[answer.solver[row]].free_joints
-             and answer.solvers[answer.solver[row]].method == "analytic"]
-    if retry:  # held joints must not make a reachable point unreachable: search every joint
-        results = [search_position(robot, matrices[row], list(answer.solvers[answer.solver[row]].free_joints),
-                                   options.reference, options.search) for row in retry]
-        solved.append(_from_results(robot, np.array(retry), results, False))
-        answer = _selected(robot, len(matrices), solved, limits, options, timings)
-    return answer
-
-
-def solutions_per_target(robot: Robot, kinds: np.ndarray, free_joints: list | None, refined: bool
-                         ) -> tuple[int, bool]:
-    """The cost model's count, before any solving: the most solutions a target of ``kinds`` (N,) can have in
-    closed form (its plan's generic count; a redundant arm's over its free values, see
-    :func:`free_joint_solutions`), and whether some kind goes to the numeric search instead (its starts count).
-    ``free_joints`` and ``refined`` (a reference is given) are :class:`AnswerOptions`'."""
-    most, numeric = 0, False
-    for constrained in np.unique(np.asarray(kinds) > 0).tolist():
-        # a position-only plan holding joints at the reference has the generic count of the kept one
-        plan = cached_plan(robot, constrain_orientation=constrained, reference=None)
-        count = None if plan is None else plan.generic_count
-        if plan is None and constrained and robot.dof > 6:
-            with _at_free_joints():
-                count = free_joint_solutions(robot, free_joints, refined)
-        most, numeric = (most, True) if count is None else (max(most, count), numeric)
-    return most, numeric
-
-
-def plans_are_kept(robot: Robot, kinds: np.ndarray, reference: np.ndarray | None) -> bool:
-    """Whether the plans that targets of ``kinds`` (N,) need are already built and kept on the robot, so that
-    neither :func:`solutions_per_target` nor :func:`answer_ik` derives one (False for direction targets, whose
-    families are chosen per tool axis)."""
-    kinds = np.asarray(kinds)
+    parts: list[_Part] = []
     if (kinds == DIRECTION).any():
-        return False
-    return all(plan_is_kept(robot, constrain_orientation=constrained, reference=reference)
-               for constrained in np.unique(kinds == POSE).tolist())
+        parts += _directions(robot, targets, options, timings)
+    if (kinds == POSE).any():
+        parts += _poses(robot, matrices, np.flatnonzero(kinds == POSE), options, timings)
+    if (kinds == POSITION).any():
+        parts += _positions(robot, matrices, np.flatnonzero(kinds == POSITION), options, timings)
+    return _assembled(robot, len(kinds), parts, limits, options, timings)
 
 
 @contextmanager
@@ -275,202 +251,341 @@ def _at_free_joints() -> Iterator[None]:
         raise error.relocated("free_joints") from None
 
 
-def _solved_directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timings: list[SolveTiming]):
-    """Position + direction targets, one closed-form solve per tool axis."""
-    directions = np.flatnonzero(np.asarray(targets.kinds) == DIRECTION)
-    if not len(directions):
-        return
-    axes, group = np.unique(np.asarray(targets.tool_axes)[directions], axis=0, return_inverse=True)
-    for number in range(len(axes)):
-        rows = directions[group.reshape(-1) == number]
-        started = time.perf_counter()
-        arrays = solve_direction(robot, targets.matrices[rows, :3, 3], targets.world_directions[rows], axes[number],
-                                 options.reference)
-        if arrays is None:
-            raise UnsupportedTargetError("no closed-form family covers position + tool direction targets of this "
-                                         "arm with this tool axis")
-        timings.append(SolveTiming("analytic", arrays.structure, time.perf_counter() - started,
-                                   arrays.count.tolist()))
-        positions = targets.matrices[rows, :3, 3]
-        details = {local: _direction_detail(robot, positions[local]) for local in np.flatnonzero(arrays.count == 0)}
-        yield _from_arrays(arrays, rows, details, True)
-
-
-def _direction_detail(robot: Robot, position: np.ndarray) -> str:
-    if bool(beyond_reach(robot, position)):
-        return "The target position is outside the workspace (farther from the base than the arm can reach)."
-    return ("No joint vector puts the tool at this position with its axis along the direction (every solution of "
-            "the closed form was checked).")
-
-
-def _solved_poses(robot: Robot, matrices: np.ndarray, kinds: np.ndarray, free: list[FreeJoint] | None,
-                  options: AnswerOptions, timings: list[SolveTiming]):
-    """Full-pose then position-only targets: the closed form where it covers and promises, else the fallback."""
-    reference = options.reference
-    for kind in (POSE, POSITION):
-        rows = np.flatnonzero(kinds == kind)
-        if not len(rows):
-            continue
-        constrained = kind == POSE
-        started = time.perf_counter()
-        if constrained and free is not None:  # a redundant arm: the family over the free joints' values
-            with _at_free_joints():
-                family = solve_free_joint_family(robot, matrices[rows], free, reference, budget=options.budget)
-            if family is None:
-                yield _numeric(robot, matrices, rows, True, options, timings, started, free)
-                continue
-            arrays = family.arrays
-            timings.append(SolveTiming("analytic", arrays.structure, time.perf_counter() - started,
-                                       arrays.count.tolist()))
-            details = {local: no_solution_detail(robot, free, matrices[rows[local], :3, 3])
-                       for local in np.flatnonzero(arrays.count == 0).tolist()}
-            part = _from_arrays(arrays, rows, details, True)
-            missing = family.missing > 0  # the answer is not complete at those values
-            part.solver[missing] += len(part.solvers)
-            part.solvers += [SolverReport(**{**vars(report), "complete": False}) for report in part.solvers]
-            part.remarks = {local: f"At {family.missing[local]} of the free values the locked arm falls outside "
-                                   f"the closed-form family, so no solution is listed there."
-                            for local in np.flatnonzero(missing).tolist()}
-            yield part
-            continue
-        arrays = solve_ik_arrays(robot, matrices[rows], constrain_orientation=constrained, reference=reference,
-                                 budget=options.budget)
-        if arrays is None:
-            yield _numeric(robot, matrices, rows, constrained, options, timings, started)
-            continue
-        timings.append(SolveTiming("analytic", arrays.structure, time.perf_counter() - started,
-                                   arrays.count.tolist()))
-        promised = np.flatnonzero(arrays.complete)
-        if len(promised) < len(rows):  # rounded geometry: the closed form cannot promise these, the fallback answers
-            arrays = arrays.take(promised)
-        if len(promised):
-            unreachable = unreachable_details(robot, arrays, matrices[rows[promised]], constrained, reference,
-                                              options.budget)
-            yield _from_arrays(arrays, rows[promised], unreachable, constrained)
-        if len(promised) < len(rows):
-            yield _numeric(robot, matrices, rows[~np.isin(np.arange(len(rows)), promised)], constrained, options,
-                           timings, time.perf_counter())
-
-
-def _numeric(robot: Robot, matrices: np.ndarray, rows: np.ndarray, constrained: bool, options: AnswerOptions,
-             timings: list[SolveTiming], started: float, free: list[FreeJoint] | None = None) -> _Solved:
-    """The fallback's answer for ``rows``: :func:`solve_ik_batch` (the numeric search where no closed form
-    covers or promises). On a redundant arm whose locked arm no family covers, says the free joints were not
-    applied."""
-    results = solve_ik_batch(robot, matrices[rows], constrain_orientation=constrained, reference=options.reference,
-                             options=options.search)
-    timings.append(SolveTiming(results[0].method, results[0].structure, time.perf_counter() - started,
-                               [len(result.solutions) for result in results]))
-    part = _from_results(robot, rows, results, constrained)
-    if free is not None:
-        names = ", ".join(f"q{f.joint + 1}" for f in free)
-        note = (f"No closed-form family covers this arm with {names} locked, so the free joints were not applied: "
-                f"a numeric search over every joint answered.")
-        part.remarks = dict.fromkeys(range(len(rows)), note)
+def _timed(timings: list[SolveTiming], part: _Part, started: float) -> _Part:
+    timings.append(SolveTiming(part.method, part.structure, time.perf_counter() - started,
+                               part.verified.count.tolist()))
     return part
 
 
-def _from_arrays(arrays: IKArrays, rows: np.ndarray, details: dict[int, str], constrained: bool) -> _Solved:
-    """Closed-form rows: one solver (complete, or not where the family cannot promise it), each row's singular
-    conditions where it has a solution."""
-    solvers = [SolverReport("analytic", arrays.structure, promise, False, tuple(arrays.free_joints))
-               for promise in (True, False)]
-    solved = arrays.count > 0
-    singularities: dict[int, list[Singularity]] = {}
-    for mask, flag in arrays.singularities.entries:
-        for local in np.flatnonzero(mask & solved).tolist():
-            met = singularities.setdefault(local, [])
-            if flag not in met:
-                met.append(flag)
-    return _Solved(rows, arrays, solvers, (~arrays.complete).astype(int), details, singularities, constrained)
+def _poses(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: AnswerOptions,
+           timings: list[SolveTiming]) -> list[_Part]:
+    """Full-pose targets: a redundant arm's family over its free joints, else the closed form where it covers and
+    promises, the numeric search elsewhere."""
+    goal = PoseGoal(matrices[rows])
+    started = time.perf_counter()
+    if options.free_joints is not None or robot.dof > 6:
+        with _at_free_joints():
+            free = free_joints_for(robot, options.free_joints)
+        if free is not None:
+            return _family(robot, goal, rows, free, options, timings, started)
+        if robot.dof > 6:  # no locking leaves a closed-form family
+            return [_timed(timings, _numeric(robot, goal, rows, options), started)]
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    if plan is None:
+        return [_timed(timings, _numeric(robot, goal, rows, options), started)]
+    verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
+    closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
+    return _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan))
 
 
-def _from_results(robot: Robot, rows: np.ndarray, results: list[IKResult], constrained: bool) -> _Solved:
-    """Rows answered as :class:`IKResult` records (the fallback, the position search), as arrays."""
-    solvers, solver = _numbered([SolverReport(r.method, r.structure, r.complete, r.search_exhausted_budget,
-                                              tuple(r.free_joints)) for r in results])
-    return _Solved(rows, arrays_from_results(robot, results), solvers, solver,
-                   {local: r.detail for local, r in enumerate(results) if r.detail},
-                   {local: list(r.singularities) for local, r in enumerate(results) if r.singularities}, constrained)
+def _positions(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: AnswerOptions,
+               timings: list[SolveTiming]) -> list[_Part]:
+    """Position-only targets: the closed form with the joints past the third held at the reference (or 0); a
+    position those held joints cannot reach is searched over every joint before it is called unreachable."""
+    goal = PoseGoal(matrices[rows], constrain_orientation=False)
+    started = time.perf_counter()
+    plan = cached_plan(robot, constrain_orientation=False, reference=options.reference)
+    if plan is None:
+        return [_timed(timings, _numeric(robot, goal, rows, options), started)]
+    verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
+    closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
+    held = [j for j in plan.free_joints if j >= 3] if robot.dof > 3 else []
+    parts = _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan))
+    if not held:
+        return parts
+    closed = parts[0]
+    empty = np.flatnonzero((closed.verified.count == 0) & closed.verified.complete)
+    if not len(empty):
+        return parts
+    names = ", ".join(f"q{i + 1}" for i in held)
+    far = beyond_reach(robot, matrices[closed.rows[empty], :3, 3])
+    for local in empty[far].tolist():
+        closed.details[local] = ("The target position is outside the workspace (farther from the base than the "
+                                 "arm can reach).")
+    search_rows = empty[~far]
+    kept = np.setdiff1d(np.arange(len(closed.rows)), search_rows)
+    parts[0] = _taken(closed, kept)
+    if len(search_rows):
+        started = time.perf_counter()
+        anchor = np.zeros(robot.dof) if options.reference is None else options.reference
+        searched = _numeric(robot, goal.take(search_rows), closed.rows[search_rows], options, anchor)
+        for local in range(len(search_rows)):
+            searched.details[local] = (
+                f"The position is out of reach with {names} held at the reference values (or 0); a numeric search "
+                f"over every joint found these solutions, nearest the held values first. It cannot promise that "
+                f"every solution was found." if searched.verified.count[local] else
+                f"The position is out of reach with {names} held at the reference values (or 0), and a numeric "
+                f"search over every joint found no solution; it lies within the arm's reach sphere, so it is not "
+                f"proven outside the workspace. " + searched.details.get(local, "")).strip()
+        parts.append(_timed(timings, searched, started))
+    return parts
 
 
-def _selected(robot: Robot, n_targets: int, parts: list[_Solved], limits: Limits, options: AnswerOptions,
-              timings: list[SolveTiming]) -> IKAnswer:
-    """Select every part's rows (once: a part keeps its selection) and gather them into one answer; a later
-    part's rows replace an earlier part's answer for the same targets (the position search after an unreachable
-    held-joint solve)."""
-    status = np.empty(n_targets, dtype=object)
-    solver_of, reports_of = np.zeros(n_targets, dtype=int), []  # index into every part's solvers, in part order
-    singular_of: dict[int, list[Singularity]] = {}
-    truncated, trimmed = np.zeros(n_targets, dtype=bool), np.zeros(n_targets, dtype=int)
-    available = np.zeros(n_targets, dtype=int)
-    kept_parts, rejected_parts = [], []
+def _directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timings: list[SolveTiming]
+                ) -> list[_Part]:
+    """Position + direction targets, one closed-form solve per tool axis."""
+    directions = np.flatnonzero(np.asarray(targets.kinds) == DIRECTION)
+    axes, group = np.unique(np.asarray(targets.tool_axes)[directions], axis=0, return_inverse=True)
+    parts = []
+    for number in range(len(axes)):
+        rows = directions[group.reshape(-1) == number]
+        started = time.perf_counter()
+        plan = direction_plan(robot, axes[number])
+        if plan is None:
+            raise UnsupportedTargetError("no closed-form family covers position + tool direction targets of this "
+                                         "arm with this tool axis")
+        world = np.asarray(targets.world_directions, dtype=float)[rows]
+        goal = DirectionGoal(targets.matrices[rows, :3, 3], world / np.linalg.norm(world, axis=-1, keepdims=True),
+                             plan.tool_axis)
+        options.budget.check("the analytic solve")
+        verified = verify(robot, goal, direction_candidates(robot, plan, goal, options.reference), options.reference)
+        roll = tool_roll(plan)
+        if roll is not None:
+            verified.singularities.add(verified.count > 0, roll)
+        part = _Part(rows, verified, "analytic", plan.structure,
+                     () if plan.roll_joint is None else (plan.roll_joint,))
+        for local in np.flatnonzero(verified.count == 0).tolist():
+            part.details[local] = (
+                "The target position is outside the workspace (farther from the base than the arm can reach)."
+                if bool(beyond_reach(robot, goal.positions[local])) else
+                "No joint vector puts the tool at this position with its axis along the direction (every "
+                "solution of the closed form was checked).")
+        parts.append(_timed(timings, part, started))
+    return parts
+
+
+def _family(robot: Robot, goal: PoseGoal, rows: np.ndarray, free: list[FreeJoint], options: AnswerOptions,
+            timings: list[SolveTiming], started: float) -> list[_Part]:
+    """A redundant arm's targets: the family over the free joints' values. Where no closed form covers the
+    locked arm, the numeric search answers at the values asked (the free joints held), or over every joint when
+    the request named none."""
+    family = family_for(robot, tuple(sorted(f.joint for f in free)))
+    if not family.available:
+        held = options.free_joints is not None
+        part = _numeric(robot, goal, rows, options, free=free if held else None)
+        names = ", ".join(f"q{f.joint + 1}" for f in free)
+        note = (f"No closed-form family covers this arm with {names} locked: a numeric search at each of their "
+                f"values answered." if held else
+                f"No closed-form family covers this arm with {names} locked, so a numeric search over every joint "
+                f"answered.")
+        part.remarks.update(dict.fromkeys(range(len(rows)), note))
+        return [_timed(timings, part, started)]
+    with _at_free_joints():
+        answer = solve_family(robot, family, goal, free, options.reference, budget=options.budget)
+    part = _Part(rows, answer.verified, "analytic", family.structure, family.free)
+    for local in np.flatnonzero(answer.verified.count == 0).tolist():
+        part.details[local] = no_solution_detail(robot, free, goal.world_T_targets[local, :3, 3])
+    for local in np.flatnonzero(answer.missing > 0).tolist():
+        part.remarks[local] = (f"At {answer.missing[local]} of the free values the locked arm falls outside the "
+                               f"closed-form family, so no solution is listed there.")
+    return [_timed(timings, part, started)]
+
+
+def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerOptions, timings: list[SolveTiming],
+                   started: float, note: str) -> list[_Part]:
+    """The closed form's part for the targets it promises, and the numeric search for the others, seeded with
+    the solutions the closed form verified there and reporting the conditions it met."""
+    verified = closed.verified
+    broken = np.flatnonzero(~verified.complete)
+    promised = np.flatnonzero(verified.complete)
+    for local in np.flatnonzero((verified.count == 0) & verified.complete).tolist():
+        closed.details[local] = _unreachable_detail(robot, goal, local, verified)
+    if not len(broken):
+        return [_timed(timings, closed, started)]
+    parts = [_timed(timings, _taken(closed, promised), started)] if len(promised) else []
+    started = time.perf_counter()
+    table = verified.table
+    known = np.full((len(broken), max(1, int(verified.count[broken].max(initial=0))), robot.dof), np.nan)
+    for index, local in enumerate(broken.tolist()):
+        start, stop = np.searchsorted(table.target, [local, local + 1])
+        known[index, :stop - start] = table.joints[start:stop]
+    fallback = _numeric(robot, goal.take(broken), closed.rows[broken], options, options.reference, known=known)
+    fallback.verified.singularities.extend(verified.singularities, rows=broken)
+    fallback.reported = np.ones(len(broken), dtype=bool)
+    for local in range(len(broken)):
+        fallback.details[local] = f"{note} {fallback.details.get(local, '')}".strip()
+    parts.append(_timed(timings, fallback, started))
+    return parts
+
+
+def _fallback_note(plan) -> str:
+    """Why the numeric search completed a target the plan could not promise."""
+    if plan.structure.startswith("general_6r"):
+        return ("The general 6R solver cannot promise every solution for this target (an ill-conditioned "
+                "eigenproblem or a near-double root), so the numeric search completed its answer.")
+    if isinstance(plan, IdealisedPlan):
+        return (f"The arm is within rounding of the {plan.structure} family but not exactly of it; its closed "
+                f"form, refined on the arm as given, cannot promise every solution for this target (a pair of "
+                f"solutions may appear or vanish between the two), so the numeric search completed it.")
+    return (f"The closed form of the {plan.structure} family cannot promise every solution for this target (it met "
+            f"a singular condition where a pair of solutions may appear or vanish), so the numeric search "
+            f"completed it.")
+
+
+def _numeric(robot: Robot, goal: PoseGoal, rows: np.ndarray, options: AnswerOptions,
+             reference: np.ndarray | None = None, *, known: np.ndarray | None = None,
+             free: list[FreeJoint] | None = None) -> _Part:
+    """The numeric search's part for the goal's targets (their indices ``rows``), seeded with ``known``
+    solutions; with ``free``, once per combination of the free joints' values, those joints held."""
+    reference = options.reference if reference is None else reference
+    search_options = options.search
+    if free is None:
+        searched = search(robot, goal, search_options.numeric, reference, known=known, held=None,
+                          budget=search_options.budget)
+        candidates, unfinished = searched.candidates, searched.unfinished
+        free_joints: tuple[int, ...] = ()
+    else:
+        candidates, unfinished = _held_searches(robot, goal, free, search_options, reference)
+        free_joints = tuple(f.joint for f in free)
+    held = None
+    if free is not None:
+        held = np.zeros(robot.dof, dtype=bool)
+        held[list(free_joints)] = True
+    verified = verify(robot, goal, candidates, reference, held=held)
+    part = _Part(rows, verified, "numeric", "general", free_joints, unfinished=unfinished)
+    for local in range(len(rows)):
+        words = []
+        if not verified.count[local]:
+            words.append("No solution was found by the numeric search; the target may be outside the workspace "
+                         "(the numeric search cannot prove it).")
+        if unfinished[local]:
+            words.append(f"The iteration cap ({search_options.numeric.max_iterations}) stopped some starts before "
+                         f"they converged.")
+        if words:
+            part.details[local] = " ".join(words)
+    coaxial = [flag for _, flag in verified.singularities.entries if flag.kind == "coaxial"]
+    if coaxial:
+        part.free_joints = tuple(sorted({*part.free_joints, coaxial[0].joints[1]}))
+    return part
+
+
+def _held_searches(robot: Robot, goal: PoseGoal, free: list[FreeJoint], search_options: IKOptions,
+                   reference: np.ndarray | None):
+    """The numeric search at each combination of the free joints' values, those joints held: the candidates of
+    every combination side by side, per target."""
+    from ._types import Candidates, SingularFlags
+
+    grids = np.meshgrid(*(np.asarray(f.values, dtype=float) for f in free), indexing="ij")
+    values = np.stack([g.ravel() for g in grids], axis=-1)
+    joints, valid, unfinished = [], [], np.zeros(len(goal), dtype=bool)
+    for row in values:
+        searched = search(robot, goal, search_options.numeric, reference,
+                          held=dict(zip((f.joint for f in free), row.tolist())), budget=search_options.budget)
+        joints.append(searched.candidates.joints)
+        valid.append(searched.candidates.valid)
+        unfinished |= searched.unfinished
+    candidates = Candidates(np.concatenate(joints, axis=1), np.concatenate(valid, axis=1), SingularFlags(len(goal)),
+                            complete=np.zeros(len(goal), dtype=bool))
+    return candidates, unfinished
+
+
+def _taken(part: _Part, local: np.ndarray) -> _Part:
+    """The part for its rows ``local`` (indices) only, renumbered."""
+    renumber = {int(old): new for new, old in enumerate(np.asarray(local).tolist())}
+    verified = part.verified
+    keep = np.isin(verified.table.target, local)
+    table = verified.table.take(keep)
+    table = table.with_targets(np.searchsorted(local, table.target))
+    taken = Verified(table, verified.complete[local], verified.nearest[local], verified.singularities.take(local))
+
+    def moved(words: dict[int, str]) -> dict[int, str]:
+        return {renumber[row]: text for row, text in words.items() if row in renumber}
+
+    return _Part(part.rows[local], taken, part.method, part.structure, part.free_joints, moved(part.details),
+                 moved(part.remarks), None if part.reported is None else part.reported[local],
+                 None if part.unfinished is None else part.unfinished[local])
+
+
+def _unreachable_detail(robot: Robot, goal: PoseGoal, local: int, verified: Verified) -> str:
+    """Why a target the closed form proves unreachable has no solution: beyond the reach sphere, or (for a pose)
+    whether the position alone is reachable."""
+    position = goal.world_T_targets[local, :3, 3]
+    if bool(beyond_reach(robot, position)):
+        return "The target position is outside the workspace (farther from the base than the arm can reach)."
+    if not goal.constrain_orientation:
+        return "The target position is outside the workspace."
+    if robot.dof < 6:  # the arm cannot set the orientation freely: is the position alone reachable?
+        plan = cached_plan(robot, constrain_orientation=False, reference=None)
+        if plan is not None:
+            position_only = solve_closed_form(robot, plan, PoseGoal(goal.world_T_targets[local:local + 1], False),
+                                              None)
+            if position_only.count[0]:
+                return ("The position is reachable but the orientation is not: " + _orientation_freedom(robot) +
+                        " No joint vector gives the requested orientation at that position.")
+            if position_only.complete[0] and not plan.free_joints:
+                return "The target position is outside the workspace."
+    return ("No joint vector reaches this pose: every solution of the closed form was checked, none places the "
+            "tool there.")
+
+
+def _orientation_freedom(robot: Robot) -> str:
+    """What orientations an arm with fewer than six joints can give the tool, in words."""
+    geometry = geometry_of(robot)
+    revolute = [i for i in range(robot.dof) if robot.is_revolute[i]]
+    if revolute and all(geometry.parallel(revolute[0], i) for i in revolute):
+        axis = np.round(geometry.direction(revolute[0]), 6).tolist()
+        return (f"every revolute axis of this arm is parallel to {axis} (world frame), so the tool can only turn "
+                f"about that direction from its home orientation (for a SCARA, Spong eq. 4.56).")
+    return f"an arm with {robot.dof} joints cannot set every orientation independently of the position."
+
+
+def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits, options: AnswerOptions,
+               timings: list[SolveTiming]) -> IKAnswer:
+    """The parts' tables laid end to end and selected once, with each target's solver, conditions and words."""
     owner, local_of = np.full(n_targets, -1), np.zeros(n_targets, dtype=int)
+    complete = np.ones(n_targets, dtype=bool)
+    reports: list[SolverReport] = []
+    report_of = np.zeros(n_targets, dtype=int)
+    singular_of: dict[int, list[Singularity]] = {}
+    tables = []
     for number, part in enumerate(parts):
         owner[part.rows], local_of[part.rows] = number, np.arange(len(part.rows))
-    for number, part in enumerate(parts):
-        live = owner[part.rows] == number
-        if not live.any():
-            continue
-        if part.chosen is None:
-            part.chosen = select_arrays(robot, part.arrays, limits, filter_limits=options.filter_limits,
-                                        reference=options.reference, ordering=options.ordering,
-                                        max_equivalents=options.max_equivalents, budget=options.budget)
-        chosen = part.chosen
-        rows = part.rows
-        status[rows[live]], truncated[rows[live]] = chosen.status[live], chosen.truncated[live]
-        trimmed[rows[live]], available[rows[live]] = chosen.trimmed[live], chosen.available[live]
-        solver_of[rows[live]] = part.solver[live] + len(reports_of)
-        reports_of += part.solvers
-        for local, met in part.singularities.items():
-            if live[local]:
-                singular_of[int(rows[local])] = met
-        for table, into in ((chosen.solutions, kept_parts), (chosen.rejected, rejected_parts)):
-            if not live.all():
-                table = table.take(np.flatnonzero(live[table.target]))
-            table = SolutionTable(rows[table.target], table.joints, table.within_limits, table.position,
-                                  table.orientation if part.constrained else np.full(len(table.target), np.nan),
-                                  table.labels)
-            into.append(table)
-    distinct, same = _numbered(reports_of)  # equal reports of different parts are one
-    by_appearance = list(dict.fromkeys(same[solver_of].tolist()))  # number them by first appearance in target order
-    renumber = np.zeros(len(distinct), dtype=int)
+        verified = part.verified
+        complete[part.rows] = verified.complete
+        unfinished = np.zeros(len(part.rows), dtype=bool) if part.unfinished is None else part.unfinished
+        for flags in {(bool(c), bool(u)) for c, u in zip(verified.complete.tolist(), unfinished.tolist())}:
+            report = SolverReport(part.method, part.structure, flags[0], flags[1], part.free_joints)
+            if report not in reports:
+                reports.append(report)
+        for local, (c, u) in enumerate(zip(verified.complete.tolist(), unfinished.tolist())):
+            report_of[part.rows[local]] = reports.index(
+                SolverReport(part.method, part.structure, c, u, part.free_joints))
+        reported = verified.count > 0 if part.reported is None else part.reported
+        for local in np.flatnonzero(reported).tolist():
+            met = verified.singularities[local]
+            if met:
+                singular_of[int(part.rows[local])] = met
+        tables.append(verified.table.with_targets(part.rows[verified.table.target]))
+    table = SolutionTable.concat(tables, robot.dof)
+    if tables and len(table) and (np.diff(table.target) < 0).any():
+        table = table.take(np.argsort(table.target, kind="stable"))
+    chosen: Selection = select(robot, table, n_targets, limits, filter_limits=options.filter_limits,
+                               reference=options.reference, ordering=options.ordering,
+                               max_equivalents=options.max_equivalents, budget=options.budget)
+    status = chosen.status.copy()
+    status[(status == "unreachable") & ~complete] = "not_found"
+    # solver reports numbered by first appearance in target order
+    by_appearance = list(dict.fromkeys(report_of.tolist()))
+    renumber = np.zeros(max(len(reports), 1), dtype=int)
     renumber[by_appearance] = np.arange(len(by_appearance))
-    solvers, solver = [distinct[i] for i in by_appearance], renumber[same[solver_of]]
-    singular_rows = sorted(singular_of)  # only the targets that meet a condition, in target order
-    reports, numbered = _numbered_lists([singular_of[row] for row in singular_rows])
-    numbered_of = dict(zip(singular_rows, numbered))
-    singularities = PerTarget(n_targets, lambda row: list(numbered_of.get(row, ())))
+    solvers, solver = [reports[i] for i in by_appearance], renumber[report_of]
+    singular_rows = sorted(singular_of)
+    distinct: dict[Singularity, int] = {}
+    numbered = {row: [distinct.setdefault(flag, len(distinct)) for flag in singular_of[row]] for row in singular_rows}
+    singularities = PerTarget(n_targets, lambda row: list(numbered.get(row, ())))
 
     def detail_of(row: int, wording: Mapping[str, str]) -> str | None:
-        return None if owner[row] < 0 else _worded(parts[int(owner[row])], int(local_of[row]), wording)
+        if owner[row] < 0:
+            return None
+        part, local = parts[int(owner[row])], int(local_of[row])
+        notes = chosen.notes.worded(row, wording) if row in chosen.notes else []
+        words = [part.details.get(local), *notes, part.remarks.get(local)]
+        return " ".join(filter(None, words)) or None
 
-    kept, rejected = _merged(kept_parts, robot.dof), _merged(rejected_parts, robot.dof)
     return IKAnswer(status, PerTarget(n_targets, lambda row: detail_of(row, NOTE_WORDING)), solver, solvers,
-                    singularities, reports, truncated, trimmed, available, kept, rejected,
-                    _violations(robot, limits, kept), _violations(robot, limits, rejected), limits, timings, detail_of)
-
-
-def _worded(part: _Solved, local: int, wording: Mapping[str, str]) -> str | None:
-    """The detail of a part's row ``local``: the solver's detail, the selection's notes in ``wording``, the
-    remarks."""
-    notes = part.chosen.notes.worded(local, wording) if local in part.chosen.notes else []
-    words = [part.details.get(local), *notes, part.remarks.get(local)]
-    return " ".join(filter(None, words)) or None
-
-
-def _numbered(items: list) -> tuple[list, np.ndarray]:
-    """The distinct items in order of first appearance, and each item's index among them, shape (N,)."""
-    index: dict = {}
-    numbers = np.array([index.setdefault(item, len(index)) for item in items], dtype=int)
-    return list(index), numbers
-
-
-def _numbered_lists(lists: list[list]) -> tuple[list, list[list[int]]]:
-    """:func:`_numbered` for lists of items: the distinct items, and each list as their indices."""
-    index: dict = {}
-    numbers = [[index.setdefault(item, len(index)) for item in items] for items in lists]
-    return list(index), numbers
+                    singularities, list(distinct), chosen.truncated, chosen.trimmed, chosen.available,
+                    chosen.solutions, chosen.rejected, _violations(robot, limits, chosen.solutions),
+                    _violations(robot, limits, chosen.rejected), limits, timings, detail_of)
 
 
 def _violations(robot: Robot, limits: Limits, table: SolutionTable) -> np.ndarray:
@@ -481,31 +596,3 @@ def _violations(robot: Robot, limits: Limits, table: SolutionTable) -> np.ndarra
     outside = (table.joints < limits.lower - tolerance) | (table.joints > limits.upper + tolerance)
     return outside & ~table.within_limits[:, None]
 
-
-def _merged(tables: list[SolutionTable], dof: int) -> SolutionTable:
-    """One table from several, rows grouped by target (stable), label codes remapped onto one vocabulary per
-    label (names in order of first appearance)."""
-    vocabularies: dict[str, list] = {}
-    for table in tables:
-        for name, (values, _) in table.labels.items():
-            vocabulary = vocabularies.setdefault(name, [])
-            vocabulary.extend(value for value in values if value not in vocabulary)
-    if len(tables) == 1 and all(tuple(vocabularies[name]) == values and codes.dtype == np.int8
-                                for name, (values, codes) in tables[0].labels.items()):
-        return tables[0]  # its values are the vocabulary already
-    remapped = []
-    for table in tables:
-        labels = {}
-        for name, vocabulary in vocabularies.items():
-            if name not in table.labels:
-                labels[name] = (tuple(vocabulary), np.full(len(table.target), -1, dtype=np.int8))
-                continue
-            values, codes = table.labels[name]
-            lookup = np.array([*(vocabulary.index(value) for value in values), -1], dtype=np.int8)
-            labels[name] = (tuple(vocabulary), lookup[codes])
-        remapped.append(SolutionTable(table.target, table.joints, table.within_limits, table.position,
-                                      table.orientation, labels))
-    if len(remapped) == 1:
-        return remapped[0]
-    merged = SolutionTable.concatenate(remapped, dof)
-    return merged.take(np.argsort(merged.target, kind="stable"))

@@ -18,8 +18,9 @@ a pose target; the tool's roll about ``a`` is what the target leaves open.
   an axis perpendicular to ``a``. A pose of the 5-joint arm is reached by the
   6-joint arm with the virtual joint at 0, and those are the solutions kept.
 
-Every solution is checked by the real arm's FK: position within
-``ACCEPT_RESIDUAL`` times its size, direction within ``ACCEPT_RESIDUAL`` rad.
+Every solution is checked by the real arm's FK (:func:`~._verify.verify` with a
+:class:`~._goals.DirectionGoal`): position within ``ACCEPT_RESIDUAL`` times its
+size, direction within ``ACCEPT_RESIDUAL`` rad.
 """
 
 from __future__ import annotations
@@ -28,22 +29,20 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._cache import memo
+from .._cache import bounded_memo
 from .._errors import InvalidInputError
-from .._forward import forward_kinematics, geometric_jacobian
 from .._robot import Robot
 from .._rotations import wrap_angle
-from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE
-from ._arrays import IKArrays
+from .._tolerances import GEOMETRY_TOLERANCE
+from ._goals import DirectionGoal
 from ._plan import Plan, geometry_of, plan_for_geometry
 from ._structure import Geometry
-from ._types import SingularFlags, Singularity
-from ._verify import distance_to_reference, first_of_each, wrap_revolute
+from ._types import Candidates, SingularFlags, Singularity
 
 #: The virtual joint's value (rad) within which a 6-joint solution is one of the 5-joint arm (the roll case).
 VIRTUAL_AT_ZERO = 1e-6
-#: Gauss–Newton steps that remove the rounding left by dropping the virtual joint.
-POLISH_STEPS = 3
+#: Direction plans kept per robot (one per tool axis a request names).
+_PLANS_KEPT = 16
 
 
 def target_kinds(robot: Robot) -> list[str]:
@@ -113,7 +112,7 @@ def direction_plan(robot: Robot, tool_axis: np.ndarray) -> DirectionPlan | None:
                 return DirectionPlan(plan, a, last, f"virtual_joint+{plan.structure}")
         return None
 
-    return memo(robot, ("direction_plan", tuple(np.round(a, 12).tolist())), build)
+    return bounded_memo(robot, "direction_plan", tuple(np.round(a, 12).tolist()), build, _PLANS_KEPT)
 
 
 def rotations_to(tool_axis: np.ndarray, world_directions: np.ndarray) -> np.ndarray:
@@ -134,93 +133,39 @@ def rotations_to(tool_axis: np.ndarray, world_directions: np.ndarray) -> np.ndar
     return np.eye(3) + s * K + (1 - c) * K @ K
 
 
-def direction_residuals(robot: Robot, joints: np.ndarray, positions: np.ndarray, directions: np.ndarray,
-                        tool_axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Position error (length units) and angle between the tool axis and the direction (rad), shape (N, m),
-    for joints (N, m, n), positions and unit directions (N, 3)."""
-    T = forward_kinematics(robot, joints.reshape(-1, robot.dof)).reshape(joints.shape[:-1] + (4, 4))
-    position = np.linalg.norm(T[..., :3, 3] - positions[:, None], axis=-1)
-    pointing = T[..., :3, :3] @ tool_axis
-    angle = np.arctan2(np.linalg.norm(np.cross(pointing, directions[:, None]), axis=-1),
-                       np.einsum("nmi,ni->nm", pointing, directions))
-    return position, angle
-
-
-def _polish(robot: Robot, q: np.ndarray, positions: np.ndarray, directions: np.ndarray,
-            tool_axis: np.ndarray) -> np.ndarray:
-    """A few Gauss–Newton steps (k, n) on [p(q) − p; R(q) a − d], which are consistent at a solution."""
-    scale = robot.characteristic_length
-    q = q.copy()
-    for _ in range(POLISH_STEPS):
-        T = forward_kinematics(robot, q)
-        pointing = T[:, :3, :3] @ tool_axis
-        error = np.concatenate([(positions - T[:, :3, 3]) / scale, directions - pointing], axis=1)
-        J = geometric_jacobian(robot, q)
-        cross = np.zeros((len(q), 3, 3))
-        cross[:, 0, 1], cross[:, 0, 2], cross[:, 1, 2] = -pointing[:, 2], pointing[:, 1], -pointing[:, 0]
-        cross = cross - np.swapaxes(cross, 1, 2)
-        A = np.concatenate([J[:, :3] / scale, -cross @ J[:, 3:]], axis=1)  # d(R a)/dq = ω × (R a)
-        step = np.linalg.lstsq(A[0], error[0], rcond=None)[0][None] if len(q) == 1 else np.stack(
-            [np.linalg.lstsq(a_i, e_i, rcond=None)[0] for a_i, e_i in zip(A, error)])
-        q = q + step
-    return q
-
-
-def solve_direction(robot: Robot, positions: np.ndarray, world_directions: np.ndarray, tool_axis: np.ndarray,
-                    reference: np.ndarray | None) -> IKArrays | None:
-    """Every solution of N position + direction targets: positions (N, 3), world directions (N, 3).
-
-    Returns :class:`IKArrays` (orientation residuals are the direction angles),
-    or None when no family covers the 6-joint problem. When the last joint turns
-    about the tool axis it is listed in ``free_joints`` and held at the reference
-    value (or 0) in every solution.
-    """
-    plan = direction_plan(robot, tool_axis)
-    if plan is None:
-        return None
+def direction_candidates(robot: Robot, plan: DirectionPlan, goal: DirectionGoal, reference: np.ndarray | None
+                         ) -> Candidates:
+    """Candidates (N, m, n) of the goal's N position + direction targets by the plan, with their labels and the
+    arm's singular conditions (those of the virtual joint left out). When the last joint turns about the tool
+    axis it is held at the reference value (or 0) in every candidate; :func:`tool_roll` then names it."""
     n = robot.dof
-    positions = np.asarray(positions, dtype=float)
-    directions = np.asarray(world_directions, dtype=float)
-    directions = directions / np.linalg.norm(directions, axis=-1, keepdims=True)
-    targets = np.zeros((len(positions), 4, 4))
+    targets = np.zeros((len(goal), 4, 4))
     targets[:, 3, 3] = 1.0
-    targets[:, :3, 3] = positions
-    targets[:, :3, :3] = rotations_to(plan.tool_axis, directions)
+    targets[:, :3, 3] = goal.positions
+    targets[:, :3, :3] = rotations_to(plan.tool_axis, goal.directions)
     extended = None if reference is None else np.append(reference, 0.0)
     candidates = plan.plan.solve(targets, extended)
     full = np.nan_to_num(candidates.joints)  # (N, m, n + 1)
     valid = candidates.valid.copy()
     if plan.roll_joint is not None:  # the arm's own pose problem: the virtual joint must stay at 0
-        virtual = np.abs(wrap_angle(full[..., n]))
-        valid &= virtual <= VIRTUAL_AT_ZERO
-    joints = wrap_revolute(robot, full[..., :n].copy())
-    if valid.any():
-        rows, slots = np.nonzero(valid)
-        joints[rows, slots] = wrap_revolute(robot, _polish(robot, joints[rows, slots], positions[rows],
-                                                           directions[rows], plan.tool_axis))
+        valid &= np.abs(wrap_angle(full[..., n])) <= VIRTUAL_AT_ZERO
+    joints = full[..., :n].copy()
     if plan.roll_joint is not None:
         joints[..., plan.roll_joint] = 0.0 if reference is None else reference[plan.roll_joint]
-    position, angle = direction_residuals(robot, joints, positions, directions, plan.tool_axis)
-    ok = valid & (position <= ACCEPT_RESIDUAL * robot.characteristic_length) & (angle <= ACCEPT_RESIDUAL)
-    kept = first_of_each(robot, joints, ok)
-    labels = plan.plan.label_codes(full.reshape(-1, n + 1))
-    m = joints.shape[1]
-    if reference is not None:
-        key = np.where(kept, distance_to_reference(robot, joints, reference), np.inf)
-        order = np.argsort(key, axis=1, kind="stable")
-    else:
-        order = np.argsort(~kept, axis=1, kind="stable")
-    take = (np.arange(len(joints))[:, None], order)
-    singular = SingularFlags(len(joints))
+    labels = candidates.labels if candidates.labels is not None else {
+        name: (values, codes.reshape(valid.shape))
+        for name, (values, codes) in plan.plan.label_codes(full.reshape(-1, n + 1)).items()}
+    singular = SingularFlags(len(goal))
     for mask, flag in candidates.singularities.entries:  # conditions that involve the virtual joint are not the arm's
         if all(j < n for j in flag.joints):
             singular.add(mask, flag)
-    if plan.roll_joint is not None:
-        singular.add(kept.any(axis=1), Singularity(
-            "tool_roll", (plan.roll_joint,), "free",
-            f"q{plan.roll_joint + 1} turns the tool about the tool axis, which the target leaves free: held at the "
-            f"reference value (or 0)"))
-    free = [] if plan.roll_joint is None else [plan.roll_joint]
-    return IKArrays(joints[take], kept[take], kept.sum(axis=1), position[take], angle[take],
-                    {name: (values, codes.reshape(len(joints), m)[take]) for name, (values, codes) in labels.items()},
-                    singular, plan.structure, free)
+    return Candidates(joints, valid, singular, labels=labels)
+
+
+def tool_roll(plan: DirectionPlan) -> Singularity | None:
+    """The condition every direction answer of an arm whose last joint turns about the tool axis reports."""
+    if plan.roll_joint is None:
+        return None
+    return Singularity("tool_roll", (plan.roll_joint,), "free",
+                       f"q{plan.roll_joint + 1} turns the tool about the tool axis, which the target leaves free: "
+                       f"held at the reference value (or 0)")

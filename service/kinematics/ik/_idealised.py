@@ -55,7 +55,9 @@ from .._tolerances import ACCEPT_RESIDUAL
 from ._screws import chain_motion
 from ._structure import arm_size
 from ._types import Candidates, LabelCodes
-from ._verify import first_of_each, polish, residual_arrays, wrap_revolute
+from ._gauss_newton import gauss_newton
+from ._goals import PoseGoal
+from ._verify import POLISH_FROM, first_of_each, residual_arrays, wrap_revolute
 
 #: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
 #: the idealisation's deviation marks the row incomplete: the perturbation moves the tool by at most a few δ
@@ -118,8 +120,7 @@ class IdealisedPlan:
         tried = finite & (ideal.valid | near_before)
         rows, slots = np.nonzero(tried)
         if len(rows):
-            refined = polish(robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation,
-                             steps=REFINE_STEPS)
+            refined = self._refined(joints[rows, slots], world_T_targets[rows], REFINE_STEPS)
             joints[rows, slots] = wrap_revolute(robot, refined)
         position, orientation = residual_arrays(robot, joints, world_T_targets)
         accepted = self._accepted(position, orientation) & tried
@@ -133,8 +134,7 @@ class IdealisedPlan:
         rescued = np.zeros(len(world_T_targets), dtype=bool)
         rows, slots = np.nonzero(rescue)
         if len(rows):  # only the refined slots that reach are kept; the others stay as they were
-            refined = wrap_revolute(robot, polish(robot, joints[rows, slots], world_T_targets[rows],
-                                                  self.constrain_orientation, steps=REFINE_STEPS))
+            refined = wrap_revolute(robot, self._refined(joints[rows, slots], world_T_targets[rows], REFINE_STEPS))
             p, o = residual_arrays(robot, refined[:, None, :], world_T_targets[rows])
             reached = self._accepted(p[:, 0], o[:, 0])
             rows, slots = rows[reached], slots[reached]
@@ -169,6 +169,11 @@ class IdealisedPlan:
         complete = converged & distinct & ~near_miss & ~singular & ~rescued
         return Candidates(joints, accepted, ideal.singularities, complete=complete)
 
+    def _refined(self, q: np.ndarray, world_T_targets: np.ndarray, steps: int) -> np.ndarray:
+        """Gauss–Newton steps on the true arm from joint vectors q (k, n) towards their targets (k, 4, 4)."""
+        goal = PoseGoal(world_T_targets, self.constrain_orientation)
+        return gauss_newton(self.robot, goal, q, np.arange(len(q)), steps=steps, tolerance=POLISH_FROM).joints
+
     def _accepted(self, position: np.ndarray, orientation: np.ndarray) -> np.ndarray:
         """Which slots reach the target on the true arm at the acceptance tolerance."""
         accepted = position <= ACCEPT_RESIDUAL * arm_size(self.robot)
@@ -187,7 +192,7 @@ class IdealisedPlan:
         no solution lies near that candidate.
         """
         rows, slots = np.nonzero(missed)
-        stepped = polish(self.robot, joints[rows, slots], world_T_targets[rows], self.constrain_orientation, steps=1)
+        stepped = self._refined(joints[rows, slots], world_T_targets[rows], 1)
         position, orientation = residual_arrays(self.robot, stepped[:, None, :], world_T_targets[rows])
         now, before = self._size(position, orientation)[:, 0], after[rows, slots]
         apart = np.zeros_like(missed)

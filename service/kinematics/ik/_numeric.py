@@ -1,14 +1,14 @@
-"""Numeric fallback: damped least squares (Levenberg–Marquardt) from many starts.
+"""The numeric search: Levenberg–Marquardt from many starts, for targets no closed form covers or promises.
 
-Used for structures no analytic family covers. It cannot promise that every
-solution was found (``complete`` is false), so it is bounded: a number of
-starts and an iteration cap, each configurable. The budget is counted in
-iterations, never read off a clock, so the answer is the same under any load;
-the request's :class:`.._budget.Budget` (its deadline, a cancellation) is
-checked between iterations and stops the search with
-:class:`.._budget.BudgetExhausted` rather than with a partial answer. All
-starts run together as one batch: each iteration is one batched FK and one
-batched Jacobian.
+It cannot promise that every solution was found (its candidates say ``complete`` false), so it is bounded: a
+number of starts and an iteration cap, each configurable. The budget is counted in iterations, never read off a
+clock, so the answer is the same under any load; the request's :class:`.._budget.Budget` (its deadline, a
+cancellation) is checked between iterations and stops the search with :class:`.._budget.BudgetExhausted` rather
+than with a partial answer. The starts of a batch run together, in chunks of at most :func:`chunk_rows` joint
+vectors, so that memory is bounded whatever the number of starts, targets and joints.
+
+The search returns :class:`~._types.Candidates` like every family: the converged starts (and the solutions a
+caller already knows, first), for :func:`~._verify.verify` to check, merge and label.
 """
 
 from __future__ import annotations
@@ -18,41 +18,44 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._budget import UNLIMITED, Budget
-from .._forward import forward_kinematics, geometric_jacobian
 from .._robot import Robot
+from ._coaxial import coaxial_pair, coaxial_report, held_split
+from ._gauss_newton import gauss_newton
+from ._goals import Goal
+from ._plan import geometry_of
+from ._structure import arm_size
+from ._types import Candidates, SingularFlags
+
+#: The normalised error (‖e‖∞, lengths in arm sizes) at which a start has converged; it is then polished and
+#: checked by FK like any candidate (:func:`~._verify.verify`).
+CONVERGED = 1e-10
+#: A start whose error stays above this when the search stops is not a candidate.
+CANDIDATE = 1e-5
+#: Bytes of working arrays one chunk of the search may use: Jacobians, the chain's frames and their temporaries,
+#: about :data:`_FLOATS_PER_JOINT` floats per joint of each joint vector.
+WORK_BYTES = 64 << 20
+_FLOATS_PER_JOINT = 96
 
 
 @dataclass(frozen=True)
 class NumericOptions:
-    """Bounds on the numeric search."""
+    """Bounds on the numeric search: starts per target, Levenberg–Marquardt iterations per start, and the seed of
+    the starts (the same starts for every target)."""
 
     starts: int = 48
     max_iterations: int = 200
     seed: int = 0
 
 
-@dataclass(frozen=True)
-class NumericOutcome:
-    joints: np.ndarray  # (k, n) converged joint vectors (not yet deduplicated or verified)
-    budget_exhausted: bool  # the iteration cap stopped some starts before they converged or gave up
-    iterations: int
-
-
-def pose_error(world_T_tool: np.ndarray, world_T_target: np.ndarray, length_scale: float) -> np.ndarray:
-    """Twist-like error from the current tool pose to the target, shape (..., 6).
-
-    Rows 0–2: position error divided by ``length_scale``; rows 3–5: rotation
-    error ``½ Σ_i r_i × r*_i`` (columns of the current and target rotations),
-    which is sin(angle)·axis near the solution.
-    """
-    position = (world_T_target[..., :3, 3] - world_T_tool[..., :3, 3]) / length_scale
-    rotation = 0.5 * np.sum(np.cross(world_T_tool[..., :3, :3], world_T_target[..., :3, :3], axis=-2), axis=-1)
-    return np.concatenate([position, rotation], axis=-1)
+def chunk_rows(dof: int) -> int:
+    """How many joint vectors one chunk of the search iterates at once for an arm of ``dof`` joints."""
+    return max(64, WORK_BYTES // (8 * _FLOATS_PER_JOINT * max(dof, 1)))
 
 
 def initial_guesses(robot: Robot, count: int, rng: np.random.Generator, reference: np.ndarray | None) -> np.ndarray:
-    """Spread starts over the joint ranges (±π, or ±scale for unlimited prismatic joints), shape (count, n)."""
-    scale = robot.characteristic_length
+    """Starts spread over the joint ranges (±π, or ±size for unlimited prismatic joints), shape (count, n): the
+    first at 0 (clipped into the limits), the second at the reference when there is one."""
+    scale = arm_size(robot)
     default_lower = np.where(robot.is_revolute, -np.pi, -scale)
     default_upper = np.where(robot.is_revolute, np.pi, scale)
     lower = np.where(np.isfinite(robot.lower), np.maximum(robot.lower, default_lower - 2 * np.pi), default_lower)
@@ -72,65 +75,54 @@ def initial_guesses(robot: Robot, count: int, rng: np.random.Generator, referenc
     return starts
 
 
-def solve_numeric(
-    robot: Robot,
-    world_T_target: np.ndarray,
-    *,
-    constrain_orientation: bool,
-    options: NumericOptions,
-    reference: np.ndarray | None = None,
-    accept: float = 1e-20,
-    budget: Budget = UNLIMITED,
-) -> NumericOutcome:
-    """Run Levenberg–Marquardt from ``options.starts`` starts at once.
+@dataclass(frozen=True)
+class Searched:
+    """The search's candidates for N targets, and which targets' searches the iteration cap stopped before every
+    start had converged or given up (N,)."""
 
-    Parameters
-    ----------
-    world_T_target : ndarray, shape (4, 4)
-    constrain_orientation : bool
-        False for position-only targets: only the three position rows are solved.
-    accept : float
-        Squared-error threshold (normalised units) at which a start has converged.
+    candidates: Candidates
+    unfinished: np.ndarray
+
+
+def search(robot: Robot, goal: Goal, options: NumericOptions, reference: np.ndarray | None, *,
+           known: np.ndarray | None = None, held: dict[int, float] | None = None,
+           budget: Budget = UNLIMITED) -> Searched:
+    """Levenberg–Marquardt from ``options.starts`` starts per target of ``goal`` (N targets).
+
+    ``known`` (N, k, n), NaN-padded, are solutions a caller already verified; they head each target's candidates.
+    ``held`` joints stay at their values (the free joints of a redundant arm a request fixed). On an arm with
+    two coaxial joints, each candidate is split with the second at the reference (or 0), as the closed form
+    splits it (:mod:`._coaxial`).
     """
-    rng = np.random.default_rng(options.seed)
-    scale = robot.characteristic_length
-    rows = slice(0, 6) if constrain_orientation else slice(0, 3)
-    q = initial_guesses(robot, options.starts, rng, reference)
-    damping = np.full(len(q), 1e-3)
-
-    def residual(joints: np.ndarray) -> np.ndarray:
-        return pose_error(forward_kinematics(robot, joints), world_T_target, scale)[:, rows]
-
-    error = residual(q)
-    cost = np.einsum("si,si->s", error, error)
-    active = cost > accept
-    iterations = 0
-    while active.any() and iterations < options.max_iterations:
-        budget.check("the numeric search")
-        iterations += 1
-        J = geometric_jacobian(robot, q[active])
-        J[:, :3, :] /= scale
-        J = J[:, rows, :]
-        JtJ = np.einsum("sij,sik->sjk", J, J)
-        gradient = np.einsum("sij,si->sj", J, error[active])
-        # Levenberg–Marquardt: damp the diagonal, scaled by the size of JᵀJ.
-        diagonal = np.arange(robot.dof)
-        JtJ[:, diagonal, diagonal] += (damping[active] * np.maximum(1.0, np.trace(JtJ, axis1=1, axis2=2)))[:, None]
-        with np.errstate(over="ignore", invalid="ignore"):
-            step = np.linalg.solve(JtJ, gradient[..., None])[..., 0]
-            trial = q[active] + step
-            trial_error = residual(trial)
-            trial_cost = np.einsum("si,si->s", trial_error, trial_error)
-        improved = np.isfinite(trial_cost) & (trial_cost < cost[active])  # an overflowing step is a failed step
-        indices = np.flatnonzero(active)
-        better = indices[improved]
-        q[better] = trial[improved]
-        error[better] = trial_error[improved]
-        cost[better] = trial_cost[improved]
-        damping[better] = np.maximum(damping[better] * 0.3, 1e-12)
-        worse = indices[~improved]
-        damping[worse] = damping[worse] * 10.0
-        active = (cost > accept) & (damping < 1e8)
-    converged = cost <= 1e-10  # polished and FK-checked by the caller
-    budget_exhausted = bool(active.any())  # starts still improving when the iterations ran out
-    return NumericOutcome(q[converged], budget_exhausted, iterations)
+    n_targets, n = len(goal), robot.dof
+    starts = initial_guesses(robot, options.starts, np.random.default_rng(options.seed), reference)
+    moving = None
+    if held:
+        starts[:, list(held)] = list(held.values())
+        moving = np.ones(n, dtype=bool)
+        moving[list(held)] = False
+    total = n_targets * len(starts)
+    joints = np.empty((total, n))
+    error = np.empty(total)
+    unfinished = np.zeros(n_targets, dtype=bool)
+    chunk = chunk_rows(n)
+    for begin in range(0, total, chunk):
+        end = min(begin + chunk, total)
+        rows = np.arange(begin, end) // len(starts)
+        reached = gauss_newton(robot, goal, starts[np.arange(begin, end) % len(starts)], rows,
+                               steps=options.max_iterations, tolerance=CONVERGED, adaptive=True, moving=moving,
+                               budget=budget, stage="the numeric search")
+        joints[begin:end], error[begin:end] = reached.joints, reached.error
+        unfinished[rows[reached.unfinished]] = True
+    joints = joints.reshape(n_targets, len(starts), n)
+    valid = (error <= CANDIDATE).reshape(n_targets, len(starts))
+    pair = coaxial_pair(geometry_of(robot))
+    if pair is not None:
+        joints = held_split(joints, pair, reference)
+    singularities = SingularFlags(n_targets)
+    if pair is not None:
+        singularities.add(valid.any(axis=1), coaxial_report(pair))
+    if known is not None and known.shape[1]:
+        joints = np.concatenate([np.nan_to_num(known), joints], axis=1)
+        valid = np.concatenate([~np.isnan(known).any(axis=-1), valid], axis=1)
+    return Searched(Candidates(joints, valid, singularities, complete=np.zeros(n_targets, dtype=bool)), unfinished)

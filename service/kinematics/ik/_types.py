@@ -8,7 +8,7 @@ from typing import Literal
 import numpy as np
 
 Branch = dict[str, str | int]
-Status = Literal["ok", "unreachable"]
+Status = Literal["ok", "unreachable", "not_found"]
 
 #: Branch labels as arrays: label name → (its values, codes of shape (M,) indexing them; −1 where the label
 #: does not apply to a row, e.g. where its two branches meet).
@@ -54,6 +54,27 @@ class SingularFlags:
         """Add every condition of ``other``; ``rows`` (N,) maps its rows onto these when it has fewer."""
         for mask, singularity in other.entries:
             self.add(mask if rows is None else mask[rows], singularity)
+
+    def take(self, rows: np.ndarray) -> "SingularFlags":
+        """The conditions of targets ``rows`` (indices or a boolean mask), renumbered in that order."""
+        rows = np.asarray(rows)
+        taken = SingularFlags(int(rows.sum()) if rows.dtype == bool else len(rows))
+        for mask, singularity in self.entries:
+            taken.add(mask[rows], singularity)
+        return taken
+
+    @classmethod
+    def concat(cls, parts: list["SingularFlags"]) -> "SingularFlags":
+        """The conditions of several groups of targets laid end to end."""
+        joined = cls(sum(part.count for part in parts))
+        offset = 0
+        for part in parts:
+            for mask, singularity in part.entries:
+                full = np.zeros(joined.count, dtype=bool)
+                full[offset:offset + part.count] = mask
+                joined.add(full, singularity)
+            offset += part.count
+        return joined
 
     def any(self) -> np.ndarray:
         """Which targets meet at least one condition, shape (N,)."""

@@ -1,21 +1,39 @@
-"""Verification of candidate solutions by forward kinematics, merging and ordering.
+"""Every candidate checked by forward kinematics, duplicates merged: a solver's candidates become a table.
 
-No solution leaves the core unless FK of it reproduces the target within a
-tolerance relative to the robot's size.
+No solution leaves the core unless FK of it reproduces its target within a tolerance relative to the robot's
+size. :func:`verify` is the one place where that happens, for every solver (the closed forms, a redundant arm's
+family, direction targets, the numeric search): candidates close to their target get a few Gauss–Newton steps
+first (:mod:`._gauss_newton`), candidates equal to an earlier kept one modulo 2π are merged into it, and the
+solver's promise that a target's solutions are all of them is weighed against what verified
+(:func:`promised`).
 """
 
 from __future__ import annotations
 
-import math
+import functools
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 
-from .._cache import memo
-from .._forward import forward_kinematics, tool_columns, tool_columns_scalar_rows
 from .._robot import Robot
 from .._rotations import wrap_angle
-from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE
+from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
+from ._gauss_newton import gauss_newton
+from ._goals import Goal, PoseGoal
 from ._structure import arm_size
+from ._table import SolutionTable
+from ._types import Candidates, LabelCodes, SingularFlags
+
+#: Candidates with errors above this (and up to ``POLISH_RESIDUAL``) get Gauss–Newton steps before the check.
+POLISH_FROM = ACCEPT_RESIDUAL * 1e-3
+#: Gauss–Newton steps of that polish: near a singularity a closed form loses digits that one or two restore.
+POLISH_STEPS = 3
+
+#: Singular relations under which a family's "no solution" is not a proof: it set a joint it found undetermined to
+#: the reference value (or 0), or two roots met (a double root that rounding can push just off the real line).
+FRAGILE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum",
+                               "boundary", "stretched", "folded", "stretched_or_folded"})
 
 
 def wrap_revolute(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -28,182 +46,12 @@ def joint_difference(robot: Robot, q: np.ndarray, reference: np.ndarray) -> np.n
     return wrap_revolute(robot, np.asarray(q) - reference)
 
 
-def residuals(robot: Robot, q: np.ndarray, world_T_target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Position error (length units) and orientation error (radians) of FK(q) against the target: k candidates
-    for one target, or one candidate per target (:func:`residual_arrays`, the one formula).
-
-    Parameters
-    ----------
-    q : ndarray, shape (k, n)
-    world_T_target : ndarray, shape (4, 4) or (k, 4, 4)
-
-    Returns
-    -------
-    position, orientation : ndarrays, shape (k,)
-    """
-    q, world_T_target = np.asarray(q, dtype=float), np.asarray(world_T_target, dtype=float)
-    if world_T_target.ndim == 2:
-        position, orientation = residual_arrays(robot, q[None], world_T_target[None])
-        return position[0], orientation[0]
-    position, orientation = residual_arrays(robot, q[:, None], world_T_target)
-    return position[:, 0], orientation[:, 0]
-
-
-def residual_arrays(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`residuals` for m candidates per target, without repeating the targets.
-
-    Parameters
-    ----------
-    q : ndarray, shape (N, m, n)
-    world_T_targets : ndarray, shape (N, 4, 4)
-
-    Returns
-    -------
-    position, orientation : ndarrays, shape (N, m)
-        Length units and radians, as :func:`residuals`.
-    """
-    n_targets, m, n = q.shape
-    if n_targets * m <= SCALAR_CANDIDATES:
-        return _residuals_scalar(robot, q, world_T_targets)
-    x, y, z, p = (c.reshape(3, n_targets, m) for c in tool_columns(robot, q.reshape(-1, n)))
-    target = np.moveaxis(world_T_targets[:, :3, :], 0, -1)[..., None]  # (3, 4, N, 1)
-    tx, ty, tz, tp = target[:, 0], target[:, 1], target[:, 2], target[:, 3]
-    delta = p - tp
-    position = np.sqrt(_dot(delta, delta))
-    # relative = target_R^T · R: entry (i, j) is target column i · column j
-    dot = _dot
-    cosine = 0.5 * (dot(tx, x) + dot(ty, y) + dot(tz, z) - 1.0)
-    sine = 0.5 * np.sqrt((dot(tz, y) - dot(ty, z)) ** 2 + (dot(tx, z) - dot(tz, x)) ** 2
-                         + (dot(ty, x) - dot(tx, y)) ** 2)
-    return position, np.arctan2(sine, cosine)
-
-
-#: Up to this many candidates in all (one pose's), :func:`residual_arrays` runs the scalar FK on each: cheaper
-#: than the array operations, whose fixed cost dominates at that size.
-SCALAR_CANDIDATES = 16
-
-
-def _residuals_scalar(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`residual_arrays` by :func:`residuals_of_rows`, target by target."""
-    n_targets, m, _ = q.shape
-    position, orientation = np.empty((n_targets, m)), np.empty((n_targets, m))
-    for row, (candidates, target) in enumerate(zip(q.tolist(), world_T_targets[:, :3, :].tolist())):
-        position[row], orientation[row] = zip(*residuals_of_rows(robot, candidates, target))
-    return position, orientation
-
-
-def residuals_of_rows(robot: Robot, rows: list[list[float]], target: list[list[float]]) -> list[tuple[float, float]]:
-    """:func:`residual_arrays` of a few candidates (lists of n floats) against one target (the top three rows of
-    its matrix, as lists), in scalar arithmetic on the scalar FK
-    (:func:`~service.kinematics._forward.tool_columns_scalar_rows`): the same formulas. Returns (position,
-    orientation) per candidate."""
-    (tx0, ty0, tz0, tp0), (tx1, ty1, tz1, tp1), (tx2, ty2, tz2, tp2) = target
-    sqrt, atan2 = math.sqrt, math.atan2
-    out = []
-    for (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) in tool_columns_scalar_rows(robot, rows):
-        d0, d1, d2 = p0 - tp0, p1 - tp1, p2 - tp2
-        cosine = 0.5 * ((tx0 * x0 + tx1 * x1 + tx2 * x2) + (ty0 * y0 + ty1 * y1 + ty2 * y2)
-                        + (tz0 * z0 + tz1 * z1 + tz2 * z2) - 1.0)
-        sine = 0.5 * sqrt(((tz0 * y0 + tz1 * y1 + tz2 * y2) - (ty0 * z0 + ty1 * z1 + ty2 * z2)) ** 2
-                          + ((tx0 * z0 + tx1 * z1 + tx2 * z2) - (tz0 * x0 + tz1 * x1 + tz2 * x2)) ** 2
-                          + ((ty0 * x0 + ty1 * x1 + ty2 * x2) - (tx0 * y0 + tx1 * y1 + tx2 * y2)) ** 2)
-        out.append((sqrt(d0 * d0 + d1 * d1 + d2 * d2), atan2(sine, cosine)))
-    return out
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Dot products along the leading axis of length 3, broadcasting the rest."""
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-
-
-def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool) -> np.ndarray:
-    """Which residuals pass the FK check."""
-    ok = position <= ACCEPT_RESIDUAL * arm_size(robot)
-    if constrain_orientation:
-        ok &= orientation <= ACCEPT_RESIDUAL
-    return ok
-
-
-def duplicate_tolerance(robot: Robot) -> np.ndarray:
-    """Per joint (n,), how close two solutions' values must be to count as one: ``DUPLICATE_TOLERANCE`` radians
-    for a revolute joint, that times the arm's size for a prismatic one."""
-    return memo(robot, "duplicate_tolerance", lambda: np.where(
-        robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot)))
-
-
-def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Which slots (N, m) hold the first occurrence of a distinct solution among the ``ok`` ones.
-
-    ``joints`` (N, m, n) has its revolute joints wrapped to (−π, π]; they are
-    compared modulo 2π, each joint within :func:`duplicate_tolerance`. A slot
-    is dropped when it equals a slot kept before it, exactly as a sequential
-    scan would (:func:`first_of_each_one` is that scan for one target): the
-    loop runs over the m slots, each step vectorised over the targets.
-    """
-    m = joints.shape[1]
-    if m == 1:
-        return ok.copy()
-    revolute = robot.is_revolute
-    # every pair (earlier slot, later slot) at once; joints are wrapped to (−π, π], so a revolute difference d
-    # lies in (−2π, 2π) and |wrap(d)| = min(|d|, 2π − |d|)
-    earlier, later = _slot_pairs(m)
-    gap = np.abs(joints[:, later, :] - joints[:, earlier, :])  # (N, pairs, n)
-    if revolute.all():
-        np.minimum(gap, 2 * np.pi - gap, out=gap)
-    elif revolute.any():
-        gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
-    same = (gap <= duplicate_tolerance(robot)).all(axis=-1)  # (N, pairs)
-    # then the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
-    kept = ok.copy()
-    start = 0
-    for slot in range(1, m):
-        kept[:, slot] &= ~np.any(same[:, start:start + slot] & kept[:, :slot], axis=1)
-        start += slot
-    return kept
-
-
-def first_of_each_one(robot: Robot, joints: list[list[float]], ok: list[bool]) -> list[bool]:
-    """:func:`first_of_each` for one target's m slots (lists of floats, revolute joints wrapped), by a plain scan:
-    cheaper than the array operations at that size."""
-    rule = memo(robot, "duplicate_rule", lambda: list(zip(robot.is_revolute.tolist(),
-                                                           duplicate_tolerance(robot).tolist())))
-    two_pi = 2 * math.pi
-    kept: list[bool] = []
-    first: list[list[float]] = []
-    for q, good in zip(joints, ok):
-        if good:
-            for other in first:
-                for a, b, (turn, tolerance) in zip(q, other, rule):
-                    gap = abs(a - b)
-                    if not (gap <= tolerance or turn and two_pi - gap <= tolerance):
-                        break  # this joint differs (modulo 2π for a revolute one)
-                else:  # every joint within tolerance: the same solution
-                    good = False
-                    break
-            if good:
-                first.append(q)
-        kept.append(good)
-    return kept
-
-
-def _slot_pairs(m: int) -> tuple[np.ndarray, np.ndarray]:
-    """Every pair of slots (earlier, later), grouped by the later slot: (0, 1), (0, 2), (1, 2), (0, 3), …"""
-    pairs = _PAIRS.get(m)
-    if pairs is None:
-        later, earlier = np.tril_indices(m, -1)
-        pairs = _PAIRS[m] = (earlier, later)
-    return pairs
-
-
-_PAIRS: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-
-
 def distance_to_reference(robot: Robot, q: np.ndarray, reference: np.ndarray, *, norm: str = "linf",
                           weights: np.ndarray | None = None) -> np.ndarray:
-    """Wrap-aware distance of each row of q from the reference, shape (k,).
+    """Wrap-aware distance of each row of q (..., n) from the reference, shape (...,).
 
-    ``norm`` is ``"linf"`` (the largest single joint move, the default) or ``"l2"``;
-    ``weights`` scale each joint's difference.
+    ``norm`` is ``"linf"`` (the largest single joint move, the default) or ``"l2"``; ``weights`` scale each
+    joint's difference.
     """
     difference = np.abs(joint_difference(robot, q, reference))
     if weights is not None:
@@ -211,29 +59,202 @@ def distance_to_reference(robot: Robot, q: np.ndarray, reference: np.ndarray, *,
     return difference.max(axis=-1) if norm == "linf" else np.linalg.norm(difference, axis=-1)
 
 
-def polish(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray, constrain_orientation: bool,
-           steps: int = 3) -> np.ndarray:
-    """A few damped Gauss–Newton steps towards the target, for candidates that are close but not exact.
+def residuals(robot: Robot, q: np.ndarray, world_T_target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Position (length units) and orientation (radians) errors of FK(q) against the target: k candidates (k, n)
+    for one target (4, 4), or one candidate per target (k, 4, 4). Returns shape (k,) each."""
+    q, world_T_target = np.asarray(q, dtype=float), np.asarray(world_T_target, dtype=float)
+    if world_T_target.ndim == 2:
+        position, orientation = PoseGoal(world_T_target[None]).residuals(robot, q[None])
+        return position[0], orientation[0]
+    position, orientation = PoseGoal(world_T_target).residuals(robot, q[:, None])
+    return position[:, 0], orientation[:, 0]
 
-    q : (k, n); world_T_targets : (k, 4, 4). Returns the refined (k, n). Rows
-    already within :data:`ACCEPT_RESIDUAL` * 1e-3 are left as they are.
+
+def residual_arrays(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`residuals` of m candidates per target: q (N, m, n), targets (N, 4, 4) → (N, m) each."""
+    return PoseGoal(np.asarray(world_T_targets, dtype=float)).residuals(robot, np.asarray(q, dtype=float))
+
+
+def error_size(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool
+               ) -> np.ndarray:
+    """One number per residual pair: the position error as a fraction of the arm's size, or the larger of that
+    and the orientation error (radians)."""
+    size = position / arm_size(robot)
+    return np.maximum(size, orientation) if constrain_orientation else size
+
+
+def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool) -> np.ndarray:
+    """Which residuals pass the FK check."""
+    return error_size(robot, position, orientation, constrain_orientation) <= ACCEPT_RESIDUAL
+
+
+def duplicate_tolerance(robot: Robot) -> np.ndarray:
+    """Per joint (n,), how close two solutions' values must be to count as one: ``DUPLICATE_TOLERANCE`` radians
+    for a revolute joint, that times the arm's size for a prismatic one."""
+    return np.where(robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot))
+
+
+#: Most slots compared pairwise at once (N × m(m − 1)/2 pairs of n values): past it the targets go in chunks, and
+#: a target of more slots than :data:`_PAIRWISE_SLOTS` (the numeric search's starts) is scanned against the
+#: solutions kept so far, so memory stays bounded whatever the number of starts.
+_PAIR_ENTRIES = 1 << 20
+_PAIRWISE_SLOTS = 32
+
+
+def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """Which slots (N, m) hold the first occurrence of a distinct solution among the ``ok`` ones.
+
+    ``joints`` (N, m, n) has its revolute joints wrapped to (−π, π]; they are compared modulo 2π, each joint
+    within :func:`duplicate_tolerance`. A slot is dropped when it equals a slot kept before it, exactly as a
+    sequential scan would.
     """
-    from .._forward import geometric_jacobian
-    from ._numeric import pose_error
+    n_targets, m, n = joints.shape
+    if m == 1:
+        return ok.copy()
+    tolerance = duplicate_tolerance(robot)
+    revolute = robot.is_revolute
+    if m > _PAIRWISE_SLOTS:
+        return np.stack([_scanned(joints[row], ok[row], tolerance, revolute) for row in range(n_targets)]) \
+            if n_targets else ok.copy()
+    earlier, later = _slot_pairs(m)
+    chunk = max(1, _PAIR_ENTRIES // max(1, len(later) * n))
+    kept = ok.copy()
+    for start in range(0, n_targets, chunk):
+        block = slice(start, start + chunk)
+        gap = np.abs(joints[block, later, :] - joints[block, earlier, :])  # (b, pairs, n)
+        # wrapped values: a revolute difference d lies in (−2π, 2π), and |wrap(d)| = min(|d|, 2π − |d|)
+        if revolute.all():
+            np.minimum(gap, 2 * np.pi - gap, out=gap)
+        elif revolute.any():
+            gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
+        same = (gap <= tolerance).all(axis=-1)
+        # the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
+        offset = 0
+        for slot in range(1, m):
+            kept[block, slot] &= ~np.any(same[:, offset:offset + slot] & kept[block, :slot], axis=1)
+            offset += slot
+    return kept
 
-    scale = arm_size(robot)
-    rows = slice(0, 6) if constrain_orientation else slice(0, 3)
-    q = q.copy()
-    for _ in range(steps):
-        error = pose_error(forward_kinematics(robot, q), world_T_targets, scale)[:, rows]
-        size = np.abs(error).max(axis=1)
-        active = size > ACCEPT_RESIDUAL * 1e-3
-        if not active.any():
-            break
-        J = geometric_jacobian(robot, q[active])
-        J[:, :3, :] /= scale
-        J = J[:, rows, :]
-        JJt = J @ np.swapaxes(J, -1, -2) + 1e-12 * np.eye(J.shape[1])
-        step = np.einsum("kji,kj->ki", J, np.linalg.solve(JJt, error[active][..., None])[..., 0])
-        q[active] += step
-    return q
+
+@functools.lru_cache(maxsize=_PAIRWISE_SLOTS)
+def _slot_pairs(m: int) -> tuple[np.ndarray, np.ndarray]:
+    """Every pair of m slots (earlier, later), grouped by the later slot: (0, 1), (0, 2), (1, 2), (0, 3), …"""
+    later, earlier = np.tril_indices(m, -1)  # row-major: grouped by the row, the later slot
+    earlier.flags.writeable = later.flags.writeable = False
+    return earlier, later
+
+
+def _scanned(joints: np.ndarray, ok: np.ndarray, tolerance: np.ndarray, revolute: np.ndarray) -> np.ndarray:
+    """:func:`first_of_each` for one target of many slots (m, n): each ok slot against the distinct ones so far."""
+    kept = np.zeros(len(ok), dtype=bool)
+    distinct = np.zeros((0, joints.shape[1]))
+    for slot in np.flatnonzero(ok).tolist():
+        gap = np.abs(distinct - joints[slot])
+        gap = np.where(revolute, np.minimum(gap, 2 * np.pi - gap), gap)
+        if not (gap <= tolerance).all(axis=1).any():
+            kept[slot] = True
+            distinct = np.vstack([distinct, joints[slot]])
+    return kept
+
+
+@dataclass(frozen=True)
+class Verified:
+    """A solver's answer for N targets after the FK check.
+
+    ``table`` holds every distinct verified solution, grouped by target, each target's in the solver's slot
+    order; ``complete`` (N,) whether the solver's promise that they are all of them stands; ``nearest`` (N,)
+    the smallest error of any candidate (:func:`error_size`; ∞ where there was none), which says whether the
+    target was narrowly missed; ``singularities`` the conditions the solver met (N rows).
+    """
+
+    table: SolutionTable
+    complete: np.ndarray
+    nearest: np.ndarray
+    singularities: SingularFlags
+
+    @property
+    def count(self) -> np.ndarray:
+        """Solutions per target, shape (N,)."""
+        return self.table.counts(len(self.complete))
+
+
+def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarray | None = None,
+           label_codes: Callable[[np.ndarray], LabelCodes] | None = None,
+           held: np.ndarray | None = None) -> Verified:
+    """The verified, distinct solutions among ``candidates`` (N, m, n) for the goal's N targets: each target's
+    in slot order, or nearest the ``reference`` (n,) first (wrap-aware, the largest joint move; ties in slot
+    order).
+
+    Labels are the candidates' own; ``label_codes`` labels joint vectors (M, n) for a solver that gives none.
+    The joints ``held`` ((n,) bool: a redundant arm's free joints at the values asked) keep their values exactly
+    when a candidate is polished.
+    """
+    n_targets, m, n = candidates.joints.shape
+    joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
+    position, orientation = goal.residuals(robot, joints)
+    constrained = goal.constrain_orientation
+    valid = candidates.valid
+    size = error_size(robot, position, orientation, constrained)
+    near = valid & (size > POLISH_FROM) & (size <= POLISH_RESIDUAL)
+    if near.any():
+        rows, slots = np.nonzero(near)
+        refined = gauss_newton(robot, goal, joints[rows, slots], rows, steps=POLISH_STEPS, tolerance=POLISH_FROM,
+                               moving=None if held is None else ~held)
+        joints[rows, slots] = wrap_revolute(robot, refined.joints)
+        p, o = _residuals_at(robot, goal, joints[rows, slots], rows)
+        position[rows, slots], orientation[rows, slots] = p, o
+        size[rows, slots] = error_size(robot, p, o, constrained)
+    kept = first_of_each(robot, joints, valid & (size <= ACCEPT_RESIDUAL))
+    count = kept.sum(axis=1)
+    nearest = np.where(valid, size, np.inf).min(axis=1, initial=np.inf)
+    complete = promised(candidates, count, nearest, constrained)
+    if candidates.promise_needs_every_slot:  # the solver's promise holds only if every valid slot gave a solution
+        complete &= count == valid.sum(axis=1)
+    labels = candidates.labels if candidates.labels is not None else (
+        {} if label_codes is None else {name: (values, codes.reshape(n_targets, m))
+                                        for name, (values, codes) in label_codes(joints.reshape(-1, n)).items()})
+    if reference is None:
+        rows, slots = np.nonzero(kept)
+    else:
+        key = np.where(kept, distance_to_reference(robot, joints, reference), np.inf)
+        order = np.argsort(key, axis=1, kind="stable")
+        rows = np.repeat(np.arange(n_targets), count)
+        slots = order[np.arange(order.shape[1]) < count[:, None]]
+    table = SolutionTable(rows.astype(np.int64), joints[rows, slots], np.ones(len(rows), dtype=bool),
+                          position[rows, slots],
+                          orientation[rows, slots] if constrained else np.full(len(rows), np.nan),
+                          {name: (values, codes[rows, slots].astype(np.int8, copy=False))
+                           for name, (values, codes) in labels.items()})
+    return Verified(table, complete, nearest, candidates.singularities)
+
+
+def _residuals_at(robot: Robot, goal: Goal, q: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The goal's residuals of one joint vector per listed target: q (K, n) against targets ``rows`` (K,)."""
+    position, orientation = goal.take(rows).residuals(robot, q[:, None, :])
+    return position[:, 0], orientation[:, 0]
+
+
+def promised(candidates: Candidates, count: np.ndarray, nearest: np.ndarray, constrain_orientation: bool
+             ) -> np.ndarray:
+    """Which rows (N,) may claim every solution: the family's own word (:attr:`Candidates.complete`), except for
+    rows with no verified solution where the family set a joint it found free or saw two roots meet:
+
+    * whose nearest candidate missed by less than ``POLISH_RESIDUAL`` (``nearest`` (N,): fraction of the arm's
+      size, or radians): the representative it chose, or the double root, failed narrowly; another value of
+      that joint, or the root pair a rounding error moved off the real line, may not (an arm whose remaining
+      axes are not exactly aligned with the free one, as rounded geometry gives);
+    * on a pose target, a joint left free (relation ``free``) where some candidate reached the position: the
+      position does not fix that joint, the orientation (or the joints after it) may, and the value the family
+      held it at is one of many. Where no candidate was valid, the family found the position out of reach
+      whatever the free joint (a family whose free joint changes the reach says so itself, through
+      :attr:`Candidates.complete`).
+
+    Those rows go to the fallback."""
+    complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
+    narrow = (count == 0) & (nearest <= POLISH_RESIDUAL)
+    for mask, flag in candidates.singularities.entries:
+        if flag.relation in FRAGILE_RELATIONS:
+            complete &= ~(mask & narrow)
+        if constrain_orientation and flag.relation == "free":
+            complete &= ~(mask & (count == 0) & candidates.valid.any(axis=1))
+    return complete

@@ -16,7 +16,7 @@ from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Joint, Robot, forward_kinematics, geometric_jacobian
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_batch
-from service.kinematics.ik._arrays import solve_ik_arrays
+from service.kinematics.ik import solve_ik_arrays
 from service.kinematics.ik._general_6r import General6RPlan, _solve_arrangement, is_pieper
 from service.kinematics.ik._plan import geometry_of, plan_for
 from service.kinematics.ik._verify import residuals
@@ -386,16 +386,16 @@ def test_targets_beyond_the_reach_bound_are_unreachable_and_complete(distance):
 
 def test_a_batch_larger_than_a_chunk_is_answered_in_one_piece():
     """The solver gives each chunk of targets only the slots it needs; chunks of different widths are merged."""
-    from service.kinematics.ik import _arrays
+    from service.kinematics.ik import _closed_form
 
     robot = random_arm(np.random.default_rng(12), "standard")
     q = np.random.default_rng(13).uniform(-np.pi, np.pi, (3 * 64 + 5, 6))
-    chunk = _arrays.CHUNK
-    _arrays.CHUNK = 64
+    chunk = _closed_form.CHUNK
+    _closed_form.CHUNK = 64
     try:
         whole = solve_ik_arrays(robot, forward_kinematics(robot, q), threads=2)
     finally:
-        _arrays.CHUNK = chunk
+        _closed_form.CHUNK = chunk
     assert len(whole.count) == len(q) and (whole.count > 0).all()
     pieces = [solve_ik_arrays(robot, forward_kinematics(robot, q[start:start + 64]))
               for start in range(0, len(q), 64)]

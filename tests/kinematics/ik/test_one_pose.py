@@ -1,5 +1,5 @@
 """The families' scalar paths for one pose (``solve_one`` and the labels it gives: ik/_scalar.py) against their
-array solvers, and the one-pose duplicate scan against the array scan."""
+array solvers, and the duplicate scan of many slots against the pairwise scan."""
 
 import numpy as np
 import pytest
@@ -8,7 +8,7 @@ from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import _verify, joint_difference, solve_ik
-from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik import cached_plan
 from service.kinematics.ik._verify import accepted, residual_arrays, wrap_revolute
 
 from tests.ik_helpers import random_configurations
@@ -111,15 +111,19 @@ def test_single_pose_answers_do_not_depend_on_the_path(robot_id, monkeypatch):
 
 
 @pytest.mark.parametrize("robot_id", ["puma560_standard", "spong_ex3_5_stanford"])
-def test_scalar_duplicate_scan_is_the_array_scan(robot_id):
-    """One pose's slots are merged by a plain scan; it must keep the slots the array scan keeps."""
+def test_the_scan_of_many_slots_is_the_pairwise_scan(robot_id, monkeypatch):
+    """A target of many slots (the numeric search's starts) is scanned against the solutions kept so far; it must
+    keep exactly the slots the pairwise scan of few slots keeps, near-duplicates and wrapped values included."""
     robot = _CATALOGUE.get(robot_id).robot
     rng = np.random.default_rng(5)
-    for _ in range(200):
-        q = random_configurations(robot, 8, seed=int(rng.integers(1 << 30)))[None]
-        copies = rng.integers(0, 8, 4)
-        q[0, copies[:2]] = q[0, copies[2:]] + rng.choice([0.0, 1e-7, 1e-5], (2, 1)) * robot.is_revolute
+    for _ in range(100):
+        q = random_configurations(robot, 40, seed=int(rng.integers(1 << 30)))[None]
+        copies = rng.integers(0, 40, 20)
+        q[0, copies[:10]] = q[0, copies[10:]] + rng.choice([0.0, 1e-7, 1e-5, 2 * np.pi], (10, 1)) * robot.is_revolute
         q[0, :, robot.is_revolute] = wrap_revolute(robot, q[0])[:, robot.is_revolute].T
-        ok = rng.random((1, 8)) < 0.8
-        scalar = _verify.first_of_each_one(robot, q[0].tolist(), ok[0].tolist())
-        assert (scalar == _verify.first_of_each(robot, np.repeat(q, 3, axis=0), np.repeat(ok, 3, axis=0))[0]).all()
+        ok = rng.random((1, 40)) < 0.8
+        scanned = _verify.first_of_each(robot, q, ok)
+        monkeypatch.setattr(_verify, "_PAIRWISE_SLOTS", 64)
+        pairwise = _verify.first_of_each(robot, np.repeat(q, 3, axis=0), np.repeat(ok, 3, axis=0))
+        monkeypatch.undo()
+        assert (scanned[0] == pairwise[0]).all() and (pairwise[1:] == pairwise[0]).all()

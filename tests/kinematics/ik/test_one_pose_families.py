@@ -9,7 +9,7 @@ import pytest
 
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
-from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik import cached_plan
 from service.kinematics.ik._screws import move_point
 from service.robots.catalogue import load_catalogue
 from service.config import Settings

@@ -15,7 +15,7 @@ import pytest
 from service.kinematics import Joint, Robot
 from service.kinematics._forward import forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
-from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik import cached_plan
 from service.kinematics.ik._subproblems import subproblem_5_prismatic
 from tests.kinematics.ik.test_spherical_wrist_classes import (
     _positioner_singular_configurations,
@@ -263,7 +263,7 @@ def test_slide_limits_filter_the_solutions_like_a_linear_axis(kind):
     and rejects the others with a violation on the slide; a pose reachable only beyond travel is
     ``no_solution_within_limits``, not ``unreachable``."""
     from service.kinematics import Limits
-    from service.kinematics.ik import select
+    from tests.selection import select
 
     limited = statements(kind, seed=list(CLASSES).index(kind), limits=(-0.2, 0.4))[0]
     free = statements(kind, seed=list(CLASSES).index(kind))[0]

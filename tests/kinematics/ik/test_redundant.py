@@ -30,7 +30,8 @@ def arm(name: str):
 
 
 def solutions_of(answer, row: int = 0) -> np.ndarray:
-    return answer.arrays.joints[row, :answer.arrays.count[row]]
+    table = answer.verified.table
+    return table.joints[table.target == row]
 
 
 def assert_fk_verified(robot, solutions: np.ndarray, target: np.ndarray) -> None:

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 
 from service.kinematics import COUNT_CAP, LIMIT_TOLERANCE, Joint, Limits, Robot, forward_kinematics
-from service.kinematics.ik import IKResult, Ordering, Solution, select, select_arrays, solve_ik_arrays
+from service.kinematics.ik import IKResult, Ordering, Solution, solve_ik_arrays
+from tests.selection import select, select_arrays
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
 
@@ -46,6 +47,26 @@ def random_case(rng):
     return robot, IKResult("ok", solutions, "analytic", "test", True), options
 
 
+def within_limits(robot, reference):
+    """The reference with each two-sided revolute joint outside its limits moved to its equivalent within them
+    nearest its value, where there is one (the selection's rule for a reference the arm cannot be at)."""
+    if reference is None:
+        return None
+    tolerance = LIMIT_TOLERANCE
+    moved = np.array(reference, dtype=float)
+    for j in range(robot.dof):
+        lower, upper = robot.lower[j], robot.upper[j]
+        if not (robot.is_revolute[j] and np.isfinite(lower) and np.isfinite(upper)):
+            continue
+        if lower - tolerance <= moved[j] <= upper + tolerance:
+            continue
+        fitting = [moved[j] + TWO_PI * k for k in range(-12, 13)
+                   if lower - tolerance <= moved[j] + TWO_PI * k <= upper + tolerance]
+        if fitting:
+            moved[j] = min(fitting, key=lambda value: abs(value - reference[j]))
+    return moved
+
+
 def oracle(robot, result, options):
     """(kept rows [(joints, within, cost)], rejected joints, available, with_all_moves) by explicit enumeration."""
     lower, upper = robot.lower, robot.upper
@@ -57,6 +78,8 @@ def oracle(robot, result, options):
 
     def inside(j, value):
         return lower[j] - tolerance[j] <= value <= upper[j] + tolerance[j]
+
+    reference = within_limits(robot, reference)
 
     def turns_of(j, value):  # every usable k, explicitly
         if not robot.is_revolute[j]:
@@ -123,7 +146,7 @@ def oracle(robot, result, options):
 
 def cost(robot, values, options):
     """The documented distance of one joint vector from the reference (per-joint travel, weights, norm)."""
-    reference, ordering = options["reference"], options.get("ordering", Ordering())
+    reference, ordering = within_limits(robot, options["reference"]), options.get("ordering", Ordering())
     continuous = robot.is_revolute & np.isinf(robot.lower) & np.isinf(robot.upper)
     d = np.abs(values - reference)
     d = np.where(continuous, np.minimum(d % TWO_PI, TWO_PI - d % TWO_PI), d)
@@ -246,3 +269,25 @@ def test_the_core_notes_name_no_option_of_the_wire():
     for text in NOTE_WORDING.values():
         for wire_name in ("max_equivalents", "filter_limits", "max_joint_move", "max_solutions", "free_joints"):
             assert wire_name not in text
+
+
+def test_a_reference_outside_the_limits_is_met_at_its_equivalent_within_them():
+    """Issue 22, item 7: with a reference outside a joint's ±π limits, the solution equal to it up to a whole
+    turn is at no distance and comes first; another solution half a turn away comes after it, though it is
+    nearer the reference's raw value."""
+    arm = Robot([Joint("q1", "revolute", 0.5, 0.0, 0.0, 0.0, -np.pi, np.pi),
+                 Joint("q2", "revolute", 0.5, 0.0, 0.0, 0.0, -np.pi, np.pi)])
+    reference = np.array([np.pi + 0.2, 0.1])
+    same_up_to_a_turn = Solution(np.array([0.2 - np.pi, 0.1]), {}, 0.0, 0.0)
+    half_a_turn_away = Solution(np.array([0.2, 0.1]), {}, 0.0, 0.0)
+    for order in ([half_a_turn_away, same_up_to_a_turn], [same_up_to_a_turn, half_a_turn_away]):
+        selection = select(arm, IKResult("ok", order, "analytic", "test", True), Limits.of(arm), reference=reference)
+        listed = [entry.solution.joints for entry in selection.solutions]
+        np.testing.assert_allclose(listed[0], same_up_to_a_turn.joints, atol=1e-15)
+        np.testing.assert_allclose(listed[1], half_a_turn_away.joints, atol=1e-15)
+    # a reference with no equivalent within the limits keeps its value
+    narrow = Robot([Joint("q1", "revolute", 0.5, 0.0, 0.0, 0.0, -1.0, 1.0)])
+    solutions = [Solution(np.array([0.9]), {}, 0.0, 0.0), Solution(np.array([-0.9]), {}, 0.0, 0.0)]
+    selection = select(narrow, IKResult("ok", solutions, "analytic", "test", True), Limits.of(narrow),
+                       reference=np.array([2.5]))
+    assert [entry.solution.joints[0] for entry in selection.solutions] == [0.9, -0.9]

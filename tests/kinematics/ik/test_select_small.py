@@ -1,7 +1,7 @@
 """One target's answer (the few-rows forms of the selection) is the general array path's, field by field.
 
 For one target the selection looks rank tuples up row by row, works out each combination's turns directly and
-skips the bookkeeping of many targets (:mod:`service.kinematics.ik._select`). The general path is forced by
+skips the bookkeeping of many targets (:mod:`service.kinematics.ik._equivalents`). The general path is forced by
 answering the same target inside a batch of other targets, with those forms switched off: the two answers must
 agree bit for bit, over random catalogue arms, limits (±2π and wider, narrow, one-sided, exactly at a
 solution's joints), references (some exactly between two equivalents) and options.
@@ -14,9 +14,9 @@ import pytest
 
 from service.config import Settings
 from service.kinematics import Limits, forward_kinematics
-from service.kinematics.ik import AnswerOptions, IKTargets, Ordering, answer_ik, select_arrays, solve_ik_arrays
-from service.kinematics.ik._arrays import concatenated
-from service.kinematics.ik import _select
+from service.kinematics.ik import AnswerOptions, IKTargets, Ordering, SolutionTable, answer_ik, select, solve_ik_arrays
+from service.kinematics.ik import _equivalents
+from tests.selection import table_of_arrays
 from service.robots.catalogue import load_catalogue
 
 CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
@@ -86,17 +86,20 @@ def _assert_identical(mine, index, general, general_index) -> None:
 def _select_both(robot, target, options, rng, monkeypatch):
     """The target's selection alone, and within a batch of six other targets through the general forms."""
     reference = options.reference
-    alone = solve_ik_arrays(robot, target[None], reference=reference)
-    others = solve_ik_arrays(robot, forward_kinematics(robot, rng.uniform(-np.pi, np.pi, (6, robot.dof))),
-                             reference=reference)
-    batch = concatenated([others.take(np.arange(3)), alone, others.take(np.arange(3, 6))])
+    alone = table_of_arrays(solve_ik_arrays(robot, target[None], reference=reference))
+    others = table_of_arrays(solve_ik_arrays(robot, forward_kinematics(robot, rng.uniform(-np.pi, np.pi,
+                                                                                           (6, robot.dof))),
+                                             reference=reference))
+    first, last = others.take(others.target < 3), others.take(others.target >= 3)
+    batch = SolutionTable.concat([first, alone.with_targets(alone.target + 3), last.with_targets(last.target + 1)],
+                                 robot.dof)
     arguments = dict(filter_limits=options.filter_limits, reference=reference, ordering=options.ordering,
                      max_equivalents=options.max_equivalents)
-    mine = select_arrays(robot, alone, options.limits, **arguments)
+    mine = select(robot, alone, 1, options.limits, **arguments)
     with monkeypatch.context() as forced:  # the general forms only: every row enumerated and tabled at once
-        forced.setattr(_select, "_FEW_ROWS", -1)
-        forced.setattr(_select, "_FEW_RANKS", -1)
-        general = select_arrays(robot, batch, options.limits, **arguments)
+        forced.setattr(_equivalents, "_FEW_ROWS", -1)
+        forced.setattr(_equivalents, "_FEW_RANKS", -1)
+        general = select(robot, batch, 7, options.limits, **arguments)
     return mine, general
 
 
@@ -111,8 +114,8 @@ def calls(monkeypatch):
             return function(*args, **kwargs)
         return wrapper
 
-    monkeypatch.setattr(_select, "_row_rank_tuples", counting(_select._row_rank_tuples, "few rows"))
-    monkeypatch.setattr(_select, "_tabled_turns", counting(_select._tabled_turns, "general"))
+    monkeypatch.setattr(_equivalents, "_row_rank_tuples", counting(_equivalents._row_rank_tuples, "few rows"))
+    monkeypatch.setattr(_equivalents, "_tabled_turns", counting(_equivalents._tabled_turns, "general"))
     return counted
 
 

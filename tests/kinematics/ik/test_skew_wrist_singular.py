@@ -22,7 +22,7 @@ import pytest
 
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
-from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik import cached_plan
 from tests.kinematics.ik.test_three_parallel_arcs import (
     RESOLVED,
     arc_holding,

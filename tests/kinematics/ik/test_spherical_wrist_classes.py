@@ -20,7 +20,7 @@ import pytest
 from service.kinematics import Joint, Robot
 from service.kinematics._forward import forward_kinematics, joint_screws, link_frames, screw_model
 from service.kinematics.ik import _numeric, joint_difference, solve_ik, solve_ik_arrays
-from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik import cached_plan
 from service.kinematics.ik._subproblems import subproblem_1
 
 DEG = np.pi / 180
@@ -412,8 +412,8 @@ def test_published_arms_never_reach_the_numeric_fallback(name, monkeypatch):
     def refuse(*args, **kwargs):
         raise AssertionError("the numeric fallback was called")
 
-    monkeypatch.setattr(_numeric, "solve_numeric", refuse)
-    monkeypatch.setattr("service.kinematics.ik._solve.solve_numeric", refuse)
+    monkeypatch.setattr(_numeric, "search", refuse)
+    monkeypatch.setattr("service.kinematics.ik._answer.search", refuse)
     for q in configurations(robot, 20, seed=9):
         result = solve_ik(robot, forward_kinematics(robot, q))
         assert (result.method, result.complete, result.status) == ("analytic", True, "ok")

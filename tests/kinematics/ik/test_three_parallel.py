@@ -17,7 +17,7 @@ import pytest
 from service.kinematics import forward_kinematics
 from service.kinematics._robot import Joint, Robot
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
-from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik import cached_plan
 from service.kinematics.ik._plan import geometry_of
 
 from tests.ik_helpers import SAME

@@ -20,7 +20,7 @@ from service.config import Settings
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics._forward import joint_screws
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
-from service.kinematics.ik._arrays import cached_plan
+from service.kinematics.ik import cached_plan
 from service.robots.catalogue import load_catalogue
 from tests.kinematics.ik.test_spherical_wrist_classes import _random_rigid
 

@@ -1,0 +1,112 @@
+"""Closed-form IK for a batch of targets: the robot's cached plan proposes candidates, :func:`~._verify.verify`
+checks them, with no loop over targets.
+
+Plans are built once per robot and kind of target (:func:`cached_plan`) and kept on the robot: they are values,
+shared by concurrent requests, so a plan's call returns everything its caller needs. A batch larger than
+:data:`CHUNK` is solved in chunks, on up to ``threads`` threads (numpy releases the GIL inside its array
+operations, so the chunks run in parallel), and the request's budget is checked before each chunk.
+"""
+
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+
+import numpy as np
+
+from .._budget import UNLIMITED, Budget
+from .._cache import is_memoised, memo
+from .._robot import Robot
+from ._goals import PoseGoal
+from ._plan import Plan, plan_for
+from ._table import SolutionTable
+from ._types import Candidates, SingularFlags
+from ._verify import Verified, verify
+
+#: Targets solved together: large enough that per-operation overhead is small, small enough that the
+#: (chunk × m × n) temporaries stay in cache and memory is bounded whatever the batch size.
+CHUNK = 4096
+
+
+def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
+    """:func:`plan_for`, built once per robot and kind of target.
+
+    A position-only target on an arm with more than three joints holds the others at the reference values:
+    those plans depend on the values and are built each time rather than kept.
+    """
+    key = _plan_key(robot, constrain_orientation, reference)
+    if key is None:
+        return plan_for(robot, constrain_orientation=False, reference=reference)
+    return memo(robot, key, lambda: plan_for(robot, constrain_orientation=constrain_orientation, reference=None))
+
+
+def plan_is_kept(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> bool:
+    """Whether :func:`cached_plan` would answer without building a plan."""
+    key = _plan_key(robot, constrain_orientation, reference)
+    return key is not None and is_memoised(robot, key)
+
+
+def _plan_key(robot: Robot, constrain_orientation: bool, reference: np.ndarray | None) -> tuple[str, str] | None:
+    """The memo key of a kept plan; None for a plan built for the reference's values each time."""
+    if constrain_orientation:
+        return ("ik_plan", "pose")
+    if robot.dof <= 3 or reference is None:
+        return ("ik_plan", "position")
+    return None
+
+
+def solve_closed_form(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.ndarray | None, *,
+                      threads: int | None = None, budget: Budget = UNLIMITED) -> Verified:
+    """Every verified solution of the goal's N targets by the plan, vectorised over the targets (see the module
+    docstring). ``reference`` (n,) sets the joints a target leaves free."""
+    n_targets = len(goal)
+    if n_targets <= CHUNK:
+        budget.check("the analytic solve")
+        return _solved(robot, plan, goal, reference)
+    starts = list(range(0, n_targets, CHUNK))
+
+    def solve(start: int) -> Verified:
+        budget.check("the analytic solve")
+        return _solved(robot, plan, goal.take(np.arange(start, min(start + CHUNK, n_targets))), reference)
+
+    workers = min(threads or os.cpu_count() or 1, len(starts))
+    if workers > 1:
+        with ThreadPoolExecutor(workers) as pool:
+            parts = list(pool.map(solve, starts))
+    else:
+        parts = [solve(start) for start in starts]
+    return joined(parts, robot.dof)
+
+
+def _solved(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.ndarray | None) -> Verified:
+    """One chunk: the plan's candidates (its scalar path for one pose when it has one and the pose is clearly
+    generic), verified."""
+    candidates = None
+    if len(goal) == 1 and hasattr(plan, "solve_one"):
+        candidates = _one_pose_candidates(plan.solve_one(goal.world_T_targets[0]))
+    if candidates is None:
+        candidates = plan.solve(goal.world_T_targets, reference)
+    return verify(robot, goal, candidates, reference, plan.label_codes)
+
+
+def _one_pose_candidates(one_pose) -> Candidates | None:
+    """A family's scalar answer for one pose (``OnePose``) as candidates with their labels; None when it has none
+    or a valid slot's label is not clear (the array path labels it then)."""
+    if one_pose is None:
+        return None
+    valid = [q is not None for q in one_pose.rows]
+    codes = one_pose.code_lists(valid)
+    if codes is None:
+        return None
+    labels = {name: (values, np.array([column], dtype=np.int8))
+              for name, values, column in zip(one_pose.names, one_pose.values, codes)}
+    return Candidates(one_pose.joints, np.array([valid]), one_pose.singularities, labels=labels)
+
+
+def joined(parts: list[Verified], dof: int) -> Verified:
+    """One :class:`Verified` of consecutive groups of targets."""
+    offsets = np.cumsum([0] + [len(part.complete) for part in parts])
+    tables = [part.table.with_targets(part.table.target + offset) for part, offset in zip(parts, offsets)]
+    return Verified(SolutionTable.concat(tables, dof), np.concatenate([part.complete for part in parts]),
+                    np.concatenate([part.nearest for part in parts]),
+                    SingularFlags.concat([part.singularities for part in parts]))

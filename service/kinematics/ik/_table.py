@@ -1,0 +1,118 @@
+"""The one form of an IK answer's solutions: a columnar table, one row per solution, grouped by target.
+
+Every solver's candidates are verified into a :class:`SolutionTable`
+(:func:`~._verify.verify`); the selection takes that table and returns two
+(kept and rejected); :class:`~._answer.IKAnswer` holds them and the boundary
+encodes them as they stand. Label codes are merged in one place
+(:func:`merged_labels`); per-target singular conditions travel beside it as
+:class:`~._types.SingularFlags`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._types import LabelCodes
+
+
+@dataclass(frozen=True)
+class SolutionTable:
+    """Solutions of many targets, one row each, grouped by target in output order.
+
+    Attributes
+    ----------
+    target : ndarray of int, shape (S,)
+        The row's target index, non-decreasing.
+    joints : ndarray, shape (S, n)
+        Radians / length units.
+    within_limits : ndarray of bool, shape (S,)
+        Whether the row fits the limits (True before any selection).
+    position, orientation : ndarrays, shape (S,)
+        FK residuals: length units and radians (the angle between tool axis and direction for a direction
+        target; NaN for a position-only target).
+    labels : dict
+        Branch labels: name → (values, codes (S,) int8), ``values[code]`` the row's label, −1 where it has none.
+    """
+
+    target: np.ndarray
+    joints: np.ndarray
+    within_limits: np.ndarray
+    position: np.ndarray
+    orientation: np.ndarray
+    labels: LabelCodes
+
+    @classmethod
+    def empty(cls, dof: int) -> "SolutionTable":
+        """A table of no rows for an arm of ``dof`` joints."""
+        return cls(np.zeros(0, dtype=np.int64), np.zeros((0, dof)), np.zeros(0, dtype=bool), np.zeros(0),
+                   np.zeros(0), {})
+
+    def __len__(self) -> int:
+        return len(self.target)
+
+    def take(self, index: np.ndarray) -> "SolutionTable":
+        """The rows ``index`` (indices or a boolean mask), in that order."""
+        return SolutionTable(self.target[index], self.joints[index], self.within_limits[index],
+                             self.position[index], self.orientation[index],
+                             {name: (values, codes[index]) for name, (values, codes) in self.labels.items()})
+
+    def with_targets(self, target: np.ndarray) -> "SolutionTable":
+        """The same rows numbered by other targets (``target`` (S,) non-decreasing), as when a part's rows
+        take their place among a whole answer's."""
+        return SolutionTable(np.asarray(target, dtype=np.int64), self.joints, self.within_limits, self.position,
+                             self.orientation, self.labels)
+
+    @classmethod
+    def concat(cls, tables: list["SolutionTable"], dof: int) -> "SolutionTable":
+        """The rows of ``tables`` in turn (regrouped by target, stably, when they interleave), their labels on
+        one vocabulary per name (:func:`merged_labels`)."""
+        tables = [table for table in tables if len(table)]
+        if not tables:
+            return cls.empty(dof)
+        if len(tables) == 1:
+            return tables[0]
+        table = cls(np.concatenate([t.target for t in tables]), np.concatenate([t.joints for t in tables]),
+                    np.concatenate([t.within_limits for t in tables]),
+                    np.concatenate([t.position for t in tables]), np.concatenate([t.orientation for t in tables]),
+                    merged_labels([t.labels for t in tables], [len(t) for t in tables]))
+        if (np.diff(table.target) < 0).any():
+            table = table.take(np.argsort(table.target, kind="stable"))
+        return table
+
+    def bounds(self, n_targets: int) -> tuple[np.ndarray, np.ndarray]:
+        """Each target's rows as [start, stop), shape (N,) each."""
+        edges = np.searchsorted(self.target, np.arange(n_targets + 1))
+        return edges[:-1], edges[1:]
+
+    def counts(self, n_targets: int) -> np.ndarray:
+        """Rows per target, shape (N,)."""
+        return np.bincount(self.target, minlength=n_targets)[:n_targets]
+
+
+def merged_labels(pieces: list[LabelCodes], lengths: list[int]) -> LabelCodes:
+    """The label codes of several pieces laid end to end (codes along axis 0; ``lengths`` their sizes there):
+    one vocabulary per name, its values in order of first appearance; −1 where a piece lacks the name or the
+    value."""
+    vocabularies: dict[str, list] = {}
+    for piece in pieces:
+        for name, (values, _) in piece.items():
+            vocabulary = vocabularies.setdefault(name, [])
+            vocabulary.extend(value for value in values if value not in vocabulary)
+    merged: LabelCodes = {}
+    for name, vocabulary in vocabularies.items():
+        columns = []
+        for piece, length in zip(pieces, lengths):
+            if name not in piece:
+                columns.append(np.full(length, -1, dtype=np.int8))
+                continue
+            values, codes = piece[name]
+            if list(values) == vocabulary[:len(values)]:
+                columns.append(codes.astype(np.int8, copy=False))
+                continue
+            lookup = np.array([*(vocabulary.index(value) for value in values), -1], dtype=np.int8)
+            columns.append(lookup[codes])
+        merged[name] = (tuple(vocabulary), np.concatenate(columns) if len(columns) > 1 else columns[0])
+    return merged
+

@@ -180,6 +180,8 @@ COLLISION_FIELD = Field(
     description="the arm's geometry: shapes fixed to its links, each in its link's frame, in the description's "
                 "length unit; null: none (for a URDF: its own <collision> elements)")
 
+COLLISION_SOURCE_FIELD = Field(None, max_length=2000, description="where the link geometry comes from")
+
 
 class TargetKind(str, Enum):
     """An IK target kind (api.md): a full pose, a position only, or a position + tool direction."""
@@ -212,6 +214,7 @@ class _RobotFields(ApiModel):
     base: Matrix4 | None = Field(None, description="world_T_base; identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool; identity when null")
     collision: list[LinkShapeDescription] | None = COLLISION_FIELD
+    collision_source: str | None = COLLISION_SOURCE_FIELD
     target_kinds: list[TargetKind] = TARGET_KINDS_FIELD
 
 
@@ -260,6 +263,7 @@ class URDFRobot(ApiModel):
                     "that URDF link's frame; an index: the service's frame i); replaces the URDF's own <collision> "
                     "elements; null: those elements are read (box, sphere, cylinder as its bounding capsule; "
                     "meshes are listed in notes, not modelled)")
+    collision_source: str | None = COLLISION_SOURCE_FIELD
     target_kinds: list[TargetKind] = TARGET_KINDS_FIELD
 
 

@@ -128,7 +128,7 @@ def _one_link_error(value: object) -> object:
     return value
 
 
-LinkRef = Annotated[Union[Annotated[int, Strict(), Field(ge=0)], Annotated[str, Field(max_length=200)]],
+LinkRef = Annotated[Union[Annotated[int, Strict(), Field(ge=0, le=1000)], Annotated[str, Field(max_length=200)]],
                     BeforeValidator(_one_link_error)]
 LINK_FIELD = Field(description="the frame the shape is fixed to: its index, 0 the base … n the flange (frame i "
                                "moves with joint i, in the convention's own frames); for URDF robots also a link "
@@ -238,8 +238,8 @@ class URDFRobot(ApiModel):
     """A robot described by a URDF: the chain from ``base_link`` to ``tip_link`` of its kinematic tree.
 
     Lengths are metres and angles radians, as URDF states them. Fixed joints are folded into their neighbours;
-    ``revolute``, ``continuous`` (no limits) and ``prismatic`` joints move. Meshes and visuals are ignored, never
-    fetched. Xacro is out of scope: expand it first (``xacro robot.urdf.xacro > robot.urdf``).
+    ``revolute``, ``continuous`` (no limits) and ``prismatic`` joints move. Collision boxes, spheres and cylinders
+    are read (unless ``collision`` is given); meshes are never fetched. Xacro is out of scope: expand it first (``xacro robot.urdf.xacro > robot.urdf``).
     """
 
     format: Literal["urdf"] = Field(description="description form: a URDF document")

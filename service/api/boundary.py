@@ -23,27 +23,18 @@ from ..kinematics import (
     LimitOrderError,
     Robot,
     check_joint_values,
-    check_rotation,
     check_transform,
     check_transforms,
     check_unit_quaternion,
-    matrix_from_euler_zyz,
     matrix_from_quaternion,
-    matrix_from_rpy,
     quaternions_from_matrices,
 )
 from ..kinematics.ik import DIRECTION, POSE, POSITION, IKTargets, NotRedundantError, Ordering, check_ordering
 from ..robots.build import bounds as _bounds
+from ..robots.orientations import rotation_from_orientation
 from .schemas.common import AngleUnit
 from .schemas.ik import Ordering as OrderingOptions
-from .schemas.poses import (
-    DirectionOrientation,
-    EulerZYZOrientation,
-    MatrixOrientation,
-    PoseTarget,
-    QuaternionOrientation,
-    RPYOrientation,
-)
+from .schemas.poses import DirectionOrientation, PoseTarget
 
 _DEGREE = math.pi / 180.0
 
@@ -114,18 +105,8 @@ def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool
         return T, True
     if orientation is None:
         return T, False
-    angle = _DEGREE if unit == "deg" else 1.0
     with located("orientation"):
-        if isinstance(orientation, MatrixOrientation):
-            with located("matrix"):
-                T[:3, :3] = check_rotation(np.asarray(orientation.matrix, dtype=float))
-        elif isinstance(orientation, QuaternionOrientation):
-            with located("wxyz"):
-                T[:3, :3] = matrix_from_quaternion(check_unit_quaternion(np.asarray(orientation.wxyz, dtype=float)))
-        elif isinstance(orientation, EulerZYZOrientation):
-            T[:3, :3] = matrix_from_euler_zyz(*(np.asarray(orientation.angles) * angle))
-        elif isinstance(orientation, RPYOrientation):
-            T[:3, :3] = matrix_from_rpy(*(np.asarray(orientation.angles) * angle))
+        T[:3, :3] = rotation_from_orientation(orientation, _DEGREE if unit == "deg" else 1.0)
     return T, True
 
 

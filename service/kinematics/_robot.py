@@ -17,7 +17,7 @@ from __future__ import annotations
 import copy
 import math
 from dataclasses import dataclass
-from typing import Literal, Sequence
+from typing import TYPE_CHECKING, Literal, Sequence
 
 import numpy as np
 
@@ -25,6 +25,9 @@ from ._cache import DerivedStore, bounded_memo, memo
 from ._conventions import CONVENTIONS, Convention
 from ._errors import InvalidInputError, LimitOrderError
 from ._tolerances import GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
+
+if TYPE_CHECKING:
+    from .collision import LinkShape
 
 #: Robots with other base/tool frames kept on their parent by :meth:`Robot.with_frames`.
 FRAMED_ROBOTS_KEPT = 16
@@ -100,6 +103,9 @@ class Robot:
         Fixed transforms; identity when omitted. Validated as rigid transforms.
     name : str, optional
         For messages only.
+    collision : sequence of LinkShape, optional
+        Shapes fixed to the links, each in the frame of its link (0 = base … n = flange, the frames of
+        :func:`~service.kinematics.link_frames`), in the robot's length unit; kept as ``robot.collision``.
 
     Raises
     ------
@@ -115,6 +121,7 @@ class Robot:
         world_T_base: np.ndarray | None = None,
         flange_T_tool: np.ndarray | None = None,
         name: str = "",
+        collision: Sequence["LinkShape"] = (),
     ) -> None:
         if convention not in CONVENTIONS:
             raise InvalidInputError(
@@ -133,6 +140,8 @@ class Robot:
         self.joints: tuple[Joint, ...] = joints
         self.world_T_base = _checked_transform(world_T_base, "base")
         self.flange_T_tool = _checked_transform(flange_T_tool, "tool")
+        #: Shapes fixed to the links (:class:`~service.kinematics.collision.LinkShape`), in their links' frames.
+        self.collision: tuple["LinkShape", ...] = _checked_collision(collision, len(joints))
         #: For a robot built from screws: ``chain_transforms[i]`` (n + 1, 4, 4) is the fixed transform after joint
         #: i's motion (F_0 before joint 1); None for a DH robot.
         self.chain_transforms: np.ndarray | None = None
@@ -156,6 +165,7 @@ class Robot:
         world_T_base: np.ndarray | None = None,
         flange_T_tool: np.ndarray | None = None,
         name: str = "",
+        collision: Sequence["LinkShape"] = (),
     ) -> "Robot":
         """A robot from its joint screws at q = 0 and the flange pose there (product of exponentials).
 
@@ -185,6 +195,7 @@ class Robot:
         robot.joints = joints
         robot.world_T_base = _checked_transform(world_T_base, "base")
         robot.flange_T_tool = _checked_transform(flange_T_tool, "tool")
+        robot.collision = _checked_collision(collision, len(joints))
         chain = np.empty((len(joints) + 1, 4, 4))
         chain[0] = frames[0]
         for i in range(1, len(joints)):
@@ -222,6 +233,14 @@ class Robot:
 
         key = (None if base is None else base.tobytes(), None if tool is None else tool.tobytes())
         return bounded_memo(self, "with_frames", key, build, FRAMED_ROBOTS_KEPT)
+
+    def with_collision(self, collision: Sequence["LinkShape"]) -> "Robot":
+        """The same arm carrying ``collision`` (link shapes, as in the constructor) instead of its own shapes."""
+        shapes = _checked_collision(collision, self.dof)
+        other = Robot.__new__(Robot)
+        other.__dict__.update({key: value for key, value in self.__dict__.items() if key != "_derived"})
+        other.collision = shapes
+        return other
 
     @property
     def dof(self) -> int:
@@ -265,6 +284,21 @@ def _check_joint(joint: Joint, index: int) -> None:
         if not math.isfinite(value):
             raise InvalidInputError(f"{field} must be a finite number, not {value}", location=(*where, field))
     _check_limits(joint, where)
+
+
+def _checked_collision(collision: Sequence["LinkShape"], dof: int) -> tuple["LinkShape", ...]:
+    """The link shapes as a tuple, each fixed to a frame 0 … ``dof``; errors at ``("collision", index, "link")``."""
+    from .collision import LinkShape  # here, not at the top: the collision package builds on the robot model
+
+    shapes = tuple(collision)
+    for index, item in enumerate(shapes):
+        if not isinstance(item, LinkShape):
+            raise InvalidInputError(f"a link shape is expected, not {type(item).__name__}",
+                                    location=("collision", index))
+        if isinstance(item.link, bool) or not isinstance(item.link, (int, np.integer)) or not 0 <= item.link <= dof:
+            raise InvalidInputError(f"link must be a frame index from 0 (the base) to {dof} (the flange), "
+                                    f"not {item.link!r}", location=("collision", index, "link"))
+    return shapes
 
 
 def _joint_frame(joint: ScrewJoint, index: int) -> np.ndarray:

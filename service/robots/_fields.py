@@ -48,6 +48,9 @@ def square_shape(size: int, what: str):
 
 
 Vector3 = Annotated[list[Number], Field(min_length=3, max_length=3)]
+Vector4 = Annotated[list[Number], Field(min_length=4, max_length=4)]
+Matrix3 = Annotated[list[Vector3], square_shape(3, "rotation matrix"),
+                    Field(min_length=3, max_length=3, description="3×3, row-major")]
 Matrix4Row = Annotated[list[Number], Field(min_length=4, max_length=4)]
 Matrix4 = Annotated[
     list[Matrix4Row],
@@ -68,14 +71,20 @@ class ApiModel(BaseModel):
 #: Tags pydantic inserts into locations inside tagged unions: robot description forms and orientation types.
 _UNION_TAGS = {"dh", "standard", "modified", "khalil", "urdf", "screws", "matrix", "quaternion", "euler_zyz", "rpy"}
 _UNION_FIELDS = {"robot", "orientation"}
+#: Tags pydantic inserts after the index of an item of a list of unions: link shapes.
+_ITEM_TAGS = {"capsule", "sphere", "box"}
+_ITEM_UNION_FIELDS = {"collision"}
 
 
 def field_location(loc: tuple | list) -> list[str | int]:
     """A validation location as a client reads it: the union tags pydantic inserts are left out.
 
     ``("body", "robot", "standard", "joints", 0)`` becomes ``["body", "robot", "joints", 0]``; a top-level tag
-    (a description file validated on its own) is dropped too.
+    (a description file validated on its own) is dropped too, and so is the tag after a link shape's index:
+    ``("collision", 0, "capsule", "capsule", "radius")`` becomes ``["collision", 0, "capsule", "radius"]``.
     """
     parts = [part if isinstance(part, (str, int)) else str(part) for part in loc]
     return [part for i, part in enumerate(parts)
-            if not (part in _UNION_TAGS and (i == 0 or parts[i - 1] in _UNION_FIELDS))]
+            if not (part in _UNION_TAGS and (i == 0 or parts[i - 1] in _UNION_FIELDS))
+            and not (part in _ITEM_TAGS and i >= 2 and isinstance(parts[i - 1], int)
+                     and parts[i - 2] in _ITEM_UNION_FIELDS)]

@@ -5,7 +5,7 @@ named ``<id>.yaml`` / ``<id>.yml`` / ``<id>.json``, in any description form
 (DH table or joint screws). A URDF is ``<id>.urdf`` with a sidecar
 ``<id>.urdf.yaml`` that names its chain (``base_link``, ``tip_link``), its
 ``source`` and its ``licence`` (both required), and may set ``name``,
-``limits_source``, ``notes``, ``base`` and ``tool``. A file that does not
+``limits_source``, ``notes``, ``base``, ``tool`` and ``collision``. A file that does not
 validate stops start-up with a message naming the file and the field.
 """
 
@@ -22,8 +22,8 @@ from pydantic import TypeAdapter, ValidationError
 
 from ..kinematics import KinematicsError, Robot
 from ._fields import field_location
-from .build import robot_from_description
-from .schemas import MAX_URDF_CHARS, AnyRobotDescription, RobotDescription
+from .build import robot_from_description, urdf_geometry_shown
+from .schemas import MAX_URDF_CHARS, AnyRobotDescription, RobotDescription, URDFRobot
 
 ROBOT_FILE_SUFFIXES = (".yaml", ".yml", ".json", ".urdf")
 URDF_SIDECAR_SUFFIX = ".urdf.yaml"
@@ -78,6 +78,8 @@ def load_robot_file(path: Path, *, max_joints: int) -> CatalogueEntry:
         raise CatalogueError(f"{path}: id: {description.id!r} must match the file name {path.stem!r}")
     try:
         robot = robot_from_description(description, max_joints=max_joints)
+        if isinstance(description, URDFRobot):
+            description = urdf_geometry_shown(description)
     except KinematicsError as error:
         field = ".".join(str(p) for p in error.location) or "(robot)"
         raise CatalogueError(f"{path}: {field}: {error.message}") from None

@@ -8,6 +8,12 @@
   standard one when its first row has a = α = 0 (otherwise a base or flange frame would change, and with it what
   a per-request base or tool means). A URDF or screws chain has no DH table in general, so ``dh`` is refused.
 
+Link geometry goes along: in another table or in screws each shape stays on its frame index, restated on the new
+model's frame of the same body (:func:`~.geometry.restated_between`), a box's orientation as a matrix. In a URDF
+each shape becomes a ``<collision>`` element of the link of its body (``base_link``, ``link_i``; the flange's on
+``link_n``), a capsule as the ``<cylinder>`` of its segment and radius, which this service reads back as that very
+capsule (URDF has no capsule; other readers see the cylinder without its rounded ends, as ``notes`` says).
+
 Refusals raise :class:`FormNotExact`, whose message says why and which form is exact instead.
 """
 
@@ -19,6 +25,9 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..kinematics import Robot, ScrewJoint, rpy_from_matrix, screw_model
+from ..kinematics.collision import Capsule, Sphere, restated, scaled
+from .build import robot_from_description
+from .geometry import base_T_frames_at_zero, restated_between, wire_from_shape
 from .schemas import (
     AnyRobotDescription,
     DHJoint,
@@ -42,7 +51,8 @@ def description_in_form(description: AnyRobotDescription, robot: Robot, form: st
     """``description`` (of ``robot``) restated in ``form``: ``dh``, ``standard``, ``modified``, ``screws`` or
     ``urdf``."""
     if form == "screws":
-        return description if isinstance(description, ScrewsRobot) else screws_description(description, robot)
+        return description if isinstance(description, ScrewsRobot) else \
+            _with_shapes(screws_description(description, robot), robot)
     if form == "urdf":
         return description if isinstance(description, URDFRobot) else urdf_description(description, robot)
     if not isinstance(description, (DHRobot, KhalilRobot)):
@@ -50,11 +60,21 @@ def description_in_form(description: AnyRobotDescription, robot: Robot, form: st
                            f"this robot are 'screws' and 'urdf'")
     if form == "dh" or form == description.convention:
         return description
-    return _converted_table(description, form)
+    return _with_shapes(_converted_table(description, form), robot)
+
+
+def _with_shapes(converted: AnyRobotDescription, robot: Robot) -> AnyRobotDescription:
+    """``converted`` (another model of ``robot``'s arm, without link geometry) with ``robot``'s shapes restated on its
+    frames."""
+    if not robot.collision:
+        return converted
+    target = robot_from_description(converted, max_joints=robot.dof)
+    return converted.model_copy(update={"collision": [wire_from_shape(item.link, item.shape) for item in
+                                                      restated_between(robot.collision, robot, target)]})
 
 
 def _converted_table(description: DHRobot | KhalilRobot, form: str) -> DHRobot | KhalilRobot:
-    fields = description.model_dump(exclude={"joints", "convention", "format"})
+    fields = description.model_dump(exclude={"joints", "convention", "format", "collision"})
     if isinstance(description, KhalilRobot):
         rows = [DHJoint(name=j.name, type=j.type, a=j.d, alpha=j.alpha, theta=j.theta, limits=j.limits, d=j.r)
                 for j in description.joints]
@@ -93,7 +113,8 @@ def screws_description(description: AnyRobotDescription, robot: Robot) -> Screws
               zip(robot.joint_names, model.is_revolute, model.directions, model.points, robot.lower, robot.upper)]
     return ScrewsRobot(format="screws", id=description.id, name=description.name, source=description.source,
                        angle_unit=angle_unit, length_unit=length_unit, limits_source=description.limits_source,
-                       notes=description.notes, joints=joints, home=_matrix(model.home),
+                       notes=description.notes, collision_source=description.collision_source,
+                       joints=joints, home=_matrix(model.home),
                        base=description.base, tool=description.tool)
 
 
@@ -111,8 +132,9 @@ def urdf_description(description: AnyRobotDescription, robot: Robot) -> URDFRobo
     chain = Robot.from_screws([ScrewJoint(n, "revolute" if r else "prismatic", tuple(d), tuple(p))
                                for n, r, d, p in zip(names, model.is_revolute, model.directions, model.points)],
                               model.home).chain_transforms
-    lines = [f"<robot name={quoteattr(description.name or description.id)}>", '  <link name="base_link"/>']
     links = ["base_link", *(f"link_{i + 1}" for i in range(robot.dof))]
+    elements = _collision_elements(robot, chain, links, metres)
+    lines = [f"<robot name={quoteattr(description.name or description.id)}>", *_link("base_link", elements)]
     for i, name in enumerate(names):
         revolute = bool(robot.is_revolute[i])
         lower, upper = float(robot.lower[i]), float(robot.upper[i])
@@ -122,7 +144,7 @@ def urdf_description(description: AnyRobotDescription, robot: Robot) -> URDFRobo
         kind = ("continuous" if revolute else "prismatic") if math.isinf(lower) else \
             ("revolute" if revolute else "prismatic")
         factor = 1.0 if revolute else metres
-        lines += [f'  <link name="{links[i + 1]}"/>',
+        lines += [*_link(links[i + 1], elements),
                   f"  <joint name={quoteattr(name)} type=\"{kind}\">",
                   f'    <parent link="{links[i]}"/>', f'    <child link="{links[i + 1]}"/>',
                   _origin(chain[i], metres), '    <axis xyz="0 0 1"/>']
@@ -131,12 +153,76 @@ def urdf_description(description: AnyRobotDescription, robot: Robot) -> URDFRobo
         lines.append("  </joint>")
     lines += ['  <link name="flange"/>', '  <joint name="flange_fixed" type="fixed">',
               f'    <parent link="{links[-1]}"/>', '    <child link="flange"/>', _origin(chain[-1], metres),
-              "  </joint>", "</robot>", ""]
+              "  </joint>"]
+    notes = description.notes
+    if any(isinstance(item.shape, Capsule) for item in robot.collision):
+        notes = " ".join(filter(None, (notes, CAPSULE_NOTE)))
+    lines += ["</robot>", ""]
     return URDFRobot(format="urdf", urdf="\n".join(lines), base_link="base_link", tip_link="flange",
                      id=description.id, name=description.name, source=description.source,
                      licence=getattr(description, "licence", None), limits_source=description.limits_source,
-                     notes=description.notes, base=_scaled(description.base, metres),
+                     notes=notes, collision_source=description.collision_source,
+                     base=_scaled(description.base, metres),
                      tool=_scaled(description.tool, metres))
+
+
+CAPSULE_NOTE = ("Capsules are written as <cylinder> elements of the capsule's segment and radius (URDF has no "
+                "capsule): this service reads each back as that capsule; other URDF readers see the cylinder "
+                "without its rounded ends.")
+
+
+def _link(name: str, elements: dict[str, list[str]]) -> list[str]:
+    """A ``<link>`` element, with its collision elements when it has any."""
+    if name not in elements:
+        return [f'  <link name="{name}"/>']
+    return [f'  <link name="{name}">', *elements[name], "  </link>"]
+
+
+def _collision_elements(robot: Robot, chain: np.ndarray, links: list[str], metres: float) -> dict[str, list[str]]:
+    """The robot's shapes as ``<collision>`` element lines by URDF link (the link of each one's body), metres.
+
+    Link k of the URDF (``base_link``, ``link_1`` … ``link_n``) sits at ``chain[0] ⋯ chain[k-1]`` at q = 0; the
+    flange's shapes (frame n) go on ``link_n``, the same body.
+    """
+    if not robot.collision:
+        return {}
+    base_T_link = [np.eye(4)]
+    for k in range(robot.dof):
+        base_T_link.append(base_T_link[-1] @ chain[k])
+    base_T_frame = base_T_frames_at_zero(robot)
+    elements: dict[str, list[str]] = {}
+    for item in robot.collision:
+        link_T_frame = np.linalg.solve(base_T_link[item.link], base_T_frame[item.link])
+        elements.setdefault(links[item.link], []).extend(
+            _collision_element(scaled(restated(item.shape, link_T_frame), metres)))
+    return elements
+
+
+def _collision_element(shape) -> list[str]:
+    """One ``<collision>`` element (lines) for a shape in its link's frame, metres."""
+    T = np.eye(4)
+    if isinstance(shape, Capsule):
+        axis = shape.end - shape.start
+        length = float(np.linalg.norm(axis))
+        T[:3, 3] = 0.5 * (shape.start + shape.end)
+        if length > 0.0:
+            T[:3, :3] = _rotation_onto_z(axis / length)
+        geometry = f'<cylinder radius="{shape.radius!r}" length="{length!r}"/>'
+    elif isinstance(shape, Sphere):
+        T[:3, 3] = shape.center
+        geometry = f'<sphere radius="{shape.radius!r}"/>'
+    else:
+        T[:3, :3], T[:3, 3] = shape.rotation, shape.center
+        geometry = f'<box size="{" ".join(repr(float(v)) for v in shape.size)}"/>'
+    return ["    <collision>", "  " + _origin(T, 1.0), f"      <geometry>{geometry}</geometry>", "    </collision>"]
+
+
+def _rotation_onto_z(direction: np.ndarray) -> np.ndarray:
+    """A rotation whose z column is the unit vector ``direction`` (x, y completing it deterministically)."""
+    helper = np.eye(3)[int(np.argmin(np.abs(direction)))]
+    x = helper - (helper @ direction) * direction
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(direction, x), direction])
 
 
 def _origin(T: np.ndarray, metres: float) -> str:

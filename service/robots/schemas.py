@@ -13,13 +13,17 @@ from __future__ import annotations
 from enum import Enum
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import Discriminator, Field, RootModel, Tag, model_validator
+from pydantic import BeforeValidator, Discriminator, Field, RootModel, Strict, Tag, model_validator
+from pydantic_core import PydanticCustomError
 
 from ._fields import AngleUnit, ApiModel, Matrix4, Number, RobotId, Vector3
+from .orientations import RigidOrientation
 
 #: Largest URDF text accepted inline or in a catalogue file, in characters (a kinematic URDF of a 7-joint arm
 #: without meshes is about 10 kB; vendor files with every visual are under 100 kB).
 MAX_URDF_CHARS = 1_000_000
+#: Longest ``notes`` text of a description.
+MAX_NOTES_CHARS = 4000
 
 class JointType(str, Enum):
     """revolute: the variable is the angle θ; prismatic: the variable is the offset d (r in Khalil form, the
@@ -82,6 +86,103 @@ class KhalilJoint(ApiModel):
     d: Number = Field(0.0, description="distance along x_{j-1}, length unit (Craig's a_{j-1})")
 
 
+#: Most link shapes one description may list.
+MAX_LINK_SHAPES = 1000
+
+Radius = Annotated[Number, Field(ge=0.0, description="length unit; ≥ 0")]
+EdgeLength = Annotated[Number, Field(gt=0.0)]
+
+
+class CapsuleGeometry(ApiModel):
+    """The points within ``radius`` of the segment from ``from`` to ``to`` (a sphere when they meet)."""
+
+    start: Vector3 = Field(alias="from", description="one end of the segment, length unit")
+    end: Vector3 = Field(alias="to", description="the other end of the segment, length unit")
+    radius: Radius
+
+
+class SphereGeometry(ApiModel):
+    """The points within ``radius`` of ``center``."""
+
+    center: Vector3 = Field(description="length unit")
+    radius: Radius
+
+
+class BoxGeometry(ApiModel):
+    """A box of edge lengths ``size`` centred at ``center``, its edges along the axes of ``orientation``."""
+
+    center: Vector3 = Field(description="length unit")
+    size: Annotated[list[EdgeLength], Field(min_length=3, max_length=3)] = Field(
+        description="edge lengths along the box's x, y, z axes, length unit; each > 0")
+    orientation: RigidOrientation | None = Field(
+        None, description="the box's axes in the frame it is given in (Euler and RPY angles in the description's "
+                          "angle unit); null: along that frame's axes")
+
+
+def _one_link_error(value: object) -> object:
+    """A frame index or a link name, refused with one message (not one per member of the union)."""
+    if isinstance(value, bool) or not isinstance(value, (int, str)) or value == "" or (
+            isinstance(value, int) and value < 0):
+        raise PydanticCustomError("link", "link must be a frame index ≥ 0 or (URDF robots) a link name, not "
+                                          "{value}", {"value": repr(value)})
+    return value
+
+
+LinkRef = Annotated[Union[Annotated[int, Strict(), Field(ge=0, le=1000)], Annotated[str, Field(max_length=200)]],
+                    BeforeValidator(_one_link_error)]
+LINK_FIELD = Field(description="the frame the shape is fixed to: its index, 0 the base … n the flange (frame i "
+                               "moves with joint i, in the convention's own frames); for URDF robots also a link "
+                               "name, the shape then in that link's frame")
+
+
+class LinkCapsule(ApiModel):
+    """A capsule fixed to a link, in that link's frame."""
+
+    link: LinkRef = LINK_FIELD
+    capsule: CapsuleGeometry
+
+
+class LinkSphere(ApiModel):
+    """A sphere fixed to a link, in that link's frame."""
+
+    link: LinkRef = LINK_FIELD
+    sphere: SphereGeometry
+
+
+class LinkBox(ApiModel):
+    """A box fixed to a link, in that link's frame."""
+
+    link: LinkRef = LINK_FIELD
+    box: BoxGeometry
+
+
+SHAPE_KINDS = ("capsule", "sphere", "box")
+
+
+def _shape_tag(value: Any) -> str | None:
+    """The variant of a link shape: the one shape key it has (None when it has none or several)."""
+    if isinstance(value, dict):
+        kinds = [kind for kind in SHAPE_KINDS if kind in value]
+        return kinds[0] if len(kinds) == 1 else None
+    return next((kind for kind in SHAPE_KINDS if hasattr(value, kind)), None)
+
+
+LinkShapeDescription = Annotated[
+    Union[Annotated[LinkCapsule, Tag("capsule")], Annotated[LinkSphere, Tag("sphere")],
+          Annotated[LinkBox, Tag("box")]],
+    Discriminator(_shape_tag, custom_error_type="link_shape",
+                  custom_error_message="a link shape has exactly one of 'capsule', 'sphere' or 'box'"),
+]
+AnyLinkShapeDescription = LinkCapsule | LinkSphere | LinkBox
+
+COLLISION_FIELD = Field(
+    None, max_length=MAX_LINK_SHAPES,
+    description="the arm's geometry: shapes fixed to its links, each in its link's frame, in the description's "
+                "length unit; null: none (for a URDF: its own <collision> elements)")
+
+COLLISION_SOURCE_FIELD = Field(None, max_length=2000, description="where the link geometry comes from")
+
+
 class TargetKind(str, Enum):
     """An IK target kind (api.md): a full pose, a position only, or a position + tool direction."""
 
@@ -108,9 +209,12 @@ class _RobotFields(ApiModel):
         None, description="values given to the source's symbolic lengths (informational)"
     )
     limits_source: str | None = Field(None, max_length=2000, description="where the joint limits come from")
-    notes: str | None = Field(None, max_length=4000, description="free text: frame choices, joint zeros, caveats")
+    notes: str | None = Field(None, max_length=MAX_NOTES_CHARS,
+                              description="free text: frame choices, joint zeros, caveats")
     base: Matrix4 | None = Field(None, description="world_T_base; identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool; identity when null")
+    collision: list[LinkShapeDescription] | None = COLLISION_FIELD
+    collision_source: str | None = COLLISION_SOURCE_FIELD
     target_kinds: list[TargetKind] = TARGET_KINDS_FIELD
 
 
@@ -134,8 +238,8 @@ class URDFRobot(ApiModel):
     """A robot described by a URDF: the chain from ``base_link`` to ``tip_link`` of its kinematic tree.
 
     Lengths are metres and angles radians, as URDF states them. Fixed joints are folded into their neighbours;
-    ``revolute``, ``continuous`` (no limits) and ``prismatic`` joints move. Meshes and visuals are ignored, never
-    fetched. Xacro is out of scope: expand it first (``xacro robot.urdf.xacro > robot.urdf``).
+    ``revolute``, ``continuous`` (no limits) and ``prismatic`` joints move. Collision boxes, spheres and cylinders
+    are read (unless ``collision`` is given); meshes are never fetched. Xacro is out of scope: expand it first (``xacro robot.urdf.xacro > robot.urdf``).
     """
 
     format: Literal["urdf"] = Field(description="description form: a URDF document")
@@ -148,9 +252,18 @@ class URDFRobot(ApiModel):
     source: str = Field("", max_length=2000, description="where the URDF comes from")
     licence: str | None = Field(None, max_length=200, description="licence of the source file")
     limits_source: str | None = Field(None, max_length=2000, description="where the joint limits come from")
-    notes: str | None = Field(None, max_length=4000, description="free text: frame choices, joint zeros, caveats")
+    notes: str | None = Field(None, max_length=MAX_NOTES_CHARS,
+                              description="free text: frame choices, joint zeros, caveats; in GET /v1/robots/"
+                                          "{robot_id}, also the <collision> elements not modelled (meshes)")
     base: Matrix4 | None = Field(None, description="world_T_base (world_T_base_link); identity when null")
     tool: Matrix4 | None = Field(None, description="flange_T_tool (tip_link_T_tool); identity when null")
+    collision: list[LinkShapeDescription] | None = Field(
+        None, max_length=MAX_LINK_SHAPES,
+        description="the arm's geometry in metres: shapes fixed to links, each in its link's frame (a link name: "
+                    "that URDF link's frame; an index: the service's frame i); replaces the URDF's own <collision> "
+                    "elements; null: those elements are read (box, sphere, cylinder as its bounding capsule; "
+                    "meshes are listed in notes, not modelled)")
+    collision_source: str | None = COLLISION_SOURCE_FIELD
     target_kinds: list[TargetKind] = TARGET_KINDS_FIELD
 
 

@@ -13,20 +13,19 @@ from ...robots._fields import (  # noqa: F401
     MAX_MAGNITUDE,
     AngleUnit,
     ApiModel,
+    Matrix3,
     Matrix4,
     Matrix4Row,
     Number,
     RobotId,
     Vector3,
+    Vector4,
     square_shape,
 )
 
 #: A JSON boolean in a request: true or false only (0, 1 and "yes" are refused, as the spec says).
 Flag = Annotated[bool, Strict()]
 
-Vector4 = Annotated[list[Number], Field(min_length=4, max_length=4)]
-Matrix3 = Annotated[list[Vector3], square_shape(3, "rotation matrix"),
-                    Field(min_length=3, max_length=3, description="3×3, row-major")]
 #: Numbers in responses: finite, but not bounded (a pose can sum many request-sized lengths).
 Real = Annotated[float, AllowInfNan(False)]
 RealVector3 = Annotated[list[Real], Field(min_length=3, max_length=3)]

@@ -7,39 +7,8 @@ from typing import Annotated, Literal, Union
 from pydantic import Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
-from .common import ApiModel, Matrix3, Matrix4, Number, RealMatrix4, RealVector3, RealVector4, Vector3, Vector4
-
-
-class MatrixOrientation(ApiModel):
-    """A 3×3 rotation matrix, orthonormal within 1e-6 with determinant +1."""
-
-    type: Literal["matrix"] = Field(description="names this variant")
-    matrix: Matrix3 = Field(description="world_R_tool, 3×3, row-major")
-
-
-class QuaternionOrientation(ApiModel):
-    """A unit quaternion, scalar first (w, x, y, z), norm within 1e-6 of 1.
-
-    ROS, scipy and Eigen's coefficient order put the scalar last (x, y, z, w): reorder before sending.
-    ``[0, 0, 0, 1]`` here is w = 0, z = 1, a half turn about z, not the identity ``[1, 0, 0, 0]``.
-    """
-
-    type: Literal["quaternion"] = Field(description="names this variant")
-    wxyz: Vector4 = Field(description="(w, x, y, z), scalar first")
-
-
-class EulerZYZOrientation(ApiModel):
-    """ZYZ Euler angles (φ, θ, ψ): R = Rot_z(φ)·Rot_y(θ)·Rot_z(ψ), in the request's angle unit."""
-
-    type: Literal["euler_zyz"] = Field(description="names this variant")
-    angles: Vector3 = Field(description="(φ, θ, ψ), the request's angle unit")
-
-
-class RPYOrientation(ApiModel):
-    """Roll, pitch, yaw about the fixed X, Y, Z axes: R = Rot_z(yaw)·Rot_y(pitch)·Rot_x(roll), in the request's angle unit."""
-
-    type: Literal["rpy"] = Field(description="names this variant")
-    angles: Vector3 = Field(description="(roll, pitch, yaw), the request's angle unit")
+from ...robots.orientations import EulerZYZOrientation, MatrixOrientation, QuaternionOrientation, RPYOrientation
+from .common import ApiModel, Matrix4, Number, RealMatrix4, RealVector3, RealVector4, Vector3, Vector4
 
 
 class DirectionOrientation(ApiModel):

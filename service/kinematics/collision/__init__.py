@@ -4,6 +4,6 @@ Pure numpy. Shapes are values (:mod:`._shapes`); distances are vectorised over
 configurations × shape pairs.
 """
 
-from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
+from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere, restated, scaled
 
-__all__ = ["Box", "Capsule", "LinkShape", "Obstacle", "Shape", "Sphere"]
+__all__ = ["Box", "Capsule", "LinkShape", "Obstacle", "Shape", "Sphere", "restated", "scaled"]

@@ -91,6 +91,30 @@ class Box:
 Shape = Union[Capsule, Sphere, Box]
 
 
+def restated(shape: Shape, a_T_b: np.ndarray) -> Shape:
+    """``shape``, given in frame b, restated in frame a; ``a_T_b`` shape (4, 4), a rigid transform.
+
+    >>> turn = np.array([[0., -1, 0, 1], [1, 0, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])  # Rz(90°), then 1 along x
+    >>> restated(Capsule([0, 0, 0], [2, 0, 0], 0.1), turn).end.tolist()
+    [1.0, 2.0, 0.0]
+    """
+    R, p = a_T_b[:3, :3], a_T_b[:3, 3]
+    if isinstance(shape, Capsule):
+        return Capsule(R @ shape.start + p, R @ shape.end + p, shape.radius)
+    if isinstance(shape, Sphere):
+        return Sphere(R @ shape.center + p, shape.radius)
+    return Box(R @ shape.center + p, shape.size, R @ shape.rotation)
+
+
+def scaled(shape: Shape, factor: float) -> Shape:
+    """``shape`` with every length multiplied by ``factor`` > 0 (a change of length unit)."""
+    if isinstance(shape, Capsule):
+        return Capsule(shape.start * factor, shape.end * factor, shape.radius * factor)
+    if isinstance(shape, Sphere):
+        return Sphere(shape.center * factor, shape.radius * factor)
+    return Box(shape.center * factor, shape.size * factor, shape.rotation)
+
+
 @dataclass(frozen=True, eq=False)
 class LinkShape:
     """A shape fixed to link ``link`` (0 = base … n = flange), in that link's frame; ``name`` for messages."""

@@ -237,8 +237,8 @@ class Robot:
     def with_collision(self, collision: Sequence["LinkShape"]) -> "Robot":
         """The same arm carrying ``collision`` (link shapes, as in the constructor) instead of its own shapes."""
         shapes = _checked_collision(collision, self.dof)
-        other = Robot.__new__(Robot)
-        other.__dict__.update({key: value for key, value in self.__dict__.items() if key != "_derived"})
+        other = copy.copy(self)
+        other.derived = DerivedStore()  # what is derived from the shapes is derived again
         other.collision = shapes
         return other
 

@@ -38,12 +38,8 @@ class RobotCache:
 
     def get(self, key: Hashable, build: Callable[[], Robot]) -> Robot:
         """The robot kept under ``key``, else ``build()``'s, kept."""
-        with self._lock:
-            entry = self._entries.get(key)
-            if entry is not None:
-                self._entries.move_to_end(key)
+        entry = self.kept(key)
         if entry is not None:
-            self._hits.inc()
             return entry
         self._misses.inc()
         robot = build()  # outside the lock: two threads missing the same key both build, the last one is kept
@@ -56,8 +52,8 @@ class RobotCache:
         return robot
 
     def kept(self, key: Hashable) -> Robot | None:
-        """The robot kept under ``key`` (a look-up, counted as a hit), or None without counting a miss: the
-        caller builds it elsewhere, through :meth:`get`."""
+        """The robot kept under ``key`` (a look-up, counted as a hit), or None without counting a miss: the caller
+        builds it elsewhere, through :meth:`get`."""
         with self._lock:
             entry = self._entries.get(key)
             if entry is not None:

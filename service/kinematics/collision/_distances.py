@@ -19,6 +19,8 @@ as apart (the Minkowski difference of the cores grows by the ball of radius r_A 
 
 So every function below computes the signed distance of the cores and subtracts the radii. Two points or two
 segments never penetrate (their Minkowski difference is at most two-dimensional), so there sd is the distance.
+A point is a segment of length 0, so three cores cover every pair: segment–segment (:func:`_segment_segment`),
+box–segment (:func:`_box_segment`) and box–box (:func:`_box_box`).
 
 Results
 -------
@@ -38,18 +40,22 @@ Conventions
   the *batch shape*, leads every result. All in one frame and one length unit; the results are in it too.
 * A box is given by its centre, rotation and half sizes (half its edge lengths, each > 0). Rotations are taken as
   orthonormal: the penetration depths use the identities of an orthonormal matrix (a rotation off by δ moves
-  results by about δ times the boxes' size).
+  results by about δ times the boxes' size). :class:`~._shapes.Box` records hold orthonormal rotations, and
+  link frames from :func:`~service.kinematics.link_frames` are products of rotations.
 * Inputs are not checked (these run inside the collision model, after validation). A non-finite input gives a
   NaN or infinite result in its row only.
-* Internally vectors are component-first, shape (3, ...), so that each arithmetic step is one numpy call on
-  contiguous blocks; the collision model (:mod:`._model`) calls the private functions directly in that layout,
-  without witness points.
+* Internally vectors are component-first, shape (3, ...), and a shape's reference points are stacked: a segment's
+  ends (3, 2, ...), a box's centre and axes (3, 4, ...). Each arithmetic step is then one numpy call on
+  contiguous blocks. The private cores run with 0/0 and x/0 allowed (:func:`_quiet`): they stand for an axis
+  that does not exist or a coordinate that does not move, and the cores handle the NaN and infinities they give.
+  The collision model (:mod:`._model`) calls them directly in that layout, without witness points.
 
 Accuracy
 --------
 Every step is either a clamped projection or a ratio whose rounding error is relative to the size of the inputs,
 so distances are accurate to a few ulps of the coordinates' magnitude, including zero-length and (nearly) parallel
-segments; see each function for its one exception, if any.
+segments and edges (tests: within 1e-13 of an exact enumeration with Qhull on 10,000 random pairs of each kind,
+and within 1e-14 of exact rational arithmetic for segments 1e-16 to 1e-2 rad from parallel).
 """
 
 from __future__ import annotations

@@ -418,6 +418,18 @@ def test_boxes_rotated_by_tiny_angles_keep_their_depth():
     assert exact == pytest.approx(-0.5, abs=1e-8)
 
 
+def test_a_box_rotation_written_with_few_decimals_becomes_the_nearest_rotation():
+    """Rotations are accepted within 1e-6 of orthonormal; a box is measured as a box, so its record holds the
+    nearest rotation (and one orthonormal to rounding exactly as given)."""
+    c, s = math.cos(0.3), math.sin(0.3)
+    exact = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+    assert np.array_equal(Box([0, 0, 0], [1, 1, 1], exact).rotation, exact)
+    written = np.round(exact, 7)
+    projected = Box([0, 0, 0], [1, 1, 1], written).rotation
+    assert np.abs(projected.T @ projected - np.eye(3)).max() < 1e-15
+    assert np.abs(projected - exact).max() < 1e-7
+
+
 # --- witnesses, symmetry, batches ---------------------------------------------------------------------------
 
 

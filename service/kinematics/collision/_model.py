@@ -387,29 +387,29 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
     skipped = _checked_ignore(ignore, count)
     skipped.update((link, link + 1) for link in range(count - 1))
 
-    # Reference rows: the link shapes' rows, grouped by link, then the obstacles'.
-    by_link: dict[int, list[np.ndarray]] = {}
+    # Reference rows: the link shapes' rows, grouped by link, then the obstacles'. Indices are plain lists here.
+    by_link: dict[int, list[list[float]]] = {}
     local_positions = []  # per link shape: its rows' positions among its link's rows
     for item in shapes:
         rows = by_link.setdefault(item.link, [])
-        local_positions.append(len(rows) + np.arange(len(_local_rows(item.shape))))
-        rows.extend(_local_rows(item.shape))
+        own = _local_rows(item.shape)
+        local_positions.append(range(len(rows), len(rows) + len(own)))
+        rows.extend(own)
     link_rows, first_row, position = [], {}, 0
     for link in sorted(by_link):
-        rows = by_link[link]
-        # component c of row k in the world is Σ_j world_T_link[c, j] x_k[j]: entry (4 c + j, c · len(rows) + k)
-        placing = np.zeros((12, 3 * len(rows)))
-        for k, row in enumerate(rows):
-            for c in range(3):
-                placing[4 * c:4 * c + 4, c * len(rows) + k] = row
+        rows = np.array(by_link[link])  # (k, 4)
+        # component c of row r in the world is Σ_j world_T_link[c, j] x_r[j]: entry (4 c + j, c k + r)
+        placing = np.zeros((3, 4, 3, len(rows)))
+        for c in range(3):
+            placing[c, :, c, :] = rows.T
         first_row[link] = position
-        link_rows.append(_LinkRows(link, position, position + len(rows), placing))
+        link_rows.append(_LinkRows(link, position, position + len(rows), placing.reshape(12, -1)))
         position += len(rows)
-    shape_rows = [first_row[item.link] + positions for item, positions in zip(shapes, local_positions)]
+    shape_rows = [[first_row[item.link] + k for k in positions] for item, positions in zip(shapes, local_positions)]
     obstacle_rows, fixed = [], []
     for obstacle in obstacle_list:
         rows = _local_rows(obstacle.shape)
-        obstacle_rows.append(position + len(fixed) + np.arange(len(rows)))
+        obstacle_rows.append(list(range(position + len(fixed), position + len(fixed) + len(rows))))
         fixed.extend(row[:3] for row in rows)
 
     # The pairs: each link shape with each obstacle, then the link shapes with each other; in the kernels' groups.
@@ -431,7 +431,7 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
         first_rows, second_rows = (rows_b, rows_a) if swapped else (rows_a, rows_b)
         pair = ShapePair(names[shapes[index].link], b, shapes[index].link, link_b, index, index_b,
                          f"{_KIND_NAMES[type(first)]}-{_KIND_NAMES[type(second)]}")
-        rows = np.concatenate([_kernel_rows(first, first_rows), _kernel_rows(second, second_rows)])
+        rows = _kernel_rows(first, first_rows) + _kernel_rows(second, second_rows)
         members[(_family(first), _family(second))].append((pair, rows, first, second, swapped))
 
     pairs: list[ShapePair] = []
@@ -453,19 +453,19 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
                           body_pair_of, tuple(link_rows), np.array(fixed).T.reshape(3, -1), tuple(groups))
 
 
-def _local_rows(shape: Shape) -> list[np.ndarray]:
+def _local_rows(shape: Shape) -> list[list[float]]:
     """The homogeneous reference rows of a shape in its own frame: points (w = 1) and directions (w = 0). A
     capsule's start and end, a sphere's centre, a box's centre and three axes."""
     if isinstance(shape, Capsule):
-        return [np.append(shape.start, 1.0), np.append(shape.end, 1.0)]
+        return [[*shape.start.tolist(), 1.0], [*shape.end.tolist(), 1.0]]
     if isinstance(shape, Sphere):
-        return [np.append(shape.center, 1.0)]
-    return [np.append(shape.center, 1.0), *(np.append(shape.rotation[:, j], 0.0) for j in range(3))]
+        return [[*shape.center.tolist(), 1.0]]
+    return [[*shape.center.tolist(), 1.0], *([*axis, 0.0] for axis in shape.rotation.T.tolist())]
 
 
-def _kernel_rows(shape: Shape, rows: np.ndarray) -> np.ndarray:
+def _kernel_rows(shape: Shape, rows: list[int]) -> list[int]:
     """The rows a kernel reads for a shape: a round shape's two ends (a sphere's centre twice), a box's four."""
-    return np.array([rows[0], rows[0]]) if isinstance(shape, Sphere) else rows
+    return [rows[0], rows[0]] if isinstance(shape, Sphere) else rows
 
 
 def _family(shape: Shape) -> str:
@@ -474,7 +474,8 @@ def _family(shape: Shape) -> str:
 
 def _half_sizes(shapes: list[Shape]) -> np.ndarray:
     """(3, P_k, 1): each box's half sizes, zeros for a round shape."""
-    return np.array([shape.half_size if isinstance(shape, Box) else np.zeros(3) for shape in shapes]).T[..., None]
+    return np.array([shape.half_size.tolist() if isinstance(shape, Box) else [0.0, 0.0, 0.0]
+                     for shape in shapes]).T[..., None]
 
 
 def _radii(shapes: list[Shape]) -> np.ndarray:

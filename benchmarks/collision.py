@@ -6,7 +6,8 @@
 A 6-joint arm (the catalogue's PUMA 560) with capsules on links 1, 2, 3, 5 and 6 and a table box: 12 pairs, seven
 capsule–capsule (self-collision of links not joined by a joint) and five box–capsule (each capsule against the
 table). Rows: ``link_frames`` for the configurations, the model's ``distances`` for those frames, and its
-``check`` (distances, clearance and the close pairs). Times are CPU seconds of this process
+``check`` (distances, clearance and the close pairs); then the cost of one call for 1 and 16 configurations (the
+single-pose path, where numpy's cost per call dominates) and of compiling the model. Times are CPU seconds of this process
 (``time.process_time``), best of the repeats: on a shared machine that is less noisy than wall time, but still
 noisy; compare rows of one run.
 """
@@ -29,7 +30,7 @@ ROBOT_FILE = Path(__file__).resolve().parents[1] / "robots" / "puma560_standard.
 
 def puma_model():
     """The PUMA 560 (standard DH, metres) with a rough capsule model and a table under it."""
-    robot = load_robot_file(ROBOT_FILE, max_joints=16).robot
+    robot = _puma()
     shapes = [
         LinkShape(1, Capsule([0, 0, -0.2], [0, 0, 0.2], 0.10)),
         LinkShape(2, Capsule([-0.4318, 0, 0], [0, 0, 0], 0.08)),
@@ -39,6 +40,15 @@ def puma_model():
     ]
     table = Obstacle("table", Box([0.6, 0.0, -0.7], [1.2, 0.8, 0.02]))
     return robot, collision_model(shapes, robot.dof + 1, [table])
+
+
+_ROBOTS: dict = {}
+
+
+def _puma():
+    if "puma" not in _ROBOTS:
+        _ROBOTS["puma"] = load_robot_file(ROBOT_FILE, max_joints=16).robot
+    return _ROBOTS["puma"]
 
 
 def best_time(function, repeats: int) -> float:
@@ -69,10 +79,17 @@ def main(argv: list[str] | None = None) -> int:
         (f"distances, {count} configurations", best_time(lambda: model.distances(frames), repeats)),
         (f"check (margin 0.01), {count} configurations", best_time(lambda: model.check(frames, 0.01), repeats)),
     ]
-    small = frames[:1]
-    single_repeats = 20 if arguments.quick else 2000
-    rows.append(("distances, 1 configuration (per call)",
-                 best_time(lambda: [model.distances(small) for _ in range(single_repeats)], 3) / single_repeats))
+    calls = 20 if arguments.quick else 2000
+    for size in (1, 16):
+        small = frames[:size]
+        rows.append((f"distances, {size} configuration{'s' if size > 1 else ''} (per call)",
+                     best_time(lambda: [model.distances(small) for _ in range(calls)], 3) / calls))
+    rows.append(("check (margin 0.01), 16 configurations (per call)",
+                 best_time(lambda: [model.check(frames[:16], 0.01) for _ in range(calls)], 3) / calls))
+    rows.append(("link_frames, 16 configurations (per call)",
+                 best_time(lambda: [link_frames(robot, q[:16]) for _ in range(calls)], 3) / calls))
+    rows.append(("collision_model (compiling the 12 pairs, per call)",
+                 best_time(lambda: [puma_model() for _ in range(calls // 10)], 3) / (calls // 10)))
     print("| what | CPU time (best of repeats) |")
     print("| --- | --- |")
     for name, seconds in rows:

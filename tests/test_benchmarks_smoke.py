@@ -44,7 +44,8 @@ def test_collision_benchmark_runs_with_tiny_sizes(capsys):
     out = capsys.readouterr().out
     assert "12 pairs: 5 box-capsule, 7 capsule-capsule" in out
     for row in ("link_frames, 200 configurations", "distances, 200 configurations",
-                "check (margin 0.01), 200 configurations", "distances, 1 configuration (per call)"):
+                "check (margin 0.01), 200 configurations", "distances, 1 configuration (per call)",
+                "distances, 16 configurations (per call)", "collision_model (compiling the 12 pairs, per call)"):
         assert f"| {row} |" in out
 
 

@@ -10,7 +10,7 @@ import shutil
 
 import pytest
 
-from benchmarks import anchors, core, http_throughput, request_profile, slide_classes, wrist_classes
+from benchmarks import anchors, collision, core, http_throughput, request_profile, slide_classes, wrist_classes
 
 
 def test_core_benchmark_runs_with_tiny_sizes(capsys):
@@ -37,6 +37,16 @@ def test_wrist_classes_benchmark_runs_with_tiny_sizes(capsys):
     assert "- KUKA KR 6 R900-2: offset_shoulder_parallel_elbow+spherical_wrist" in out
     assert "| random skew axes | IK, batch of 20 | core |" in out
     assert "| random wrist at the base | IK, single pose | core |" in out
+
+
+def test_collision_benchmark_runs_with_tiny_sizes(capsys):
+    assert collision.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "12 pairs: 5 box-capsule, 7 capsule-capsule" in out
+    for row in ("link_frames, 200 configurations", "distances, 200 configurations",
+                "check (margin 0.01), 200 configurations", "distances, 1 configuration (per call)",
+                "distances, 16 configurations (per call)", "collision_model (compiling the 12 pairs, per call)"):
+        assert f"| {row} |" in out
 
 
 def test_slide_classes_benchmark_runs_with_tiny_sizes(capsys):

@@ -18,6 +18,7 @@ import numpy as np
 
 from .._errors import InvalidInputError
 from .._rotations import check_rotation
+from .._tolerances import ROUNDING_TOLERANCE
 
 
 def _point(value, what: str) -> np.ndarray:
@@ -66,7 +67,11 @@ class Sphere:
 @dataclass(frozen=True, eq=False)
 class Box:
     """A box of edge lengths ``size`` (3,), centred at ``center`` (3,), its edges along the columns of
-    ``rotation`` (3, 3) (identity: along the frame's axes)."""
+    ``rotation`` (3, 3) (identity: along the frame's axes).
+
+    A rotation that is orthonormal only to the input tolerance (``ORTHONORMAL_TOLERANCE``, say written with a
+    few decimals) is replaced by the nearest rotation, so that distances measure a true box; one orthonormal to
+    rounding is kept as given."""
 
     center: np.ndarray
     size: np.ndarray
@@ -79,6 +84,11 @@ class Box:
             raise InvalidInputError(f"size must be three numbers > 0, not {size.tolist()}", location=("size",))
         object.__setattr__(self, "size", size)
         rotation = np.eye(3) if self.rotation is None else check_rotation(self.rotation)
+        if np.abs(rotation.T @ rotation - np.eye(3)).max() > ROUNDING_TOLERANCE:
+            # accepted within ORTHONORMAL_TOLERANCE, but a box is measured as a box: the nearest rotation
+            # (polar factor U V^T of the SVD; check_rotation has ruled out reflections)
+            left, _, right = np.linalg.svd(rotation)
+            rotation = left @ right
         rotation.setflags(write=False)
         object.__setattr__(self, "rotation", rotation)
 

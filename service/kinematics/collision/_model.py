@@ -1,0 +1,567 @@
+"""The collision model of a robot: which shape pairs to check, compiled once, and their signed distances for a
+batch of configurations.
+
+A model is built from the robot's link shapes (:class:`~._shapes.LinkShape`, each in its link's frame), the
+obstacles (:class:`~._shapes.Obstacle`, world frame) and the rules of the request (self-collision, ignored link
+pairs). It is a value: it holds no per-call state, so one model may serve concurrent requests.
+
+Evaluation takes link frames as :func:`~service.kinematics.link_frames` returns them, ``world_T_frame`` of
+shape (S, n + 1, 4, 4) (0 the base, i the frame that moves with joint i, n the flange), and gives the signed
+distance of every pair in every configuration, shape (S, P), with the sign convention of :mod:`._distances`
+(positive apart, negative in overlap). The frames are taken as rigid transforms, as link_frames gives them.
+
+How the work is laid out: every shape is reduced to a few reference rows (a capsule's two end points, a sphere's
+centre, a box's centre and its three axes), each a homogeneous point or direction fixed to a link or to the
+world. One matrix product per link maps that link's rows to the world for a block of configurations; the pairs
+then fall into three groups by the kernel that measures them (round–round for capsules and spheres, a sphere
+being a capsule of length 0; box–round; box–box), and each group gathers its rows and runs one vectorised kernel
+over the block. Configurations go through in blocks of a few thousand pair evaluations, so that the temporaries
+stay in cache.
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+from dataclasses import dataclass
+from typing import Callable, NamedTuple, Sequence
+
+import numpy as np
+
+from .._errors import InvalidInputError
+from ._distances import Separation, _box_box, _box_segment, _quiet, _segment_segment, _swept
+from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
+
+#: Pair evaluations per block (configurations × pairs of one group). Large enough that numpy's cost per call is
+#: small against the arithmetic, small enough that a block's temporaries stay in the core's cache (measured:
+#: 4096 to 16384 are alike, 1024 and 65536 slower).
+_BLOCK_ELEMENTS = 8192
+
+#: The order in which pairs name the kinds of their shapes, and in which the kernels take them.
+_KIND_ORDER = (Box, Capsule, Sphere)
+_KIND_NAMES = {Box: "box", Capsule: "capsule", Sphere: "sphere"}
+
+
+@dataclass(frozen=True)
+class ShapePair:
+    """One pair of shapes the model checks.
+
+    ``a`` and ``b`` name the bodies for answers: a link as ``"link 3"`` (or its name, when the model was given
+    link names), an obstacle by its name. ``a`` is always a link; ``b`` is a link of higher index, or an
+    obstacle (``link_b`` is then None). ``shape_a`` indexes the model's link shapes; ``shape_b`` the link
+    shapes too, or the obstacles when ``link_b`` is None. ``kind`` names the two shapes' kinds in the order box,
+    capsule, sphere (``"box-capsule"``), whichever of them is ``a``.
+    """
+
+    a: str
+    b: str
+    link_a: int
+    link_b: int | None
+    shape_a: int
+    shape_b: int
+    kind: str
+
+
+class _Group(NamedTuple):
+    """The pairs one kernel measures: columns [start, stop) of the distances. Per pair, the reference rows the
+    kernel reads (those of its first shape, then its second), the sizes, and whether the kernel's first shape is
+    the pair's ``b``."""
+
+    start: int
+    stop: int
+    kernel: Callable
+    rows: np.ndarray  # (P_k, m) row indices
+    half_size_a: np.ndarray  # (3, P_k, 1): a box's half sizes (zeros for a round shape)
+    half_size_b: np.ndarray
+    radius_a: np.ndarray  # (P_k, 1): a round shape's radius (0 for a box)
+    radius_b: np.ndarray
+    swapped: np.ndarray  # (P_k,) bool
+
+
+class CollisionCheck(NamedTuple):
+    """The outcome of :meth:`CollisionModel.check` for S configurations, in columns.
+
+    ``clearance`` (S,): the smallest signed distance over the model's pairs (+inf when it has none).
+    ``pair_distances`` (S, P): every pair's signed distance, in the order of :attr:`CollisionModel.pairs`.
+    The close body pairs, those closer than the margin, are listed for configuration i at positions
+    ``offsets[i]:offsets[i + 1]`` of ``body_pairs`` (indices into :attr:`CollisionModel.body_pairs`) and
+    ``distances`` (their signed distance: the smallest over their shape pairs), nearest first.
+    """
+
+    clearance: np.ndarray
+    pair_distances: np.ndarray
+    offsets: np.ndarray
+    body_pairs: np.ndarray
+    distances: np.ndarray
+
+    @property
+    def colliding(self) -> np.ndarray:
+        """(S,) bool: the configuration has a close pair."""
+        return self.offsets[1:] > self.offsets[:-1]
+
+    def close_pairs(self, model: "CollisionModel", configuration: int) -> list[tuple[str, str, float]]:
+        """Configuration ``configuration``'s close body pairs as (a, b, distance), nearest first."""
+        span = slice(self.offsets[configuration], self.offsets[configuration + 1])
+        return [(*model.body_pairs[pair], distance)
+                for pair, distance in zip(self.body_pairs[span].tolist(), self.distances[span].tolist())]
+
+
+class _LinkRows(NamedTuple):
+    """The reference rows fixed to one link: rows [first, end) of the world block, and the (12, 3 k) matrix
+    that takes the link's frame (its top 3 × 4, flattened) to their world coordinates."""
+
+    link: int
+    first: int
+    end: int
+    placing: np.ndarray
+
+
+@dataclass(frozen=True, eq=False)
+class CollisionModel:
+    """The shape pairs of a robot and its obstacles, compiled for evaluation; build it with
+    :func:`collision_model`.
+
+    Attributes
+    ----------
+    link_count : int
+        n + 1, the number of link frames the model expects.
+    pairs : tuple of ShapePair
+        The checked pairs, in the order of the columns of :meth:`distances`.
+    body_pairs : tuple of (str, str)
+        The distinct (a, b) names of the pairs: the bodies answers report. Several shape pairs share one when
+        a link carries several shapes, or several obstacles share a name (one obstacle made of several shapes).
+    body_pair_of : ndarray of int, shape (P,)
+        For each pair, its index in ``body_pairs``.
+    """
+
+    link_count: int
+    link_shapes: tuple[LinkShape, ...]
+    obstacles: tuple[Obstacle, ...]
+    pairs: tuple[ShapePair, ...]
+    body_pairs: tuple[tuple[str, str], ...]
+    body_pair_of: np.ndarray
+    _link_rows: tuple[_LinkRows, ...]
+    _world_rows_fixed: np.ndarray  # (3, K_obstacles): the obstacles' rows, already in the world
+    _groups: tuple[_Group, ...]
+
+    # --- evaluation -------------------------------------------------------------------------------------------
+
+    def distances(self, world_T_frames: np.ndarray) -> np.ndarray:
+        """Signed distance of every pair in every configuration.
+
+        Parameters
+        ----------
+        world_T_frames : array_like, shape (S, n + 1, 4, 4) or (n + 1, 4, 4)
+            Link frames as :func:`~service.kinematics.link_frames` returns them.
+
+        Returns
+        -------
+        ndarray, shape (S, P) or (P,)
+            In the order of :attr:`pairs`; in the frames' length unit.
+
+        Raises
+        ------
+        InvalidInputError
+            Frames of the wrong shape (location ``("frames",)``), or not finite where a shape sits (location
+            ``("frames", configuration, link)``, without the configuration for a single one).
+        """
+        frames, single = self._checked_frames(world_T_frames)
+        result = self._distances(frames)
+        self._check_finite(frames, result, single)
+        return result[0] if single else result
+
+    def check(self, world_T_frames: np.ndarray, margin: float = 0.0) -> CollisionCheck:
+        """Clearance of every configuration and the body pairs closer than ``margin``.
+
+        ``world_T_frames`` as in :meth:`distances` (a single configuration counts as S = 1). ``margin`` is a
+        finite length (location ``("margin",)``); a pair is close when its signed distance is < margin, so with
+        margin 0 touching shapes are not reported and overlapping ones are.
+        """
+        margin_value = _finite_number(margin, ("margin",))
+        frames, single = self._checked_frames(world_T_frames)
+        pair_distances = self._distances(frames)
+        self._check_finite(frames, pair_distances, single)
+        return _close_pairs(pair_distances, self.body_pair_of, len(self.body_pairs), margin_value)
+
+    def witnesses(self, world_T_frames: np.ndarray, configurations: Sequence[int] | np.ndarray,
+                  pairs: Sequence[int] | np.ndarray) -> Separation:
+        """Signed distance and witness points (world frame) of chosen entries: pair ``pairs[k]`` in configuration
+        ``configurations[k]``, for example the close pairs to draw. ``point_a`` is on the pair's ``a`` and
+        ``normal`` runs from a to b.
+
+        Returns a :class:`~._distances.Separation` of batch shape (len(pairs),).
+        """
+        frames, _ = self._checked_frames(world_T_frames)
+        configuration = np.asarray(configurations).reshape(-1)
+        column = np.asarray(pairs).reshape(-1)
+        for values, name, size in ((configuration, "configurations", frames.shape[0]),
+                                   (column, "pairs", len(self.pairs))):
+            if values.size and not (np.issubdtype(values.dtype, np.integer) and 0 <= values.min()
+                                    and values.max() < size):
+                raise InvalidInputError(f"{name} must be indices in [0, {size})", location=(name,))
+        if configuration.shape != column.shape:
+            raise InvalidInputError("configurations and pairs must have the same length", location=("pairs",))
+        count = column.size
+        result = Separation(np.empty(count), np.empty((count, 3)), np.empty((count, 3)), np.empty((count, 3)))
+        for group in self._groups:
+            chosen = np.flatnonzero((column >= group.start) & (column < group.stop))
+            if chosen.size == 0:
+                continue
+            local = column[chosen] - group.start
+            world = self._world_rows(frames[configuration[chosen]])
+            # entry k is pair local[k] in configuration k of this block: gather one (3, m) per entry
+            rows = world[:, group.rows[local].T, np.arange(chosen.size)][:, :, None]
+            with _quiet():
+                core = group.kernel(rows, *(size[..., local, 0][..., None, :] for size in group[4:8]),
+                                    witness=True)
+            swapped = group.swapped[local][:, None]
+            first, second, normal = (vector[:, 0].T for vector in core[1:])
+            result.distance[chosen] = core.distance[0]
+            result.point_a[chosen] = np.where(swapped, second, first)
+            result.point_b[chosen] = np.where(swapped, first, second)
+            result.normal[chosen] = np.where(swapped, -normal, normal)
+        return result
+
+    # --- internals --------------------------------------------------------------------------------------------
+
+    def _checked_frames(self, world_T_frames) -> tuple[np.ndarray, bool]:
+        try:
+            frames = np.asarray(world_T_frames, dtype=float)
+        except (TypeError, ValueError) as error:
+            raise InvalidInputError(f"frames must be an array of numbers: {error}", location=("frames",)) from None
+        single = frames.ndim == 3
+        if single:
+            frames = frames[None]
+        if frames.ndim != 4 or frames.shape[1:] != (self.link_count, 4, 4):
+            raise InvalidInputError(
+                f"frames must have shape (S, {self.link_count}, 4, 4) or ({self.link_count}, 4, 4), "
+                f"got {np.shape(world_T_frames)}", location=("frames",))
+        return frames, single
+
+    def _check_finite(self, frames: np.ndarray, result: np.ndarray, single: bool) -> None:
+        if np.isfinite(result).all():
+            return
+        configuration = int(np.flatnonzero(~np.isfinite(result).all(axis=1))[0])
+        where = () if single else (configuration,)
+        for rows in self._link_rows:
+            if not np.isfinite(frames[configuration, rows.link]).all():
+                raise InvalidInputError(f"link frame {rows.link} is not finite",
+                                        location=("frames", *where, rows.link))
+        raise InvalidInputError("link frames too large: the distances overflow", location=("frames", *where))
+
+    def _distances(self, frames: np.ndarray) -> np.ndarray:
+        count = frames.shape[0]
+        result = np.empty((count, len(self.pairs)))
+        if count == 0 or not self.pairs:
+            return result
+        widest = max(group.stop - group.start for group in self._groups)
+        block = max(1, min(count, _BLOCK_ELEMENTS // widest))
+        world = self._world_buffer(block)
+        with _quiet():
+            for begin in range(0, count, block):
+                end = min(begin + block, count)
+                part = world[:, :, : end - begin]
+                self._world_rows(frames[begin:end], part)
+                for group in self._groups:
+                    rows = np.take(part, group.rows.T, axis=1)  # (3, m, P_k, B): each row a contiguous block
+                    distances = group.kernel(rows, *group[4:8], witness=False)
+                    result[begin:end, group.start:group.stop] = distances.T
+        return result
+
+    def _world_buffer(self, block: int) -> np.ndarray:
+        """(3, K, block): room for every reference row of a block of configurations, the obstacles' filled in."""
+        links = self._link_rows[-1].end
+        world = np.empty((3, links + self._world_rows_fixed.shape[1], block))
+        world[:, links:, :] = self._world_rows_fixed[:, :, None]
+        return world
+
+    def _world_rows(self, frames: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """World coordinates (3, K, B) of every reference row for the configurations of ``frames`` (B, L, 4, 4):
+        x_world = world_T_link · x_link, homogeneous (w = 1 for points, 0 for directions)."""
+        if out is None:
+            out = self._world_buffer(frames.shape[0])
+        count = frames.shape[0]
+        for link, first, end, placing in self._link_rows:
+            # the top 3 × 4 of world_T_link, 12 numbers a configuration (a view), times the matrix that places
+            # the link's rows: (B, 12) @ (12, 3 k), small enough for one thread of any BLAS
+            product = frames[:, link, :3, :].reshape(count, 12) @ placing
+            out[:, first:end, :] = product.reshape(count, 3, end - first).transpose(1, 2, 0)
+        return out
+
+
+# --- kernels: gathered rows (3, m, ...) and sizes -> distances, or cores with witnesses ------------------------
+
+
+def _round_round(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
+    """Capsules and spheres: rows p0, p1, q0, q1."""
+    core = _segment_segment(rows, witness)
+    return _swept(core, radius_a, radius_b) if witness else core - (radius_a + radius_b)
+
+
+def _box_round(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
+    """A box and a capsule or sphere: rows centre, three axes, start, end."""
+    core = _box_segment(rows[:, :4], half_size_a, rows[:, 4:6], witness)
+    return _swept(core, 0.0, radius_b) if witness else core - radius_b
+
+
+def _box_box_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
+    """Two boxes: rows centre and three axes of each."""
+    return _box_box(rows[:, :4], half_size_a, rows[:, 4:8], half_size_b, witness)
+
+
+#: The kernel of each pair of families, in the order of the columns. A sphere is a capsule of length 0.
+_KERNELS = {("round", "round"): _round_round, ("box", "round"): _box_round, ("box", "box"): _box_box_kernel}
+
+
+# --- the close pairs ------------------------------------------------------------------------------------------
+
+
+def _close_pairs(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_count: int,
+                 margin: float) -> CollisionCheck:
+    count, pairs = pair_distances.shape
+    clearance = pair_distances.min(axis=1) if pairs else np.full(count, np.inf)
+    rows, columns = np.nonzero(pair_distances < margin)
+    values = pair_distances[rows, columns]
+    bodies = body_pair_of[columns]
+    if bodies.size and body_count < pairs:  # some body pairs have several shape pairs: keep each one's smallest
+        order = np.lexsort((values, bodies, rows))
+        rows, bodies, values = rows[order], bodies[order], values[order]
+        first = np.ones(rows.size, dtype=bool)
+        first[1:] = (rows[1:] != rows[:-1]) | (bodies[1:] != bodies[:-1])
+        rows, bodies, values = rows[first], bodies[first], values[first]
+    order = np.lexsort((bodies, values, rows))  # by configuration, then nearest first
+    rows, bodies, values = rows[order], bodies[order], values[order]
+    offsets = np.zeros(count + 1, dtype=np.intp)
+    np.cumsum(np.bincount(rows, minlength=count), out=offsets[1:])
+    return CollisionCheck(clearance, pair_distances, offsets, bodies, values)
+
+
+# --- compilation ----------------------------------------------------------------------------------------------
+
+
+def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles: Sequence[Obstacle] = (), *,
+                    self_collision: bool = True, ignore: Sequence[Sequence[int]] = (),
+                    link_names: Sequence[str] | None = None) -> CollisionModel:
+    """Compile the pairs to check for a robot's link shapes and the obstacles.
+
+    Pairs: every link shape with every obstacle (the base's shapes too); and with ``self_collision``, every two
+    link shapes except those on the same link, on links joined by a joint (i and i + 1), and on the link pairs
+    of ``ignore``.
+
+    Parameters
+    ----------
+    link_shapes : sequence of LinkShape
+        At least one. Each ``link`` is a frame index 0 … n (0 the base, n the flange).
+    link_count : int
+        n + 1, the number of frames of :func:`~service.kinematics.link_frames` (the robot's dof + 1).
+    obstacles : sequence of Obstacle
+        In the world frame. Obstacles that share a name are one body (their pairs report under one name); a name
+        must not be empty nor the name of a link.
+    self_collision : bool
+    ignore : sequence of (int, int)
+        More link pairs not to check against each other (two different links, either order).
+    link_names : sequence of str, optional
+        n + 1 distinct names of the links, for answers; otherwise a link is called ``"link i"``.
+
+    Raises
+    ------
+    InvalidInputError
+        Located by argument: ``("link_shapes",)`` when empty, ``("link_shapes", k)`` or
+        ``("link_shapes", k, "link")``, ``("obstacles", k)`` or ``("obstacles", k, "name")``, ``("ignore", k)``
+        or ``("ignore", k, 0 | 1)``, ``("link_names",)`` or ``("link_names", k)``, ``("link_count",)``.
+
+    Examples
+    --------
+    Three capsules on links 1, 2 and 3 of a 3-joint arm, and a table: links 1–2 and 2–3 are joined, so only
+    1–3 is checked for self-collision, and each link against the table.
+
+    >>> arm = [LinkShape(i, Capsule([0, 0, 0], [0.3, 0, 0], 0.05)) for i in (1, 2, 3)]
+    >>> table = Obstacle("table", Box([0, 0, -0.1], [2, 2, 0.2]))
+    >>> [(pair.a, pair.b) for pair in collision_model(arm, 4, [table]).pairs]
+    [('link 1', 'link 3'), ('link 1', 'table'), ('link 2', 'table'), ('link 3', 'table')]
+    """
+    count = _checked_link_count(link_count)
+    names = _checked_link_names(link_names, count)
+    shapes = _checked_link_shapes(link_shapes, count)
+    obstacle_list = _checked_obstacles(obstacles, set(names))
+    skipped = _checked_ignore(ignore, count)
+    skipped.update((link, link + 1) for link in range(count - 1))
+
+    # Reference rows: the link shapes' rows, grouped by link, then the obstacles'. Indices are plain lists here.
+    by_link: dict[int, list[list[float]]] = {}
+    local_positions = []  # per link shape: its rows' positions among its link's rows
+    for item in shapes:
+        rows = by_link.setdefault(item.link, [])
+        own = _local_rows(item.shape)
+        local_positions.append(range(len(rows), len(rows) + len(own)))
+        rows.extend(own)
+    link_rows, first_row, position = [], {}, 0
+    for link in sorted(by_link):
+        rows = np.array(by_link[link])  # (k, 4)
+        # component c of row r in the world is Σ_j world_T_link[c, j] x_r[j]: entry (4 c + j, c k + r)
+        placing = np.zeros((3, 4, 3, len(rows)))
+        for c in range(3):
+            placing[c, :, c, :] = rows.T
+        first_row[link] = position
+        link_rows.append(_LinkRows(link, position, position + len(rows), placing.reshape(12, -1)))
+        position += len(rows)
+    shape_rows = [[first_row[item.link] + k for k in positions] for item, positions in zip(shapes, local_positions)]
+    obstacle_rows, fixed = [], []
+    for obstacle in obstacle_list:
+        rows = _local_rows(obstacle.shape)
+        obstacle_rows.append(list(range(position + len(fixed), position + len(fixed) + len(rows))))
+        fixed.extend(row[:3] for row in rows)
+
+    # The pairs: each link shape with each obstacle, then the link shapes with each other; in the kernels' groups.
+    candidates = [(index, shapes[index].shape, shape_rows[index], obstacle.name, None, number, obstacle.shape,
+                   obstacle_rows[number])
+                  for index in range(len(shapes)) for number, obstacle in enumerate(obstacle_list)]
+    if self_collision:
+        ordered = sorted(range(len(shapes)), key=lambda index: shapes[index].link)
+        for position_a, index in enumerate(ordered):
+            for other in ordered[position_a + 1:]:
+                link_a, link_b = shapes[index].link, shapes[other].link
+                if link_a != link_b and (link_a, link_b) not in skipped:
+                    candidates.append((index, shapes[index].shape, shape_rows[index], names[link_b], link_b, other,
+                                       shapes[other].shape, shape_rows[other]))
+    members: dict[tuple[str, str], list] = {family: [] for family in _KERNELS}
+    for index, shape_a, rows_a, b, link_b, index_b, shape_b, rows_b in candidates:
+        swapped = _KIND_ORDER.index(type(shape_a)) > _KIND_ORDER.index(type(shape_b))
+        first, second = (shape_b, shape_a) if swapped else (shape_a, shape_b)
+        first_rows, second_rows = (rows_b, rows_a) if swapped else (rows_a, rows_b)
+        pair = ShapePair(names[shapes[index].link], b, shapes[index].link, link_b, index, index_b,
+                         f"{_KIND_NAMES[type(first)]}-{_KIND_NAMES[type(second)]}")
+        rows = _kernel_rows(first, first_rows) + _kernel_rows(second, second_rows)
+        members[(_family(first), _family(second))].append((pair, rows, first, second, swapped))
+
+    pairs: list[ShapePair] = []
+    groups: list[_Group] = []
+    for family, kernel in _KERNELS.items():
+        if not members[family]:
+            continue
+        start = len(pairs)
+        pairs.extend(member[0] for member in members[family])
+        firsts = [member[2] for member in members[family]]
+        seconds = [member[3] for member in members[family]]
+        groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in members[family]]),
+                             _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
+                             np.array([member[4] for member in members[family]], dtype=bool)))
+    body_pairs: dict[tuple[str, str], int] = {}
+    body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
+                            dtype=np.intp)
+    return CollisionModel(count, tuple(shapes), tuple(obstacle_list), tuple(pairs), tuple(body_pairs),
+                          body_pair_of, tuple(link_rows), np.array(fixed).T.reshape(3, -1), tuple(groups))
+
+
+def _local_rows(shape: Shape) -> list[list[float]]:
+    """The homogeneous reference rows of a shape in its own frame: points (w = 1) and directions (w = 0). A
+    capsule's start and end, a sphere's centre, a box's centre and three axes."""
+    if isinstance(shape, Capsule):
+        return [[*shape.start.tolist(), 1.0], [*shape.end.tolist(), 1.0]]
+    if isinstance(shape, Sphere):
+        return [[*shape.center.tolist(), 1.0]]
+    return [[*shape.center.tolist(), 1.0], *([*axis, 0.0] for axis in shape.rotation.T.tolist())]
+
+
+def _kernel_rows(shape: Shape, rows: list[int]) -> list[int]:
+    """The rows a kernel reads for a shape: a round shape's two ends (a sphere's centre twice), a box's four."""
+    return [rows[0], rows[0]] if isinstance(shape, Sphere) else rows
+
+
+def _family(shape: Shape) -> str:
+    return "box" if isinstance(shape, Box) else "round"
+
+
+def _half_sizes(shapes: list[Shape]) -> np.ndarray:
+    """(3, P_k, 1): each box's half sizes, zeros for a round shape."""
+    return np.array([shape.half_size.tolist() if isinstance(shape, Box) else [0.0, 0.0, 0.0]
+                     for shape in shapes]).T[..., None]
+
+
+def _radii(shapes: list[Shape]) -> np.ndarray:
+    """(P_k, 1): each round shape's radius, 0 for a box."""
+    return np.array([0.0 if isinstance(shape, Box) else shape.radius for shape in shapes])[:, None]
+
+
+# --- validation -----------------------------------------------------------------------------------------------
+
+
+def _is_index(value) -> bool:
+    return isinstance(value, numbers.Integral) and not isinstance(value, bool)
+
+
+def _checked_link_count(link_count) -> int:
+    if not _is_index(link_count) or link_count < 1:
+        raise InvalidInputError(f"link_count must be an integer ≥ 1, not {link_count!r}", location=("link_count",))
+    return int(link_count)
+
+
+def _checked_link_names(link_names, count: int) -> list[str]:
+    if link_names is None:
+        return [f"link {i}" for i in range(count)]
+    names = list(link_names)
+    if len(names) != count:
+        raise InvalidInputError(f"link_names must name all {count} links, got {len(names)}",
+                                location=("link_names",))
+    for index, name in enumerate(names):
+        if not isinstance(name, str) or not name:
+            raise InvalidInputError("a link name must be a non-empty string", location=("link_names", index))
+        if names.index(name) != index:
+            raise InvalidInputError(f"link name {name!r} is given twice", location=("link_names", index))
+    return names
+
+
+def _checked_link_shapes(link_shapes, count: int) -> list[LinkShape]:
+    shapes = list(link_shapes)
+    if not shapes:
+        raise InvalidInputError("the robot has no collision shapes to check", location=("link_shapes",))
+    for index, item in enumerate(shapes):
+        if not isinstance(item, LinkShape) or not isinstance(item.shape, _KIND_ORDER):
+            raise InvalidInputError("a link shape must be a LinkShape holding a Capsule, Sphere or Box",
+                                    location=("link_shapes", index))
+        if not _is_index(item.link) or not 0 <= item.link < count:
+            raise InvalidInputError(f"link must be a frame index from 0 (the base) to {count - 1} (the flange), "
+                                    f"not {item.link!r}", location=("link_shapes", index, "link"))
+    return shapes
+
+
+def _checked_obstacles(obstacles, link_names: set[str]) -> list[Obstacle]:
+    items = list(obstacles)
+    for index, item in enumerate(items):
+        if not isinstance(item, Obstacle) or not isinstance(item.shape, _KIND_ORDER):
+            raise InvalidInputError("an obstacle must be an Obstacle holding a Capsule, Sphere or Box",
+                                    location=("obstacles", index))
+        if not isinstance(item.name, str) or not item.name:
+            raise InvalidInputError("an obstacle needs a non-empty name", location=("obstacles", index, "name"))
+        if item.name in link_names:
+            raise InvalidInputError(f"obstacle name {item.name!r} is the name of a link",
+                                    location=("obstacles", index, "name"))
+    return items
+
+
+def _checked_ignore(ignore, count: int) -> set[tuple[int, int]]:
+    skipped = set()
+    for index, item in enumerate(ignore):
+        try:
+            first, second = item
+        except (TypeError, ValueError):
+            raise InvalidInputError("an ignored pair must be two link indices", location=("ignore", index)) from None
+        for position, link in enumerate((first, second)):
+            if not _is_index(link) or not 0 <= link < count:
+                raise InvalidInputError(f"link must be a frame index from 0 to {count - 1}, not {link!r}",
+                                        location=("ignore", index, position))
+        if first == second:
+            raise InvalidInputError(f"an ignored pair needs two different links, not {first} twice",
+                                    location=("ignore", index))
+        skipped.add((min(first, second), max(first, second)))
+    return skipped
+
+
+def _finite_number(value, location) -> float:
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise InvalidInputError(f"must be a number, not {value!r}", location=location) from None
+    if not math.isfinite(number):
+        raise InvalidInputError(f"must be finite, not {number}", location=location)
+    return number

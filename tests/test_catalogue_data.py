@@ -69,7 +69,10 @@ REQUIRED_KEYS = (
     "id", "name", "source", "convention", "angle_unit", "length_unit",
     "parameters", "limits_source", "joints", "base", "tool",
 )
-OPTIONAL_KEYS = ("notes", "licence")
+OPTIONAL_KEYS = ("notes", "licence", "collision", "collision_source")
+
+#: The shape kinds a catalogue link-geometry entry may carry (../shared/api.md, Collisions).
+SHAPE_KINDS = {"capsule", "sphere", "box"}
 
 #: Keys of one joint mapping per convention, in the required order (``d`` last:
 #: openapi-python-client binds the parsed dict to a local named ``d``).
@@ -259,6 +262,7 @@ def test_robot_file_is_well_formed(path: Path):
     for key in ("name", "source", "limits_source"):
         assert isinstance(robot[key], str) and robot[key].strip()
     assert isinstance(robot.get("notes", ""), str)
+    _check_collision(robot)
     assert robot["convention"] in JOINT_KEYS
     assert robot["angle_unit"] == "deg"
     assert robot["length_unit"] in ("m", "mm")
@@ -292,6 +296,22 @@ def test_robot_file_is_well_formed(path: Path):
             assert lower is not None and upper is not None, "revolute limits are two-sided"
         elif lower is not None:
             assert lower >= 0, "no prismatic joint in this catalogue extends negatively"
+
+
+def _check_collision(robot: dict) -> None:
+    """A link-geometry list comes with its source, and each entry is one known shape on a link of the arm."""
+    if "collision" not in robot:
+        assert "collision_source" not in robot, "a collision_source without a collision list"
+        return
+    assert isinstance(robot.get("collision_source"), str) and robot["collision_source"].strip(), (
+        "every capsule model names its source"
+    )
+    shapes = robot["collision"]
+    assert isinstance(shapes, list) and shapes
+    for shape in shapes:
+        assert 0 <= shape["link"] <= len(robot["joints"]), shape
+        kinds = set(shape) - {"link", "name"}
+        assert len(kinds) == 1 and kinds <= SHAPE_KINDS, shape
 
 
 #: (robot id, joint index) of the slides whose negative extension the textbook discards.

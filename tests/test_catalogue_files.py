@@ -13,24 +13,25 @@ from service.robots.catalogue import CatalogueError, load_catalogue
 from service.config import BUILTIN_ROBOTS_DIR
 
 
-class _Lines(logging.Handler):
-    def __init__(self) -> None:
-        super().__init__()
-        self.lines: list[str] = []
-
-    def emit(self, record: logging.LogRecord) -> None:
-        self.lines.append(record.getMessage())
-
-
 @pytest.fixture
-def logged():
-    handler = _Lines()
+def logged(caplog):
+    """The messages logged on ``service.catalogue`` at INFO and above during the test.
+
+    ``caplog.at_level`` goes through ``Logger.setLevel``, which clears ``logging``'s per-logger level cache (an
+    assignment to ``logger.level`` does not: a test that logged earlier at a higher level hid the lines). A logger
+    switched off by an earlier ``logging.config`` call (uvicorn's, with ``disable_existing_loggers``) is switched
+    back on for the test, and caplog's handler sits on the logger itself: the app's logging set-up stops the
+    ``service`` loggers from propagating to the root logger, where caplog listens.
+    """
     logger = logging.getLogger("service.catalogue")
-    logger.addHandler(handler)
-    level, logger.level = logger.level, logging.INFO
-    yield handler.lines
-    logger.removeHandler(handler)
-    logger.setLevel(level)
+    disabled, logger.disabled = logger.disabled, False
+    logger.addHandler(caplog.handler)
+    try:
+        with caplog.at_level(logging.INFO, logger="service.catalogue"):
+            yield caplog
+    finally:
+        logger.removeHandler(caplog.handler)
+        logger.disabled = disabled
 
 
 def test_every_left_out_entry_is_logged_and_links_out_are_refused(tmp_path, logged):
@@ -45,7 +46,7 @@ def test_every_left_out_entry_is_logged_and_links_out_are_refused(tmp_path, logg
     shutil.copy(BUILTIN_ROBOTS_DIR / "puma560_standard.yaml", robots)
     catalogue = load_catalogue([robots], max_joints=32)
     assert [e.description.id for e in catalogue.entries()] == ["puma560_standard"]
-    text = "\n".join(logged)
+    text = "\n".join(r.getMessage() for r in logged.records if r.name == "service.catalogue")
     assert "refused" in text and "ur5_copy.yaml: a symbolic link out of the robot directory" in text
     assert "gone.yaml: a broken symbolic link" in text
     assert "notes.txt: not a robot file" in text and "dir.yaml: not a regular file" in text

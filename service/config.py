@@ -50,6 +50,12 @@ class Settings(BaseSettings):
         100.0, gt=0, description="most whole turns a revolute joint's limits may span (per-request limits included)")
     max_numeric_starts: int = Field(
         20_000, ge=1, description="most numeric-search starts in one request (targets × numeric.starts)")
+    max_collision_pairs: int = Field(
+        10_000, ge=1, description="most shape pairs one request's collision check may compare (link shapes with "
+                                  "each other and with the obstacles)")
+    max_collision_checks: int = Field(
+        50_000_000, ge=1, description="most pair distances one request's collision check may compute (distinct "
+                                      "solutions × shape pairs)")
     max_in_flight: int = Field(32, ge=1, le=10_000, description="most requests worked on at once; more get 503")
     timeout_keep_alive_s: float = Field(5.0, gt=0, description="idle keep-alive connections close after this")
     header_timeout_s: float = Field(10.0, gt=0, description="a connection must send its request head within this")

@@ -30,8 +30,11 @@ from ..kinematics import (
     quaternions_from_matrices,
 )
 from ..kinematics.ik import DIRECTION, POSE, POSITION, IKTargets, NotRedundantError, Ordering, check_ordering
+from ..kinematics.collision import CollisionRequest, Obstacle, clearances, frame_index
 from ..robots.build import bounds as _bounds
+from ..robots.geometry import shape_from_wire
 from ..robots.orientations import rotation_from_orientation
+from .schemas.collisions import CollisionOptions
 from .schemas.common import AngleUnit
 from .schemas.ik import Ordering as OrderingOptions
 from .schemas.poses import DirectionOrientation, PoseTarget
@@ -306,6 +309,8 @@ WIRE_NOTES = {
                  "reference.",
     "lowered": "At most {limit} are listed for a {dof}-joint arm whatever max_equivalents asks: ranking more of so "
                "many equivalents would take more work than one answer may.",
+    "collide": "{collided} solutions collide (a pair closer than collisions.margin); they are listed in 'rejected' "
+               "with their collisions.",
 }
 
 
@@ -315,3 +320,35 @@ def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> di
     lower = None if math.isinf(violation.lower) else violation.lower / scale
     upper = None if math.isinf(violation.upper) else violation.upper / scale
     return {"joint": violation.joint, "value": violation.value / scale, "lower": lower, "upper": upper}
+
+
+def collisions_to_core(robot: Robot, options: CollisionOptions | None, unit: AngleUnit) -> CollisionRequest | None:
+    """A request's ``collisions`` in core terms: obstacles as shapes (lengths in the robot's unit, a box's
+    orientation angles in the request's angle unit), ignored pairs as frame indices; None without it. Errors are
+    located at ``("body", "collisions", …)``."""
+    if options is None:
+        return None
+    radians_per_unit = _DEGREE if unit == "deg" else 1.0
+    obstacles = []
+    for index, entry in enumerate(options.obstacles):
+        with located("body", "collisions", "obstacles", index):
+            obstacles.append(Obstacle(entry.name, shape_from_wire(entry, radians_per_unit)))
+    ignore = []
+    for index, pair in enumerate(options.ignore):
+        frames = []
+        for side, link in enumerate(pair):
+            with located("body", "collisions", "ignore", index, side):
+                frames.append(frame_index(robot, link))
+        ignore.append(tuple(frames))
+    return CollisionRequest(tuple(obstacles), options.self_collision, float(options.margin), options.filter,
+                            tuple(ignore))
+
+
+def clearance_to_wire(robot: Robot, request: CollisionRequest, q: np.ndarray) -> dict:
+    """One joint vector's collision check as the wire gives it: ``clearance`` (null when nothing is checked) and
+    ``collisions``."""
+    with located("body", "collisions"):
+        checked = clearances(robot, request, q[None])
+    clearance = float(checked.clearance[0])
+    return {"clearance": None if math.isinf(clearance) else clearance,
+            "collisions": [{"a": a, "b": b, "distance": distance} for a, b, distance in checked.contacts[0]]}

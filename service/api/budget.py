@@ -218,6 +218,19 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, cost: Cost, 
                            f"held free values), {cost.numeric_starts - settings.max_numeric_starts:,} more than "
                            f"KIN_MAX_NUMERIC_STARTS = {settings.max_numeric_starts:,}. Send fewer targets, fewer "
                            f"numeric.starts or fewer free values.")
+    if cost.collision_pairs > settings.max_collision_pairs:
+        raise ProblemError(413, "too-much-work", "Too much work",
+                           f"The collision check would compare up to {cost.collision_pairs:,} pairs of shapes, "
+                           f"{cost.collision_pairs - settings.max_collision_pairs:,} more than "
+                           f"KIN_MAX_COLLISION_PAIRS = {settings.max_collision_pairs:,}. Give the links fewer "
+                           f"shapes, name fewer obstacles, or ignore link pairs.")
+    if cost.collision_checks > settings.max_collision_checks:
+        raise ProblemError(413, "too-much-work", "Too much work",
+                           f"The collision check would compute {cost.collision_checks:,} distances ({cost.targets:,} "
+                           f"targets × up to {cost.solutions_per_target} solutions × {cost.collision_pairs:,} pairs), "
+                           f"{cost.collision_checks - settings.max_collision_checks:,} more than "
+                           f"KIN_MAX_COLLISION_CHECKS = {settings.max_collision_checks:,}. Send fewer targets, or "
+                           f"check fewer pairs.")
     if cost.too_many_to_rank:
         most = enumerable_limit(robot.dof)
         raise ProblemError(413, "too-much-work", "Too much work",

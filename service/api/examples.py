@@ -29,6 +29,17 @@ _PUMA_MATRIX = [[0.814643563, -0.299355005, -0.496731765, 0.27327552],
                 [0.554032293, 0.148452506, 0.819152044, 0.805749769],
                 [0.0, 0.0, 0.0, 1.0]]
 _PUMA_Q_DEG = [20.0, 60.0, -60.0, 10.0, 35.0, -15.0]
+#: PUMA 560 at q = (0.4, 0.9, −2.4, 0.7, 1.1, −0.5) rad over a table, beside a post (tests/api/test_collisions.py):
+#: the table takes its four elbow-down solutions, the post two of the elbow-up ones, two stay.
+_PUMA_OVER_TABLE = {
+    "target": {"matrix": [[0.80145448, 0.050617774, 0.595909857, 0.703695764],
+                          [0.219158856, 0.902240812, -0.371390514, 0.134607848],
+                          [-0.556453154, 0.428251513, 0.712011607, 0.348535735], [0.0, 0.0, 0.0, 1.0]]},
+    "filter_limits": False,
+    "collisions": {"self": True, "margin": 0.005, "obstacles": [
+        {"name": "table", "box": {"center": [0.55, 0.0, -0.15], "size": [0.5, 1.0, 0.1]}},
+        {"name": "post", "capsule": {"from": [0.27, -0.2, -0.6], "to": [0.27, -0.2, 0.6], "radius": 0.06}}]},
+}
 #: UR5 tool pointing down at two points of a pick-and-place move (q = (0, −90, 90, −90, −90, 0)° and
 #: (15, −80, 85, −95, −90, 15)°).
 _UR5_DOWN = [[[0.0, 1.0, 0.0, -0.4869], [1.0, 0.0, 0.0, -0.10915], [0.0, 0.0, -1.0, 0.431859], [0.0, 0.0, 0.0, 1.0]],
@@ -80,6 +91,9 @@ REQUEST_EXAMPLES: dict[str, dict[str, dict]] = {
                          "reference": _UR5_Q_DEG, "angle_unit": "deg", "max_solutions": 8}, "ur5"),
         "puma_matrix": _example("PUMA 560: a 4×4 target, solutions outside the limits in `rejected`",
                                 {"target": {"matrix": _PUMA_MATRIX}, "angle_unit": "deg"}, "puma560_standard"),
+        "puma_over_table": _example("PUMA 560 over a table, beside a post: the collision-free solutions, each with "
+                                    "its clearance; the colliding ones in `rejected` with their contacts",
+                                    _PUMA_OVER_TABLE, "puma560_standard"),
         "position_only": _example("A planar arm: a position-only target (no orientation)",
                                   {"target": {"position": [1.367616, 0.380091, 0.0]}, "angle_unit": "deg"},
                                   "spong_ex3_1_planar_rr"),

@@ -8,6 +8,8 @@ columns, solvers and singularity reports listed once and referred to by index.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..kinematics import Budget, Robot
@@ -64,7 +66,21 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
             "within_limits": within[k], "violations": violations.get(k, []),
             "residual": {"position": position[k], "orientation": orientation[k]},
             "free_values": {str(j): joints[k][j] for j in free_of_target[target]}})
+    if table.clearance is not None:
+        for solution, clearance, contacts in zip((s for rows in per_target for s in rows), _clearances(table),
+                                                 _contacts(table)):
+            solution["clearance"], solution["collisions"] = clearance, contacts
     return per_target
+
+
+def _clearances(table: SolutionTable) -> list[float | None]:
+    """Each row's clearance; null where no pair was checked (+inf)."""
+    return [None if math.isinf(value) else value for value in table.clearance.tolist()]
+
+
+def _contacts(table: SolutionTable) -> list[list[dict]]:
+    """Each row's pairs closer than the margin, as the wire names them."""
+    return [[{"a": a, "b": b, "distance": distance} for a, b, distance in row] for row in table.contacts]
 
 
 def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget: Budget) -> dict:
@@ -108,9 +124,12 @@ def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer) -> dict:
         rows = joints.tolist()
         free_values = {str(j): [row[j] if j in free else None for row, free in zip(rows, free_of_row)]
                        for j in sorted({j for free in free_of_row for j in free})}
-    return {"target": table.target, "joints": joints, "within_limits": table.within_limits,
-            "residual_position": table.position, "residual_orientation": orientation, "branch": branch,
-            "free_values": free_values}
+    columns = {"target": table.target, "joints": joints, "within_limits": table.within_limits,
+               "residual_position": table.position, "residual_orientation": orientation, "branch": branch,
+               "free_values": free_values}
+    if table.clearance is not None:
+        columns["clearance"], columns["collisions"] = _clearances(table), _contacts(table)
+    return columns
 
 
 def _report(singularity) -> dict:

@@ -9,7 +9,7 @@ from fastapi import Request
 
 from ..kinematics.ik import (AnswerOptions, IKAnswer, IKOptions, IKTargets, NumericOptions, UnsupportedTargetError,
                              answer_ik, estimate)
-from .boundary import free_joints_to_core, ik_selection_to_core, ik_targets_to_core, located
+from .boundary import collisions_to_core, free_joints_to_core, ik_selection_to_core, ik_targets_to_core, located
 from .budget import budget_of, check_ik_cost
 from .deps import RobotRef, settings_of, with_request_frames
 from .observability import observe_ik
@@ -41,7 +41,8 @@ def ik_request_in_core(request: Request, ref: RobotRef, body: IKRequest | IKBatc
     search = IKOptions(NumericOptions(starts=body.numeric.starts, max_iterations=body.numeric.iterations),
                        budget=budget_of(request).within(cap_ms / 1000.0))
     options = AnswerOptions(reference, limits, body.filter_limits, ordering, body.max_equivalents, search,
-                            free_joints_to_core(robot, body.free_joints, unit), budget_of(request))
+                            free_joints_to_core(robot, body.free_joints, unit), budget_of(request),
+                            collisions_to_core(robot, body.collisions, unit))
     return AskedIK(ref, targets, options, bool({"max_equivalents", "max_solutions"} & body.model_fields_set))
 
 

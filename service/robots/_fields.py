@@ -73,7 +73,7 @@ _UNION_TAGS = {"dh", "standard", "modified", "khalil", "urdf", "screws", "matrix
 _UNION_FIELDS = {"robot", "orientation"}
 #: Tags pydantic inserts after the index of an item of a list of unions: link shapes.
 _ITEM_TAGS = {"capsule", "sphere", "box"}
-_ITEM_UNION_FIELDS = {"collision"}
+_ITEM_UNION_FIELDS = {"collision", "obstacles"}
 
 
 def field_location(loc: tuple | list) -> list[str | int]:
@@ -81,7 +81,8 @@ def field_location(loc: tuple | list) -> list[str | int]:
 
     ``("body", "robot", "standard", "joints", 0)`` becomes ``["body", "robot", "joints", 0]``; a top-level tag
     (a description file validated on its own) is dropped too, and so is the tag after a link shape's index:
-    ``("collision", 0, "capsule", "capsule", "radius")`` becomes ``["collision", 0, "capsule", "radius"]``.
+    ``("collision", 0, "capsule", "capsule", "radius")`` becomes ``["collision", 0, "capsule", "radius"]`` (and so
+    for a request's ``obstacles``).
     """
     parts = [part if isinstance(part, (str, int)) else str(part) for part in loc]
     return [part for i, part in enumerate(parts)

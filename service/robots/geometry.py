@@ -45,12 +45,12 @@ def _at(*prefix: str | int) -> Iterator[None]:
 
 
 def shape_from_wire(entry: AnyLinkShapeDescription, radians_per_unit: float) -> Shape:
-    """The core shape of one ``collision`` entry, in its link's frame; errors located in the entry
-    (``("box", "orientation", "matrix", 0, 1)``)."""
-    if isinstance(entry, LinkCapsule):
+    """The core shape of one entry with a ``capsule``, ``sphere`` or ``box`` (a ``collision`` entry, in its
+    link's frame, or an obstacle); errors located in the entry (``("box", "orientation", "matrix", 0, 1)``)."""
+    if getattr(entry, "capsule", None) is not None:
         with _at("capsule"):
             return Capsule(entry.capsule.start, entry.capsule.end, entry.capsule.radius)
-    if isinstance(entry, LinkSphere):
+    if getattr(entry, "sphere", None) is not None:
         with _at("sphere"):
             return Sphere(entry.sphere.center, entry.sphere.radius)
     box = entry.box

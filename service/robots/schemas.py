@@ -139,21 +139,21 @@ class LinkCapsule(ApiModel):
     """A capsule fixed to a link, in that link's frame."""
 
     link: LinkRef = LINK_FIELD
-    capsule: CapsuleGeometry
+    capsule: CapsuleGeometry = Field(description="the segment and radius, in the link's frame and length unit")
 
 
 class LinkSphere(ApiModel):
     """A sphere fixed to a link, in that link's frame."""
 
     link: LinkRef = LINK_FIELD
-    sphere: SphereGeometry
+    sphere: SphereGeometry = Field(description="the centre and radius, in the link's frame and length unit")
 
 
 class LinkBox(ApiModel):
     """A box fixed to a link, in that link's frame."""
 
     link: LinkRef = LINK_FIELD
-    box: BoxGeometry
+    box: BoxGeometry = Field(description="the centre, full edge lengths and orientation, in the link's frame")
 
 
 SHAPE_KINDS = ("capsule", "sphere", "box")

@@ -5,7 +5,8 @@ from __future__ import annotations
 from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import forward_kinematics, link_frames
-from ..boundary import joints_to_core, located, pose_from_matrix, poses_from_matrices
+from ..boundary import (clearance_to_wire, collisions_to_core, joints_to_core, located, pose_from_matrix,
+                        poses_from_matrices)
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, kept_inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..responses import FastJSONResponse
@@ -32,6 +33,8 @@ def _forward(ref: RobotRef, body: FKRequest) -> FastJSONResponse:
     answer = {"robot_id": ref.id, "joint_names": robot.joint_names, "pose": pose_from_matrix(world_T_tool)}
     if frames is not None:
         answer["frames"] = frames
+    if body.collisions is not None:
+        answer.update(clearance_to_wire(robot, collisions_to_core(robot, body.collisions, body.angle_unit), q))
     return FastJSONResponse(answer)  # built to FKResponse field by field (a test validates it): not validated again
 
 

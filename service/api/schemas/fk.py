@@ -6,6 +6,7 @@ from typing import Annotated
 
 from pydantic import Field
 
+from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair
 from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames,
                      RobotId)
 from .poses import NamedPose, Pose
@@ -18,6 +19,9 @@ class FKRequest(RequestFrames):
     joints: list[Number] = Field(description="one value per joint, in table order")
     frames: Flag = Field(False, description="also return the pose of every link frame")
     angle_unit: AngleUnit = ANGLE_UNIT_FIELD
+    collisions: CollisionOptions | None = Field(
+        None, description="check these joint values against the robot's own link shapes and these obstacles: the "
+                          "answer then carries clearance and collisions (filter does not apply)")
 
 
 class FKInlineRequest(FKRequest):
@@ -35,6 +39,8 @@ class FKResponse(ApiModel):
     frames: list[NamedPose] | None = Field(
         None, description="with frames=true: the base frame, every link frame (named by its joint), and the tool"
     )
+    clearance: float | None = CLEARANCE_FIELD
+    collisions: list[CollisionPair] | None = COLLISIONS_FIELD
 
 
 class FKBatchRequest(RequestFrames):

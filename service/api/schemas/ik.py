@@ -8,6 +8,7 @@ from typing import Annotated, Literal
 from pydantic import Field, model_serializer, model_validator
 
 from ...kinematics.ik import MAX_EQUIVALENTS, MAX_FREE_VALUES
+from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair
 from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames,
                      RobotId)
 from .limits import JointLimitsOverride, LimitViolation
@@ -63,12 +64,14 @@ class SolverMethod(str, Enum):
 class IKStatus(str, Enum):
     """ok: at least one solution; unreachable: none exists (proved by a closed form or a reach bound);
     not_found: a search that cannot promise completeness (solver.complete false) found none, and the target may
-    still be reachable; no_solution_within_limits: all are in `rejected`."""
+    still be reachable; no_solution_within_limits: all are in `rejected`; no_collision_free_solution (with
+    `collisions`): solutions exist within the limits, but every one collides (all in `rejected`)."""
 
     ok = "ok"
     unreachable = "unreachable"
     not_found = "not_found"
     no_solution_within_limits = "no_solution_within_limits"
+    no_collision_free_solution = "no_collision_free_solution"
 
 
 class Ordering(ApiModel):
@@ -159,6 +162,10 @@ class IKRequestOptions(RequestFrames):
                           "joint are tried first) and samples each 32 times. With "
                           "`reference` the free joints are also searched continuously between the samples, so "
                           "the first solution is the nearest over the whole family.")
+    collisions: CollisionOptions | None = Field(
+        None, description="check every solution against the robot's own link shapes and these obstacles: each "
+                          "solution then carries clearance and collisions, and (filter, the default) colliding "
+                          "ones move to rejected, before the nearest-first order and max_solutions apply")
 
 
 class IKRequest(IKRequestOptions, _Target):
@@ -210,6 +217,20 @@ class IKSolution(ApiModel):
     free_values: dict[str, float] = Field(
         default_factory=dict, description="the value of each free joint in this solution (its joint value), "
                                           "keyed by joint index, e.g. {\"2\": 0.5}")
+    clearance: float | None = CLEARANCE_FIELD
+    collisions: list[CollisionPair] | None = COLLISIONS_FIELD
+
+    @model_serializer(mode="wrap")
+    def _checked_only(self, handler):
+        """clearance and collisions appear only when the request asked for a collision check."""
+        return _without_unchecked(handler(self))
+
+
+def _without_unchecked(fields: dict) -> dict:
+    if fields.get("collisions") is None and fields.get("clearance") is None:
+        fields.pop("clearance", None)
+        fields.pop("collisions", None)
+    return fields
 
 
 class SolverInfo(ApiModel):
@@ -242,11 +263,13 @@ class IKResponse(ApiModel):
     robot_id: RobotId = Field(description="the catalogue id, or the inline robot's id")
     joint_names: list[str] = JOINT_NAMES_FIELD
     status: IKStatus = Field(description="ok, unreachable (proved), not_found (a search that cannot promise "
-                                         "completeness found none), or no_solution_within_limits")
+                                         "completeness found none), no_solution_within_limits, or (with "
+                                         "collisions) no_collision_free_solution")
     detail: str | None = Field(None, description="why a target is unreachable, and notes on caps and trims")
     solutions: list[IKSolution] = Field(description="every distinct solution; nearest the reference first when "
                                                     "one is given")
-    rejected: list[IKSolution] = Field(description="the solutions filter_limits removed, with their violations")
+    rejected: list[IKSolution] = Field(description="the solutions filter_limits removed, with their violations, "
+                                                   "and (collisions.filter) those that collide")
     solver: SolverInfo = Field(description="which solver answered and what it guarantees")
     singularities: list[SingularityReport] = Field(description="each singular condition the target meets")
     free_joints: list[int] = Field(default_factory=list,
@@ -306,6 +329,15 @@ class SolutionColumns(ApiModel):
         default_factory=dict, description="one column per free joint (keyed by joint index, as each solution's "
                                           "free_values in the objects form); null where the row's target has no "
                                           "such free joint")
+    clearance: list[float | None] | None = Field(None, description="with collisions: each row's clearance, as in "
+                                                                   "the objects form")
+    collisions: list[list[CollisionPair]] | None = Field(None, description="with collisions: each row's pairs "
+                                                                           "closer than the margin")
+
+    @model_serializer(mode="wrap")
+    def _checked_only(self, handler):
+        """clearance and collisions appear only when the request asked for a collision check."""
+        return _without_unchecked(handler(self))
 
 
 class IKBatchArraysResponse(ApiModel):

@@ -16,12 +16,15 @@ from ._distances import (
     separation,
     sphere_sphere,
 )
+from ._clearance import Clearances, CollisionRequest, clearances, frame_index, link_names, model_for
 from ._model import CollisionCheck, CollisionModel, ShapePair, collision_model
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere, restated, scaled
 
 __all__ = [
     "Box",
     "Capsule",
+    "Clearances",
+    "CollisionRequest",
     "CollisionCheck",
     "CollisionModel",
     "LinkShape",
@@ -35,7 +38,11 @@ __all__ = [
     "box_sphere",
     "capsule_capsule",
     "capsule_sphere",
+    "clearances",
     "collision_model",
+    "frame_index",
+    "link_names",
+    "model_for",
     "restated",
     "scaled",
     "separation",

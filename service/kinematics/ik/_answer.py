@@ -29,6 +29,7 @@ from .._budget import UNLIMITED, Budget
 from .._errors import InvalidInputError, KinematicsError
 from .._limits import Limits
 from .._robot import Robot
+from ..collision import CollisionRequest, clearances
 from ._closed_form import cached_plan, solve_closed_form
 from ._direction import direction_candidates, direction_plan, tool_roll
 from ._goals import DirectionGoal, PoseGoal
@@ -83,7 +84,8 @@ class IKOptions:
 class AnswerOptions:
     """How to answer: reference (n,) and limits in radians / length units, the selection's options, the
     requested free joints of a redundant arm (``(joint, values or None, samples or None)`` entries, see
-    :func:`~._redundant.free_joints_for`), the numeric search's bounds and the request's budget."""
+    :func:`~._redundant.free_joints_for`), the numeric search's bounds, the request's budget, and what each
+    solution is checked against for collisions (None: no check)."""
 
     reference: np.ndarray | None = None
     limits: Limits | None = None  # default: the robot's own
@@ -93,6 +95,7 @@ class AnswerOptions:
     search: IKOptions = field(default_factory=IKOptions)
     free_joints: list[tuple[int, list[float] | None, int | None]] | None = None
     budget: Budget = UNLIMITED
+    collisions: CollisionRequest | None = None
 
 
 @dataclass(frozen=True)
@@ -240,6 +243,18 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
     if (kinds == POSITION).any():
         parts += _positions(robot, matrices, np.flatnonzero(kinds == POSITION), options, timings)
     return _assembled(robot, len(kinds), parts, limits, options, timings)
+
+
+@contextmanager
+def _at_collisions() -> Iterator[None]:
+    """Locate the errors about the collision check at the option that asks for it (``collisions``); those about
+    the robot's own shapes stay at its description."""
+    try:
+        yield
+    except InvalidInputError as error:
+        if error.location[:1] == ("robot",):
+            raise
+        raise error.relocated("collisions") from None
 
 
 @contextmanager
@@ -559,9 +574,16 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
     table = SolutionTable.concat(tables, robot.dof)
     if tables and len(table) and (np.diff(table.target) < 0).any():
         table = table.take(np.argsort(table.target, kind="stable"))
+    excluded = None
+    if options.collisions is not None:  # a 2π-equivalent moves no link: each distinct solution is checked once
+        options.budget.check("the collision check")
+        with _at_collisions():
+            checked = clearances(robot, options.collisions, table.joints)
+        table = table.with_clearances(checked.clearance, checked.contacts)
+        excluded = checked.colliding if options.collisions.filter else None
     chosen: Selection = select(robot, table, n_targets, limits, filter_limits=options.filter_limits,
                                reference=options.reference, ordering=options.ordering,
-                               max_equivalents=options.max_equivalents, budget=options.budget)
+                               max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget)
     status = chosen.status.copy()
     status[(status == "unreachable") & ~complete] = "not_found"
     # solver reports numbered by first appearance in target order

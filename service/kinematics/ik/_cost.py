@@ -14,7 +14,8 @@ import numpy as np
 
 from .._limits import Limits
 from .._robot import Robot
-from ._answer import DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_free_joints
+from ..collision import model_for
+from ._answer import DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_collisions, _at_free_joints
 from ._closed_form import cached_plan, plan_is_kept
 from ._direction import direction_plan
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit,
@@ -42,7 +43,9 @@ class Cost:
     many of those are rejected; ``rows``: the worst answer in all. ``small``: the work is bounded by a few
     milliseconds whatever the targets ask (:func:`is_small`). A position target on an arm of more than three
     joints may be searched over every joint when its held joints leave it out of reach: that search is bounded by
-    the request's deadline, not counted in ``numeric_starts``.
+    the request's deadline, not counted in ``numeric_starts``. With a collision check: ``collision_pairs``, the
+    shape pairs checked per solution, and ``collision_checks``, the pair distances in all (every distinct
+    solution, before its 2π-equivalents, which move no link).
     """
 
     targets: int
@@ -57,6 +60,8 @@ class Cost:
     rejected_per_target: int
     rows: int
     small: bool
+    collision_pairs: int = 0
+    collision_checks: int = 0
 
     @property
     def too_many_to_rank(self) -> bool:
@@ -117,8 +122,27 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
     rows_per_target, rejected = worst_answer_per_target(most, equivalents, kept)
     numeric_starts = numeric_targets * numeric_per_target
     count = len(kinds)
+    pairs = 0
+    if options.collisions is not None:
+        pairs = collision_pair_bound(robot, options.collisions)
+        if pairs <= COMPILED_PAIRS:  # few enough to compile (and count exactly) now
+            with _at_collisions():
+                pairs = len(model_for(robot, options.collisions).pairs)
     return Cost(count, most, numeric_starts, free_values, equivalents, kept, lowered, ranked, rows_per_target,
-                rejected, count * rows_per_target, small)
+                rejected, count * rows_per_target, small, pairs,
+                count * most * pairs)
+
+
+#: Most shape pairs compiled while the cost is counted; past it the bound of :func:`collision_pair_bound` stands
+#: for the count (compiling is a Python loop over the pairs), for a boundary to refuse.
+COMPILED_PAIRS = 200_000
+
+
+def collision_pair_bound(robot: Robot, request) -> int:
+    """An upper bound on the shape pairs a collision request checks, without compiling them: every two link
+    shapes (when self-collision is checked) and every link shape with every obstacle."""
+    shapes = len(robot.collision)
+    return (shapes * (shapes - 1) // 2 if request.self_collision else 0) + shapes * len(request.obstacles)
 
 
 def is_small(robot: Robot, targets: IKTargets, options: AnswerOptions) -> bool:
@@ -126,6 +150,8 @@ def is_small(robot: Robot, targets: IKTargets, options: AnswerOptions) -> bool:
     the closed form of a kept plan, no search, no family, an answer of at most :data:`SMALL_ROWS` rows."""
     kinds = np.asarray(targets.kinds)
     if robot.dof > 6 or options.free_joints is not None or (kinds == DIRECTION).any():
+        return False
+    if options.collisions is not None:  # compiling the pairs may take milliseconds
         return False
     if robot.dof > 3 and (kinds == POSITION).any():  # a held joint may leave a point to the search
         return False

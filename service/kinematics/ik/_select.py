@@ -38,7 +38,7 @@ capped at :data:`.._budget.COUNT_CAP`.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -69,6 +69,8 @@ NOTE_WORDING = {
                  "near the reference.",
     "lowered": "At most {limit} are listed for a {dof}-joint arm whatever cap on 2π-equivalents is asked: ranking "
                "more of so many equivalents would take more work than one answer may.",
+    "collide": "{collided} solutions collide (a pair of shapes closer than the margin); they are listed in "
+               "'rejected' with their collisions.",
 }
 
 #: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
@@ -206,7 +208,8 @@ def effective_reference(robot: Robot, limits: Limits, reference: np.ndarray) -> 
 
 def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *, filter_limits: bool = True,
            reference: np.ndarray | None = None, ordering: Ordering = Ordering(),
-           max_equivalents: int = MAX_EQUIVALENTS, budget: Budget = UNLIMITED) -> Selection:
+           max_equivalents: int = MAX_EQUIVALENTS, excluded: np.ndarray | None = None,
+           budget: Budget = UNLIMITED) -> Selection:
     """Apply limits, expand 2π-equivalents, order and trim the verified solutions of N targets (``table``,
     grouped by target; see the module docstring).
 
@@ -223,6 +226,9 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     max_equivalents : int
         Most solutions returned per target after expansion (≥ 1). The counts (``available``, ``trimmed``) are
         computed without generating the rest and stop at :data:`.._budget.COUNT_CAP`.
+    excluded : ndarray of bool, shape (S,), optional
+        Rows that may not be kept whatever the limits (they collide, and the request filters collisions): they
+        are rejected at their closest equivalent, and the order and the caps apply to the others.
     budget : Budget
         Checked between chunks of the work.
     """
@@ -234,20 +240,22 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     target, q = table.target, table.joints
     first, last = turn_ranges(robot, limits, q)
     fits = np.all(last >= first, axis=1)
+    keepable = fits if filter_limits else np.ones(len(q), dtype=bool)
+    if excluded is not None:
+        keepable = keepable & ~excluded
+    dropped = np.flatnonzero(~keepable)  # rejected at their closest equivalent
     misfits = np.flatnonzero(~fits)
     misfit_q = q.take(misfits, axis=0)
     misfit_turns = (closest_turns(robot, limits, misfit_q, first.take(misfits, axis=0), last.take(misfits, axis=0))
                     if len(misfits) else misfit_q)
-    if not len(misfits):
+    if not len(misfits) and not len(dropped):
         candidates = np.arange(len(target))
         c_target, c_q, c_first, c_last = target, q, first, last
-    elif filter_limits:  # the rows that fit are the candidates; the others are rejected at their closest equivalent
-        candidates = np.flatnonzero(fits)
+    else:  # a solution that does not fit and stays (limits flag it) has one value: its closest equivalent
+        if not filter_limits and len(misfits):
+            first[misfits], last[misfits] = misfit_turns, misfit_turns
+        candidates = np.flatnonzero(keepable)
         c_target, c_q, c_first, c_last = (a.take(candidates, axis=0) for a in (target, q, first, last))
-    else:  # a solution that does not fit stays among the candidates with one value: its closest equivalent
-        candidates = np.arange(len(target))
-        first[misfits], last[misfits] = misfit_turns, misfit_turns
-        c_target, c_q, c_first, c_last = target, q, first, last
     counts = c_last - c_first + 1.0  # ≥ 1: every candidate has a usable turn per joint
     combinations = capped_products(counts)  # (C,) each candidate's usable combinations
     with_all_moves = available = capped_sums(c_target, combinations, n_targets)
@@ -270,30 +278,38 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     kept_rows = candidates[kept_rows]
     kept = _listed(table.take(kept_rows), kept_values, fits[kept_rows])
 
-    dropped, dropped_values = (misfits, misfit_q + _TWO_PI * misfit_turns) if filter_limits else (misfits[:0], q[:0])
+    dropped_values = q[dropped] + _TWO_PI * closest_turns(robot, limits, q[dropped], first[dropped], last[dropped])
     if reference is not None and len(dropped):
         order = np.lexsort((travel(robot, limits, dropped_values, reference, ordering), target[dropped]))
         dropped, dropped_values = dropped[order], dropped_values[order]
-    rejected = _listed(table.take(dropped), dropped_values, np.zeros(len(dropped), dtype=bool))
+    rejected = _listed(table.take(dropped), dropped_values, fits[dropped])
 
     n_kept = kept.counts(n_targets)
     n_rejected = rejected.counts(n_targets)
     outside = np.bincount(kept.target[~kept.within_limits], minlength=n_targets)
-    no_fit = filter_limits & (np.bincount(c_target, minlength=n_targets) == 0) & (n_rejected > 0)
+    none_kept = (np.bincount(c_target, minlength=n_targets) == 0) & (n_rejected > 0)
+    collided = np.zeros(n_targets, dtype=np.int64)  # rejected for a collision alone (within the limits, or flagged)
+    if excluded is not None:
+        collided = np.bincount(target[excluded & (fits | (not filter_limits))], minlength=n_targets)
     status = np.full(n_targets, "ok", dtype=object)
-    status[no_fit], status[table.counts(n_targets) == 0] = "no_solution_within_limits", "unreachable"
+    status[none_kept] = "no_solution_within_limits"
+    status[none_kept & (collided > 0)] = "no_collision_free_solution"
+    status[table.counts(n_targets) == 0] = "unreachable"
+    no_fit = status == "no_solution_within_limits"
     capped = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
     truncated = (available > n_kept) & (not capped)
     trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
-    noted = no_fit | (outside > 0) | truncated | ((status == "ok") & (n_kept == 0) & (with_all_moves > 0))
+    noted = (no_fit | (outside > 0) | truncated | ((status == "ok") & (n_kept == 0) & (with_all_moves > 0))
+             | (collided > 0))
     notes = TargetNotes(np.flatnonzero(noted), status, n_rejected, outside, truncated, available, n_kept,
-                        with_all_moves, max_equivalents, reference is not None, limit if lowered else None, n)
+                        with_all_moves, collided, max_equivalents, reference is not None, limit if lowered else None,
+                        n)
     return Selection(status, truncated, trimmed, available, notes, kept, rejected)
 
 
 def _listed(rows: SolutionTable, joints: np.ndarray, within: np.ndarray) -> SolutionTable:
     """``rows`` at the equivalents ``joints`` (K, n) listed, flagged ``within`` the limits (K,)."""
-    return SolutionTable(rows.target, joints, within, rows.position, rows.orientation, rows.labels)
+    return replace(rows, joints=joints, within_limits=within)
 
 
 def _within_move(robot: Robot, limits: Limits, q: np.ndarray, first: np.ndarray, last: np.ndarray,
@@ -390,15 +406,17 @@ class TargetNotes(Mapping):
     worded only when read (a batch has thousands; most readers look at a few).
 
     ``rows`` (k,) ascending are the noted targets; the other arrays (N,) are the per-target counts the notes
-    quote: status, rejected, flagged outside the limits, truncated, available, kept, and fitting before
-    ``max_joint_move``. ``lowered_to`` is the per-target limit :func:`enumerable_limit` imposed, if any.
+    quote: status, rejected, flagged outside the limits, truncated, available, kept, fitting before
+    ``max_joint_move``, and rejected for a collision alone. ``lowered_to`` is the per-target limit
+    :func:`enumerable_limit` imposed, if any.
     """
 
     def __init__(self, rows: np.ndarray, status: np.ndarray, rejected: np.ndarray, outside: np.ndarray,
                  truncated: np.ndarray, available: np.ndarray, kept: np.ndarray, with_all_moves: np.ndarray,
-                 max_equivalents: int, has_reference: bool, lowered_to: int | None, dof: int) -> None:
+                 collided: np.ndarray, max_equivalents: int, has_reference: bool, lowered_to: int | None,
+                 dof: int) -> None:
         self.rows = rows
-        self._columns = (status, rejected, outside, truncated, available, kept, with_all_moves)
+        self._columns = (status, rejected, outside, truncated, available, kept, with_all_moves, collided)
         self._max_equivalents, self._has_reference = max_equivalents, has_reference
         self._lowered_to, self._dof = lowered_to, dof
 
@@ -422,11 +440,13 @@ class TargetNotes(Mapping):
         if row not in self:
             raise KeyError(row)
         status, *counts = self._columns
-        status, (rejected, outside, truncated, available, kept, with_all_moves) = (
+        status, (rejected, outside, truncated, available, kept, with_all_moves, collided) = (
             status[row], (column[row].item() for column in counts))
         notes = []
         if status == "no_solution_within_limits":
             notes.append(wording["no_fit"].format(rejected=rejected))
+        if collided:
+            notes.append(wording["collide"].format(collided=collided))
         if outside:
             notes.append(wording["flagged"].format(outside=outside))
         if truncated:

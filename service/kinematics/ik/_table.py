@@ -10,7 +10,7 @@ encodes them as they stand. Label codes are merged in one place
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -34,6 +34,9 @@ class SolutionTable:
         target; NaN for a position-only target).
     labels : dict
         Branch labels: name → (values, codes (S,) int8), ``values[code]`` the row's label, −1 where it has none.
+    clearance, contacts : ndarrays, shape (S,), optional
+        With a collision check (:mod:`service.kinematics.collision`): the smallest signed distance over the
+        checked pairs, and each row's pairs closer than the margin (a tuple of (a, b, distance)). None without.
     """
 
     target: np.ndarray
@@ -42,6 +45,8 @@ class SolutionTable:
     position: np.ndarray
     orientation: np.ndarray
     labels: LabelCodes
+    clearance: np.ndarray | None = None
+    contacts: np.ndarray | None = None
 
     @classmethod
     def empty(cls, dof: int) -> "SolutionTable":
@@ -56,13 +61,18 @@ class SolutionTable:
         """The rows ``index`` (indices or a boolean mask), in that order."""
         return SolutionTable(self.target[index], self.joints[index], self.within_limits[index],
                              self.position[index], self.orientation[index],
-                             {name: (values, codes[index]) for name, (values, codes) in self.labels.items()})
+                             {name: (values, codes[index]) for name, (values, codes) in self.labels.items()},
+                             None if self.clearance is None else self.clearance[index],
+                             None if self.contacts is None else self.contacts[index])
 
     def with_targets(self, target: np.ndarray) -> "SolutionTable":
         """The same rows numbered by other targets (``target`` (S,) non-decreasing), as when a part's rows
         take their place among a whole answer's."""
-        return SolutionTable(np.asarray(target, dtype=np.int64), self.joints, self.within_limits, self.position,
-                             self.orientation, self.labels)
+        return replace(self, target=np.asarray(target, dtype=np.int64))
+
+    def with_clearances(self, clearance: np.ndarray, contacts: np.ndarray) -> "SolutionTable":
+        """The same rows with their collision check (see the class docstring)."""
+        return replace(self, clearance=clearance, contacts=contacts)
 
     @classmethod
     def concat(cls, tables: list["SolutionTable"], dof: int) -> "SolutionTable":
@@ -73,10 +83,15 @@ class SolutionTable:
             return cls.empty(dof)
         if len(tables) == 1:
             return tables[0]
+        checked = any(t.clearance is not None for t in tables)
         table = cls(np.concatenate([t.target for t in tables]), np.concatenate([t.joints for t in tables]),
                     np.concatenate([t.within_limits for t in tables]),
                     np.concatenate([t.position for t in tables]), np.concatenate([t.orientation for t in tables]),
-                    merged_labels([t.labels for t in tables], [len(t) for t in tables]))
+                    merged_labels([t.labels for t in tables], [len(t) for t in tables]),
+                    np.concatenate([t.clearance if t.clearance is not None else np.full(len(t), np.inf)
+                                    for t in tables]) if checked else None,
+                    np.concatenate([t.contacts if t.contacts is not None else _no_contacts(len(t))
+                                    for t in tables]) if checked else None)
         if (np.diff(table.target) < 0).any():
             table = table.take(np.argsort(table.target, kind="stable"))
         return table
@@ -116,3 +131,8 @@ def merged_labels(pieces: list[LabelCodes], lengths: list[int]) -> LabelCodes:
         merged[name] = (tuple(vocabulary), np.concatenate(columns) if len(columns) > 1 else columns[0])
     return merged
 
+
+def _no_contacts(count: int) -> np.ndarray:
+    contacts = np.empty(count, dtype=object)
+    contacts[:] = [()] * count
+    return contacts

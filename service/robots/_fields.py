@@ -61,11 +61,12 @@ RobotId = Annotated[str, Field(pattern=r"^[a-z0-9][a-z0-9_-]{0,63}$", examples=[
 
 
 class ApiModel(BaseModel):
-    """Base for request bodies: unknown fields are errors, not silently dropped."""
+    """Base for request bodies: unknown fields are errors, not silently dropped; a dump uses the wire names (a
+    capsule's ``from``, the collision options' ``self``), so that what is dumped validates again."""
 
     # Enums are named schemas in the spec (clean names in generated clients), but validated values are plain
     # strings, so code compares them with string literals.
-    model_config = ConfigDict(extra="forbid", use_enum_values=True)
+    model_config = ConfigDict(extra="forbid", use_enum_values=True, serialize_by_alias=True)
 
 
 #: Tags pydantic inserts into locations inside tagged unions: robot description forms and orientation types.

@@ -145,3 +145,15 @@ def test_urdf_link_names_and_errors(client):
     ends = sorted((frames[1][:3, :3] @ point + frames[1][:3, 3]).round(12).tolist() for point in
                   (capsule.start, capsule.end))
     np.testing.assert_allclose(ends, [[0, 0, 0], [0.5 * math.cos(0.3), 0.5 * math.sin(0.3), 0]], atol=1e-12)
+
+
+def test_a_dumped_catalogue_description_is_a_valid_inline_robot(client):
+    """What a Python client dumps from the service's own description models is what the wire takes: a capsule's
+    ``from`` (the field is ``start`` in Python) round-trips; CI's HTTP benchmark and the schemathesis test sent the
+    field names and got 422s."""
+    for robot_id in ("puma560_standard", "franka_panda"):
+        entry = client.app.state.catalogue.get(robot_id)
+        dumped = entry.description.model_dump(mode="json", exclude_none=True)
+        assert "from" in str(dumped["collision"]) and "start" not in str(dumped["collision"])
+        response = client.post("/v1/fk", json={"robot": dumped, "joints": [0.1] * entry.robot.dof})
+        assert response.status_code == 200, response.text

@@ -7,7 +7,10 @@ A 6-joint arm (the catalogue's PUMA 560) with capsules on links 1, 2, 3, 5 and 6
 capsule–capsule (self-collision of links not joined by a joint) and five box–capsule (each capsule against the
 table). Rows: ``link_frames`` for the configurations, the model's ``distances`` for those frames, and its
 ``check`` (distances, clearance and the close pairs); then the cost of one call for 1 and 16 configurations (the
-single-pose path, where numpy's cost per call dominates) and of compiling the model. Times are CPU seconds of this process
+single-pose path, where numpy's cost per call dominates) and of compiling the model. Last, what a request pays: the
+core's whole IK answer (``answer_ik``) for a batch of 10,000 targets from the PUMA's own FK, with its catalogue
+capsule model, without and with ``collisions`` (self-collision, a table and a post: the API example's cell), and
+their ratio (issue 25's goal: at most 2). Times are CPU seconds of this process
 (``time.process_time``), best of the repeats: on a shared machine that is less noisy than wall time, but still
 noisy; compare rows of one run.
 """
@@ -21,8 +24,9 @@ from pathlib import Path
 
 import numpy as np
 
-from service.kinematics import link_frames
-from service.kinematics.collision import Box, Capsule, LinkShape, Obstacle, collision_model
+from service.kinematics import forward_kinematics, link_frames
+from service.kinematics.collision import Box, Capsule, CollisionRequest, LinkShape, Obstacle, collision_model
+from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik
 from service.robots.catalogue import load_robot_file
 
 ROBOT_FILE = Path(__file__).resolve().parents[1] / "robots" / "puma560_standard.yaml"
@@ -64,6 +68,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="tiny sizes (a smoke run)")
     parser.add_argument("--configurations", type=int, default=80_000)
+    parser.add_argument("--targets", type=int, default=10_000, help="targets of the whole-answer rows")
     parser.add_argument("--repeats", type=int, default=5)
     arguments = parser.parse_args(argv)
     count = 200 if arguments.quick else arguments.configurations
@@ -90,11 +95,34 @@ def main(argv: list[str] | None = None) -> int:
                  best_time(lambda: [link_frames(robot, q[:16]) for _ in range(calls)], 3) / calls))
     rows.append(("collision_model (compiling the 12 pairs, per call)",
                  best_time(lambda: [puma_model() for _ in range(calls // 10)], 3) / (calls // 10)))
+    targets = 100 if arguments.quick else arguments.targets
+    plain, checked = whole_answers(targets, repeats)
+    rows.append((f"answer_ik, {targets} targets, no collision check", plain))
+    rows.append((f"answer_ik, {targets} targets, self-collision + table + post", checked))
     print("| what | CPU time (best of repeats) |")
     print("| --- | --- |")
     for name, seconds in rows:
         print(f"| {name} | {seconds * 1e3:.3f} ms |")
+    print(f"whole answer with collisions / without: {checked / plain:.2f}x (goal <= 2)")
     return 0
+
+
+#: The API example's cell (service/api/examples.py, tests/api/test_collisions.py): a table and a post, metres.
+CELL = (Obstacle("table", Box([0.55, 0.0, -0.15], [0.5, 1.0, 0.1])),
+        Obstacle("post", Capsule([0.27, -0.2, -0.6], [0.27, -0.2, 0.6], 0.06)))
+
+
+def whole_answers(count: int, repeats: int) -> tuple[float, float]:
+    """CPU seconds of ``answer_ik`` on ``count`` PUMA targets from its own FK (catalogue limits), without and
+    with the collision check of the catalogue capsule model against itself and :data:`CELL` (margin 5 mm)."""
+    robot = _puma()
+    q = np.random.default_rng(1).uniform(robot.lower, robot.upper, (count, robot.dof))
+    targets = IKTargets.poses(forward_kinematics(robot, q))
+    plain = AnswerOptions()
+    checked = AnswerOptions(collisions=CollisionRequest(obstacles=CELL, margin=0.005))
+    answer_ik(robot, targets, checked)  # compile the pairs once, as a server's first request does
+    return (best_time(lambda: answer_ik(robot, targets, plain), repeats),
+            best_time(lambda: answer_ik(robot, targets, checked), repeats))
 
 
 if __name__ == "__main__":

@@ -95,6 +95,31 @@ def test_link_frames_start_at_the_base_and_end_at_the_flange():
     np.testing.assert_allclose(frames[-1] @ _trans("z", 0.3), forward_kinematics(robot, q), atol=1e-14)
 
 
+@pytest.mark.parametrize("convention", ["standard", "modified", "khalil"])
+def test_every_link_frame_is_the_product_of_the_elementary_motions_before_it(convention):
+    """link_frames runs the chain program; each frame is checked against the rows' elementary motions multiplied
+    out here, in batches of several shapes, with a base and prismatic joints."""
+    rng = np.random.default_rng(7)
+    plain = _random_robot(rng, convention, "RPRRPR")
+    base = _rot("z", 0.4) @ _trans("x", 0.2) @ _rot("x", -0.3)
+    robot = Robot(plain.joints, convention=convention, world_T_base=base)
+    q = rng.uniform(-2, 2, (3, 5, 6))
+    frames = link_frames(robot, q)
+    assert frames.shape == (3, 5, 7, 4, 4)
+    for index in np.ndindex(3, 5):
+        expected = base
+        np.testing.assert_allclose(frames[index][0], base, atol=1e-15)
+        for i in range(6):
+            theta = robot.theta[i] + (q[index][i] if robot.is_revolute[i] else 0.0)
+            d = robot.d[i] + (0.0 if robot.is_revolute[i] else q[index][i])
+            if convention == "standard":
+                step = _rot("z", theta) @ _trans("z", d) @ _trans("x", robot.a[i]) @ _rot("x", robot.alpha[i])
+            else:
+                step = _rot("x", robot.alpha[i]) @ _trans("x", robot.a[i]) @ _rot("z", theta) @ _trans("z", d)
+            expected = expected @ step
+            np.testing.assert_allclose(frames[index][i + 1], expected, atol=1e-13)
+
+
 def _exp_twist(direction, point, revolute, q):
     """exp([S] q) for a unit screw, written independently of the core (Rodrigues)."""
     T = np.eye(4)

@@ -144,6 +144,13 @@ class Clearances:
 _NO_CONTACTS: tuple = ()
 
 
+def _as_objects(items: list) -> np.ndarray:
+    """A 1-D object array of ``items`` (tuples stay elements; numpy would make a 2-D array of equal-length ones)."""
+    array = np.empty(len(items), dtype=object)
+    array[:] = items
+    return array
+
+
 def clearances(robot, request: CollisionRequest, joints: np.ndarray) -> Clearances:
     """The collision check of joint vectors (S, n) under ``request`` (see :class:`Clearances`)."""
     model = model_for(robot, request)
@@ -151,6 +158,7 @@ def clearances(robot, request: CollisionRequest, joints: np.ndarray) -> Clearanc
     check = model.check(link_frames(robot, joints), request.margin)
     contacts = np.empty(len(joints), dtype=object)
     contacts[:] = [_NO_CONTACTS] * len(joints)
-    for row in np.flatnonzero(check.colliding).tolist():
-        contacts[row] = tuple(check.close_pairs(model, row))
+    colliding = np.flatnonzero(check.colliding)
+    if len(colliding):
+        contacts[colliding] = _as_objects(check.close_pairs_of(model, colliding.tolist()))
     return Clearances(check.clearance, check.colliding, contacts)

@@ -101,9 +101,17 @@ class CollisionCheck(NamedTuple):
 
     def close_pairs(self, model: "CollisionModel", configuration: int) -> list[tuple[str, str, float]]:
         """Configuration ``configuration``'s close body pairs as (a, b, distance), nearest first."""
-        span = slice(self.offsets[configuration], self.offsets[configuration + 1])
-        return [(*model.body_pairs[pair], distance)
-                for pair, distance in zip(self.body_pairs[span].tolist(), self.distances[span].tolist())]
+        return list(self.close_pairs_of(model, [configuration])[0])
+
+    def close_pairs_of(self, model: "CollisionModel", configurations) -> list[tuple[tuple[str, str, float], ...]]:
+        """:meth:`close_pairs` of several configurations, each as a tuple (one pass over plain lists: a batch
+        may have tens of thousands of colliding configurations)."""
+        names = model.body_pairs
+        pairs, distances, offsets = self.body_pairs.tolist(), self.distances.tolist(), self.offsets.tolist()
+        return [tuple((names[pair][0], names[pair][1], distance)
+                      for pair, distance in zip(pairs[offsets[row]:offsets[row + 1]],
+                                                distances[offsets[row]:offsets[row + 1]]))
+                for row in configurations]
 
 
 class _LinkRows(NamedTuple):

@@ -54,8 +54,8 @@ class Settings(BaseSettings):
         10_000, ge=1, description="most shape pairs one request's collision check may compare (link shapes with "
                                   "each other and with the obstacles)")
     max_collision_checks: int = Field(
-        50_000_000, ge=1, description="most pair distances one request's collision check may compute (distinct "
-                                      "solutions × shape pairs)")
+        5_000_000, ge=1, description="most pair distances one request's collision check may compute (distinct "
+                                     "solutions × shape pairs; about 2 s on one core)")
     max_in_flight: int = Field(32, ge=1, le=10_000, description="most requests worked on at once; more get 503")
     timeout_keep_alive_s: float = Field(5.0, gt=0, description="idle keep-alive connections close after this")
     header_timeout_s: float = Field(10.0, gt=0, description="a connection must send its request head within this")

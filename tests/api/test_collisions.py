@@ -182,3 +182,28 @@ def test_a_robot_without_shapes_says_how_to_give_them(client):
     response = client.post("/v1/robots/spong_ex3_1_planar_rr/ik",
                            json={"target": {"position": [1.0, 0.5, 0.0]}, "collisions": {}})
     assert response.status_code == 422 and "collision" in response.json()["detail"]
+
+
+@pytest.mark.parametrize("settings, words", [
+    ({"max_collision_pairs": 20}, "KIN_MAX_COLLISION_PAIRS = 20"),
+    ({"max_collision_checks": 1_000}, "KIN_MAX_COLLISION_CHECKS = 1,000"),
+])
+def test_a_check_past_its_caps_is_refused_before_any_work(settings, words):
+    """The cost model counts the pairs (8 PUMA shapes: their self pairs and 8 per obstacle) and the distances
+    (targets × solutions × pairs) before solving."""
+    from fastapi.testclient import TestClient
+
+    from service.api.app import create_app
+    from service.config import Settings
+
+    case = CASES["puma560_standard"]
+    with TestClient(create_app(Settings(_env_file=None, **settings))) as capped:
+        target = capped.post("/v1/robots/puma560_standard/fk", json={"joints": case["q"]}).json()["pose"]["matrix"]
+        body = {"targets": [{"matrix": target}] * 20, "collisions": {"obstacles": case["obstacles"]}}
+        response = capped.post("/v1/robots/puma560_standard/ik/batch", json=body)
+        assert response.status_code == 413, response.text
+        assert response.headers["content-type"] == "application/problem+json"
+        assert words in response.json()["detail"]
+        fine = capped.post("/v1/robots/puma560_standard/ik", json={
+            "target": {"matrix": target}, "collisions": {"self": False, "obstacles": case["obstacles"][:1]}})
+        assert fine.status_code == 200, fine.text

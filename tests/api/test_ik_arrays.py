@@ -58,6 +58,9 @@ def _columns_of_objects(results: list[dict]) -> dict:
             "residual_orientation": [s["residual"]["orientation"] for _, s in rows],
             "branch": {label: [s["branch"].get(label) for _, s in rows] for label in labels},
         }
+        if any("clearance" in s for _, s in rows):
+            columns[name]["clearance"] = [s["clearance"] for _, s in rows]
+            columns[name]["collisions"] = [s["collisions"] for _, s in rows]
     return {"solvers": solvers, "singularity_reports": reports, "targets": targets, **columns}
 
 
@@ -75,6 +78,9 @@ def _assert_same(arrays: dict, objects: dict) -> None:
                                    rtol=0, atol=1e-12)
         np.testing.assert_allclose(got["residual_position"], want["residual_position"], rtol=0, atol=1e-15)
         assert [x is None for x in got["residual_orientation"]] == [x is None for x in want["residual_orientation"]]
+        assert ("clearance" in want) == (got.get("clearance") is not None)
+        if "clearance" in want:
+            assert got["clearance"] == want["clearance"] and got["collisions"] == want["collisions"]
 
 
 CASES = {
@@ -97,6 +103,11 @@ CASES = {
     "ur5, no limits": ("ur5", {"limits": [None] * 6}, False),
     "stanford (prismatic joint), position and pose": ("spong_ex3_5_stanford", {}, False),
     "polar arm, position-only targets": ("ex004_2_polar_rrp", {}, True),
+    "puma, collisions with a table and a post, not filtered by limits": (
+        "puma560_standard", {"filter_limits": False, "collisions": {"margin": 0.005, "obstacles": [
+            {"name": "table", "box": {"center": [0.55, 0.0, -0.15], "size": [0.5, 1.0, 0.1]}},
+            {"name": "post", "capsule": {"from": [0.27, -0.2, -0.6], "to": [0.27, -0.2, 0.6], "radius": 0.06}}]}},
+        False),
 }
 
 

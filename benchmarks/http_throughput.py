@@ -160,6 +160,9 @@ def main(argv: list[str] | None = None) -> int:
         "batch_arrays": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "limits": unlimited,
                                     "format": "arrays"}).encode(),
         "batch_objects": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "limits": unlimited}).encode(),
+        # the same targets as numbers only (one row of 16 per target), answered as columns
+        "batch_matrices": json.dumps({"targets": {"matrices": T.reshape(-1, 16).tolist()}, "limits": unlimited,
+                                      "format": "arrays"}).encode(),
         # no "limits": the catalogue's limits apply, as they do for a user who sends none
         "batch_limited": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "format": "arrays"}).encode(),
     }
@@ -195,6 +198,7 @@ def main(argv: list[str] | None = None) -> int:
             loads.append(run_wrk(f"POST /v1/ik, one pose, inline {ROBOT}", f"{base}/v1/ik", scripts["ik_inline"],
                                  **single))
             for form, what in (("arrays", "format arrays"), ("objects", "format objects"),
+                               ("matrices", "targets as matrix rows, format arrays"),
                                ("limited", "format arrays, catalogue limits")):
                 # one request first (warm-up), so that the run is long enough for several requests of this size
                 once = _post(f"{base}/v1/robots/{ROBOT}/ik/batch", bodies[f"batch_{form}"])
@@ -253,6 +257,9 @@ def main(argv: list[str] | None = None) -> int:
          3, at_least=False)
     print(f"- {args.batch:,}-target batch over HTTP (objects form, p50) / core batch time: "
           f"{(objects.p50_ms / 1e3) / core:.2f}")
+    matrices = by_name[f"POST ik/batch, {args.batch:,} targets, targets as matrix rows, format arrays"]
+    print(f"- {args.batch:,}-target batch over HTTP (targets as matrix rows, arrays form, p50) / core batch time: "
+          f"{(matrices.p50_ms / 1e3) / core:.2f}")
     if eaik is None:
         print("- EAIK is not installed (pip install -e '.[bench]'): the limits-on batch has no anchor in this run")
     else:

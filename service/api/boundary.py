@@ -36,7 +36,7 @@ from ..robots.geometry import shape_from_wire
 from ..robots.orientations import rotation_from_orientation
 from .schemas.collisions import CollisionOptions
 from .schemas.common import AngleUnit
-from .schemas.ik import Ordering as OrderingOptions
+from .schemas.ik import MatrixRows, Ordering as OrderingOptions
 from .schemas.poses import DirectionOrientation, PoseTarget
 
 _DEGREE = math.pi / 180.0
@@ -171,10 +171,26 @@ def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str
     return matrices, constrained
 
 
-def ik_targets_to_core(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str | int,
+def _matrices_of_rows(rows: Sequence[Sequence[float]], *prefix: str | int) -> np.ndarray:
+    """(N, 4, 4) rigid transforms from rows of 16 numbers (row-major), checked in one pass; on an error each row is
+    checked on its own, so that the problem names the row."""
+    stacked = np.asarray(rows, dtype=float).reshape(-1, 4, 4)
+    try:
+        return check_transforms(stacked)
+    except KinematicsError:
+        for index, matrix in enumerate(stacked):
+            with located(*prefix, index):
+                check_transform(matrix)
+        raise
+
+
+def ik_targets_to_core(targets: Sequence[PoseTarget] | MatrixRows, unit: AngleUnit, *prefix: str | int,
                        indexed: bool = True) -> IKTargets:
-    """The core's :class:`IKTargets` from an IK request's targets; errors are located at ``prefix`` (followed by
-    the target's index when ``indexed``). A direction target's matrix holds its position."""
+    """The core's :class:`IKTargets` from an IK request's targets (target objects, or a batch's flat matrix rows);
+    errors are located at ``prefix`` (followed by the target's index when ``indexed``). A direction target's
+    matrix holds its position."""
+    if isinstance(targets, MatrixRows):
+        return IKTargets.poses(_matrices_of_rows(targets.matrices, *prefix, "matrices"))
     def at(index: int):
         return located(*prefix, index) if indexed else located(*prefix)
     directions = {}

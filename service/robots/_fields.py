@@ -70,8 +70,9 @@ class ApiModel(BaseModel):
 
 
 #: Tags pydantic inserts into locations inside tagged unions: robot description forms and orientation types.
-_UNION_TAGS = {"dh", "standard", "modified", "khalil", "urdf", "screws", "matrix", "quaternion", "euler_zyz", "rpy"}
-_UNION_FIELDS = {"robot", "orientation"}
+_UNION_TAGS = {"dh", "standard", "modified", "khalil", "urdf", "screws", "matrix", "quaternion", "euler_zyz", "rpy",
+               "objects", "matrices"}
+_UNION_FIELDS = {"robot", "orientation", "targets"}
 #: Tags pydantic inserts after the index of an item of a list of unions: link shapes.
 _ITEM_TAGS = {"capsule", "sphere", "box"}
 _ITEM_UNION_FIELDS = {"collision", "obstacles"}

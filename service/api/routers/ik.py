@@ -70,7 +70,7 @@ def _single_response(request: Request, asked: AskedIK, body: IKRequest, render: 
              response_model=IKBatchResponse | IKBatchArraysResponse, responses=problem_responses(404, 413, 422))
 def inverse_kinematics_batch(request: Request, body: IKBatchRequest, ref: RobotRef = Depends(catalogue_robot)):
     """Every solution for each target; the analytic solvers run vectorised over the targets."""
-    check_batch_size(request, len(body.targets), "targets")
+    check_batch_size(request, body.target_count, "targets")
     asked = ik_request_in_core(request, ref, body)
     encode = ik_columns if body.format == "arrays" else ik_objects
     encoded = encode(asked.ref.id, asked.ref.robot, answered(request, asked, body.format), body.angle_unit,

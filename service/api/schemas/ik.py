@@ -5,7 +5,7 @@ from __future__ import annotations
 from enum import Enum, IntEnum
 from typing import Annotated, Literal
 
-from pydantic import Field, model_serializer, model_validator
+from pydantic import Discriminator, Field, Tag, model_serializer, model_validator
 
 from ...kinematics.ik import MAX_EQUIVALENTS, MAX_FREE_VALUES
 from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair
@@ -103,9 +103,43 @@ class _Target(ApiModel):
     target: PoseTarget = Field(description="the tool pose to reach, in the world frame")
 
 
+MatrixRow = Annotated[list[Number], Field(min_length=16, max_length=16)]
+
+
+class MatrixRows(ApiModel):
+    """Many pose targets as numbers only: each the 16 entries of its 4×4 ``world_T_tool``, row by row. A batch of
+    10,000 targets then parses as one array of numbers, not as 10,000 target objects."""
+
+    matrices: Annotated[list[MatrixRow], IN_PIECES] = Field(
+        min_length=1, description="one row of 16 numbers per target: the homogeneous matrix in row-major order "
+                                  "(rotation and position, then 0, 0, 0, 1), world frame, robot length unit")
+
+
+def _targets_form(value) -> str | None:
+    """Which form a batch's ``targets`` takes: a list of target objects, or ``{"matrices": [...]}``."""
+    if isinstance(value, (list, tuple)):
+        return "objects"
+    if isinstance(value, (dict, MatrixRows)):
+        return "matrices"
+    return None
+
+
+BatchTargets = Annotated[
+    Annotated[Annotated[list[PoseTarget], IN_PIECES, Field(min_length=1)], Tag("objects")]
+    | Annotated[MatrixRows, Tag("matrices")],
+    Discriminator(_targets_form, custom_error_type="targets",
+                  custom_error_message="targets is a list of target objects or {\"matrices\": [[16 numbers], ...]}"),
+]
+
+
 class _Targets(ApiModel):
-    targets: Annotated[list[PoseTarget], IN_PIECES] = Field(min_length=1, description="the tool poses to reach, world frame; each is "
-                                                                "solved as an IKRequest target")
+    targets: BatchTargets = Field(
+        description="the tool poses to reach, world frame: a list of targets, each solved as an IKRequest target, "
+                    "or (pose targets only) {\"matrices\": [[16 numbers], ...]}, each row a 4×4 matrix row by row")
+
+    @property
+    def target_count(self) -> int:
+        return len(self.targets.matrices if isinstance(self.targets, MatrixRows) else self.targets)
 
 
 class FreeJointChoice(ApiModel):

@@ -63,7 +63,8 @@ def _single_response(request: Request, asked: AskedIK, body: IKRequest, render: 
                         budget_of(request))[0]
     if not picture:
         return FastJSONResponse(answer)  # built to IKResponse field by field (a test validates it), as it stands
-    return ik_picture(ref.robot, ref.id, answer, body.angle_unit, render or "iso", body.reference is not None)
+    return ik_picture(ref.robot, ref.id, answer, body.angle_unit, render or "iso", body.reference is not None,
+                      asked.options.collisions)
 
 
 @router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch",

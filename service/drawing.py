@@ -210,6 +210,7 @@ def render_svg(poses: Sequence[ArmPose], *, view: View = "iso", columns: int | N
     rows = math.ceil(len(poses) / columns)
     caption_lines = max(len(p.caption) + 1 + bool(p.collision_status) for p in poses)
     checked = any(p.collision_status for p in poses)
+    drawn: dict[tuple[int, bool], str] = {}  # obstacles, the same in every panel: drawn once per marking
     cell_h = panel + caption_lines * _CAPTION_LINE + 8
     title_h = 24 if title else 0
     width, height = columns * panel, rows * cell_h + title_h
@@ -232,7 +233,7 @@ def render_svg(poses: Sequence[ArmPose], *, view: View = "iso", columns: int | N
         out.append(f'<g class="{css}" data-index="{index}" data-within-limits="{str(pose.within_limits).lower()}"'
                    f'{attributes} transform="translate({x0},{y0})">')
         out.append(f'<rect class="panel" x="2" y="2" width="{panel - 4}" height="{cell_h - 4}" rx="6"/>')
-        out.extend(_panel(pose, screen, depth_axis, triad, axis_half, scale))
+        out.extend(_panel(pose, screen, depth_axis, triad, axis_half, scale, drawn))
         for line, text in enumerate(pose.caption):
             weight = ' font-weight="bold"' if line == 0 else ""
             out.append(f'<text class="caption" x="10" y="{panel + (line + 1) * _CAPTION_LINE - 4}"{weight}>'
@@ -249,7 +250,7 @@ def render_svg(poses: Sequence[ArmPose], *, view: View = "iso", columns: int | N
 
 
 def _panel(pose: ArmPose, screen, depth_axis: np.ndarray, triad: float, axis_half: float,
-           scale: float) -> list[str]:
+           scale: float, obstacles_drawn: dict[tuple[int, bool], str]) -> list[str]:
     """The SVG elements of one arm, far ones first (painter's order by depth along the view); its solids
     (translucent) between the pedestal and the stick figure, obstacles under link shapes."""
     items: list[tuple[float, str]] = []
@@ -279,7 +280,15 @@ def _panel(pose: ArmPose, screen, depth_axis: np.ndarray, triad: float, axis_hal
         items.append((math.inf, f'<g class="{name}-frame">' + "".join(lines) + "</g>"))
     items.sort(key=lambda item: item[0])
     solids = sorted(pose.solids, key=lambda solid: (solid.link is not None, float(_centre(solid.shape) @ depth_axis)))
-    drawn = [_solid(solid, screen, scale) for solid in solids]
+    drawn = []
+    for solid in solids:
+        if solid.link is not None:
+            drawn.append(_solid(solid, screen, scale))
+            continue
+        key = (id(solid.shape), solid.colliding)
+        if key not in obstacles_drawn:
+            obstacles_drawn[key] = _solid(solid, screen, scale)
+        drawn.append(obstacles_drawn[key])
     return [items[0][1], *drawn, *(svg for _, svg in items[1:])]  # items[0]: the pedestal
 
 

@@ -166,3 +166,16 @@ def test_inline_render_draws_the_described_shapes(client):
     stretched, folded = _panels(svg)
     assert _marked(stretched) == {"link 2", "wall"} and _marked(folded) == set()
     assert [e.get("data-kind") for e in _solids(stretched)] == ["box", "capsule", "sphere"]
+
+
+def test_a_picture_of_too_many_shapes_is_413_before_drawing(client):
+    from service.api.budget import MAX_PICTURE_SHAPES
+
+    balls = [{"name": f"ball {i}", "sphere": {"center": [1.0, 0.1 * i, 0.0], "radius": 0.01}} for i in range(100)]
+    body = {"joints": [PUMA_Q] * 256, "collisions": {"obstacles": balls}}  # 256 × (100 + the PUMA's shapes)
+    shapes = len(client.get("/v1/robots/puma560_standard").json()["collision"])
+    if 256 * (100 + shapes) <= MAX_PICTURE_SHAPES:
+        pytest.skip("the cap is above what one render request may ask")
+    assert_problem(client.post("/v1/robots/puma560_standard/render", json=body), 413, match="shapes")
+    assert client.post("/v1/robots/puma560_standard/render",
+                       json={**body, "joints": [PUMA_Q] * 8}).status_code == 200

@@ -13,6 +13,7 @@ from ...kinematics import InvalidInputError, Robot
 from ...kinematics.ik import wrap_revolute
 from ...kinematics.collision import CollisionRequest
 from ..boundary import collisions_to_core, joints_to_core, located, _unit_scale
+from ..budget import check_picture_cost
 from ..deps import RobotRef, catalogue_robot, inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..routing import FastJSONRoute
@@ -53,6 +54,8 @@ def _render(ref: RobotRef, body: RenderRequest) -> Response:
                                 f"{len(body.captions)}", location=("body", "captions"))
     captions = None if body.captions is None else [caption.split("\n") for caption in body.captions]
     collisions = collisions_to_core(robot, body.collisions, body.angle_unit)
+    if collisions is not None:
+        check_picture_cost(len(q), robot, len(collisions.obstacles))
     with located("body", "collisions"):
         poses = arm_poses(robot, q, captions, collisions=collisions)
     return svg_response(render_svg(poses, view=body.view, columns=body.columns, panel=body.panel_size,
@@ -60,14 +63,14 @@ def _render(ref: RobotRef, body: RenderRequest) -> Response:
 
 
 @router.post("/robots/{robot_id}/render", operation_id="render", response_class=Response,
-             responses={200: SVG_RESPONSE, **problem_responses(404, 422)})
+             responses={200: SVG_RESPONSE, **problem_responses(404, 413, 422)})
 def render(body: RenderRequest, ref: RobotRef = Depends(catalogue_robot)) -> Response:
     """An SVG of the arm in each configuration, side by side: links, joint axes, base and tool frames."""
     return _render(ref, body)
 
 
 @router.post("/render", operation_id="render_inline", response_class=Response,
-             responses={200: SVG_RESPONSE, **problem_responses(422)})
+             responses={200: SVG_RESPONSE, **problem_responses(413, 422)})
 def render_inline(request: Request, body: RenderInlineRequest) -> Response:
     """An SVG of a robot described in the request body, in each configuration."""
     return _render(inline_robot(request, body.robot), body)
@@ -112,6 +115,8 @@ def ik_picture(robot: Robot, robot_id: str, answer: dict, unit: str, view: str, 
     if not rows:
         return svg_response(_empty_svg(title))
     violated = [[v["joint"] for v in group["solution"]["violations"]] for group in groups.values()]
+    if collisions is not None:
+        check_picture_cost(len(rows), robot, len(collisions.obstacles))
     checked = None if collisions is None else [
         (group["solution"]["clearance"], [(c["a"], c["b"], c["distance"]) for c in group["solution"]["collisions"]])
         for group in groups.values()]

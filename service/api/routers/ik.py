@@ -20,7 +20,8 @@ from .render import IK_PICTURE_RESPONSE, ik_picture, wants_svg
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinematics"])
 RENDER_QUERY = Query(None, description="answer with an SVG picture of every distinct solution (those that differ "
                                        "only by whole turns share a panel) seen from this view, instead of JSON; "
-                                       "the same as Accept: image/svg+xml with the iso view")
+                                       "the same as Accept: image/svg+xml with the iso view. With 'collisions', "
+                                       "each panel draws the obstacles and link shapes, colliding ones red")
 
 
 @router.post("/robots/{robot_id}/ik", operation_id="inverse_kinematics", response_model=IKResponse,

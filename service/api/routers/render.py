@@ -30,7 +30,8 @@ SVG_RESPONSE = {"description": "An SVG picture: one panel per configuration, cap
                 "content": {SVG_MEDIA_TYPE: {"schema": {"type": "string"}}}}
 #: The SVG alternative of the IK operations' 200 answer.
 IK_PICTURE_RESPONSE = {"description": "Every solution (JSON), or with `render` or `Accept: image/svg+xml`, a "
-                                      "picture of every distinct solution",
+                                      "picture of every distinct solution (with `collisions`, the obstacles and "
+                                      "link shapes too, colliding ones red)",
                        "content": {SVG_MEDIA_TYPE: {"schema": {"type": "string"}}}}
 
 

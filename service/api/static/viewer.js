@@ -202,6 +202,9 @@ async function collisionsChanged() {
 async function addBox(name, center, size) {
   showError(null);
   if (!state.robot) throw new Error("choose a robot first");
+  if (!(state.description.collision || []).length) {
+    throw new Error("this robot carries no link shapes: there is nothing to check an obstacle against");
+  }
   name = (name === undefined ? $("#box-name").value : name).trim();
   center = center || parseTriple($("#box-center").value, "the centre");
   size = size || parseTriple($("#box-size").value, "the size");

@@ -111,9 +111,8 @@ def _post(url: str, body: dict) -> dict:
         return json.load(answer)
 
 
-def test_viewer_draws_every_ik_solution_of_the_ur5(browser, base_url):
-    import numpy as np
-
+def _viewer_with_the_ur5_at(browser, base_url, joints_deg) -> None:
+    """Open the viewer, choose the UR5 and type each joint, as a user does; wait for the redraw."""
     browser.clear()
     browser.navigate(f"{base_url}/viewer")
     browser.wait_for("Number(document.querySelector('#robot').dataset.loaded || 0) > 0")
@@ -123,13 +122,19 @@ def test_viewer_draws_every_ik_solution_of_the_ur5(browser, base_url):
     browser.wait_for("document.querySelectorAll('#joints input[type=range]').length === 6"
                      " && document.querySelector('#current-picture svg') !== null")
     # type each joint into its number box, then take the pose as the target and solve
-    for index, value in enumerate(UR5_Q_DEG):
+    for index, value in enumerate(joints_deg):
         browser.evaluate(f"(() => {{ const box = document.querySelector('#joints input[type=number][data-joint=\"{index}\"]');"
                          f" box.value = '{value}'; box.dispatchEvent(new Event('input')); }})()")
     sliders = browser.evaluate("[...document.querySelectorAll('#joints input[type=range]')].map(r => Number(r.value))")
-    assert sliders == UR5_Q_DEG  # the number boxes moved their sliders
+    assert sliders == joints_deg  # the number boxes moved their sliders
     browser.evaluate("new Promise(r => setTimeout(r, 600))")  # the redraw after the last joint is debounced
     browser.wait_for("document.querySelector('#tool-pose').textContent !== ''")
+
+
+def test_viewer_draws_every_ik_solution_of_the_ur5(browser, base_url):
+    import numpy as np
+
+    _viewer_with_the_ur5_at(browser, base_url, UR5_Q_DEG)
     browser.evaluate("document.querySelector('#use-current').click()")
     browser.evaluate("document.querySelector('#solve').click()")
     count = int(browser.wait_for("document.querySelector('#summary').dataset.count", timeout=60))
@@ -159,5 +164,94 @@ def test_viewer_draws_every_ik_solution_of_the_ur5(browser, base_url):
     np.testing.assert_allclose(answer["solutions"][0]["joints"], UR5_Q_DEG, atol=1e-6)
     assert browser.evaluate("document.querySelector('#error').textContent") == ""
     browser.screenshot("viewer-ur5.png")
+    assert browser.foreign_requests(base_url) == []
+    assert browser.console_errors == []
+
+
+#: A table under the UR5's two elbow-down configurations whose elbow dips below the base (z ≈ −0.14 m), clear of
+#: the other six (their elbows at z ≥ 0.04 m, link radius 0.075 m): the box's top is at z = −0.10 m.
+UR5_TABLE = {"name": "table", "center": [-0.35, -0.15, -0.15], "size": [0.5, 0.5, 0.1]}
+
+
+def _marked(svg_selector: str) -> str:
+    """JS: for each panel of the picture, the names of its solids marked colliding."""
+    return (f"[...document.querySelectorAll('{svg_selector} g.configuration')].map(g => "
+            "[...g.querySelectorAll('.solid.colliding')].map(e => e.dataset.name).sort())")
+
+
+def test_viewer_draws_link_capsules_and_a_box_added_filters_the_solutions(browser, base_url):
+    import numpy as np
+
+    _viewer_with_the_ur5_at(browser, base_url, UR5_Q_DEG)
+    shapes = json.loads(browser.evaluate("JSON.stringify(window.kinematicsViewer.state.description.collision)"))
+    # the current joints: every link capsule of the UR5 drawn, none colliding, and the clearance said
+    drawn = browser.wait_for("(() => { const s = [...document.querySelectorAll('#current-picture .solid.link-shape')]"
+                             ".map(e => [Number(e.dataset.link), e.dataset.kind]);"
+                             f" return s.length === {len(shapes)} ? s : null; }})()")
+    assert sorted(map(tuple, drawn)) == sorted((shape["link"], "capsule") for shape in shapes)
+    assert browser.evaluate("document.querySelector('#current-picture .solid.colliding')") is None
+    assert browser.evaluate("document.querySelector('#clearance').textContent").startswith("current joints: clear by")
+
+    browser.evaluate("document.querySelector('#use-current').click()")
+    browser.evaluate("document.querySelector('#solve').click()")
+    assert int(browser.wait_for("document.querySelector('#summary').dataset.count", timeout=60)) == 512
+    assert browser.evaluate("document.querySelectorAll('#solutions g.configuration').length") == 8
+    assert browser.evaluate("document.querySelectorAll('#solutions .solid.link-shape').length") == 8 * len(shapes)
+    asked = browser.evaluate("window.kinematicsViewer.state.lastRequest.collisions")
+    assert asked == {"self": True, "margin": 0, "obstacles": []}  # the viewer checks self-collision by default
+
+    # add the table through the form, as a user does: the viewer solves again with it
+    for field, value in (("#box-name", UR5_TABLE["name"]), ("#box-center", ", ".join(map(str, UR5_TABLE["center"]))),
+                         ("#box-size", ", ".join(map(str, UR5_TABLE["size"])))):
+        browser.evaluate(f"document.querySelector('{field}').value = {json.dumps(value)}")
+    browser.evaluate("document.querySelector('#add-box').click()")
+    browser.wait_for("document.querySelector('#summary').dataset.obstacles === '1'"
+                     " && document.querySelector('#summary').dataset.count !== undefined", timeout=60)
+    assert browser.evaluate("document.querySelector('#error').textContent") == ""
+    assert browser.evaluate("[...document.querySelectorAll('#obstacles li')].map(li => li.dataset.name)") == ["table"]
+    request = browser.evaluate("window.kinematicsViewer.state.lastRequest")
+    assert request["collisions"]["obstacles"] == [{"name": "table", "box": {"center": UR5_TABLE["center"],
+                                                                            "size": UR5_TABLE["size"]}}]
+
+    # the survivors are those the API keeps for the same request, and only they are listed
+    answer = _post(f"{base_url}/v1/robots/ur5/ik", request)
+    count = int(browser.evaluate("document.querySelector('#summary').dataset.count"))
+    assert count == len(answer["solutions"]) == 512 - 2 * 64  # two of eight configurations hit the table
+    assert all(not s["collisions"] and s["clearance"] >= 0.0 for s in answer["solutions"])
+    colliding = [s for s in answer["rejected"] if s["collisions"]]
+    assert len(colliding) == int(browser.evaluate("document.querySelector('#summary').dataset.colliding")) == 2
+    rows = browser.evaluate("[...document.querySelectorAll('#solution-table tbody tr')]"
+                            ".map(r => [r.children[1].textContent, r.querySelector('td.clearance').textContent])")
+    assert len(rows) == count
+    for (joints, clearance), solution in zip(rows, answer["solutions"]):
+        np.testing.assert_allclose([float(v) for v in joints.split(", ")], solution["joints"], atol=0.006)
+        assert float(clearance) == pytest.approx(solution["clearance"], abs=6e-5)
+    # the picture: the table in every panel; the two rejected configurations marked, links and table alike
+    tables = browser.evaluate("[...document.querySelectorAll('#solutions g.configuration')].map(g => "
+                              "g.querySelectorAll('.solid.obstacle[data-name=\"table\"][data-kind=\"box\"]').length)")
+    assert tables == [1] * 8
+    marked = browser.evaluate(_marked("#solutions"))
+    expected = [sorted({name for pair in s["collisions"] for name in (pair["a"], pair["b"])}) for s in colliding]
+    assert marked[:6] == [[]] * 6 and sorted(marked[6:]) == sorted(expected)
+    assert all("table" in names and len(names) >= 2 for names in expected)
+    assert browser.evaluate("[...document.querySelectorAll('#solutions g.configuration.colliding')].length") == 2
+    browser.screenshot("viewer-ur5-table.png")
+
+    # render, as the viewer calls it for the current joints, with a colliding configuration: the SVG has the
+    # obstacle and the colliding links marked
+    q_hit = colliding[0]["joints"]
+    browser.evaluate(f"window.kinematicsViewer.setJoints({json.dumps(q_hit)})")
+    browser.wait_for("document.querySelector('#current-picture .solid.colliding') !== null")
+    current = browser.evaluate(_marked("#current-picture"))
+    assert current == [sorted({name for pair in colliding[0]["collisions"] for name in (pair["a"], pair["b"])})]
+    assert browser.evaluate("document.querySelector('#clearance').textContent").startswith("current joints collide:")
+    svg = browser.evaluate("document.querySelector('#current-picture').innerHTML")
+    assert 'data-name="table"' in svg and "solid link-shape colliding" in svg
+    browser.screenshot("viewer-ur5-colliding.png")
+
+    # removing the table gives every solution back
+    browser.evaluate("document.querySelector('#obstacles li button').click()")
+    browser.wait_for("document.querySelector('#summary').dataset.obstacles === '0'"
+                     " && document.querySelector('#summary').dataset.count === '512'", timeout=60)
     assert browser.foreign_requests(base_url) == []
     assert browser.console_errors == []

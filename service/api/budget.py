@@ -206,6 +206,21 @@ def check_answer_size(settings: Settings, robot: Robot, *, rows: int, form: str,
                            f"more than KIN_MAX_RESPONSE_BYTES = {settings.max_response_bytes:,}. {remedy}")
 
 
+#: Most shapes one picture draws (panels × (obstacles + link shapes)): each is SVG text written in Python.
+MAX_PICTURE_SHAPES = 20_000
+
+
+def check_picture_cost(panels: int, robot: Robot, obstacles: int) -> None:
+    """413 when a picture with collisions would draw more than :data:`MAX_PICTURE_SHAPES` shapes."""
+    shapes = panels * (obstacles + len(robot.collision))
+    if shapes > MAX_PICTURE_SHAPES:
+        raise ProblemError(413, "too-much-work", "Too much work",
+                           f"The picture would draw {shapes:,} shapes ({panels:,} panels × ({obstacles:,} obstacles "
+                           f"+ {len(robot.collision):,} link shapes)), {shapes - MAX_PICTURE_SHAPES:,} more than the "
+                           f"{MAX_PICTURE_SHAPES:,} one picture may. Draw fewer configurations or name fewer "
+                           f"obstacles.")
+
+
 def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, cost: Cost, *, form: str = "objects") -> None:
     """The caps on an IK request's cost (:func:`~service.kinematics.ik.estimate`, counted before any solving):
     turns per joint (422), the numeric search's starts, the combinations ranked per solution and the answer's

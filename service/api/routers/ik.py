@@ -20,7 +20,8 @@ from .render import IK_PICTURE_RESPONSE, ik_picture, wants_svg
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinematics"])
 RENDER_QUERY = Query(None, description="answer with an SVG picture of every distinct solution (those that differ "
                                        "only by whole turns share a panel) seen from this view, instead of JSON; "
-                                       "the same as Accept: image/svg+xml with the iso view")
+                                       "the same as Accept: image/svg+xml with the iso view. With 'collisions', "
+                                       "each panel draws the obstacles and link shapes, colliding ones red")
 
 
 @router.post("/robots/{robot_id}/ik", operation_id="inverse_kinematics", response_model=IKResponse,
@@ -63,7 +64,8 @@ def _single_response(request: Request, asked: AskedIK, body: IKRequest, render: 
                         budget_of(request))[0]
     if not picture:
         return FastJSONResponse(answer)  # built to IKResponse field by field (a test validates it), as it stands
-    return ik_picture(ref.robot, ref.id, answer, body.angle_unit, render or "iso", body.reference is not None)
+    return ik_picture(ref.robot, ref.id, answer, body.angle_unit, render or "iso", body.reference is not None,
+                      asked.options.collisions)
 
 
 @router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch",

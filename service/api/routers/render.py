@@ -11,7 +11,9 @@ from fastapi.responses import Response
 from ...drawing import arm_poses, render_svg
 from ...kinematics import InvalidInputError, Robot
 from ...kinematics.ik import wrap_revolute
-from ..boundary import joints_to_core, located, _unit_scale
+from ...kinematics.collision import CollisionRequest
+from ..boundary import collisions_to_core, joints_to_core, located, _unit_scale
+from ..budget import check_picture_cost
 from ..deps import RobotRef, catalogue_robot, inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..routing import FastJSONRoute
@@ -22,11 +24,14 @@ router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["pictures"])
 SVG_MEDIA_TYPE = "image/svg+xml"
 #: The 200 answer of the picture operations (and the SVG alternative of the IK operations) in the spec.
 SVG_RESPONSE = {"description": "An SVG picture: one panel per configuration, captioned with its labels and "
-                               "its limit status (class `configuration` on each panel's group)",
+                               "its limit status (class `configuration` on each panel's group); with "
+                               "`collisions`, the obstacles and link shapes too (class `solid`), colliding ones "
+                               "and their panels with class `colliding`",
                 "content": {SVG_MEDIA_TYPE: {"schema": {"type": "string"}}}}
 #: The SVG alternative of the IK operations' 200 answer.
 IK_PICTURE_RESPONSE = {"description": "Every solution (JSON), or with `render` or `Accept: image/svg+xml`, a "
-                                      "picture of every distinct solution",
+                                      "picture of every distinct solution (with `collisions`, the obstacles and "
+                                      "link shapes too, colliding ones red)",
                        "content": {SVG_MEDIA_TYPE: {"schema": {"type": "string"}}}}
 
 
@@ -49,30 +54,37 @@ def _render(ref: RobotRef, body: RenderRequest) -> Response:
         raise InvalidInputError(f"expected {len(body.joints)} captions, one per joint vector, got "
                                 f"{len(body.captions)}", location=("body", "captions"))
     captions = None if body.captions is None else [caption.split("\n") for caption in body.captions]
-    poses = arm_poses(robot, q, captions)
+    collisions = collisions_to_core(robot, body.collisions, body.angle_unit)
+    if collisions is not None:
+        check_picture_cost(len(q), robot, len(collisions.obstacles))
+    with located("body", "collisions"):
+        poses = arm_poses(robot, q, captions, collisions=collisions)
     return svg_response(render_svg(poses, view=body.view, columns=body.columns, panel=body.panel_size,
                                    title=body.title or ""))
 
 
 @router.post("/robots/{robot_id}/render", operation_id="render", response_class=Response,
-             responses={200: SVG_RESPONSE, **problem_responses(404, 422)})
+             responses={200: SVG_RESPONSE, **problem_responses(404, 413, 422)})
 def render(body: RenderRequest, ref: RobotRef = Depends(catalogue_robot)) -> Response:
     """An SVG of the arm in each configuration, side by side: links, joint axes, base and tool frames."""
     return _render(ref, body)
 
 
 @router.post("/render", operation_id="render_inline", response_class=Response,
-             responses={200: SVG_RESPONSE, **problem_responses(422)})
+             responses={200: SVG_RESPONSE, **problem_responses(413, 422)})
 def render_inline(request: Request, body: RenderInlineRequest) -> Response:
     """An SVG of a robot described in the request body, in each configuration."""
     return _render(inline_robot(request, body.robot), body)
 
 
-def ik_picture(robot: Robot, robot_id: str, answer: dict, unit: str, view: str, reference_given: bool) -> Response:
+def ik_picture(robot: Robot, robot_id: str, answer: dict, unit: str, view: str, reference_given: bool,
+               collisions: CollisionRequest | None = None) -> Response:
     """Every distinct arm configuration of an IK answer (``solutions`` then ``rejected``) as one picture.
 
     Solutions that differ only by whole turns of revolute joints put the arm in the same place: they share
-    one panel, whose caption says how many of the answer's solutions it stands for.
+    one panel, whose caption says how many of the answer's solutions it stands for. With ``collisions`` (the
+    request's, in core terms), each panel draws the obstacles and link shapes, marked by the answer's own
+    ``collisions`` of that solution.
     """
     scale = _unit_scale(robot, unit)
     groups: dict[tuple, dict] = {}
@@ -95,12 +107,21 @@ def ik_picture(robot: Robot, robot_id: str, answer: dict, unit: str, view: str, 
         captions.append(lines)
         rows.append(group["q"])
     title = f"{robot_id}: {answer['status']}, {len(answer['solutions'])} solutions"
-    if answer["rejected"]:
+    if answer["rejected"] and collisions is None:
         title += f", {len(answer['rejected'])} outside the limits"
+    elif answer["rejected"]:
+        outside = sum(bool(s["violations"]) for s in answer["rejected"])
+        colliding = sum(bool(s["collisions"]) for s in answer["rejected"])
+        title += f", {len(answer['rejected'])} rejected ({outside} outside the limits, {colliding} colliding)"
     if not rows:
         return svg_response(_empty_svg(title))
     violated = [[v["joint"] for v in group["solution"]["violations"]] for group in groups.values()]
-    poses = arm_poses(robot, np.array(rows), captions, violated=violated)
+    if collisions is not None:
+        check_picture_cost(len(rows), robot, len(collisions.obstacles))
+    checked = None if collisions is None else [
+        (group["solution"]["clearance"], [(c["a"], c["b"], c["distance"]) for c in group["solution"]["collisions"]])
+        for group in groups.values()]
+    poses = arm_poses(robot, np.array(rows), captions, violated=violated, collisions=collisions, checked=checked)
     return svg_response(render_svg(poses, view=view, title=title))
 
 

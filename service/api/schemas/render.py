@@ -6,6 +6,7 @@ from enum import Enum
 
 from pydantic import Field
 
+from .collisions import CollisionOptions
 from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RequestFrames
 from ...robots.schemas import RobotDescription
 
@@ -35,6 +36,11 @@ class RenderRequest(RequestFrames):
     columns: int | None = Field(None, ge=1, le=32, description="panels per row; default up to 4")
     panel_size: int = Field(300, ge=120, le=1200, description="width and drawing height of one panel, px")
     title: str | None = Field(None, max_length=200, description="a line of text above the panels")
+    collisions: CollisionOptions | None = Field(
+        None, description="draw the obstacles and the robot's link shapes (capsules, spheres, boxes) in every panel, "
+                          "the links and obstacles of each pair closer than the margin in red, with a line that "
+                          "gives the clearance or the colliding pairs; checked as IK and FK check them ('filter' "
+                          "is not used: every panel is drawn). The robot must carry link shapes")
 
 
 class RenderInlineRequest(RenderRequest):

@@ -1,10 +1,14 @@
 // The viewer: pick a robot, set its joints or type a target, and see every IK solution drawn.
 // It uses the public API only: GET /v1/robots, GET /v1/robots/{id}, and POST .../fk, .../render, .../ik.
-// Joint values are sent with "angle_unit": "deg".
+// Joint values are sent with "angle_unit": "deg". When the robot carries link shapes, every request also sends
+// "collisions" (self-collision, the margin and the box obstacles added here), so the pictures draw the shapes
+// and mark colliding links, and IK rejects the colliding solutions.
 "use strict";
 
 const $ = (selector) => document.querySelector(selector);
-const state = { robot: null, description: null, joints: [] };
+// lastRequest and lastAnswer: the IK body the last "Solve IK" sent and its JSON answer
+const state = { robot: null, description: null, joints: [], obstacles: [], solved: false, lastRequest: null,
+                lastAnswer: null };
 
 function headers() {
   const key = $("#api-key").value.trim();
@@ -57,9 +61,19 @@ async function chooseRobot(id) {
   $("#joints").innerHTML = "";
   $("#solutions").innerHTML = "";
   $("#solution-table tbody").innerHTML = "";
+  state.solved = false;
+  state.obstacles = [];  // in the length unit of the robot they were added for
+  showObstacles();
   if (!id) return;
   const description = await call("GET", `/v1/robots/${encodeURIComponent(id)}`);
   state.description = description;
+  const shaped = (description.collision || []).length > 0;
+  $("#check-collisions").disabled = !shaped;
+  $("#check-collisions").title = shaped ? "" : "this robot carries no link shapes";
+  $("#length-unit").textContent = description.length_unit;
+  const unit = description.length_unit === "mm" ? 1000 : 1;
+  $("#box-center").value = [0.4, 0, -0.05].map((v) => v * unit).join(", ");
+  $("#box-size").value = [0.6, 0.6, 0.1].map((v) => v * unit).join(", ");
   $("#robot-info").textContent = `${description.name || id}: ${description.joints.length} joints, ` +
     `${description.convention} DH, lengths in ${description.length_unit}. ${description.source || ""}`;
   state.joints = description.joints.map(() => 0);
@@ -103,11 +117,14 @@ function scheduleCurrent() {
 async function showCurrent(asTarget) {
   if (!state.robot) return;
   const id = encodeURIComponent(state.robot);
-  const fk = await call("POST", `/v1/robots/${id}/fk`, { joints: state.joints, angle_unit: "deg" });
+  const collisions = collisionOptions();
+  const fk = await call("POST", `/v1/robots/${id}/fk`,
+    withCollisions({ joints: state.joints, angle_unit: "deg" }, collisions));
   const svg = await call("POST", `/v1/robots/${id}/render`,
-    { joints: [state.joints], angle_unit: "deg", view: $("#view").value, captions: ["current joints"],
-      panel_size: 360 }, "image/svg+xml");
+    withCollisions({ joints: [state.joints], angle_unit: "deg", view: $("#view").value,
+                     captions: ["current joints"], panel_size: 360 }, collisions), "image/svg+xml");
   $("#current-picture").innerHTML = svg;
+  showClearance(fk, collisions);
   const p = fk.pose.position.map((v) => v.toFixed(4)).join(", ");
   const q = fk.pose.quaternion_wxyz.map((v) => v.toFixed(4)).join(", ");
   $("#tool-pose").textContent = `tool position (${p}), quaternion wxyz (${q})`;
@@ -118,6 +135,92 @@ async function showCurrent(asTarget) {
 function useCurrentPose() {
   if (!state.pose) return;
   $("#target").value = JSON.stringify({ matrix: state.pose.matrix.map((row) => row.map((v) => +v.toFixed(12))) });
+}
+
+// --------------------------------------------------------------------------- collisions
+
+/** The requests' "collisions": null when the robot has no link shapes or the check is off. */
+function collisionOptions() {
+  if (!state.description || !(state.description.collision || []).length || !$("#check-collisions").checked) {
+    return null;
+  }
+  return { self: true, margin: Math.max(0, Number($("#margin").value) || 0), obstacles: state.obstacles };
+}
+
+function withCollisions(body, collisions) {
+  return collisions ? { ...body, collisions } : body;
+}
+
+function describeContacts(contacts) {
+  return contacts.map((c) => `${c.a} – ${c.b} (${c.distance.toFixed(4)})`).join(", ");
+}
+
+function showClearance(fk, collisions) {
+  const line = $("#clearance");
+  line.classList.toggle("colliding", Boolean(collisions && fk.collisions && fk.collisions.length));
+  if (!collisions) { line.textContent = ""; return; }
+  line.textContent = fk.collisions.length ? `current joints collide: ${describeContacts(fk.collisions)}` :
+    fk.clearance === null || fk.clearance === undefined ? "current joints: no pair checked" :
+    `current joints: clear by ${fk.clearance.toFixed(4)} ${state.description.length_unit}`;
+}
+
+function parseTriple(text, what) {
+  const values = text.split(/[\s,]+/).filter((v) => v !== "").map(Number);
+  if (values.length !== 3 || values.some((v) => !Number.isFinite(v))) {
+    throw new Error(`${what} must be three numbers, as "0.4, 0, -0.05"`);
+  }
+  return values;
+}
+
+function showObstacles() {
+  const list = $("#obstacles");
+  list.innerHTML = "";
+  state.obstacles.forEach((obstacle, index) => {
+    const item = document.createElement("li");
+    item.className = "obstacle";
+    item.dataset.name = obstacle.name;
+    item.textContent = `${obstacle.name}: box at (${obstacle.box.center.join(", ")}), size ` +
+      `(${obstacle.box.size.join(", ")})`;
+    const remove = document.createElement("button");
+    remove.type = "button";
+    remove.textContent = "remove";
+    remove.addEventListener("click", () => removeObstacle(index).catch(showError));
+    item.append(remove);
+    list.append(item);
+  });
+  list.dataset.count = String(state.obstacles.length);
+}
+
+/** Redraw the current joints and, once IK has been solved, solve again: the survivors of the new scene. */
+async function collisionsChanged() {
+  showObstacles();
+  await showCurrent(false);
+  if (state.solved) await solve();
+}
+
+/** Add a box obstacle (world frame, the robot's length unit); the form's values unless given. */
+async function addBox(name, center, size) {
+  showError(null);
+  if (!state.robot) throw new Error("choose a robot first");
+  if (!(state.description.collision || []).length) {
+    throw new Error("this robot carries no link shapes: there is nothing to check an obstacle against");
+  }
+  name = (name === undefined ? $("#box-name").value : name).trim();
+  center = center || parseTriple($("#box-center").value, "the centre");
+  size = size || parseTriple($("#box-size").value, "the size");
+  if (!name) throw new Error("give the box a name");
+  if (state.obstacles.some((o) => o.name === name)) throw new Error(`there is already an obstacle named ${name}`);
+  if (size.some((v) => v <= 0)) throw new Error("the size must be three numbers > 0");
+  state.obstacles.push({ name, box: { center, size } });
+  $("#box-name").value = `box ${state.obstacles.length + 1}`;
+  if (!$("#check-collisions").checked) $("#check-collisions").checked = true;
+  await collisionsChanged();
+}
+
+async function removeObstacle(index) {
+  showError(null);
+  state.obstacles.splice(index, 1);
+  await collisionsChanged();
 }
 
 // --------------------------------------------------------------------------- IK
@@ -132,11 +235,16 @@ async function solve() {
   let target;
   try { target = JSON.parse($("#target").value); } catch (error) { throw new Error(`target is not JSON: ${error}`); }
   const id = encodeURIComponent(state.robot);
-  const body = { target, reference: state.joints, angle_unit: "deg", filter_limits: false };
+  const collisions = collisionOptions();
+  const body = withCollisions({ target, reference: state.joints, angle_unit: "deg", filter_limits: false },
+                              collisions);
   $("#summary").textContent = "solving…";
-  delete $("#summary").dataset.count;
+  for (const key of ["count", "rejected", "colliding", "obstacles"]) delete $("#summary").dataset[key];
   const answer = await call("POST", `/v1/robots/${id}/ik`, body);
   const picture = await call("POST", `/v1/robots/${id}/ik?render=${$("#view").value}`, body, "image/svg+xml");
+  state.solved = true;
+  state.lastRequest = body;
+  state.lastAnswer = answer;
   $("#solutions").innerHTML = picture;
   const rows = $("#solution-table tbody");
   rows.innerHTML = "";
@@ -146,8 +254,11 @@ async function solve() {
     const branch = Object.entries(solution.branch).map(([k, v]) => `${k} ${v}`).join(", ");
     const limits = solution.within_limits ? "within" :
       "outside: " + solution.violations.map((v) => state.description.joints[v.joint].name || `q${v.joint + 1}`).join(", ");
+    const clearance = solution.clearance === null || solution.clearance === undefined ? "" :
+      solution.clearance.toFixed(4);
     row.innerHTML = `<td>${index + 1}</td><td class="joints">${solution.joints.map((v) => v.toFixed(2)).join(", ")}</td>` +
-      `<td>${branch}</td><td>${limits}</td><td>${largestMove(solution.joints, state.joints).toFixed(2)}</td>`;
+      `<td>${branch}</td><td>${limits}</td><td class="clearance">${clearance}</td>` +
+      `<td>${largestMove(solution.joints, state.joints).toFixed(2)}</td>`;
     row.addEventListener("click", () => setJoints(solution.joints).catch(showError));
     rows.append(row);
   });
@@ -156,10 +267,19 @@ async function solve() {
   let summary = `${answer.status}: ${answer.solutions.length} solutions in ${panels} arm configurations ` +
     `(${outside} outside the limits), nearest the current joints first; ` +
     `solver ${answer.solver.method}, ${answer.solver.structure}${answer.solver.complete ? ", complete" : ""}.`;
+  const colliding = answer.rejected.filter((s) => s.collisions && s.collisions.length).length;
+  if (collisions) {
+    const n = collisions.obstacles.length;
+    summary += ` Collisions checked (self and ${n} obstacle${n === 1 ? "" : "s"}, margin ${collisions.margin}):` +
+      ` colliding links are drawn red.`;
+  }
   if (answer.detail) summary += ` ${answer.detail}`;
   $("#summary").textContent = summary;
-  $("#summary").dataset.count = String(answer.solutions.length);
+  $("#summary").dataset.rejected = String(answer.rejected.length);
+  $("#summary").dataset.colliding = String(colliding);
+  $("#summary").dataset.obstacles = String(collisions ? collisions.obstacles.length : 0);
   $("#summary").dataset.panels = String(panels);
+  $("#summary").dataset.count = String(answer.solutions.length);  // last: tests wait for it
 }
 
 // --------------------------------------------------------------------------- wiring
@@ -170,5 +290,8 @@ $("#view").addEventListener("change", () => showCurrent(false).catch(showError))
 $("#use-current").addEventListener("click", useCurrentPose);
 $("#solve").addEventListener("click", () => solve().catch((error) => { $("#summary").textContent = ""; showError(error); }));
 $("#api-key").addEventListener("change", () => loadRobots().catch(showError));
-window.kinematicsViewer = { chooseRobot, setJoints, solve };
+$("#add-box").addEventListener("click", () => addBox().catch(showError));
+$("#check-collisions").addEventListener("change", () => collisionsChanged().catch(showError));
+$("#margin").addEventListener("change", () => collisionsChanged().catch(showError));
+window.kinematicsViewer = { chooseRobot, setJoints, solve, addBox, removeObstacle, state };
 loadRobots().catch(showError);

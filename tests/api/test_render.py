@@ -4,7 +4,8 @@ Geometry is checked against forward kinematics computed here: in the top view a 
 are world (x, −y) times one scale shared by every panel, so the base-to-tool vector of each panel must be
 the FK tool position (minus the base) times that scale.
 
-``python -m tests.api.test_render`` rewrites the README's picture (docs/puma560_ik_solutions.svg).
+``python -m tests.api.test_render`` rewrites the README's pictures (docs/puma560_ik_solutions.svg and
+docs/puma560_over_table.svg).
 """
 
 from __future__ import annotations
@@ -163,20 +164,36 @@ def _readme_picture(client) -> str:
                        json={"target": {"matrix": matrix}, "reference": README_Q_DEG, "angle_unit": "deg"}).text
 
 
+COLLISION_PICTURE = ROOT / "docs" / "puma560_over_table.svg"
+
+
+def _collision_picture(client) -> str:
+    """The spec's PUMA over a table, beside a post (service/api/examples.py): every solution, colliding ones red."""
+    from service.api.examples import _PUMA_OVER_TABLE
+
+    return client.post("/v1/robots/puma560_standard/ik", headers={"Accept": "image/svg+xml"},
+                       json=_PUMA_OVER_TABLE).text
+
+
+PICTURES = {"puma560_ik_solutions.svg": (README_PICTURE, _readme_picture),
+            "puma560_over_table.svg": (COLLISION_PICTURE, _collision_picture)}
+
+
 def _numbers_and_text(svg: str) -> tuple[list[float], str]:
     pattern = r"-?\d+(?:\.\d+)?(?:e-?\d+)?"
     return [float(n) for n in re.findall(pattern, svg)], re.sub(pattern, "#", svg)
 
 
-def test_the_readme_picture_is_what_the_service_draws(client):
+@pytest.mark.parametrize("name", sorted(PICTURES))
+def test_the_readme_pictures_are_what_the_service_draws(client, name):
     """Regenerated and compared: the same text, and every coordinate within 0.02 px (rounding across numpy
     builds can move the last printed digit)."""
-    committed, drawn = _numbers_and_text(README_PICTURE.read_text(encoding="utf-8")), _numbers_and_text(
-        _readme_picture(client))
-    assert committed[1] == drawn[1], "docs/puma560_ik_solutions.svg is stale: python -m tests.api.test_render"
+    path, draw = PICTURES[name]
+    committed, drawn = _numbers_and_text(path.read_text(encoding="utf-8")), _numbers_and_text(draw(client))
+    assert committed[1] == drawn[1], f"docs/{name} is stale: python -m tests.api.test_render"
     np.testing.assert_allclose(committed[0], drawn[0], atol=0.02)
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert "](docs/puma560_ik_solutions.svg)" in readme
+    assert f"](docs/{name})" in readme
 
 
 if __name__ == "__main__":
@@ -186,5 +203,6 @@ if __name__ == "__main__":
 
     with TestClient(create_app()) as test_client:
         README_PICTURE.parent.mkdir(exist_ok=True)
-        README_PICTURE.write_text(_readme_picture(test_client), encoding="utf-8")
-    print(f"wrote {README_PICTURE}", file=sys.stderr)
+        for path, draw in PICTURES.values():
+            path.write_text(draw(test_client), encoding="utf-8")
+            print(f"wrote {path}", file=sys.stderr)

@@ -70,3 +70,18 @@ def test_the_ur5_solution_counts_the_readme_states(client):
         fits = [sum(abs(v + 2 * k * np.pi) <= 2 * np.pi + 1e-9 for k in range(-2, 3)) for v in branches.ravel()]
         assert len(answer["solutions"]) == int(np.prod(np.reshape(fits, branches.shape), axis=1).sum())
     assert stated == counted
+
+
+def test_the_core_library_example_runs():
+    """"Use the core from Python" runs as written (the other Python blocks talk to a server): its asserts are the
+    README's claims."""
+    import contextlib
+    import io
+
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme.split("### Use the core from Python", 1)[1].split("\n### ", 1)[0]
+    blocks = re.findall(r"```python\n(.+?)```", section, re.S)
+    assert blocks, "the README shows the core's Python API"
+    for block in blocks:
+        with contextlib.redirect_stdout(io.StringIO()):
+            exec(compile(block, "README.md", "exec"), {"__name__": "readme_example"})

@@ -58,6 +58,7 @@ class Server:
             except httpx.HTTPError:
                 pass
             if self.process.poll() is not None or time.monotonic() > deadline:
+                self.stop()  # never leave a server behind: with several workers it outlives the test run
                 raise RuntimeError(f"the service did not start: {self.log.read_text()}")
             time.sleep(0.2)
 

@@ -170,7 +170,7 @@ def main(argv: list[str] | None = None) -> int:
         arm = catalogue.get(robot_id).robot
         pose = forward_kinematics(arm, sample_configurations(arm, 1, seed=5)[0])
         bodies[f"ik_{robot_id}"] = json.dumps({"target": {"matrix": pose.tolist()}}).encode()
-    description = json.loads(catalogue.get(ROBOT).description.model_dump_json(exclude_none=True))
+    description = json.loads(catalogue.get(ROBOT).description.model_dump_json(exclude_none=True, by_alias=True))
     bodies["ik_inline"] = json.dumps({"robot": description, "target": {"matrix": T[0].tolist()}}).encode()
 
     # the core's own time for the same batch, in this process, before the server starts

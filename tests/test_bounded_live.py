@@ -58,6 +58,7 @@ class Server:
             except httpx.HTTPError:
                 pass
             if self.process.poll() is not None or time.monotonic() > deadline:
+                self.stop()  # never leave a server behind: with several workers it outlives the test run
                 raise RuntimeError(f"the service did not start: {self.log.read_text()}")
             time.sleep(0.2)
 
@@ -184,6 +185,51 @@ def test_sigterm_during_a_request_finishes_or_refuses_it_cleanly(tmp_path):
     assert code in (0, -signal.SIGTERM)
     for line in server.lines():
         json.loads(line)
+
+
+def test_a_saturated_server_stays_ready_sheds_each_request_past_the_limit_and_is_not_ready_in_shutdown(tmp_path):
+    """Issue 22.9, load shed per request: with KIN_MAX_IN_FLIGHT = 1 and one slow request in flight, /readyz is
+    200 (in_flight 1) and a new request gets a 503 problem with Retry-After; once SIGTERM arrives, the readiness
+    probe never answers 200 again (refused: uvicorn closes its listening socket; or 503), while the slow request
+    still ends cleanly."""
+    server = Server(tmp_path, KIN_MAX_IN_FLIGHT="1", KIN_REQUEST_TIMEOUT_MS="3000", KIN_MAX_IK_TIME_MS="600000")
+    answer: dict = {}
+
+    def slow_request() -> None:
+        with httpx.Client(timeout=60) as client:
+            response = client.post(f"{server.url}/v1/ik", json={
+                "robot": NUMERIC_ARM, "target": NUMERIC_TARGET, "numeric": {"starts": 2000, "time_budget_ms": 10_000}})
+            answer["status"], answer["type"] = response.status_code, response.headers["content-type"]
+
+    request = threading.Thread(target=slow_request)
+    try:
+        request.start()
+        deadline = time.monotonic() + 2.0
+        while (ready := httpx.get(f"{server.url}/readyz", timeout=5)).json().get("in_flight") != 1:
+            assert time.monotonic() < deadline, ready.text
+            time.sleep(0.02)
+        assert ready.status_code == 200 and ready.json()["status"] == "ready"  # saturated, and still ready
+        refused = httpx.post(f"{server.url}/v1/robots/ur5/fk", json={"joints": UR5_Q}, timeout=5)
+        assert refused.status_code == 503 and refused.headers["retry-after"] == "1"
+        assert refused.headers["content-type"].startswith("application/problem+json")
+        assert refused.json()["type"].endswith("/overloaded") and "KIN_MAX_IN_FLIGHT = 1" in refused.json()["detail"]
+        assert answer == {}  # the slow request is still being worked on
+        server.process.send_signal(signal.SIGTERM)
+        time.sleep(0.3)
+        probes = []
+        while request.is_alive() and len(probes) < 20:  # during the drain
+            try:
+                probes.append(httpx.get(f"{server.url}/readyz", timeout=2).status_code)
+            except httpx.TransportError:
+                probes.append(None)  # refused: the socket is closed, which the probe counts as not ready
+            time.sleep(0.1)
+        request.join(timeout=30)
+    finally:
+        code = server.stop()
+    assert probes and 200 not in probes, probes
+    assert answer["status"] in (200, 503), answer
+    assert answer["status"] == 200 or answer["type"].startswith("application/problem+json")
+    assert code in (0, -signal.SIGTERM)
 
 
 def test_a_connection_over_the_cap_gets_a_problem_and_is_logged(tmp_path):

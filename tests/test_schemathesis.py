@@ -121,9 +121,9 @@ def _meaningful_case(path: str, method: str, robot_id: str, seed: int, variant: 
     entry = CATALOGUE.get(robot_id)
     robot, rng = entry.robot, np.random.default_rng(seed)
     q = _joints(robot, rng)
-    inline = entry.description.model_dump(mode="json")
+    inline = entry.description.model_dump(mode="json", by_alias=True)
     if seed % 3 == 1:
-        inline = screws_description(entry.description, robot).model_dump(mode="json")
+        inline = screws_description(entry.description, robot).model_dump(mode="json", by_alias=True)
     frames = {}
     if seed % 3 == 2:
         base, tool = np.eye(4), np.eye(4)

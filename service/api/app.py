@@ -85,6 +85,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         directories = [settings.builtin_robots_dir]
         if settings.robots_dir is not None:
             directories.append(settings.robots_dir)
+        app.state.shutting_down = False
         app.state.catalogue = load_catalogue(directories, max_joints=settings.max_joints,
                                              max_file_bytes=settings.max_robot_file_bytes)
         logger.info("catalogue loaded: %d robots from %s", len(app.state.catalogue),
@@ -92,6 +93,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         thresholds = gc.get_threshold()
         _tune_collector()
         yield
+        app.state.shutting_down = True  # /readyz: 503 from here on (the catalogue is dropped below)
         gc.unfreeze()  # an application started again in this process (tests) must not pile frozen objects up
         gc.set_threshold(*thresholds)
         app.state.catalogue = None
@@ -108,6 +110,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     )
     app.state.settings = settings
     app.state.catalogue = None
+    app.state.shutting_down = False
     app.state.in_flight = InFlight(settings.max_in_flight)
     app.state.inline_robots = RobotCache("inline", settings.robot_cache_size)
     configure_logging(settings.log_level)

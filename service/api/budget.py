@@ -3,7 +3,9 @@
 * :class:`WorkLimits` (pure ASGI middleware) gives every ``POST /v1/...`` request a core
   :class:`~service.kinematics.Budget`: a deadline of ``KIN_REQUEST_TIMEOUT_MS`` (or the lower value of the
   request's ``X-Request-Timeout-Ms`` header), cancelled when the client disconnects. It refuses work beyond
-  ``KIN_MAX_IN_FLIGHT`` requests at once with 503 and ``Retry-After``; ``/readyz`` reports the same saturation.
+  ``KIN_MAX_IN_FLIGHT`` requests at once with 503 and ``Retry-After``. Load is shed here, request by request:
+  ``/readyz`` stays 200 while saturated (a fleet whose every pod left its Service at a peak would refuse
+  connections instead of answering this 503), and reports the count as ``in_flight``.
 * The routers call :func:`check_ik_cost` before solving: the core's cost estimate (the worst-case answer,
   targets × solutions per target × 2π-equivalents per solution, and the numeric starts) is held against
   ``KIN_MAX_SOLUTIONS_PER_RESPONSE`` and ``KIN_MAX_RESPONSE_BYTES``, and each joint's limits against

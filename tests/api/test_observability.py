@@ -150,6 +150,17 @@ def test_readiness_is_503_until_the_catalogue_is_loaded():
         assert ready.json() == {"status": "ready", "robots": len(files), "in_flight": 0}
 
 
+def test_readiness_is_503_once_shutdown_begins_and_200_again_after_a_new_start_up():
+    app = create_app(Settings(_env_file=None))
+    with TestClient(app) as client:
+        assert client.get("/readyz").status_code == 200
+    stopped = TestClient(app)  # the lifespan's shutdown has run
+    assert_problem(stopped.get("/readyz"), 503, match="shutting down")
+    assert stopped.get("/healthz").status_code == 200
+    with TestClient(app) as client:  # started again (tests do): ready again
+        assert client.get("/readyz").status_code == 200
+
+
 def test_a_bad_robot_file_keeps_the_service_from_becoming_ready(tmp_path):
     (tmp_path / "broken.yaml").write_text("id: broken\nconvention: standard\njoints: []\n")
     app = create_app(Settings(_env_file=None, robots_dir=tmp_path))

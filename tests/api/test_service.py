@@ -2,13 +2,6 @@
 
 from __future__ import annotations
 
-import os
-import socket
-import subprocess
-import sys
-import time
-from pathlib import Path
-
 import httpx
 import pytest
 from fastapi.testclient import TestClient
@@ -16,8 +9,7 @@ from fastapi.testclient import TestClient
 from service.api.app import create_app
 from service.robots.catalogue import CatalogueError, load_catalogue
 from service.config import BUILTIN_ROBOTS_DIR, Settings
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.live import serve
 
 EXTRA_ROBOT = """\
 id: my_cell_arm
@@ -31,38 +23,14 @@ joints:
 """
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
 @pytest.fixture
 def live_server(tmp_path):
     """``python -m service`` on a free loopback port, with an extra robots directory; yields its base URL."""
     extra = tmp_path / "robots.d"
     extra.mkdir()
     (extra / "my_cell_arm.yaml").write_text(EXTRA_ROBOT)
-    port = _free_port()
-    env = {**os.environ, "HOST": "127.0.0.1", "PORT": str(port), "KIN_ROBOTS_DIR": str(extra),
-           "KIN_LOG_LEVEL": "warning"}
-    process = subprocess.Popen([sys.executable, "-m", "service"], cwd=ROOT, env=env,
-                               stdout=subprocess.PIPE, stderr=subprocess.STDOUT)
-    base = f"http://127.0.0.1:{port}"
-    try:
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            try:
-                if httpx.get(f"{base}/readyz", timeout=1).status_code == 200:
-                    break
-            except httpx.TransportError:
-                time.sleep(0.1)
-        else:
-            pytest.fail(f"service did not become ready: {process.stdout.read1().decode(errors='replace')}")
+    with serve(KIN_ROBOTS_DIR=str(extra)) as base:
         yield base
-    finally:
-        process.terminate()
-        process.wait(timeout=15)
 
 
 def test_real_server_over_tcp(live_server):

@@ -20,7 +20,8 @@ class Health(ApiModel):
 
     status: str = Field(description="ok (liveness) or ready (readiness)")
     robots: int | None = Field(None, description="robots in the loaded catalogue (readiness)")
-    in_flight: int | None = Field(None, description="requests being solved now (readiness)")
+    in_flight: int | None = Field(None, description="requests being worked on now, up to KIN_MAX_IN_FLIGHT "
+                                                    "(readiness; informational: it does not change readiness)")
 
 
 @router.get("/healthz", operation_id="liveness", response_model=Health, response_model_exclude_none=True)
@@ -31,14 +32,14 @@ async def liveness() -> Health:
 
 @router.get("/readyz", operation_id="readiness", response_model=Health, responses=problem_responses(503))
 async def readiness(request: Request) -> Health:
-    """Answer 200 once the robot catalogue is loaded and the service has room for work; 503 before the catalogue
-    is loaded and while KIN_MAX_IN_FLIGHT requests are in flight (saturated: send traffic elsewhere)."""
+    """Answer 200 while the service can serve: its robot catalogue is loaded and it is not shutting down; 503
+    before the catalogue is loaded and once shutdown has begun. Load does not change readiness: with
+    KIN_MAX_IN_FLIGHT requests in flight it stays 200 (in_flight says how busy it is), and each request past that
+    limit is answered 503 with Retry-After by itself. A pod's readiness that followed its load would take every pod
+    of a saturated fleet out of its Service at once, and clients would get connection errors instead of that 503."""
+    if request.app.state.shutting_down:
+        raise ProblemError(503, "not-ready", "Not ready", "The service is shutting down.")
     catalogue = request.app.state.catalogue
     if catalogue is None:
         raise ProblemError(503, "not-ready", "Not ready", "The robot catalogue is not loaded yet.")
-    in_flight = request.app.state.in_flight
-    if in_flight.saturated:
-        raise ProblemError(503, "saturated", "Saturated",
-                           f"{in_flight.count} requests in flight, the limit (KIN_MAX_IN_FLIGHT = "
-                           f"{in_flight.capacity}).", headers={"Retry-After": "1"})
-    return Health(status="ready", robots=len(catalogue), in_flight=in_flight.count)
+    return Health(status="ready", robots=len(catalogue), in_flight=request.app.state.in_flight.count)

@@ -568,7 +568,7 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
             lookup[code] = reports.index(report)
         report_of[part.rows] = lookup[flags]
         reported = verified.count > 0 if part.reported is None else part.reported
-        for local in np.flatnonzero(reported).tolist():
+        for local in np.flatnonzero(reported & verified.singularities.any()).tolist():  # the others meet none
             met = verified.singularities[local]
             if met:
                 singular_of[int(part.rows[local])] = met

@@ -26,6 +26,8 @@ class Anchor:
     library: str
     ik_single: Callable[[np.ndarray], np.ndarray] | None = None  # (4, 4) -> (m, n)
     ik_batch: Callable[[np.ndarray], list[np.ndarray]] | None = None  # (N, 4, 4) -> N × (m, n)
+    #: the batch call with a given number of worker threads, for a library that takes one: (N, 4, 4), k -> N × (m, n)
+    ik_batch_threads: Callable[[np.ndarray, int], list[np.ndarray]] | None = None
     fk_single: Callable[[np.ndarray], object] | None = None  # (n,) -> pose
     fk_batch: Callable[[np.ndarray], object] | None = None  # (N, n) -> poses
     notes: list[str] = field(default_factory=list)
@@ -69,8 +71,57 @@ def eaik(robot: Robot) -> Anchor | str:
         "EAIK",
         ik_single=lambda T: solutions(bot.IK(T)),
         ik_batch=lambda Ts: [solutions(r) for r in bot.IK_batched(Ts)],
+        ik_batch_threads=lambda Ts, threads: [solutions(r) for r in bot.IK_batched(Ts, threads)],
         fk_single=lambda q: bot.fwdKin(q + offset),
         notes=[f"family {bot.getKinematicFamily()}; IK_batched with its default 4 worker threads"],
+    )
+
+
+def _screw_chain(robot: Robot):
+    """The arm's screw model as axis directions h (n, 3), offsets p (n + 1, 3) between consecutive axis points
+    (from the world origin to the tool), the home rotation (3, 3) and the geometry: consecutive axes that meet share
+    their point, so that the zero offsets a family expects are exact zeros."""
+    geometry = geometry_of(robot)
+    model = geometry.model
+    h = model.directions.copy()
+    points = model.points.copy()
+    for i in range(len(points) - 1):
+        meet = geometry.intersection(i, i + 1)
+        if meet is not None:
+            points[i] = points[i + 1] = meet
+    if robot.dof == 6 and geometry.common_point((3, 4, 5)) is not None:
+        points[3] = points[4] = points[5] = geometry.common_point((3, 4, 5))
+    tool = model.home[:3, 3]
+    p = np.vstack([points[0], np.diff(points, axis=0), tool - points[-1]])
+    return h, p, model.home[:3, :3], geometry
+
+
+def eaik_screws(robot: Robot) -> Anchor | str:
+    """EAIK (C++) from the screw model, for an arm that is no plain standard DH table (a Craig table, a base or a
+    tool): its ``Robot`` from h, p and the home rotation; ``IK`` and ``IK_batched``."""
+    import eaik.pybindings.EAIK as EAIK
+    from eaik.IK_HP import HPRobot
+
+    if not robot.is_revolute.all():
+        return "EAIK takes revolute joints only"
+    h, p, home_R, _ = _screw_chain(robot)
+    bot = HPRobot(h, p)
+    bot._robot = EAIK.Robot(h.T, p.T, home_R, [], True)  # HPRobot takes no home rotation; the binding does
+    if not bot.hasKnownDecomposition():
+        return f"no closed form for this arm ({bot.getKinematicFamily()})"
+
+    def solutions(result) -> np.ndarray:
+        Q = np.asarray(result.Q, dtype=float).reshape(-1, robot.dof)
+        return Q[~np.asarray(result.is_LS, dtype=bool)]
+
+    return Anchor(
+        "EAIK",
+        ik_single=lambda T: solutions(bot.IK(T)),
+        ik_batch=lambda Ts: [solutions(r) for r in bot.IK_batched(Ts)],
+        ik_batch_threads=lambda Ts, threads: [solutions(r) for r in bot.IK_batched(Ts, threads)],
+        fk_single=lambda q: bot.fwdKin(q),
+        notes=[f"family {bot.getKinematicFamily()} (from the screw model); IK_batched with its default 4 worker "
+               f"threads"],
     )
 
 
@@ -80,20 +131,7 @@ def ik_geo(robot: Robot) -> Anchor | str:
 
     if robot.dof != 6 or not robot.is_revolute.all():
         return "6R arms only"
-    geometry = geometry_of(robot)
-    model = geometry.model
-    h = model.directions.copy()
-    points = model.points.copy()
-    # consecutive axes that meet share their point, so that the zero offsets the family expects are exact zeros
-    for i in range(5):
-        meet = geometry.intersection(i, i + 1)
-        if meet is not None:
-            points[i] = points[i + 1] = meet
-    if geometry.common_point((3, 4, 5)) is not None:
-        points[3] = points[4] = points[5] = geometry.common_point((3, 4, 5))
-    tool = model.home[:3, 3]
-    p = np.vstack([points[0], np.diff(points, axis=0), tool - points[5]])
-    home_R = model.home[:3, :3]
+    h, p, home_R, geometry = _screw_chain(robot)
     if geometry.common_point((3, 4, 5)) is not None and geometry.intersection(0, 1) is not None:
         bot, family = lib.Robot.spherical_two_intersecting(h, p), "spherical_two_intersecting"
     elif geometry.parallel(1, 2) and geometry.parallel(2, 3) and geometry.intersection(4, 5) is not None:

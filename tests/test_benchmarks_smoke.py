@@ -19,6 +19,10 @@ def test_core_benchmark_runs_with_tiny_sizes(capsys):
     assert "| PUMA 560 | IK, single pose | core |" in out
     assert "| Stanford | FK, batch of 20 | core |" in out
     assert "peak traced memory for a 200-pose batch" in out
+    for robot in ("PUMA 560", "UR5", "KUKA KR6"):  # what a request pays: the whole answer beside the solve alone
+        for limits in ("limits ±π, no filter", "catalogue limits"):
+            assert f"| {robot} | IK answer, {limits}, single pose | core |" in out
+            assert f"| {robot} | IK answer, {limits}, batch of 20 | core, solve only (solve_ik_arrays) |" in out
     for name in anchors.LIBRARIES:
         if not anchors.installed(name):
             assert f"{name}: not installed" in out

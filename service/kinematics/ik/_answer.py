@@ -557,16 +557,18 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
         owner[part.rows], local_of[part.rows] = number, np.arange(len(part.rows))
         verified = part.verified
         complete[part.rows] = verified.complete
-        unfinished = np.zeros(len(part.rows), dtype=bool) if part.unfinished is None else part.unfinished
-        for flags in {(bool(c), bool(u)) for c, u in zip(verified.complete.tolist(), unfinished.tolist())}:
-            report = SolverReport(part.method, part.structure, flags[0], flags[1], part.free_joints)
+        flags = 2 * verified.complete.astype(int)  # (complete, unfinished) as one code per target: 0 … 3
+        if part.unfinished is not None:
+            flags += part.unfinished
+        lookup = np.zeros(4, dtype=int)
+        for code in np.unique(flags).tolist():
+            report = SolverReport(part.method, part.structure, code >= 2, code % 2 == 1, part.free_joints)
             if report not in reports:
                 reports.append(report)
-        for local, (c, u) in enumerate(zip(verified.complete.tolist(), unfinished.tolist())):
-            report_of[part.rows[local]] = reports.index(
-                SolverReport(part.method, part.structure, c, u, part.free_joints))
+            lookup[code] = reports.index(report)
+        report_of[part.rows] = lookup[flags]
         reported = verified.count > 0 if part.reported is None else part.reported
-        for local in np.flatnonzero(reported).tolist():
+        for local in np.flatnonzero(reported & verified.singularities.any()).tolist():  # the others meet none
             met = verified.singularities[local]
             if met:
                 singular_of[int(part.rows[local])] = met

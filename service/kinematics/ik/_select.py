@@ -38,7 +38,7 @@ capped at :data:`.._budget.COUNT_CAP`.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -239,6 +239,8 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     n = robot.dof
     target, q = table.target, table.joints
     first, last = turn_ranges(robot, limits, q)
+    if reference is None and excluded is None and (first == last).all():
+        return _each_once(table, n_targets, first, max_equivalents, n)
     fits = np.all(last >= first, axis=1)
     keepable = fits if filter_limits else np.ones(len(q), dtype=bool)
     if excluded is not None:
@@ -307,9 +309,36 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     return Selection(status, truncated, trimmed, available, notes, kept, rejected)
 
 
+def _each_once(table: SolutionTable, n_targets: int, turns: np.ndarray, max_equivalents: int, n: int) -> Selection:
+    """:func:`select` where every row fits the limits at exactly one 2π-equivalent (limits within a whole turn,
+    or none: each solution once) and nothing orders or excludes rows: each target's first ``max_equivalents``
+    rows in table order, at that equivalent, and the per-target counts the general path gives for them (each
+    row one combination, no rejected row), in a few array operations."""
+    target = table.target
+    rows_per_target = table.counts(n_targets)
+    values = table.joints + _TWO_PI * turns
+    if len(target) and rows_per_target.max() > max_equivalents:  # the cap: each target's first rows
+        keep = position_in_group(target) < max_equivalents
+        kept = _listed(table.take(keep), values[keep], np.ones(int(keep.sum()), dtype=bool))
+        n_kept = np.minimum(rows_per_target, max_equivalents)
+    else:
+        kept = _listed(table, values, np.ones(len(target), dtype=bool))
+        n_kept = rows_per_target
+    zeros = np.zeros(n_targets, dtype=np.int64)
+    status = np.full(n_targets, "ok", dtype=object)
+    status[rows_per_target == 0] = "unreachable"
+    truncated = rows_per_target > n_kept
+    available = rows_per_target.astype(np.int64, copy=False)
+    notes = TargetNotes(np.flatnonzero(truncated), status, zeros, zeros, truncated, available, n_kept, available,
+                        zeros, max_equivalents, False, None, n)
+    rejected = _listed(table.take(np.zeros(0, dtype=np.int64)), np.zeros((0, n)), np.zeros(0, dtype=bool))
+    return Selection(status, truncated, np.zeros(n_targets, dtype=np.int64), available, notes, kept, rejected)
+
+
 def _listed(rows: SolutionTable, joints: np.ndarray, within: np.ndarray) -> SolutionTable:
     """``rows`` at the equivalents ``joints`` (K, n) listed, flagged ``within`` the limits (K,)."""
-    return replace(rows, joints=joints, within_limits=within)
+    return SolutionTable(rows.target, joints, within, rows.position, rows.orientation, rows.labels, rows.clearance,
+                         rows.contacts)
 
 
 def _within_move(robot: Robot, limits: Limits, q: np.ndarray, first: np.ndarray, last: np.ndarray,

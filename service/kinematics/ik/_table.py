@@ -68,7 +68,8 @@ class SolutionTable:
     def with_targets(self, target: np.ndarray) -> "SolutionTable":
         """The same rows numbered by other targets (``target`` (S,) non-decreasing), as when a part's rows
         take their place among a whole answer's."""
-        return replace(self, target=np.asarray(target, dtype=np.int64))
+        return SolutionTable(np.asarray(target, dtype=np.int64), self.joints, self.within_limits, self.position,
+                             self.orientation, self.labels, self.clearance, self.contacts)
 
     def with_clearances(self, clearance: np.ndarray, contacts: np.ndarray) -> "SolutionTable":
         """The same rows with their collision check (see the class docstring)."""

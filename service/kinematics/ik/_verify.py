@@ -128,11 +128,25 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
         elif revolute.any():
             gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
         same = (gap <= tolerance).all(axis=-1)
+        if n_targets == 1:  # one target: the same scan on Python booleans (m − 1 steps of a few pairs each)
+            kept[0] = _scanned_pairs(same[0].tolist(), kept[0].tolist())
+            return kept
         # the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
         offset = 0
         for slot in range(1, m):
             kept[block, slot] &= ~np.any(same[:, offset:offset + slot] & kept[block, :slot], axis=1)
             offset += slot
+    return kept
+
+
+def _scanned_pairs(same: list[bool], kept: list[bool]) -> list[bool]:
+    """The scan of :func:`first_of_each` for one target: ``same`` lists its slot pairs in :func:`_slot_pairs`
+    order, ``kept`` (m,) the ok slots; a slot is dropped when it equals a slot kept before it."""
+    offset = 0
+    for slot in range(1, len(kept)):
+        if kept[slot] and any(s and k for s, k in zip(same[offset:offset + slot], kept)):
+            kept[slot] = False
+        offset += slot
     return kept
 
 
@@ -190,7 +204,8 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
     when a candidate is polished.
     """
     n_targets, m, n = candidates.joints.shape
-    joints = wrap_revolute(robot, np.nan_to_num(candidates.joints))
+    raw = candidates.joints
+    joints = wrap_revolute(robot, raw if np.isfinite(raw).all() else np.nan_to_num(raw))
     position, orientation = goal.residuals(robot, joints)
     constrained = goal.constrain_orientation
     valid = candidates.valid

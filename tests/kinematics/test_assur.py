@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.kinematics import _assur
+from service.kinematics import _assur, _assur_functions
 from service.kinematics._assur import (
     RRRCase,
     angle_function,
@@ -618,6 +618,9 @@ def test_invalid_input_error_names_the_field():
 
 
 def test_docstring_examples():
-    result = doctest.testmod(_assur, optionflags=doctest.NORMALIZE_WHITESPACE)
+    result = doctest.TestResults(failed=0, attempted=0)
+    for module in (_assur, _assur_functions):
+        failed, attempted = doctest.testmod(module, optionflags=doctest.NORMALIZE_WHITESPACE)
+        result = doctest.TestResults(result.failed + failed, result.attempted + attempted)
     assert result.attempted >= 10
     assert result.failed == 0

@@ -4,9 +4,9 @@ Each pose is FK of a random configuration whose middle wrist joint is ``eps`` (d
 ``eps = 0`` the pose determines ``q4 + q6`` well but their split only to about ``1e-16 / eps``: two configurations
 whose split differs by ``δ`` have orientations ``~ eps · δ`` apart. So a solution "is" the generating one when
 every well-determined coordinate agrees to 1e-7 and the split agrees to what the pose can tell (``eps · δ`` at
-most 1e-9, the FK acceptance). Before the fix of :func:`_subproblems._crossing_gap`, ``g = 1 - ||x0||²`` lost
-every digit at ``eps ≲ 1e-8``: the two wrist roots merged into one wrong one, and a whole arm branch (6 or 7
-solutions instead of 8) was gone with ``complete: true`` and no singularity reported.
+most 1e-9, the FK acceptance). Before the fix of :func:`subproblems._paden_kahan._crossing_gap`,
+``g = 1 - ||x0||²`` lost every digit at ``eps ≲ 1e-8``: the two wrist roots merged into one wrong one, and a whole
+arm branch (6 or 7 solutions instead of 8) was gone with ``complete: true`` and no singularity reported.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ from service.config import BUILTIN_ROBOTS_DIR
 from service.kinematics import forward_kinematics
 from service.kinematics._tolerances import DUPLICATE_TOLERANCE
 from service.kinematics.ik import joint_difference, solve_ik
-from service.kinematics.ik._subproblems import subproblem_2_chain
+from service.kinematics.ik.subproblems import subproblem_2_chain
 from service.kinematics.ik._screws import rotate_about
 
 EPSILONS = [1e-3, 1e-5, 1e-7, 3e-8, 1e-8, 5e-9, 3e-9, 2e-9, 1e-9, 1e-10, 1e-12, 0.0]

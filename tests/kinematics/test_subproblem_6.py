@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from service.kinematics.ik._screws import rotate_about
-from service.kinematics.ik._subproblems import subproblem_6
+from service.kinematics.ik.subproblems import subproblem_6
 
 
 def _unit(x: np.ndarray) -> np.ndarray:

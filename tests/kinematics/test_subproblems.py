@@ -14,15 +14,18 @@ from __future__ import annotations
 
 import ast
 import doctest
+import importlib
 import pathlib
+import pkgutil
 
 import numpy as np
 import pytest
 
 from service.kinematics._errors import InvalidInputError
 from service.kinematics._tolerances import DUPLICATE_TOLERANCE
-from service.kinematics.ik import _subproblems
-from service.kinematics.ik._subproblems import (
+from service.kinematics.ik import subproblems
+from service.kinematics.ik.subproblems import _roots
+from service.kinematics.ik.subproblems import (
     AnglePairSolutions,
     AngleSolutions,
     DisplacementSolutions,
@@ -719,20 +722,30 @@ def test_single_rows_return_arrays():
         assert_record_shapes(sol, (), m)
 
 
+def package_modules():
+    """Every module of the subproblems package, the package itself first."""
+    return [subproblems] + [importlib.import_module(f"{subproblems.__name__}.{info.name}")
+                            for info in pkgutil.iter_modules(subproblems.__path__)]
+
+
 def test_docstring_examples():
-    result = doctest.testmod(_subproblems, extraglobs={"np": np})
+    result = doctest.TestResults(failed=0, attempted=0)
+    for module in package_modules():
+        failed, attempted = doctest.testmod(module, extraglobs={"np": np})
+        result = doctest.TestResults(result.failed + failed, result.attempted + attempted)
     assert result.attempted >= 10
     assert result.failed == 0
 
 
 def test_core_imports_numpy_and_standard_library_only():
-    source = pathlib.Path(_subproblems.__file__).read_text()
     imported = set()
-    for node in ast.walk(ast.parse(source)):
-        if isinstance(node, ast.Import):
-            imported.update(alias.name.split(".")[0] for alias in node.names)
-        elif isinstance(node, ast.ImportFrom) and node.level == 0:
-            imported.add(node.module.split(".")[0])
+    for module in package_modules():
+        source = pathlib.Path(module.__file__).read_text()
+        for node in ast.walk(ast.parse(source)):
+            if isinstance(node, ast.Import):
+                imported.update(alias.name.split(".")[0] for alias in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.level == 0:
+                imported.add(node.module.split(".")[0])
     assert imported <= {"__future__", "math", "typing", "numpy"}
 
 
@@ -763,7 +776,7 @@ def test_sp5_exact_instances(rng):
     for _ in range(N_AXES):
         known = rng.uniform(-np.pi, np.pi, (N_ROWS, 3))
         axes, points = sp5_instances(rng, known)
-        sol = _subproblems.subproblem_5(*axes, *points)
+        sol = subproblems.subproblem_5(*axes, *points)
         assert_record_shapes_sp5(sol, (N_ROWS,))
         gap = np.where(sol.valid[..., None], angle_gap(np.stack([sol.theta1, sol.theta2, sol.theta3], -1),
                                                         known[:, None, :]), np.inf).max(axis=-1).min(axis=-1)
@@ -772,7 +785,7 @@ def test_sp5_exact_instances(rng):
         assert sol.exact[sol.valid].all()
         # a real trigonometric quartic has its real roots in pairs: 2 or 4 here (one is known)
         assert set(sol.valid.sum(axis=1).tolist()) <= {2, 4}
-        assert_rows_match(sol, lambda i: _subproblems.subproblem_5(*axes, *(p[i] for p in points)),
+        assert_rows_match(sol, lambda i: subproblems.subproblem_5(*axes, *(p[i] for p in points)),
                           range(0, N_ROWS, 9))
 
 
@@ -788,7 +801,7 @@ def test_sp5_roots_at_pi_are_ordinary(rng):
     """z = exp(i t) has no pole at t = π (a tangent half-angle would)."""
     known = np.array([[np.pi, 0.3, np.pi], [np.pi, np.pi, -0.7], [0.2, -1.0, np.pi]])
     axes, points = sp5_instances(rng, known)
-    sol = _subproblems.subproblem_5(*axes, *points)
+    sol = subproblems.subproblem_5(*axes, *points)
     found = np.stack([sol.theta1, sol.theta2, sol.theta3], -1)
     gap = np.where(sol.valid[..., None], angle_gap(found, known[:, None, :]), np.inf).max(axis=-1).min(axis=-1)
     assert (gap < ANGLE).all()
@@ -798,32 +811,32 @@ def test_sp5_infeasible_degenerate_and_inseparable(rng):
     k1, k2, k3 = random_unit(rng, 3)
     p0, p2, p3 = rng.normal(size=(3, 3))
     # far out of reach: no root on the unit circle, no slot (no least-squares candidate for this one)
-    far = _subproblems.subproblem_5(k1, k2, k3, p0, 100 * rng.normal(size=3) + 1000 * k1[[1, 2, 0]], p2, p3)
+    far = subproblems.subproblem_5(k1, k2, k3, p0, 100 * rng.normal(size=3) + 1000 * k1[[1, 2, 0]], p2, p3)
     assert not far.valid.any()
     # p1 on k1: the left side does not depend on t1, which is free when the target is reachable
     t2, t3 = 0.4, -1.2
     right = rotate(k2, t2, p2 + rotate(k3, t3, p3))
     p1_free = 0.7 * k1
     p0_free = right - p1_free  # L = p0 + R(k1, t1) p1 = right for every t1
-    sol = _subproblems.subproblem_5(k1, k2, k3, p0_free, p1_free, p2, p3)
+    sol = subproblems.subproblem_5(k1, k2, k3, p0_free, p1_free, p2, p3)
     assert sol.degenerate and sol.valid[0] and sol.theta1[0] == 0.0
     assert (sp5_residual((k1, k2, k3), (p0_free, p1_free, p2, p3), sol)[sol.valid] < 1e-9).all()
     # k2 ∥ k3: the height row does not involve t3 and neither block inverts: no slot (use subproblems 3, 4)
-    assert not _subproblems.subproblem_5(k1, k2, k2, p0, rng.normal(size=3), p2, p3).valid.any()
+    assert not subproblems.subproblem_5(k1, k2, k2, p0, rng.normal(size=3), p2, p3).valid.any()
 
 
 def test_sp5_quartic_that_drops_to_a_quadratic():
     """||f + G u||² = 1 with G a scaled rotation has no 2θ terms: the leading coefficient vanishes and the
     harmonic equation 2 g·u + c0 = 0 is what is left (here 0.6 cos θ + 0.8 sin θ = 0.25)."""
-    theta, valid, double = _subproblems._trig_quartic_roots(
+    theta, valid, double = _roots._trig_quartic_roots(
         np.array([-0.25]), np.array([0.6]), np.array([0.8]), np.array([0.0]), np.array([0.0]))
     phi, half = np.arctan2(0.8, 0.6), np.arccos(0.25)
     assert valid.sum() == 2 and not double[0]
     assert np.allclose(np.sort(theta[valid]), np.sort(np.angle(np.exp(1j * np.array([phi + half, phi - half])))))
     # and the constant left when g vanishes too: identically zero (free) or never
     zeros = np.zeros(2)
-    theta, valid, _ = _subproblems._trig_quartic_roots(np.array([0.0, 0.5]), zeros, zeros, zeros, zeros)
-    free = _subproblems._vanishes(np.array([0.0, 0.5]), zeros, zeros, zeros, zeros, np.ones(2))
+    theta, valid, _ = _roots._trig_quartic_roots(np.array([0.0, 0.5]), zeros, zeros, zeros, zeros)
+    free = _roots._vanishes(np.array([0.0, 0.5]), zeros, zeros, zeros, zeros, np.ones(2))
     assert free.tolist() == [True, False] and not valid[1].any()
     # every angle solves 0 = 0: the root finder gives one representative, angle 0 (the caller marks it free)
     assert valid[0].tolist() == [True, False, False, False] and theta[0, 0] == 0.0

@@ -8,7 +8,7 @@ Every equation here is built from its roots: ``(p0 - cos(t - m1)) (q0 - cos(t - 
 import numpy as np
 import pytest
 
-from service.kinematics.ik._subproblems import _ON_UNIT_CIRCLE, _trig_quartic_roots, _vanishes
+from service.kinematics.ik.subproblems._roots import _ON_UNIT_CIRCLE, _trig_quartic_roots, _vanishes
 
 DOUBLE_ROOT = 1e-7  # a double root is found to about sqrt(eps)
 

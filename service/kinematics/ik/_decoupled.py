@@ -19,7 +19,7 @@ from .._tolerances import GEOMETRY_TOLERANCE
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, Positioner
 from ._screws import apply, chain_rotation, invert, rotation_about
-from ._subproblems import subproblem_1
+from .subproblems import subproblem_1
 from ._types import Candidates, LabelCodes, SingularFlags
 from ._wrist import Roll, SphericalWrist, _perpendicular_unit
 

@@ -20,7 +20,7 @@ from .._tolerances import (ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERA
 from .._rotations import wrap_angle
 from ._screws import chain_motion, chain_rotation, move_point, rotate_about
 from ._structure import Geometry
-from ._subproblems import (
+from .subproblems import (
     prismatic_to_distance,
     prismatic_to_plane,
     subproblem_1,

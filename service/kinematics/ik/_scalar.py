@@ -17,7 +17,7 @@ the threshold where the array solver would decide otherwise. Anything else
 raises :class:`NotGeneric` and the pose takes the array path, which is the
 reference (``tests/kinematics/ik/test_one_pose.py`` and
 ``test_one_pose_families.py`` hold these paths to it). The formulas are those
-of :mod:`._subproblems` (same slot order, same roots).
+of :mod:`.subproblems` (same slot order, same roots).
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ import math
 import numpy as np
 
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
-from ._subproblems import axis_frame
+from .subproblems._vectors import axis_frame
 from ._types import LabelCodes, SingularFlags
 
 #: How far (as a multiple of each tolerance) a quantity must be from the array solver's threshold for the
@@ -194,7 +194,7 @@ def rotate(k: Vector, theta: float, v: Vector) -> Vector:
 
 
 def wrap(theta: float) -> float:
-    """As :func:`._subproblems._wrap`: (−3π, 3π] to (−π, π]."""
+    """As :func:`service.kinematics._rotations.wrap_angle`: (−3π, 3π] to (−π, π]."""
     if theta > _PI:
         return theta - _TWO_PI
     if theta <= -_PI:
@@ -205,7 +205,7 @@ def wrap(theta: float) -> float:
 # --- the subproblems, generic case only ------------------------------------------------------------------
 
 def plane_axes(k: Vector) -> tuple[Vector, Vector]:
-    """e1, e2 of :func:`._subproblems.axis_frame` (k completes the right-handed frame); built once per plan."""
+    """e1, e2 of :func:`.subproblems._vectors.axis_frame` (k completes the right-handed frame); built once per plan."""
     frame = axis_frame(np.asarray(k, dtype=float))
     return tuple(frame[:, 0].tolist()), tuple(frame[:, 1].tolist())
 
@@ -289,7 +289,7 @@ class Height:
 
 class TwoTurns:
     """Subproblem 2 as a chain for a fixed pair of axes k1, k2 (not parallel): the two (θ1, θ2) with
-    R(k1, θ1) R(k2, θ2) start = goal, that is :func:`._subproblems.subproblem_2` on (goal, start) with θ1 negated.
+    R(k1, θ1) R(k2, θ2) start = goal, that is :func:`.subproblems.subproblem_2` on (goal, start) with θ1 negated.
     The vectors enter as :meth:`start` and :meth:`goal` (those of fixed vectors computed once per plan)."""
 
     def __init__(self, k1: Vector, k2: Vector) -> None:
@@ -331,7 +331,7 @@ class TwoTurns:
         h1, h2 = p1 / norm_p, q2 / norm_q
         rho1, rho2 = radius_p / norm_p, radius_q / norm_q
         alpha, beta = (h1 - cos * h2) / sin2, (h2 - cos * h1) / sin2
-        # _subproblems._crossing_gap, in scalar form
+        # subproblems._paden_kahan._crossing_gap, in scalar form
         if rho1 <= rho2:
             g = (rho1 - abs(beta * sin)) * (rho1 + abs(beta * sin))
         else:

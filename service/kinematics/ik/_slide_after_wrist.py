@@ -6,7 +6,7 @@ revolute joints is known from the target, ``Q = R_target · R_home⁻¹``. With 
 v its slide direction at q = 0, the wrist joints keep c and turn the slide, so
 ``G₁G₂(c) = x_c − s Q v`` where ``x_c = world_T_target · home⁻¹ · c`` (the wrist centre if the slide
 were at 0). That is subproblem 5 with a slide of per-target direction
-(:func:`~._subproblems.subproblem_5_prismatic`): up to 4 ``(q₁, q₂, s)``. Each leaves the wrist
+(:func:`~.subproblems.subproblem_5_prismatic`): up to 4 ``(q₁, q₂, s)``. Each leaves the wrist
 ``R_w = (R₁R₂)ᵀ Q``: 2 solutions, 8 in all.
 """
 
@@ -16,7 +16,7 @@ import numpy as np
 
 from ._screws import apply, chain_rotation, invert
 from ._structure import Geometry
-from ._subproblems import subproblem_5_prismatic
+from .subproblems import subproblem_5_prismatic
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 from ._wrist import SphericalWrist
 

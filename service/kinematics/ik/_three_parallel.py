@@ -40,7 +40,7 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
 from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
-from ._subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
+from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 from ._wrist import _perpendicular_unit, wrist_codes
 

@@ -28,7 +28,7 @@ from .._rotations import wrap_angle
 from ._positioning import side_codes
 from ._screws import apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
-from ._subproblems import subproblem_1, subproblem_3, subproblem_6
+from .subproblems import subproblem_1, subproblem_3, subproblem_6
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 from ._three_parallel import _split_double_root
 from ._wrist import _perpendicular_unit

@@ -17,7 +17,7 @@ import numpy as np
 from .._tolerances import GEOMETRY_TOLERANCE
 from ._screws import rotate_about
 from ._structure import Geometry
-from ._subproblems import subproblem_1, subproblem_2_chain
+from .subproblems import subproblem_1, subproblem_2_chain
 from ._types import LabelCodes, SingularFlags, Singularity
 
 

@@ -16,7 +16,7 @@ from service.kinematics import Joint, Robot
 from service.kinematics._forward import forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
-from service.kinematics.ik._subproblems import subproblem_5_prismatic
+from service.kinematics.ik.subproblems import subproblem_5_prismatic
 from tests.kinematics.ik.test_spherical_wrist_classes import (
     _positioner_singular_configurations,
     _random_rigid,

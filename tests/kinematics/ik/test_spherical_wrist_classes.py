@@ -21,7 +21,7 @@ from service.kinematics import Joint, Robot
 from service.kinematics._forward import forward_kinematics, joint_screws, link_frames, screw_model
 from service.kinematics.ik import _numeric, joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
-from service.kinematics.ik._subproblems import subproblem_1
+from service.kinematics.ik.subproblems import subproblem_1
 
 DEG = np.pi / 180
 POSES = 400  # per statement; three statements (conventions) per class

@@ -239,7 +239,7 @@ def test_axis_one_parallel_to_the_triple_is_a_free_base_with_verified_representa
     """Where joints 2 and 3 turn the parallel axes 4–6 parallel to axis 1 (joints 4 and 5 turn axis 6 parallel
     to axes 1–3 in the base case), four axes are parallel: a one-parameter self-motion. Every such pose is
     reached, its solutions verified, and the singularity reported with the joints it frees."""
-    from service.kinematics.ik._subproblems import subproblem_2_chain
+    from service.kinematics.ik.subproblems import subproblem_2_chain
 
     for seed in range(100, 140):
         robot = random_arm(case, "standard", seed)

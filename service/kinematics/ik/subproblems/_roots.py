@@ -1,0 +1,137 @@
+"""Roots of the scalar equations the subproblems reduce to.
+
+* The harmonic equation ``a cos(theta) + b sin(theta) = c`` (:func:`_harmonic`): subproblems 3 and 4, the
+  two-link elbow, the degenerate rows of the quartic and of subproblem 6, and the turn-slide split.
+* The trigonometric quartic ``alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t = 0``
+  (:func:`_trig_quartic_roots`, :func:`_vanishes`): subproblems 5 and 6 and the turn-slide subproblem 5, through
+  the companion matrix of a quartic in ``exp(i t)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..._rotations import wrap_angle
+from ..._tolerances import GEOMETRY_TOLERANCE
+from ._records import _MERGE_COS_GAP, AngleSolutions
+from ._vectors import _hypot, _pair
+
+
+def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> AngleSolutions:
+    """Solve ``a cos(theta) + b sin(theta) = c`` elementwise.
+
+    Subproblems 3 and 4 and the two-link elbow all reduce to this equation.
+    ``scale`` (same unit as ``a``, ``b``, ``c``) sets the tolerance. With
+    ``rho = hypot(a, b)`` and ``phi = atan2(b, a)`` the equation reads
+    ``rho cos(theta - phi) = c``. The roots are ``phi + half`` and
+    ``phi - half``, in that order, where ``half = atan2(sqrt(rho**2 - c**2), c)``.
+    When ``|c| > rho``, ``theta = phi`` (``c > 0``) or ``phi + pi`` (``c < 0``)
+    minimises ``|a cos + b sin - c|``. When ``rho`` is about 0 the equation is
+    degenerate. The two roots are one (``merged``) when they are closer than
+    ``DUPLICATE_TOLERANCE`` in angle, i.e. ``rho - |c| < rho (1 - cos(tol / 2))``.
+    """
+    tol = GEOMETRY_TOLERANCE * scale
+    rho = _hypot(a, b)
+    abs_c = np.abs(c)
+    excess = abs_c - rho  # > 0: c is outside the range [-rho, rho] of the left side
+    exact = np.asarray(excess <= tol)
+    shape = exact.shape  # the broadcast batch shape
+    degenerate = rho <= tol
+    if np.shape(degenerate) != shape:
+        degenerate = np.broadcast_to(degenerate, shape)
+    regular = exact & ~degenerate
+    merged = regular & (-excess <= rho * _MERGE_COS_GAP)
+    two = regular & ~merged
+    root = np.sqrt(np.maximum(-excess, 0.0) * (rho + abs_c))  # sqrt(rho**2 - c**2) without cancellation
+    half = np.arctan2(root * two, c)  # 0 or pi unless there are two roots
+    phi = np.arctan2(b, a)
+    first = np.where(degenerate, 0.0, wrap_angle(phi + half))
+    second = np.where(two, wrap_angle(phi - half), np.nan)
+    exact_first = regular | (degenerate & (np.abs(a - c) <= tol))
+    return AngleSolutions(
+        theta=_pair(shape, first, second, float),
+        valid=_pair(shape, True, two, bool),
+        exact=_pair(shape, exact_first, two, bool),
+        degenerate=np.array(degenerate),
+        merged=np.asarray(merged),
+    )
+
+
+# A root z of a trigonometric quartic (:func:`_trig_quartic_roots`) counts as a real angle when | |z| - 1 | is at
+# most this. Real roots lie on the unit circle and the others come in pairs (z, 1 / conj(z)); a double root (a
+# tangent case) that rounding splits lies about sqrt(eps) ~ 1.5e-8 off it, some 600 times inside. A root accepted
+# here that solves nothing fails the caller's residual test after its Newton steps.
+_ON_UNIT_CIRCLE = 1e-5
+# The degree-2 terms of a trigonometric quartic count as absent below this fraction of its coefficients' size: the
+# companion matrix would carry entries of 1 / this and more, while the harmonic equation left is off by at most
+# this (the callers' Newton steps remove it).
+_LEADING_NEGLIGIBLE = 1e-8
+# A trigonometric quartic vanishes identically (every angle solves it) when each coefficient is at most this
+# fraction of the problem's scale.
+_VANISHING = 1e-12
+
+
+def _trig_quartic_roots(alpha0: np.ndarray, alpha1: np.ndarray, beta1: np.ndarray, alpha2: np.ndarray,
+                        beta2: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The real roots of ``alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t = 0``: four slots.
+
+    Times ``z**2`` with ``z = exp(i t)`` the equation is the quartic
+    ``c4 z**4 + c3 z**3 + alpha0 z**2 + conj(c3) z + conj(c4)`` with ``c4 = (alpha2 - i beta2) / 2`` and
+    ``c3 = (alpha1 - i beta1) / 2``, whose roots on the unit circle are the real angles (no tangent half-angle,
+    so ``t = pi`` is an ordinary root). The roots are the eigenvalues of its companion matrices, one batched
+    ``eigvals``. Where the degree-2 part is negligible (``|c4|`` at most :data:`_LEADING_NEGLIGIBLE` of the
+    coefficients' size) the harmonic equation ``alpha1 cos t + beta1 sin t = -alpha0`` is solved instead: two
+    slots, the other two copies of the first, not on the circle.
+
+    The coefficients are arrays of one shape (...). Returns ``(theta, on_circle, double)``: ``theta``
+    (..., 4) radians in (-pi, pi], each root's angle (off the circle too: the nearest angle for a row without
+    a real root); ``on_circle`` (..., 4) where the root is real (within :data:`_ON_UNIT_CIRCLE` radially, or an
+    exact root of the harmonic equation); ``double`` (...,) where the harmonic equation's two roots are one.
+    Whether the quartic vanishes identically is the caller's to judge (:func:`_vanishes`).
+
+    Examples
+    --------
+    ``cos 2t = 0``: t = +/-pi/4 and +/-3pi/4.
+
+    >>> theta, on_circle, _ = _trig_quartic_roots(*np.array([[0.0], [0.0], [0.0], [1.0], [0.0]]))
+    >>> np.sort(np.degrees(theta[on_circle])).round(9).tolist()
+    [-135.0, -45.0, 45.0, 135.0]
+    """
+    shape = np.shape(alpha0)
+    c4 = 0.5 * (alpha2 - 1j * beta2)
+    c3 = 0.5 * (alpha1 - 1j * beta1)
+    size = np.maximum.reduce([np.abs(alpha0), np.abs(alpha1) + np.abs(beta1), np.abs(alpha2) + np.abs(beta2)])
+    size = np.where(size > 0.0, size, 1.0)
+    quartic = np.abs(c4) > _LEADING_NEGLIGIBLE * size
+    theta = np.full(shape + (4,), np.nan)
+    on_circle = np.zeros(shape + (4,), dtype=bool)
+    double = np.zeros(shape, dtype=bool)
+    if quartic.any():
+        lead = np.where(quartic, c4, 1.0)
+        companion = np.zeros(shape + (4, 4), dtype=complex)
+        companion[..., 1, 0] = companion[..., 2, 1] = companion[..., 3, 2] = 1.0
+        companion[..., 0, 0] = -c3 / lead
+        companion[..., 0, 1] = -alpha0 / lead
+        companion[..., 0, 2] = -np.conj(c3) / lead
+        companion[..., 0, 3] = -np.conj(c4) / lead
+        companion[~quartic] = np.eye(4) * 2.0  # placeholder rows: roots off the circle, overwritten below
+        z = np.linalg.eigvals(companion)
+        on_circle = quartic[..., None] & (np.abs(np.abs(z) - 1.0) <= _ON_UNIT_CIRCLE)
+        theta = np.angle(z)
+    if not quartic.all():
+        harmonic = _harmonic(alpha1, beta1, -alpha0, size)
+        two = harmonic.valid & harmonic.exact
+        theta[..., :2] = np.where(~quartic[..., None], np.nan_to_num(harmonic.theta), theta[..., :2])
+        theta[..., 2:] = np.where(~quartic[..., None], theta[..., :1], theta[..., 2:])
+        on_circle[..., :2] = np.where(~quartic[..., None], two, on_circle[..., :2])
+        double = ~quartic & harmonic.merged
+    return wrap_angle(np.nan_to_num(theta)), on_circle, double
+
+
+def _vanishes(alpha0: np.ndarray, alpha1: np.ndarray, beta1: np.ndarray, alpha2: np.ndarray, beta2: np.ndarray,
+              scale: np.ndarray) -> np.ndarray:
+    """Whether the trigonometric quartic of :func:`_trig_quartic_roots` is 0 for every angle (...,): each of its
+    complex coefficients at most :data:`_VANISHING` times ``scale`` (...,)."""
+    largest = np.maximum.reduce([np.abs(alpha0), 0.5 * _hypot(alpha1, beta1), 0.5 * _hypot(alpha2, beta2)])
+    return largest <= _VANISHING * scale

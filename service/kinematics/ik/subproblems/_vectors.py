@@ -1,0 +1,181 @@
+"""Checked inputs, axis frames and the small vector algebra the subproblems share.
+
+* Input checks at the subproblems' boundary: constant unit axes (``_unit``, remembered by value in a bounded
+  cache), batches of points (``_points``) and distances (``_distances``).
+* Axis frames: ``axis_frame(k)``, the right-handed frame ``[e1, e2, k]`` around an axis (bounded cache), and the
+  coordinates of points in it.
+* Vector helpers: row-wise dot products and norms, the cross product of two 3-vectors, two-slot candidates,
+  Rodrigues' rotation of points, and the subproblem 1 core ``_rotate_onto`` that subproblems 1, 2, 5 and the
+  turn-slide subproblem 5 all end with.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..._errors import InvalidInputError
+from ..._rotations import wrap_angle
+from ..._tolerances import GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
+
+
+def _unit(k: ArrayLike, name: str) -> np.ndarray:
+    """Return the constant unit vector ``k`` (shape (3,)) renormalised, or raise.
+
+    The solvers pass the same few joint axes on every call, so a vector that passed is remembered by value
+    (read-only) and the next call with it skips the checks.
+    """
+    try:
+        key = tuple(k.tolist()) if isinstance(k, np.ndarray) else tuple(k)
+        known = _UNITS.get(key)
+    except TypeError:  # not a flat sequence of numbers: let the checks below say what is wrong
+        key, known = None, None
+    if known is not None:
+        return known
+    unit = _checked_unit(k, name)
+    if key is not None and len(_UNITS) < _UNITS_KEPT:
+        unit.setflags(write=False)
+        _UNITS[key] = unit
+    return unit
+
+
+_UNITS: dict[tuple, np.ndarray] = {}
+_UNITS_KEPT = 4096  # bounded: a caller sweeping over many axes keeps no more than this
+
+
+def _checked_unit(k: ArrayLike, name: str) -> np.ndarray:
+    k = np.asarray(k, dtype=float)
+    if k.shape != (3,):
+        raise InvalidInputError(f"{name} must be a unit vector of shape (3,), got shape {k.shape}", location=(name,))
+    norm = math.sqrt(float(k @ k))
+    if not abs(norm - 1.0) <= ORTHONORMAL_TOLERANCE:  # also rejects NaN
+        raise InvalidInputError(f"{name} must be a unit vector, its norm is {norm:.9g}", location=(name,))
+    return k / norm
+
+
+def _points(p: ArrayLike, name: str) -> np.ndarray:
+    p = np.asarray(p, dtype=float)
+    if p.ndim == 0 or p.shape[-1] != 3:
+        raise InvalidInputError(f"{name} must have shape (..., 3), got shape {p.shape}", location=(name,))
+    return p
+
+
+def _distances(d: ArrayLike, name: str) -> np.ndarray:
+    d = np.asarray(d, dtype=float)
+    if (d < 0.0).any():
+        raise InvalidInputError(f"{name} is a distance and must not be negative", location=(name,))
+    return d
+
+
+def axis_frame(k: np.ndarray) -> np.ndarray:
+    """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``, remembered by value
+    (read-only) as :func:`_unit` remembers the axes."""
+    key = tuple(k.tolist())
+    frame = _FRAMES.get(key)
+    if frame is None:
+        frame = _build_frame(k)
+        if len(_FRAMES) < _UNITS_KEPT:
+            frame.setflags(write=False)
+            _FRAMES[key] = frame
+    return frame
+
+
+_FRAMES: dict[tuple, np.ndarray] = {}
+
+
+def _build_frame(k: np.ndarray) -> np.ndarray:
+    """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``.
+
+    ``p @ axis_frame(k)`` gives the coordinates ``(x, y, z)`` of ``p``, where ``z = k.p``
+    is the height along the axis. A rotation about ``k`` turns ``(x, y)`` like a
+    plane rotation: ``R(k, theta) p`` has ``(x cos - y sin, x sin + y cos, z)``.
+    """
+    kx, ky, kz = k.tolist()
+    # e1 = k x (the coordinate axis least aligned with k), normalised.
+    if abs(kx) <= abs(ky) and abs(kx) <= abs(kz):
+        e1 = (0.0, kz, -ky)
+    elif abs(ky) <= abs(kz):
+        e1 = (-kz, 0.0, kx)
+    else:
+        e1 = (ky, -kx, 0.0)
+    n = math.sqrt(e1[0] ** 2 + e1[1] ** 2 + e1[2] ** 2)
+    ax, ay, az = e1[0] / n, e1[1] / n, e1[2] / n
+    e2 = (ky * az - kz * ay, kz * ax - kx * az, kx * ay - ky * ax)  # k x e1
+    return np.array([[ax, e2[0], kx], [ay, e2[1], ky], [az, e2[2], kz]])
+
+
+def _coords(p: np.ndarray, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    c = p @ frame
+    return c[..., 0], c[..., 1], c[..., 2]
+
+
+def _cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Cross product of two vectors of shape (3,) (cheaper than ``np.cross`` for one pair)."""
+    (ax, ay, az), (bx, by, bz) = a.tolist(), b.tolist()
+    return np.array([ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx])
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise dot product over the last axis, broadcasting the batch axes."""
+    if a.ndim == 1 and b.ndim == 1:  # single row: ``@`` has less overhead than einsum
+        return a @ b
+    return np.einsum("...i,...i->...", a, b)
+
+
+def _hypot(x: ArrayLike, y: ArrayLike) -> np.ndarray:
+    """``sqrt(x**2 + y**2)``, several times faster than ``np.hypot``.
+
+    Accurate for any length far from float overflow or underflow (1e+-154).
+    """
+    return np.sqrt(x * x + y * y)
+
+
+def _norm(a: np.ndarray) -> np.ndarray:
+    return np.sqrt(_dot(a, a))
+
+
+def _rotation_parts(k: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``R(k, theta) p = fixed + cos(theta) perp + sin(theta) cross`` for points ``p`` (..., 3)."""
+    fixed = (p @ k)[..., None] * k
+    return fixed, p - fixed, np.cross(k, p)
+
+
+def _rotate_points(k: np.ndarray, theta: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """``R(k, theta) p`` (Rodrigues), broadcasting ``theta`` (...) against points ``p`` (..., 3)."""
+    fixed, perp, cross = _rotation_parts(k, p)
+    c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
+    return fixed + c * perp + s * cross
+
+
+def _pair(shape: tuple[int, ...], first: ArrayLike, second: ArrayLike, dtype: type) -> np.ndarray:
+    """Candidates of shape ``shape + (2,)`` from the two slots (cheaper than ``np.stack`` for one row)."""
+    out = np.empty(shape + (2,), dtype=dtype)
+    out[..., 0] = first
+    out[..., 1] = second
+    return out
+
+
+def _rotate_onto(
+    frame: np.ndarray, p: np.ndarray, q: np.ndarray, scale: np.ndarray | None = None,
+    free_below: np.ndarray | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Subproblem 1 core: ``(theta, exact, degenerate)`` for ``R(k, theta) p = q``.
+
+    ``frame`` is ``axis_frame(k)``. ``scale`` defaults to ``max(||p||, ||q||)``. ``free_below``, the radius
+    at or below which ``p`` or ``q`` counts as on the axis, defaults to ``GEOMETRY_TOLERANCE * scale``.
+    """
+    px, py, pz = _coords(p, frame)
+    qx, qy, qz = _coords(q, frame)
+    # q.R p = pz qz + cos(theta) (px qx + py qy) + sin(theta) (px qy - py qx), largest at:
+    theta = np.arctan2(px * qy - py * qx, px * qx + py * qy)
+    radius_p = _hypot(px, py)
+    radius_q = _hypot(qx, qy)
+    if scale is None:
+        scale = np.maximum(_hypot(radius_p, pz), _hypot(radius_q, qz))
+    tol = GEOMETRY_TOLERANCE * scale
+    exact = (np.abs(radius_p - radius_q) <= tol) & (np.abs(pz - qz) <= tol)
+    free_below = tol if free_below is None else free_below
+    degenerate = (radius_p <= free_below) | (radius_q <= free_below)
+    return np.where(degenerate, 0.0, wrap_angle(theta)), exact, degenerate

@@ -20,17 +20,32 @@ three passes:
      that label and the sample reports the held value. When no solution
      matches, the sample continues on the nearest one and says so
      (``status = "branch_unavailable"``);
-   * among the candidates, the one nearest to the previous sample (or to
-     ``reference`` at the first sample; the first solution in IK order when
-     there is neither), wrap-aware, by the largest single joint move with
-     prismatic moves measured in units of the robot's size;
+   * among the candidates, the one nearest (wrap-aware, Euclidean in joint
+     space, prismatic moves in units of the robot's size) to the previous
+     sample's joints carried forward to this sample's time: by its twist and
+     acceleration (q + q̇dt + ½q̈dt², exact inverse rates), or the polynomial
+     through the last reached samples (:func:`_prediction`); at the first
+     sample, the one nearest ``reference`` (the first in IK order without
+     one). So the sample continues the branch, not the labels: beside a
+     fold, where two solutions with the same labels meet, the other one is
+     O(dt) from the prediction and the branch's own O(dt²) or less;
+   * where the IK's answer leaves that open (no solution near the
+     prediction, or two about as near), the prediction is carried onto the
+     pose by Newton steps (the core's Gauss–Newton), which adds the branch's
+     solution where a search near a singularity missed it; and every chosen
+     solution is polished by Newton steps to the rounding of the pose, so a
+     near-singular sample is exact to the digits its conditioning allows;
    * revolute joints are unwrapped so that each sample continues from the
      previous one (the first from ``reference``; without one, from its
      (−π, π] value, or the 2π-equivalent that fits the limits);
    * ``branch`` reports the solution's labels, except that a label the
-     sample is singular in keeps the held value or the previous sample's;
-     ``branch_changed`` is true when the labels differ from the previous
-     reached sample's.
+     sample is singular in (or that the IK leaves out) keeps the held value
+     or the previous sample's; a held label the solution leaves out does not
+     rule it out. ``branch_changed`` is true when the labels differ from the
+     previous reached sample's, or when the sample may not continue its
+     branch: another solution about as near the prediction
+     (:data:`AMBIGUITY_FACTOR`), or none within :data:`JUMP_FACTOR` joint
+     steps of it (not reported where held labels chose the jump).
 3. **Rates**, vectorised over all reached samples (:mod:`._rates`):
    ``q̇ = J⁻¹ v``, ``q̈ = J⁻¹ (a − J̇ q̇)`` on the task rows the arm controls.
    For the paper's SCARA (:func:`~._assur_arm.assur_scara_of`) positions,

@@ -71,7 +71,8 @@ from ._assur import RRRCase
 from ._assur_arm import AssurScara, assur_scara_of
 from ._errors import InvalidInputError
 from ._limits import Limits, Violation, nearest_fitting_equivalent, violations, within
-from ._rates import TaskSpace, joint_rates, rate_residuals, task_space
+from ._forward import geometric_jacobian
+from ._rates import TaskSpace, joint_rates, rate_residuals, task_jacobian, task_space
 from ._robot import Robot, check_joint_values
 from ._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, RATE_SINGULARITY_TOLERANCE
 from .ik import (
@@ -589,6 +590,7 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
     floor = DUPLICATE_TOLERANCE
     history: list[_Reached] = []  # the continuous stretch of reached samples that the next one continues
     to_polish: list[tuple[int, int, list[np.ndarray], np.ndarray]] = []
+    listed_rates = _listed_rates(robot, results, tracking)
     previous_branch: dict | None = None
     samples: list[SampleResult] = []
     for k, result in enumerate(results):
@@ -597,27 +599,29 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
         previous = history[-1] if history else None
         predicted, scale = (reference, None) if previous is None else _prediction(history, float(times[k]),
                                                                                   weights)
+        rates_of = None if listed_rates is None else listed_rates[k]
         if previous is not None and _has_free_joint(result):
             # the joint the pose leaves free keeps the previous sample's value
             result = solve_ik(robot, targets[k], constrain_orientation=constrain_orientation, reference=previous.q,
                               options=ik_options)
-        joints = [np.asarray(s.joints, dtype=float) for s in result.solutions]
+            rates_of = None
+        joints = np.array([s.joints for s in result.solutions], dtype=float).reshape(-1, robot.dof)
         branches = [dict(s.branch) for s in result.solutions]
         ambiguous = ambiguous_labels(result.singularities)
+        to_prediction = None if predicted is None else _distance(robot, joints, predicted, weights)
         tracked = None
         if tracking is not None and previous is not None and not _has_free_joint(result) and _unclear(
-                robot, [joints[i] for i in _matching(branches, held, ambiguous)] if held else joints, predicted,
-                scale, weights):
+                to_prediction[_matching(branches, held, ambiguous)] if held else to_prediction, scale):
             q_tracked, error = _newton(robot, targets[k], constrain_orientation, predicted, moving,
                                        TRACK_NEWTON_STEPS, ik_options.budget)
             if error <= ACCEPT_RESIDUAL:
                 tracked = q_tracked
-                gaps = [float(_distance(robot, q, tracked, weights)) for q in joints]
-                if min(gaps, default=np.inf) > SAME_SOLUTION:
+                if _distance(robot, joints, tracked, weights).min(initial=np.inf) > SAME_SOLUTION:
                     # the branch's solution, which the IK's answer lacks (a search near a singularity can miss it)
-                    joints.append(tracked)
+                    joints = np.vstack([joints, tracked])
                     branches.append(_labels_of(tracking.label_codes, tracked))
-        if not joints:
+                    to_prediction = np.append(to_prediction, _distance(robot, tracked, predicted, weights))
+        if not len(joints):
             # unreachable only where the solver proves it; a search that found nothing says not_found
             samples.append(SampleResult(float(times[k]), "unreachable" if result.complete else "not_found"))
             continue
@@ -626,7 +630,7 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
         distances = None
         choice = pool[0]
         if predicted is not None:
-            distances = _distance(robot, np.array([joints[i] for i in pool]), predicted, weights)
+            distances = to_prediction[pool]
             choice = pool[int(np.argmin(distances))]
         q = joints[choice]
         if previous is not None:
@@ -657,8 +661,8 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
         left_branch = jumped = False
         if previous is not None and distances is not None:
             nearest = float(distances.min())
-            others = [d for i, d in zip(pool, distances.tolist()) if i != choice
-                      and _distance(robot, joints[i], joints[choice], weights) > SAME_SOLUTION]
+            apart = _distance(robot, joints[pool], joints[choice], weights) > SAME_SOLUTION
+            others = distances[apart].tolist()
             # another solution about as near the prediction: which one continues the branch is not known
             unsure = any(d <= AMBIGUITY_FACTOR * nearest and d > SAME_SOLUTION for d in others)
             # no solution within a few joint steps of the prediction: the branch does not continue here (unless
@@ -670,7 +674,9 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
             branch_changed=previous is not None and (branch != previous_branch or left_branch),
             singularities=list(result.singularities)))
         rates = (None, None)
-        if tracking is not None and tracking.twists is not None and not np.isnan(tracking.twists[k]).all():
+        if rates_of is not None and choice < len(rates_of[0]):  # a listed solution: rates known (2π-invariant)
+            rates = (rates_of[0][choice], rates_of[1][choice])
+        elif tracking is not None and tracking.twists is not None and not np.isnan(tracking.twists[k]).all():
             rates = _rates_at(robot, q, tracking.twists[k], None if tracking.accelerations is None or np.isnan(
                 tracking.accelerations[k]).all() else tracking.accelerations[k], tracking.task)
         if left_branch or jumped:  # a jump is no base for extrapolating the next step
@@ -689,14 +695,57 @@ def _matching(branches: list[dict], held: dict, ambiguous: set[str]) -> list[int
             if all(branch.get(key, value) == value or key in ambiguous for key, value in held.items())]
 
 
-def _unclear(robot: Robot, joints: list[np.ndarray], predicted: np.ndarray, scale: float | None,
-             weights: np.ndarray) -> bool:
-    """Whether the IK's solutions (each (n,)) leave the continuation open: none, none within half a joint step
-    of the prediction (n,) (which is off the branch by O(dt²) at most), or a second one about as near. Then the
-    prediction is carried onto the pose."""
-    if not joints:
+def _listed_rates(robot: Robot, results: list[IKResult], tracking: Tracking | None
+                  ) -> list[tuple[list, list]] | None:
+    """Per sample, the joint rates (q̇ and q̈, each (n,) or None) at each of the IK's solutions, from the sample's
+    twist and acceleration by the exact inverse (:func:`_rates_at`), all samples in one vectorised call; None
+    without twists."""
+    if tracking is None or tracking.twists is None:
+        return None
+    rows = [(k, s.joints) for k, result in enumerate(results) for s in result.solutions]
+    if not rows:
+        return [([], [])] * len(results)
+    index = np.array([k for k, _ in rows])
+    q = np.array([joints for _, joints in rows], dtype=float)
+    task, twists = tracking.task, tracking.twists[index]
+    if tracking.accelerations is not None and not np.isnan(tracking.accelerations).all():
+        rates = joint_rates(robot, q, twists, tracking.accelerations[index], task, tolerance=0.0)
+        velocities, accelerations = rates.velocities, rates.accelerations
+    else:  # q̇ alone: one linear solve per solution (the exact inverse of the scaled task Jacobian)
+        size = robot.characteristic_length  # the scaling of _rates: linear rows over the size, slides times it
+        row_scale = np.array([1.0 / size] * 3 + [1.0] * 3)
+        column_scale = np.where(robot.is_revolute, 1.0, size)
+        Js = task_jacobian(robot, geometric_jacobian(robot, q), task)  # (M, m, k)
+        b = np.nan_to_num(row_scale * twists) @ task.basis.T  # (M, m)
+        with np.errstate(all="ignore"):
+            if task.solve == "exact":
+                try:
+                    y = np.linalg.solve(Js, b[..., None])[..., 0]
+                except np.linalg.LinAlgError:  # an exactly singular one: the pseudo-inverse for all
+                    y = np.einsum("nkm,nm->nk", np.linalg.pinv(Js), b)
+            else:
+                y = np.einsum("nkm,nm->nk", np.linalg.pinv(Js), b)
+        velocities = np.zeros((len(q), robot.dof))
+        velocities[:, task.columns] = y * column_scale[task.columns]
+        missing = (np.isnan(twists).astype(float) @ (task.basis != 0).T.astype(float)).any(axis=1)
+        velocities[missing] = np.nan
+        accelerations = np.full_like(velocities, np.nan)
+    qd_ok = np.isfinite(velocities).all(axis=1)
+    qdd_ok = np.isfinite(accelerations).all(axis=1)
+    out: list[tuple[list, list]] = [([], []) for _ in results]
+    for row, k in enumerate(index.tolist()):
+        out[k][0].append(velocities[row] if qd_ok[row] else None)
+        out[k][1].append(accelerations[row] if qdd_ok[row] else None)
+    return out
+
+
+def _unclear(distances: np.ndarray, scale: float | None) -> bool:
+    """Whether the IK's solutions leave the continuation open, from their distances (m,) to the prediction:
+    none, none within half a joint step (the prediction is off the branch by O(dt²) at most), or a second one
+    about as near. Then the prediction is carried onto the pose."""
+    if not len(distances):
         return True
-    distances = np.sort(_distance(robot, np.array(joints), predicted, weights))
+    distances = np.sort(distances)
     if scale is None or distances[0] > max(TRACK_FACTOR * scale, DUPLICATE_TOLERANCE):
         return True
     return len(distances) > 1 and distances[1] <= AMBIGUITY_FACTOR * distances[0] + SAME_SOLUTION

@@ -20,17 +20,32 @@ three passes:
      that label and the sample reports the held value. When no solution
      matches, the sample continues on the nearest one and says so
      (``status = "branch_unavailable"``);
-   * among the candidates, the one nearest to the previous sample (or to
-     ``reference`` at the first sample; the first solution in IK order when
-     there is neither), wrap-aware, by the largest single joint move with
-     prismatic moves measured in units of the robot's size;
+   * among the candidates, the one nearest (wrap-aware, Euclidean in joint
+     space, prismatic moves in units of the robot's size) to the previous
+     sample's joints carried forward to this sample's time: by its twist and
+     acceleration (q + q̇dt + ½q̈dt², exact inverse rates), or the polynomial
+     through the last reached samples (:func:`_prediction`); at the first
+     sample, the one nearest ``reference`` (the first in IK order without
+     one). So the sample continues the branch, not the labels: beside a
+     fold, where two solutions with the same labels meet, the other one is
+     O(dt) from the prediction and the branch's own O(dt²) or less;
+   * where the IK's answer leaves that open (no solution near the
+     prediction, or two about as near), the prediction is carried onto the
+     pose by Newton steps (the core's Gauss–Newton), which adds the branch's
+     solution where a search near a singularity missed it; and every chosen
+     solution is polished by Newton steps to the rounding of the pose, so a
+     near-singular sample is exact to the digits its conditioning allows;
    * revolute joints are unwrapped so that each sample continues from the
      previous one (the first from ``reference``; without one, from its
      (−π, π] value, or the 2π-equivalent that fits the limits);
    * ``branch`` reports the solution's labels, except that a label the
-     sample is singular in keeps the held value or the previous sample's;
-     ``branch_changed`` is true when the labels differ from the previous
-     reached sample's.
+     sample is singular in (or that the IK leaves out) keeps the held value
+     or the previous sample's; a held label the solution leaves out does not
+     rule it out. ``branch_changed`` is true when the labels differ from the
+     previous reached sample's, or when the sample may not continue its
+     branch: another solution about as near the prediction
+     (:data:`AMBIGUITY_FACTOR`), or none within :data:`JUMP_FACTOR` joint
+     steps of it (not reported where held labels chose the jump).
 3. **Rates**, vectorised over all reached samples (:mod:`._rates`):
    ``q̇ = J⁻¹ v``, ``q̈ = J⁻¹ (a − J̇ q̇)`` on the task rows the arm controls.
    For the paper's SCARA (:func:`~._assur_arm.assur_scara_of`) positions,
@@ -48,7 +63,7 @@ rates unless ``damping`` is given, in which case they are damped least squares.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Literal, Mapping
+from typing import Callable, Literal, Mapping
 
 import numpy as np
 
@@ -56,9 +71,10 @@ from ._assur import RRRCase
 from ._assur_arm import AssurScara, assur_scara_of
 from ._errors import InvalidInputError
 from ._limits import Limits, Violation, nearest_fitting_equivalent, violations, within
-from ._rates import TaskSpace, joint_rates, rate_residuals, task_space
+from ._forward import geometric_jacobian
+from ._rates import TaskSpace, joint_rates, rate_residuals, task_jacobian, task_space
 from ._robot import Robot, check_joint_values
-from ._tolerances import RATE_SINGULARITY_TOLERANCE
+from ._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, RATE_SINGULARITY_TOLERANCE
 from .ik import (
     AnswerOptions,
     IKOptions,
@@ -75,6 +91,9 @@ from .ik import (
     solve_ik_batch,
     unlimited,
 )
+from .ik._gauss_newton import gauss_newton
+from .ik._goals import PoseGoal
+from .ik._types import LabelCodes
 
 __all__ = [
     "PaperJoints",
@@ -126,6 +145,9 @@ class TrajectoryOptions:
         their rates NaN.
     ik : IKOptions
         Passed to the position IK.
+    free_joints : list of (joint, values or None, samples or None), optional
+        A redundant arm's free joints and where to solve them, radians / length units, as single IK takes them
+        (:class:`~.ik.AnswerOptions`); None lets the trajectory choose and hold them continuous.
     """
 
     branch: Mapping[str, str | int] | None = None
@@ -134,6 +156,7 @@ class TrajectoryOptions:
     singularity_tolerance: float = RATE_SINGULARITY_TOLERANCE
     damping: float | None = None
     ik: IKOptions = field(default_factory=IKOptions)
+    free_joints: list[tuple[int, list[float] | None, int | None]] | None = None
 
 
 @dataclass(frozen=True)
@@ -316,9 +339,14 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
     limits = options.limits or Limits.of(robot)
 
     plan = plan_for(robot, constrain_orientation=constrain_orientation, reference=reference)
-    # a redundant arm (issue 14): the free joint held continuous along the path, its rate 0
-    family = follow_free_joints(robot, targets, reference, options.ik) \
-        if constrain_orientation and robot.dof > 6 else None
+    # a redundant arm (issue 14): the free joints held continuous along the path, their rates 0; the ones the
+    # request names, where it names them (as single IK takes them)
+    family = None
+    if constrain_orientation and (robot.dof > 6 or options.free_joints is not None):
+        try:
+            family = follow_free_joints(robot, targets, reference, options.ik, options.free_joints)
+        except InvalidInputError as error:
+            raise error.relocated("free_joints") from None
     task = task_space(robot, constrain_orientation=constrain_orientation,
                       free_joints=family[1] if family is not None else
                       plan.free_joints if plan is not None else ())
@@ -332,7 +360,11 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
         robot, targets, constrain_orientation=constrain_orientation, reference=reference, options=options.ik)
     held = _check_branch(options.branch, results)
 
-    samples = _follow(robot, times, targets, results, held, reference, limits, constrain_orientation, options.ik)
+    labels = None
+    if plan is not None and robot.dof <= 6:
+        labels = plan.label_codes
+    samples = _follow(robot, times, targets, results, held, reference, limits, constrain_orientation, options.ik,
+                      Tracking(twist, task, labels, acceleration))
     assur = assur_scara_of(robot)
     reached = np.array([k for k, s in enumerate(samples) if s.reached], dtype=int)
     if len(reached):
@@ -353,8 +385,13 @@ TRACK_SAMPLES = 9
 
 
 def follow_free_joints(robot: Robot, world_T_targets: np.ndarray, reference: np.ndarray | None,
-                       ik: IKOptions) -> tuple[list[IKResult], list[int]] | None:
+                       ik: IKOptions, requested: list | None = None) -> tuple[list[IKResult], list[int]] | None:
     """Per-sample IK results of a redundant arm along a path, with the free joint held continuous.
+
+    ``requested``: the request's free joints, ``(joint, values or None, samples or None)`` entries in radians /
+    length units, with the meaning they have in single IK (:func:`~.ik.free_joints_for`): each sample is
+    answered over those joints at those values (:func:`~.ik.answer_ik`), nearest the previous sample first.
+    Raises :class:`InvalidInputError` (located in the list) for entries single IK refuses.
 
     The first sample takes the family's solution nearest the reference (over the whole family: sampled, then
     searched continuously) or, without one, the family's first. Each later sample searches the free joint within
@@ -364,6 +401,16 @@ def follow_free_joints(robot: Robot, world_T_targets: np.ndarray, reference: np.
     is. Returns (results, free joints), one :class:`IKResult` per sample (nearest first), or None when the arm has
     no single free joint a family covers.
     """
+    if requested is not None:
+        joints = sorted(f.joint for f in free_joints_for(robot, requested))
+        results, previous = [], reference
+        for target in np.asarray(world_T_targets, dtype=float):
+            ik.budget.check("the trajectory")
+            result = _family_result(robot, target, requested, previous, ik)
+            if result.solutions:
+                previous = np.asarray(result.solutions[0].joints, dtype=float)
+            results.append(result)
+        return results, joints
     free = free_joints_for(robot, None)
     if free is None or len(free) != 1:
         return None
@@ -399,39 +446,210 @@ def _has_free_joint(result: IKResult) -> bool:
     return any(s.relation in _FREE_RELATIONS for s in result.singularities)
 
 
+#: Gauss–Newton steps that carry the predicted joints onto a sample's pose (tracking), and that polish the chosen
+#: solution to the end of its digits; both stop once a step no longer halves the error.
+TRACK_NEWTON_STEPS = 8
+POLISH_NEWTON_STEPS = 4
+#: The polish leaves joints whose error (normalised, ‖e‖∞) is already at the rounding of the pose (a few ulps).
+POLISHED = 4.0 * float(np.finfo(float).eps)
+#: A second solution within this factor of the chosen one's distance to the prediction leaves the choice open.
+AMBIGUITY_FACTOR = 2.0
+#: The chosen solution is off the branch when it is farther from the prediction than this many joint steps.
+JUMP_FACTOR = 4.0
+#: The prediction is carried onto the pose by Newton steps when no solution of the IK is within this many joint
+#: steps of it (or the choice is ambiguous).
+TRACK_FACTOR = 0.5
+#: Two solutions closer than this (Euclidean, radians or fractions of the robot's size) are one: at a fold
+#: (two solutions meeting) the residual grows with the square of the distance, so the FK check accepts a band
+#: of about √ACCEPT_RESIDUAL around the solution.
+SAME_SOLUTION = float(np.sqrt(ACCEPT_RESIDUAL))
+
+
+@dataclass(frozen=True)
+class Tracking:
+    """What the branch following needs besides the IK answers: the twists and accelerations (N, 6) (NaN rows:
+    none), the task rows
+    the rates are solved on (its ``columns`` are the joints that move), and the labels of a joint vector (M, n)
+    as the IK names them (None: no labels). Without it (``_follow(..., tracking=None)``) the choice is from
+    the IK's solutions alone, by the previous sample's joints extrapolated."""
+
+    twists: np.ndarray | None
+    task: TaskSpace
+    label_codes: Callable[[np.ndarray], LabelCodes] | None = None
+    accelerations: np.ndarray | None = None
+
+
+@dataclass
+class _Reached:
+    """A reached sample on the branch being followed: joints (n,), time, and joint rates (n,) from its twist (and
+    acceleration), None where not given."""
+
+    q: np.ndarray
+    time: float
+    qd: np.ndarray | None = None
+    qdd: np.ndarray | None = None
+
+
+def _rates_at(robot: Robot, q: np.ndarray, twist: np.ndarray | None, acceleration: np.ndarray | None,
+              task: TaskSpace) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """q̇ = J⁻¹ v and q̈ = J⁻¹ (a − J̇ q̇) at one sample (n,) each, by the exact inverse however near a
+    singularity (the twist of a path that stays on a branch has no component the branch cannot make); None
+    where not given or not finite."""
+    if twist is None:
+        return None, None
+    rates = joint_rates(robot, q[None], twist[None], None if acceleration is None else acceleration[None], task,
+                        tolerance=0.0)
+    qd, qdd = rates.velocities[0], rates.accelerations[0]
+    return (qd if np.isfinite(qd).all() else None), (qdd if np.isfinite(qdd).all() else None)
+
+
+def _prediction(history: list[_Reached], time: float, weights: np.ndarray) -> tuple[np.ndarray, float | None]:
+    """The joints (n,) expected at ``time`` on the branch the last reached samples ``history`` (oldest first, the
+    continuous stretch only) are on, and the size of a joint step there (Euclidean, prismatic joints in units of
+    the robot's size; None when nothing tells it).
+
+    With rates at the last sample, its Taylor step ``q̇ dt + ½ q̈ dt²`` (q̈ from its acceleration, or from the
+    change of q̇ since the sample before); without, the polynomial through the last (up to three) samples.
+    Either is off the branch by O(dt³) (O(dt²) with only q̇ or two samples), while a neighbouring branch that
+    meets this one at a fold is O(dt) away."""
+    last = history[-1]
+    dt = time - last.time
+    step = None
+    if last.qd is not None and (np.abs(last.qd * dt) * weights).max(initial=0.0) <= 0.5 * np.pi:
+        step = last.qd * dt
+        qdd = last.qdd
+        if qdd is None and len(history) > 1 and history[-2].qd is not None:
+            qdd = (last.qd - history[-2].qd) / (last.time - history[-2].time)
+        if qdd is not None and (np.abs(0.5 * qdd * dt * dt) * weights).max(initial=0.0) <= 0.5 * np.pi:
+            step = step + 0.5 * qdd * dt * dt
+    if step is None and len(history) > 1:
+        # Lagrange extrapolation through the last samples
+        points = history[-3:]
+        predicted = np.zeros_like(last.q)
+        for i, a in enumerate(points):
+            weight = 1.0
+            for j, b in enumerate(points):
+                if j != i:
+                    weight *= (time - b.time) / (a.time - b.time)
+            predicted = predicted + weight * a.q
+        step = predicted - last.q
+    if step is None:
+        return last.q, None
+    scale = float(np.linalg.norm(step * weights))
+    if len(history) > 1:
+        scale = max(scale, float(np.linalg.norm((last.q - history[-2].q) * weights)))
+    return last.q + step, scale
+
+
+def _newton(robot: Robot, target: np.ndarray, constrain_orientation: bool, q: np.ndarray, moving: np.ndarray,
+            steps: int, budget) -> tuple[np.ndarray, float]:
+    """Newton steps (the core's damped Gauss–Newton) from q (n,) onto one pose (4, 4), the joints ``moving``
+    (n,) bool only, until a step no longer halves the error; the joints and their error (normalised, ‖e‖∞),
+    or q itself when the steps did not lower it."""
+    goal = PoseGoal(target[None], constrain_orientation)
+    rows = np.zeros(1, dtype=int)
+    start = float(np.abs(goal.error(robot, q[None], rows)).max())
+    reached = gauss_newton(robot, goal, q[None], rows, steps=steps, tolerance=0.0, contraction=0.5, moving=moving,
+                           budget=budget, stage="the trajectory")
+    error = float(reached.error[0])
+    return (reached.joints[0], error) if np.isfinite(error) and error <= start else (q, start)
+
+
+def _distance(robot: Robot, q: np.ndarray, reference: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """Wrap-aware Euclidean distance in joint space of each row of q (..., n) from ``reference`` (n,), prismatic
+    joints in units of the robot's size: unlike the largest single move, it tells apart two solutions that share
+    the joint that moves most (a wrist flip beside its twin)."""
+    return distance_to_reference(robot, q, reference, norm="l2", weights=weights)
+
+
+def _labels_of(label_codes, q: np.ndarray) -> dict:
+    """The IK's branch labels of one joint vector (n,) (a label whose branches meet there is left out)."""
+    if label_codes is None:
+        return {}
+    return {name: values[int(codes[0])] for name, (values, codes) in label_codes(q[None]).items() if codes[0] >= 0}
+
+
 def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[IKResult], held: dict,
             reference: np.ndarray | None, limits: Limits, constrain_orientation: bool,
-            ik_options: IKOptions) -> list[SampleResult]:
-    """Choose one solution per sample (the branch rules of the module docstring)."""
+            ik_options: IKOptions, tracking: Tracking | None = None) -> list[SampleResult]:
+    """Choose one solution per sample (the branch rules of the module docstring).
+
+    Each sample after the first takes the solution nearest to the previous sample's joints carried forward
+    (:func:`_prediction`): the continuous branch, whatever its labels. With ``tracking`` the prediction is also
+    carried onto the pose by Newton steps, which adds the branch's solution where the IK's answer lacks it, and
+    the chosen solution is polished by Newton steps to the end of its digits (near a singularity a closed form
+    or a search stops at a residual that leaves the joints off by residual / σmin). A sample whose solution is
+    not clearly the continuation (another solution about as near the prediction, or none within a few joint
+    steps of it) reports ``branch_changed``, as one whose labels differ from the previous sample's does.
+    """
     weights = np.where(robot.is_revolute, 1.0, 1.0 / robot.characteristic_length)
-    previous_q = reference
+    moving = np.ones(robot.dof, dtype=bool)
+    if tracking is not None:
+        moving = np.zeros(robot.dof, dtype=bool)
+        moving[tracking.task.columns] = True
+    floor = DUPLICATE_TOLERANCE
+    history: list[_Reached] = []  # the continuous stretch of reached samples that the next one continues
+    to_polish: list[tuple[int, int, list[np.ndarray], np.ndarray]] = []
+    listed_rates = _listed_rates(robot, results, tracking)
     previous_branch: dict | None = None
     samples: list[SampleResult] = []
     for k, result in enumerate(results):
         if k % 64 == 0:
             ik_options.budget.check("the trajectory")
-        if previous_q is not None and _has_free_joint(result):
-            result = solve_ik(robot, targets[k], constrain_orientation=constrain_orientation, reference=previous_q,
+        previous = history[-1] if history else None
+        predicted, scale = (reference, None) if previous is None else _prediction(history, float(times[k]),
+                                                                                  weights)
+        rates_of = None if listed_rates is None else listed_rates[k]
+        if previous is not None and _has_free_joint(result):
+            # the joint the pose leaves free keeps the previous sample's value
+            result = solve_ik(robot, targets[k], constrain_orientation=constrain_orientation, reference=previous.q,
                               options=ik_options)
-        if not result.solutions:
+            rates_of = None
+        joints = np.array([s.joints for s in result.solutions], dtype=float).reshape(-1, robot.dof)
+        branches = [dict(s.branch) for s in result.solutions]
+        ambiguous = ambiguous_labels(result.singularities)
+        to_prediction = None if predicted is None else _distance(robot, joints, predicted, weights)
+        tracked = None
+        if tracking is not None and previous is not None and not _has_free_joint(result) and _unclear(
+                to_prediction[_matching(branches, held, ambiguous)] if held else to_prediction, scale):
+            q_tracked, error = _newton(robot, targets[k], constrain_orientation, predicted, moving,
+                                       TRACK_NEWTON_STEPS, ik_options.budget)
+            if error <= ACCEPT_RESIDUAL:
+                tracked = q_tracked
+                if _distance(robot, joints, tracked, weights).min(initial=np.inf) > SAME_SOLUTION:
+                    # the branch's solution, which the IK's answer lacks (a search near a singularity can miss it)
+                    joints = np.vstack([joints, tracked])
+                    branches.append(_labels_of(tracking.label_codes, tracked))
+                    to_prediction = np.append(to_prediction, _distance(robot, tracked, predicted, weights))
+        if not len(joints):
             # unreachable only where the solver proves it; a search that found nothing says not_found
             samples.append(SampleResult(float(times[k]), "unreachable" if result.complete else "not_found"))
             continue
-        ambiguous = ambiguous_labels(result.singularities)
-        matching = [s for s in result.solutions
-                    if all(s.branch.get(key) == value or key in ambiguous for key, value in held.items())]
-        pool = matching or result.solutions
-        joints = np.array([s.joints for s in pool])
-        choice = 0
-        if previous_q is not None:
-            choice = int(np.argmin(distance_to_reference(robot, joints, previous_q, weights=weights)))
+        matching = _matching(branches, held, ambiguous)
+        pool = matching or list(range(len(joints)))
+        distances = None
+        choice = pool[0]
+        if predicted is not None:
+            distances = to_prediction[pool]
+            choice = pool[int(np.argmin(distances))]
         q = joints[choice]
-        if previous_q is not None:
-            q = _continued(robot, limits, q, previous_q)
+        if previous is not None:
+            q = _continued(robot, limits, q, previous.q)
+        elif reference is not None:
+            q = _continued(robot, limits, q, reference)
         elif not within(robot, limits, q):
             fitting = nearest_fitting_equivalent(robot, limits, q)
             q = q if fitting is None else fitting
-        branch = dict(pool[choice].branch)
+        if tracking is not None:
+            # a joint the IK set free at this sample keeps its value: the polish moves only the determined ones
+            polished = moving.copy()
+            polished[[x.joints[0] for x in result.singularities if x.relation in _FREE_RELATIONS and x.joints]] = False
+            starts = [q]
+            if tracked is not None and _distance(robot, tracked, q, weights) <= SAME_SOLUTION:
+                # the same solution carried along the path: near a fold it may be the more accurate of the two
+                starts.append(_continued(robot, limits, tracked, q))
+            to_polish.append((len(samples), k, starts, polished))
+        branch = dict(branches[choice])
         # Where two branches meet, IK leaves their label out (or the singularity makes it ambiguous): the
         # trajectory carries the held label, or the previous sample's, through that sample.
         undefined = (ambiguous & branch.keys()) | ({*held, *(previous_branch or {})} - branch.keys())
@@ -440,12 +658,125 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
                 branch[key] = held[key]
             elif previous_branch is not None and key in previous_branch:
                 branch[key] = previous_branch[key]
+        left_branch = jumped = False
+        if previous is not None and distances is not None:
+            nearest = float(distances.min())
+            apart = _distance(robot, joints[pool], joints[choice], weights) > SAME_SOLUTION
+            others = distances[apart].tolist()
+            # another solution about as near the prediction: which one continues the branch is not known
+            unsure = any(d <= AMBIGUITY_FACTOR * nearest and d > SAME_SOLUTION for d in others)
+            # no solution within a few joint steps of the prediction: the branch does not continue here (unless
+            # the held labels chose the jump, which the summary's largest step shows)
+            jumped = scale is not None and nearest > max(JUMP_FACTOR * scale, floor)
+            left_branch = (jumped and not (held and matching)) or (unsure and not jumped)
         samples.append(SampleResult(
             float(times[k]), "ok" if matching or not held else "branch_unavailable", q, branch=branch,
-            branch_changed=previous_branch is not None and branch != previous_branch,
+            branch_changed=previous is not None and (branch != previous_branch or left_branch),
             singularities=list(result.singularities)))
-        previous_q, previous_branch = q, branch
+        rates = (None, None)
+        if rates_of is not None and choice < len(rates_of[0]):  # a listed solution: rates known (2π-invariant)
+            rates = (rates_of[0][choice], rates_of[1][choice])
+        elif tracking is not None and tracking.twists is not None and not np.isnan(tracking.twists[k]).all():
+            rates = _rates_at(robot, q, tracking.twists[k], None if tracking.accelerations is None or np.isnan(
+                tracking.accelerations[k]).all() else tracking.accelerations[k], tracking.task)
+        if left_branch or jumped:  # a jump is no base for extrapolating the next step
+            history = []
+        history = [*history[-2:], _Reached(q, float(times[k]), *rates)]
+        previous_branch = branch
+    if to_polish:
+        _polish(robot, targets, samples, to_polish, constrain_orientation, ik_options)
     return samples
+
+
+def _matching(branches: list[dict], held: dict, ambiguous: set[str]) -> list[int]:
+    """Which solutions' labels agree with the held ones: a label the solution does not carry (its branches meet
+    there) or that the sample's singularity makes ambiguous does not rule it out."""
+    return [i for i, branch in enumerate(branches)
+            if all(branch.get(key, value) == value or key in ambiguous for key, value in held.items())]
+
+
+def _listed_rates(robot: Robot, results: list[IKResult], tracking: Tracking | None
+                  ) -> list[tuple[list, list]] | None:
+    """Per sample, the joint rates (q̇ and q̈, each (n,) or None) at each of the IK's solutions, from the sample's
+    twist and acceleration by the exact inverse (:func:`_rates_at`), all samples in one vectorised call; None
+    without twists."""
+    if tracking is None or tracking.twists is None:
+        return None
+    rows = [(k, s.joints) for k, result in enumerate(results) for s in result.solutions]
+    if not rows:
+        return [([], [])] * len(results)
+    index = np.array([k for k, _ in rows])
+    q = np.array([joints for _, joints in rows], dtype=float)
+    task, twists = tracking.task, tracking.twists[index]
+    if tracking.accelerations is not None and not np.isnan(tracking.accelerations).all():
+        rates = joint_rates(robot, q, twists, tracking.accelerations[index], task, tolerance=0.0)
+        velocities, accelerations = rates.velocities, rates.accelerations
+    else:  # q̇ alone: one linear solve per solution (the exact inverse of the scaled task Jacobian)
+        size = robot.characteristic_length  # the scaling of _rates: linear rows over the size, slides times it
+        row_scale = np.array([1.0 / size] * 3 + [1.0] * 3)
+        column_scale = np.where(robot.is_revolute, 1.0, size)
+        Js = task_jacobian(robot, geometric_jacobian(robot, q), task)  # (M, m, k)
+        b = np.nan_to_num(row_scale * twists) @ task.basis.T  # (M, m)
+        with np.errstate(all="ignore"):
+            if task.solve == "exact":
+                try:
+                    y = np.linalg.solve(Js, b[..., None])[..., 0]
+                except np.linalg.LinAlgError:  # an exactly singular one: the pseudo-inverse for all
+                    y = np.einsum("nkm,nm->nk", np.linalg.pinv(Js), b)
+            else:
+                y = np.einsum("nkm,nm->nk", np.linalg.pinv(Js), b)
+        velocities = np.zeros((len(q), robot.dof))
+        velocities[:, task.columns] = y * column_scale[task.columns]
+        missing = (np.isnan(twists).astype(float) @ (task.basis != 0).T.astype(float)).any(axis=1)
+        velocities[missing] = np.nan
+        accelerations = np.full_like(velocities, np.nan)
+    qd_ok = np.isfinite(velocities).all(axis=1)
+    qdd_ok = np.isfinite(accelerations).all(axis=1)
+    out: list[tuple[list, list]] = [([], []) for _ in results]
+    for row, k in enumerate(index.tolist()):
+        out[k][0].append(velocities[row] if qd_ok[row] else None)
+        out[k][1].append(accelerations[row] if qdd_ok[row] else None)
+    return out
+
+
+def _unclear(distances: np.ndarray, scale: float | None) -> bool:
+    """Whether the IK's solutions leave the continuation open, from their distances (m,) to the prediction:
+    none, none within half a joint step (the prediction is off the branch by O(dt²) at most), or a second one
+    about as near. Then the prediction is carried onto the pose."""
+    if not len(distances):
+        return True
+    distances = np.sort(distances)
+    if scale is None or distances[0] > max(TRACK_FACTOR * scale, DUPLICATE_TOLERANCE):
+        return True
+    return len(distances) > 1 and distances[1] <= AMBIGUITY_FACTOR * distances[0] + SAME_SOLUTION
+
+
+def _polish(robot: Robot, targets: np.ndarray, samples: list[SampleResult],
+            to_polish: list[tuple[int, int, list[np.ndarray], np.ndarray]], constrain_orientation: bool,
+            ik_options: IKOptions) -> None:
+    """Newton steps on the chosen joints of samples (sample index, target index, starts (n,) each, joints that
+    move (n,) bool), all at once per set of moving joints, each sample keeping the start that ends with the
+    smallest error (a start's own joints where no step lowers it). Fills ``samples[index].joints``."""
+    groups: dict[bytes, list[tuple[int, int, np.ndarray]]] = {}
+    for index, k, starts, moving in to_polish:
+        for start in starts:
+            groups.setdefault(moving.tobytes(), []).append((index, k, start))
+    best: dict[int, tuple[float, np.ndarray]] = {}
+    for key, rows in groups.items():
+        moving = np.frombuffer(key, dtype=bool)
+        q = np.array([start for _, _, start in rows])
+        goal = PoseGoal(targets[[k for _, k, _ in rows]], constrain_orientation)
+        number = np.arange(len(rows))
+        before = np.abs(goal.error(robot, q, number)).max(axis=1)
+        reached = gauss_newton(robot, goal, q, number, steps=POLISH_NEWTON_STEPS, tolerance=POLISHED, contraction=0.5,
+                               moving=moving, budget=ik_options.budget, stage="the trajectory")
+        improved = np.isfinite(reached.error) & (reached.error <= before)
+        for row, (index, _, start) in enumerate(rows):
+            error, joints = (reached.error[row], reached.joints[row]) if improved[row] else (before[row], start)
+            if index not in best or error < best[index][0]:
+                best[index] = (float(error), joints)
+    for index, (_, joints) in best.items():
+        samples[index].joints = joints
 
 
 def _continued(robot: Robot, limits: Limits, q: np.ndarray, previous: np.ndarray) -> np.ndarray:

@@ -116,11 +116,21 @@ def test_a_trajectory_on_many_joints_never_says_unreachable_without_a_proof(clie
     description = _random_arm(32, 5)
     robot = _core(description)
     rng = np.random.default_rng(6)
-    q = rng.uniform(-1, 1, 32) + np.linspace(0, 0.05, 4)[:, None]
+    q = rng.uniform(-1, 1, 32) + np.linspace(0, 0.05, 20)[:, None]  # the 20 samples
     positions = forward_kinematics(robot, q)[:, :3, 3]
     samples = [{"time": 0.1 * k, "pose": {"position": p.tolist()}} for k, p in enumerate(positions)]
     response = client.post("/v1/ik/trajectory", json={"robot": description, "samples": samples})
     assert response.status_code in (200, 503), response.text
     if response.status_code == 200:
-        statuses = [sample["status"] for sample in response.json()["samples"]]
+        answer = response.json()
+        statuses = [sample["status"] for sample in answer["samples"]]
         assert "unreachable" not in statuses and "ok" in statuses, statuses
+        assert answer["solver"]["complete"] is False  # a numeric search: no sample's "none" is a proof here
+        for k, sample in enumerate(answer["samples"]):
+            if sample["joints"] is not None:  # each reached sample is a solution of its own position
+                reached = forward_kinematics(robot, np.array(sample["joints"]))[:3, 3]
+                assert np.linalg.norm(reached - positions[k]) <= 1e-9, k
+        single = client.post("/v1/ik", json={"robot": description, "target": {"position": positions[0].tolist()}})
+        assert single.status_code in (200, 503)
+        if single.status_code == 200:  # the trajectory's pipeline is single IK's: the same kind of answer
+            assert single.json()["status"] == "ok" and statuses[0] == "ok"

@@ -426,3 +426,58 @@ def test_a_long_trajectory_stops_while_its_samples_are_read():
         response = client.post("/v1/robots/ur5/ik/trajectory", json=body, headers={"X-Request-Timeout-Ms": "1"})
     problem = assert_problem(response, 503)
     assert "during reading the samples" in problem["detail"]
+
+
+# ---------------------------------------------------------------------------
+# Issue 22.11: a redundant arm's free joints, as in single IK; a near-singular path through HTTP
+# ---------------------------------------------------------------------------
+
+
+def test_a_seven_joint_arm_holds_the_free_joint_the_request_names(client):
+    """Kinova Gen3 with q3 held at 0.3 rad: every sample's joints are the generating path's, q3 exactly 0.3 and
+    its rate 0 (before issue 22.11 the request was a 422: the field did not exist)."""
+    robot = catalogue_robot(client, "kinova_gen3")
+    t = np.linspace(0.0, 1.0, 11)
+    q = np.array([0.2, 0.4, 0.3, -1.6, 0.2, 1.5, 0.4]) + np.outer(t, [0.3, -0.2, 0.0, 0.25, -0.3, 0.2, 0.1])
+    qd = np.tile([0.3, -0.2, 0.0, 0.25, -0.3, 0.2, 0.1], (len(t), 1))
+    J = np.array([difference_jacobian(robot, row) for row in q])  # FK differences, not the code under test
+    body = {"samples": pose_samples(t, forward_kinematics(robot, q), J @ qd[0]),
+            "free_joints": [{"joint": 2, "values": [0.3]}], "reference": q[0].tolist()}
+    answer = post(client, "kinova_gen3", body)
+    joints = np.array([s["joints"] for s in answer["samples"]])
+    np.testing.assert_allclose(joints, q, atol=1e-9)
+    assert (joints[:, 2] == 0.3).all()
+    np.testing.assert_allclose([s["velocities"] for s in answer["samples"]], qd, atol=1e-6)
+    assert answer["summary"]["branch_changes"] == []
+    degrees = post(client, "kinova_gen3", {**body, "angle_unit": "deg", "reference": np.degrees(q[0]).tolist(),
+                                           "free_joints": [{"joint": 2, "values": [float(np.degrees(0.3))]}],
+                                           "samples": pose_samples(t, forward_kinematics(robot, q))})
+    np.testing.assert_allclose(np.radians([s["joints"] for s in degrees["samples"]]), q, atol=1e-9)
+
+
+def test_free_joints_on_a_six_joint_arm_is_a_422_at_the_field(client):
+    body = {"samples": [{"time": 0.0, "pose": {"position": [0.3, 0.1, 0.4], "quaternion_wxyz": [0, 1, 0, 0]}}],
+            "free_joints": [{"joint": 2, "values": [0.3]}]}
+    problem = post(client, "ur5e", body, status=422)
+    assert problem["errors"][0]["loc"][:2] == ["body", "free_joints"], problem
+    assert "more than 6 joints" in problem["errors"][0]["msg"]
+
+
+def test_a_ur5e_path_near_its_shoulder_singularity_stays_on_its_branch_through_http(client):
+    """The issue's case through the route: poses and twists by FK of a joint path whose middle is 3e-5 (σmin/σmax)
+    from the shoulder singularity; every sample on the generating joints, and the rates its q̇."""
+    from tests.kinematics.test_trajectory_near_singular import TIMES, UR5E_PATH, twists_of
+    from tests.oracles.paths import near_singular_path
+
+    robot = catalogue_robot(client, "ur5e")
+    q, qd, _ = near_singular_path(robot, *UR5E_PATH, TIMES)
+    answer = post(client, "ur5e", {"samples": pose_samples(TIMES, forward_kinematics(robot, q),
+                                                           twists_of(robot, q, qd)),
+                                   "reference": q[0].tolist(), "damping": 1e-6})
+    joints = np.array([s["joints"] for s in answer["samples"]])
+    assert np.abs(joints - q).max() <= 1e-9
+    assert all(s["status"] == "ok" for s in answer["samples"])
+    middle = [k for k in range(len(TIMES)) if abs(TIMES[k] - 0.5) < 0.1]
+    assert not any(answer["samples"][k]["branch_changed"] for k in middle)
+    velocities = np.array([s["velocities"] for s in answer["samples"]])
+    assert np.abs(velocities - qd).max() < 1e-3 * np.abs(qd).max()

@@ -321,3 +321,24 @@ def test_a_twist_is_optional_per_sample():
     result = scara_call(twists=np.array([[0.1, 0, 0, 0, 0, 0.2], [np.nan] * 6]))
     assert np.isfinite(result.samples[0].velocities).all() and np.isnan(result.samples[1].velocities).all()
     assert result.samples[1].velocity_residual is None
+
+
+def test_a_sample_that_may_not_continue_the_branch_says_so_whatever_its_labels():
+    """Issue 22.11: the labels alone do not tell a neighbouring branch; branch_changed is also set where the
+    joints cannot be told to continue the branch (the previous samples extrapolate to [0.3, 0.5])."""
+    on_path = [fake([([0.1 * k, 0.5], {"elbow": "up"})]) for k in range(3)]
+    ended = follow_fake(on_path + [fake([([1.5, -0.5], {"elbow": "up"})])])  # nothing near the extrapolation
+    assert [s.branch_changed for s in ended] == [False, False, False, True]
+    split = follow_fake(on_path + [fake([([0.3, 0.52], {"elbow": "up"}), ([0.3, 0.48], {"elbow": "up"})])])
+    assert [s.branch_changed for s in split] == [False, False, False, True]  # two about as near: not known
+    clear = follow_fake(on_path + [fake([([0.3, 0.5001], {"elbow": "up"}), ([0.3, 0.45], {"elbow": "up"})])])
+    assert [s.branch_changed for s in clear] == [False, False, False, False]
+    np.testing.assert_allclose(clear[3].joints, [0.3, 0.5001])
+
+
+def test_the_continuation_is_the_nearest_to_the_extrapolated_joints_not_to_the_last():
+    """Two solutions with the same labels: the one the path's motion leads to, though the other is nearer to
+    the previous sample's joints."""
+    on_path = [fake([([0.1 * k, 0.5 - 0.1 * k], {})]) for k in range(3)]  # moving by (0.1, -0.1) a sample
+    samples = follow_fake(on_path + [fake([([0.22, 0.32], {}), ([0.3, 0.2], {})])])
+    np.testing.assert_allclose(samples[3].joints, [0.3, 0.2])

@@ -83,3 +83,46 @@ def scaled_sigma_min(robot, J: np.ndarray, rows: list[int]) -> float:
     Js = J[rows] * np.array([1 / L if r < 3 else 1.0 for r in rows])[:, None]
     Js = Js * np.where(robot.is_revolute, 1.0, L)
     return float(np.linalg.svd(Js, compute_uv=False)[-1])
+
+
+def _det(robot, q: np.ndarray) -> float:
+    return float(np.linalg.det(difference_jacobian(robot, q)))
+
+
+def _det_gradient(robot, q: np.ndarray, h: float = 1e-6) -> np.ndarray:
+    step = np.eye(len(q)) * h
+    return np.array([(_det(robot, q + e) - _det(robot, q - e)) / (2 * h) for e in step])
+
+
+def near_singular_path(robot, q0, v, delta: float, t):
+    """A joint path (6-joint arm) that passes near a singularity at t = 0.5 without crossing it, with its exact
+    rates: q(t) = q* + s v + (δ + c s²) n, s = t − 0.5.
+
+    q* is a singular configuration (det J = 0, J by FK differences) found by Newton steps from ``q0``; v is ``v``
+    made tangent to the singular set there, n = ∇det / |∇det|² (so det J ≈ δ + … at the middle), and c is chosen
+    so that det J keeps its sign along the whole path (checked here). Returns q, q̇, q̈, each of shape (N, 6).
+    """
+    q = np.array(q0, dtype=float)
+    for _ in range(50):
+        f, g = _det(robot, q), _det_gradient(robot, q)
+        q = q - f * g / (g @ g)
+        if abs(f) < 1e-14:
+            break
+    g = _det_gradient(robot, q)
+    n = g / (g @ g)
+    v = np.asarray(v, dtype=float)
+    v = v - (v @ g) / (g @ g) * g
+    s = np.asarray(t, dtype=float) - 0.5
+    away = np.abs(s) > 1e-3
+    curvature = np.array([_det(robot, q + si * v) for si in s[away]]) / s[away] ** 2
+    c = 1.5 * max(0.0, float(np.max(-curvature))) + 0.5
+    path = q + s[:, None] * v + (delta + c * s[:, None] ** 2) * n
+    dets = np.array([_det(robot, row) for row in path])
+    assert (dets > 0).all(), "the path crosses the singularity"
+    return path, v + 2 * c * s[:, None] * n, np.tile(2 * c * n, (len(s), 1))
+
+
+def sigma_ratio(robot, q: np.ndarray) -> float:
+    """σ_min / σ_max of the FK-difference Jacobian at q."""
+    values = np.linalg.svd(difference_jacobian(robot, q), compute_uv=False)
+    return float(values[-1] / values[0])

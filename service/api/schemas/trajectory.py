@@ -9,7 +9,7 @@ from pydantic import Field, model_validator
 from ...kinematics import RATE_SINGULARITY_TOLERANCE
 from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId,
                      Vector3)
-from .ik import Branch, SingularityReport
+from .ik import Branch, FreeJointChoice, SingularityReport
 from .limits import LimitViolation
 from .poses import PoseTarget
 from ...robots.schemas import RobotDescription
@@ -71,6 +71,11 @@ class TrajectoryRequest(RequestFrames):
     damping: Number | None = Field(
         None, gt=0, description="λ for damped least-squares rates at singular samples; without it their "
                                 "velocities and accelerations are null")
+    free_joints: list[FreeJointChoice] | None = Field(
+        None, description="arms with more than 6 joints: the n − 6 free joints and where to solve them, as in "
+                          "single IK; each sample is answered over them and continues from the previous one, and "
+                          "their rates are 0. Without it the service picks the joint(s), as single IK does, and "
+                          "holds them continuous along the path")
 
 
 class TrajectoryInlineRequest(TrajectoryRequest):
@@ -116,7 +121,10 @@ class TrajectorySampleResult(ApiModel):
     accelerations: list[float] | None = Field(description="joint accelerations; null without an acceleration, or "
                                                           "at a singular sample without damping")
     branch: Branch = Field(description="branch labels of this sample's solution")
-    branch_changed: bool = Field(description="the labels differ from the previous reached sample's")
+    branch_changed: bool = Field(description="the labels differ from the previous reached sample's, or the joints "
+                                             "may not continue its branch: another solution is about as near the "
+                                             "previous joints carried forward (by the twist, or the last samples), "
+                                             "or none is within a few joint steps of them")
     singularities: list[SingularityReport] = Field(
         description="the IK's singular conditions, the Assur group's case, and kind 'jacobian' (near_singular) "
                     "when the distance to a singularity is below the tolerance")

@@ -39,7 +39,7 @@ from ._plan import geometry_of
 from ._redundant import (FreeJoint, beyond_reach, family_for, free_joints_for, no_solution_detail, solve_family)
 from ._select import MAX_EQUIVALENTS, NOTE_WORDING, Ordering, Selection, check_options, select
 from ._table import SolutionTable
-from ._types import Singularity
+from ._types import LabelCodes, Singularity
 from ._verify import Verified, verify
 
 #: Target kinds (:attr:`IKTargets.kinds`).
@@ -290,7 +290,7 @@ def _poses(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: Answer
         return [_timed(timings, _numeric(robot, goal, rows, options), started)]
     verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
     closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
-    return _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan))
+    return _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan), plan.label_codes)
 
 
 def _positions(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: AnswerOptions,
@@ -305,7 +305,7 @@ def _positions(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: An
     verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
     closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
     held = [j for j in plan.free_joints if j >= 3] if robot.dof > 3 else []
-    parts = _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan))
+    parts = _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan), plan.label_codes)
     if not held:
         return parts
     closed = parts[0]
@@ -397,9 +397,12 @@ def _family(robot: Robot, goal: PoseGoal, rows: np.ndarray, free: list[FreeJoint
 
 
 def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerOptions, timings: list[SolveTiming],
-                   started: float, note: str) -> list[_Part]:
+                   started: float, note: str, label_codes: Callable[[np.ndarray], LabelCodes] | None = None
+                   ) -> list[_Part]:
     """The closed form's part for the targets it promises, and the numeric search for the others, seeded with
-    the solutions the closed form verified there and reporting the conditions it met."""
+    the solutions the closed form verified there and reporting the conditions it met. The search's solutions
+    carry the plan's branch labels (``label_codes``), as the closed form's do: a target near a singularity,
+    which the closed form hands over, keeps the labels a client holds along a path (issue 22.11)."""
     verified = closed.verified
     broken = np.flatnonzero(~verified.complete)
     promised = np.flatnonzero(verified.complete)
@@ -414,7 +417,8 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
     for index, local in enumerate(broken.tolist()):
         start, stop = np.searchsorted(table.target, [local, local + 1])
         known[index, :stop - start] = table.joints[start:stop]
-    fallback = _numeric(robot, goal.take(broken), closed.rows[broken], options, options.reference, known=known)
+    fallback = _numeric(robot, goal.take(broken), closed.rows[broken], options, options.reference, known=known,
+                        label_codes=label_codes)
     fallback.verified.singularities.extend(verified.singularities, rows=broken)
     fallback.reported = np.ones(len(broken), dtype=bool)
     for local in range(len(broken)):
@@ -439,9 +443,12 @@ def _fallback_note(plan) -> str:
 
 def _numeric(robot: Robot, goal: PoseGoal, rows: np.ndarray, options: AnswerOptions,
              reference: np.ndarray | None = None, *, known: np.ndarray | None = None,
-             free: list[FreeJoint] | None = None) -> _Part:
+             free: list[FreeJoint] | None = None,
+             label_codes: Callable[[np.ndarray], LabelCodes] | None = None) -> _Part:
     """The numeric search's part for the goal's targets (their indices ``rows``), seeded with ``known``
-    solutions; with ``free``, once per combination of the free joints' values, those joints held."""
+    solutions; with ``free``, once per combination of the free joints' values, those joints held. ``label_codes``
+    labels the solutions (a closed-form plan's, where the search completes its answer); None leaves them
+    unlabelled."""
     reference = options.reference if reference is None else reference
     search_options = options.search
     if free is None:
@@ -456,7 +463,7 @@ def _numeric(robot: Robot, goal: PoseGoal, rows: np.ndarray, options: AnswerOpti
     if free is not None:
         held = np.zeros(robot.dof, dtype=bool)
         held[list(free_joints)] = True
-    verified = verify(robot, goal, candidates, reference, held=held)
+    verified = verify(robot, goal, candidates, reference, label_codes, held=held)
     part = _Part(rows, verified, "numeric", "general", free_joints, unfinished=unfinished)
     for local in range(len(rows)):
         words = []

@@ -228,7 +228,33 @@ class IdealisedPlan:
         return np.maximum(size, orientation) if self.constrain_orientation else size
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        return self.inner.label_codes(joints)
+        """The idealised family's labels of joint vectors (M, n) of the true arm, except where they are not the
+        true arm's: a label changes where the idealised arm's branches meet, which is up to a few δ from where
+        the true arm's do. So near a singularity of the true arm (σ_min within :data:`SINGULAR_MARGIN` δ), a
+        label whose value changes within that margin of the joints (any joint moved by SINGULAR_MARGIN δ) is left
+        out (−1), as where two branches meet: the true arm's solution there may carry either value, and a path
+        that stays on one branch of the true arm would see it flip (issue 22.11, a Doosan M1013 written with
+        1.571 for π/2)."""
+        joints = np.asarray(joints, dtype=float)
+        codes = self.inner.label_codes(joints)
+        if not codes or not len(joints):
+            return codes
+        near = np.flatnonzero(self._smallest_singular_value(joints) <= SINGULAR_MARGIN * self.deviation)
+        if not len(near):
+            return codes
+        n = joints.shape[-1]
+        steps = SINGULAR_MARGIN * self.deviation * np.concatenate([np.eye(n), -np.eye(n)])  # (2n, n)
+        moved = (joints[near, None, :] + steps[None]).reshape(-1, n)
+        around = self.inner.label_codes(moved)
+        out: LabelCodes = {}
+        for name, (values, own) in codes.items():
+            own = own.copy()
+            if name in around:
+                other = around[name][1].reshape(len(near), 2 * n)
+                flips = ((other != own[near, None]) & (other >= 0)).any(axis=1)
+                own[near[flips]] = -1
+            out[name] = (values, own)
+        return out
 
 
 def _distinct_counts(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:

@@ -1,0 +1,133 @@
+"""A trajectory request in core terms and its answer on the wire: units converted once, here (the route only
+calls these and the core's :func:`~service.kinematics.follow_trajectory`)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from fastapi import Request
+
+from ..kinematics import Budget, InvalidInputError, Robot, TrajectoryOptions, TrajectoryResult
+from ..kinematics.ik import IKOptions
+from .boundary import free_joints_to_core, joints_from_core, joints_to_core, located, target_matrix, violation_to_wire
+from .budget import budget_of
+from .deps import RobotRef, check_batch_size, with_request_frames
+from .schemas.trajectory import TrajectoryRequest
+
+
+@dataclass(frozen=True)
+class AskedTrajectory:
+    """A trajectory request in core terms: the robot (with the request's frames), sample times (N,), target poses
+    (N, 4, 4) ``world_T_tool``, whether they constrain the orientation, twists and accelerations (N, 6) in
+    radians and length units (NaN where not given), and the options."""
+
+    ref: RobotRef
+    times: list[float]
+    world_T_targets: np.ndarray
+    constrain_orientation: bool
+    twists: np.ndarray
+    accelerations: np.ndarray
+    options: TrajectoryOptions
+    budget: Budget
+
+
+def _cartesian(parts, angle: float) -> list[float]:
+    """One twist or acceleration as 6 numbers in core units; NaN for a part not given."""
+    if parts is None:
+        return [math.nan] * 6
+    linear = parts.linear if parts.linear is not None else [math.nan] * 3
+    angular = [v * angle for v in parts.angular] if parts.angular is not None else [math.nan] * 3
+    return [*linear, *angular]
+
+
+def trajectory_in_core(request: Request, ref: RobotRef, body: TrajectoryRequest) -> AskedTrajectory:
+    """Body → core: every sample's pose a matrix (all of one kind), rates and joint values in radians, the
+    options (``free_joints`` as single IK takes them)."""
+    check_batch_size(request, len(body.samples), "samples")
+    ref = with_request_frames(ref, body)
+    robot, unit = ref.robot, body.angle_unit
+    matrices, constrained = [], []
+    budget = budget_of(request)
+    for k, sample in enumerate(body.samples):
+        if k % 256 == 255:
+            budget.check("reading the samples")
+        with located("body", "samples", k, "pose"):
+            matrix, flag = target_matrix(sample.pose, unit)
+        matrices.append(matrix)
+        constrained.append(flag)
+        if flag != constrained[0]:
+            raise InvalidInputError("every sample's pose must be the same kind: all with an orientation, or all "
+                                    "position-only", location=("body", "samples", k, "pose"))
+    angle = math.pi / 180.0 if unit == "deg" else 1.0
+    reference = None
+    if body.reference is not None:
+        with located("body", "reference"):
+            reference = joints_to_core(robot, body.reference, unit)
+    options = TrajectoryOptions(
+        branch=None if body.branch is None else body.branch.model_dump(), reference=reference,
+        singularity_tolerance=body.singularity_tolerance, damping=body.damping, ik=IKOptions(budget=budget),
+        free_joints=free_joints_to_core(robot, body.free_joints, unit))
+    return AskedTrajectory(ref, [s.time for s in body.samples], np.array(matrices), constrained[0],
+                           np.array([_cartesian(s.twist, angle) for s in body.samples]),
+                           np.array([_cartesian(s.acceleration, angle) for s in body.samples]), options, budget)
+
+
+def _vector(robot: Robot, values: np.ndarray | None, unit: str, scale: np.ndarray | None = None) -> list | None:
+    if values is None or np.isnan(values).any():
+        return None
+    return (joints_from_core(robot, values, unit) if scale is None else values / scale).tolist()
+
+
+def trajectory_to_wire(asked: AskedTrajectory, result: TrajectoryResult, body: TrajectoryRequest) -> dict:
+    """The answer as TrajectoryResponse's fields, built field by field (a test validates it against the model)."""
+    robot, unit, budget = asked.ref.robot, body.angle_unit, asked.budget
+    paper_scale = np.array([math.pi / 180.0, math.pi / 180.0, 1.0]) if unit == "deg" else np.ones(3)
+    samples = []
+    for k, s in enumerate(result.samples):
+        if k % 256 == 0:
+            budget.check("encoding")
+        samples.append({
+            "time": s.time,
+            "status": s.status,
+            "joints": _vector(robot, s.joints, unit),
+            "velocities": _vector(robot, s.velocities, unit),
+            "accelerations": _vector(robot, s.accelerations, unit),
+            "branch": s.branch,
+            "branch_changed": s.branch_changed,
+            "singularities": [{"kind": x.kind, "joints": list(x.joints), "relation": x.relation, "detail": x.detail}
+                              for x in s.singularities],
+            "distance_to_singularity": s.distance_to_singularity,
+            "damped": s.damped,
+            "within_limits": None if not s.reached else not s.violations,
+            "violations": [violation_to_wire(robot, v, unit) for v in s.violations],
+            "residual": None if not s.reached else {"velocity": s.velocity_residual,
+                                                    "acceleration": s.acceleration_residual},
+            "paper": None if s.paper is None else {
+                "joints": _vector(robot, s.paper.joints, unit, paper_scale),
+                "velocities": _vector(robot, s.paper.velocities, unit, paper_scale),
+                "accelerations": _vector(robot, s.paper.accelerations, unit, paper_scale),
+                "case": s.paper.case},
+        })
+    summary = result.summary
+    step = joints_from_core(robot, summary.largest_joint_step, unit)
+    return {
+        "robot_id": asked.ref.id,
+        "joint_names": robot.joint_names,
+        "samples": samples,
+        "summary": {
+            "largest_joint_step": {"values": [None if np.isnan(v) else float(v) for v in step],
+                                   "samples": summary.largest_joint_step_at},
+            "smallest_distance_to_singularity": {"value": summary.smallest_distance_to_singularity,
+                                                 "sample": summary.smallest_distance_at},
+            "limit_violations": [{"sample": k, **violation_to_wire(robot, v, unit)}
+                                 for k, v in summary.limit_violations],
+            "singular_samples": summary.singular_samples,
+            "branch_changes": summary.branch_changes,
+            "unreachable_samples": summary.unreachable_samples,
+        },
+        "solver": {"positions": result.method, "structure": result.structure, "complete": result.complete,
+                   "rates": result.rates, "task_rows": list(result.task.names), "solve": result.task.solve,
+                   "singularity_tolerance": body.singularity_tolerance, "damping": body.damping},
+    }

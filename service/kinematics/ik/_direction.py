@@ -1,4 +1,5 @@
-"""Position + tool direction targets of 5-joint arms, as a 6-joint pose problem with a virtual joint.
+"""Position + tool direction targets: 5-joint arms as a 6-joint pose problem with a virtual joint; arms of 6 or
+more joints as a family over the free roll.
 
 The target asks that the tool origin reach ``p`` and the tool axis ``a`` (tool
 frame) point along ``d`` (world frame), as IKFast's TranslationDirection5D:
@@ -18,6 +19,15 @@ a pose target; the tool's roll about ``a`` is what the target leaves open.
   an axis perpendicular to ``a``. A pose of the 5-joint arm is reached by the
   6-joint arm with the virtual joint at 0, and those are the solutions kept.
 
+Arms of 6 or more joints (:class:`RollFamily`): the target leaves one more freedom than the pose problem, the
+tool's roll ψ about ``a``. Each roll gives a full pose, ``R(ψ) = R_t · Rot(a, ψ)`` with ``R_t`` the shortest turn
+of ``a`` onto ``d`` (:func:`rotations_to`), which the arm's closed form solves completely: the pose plan of a
+6-joint arm, or a redundant arm's free-joint family (:mod:`._redundant`) at each of its free values. The family is
+sampled at :data:`DEFAULT_ROLL_SAMPLES` rolls evenly over the turn (or the rolls a request gives); with a
+reference, the roll is also searched continuously between the samples (:func:`~._free_search.refine_over`), so
+the nearest member of the whole family is listed. Each solution carries its roll (:func:`rolls_of`, read from
+its FK), as a free joint carries its value.
+
 Every solution is checked by the real arm's FK (:func:`~._verify.verify` with a
 :class:`~._goals.DirectionGoal`): position within ``ACCEPT_RESIDUAL`` times its
 size, direction within ``ACCEPT_RESIDUAL`` rad.
@@ -25,30 +35,42 @@ size, direction within ``ACCEPT_RESIDUAL`` rad.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
+from .._budget import UNLIMITED, Budget
 from .._cache import bounded_memo
 from .._errors import InvalidInputError
+from .._forward import forward_kinematics
 from .._robot import Robot
 from .._rotations import wrap_angle
-from .._tolerances import GEOMETRY_TOLERANCE
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from ._closed_form import cached_plan
 from ._goals import DirectionGoal
 from ._plan import Plan, geometry_of, plan_for_geometry
-from ._structure import Geometry
+from ._redundant import MAX_FREE_VALUES, FreeJoint, FreeJointFamily, family_for, free_value_grid, grid_size
+from ._structure import Geometry, arm_size
+from ._table import SolutionTable
 from ._types import Candidates, SingularFlags, Singularity
+from ._verify import Verified, distance_to_reference, joint_difference, verify
 
 #: The virtual joint's value (rad) within which a 6-joint solution is one of the 5-joint arm (the roll case).
 VIRTUAL_AT_ZERO = 1e-6
 #: Direction plans kept per robot (one per tool axis a request names).
 _PLANS_KEPT = 16
+#: Samples of the free roll per direction target of an arm of 6 or more joints when the request names none: 10°
+#: apart.
+DEFAULT_ROLL_SAMPLES = 36
+#: Most rolls × free values of a redundant arm per direction target: each is one complete pose solve (the
+#: free-joint family's own cap, :data:`~._redundant.MAX_FREE_VALUES`).
+MAX_ROLL_ROWS = MAX_FREE_VALUES
 
 
 def target_kinds(robot: Robot) -> list[str]:
     """The IK target kinds this arm takes (api.md): ``pose`` and ``position`` always, ``position_direction``
-    for arms with 5 joints."""
-    return ["pose", "position"] + (["position_direction"] if robot.dof == 5 else [])
+    for arms with 5 joints or more (6 or more: a family over the free roll)."""
+    return ["pose", "position"] + (["position_direction"] if robot.dof >= 5 else [])
 
 
 @dataclass(frozen=True)
@@ -83,12 +105,15 @@ def _with_virtual_roll(geometry: Geometry, axis_world: np.ndarray) -> Geometry:
 def direction_plan(robot: Robot, tool_axis: np.ndarray) -> DirectionPlan | None:
     """The plan for direction targets with this tool axis, or None when no family covers the 6-joint problem.
 
-    Raises :class:`InvalidInputError` for an arm without exactly 5 joints.
+    Raises :class:`InvalidInputError` for an arm with fewer than 5 joints; arms of 6 or more take
+    :class:`RollFamily` instead.
     """
-    if robot.dof != 5:
+    if robot.dof < 5:
         raise InvalidInputError(
-            f"position + tool direction targets are solved for arms with 5 joints; this one has {robot.dof} "
-            f"(give a full pose, or the position only)", location=("target", "orientation"))
+            f"position + tool direction targets need at least 5 joints (five conditions); this one has "
+            f"{robot.dof} (give a full pose, or the position only)", location=("target", "orientation"))
+    if robot.dof > 5:
+        raise ValueError("arms of 6 or more joints solve direction targets by RollFamily")
     a = _unit(np.asarray(tool_axis, dtype=float))
 
     def build() -> DirectionPlan | None:
@@ -169,3 +194,231 @@ def tool_roll(plan: DirectionPlan) -> Singularity | None:
     return Singularity("tool_roll", (plan.roll_joint,), "free",
                        f"q{plan.roll_joint + 1} turns the tool about the tool axis, which the target leaves free: "
                        f"held at the reference value (or 0)")
+
+
+def roll_samples(count: int) -> np.ndarray:
+    """``count`` rolls (rad) evenly over a turn, from −π: shape (count,)."""
+    return -np.pi + 2 * np.pi * np.arange(count) / count
+
+
+def about_axis(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rotations (S, 3, 3) by ``angles`` (S,) about the unit ``axis`` (3,) (Rodrigues)."""
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    s, c = np.sin(angles)[:, None, None], np.cos(angles)[:, None, None]
+    return np.eye(3) + s * K + (1 - c) * (K @ K)
+
+
+def roll_poses(tool_axis: np.ndarray, position: np.ndarray, direction: np.ndarray, rolls: np.ndarray) -> np.ndarray:
+    """The full poses ``world_T_tool`` (S, 4, 4) of one direction target at each roll (S,):
+    rotation ``R_t · Rot(a, ψ)`` (``R_t``: :func:`rotations_to` of the tool axis onto the direction), origin at
+    ``position`` (3,). Each turns ``tool_axis`` (3,, unit, tool frame) onto ``direction`` (3,, unit, world)."""
+    R_t = rotations_to(tool_axis, direction[None])[0]
+    poses = np.zeros((len(rolls), 4, 4))
+    poses[:, :3, :3] = R_t @ about_axis(tool_axis, rolls)
+    poses[:, :3, 3] = position
+    poses[:, 3, 3] = 1.0
+    return poses
+
+
+def rolls_of(tool_axis: np.ndarray, directions: np.ndarray, world_R_tool: np.ndarray) -> np.ndarray:
+    """The roll ψ (K,), radians in (−π, π], of each tool rotation ``world_R_tool`` (K, 3, 3) whose tool axis
+    (3,, unit, tool frame) points along ``directions`` (K, 3): the angle of ``R_t⁻¹ · R`` about the tool axis, as
+    :func:`roll_poses` builds it (``u`` ⟂ ``a`` turns to ``cos ψ u + sin ψ (a × u)``).
+
+    >>> a = np.array([0.0, 0.0, 1.0]); d = np.array([[1.0, 0.0, 0.0]])
+    >>> round(float(rolls_of(a, d, roll_poses(a, np.zeros(3), d[0], np.array([0.5]))[:, :3, :3])[0]), 12)
+    0.5
+    """
+    a = _unit(np.asarray(tool_axis, dtype=float))
+    u = _perpendicular(a)
+    v = np.cross(a, u)
+    R_t = rotations_to(a, directions)
+    turned = np.einsum("kji,kjl,l->ki", R_t, world_R_tool, u)  # R_t^T R u, (K, 3)
+    return np.arctan2(turned @ v, turned @ u)
+
+
+@dataclass(frozen=True)
+class RollFamily:
+    """How an arm of 6 or more joints solves direction targets: the pose at each roll by ``plan`` (a 6-joint arm's
+    pose plan), or by ``family`` (a redundant arm's free-joint family) at each of the ``free`` values (V, f).
+    ``generic_count``: the most solutions of one roll (and free value)."""
+
+    plan: Plan | None
+    family: FreeJointFamily | None
+    free: np.ndarray | None
+    structure: str
+    generic_count: int
+
+    @property
+    def free_joints(self) -> tuple[int, ...]:
+        return () if self.family is None else self.family.free
+
+    @property
+    def free_rows(self) -> int:
+        """Free values per roll: 1 for a 6-joint arm."""
+        return 1 if self.free is None else len(self.free)
+
+
+def roll_family(robot: Robot, free_joints: list[FreeJoint] | None) -> RollFamily | None:
+    """The roll family of an arm of 6 or more joints, or None when no closed form covers its pose problem (a
+    redundant arm: with the free joints ``free_joints``, as :func:`~._redundant.free_joints_for` gives them)."""
+    if robot.dof == 6:
+        plan = cached_plan(robot, constrain_orientation=True, reference=None)
+        return None if plan is None else RollFamily(plan, None, None, f"roll_family+{plan.structure}",
+                                                    plan.generic_count)
+    if free_joints is None:
+        return None
+    family = family_for(robot, tuple(sorted(f.joint for f in free_joints)))
+    if not family.available:
+        return None
+    return RollFamily(None, family, free_value_grid(free_joints, family), f"roll_family+{family.structure}",
+                      family.generic_count)
+
+
+def roll_rows(robot: Robot, rolls: np.ndarray, free_joints: list[FreeJoint] | None) -> int:
+    """Pose solves per direction target: rolls × free values; :class:`InvalidInputError` past
+    :data:`MAX_ROLL_ROWS`."""
+    values = 1 if free_joints is None else grid_size([len(f.values) for f in free_joints])
+    rows = len(rolls) * values
+    if rows > MAX_ROLL_ROWS:
+        raise InvalidInputError(f"{len(rolls)} roll samples × {values} free values = {rows} pose solves per "
+                                f"direction target; at most {MAX_ROLL_ROWS} (lower roll_samples or the free "
+                                f"joints' samples)", location=("target", "orientation"))
+    return rows
+
+
+@dataclass(frozen=True)
+class RollVerified:
+    """The roll family's answer for N direction targets: ``verified`` (each target's solutions over every roll,
+    the table carrying each row's roll), and per target (N,) how many poses the closed form could not promise
+    (``unpromised``) and how many rolls the continuous search added (``refined``)."""
+
+    verified: Verified
+    unpromised: np.ndarray
+    refined: np.ndarray
+
+
+def solve_roll_family(robot: Robot, family: RollFamily, goal: DirectionGoal, rolls: np.ndarray,
+                      reference: np.ndarray | None, *, budget: Budget = UNLIMITED) -> RollVerified:
+    """Every solution of each of the goal's N targets at each roll of ``rolls`` (S,) (and each free value), each
+    verified by FK against the direction target; with a reference on a 6-joint arm, also at the rolls where a
+    branch comes nearest it between samples (:func:`~._free_search.refine_over`). ``budget`` is checked before
+    each target."""
+    from ._free_search import REFINE_ROUNDS, REFINED_MINIMA, _evenly_over_a_turn, refine_over
+
+    tables, complete, nearest, flags, unpromised, refined = [], [], [], [], [], []
+    for index in range(len(goal)):
+        budget.check("the roll family")
+
+        def solve(chosen: np.ndarray, index: int = index) -> Verified:
+            return _at_rolls(robot, family, goal, index, chosen, reference)
+
+        grid = solve(rolls)
+        parts = [grid]
+        if reference is not None and family.family is None:
+            extra = refine_over(robot, rolls, grid, reference, REFINED_MINIMA, REFINE_ROUNDS, solve, None,
+                                _evenly_over_a_turn(rolls), wrap_angle)
+            if extra is not None:
+                parts.append(extra)
+        elif reference is not None and family.free.shape[1] == 1:
+            extra = _nearest_of_redundant(robot, family, goal, index, rolls, grid, reference)
+            if extra is not None:
+                parts.append(extra)
+        refined.append(sum(len(part.complete) for part in parts[1:]))
+        unpromised.append(sum(int((~part.complete).sum()) for part in parts))
+        table = SolutionTable.concat([part.table.with_targets(np.zeros(len(part.table), dtype=np.int64))
+                                      for part in parts], robot.dof)
+        if reference is not None:  # nearest the reference first over the whole family
+            table = table.take(np.argsort(distance_to_reference(robot, table.joints, reference), kind="stable"))
+        tables.append(table.with_targets(np.full(len(table), index)))
+        complete.append(all(part.complete.all() for part in parts))
+        nearest.append(min(float(part.nearest.min(initial=np.inf)) for part in parts))
+        met = SingularFlags(1)
+        for part in parts:
+            solved = part.count > 0
+            for mask, flag in part.singularities.entries:
+                if (mask & solved).any():
+                    met.add(np.ones(1, dtype=bool), flag)
+        flags.append(met)
+    missing = 0 if family.family is None or family.family.ends_only else sum(
+        family.family.locked_plan(row) is None for row in family.free)
+    verified = Verified(SolutionTable.concat(tables, robot.dof), np.array(complete, dtype=bool) & (missing == 0),
+                        np.array(nearest), SingularFlags.concat(flags) if flags else SingularFlags(0))
+    return RollVerified(verified, np.array(unpromised, dtype=int), np.array(refined, dtype=int))
+
+
+#: Steps of the projected descent towards the reference along a redundant arm's (roll, free value) family, and
+#: the largest joint move (rad or length units over the arm's size) of its step along the family.
+PROJECTION_STEPS = 60
+PROJECTION_STRIDE = 0.2
+
+
+def _nearest_of_redundant(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,
+                          grid: Verified, reference: np.ndarray) -> Verified | None:
+    """A redundant arm's member nearest the reference over the whole (roll, free value) family: from the grid's
+    nearest solution, a descent that keeps the direction target (Gauss–Newton on the goal) and moves along the
+    family towards the reference (the step's part in the Jacobian's null space) reaches the nearest point of its
+    branch; the roll and free value read off it are then solved completely (one verified row). None when the
+    grid is empty or the point reached is on the grid."""
+    table = grid.table
+    if not len(table):
+        return None
+    joint = family.free_joints[0]
+    start = int(np.argmin(distance_to_reference(robot, table.joints, reference)))
+    q = _projected_nearest(robot, goal.take(np.array([index])), table.joints[start], reference)
+    if q is None:
+        return None
+    roll = float(rolls_of(goal.tool_axis, goal.directions[index][None],
+                          forward_kinematics(robot, q[None])[:, :3, :3])[0])
+    value = float(q[joint])
+    values = family.free[:, 0]
+    if (np.abs(wrap_angle(rolls - roll)).min() <= DUPLICATE_TOLERANCE
+            and np.abs(values - value).min() <= DUPLICATE_TOLERANCE):
+        return None
+    return _at_rolls(robot, replace(family, free=np.array([[value]])), goal, index, np.array([roll]), reference)
+
+
+def _projected_nearest(robot: Robot, goal: DirectionGoal, q: np.ndarray, reference: np.ndarray
+                       ) -> np.ndarray | None:
+    """From a solution q (n,) of the one-target ``goal``, the nearest point (locally, in the joints' 2-norm,
+    revolute differences across the wrap) of the family of solutions to the reference (n,): each step is the
+    Gauss–Newton correction ``J⁺ e`` plus the move towards the reference projected on the null space of the
+    goal's Jacobian J (6, n), at most :data:`PROJECTION_STRIDE` per joint. None when it left the target."""
+    rows = np.zeros(1, dtype=int)
+    stride = np.where(robot.is_revolute, PROJECTION_STRIDE, PROJECTION_STRIDE * arm_size(robot))
+    q = np.array(q, dtype=float)
+    for _ in range(PROJECTION_STEPS):
+        error = goal.error(robot, q[None], rows)[0]
+        J = goal.jacobian(robot, q[None], rows)[0]
+        inverse = np.linalg.pinv(J, rcond=1e-9)
+        toward = -joint_difference(robot, q, reference)
+        along = toward - inverse @ (J @ toward)
+        along *= min(1.0, float(np.min(stride / np.maximum(np.abs(along), 1e-300))))
+        q = q + inverse @ error + along
+        if np.abs(along).max() < 1e-13 and np.abs(error).max() < 1e-13:
+            break
+    error = goal.error(robot, q[None], rows)[0]
+    return q if np.abs(error).max() <= 1e-9 else None
+
+
+def _at_rolls(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,
+              reference: np.ndarray | None) -> Verified:
+    """Every solution of target ``index`` of the goal at each roll (S,) (and, for a redundant arm, each free
+    value: rows roll-major), verified against the direction target: one verified row per (roll, free value),
+    each table row carrying its roll."""
+    poses = roll_poses(goal.tool_axis, goal.positions[index], goal.directions[index], rolls)
+    held, label_codes = None, None
+    if family.family is None:
+        candidates, label_codes = family.plan.solve(poses, reference), family.plan.label_codes
+    else:
+        free = family.free
+        candidates = family.family.solve_rows(np.repeat(poses, len(free), axis=0), np.tile(free, (len(rolls), 1)),
+                                              reference)
+        held = np.zeros(robot.dof, dtype=bool)
+        held[list(family.free_joints)] = True
+    rows = len(candidates.valid)
+    verified = verify(robot, goal.take(np.full(rows, index)), candidates, reference, label_codes, held=held)
+    table = verified.table
+    R = forward_kinematics(robot, table.joints)[:, :3, :3]
+    roll = rolls_of(goal.tool_axis, np.broadcast_to(goal.directions[index], (len(table), 3)), R)
+    return replace(verified, table=table.with_roll(roll))

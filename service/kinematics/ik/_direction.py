@@ -220,21 +220,20 @@ def roll_poses(tool_axis: np.ndarray, position: np.ndarray, direction: np.ndarra
     return poses
 
 
-def rolls_of(tool_axis: np.ndarray, directions: np.ndarray, world_R_tool: np.ndarray) -> np.ndarray:
+def rolls_of(tool_axis: np.ndarray, direction: np.ndarray, world_R_tool: np.ndarray) -> np.ndarray:
     """The roll ψ (K,), radians in (−π, π], of each tool rotation ``world_R_tool`` (K, 3, 3) whose tool axis
-    (3,, unit, tool frame) points along ``directions`` (K, 3): the angle of ``R_t⁻¹ · R`` about the tool axis, as
-    :func:`roll_poses` builds it (``u`` ⟂ ``a`` turns to ``cos ψ u + sin ψ (a × u)``).
+    (3,, unit, tool frame) points along ``direction`` (3,, unit, world frame): the angle of ``R_t⁻¹ · R`` about
+    the tool axis, as :func:`roll_poses` builds it (``u`` ⟂ ``a`` turns to ``cos ψ u + sin ψ (a × u)``).
 
-    >>> a = np.array([0.0, 0.0, 1.0]); d = np.array([[1.0, 0.0, 0.0]])
-    >>> round(float(rolls_of(a, d, roll_poses(a, np.zeros(3), d[0], np.array([0.5]))[:, :3, :3])[0]), 12)
+    >>> a = np.array([0.0, 0.0, 1.0]); d = np.array([1.0, 0.0, 0.0])
+    >>> round(float(rolls_of(a, d, roll_poses(a, np.zeros(3), d, np.array([0.5]))[:, :3, :3])[0]), 12)
     0.5
     """
     a = _unit(np.asarray(tool_axis, dtype=float))
     u = _perpendicular(a)
-    v = np.cross(a, u)
-    R_t = rotations_to(a, directions)
-    turned = np.einsum("kji,kjl,l->ki", R_t, world_R_tool, u)  # R_t^T R u, (K, 3)
-    return np.arctan2(turned @ v, turned @ u)
+    R_t = rotations_to(a, np.asarray(direction, dtype=float)[None])[0]
+    turned = (world_R_tool @ u) @ R_t  # rows: (R_t^T R u)^T, (K, 3)
+    return np.arctan2(turned @ np.cross(a, u), turned @ u)
 
 
 @dataclass(frozen=True)
@@ -368,8 +367,7 @@ def _nearest_of_redundant(robot: Robot, family: RollFamily, goal: DirectionGoal,
     q = _projected_nearest(robot, goal.take(np.array([index])), table.joints[start], reference)
     if q is None:
         return None
-    roll = float(rolls_of(goal.tool_axis, goal.directions[index][None],
-                          forward_kinematics(robot, q[None])[:, :3, :3])[0])
+    roll = float(rolls_of(goal.tool_axis, goal.directions[index], forward_kinematics(robot, q[None])[:, :3, :3])[0])
     value = float(q[joint])
     values = family.free[:, 0]
     if (np.abs(wrap_angle(rolls - roll)).min() <= DUPLICATE_TOLERANCE
@@ -420,5 +418,5 @@ def _at_rolls(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int,
     verified = verify(robot, goal.take(np.full(rows, index)), candidates, reference, label_codes, held=held)
     table = verified.table
     R = forward_kinematics(robot, table.joints)[:, :3, :3]
-    roll = rolls_of(goal.tool_axis, np.broadcast_to(goal.directions[index], (len(table), 3)), R)
+    roll = rolls_of(goal.tool_axis, goal.directions[index], R)
     return replace(verified, table=table.with_roll(roll))

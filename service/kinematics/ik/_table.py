@@ -39,7 +39,7 @@ class SolutionTable:
         checked pairs, and each row's pairs closer than the margin (a tuple of (a, b, distance)). None without.
     roll : ndarray, shape (S,), optional
         A direction target solved over its free roll (:mod:`._direction`): the row's roll of the tool about the
-        tool axis, radians in [−π, π) (:func:`~._direction.rolls_of`); NaN for rows of other targets. None when
+        tool axis, radians in (−π, π] (:func:`~._direction.rolls_of`); NaN for rows of other targets. None when
         no row has one.
     """
 

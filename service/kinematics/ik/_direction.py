@@ -300,9 +300,9 @@ class RollVerified:
 def solve_roll_family(robot: Robot, family: RollFamily, goal: DirectionGoal, rolls: np.ndarray,
                       reference: np.ndarray | None, *, budget: Budget = UNLIMITED) -> RollVerified:
     """Every solution of each of the goal's N targets at each roll of ``rolls`` (S,) (and each free value), each
-    verified by FK against the direction target; with a reference on a 6-joint arm, also at the rolls where a
-    branch comes nearest it between samples (:func:`~._free_search.refine_over`). ``budget`` is checked before
-    each target."""
+    verified by FK against the direction target; with a reference, also at the rolls (and free values) where a
+    branch comes nearest it between samples: :func:`_projected_members` and, over the roll of a 6-joint arm,
+    :func:`~._free_search.refine_over`. ``budget`` is checked before each target."""
     from ._free_search import REFINE_ROUNDS, REFINED_MINIMA, _evenly_over_a_turn, refine_over
 
     tables, complete, nearest, flags, unpromised, refined = [], [], [], [], [], []
@@ -314,15 +314,12 @@ def solve_roll_family(robot: Robot, family: RollFamily, goal: DirectionGoal, rol
 
         grid = solve(rolls)
         parts = [grid]
-        if reference is not None and family.family is None:
-            extra = refine_over(robot, rolls, grid, reference, REFINED_MINIMA, REFINE_ROUNDS, solve, None,
-                                _evenly_over_a_turn(rolls), wrap_angle)
-            if extra is not None:
-                parts.append(extra)
-        elif reference is not None and family.free.shape[1] == 1:
-            extra = _nearest_of_redundant(robot, family, goal, index, rolls, grid, reference)
-            if extra is not None:
-                parts.append(extra)
+        if reference is not None:
+            extras = [_projected_members(robot, family, goal, index, rolls, grid, reference)]
+            if family.family is None:
+                extras.append(refine_over(robot, rolls, grid, reference, REFINED_MINIMA, REFINE_ROUNDS, solve, None,
+                                          _evenly_over_a_turn(rolls), wrap_angle))
+            parts += [extra for extra in extras if extra is not None]
         refined.append(sum(len(part.complete) for part in parts[1:]))
         unpromised.append(sum(int((~part.complete).sum()) for part in parts))
         table = SolutionTable.concat([part.table.with_targets(np.zeros(len(part.table), dtype=np.int64))
@@ -346,77 +343,111 @@ def solve_roll_family(robot: Robot, family: RollFamily, goal: DirectionGoal, rol
     return RollVerified(verified, np.array(unpromised, dtype=int), np.array(refined, dtype=int))
 
 
-#: Steps of the projected descent towards the reference along a redundant arm's (roll, free value) family, and
-#: the largest joint move (rad or length units over the arm's size) of its step along the family.
+#: Steps of the projected descent towards the reference along the family, the largest joint move (rad, or
+#: length units over the arm's size) of its step along the family, and the branches it starts from.
 PROJECTION_STEPS = 60
 PROJECTION_STRIDE = 0.2
+PROJECTION_STARTS = 4
 
 
-def _nearest_of_redundant(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,
-                          grid: Verified, reference: np.ndarray) -> Verified | None:
-    """A redundant arm's member nearest the reference over the whole (roll, free value) family: from the grid's
-    nearest solution, a descent that keeps the direction target (Gauss–Newton on the goal) and moves along the
-    family towards the reference (the step's part in the Jacobian's null space) reaches the nearest point of its
-    branch; the roll and free value read off it are then solved completely (one verified row). None when the
-    grid is empty or the point reached is on the grid."""
+def _projected_members(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,
+                       grid: Verified, reference: np.ndarray) -> Verified | None:
+    """The members nearest the reference of the :data:`PROJECTION_STARTS` branches whose grid solutions come
+    nearest it: from each, a descent that keeps the direction target and moves along the family towards the
+    reference (:func:`_projected_nearest`); the roll (and free value) read off each point reached is then solved
+    completely, one verified row per point. None when the grid is empty or every point is on the grid.
+
+    This is what finds the nearest member of a redundant arm's two-parameter family (roll × free joint), and it
+    backs up the bracketing search over the roll where a branch moves fast with the roll (near a singularity),
+    so that its nearest grid sample is not among the nearest minima."""
+    from ._free_search import branch_keys
+
     table = grid.table
     if not len(table):
         return None
-    joint = family.free_joints[0]
-    start = int(np.argmin(distance_to_reference(robot, table.joints, reference)))
-    q = _projected_nearest(robot, goal.take(np.array([index])), table.joints[start], reference)
-    if q is None:
+    distance = distance_to_reference(robot, table.joints, reference)
+    keys = branch_keys(table.labels, len(table))
+    order = np.argsort(distance, kind="stable")
+    _, first = np.unique(keys[order], return_index=True)  # each branch's nearest grid solution
+    starts = order[np.sort(first)]
+    starts = starts[np.argsort(distance[starts], kind="stable")][:PROJECTION_STARTS]
+    q, reached = _projected_nearest(robot, goal.take(np.full(len(starts), index)), table.joints[starts], reference)
+    if not reached.any():
         return None
-    roll = float(rolls_of(goal.tool_axis, goal.directions[index], forward_kinematics(robot, q[None])[:, :3, :3])[0])
-    value = float(q[joint])
-    values = family.free[:, 0]
-    if (np.abs(wrap_angle(rolls - roll)).min() <= DUPLICATE_TOLERANCE
-            and np.abs(values - value).min() <= DUPLICATE_TOLERANCE):
+    q = q[reached]
+    point_rolls = rolls_of(goal.tool_axis, goal.directions[index], forward_kinematics(robot, q)[:, :3, :3])
+    free = None if family.family is None else q[:, list(family.free_joints)]
+    points = np.column_stack([point_rolls] + ([] if free is None else [free]))
+    points = points[first_of_each_point(points)]
+    on_grid = np.abs(wrap_angle(points[:, :1] - rolls[None, :])).min(axis=1) <= DUPLICATE_TOLERANCE
+    if free is not None:
+        on_grid &= (np.abs(points[:, None, 1:] - family.free[None]).max(axis=2) <= DUPLICATE_TOLERANCE).any(axis=1)
+    points = points[~on_grid]
+    if not len(points):
         return None
-    return _at_rolls(robot, replace(family, free=np.array([[value]])), goal, index, np.array([roll]), reference)
+    return _solved_at(robot, family, goal, index, points[:, 0], None if free is None else points[:, 1:], reference)
+
+
+def first_of_each_point(points: np.ndarray) -> np.ndarray:
+    """Which rows (K,) of ``points`` (K, 1 + f: roll, free values) are the first of their kind (within
+    ``DUPLICATE_TOLERANCE``, the roll across the wrap)."""
+    kept = np.zeros(len(points), dtype=bool)
+    for k in range(len(points)):
+        gap = np.abs(points[:k] - points[k])
+        gap[:, 0] = np.abs(wrap_angle(points[:k, 0] - points[k, 0]))
+        kept[k] = not ((gap <= DUPLICATE_TOLERANCE).all(axis=1) & kept[:k]).any()
+    return kept
 
 
 def _projected_nearest(robot: Robot, goal: DirectionGoal, q: np.ndarray, reference: np.ndarray
-                       ) -> np.ndarray | None:
-    """From a solution q (n,) of the one-target ``goal``, the nearest point (locally, in the joints' 2-norm,
+                       ) -> tuple[np.ndarray, np.ndarray]:
+    """From solutions q (K, n) of the goal's K targets, the nearest points (locally, in the joints' 2-norm,
     revolute differences across the wrap) of the family of solutions to the reference (n,): each step is the
     Gauss–Newton correction ``J⁺ e`` plus the move towards the reference projected on the null space of the
-    goal's Jacobian J (6, n), at most :data:`PROJECTION_STRIDE` per joint. None when it left the target."""
-    rows = np.zeros(1, dtype=int)
+    goal's Jacobian J (6, n), at most :data:`PROJECTION_STRIDE` per joint. Returns the points (K, n) and which
+    of them are still on the target (K,)."""
+    rows = np.arange(len(q))
     stride = np.where(robot.is_revolute, PROJECTION_STRIDE, PROJECTION_STRIDE * arm_size(robot))
     q = np.array(q, dtype=float)
     for _ in range(PROJECTION_STEPS):
-        error = goal.error(robot, q[None], rows)[0]
-        J = goal.jacobian(robot, q[None], rows)[0]
-        inverse = np.linalg.pinv(J, rcond=1e-9)
+        error = goal.error(robot, q, rows)
+        J = goal.jacobian(robot, q, rows)
+        inverse = np.linalg.pinv(J, rcond=1e-9)  # (K, n, 6)
         toward = -joint_difference(robot, q, reference)
-        along = toward - inverse @ (J @ toward)
-        along *= min(1.0, float(np.min(stride / np.maximum(np.abs(along), 1e-300))))
-        q = q + inverse @ error + along
+        along = toward - np.einsum("kij,kj->ki", inverse, np.einsum("kij,kj->ki", J, toward))
+        along *= np.minimum(1.0, (stride / np.maximum(np.abs(along), 1e-300)).min(axis=1))[:, None]
+        q = q + np.einsum("kij,kj->ki", inverse, error) + along
         if np.abs(along).max() < 1e-13 and np.abs(error).max() < 1e-13:
             break
-    error = goal.error(robot, q[None], rows)[0]
-    return q if np.abs(error).max() <= 1e-9 else None
+    return q, np.abs(goal.error(robot, q, rows)).max(axis=1) <= 1e-9
 
 
 def _at_rolls(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,
               reference: np.ndarray | None) -> Verified:
-    """Every solution of target ``index`` of the goal at each roll (S,) (and, for a redundant arm, each free
-    value: rows roll-major), verified against the direction target: one verified row per (roll, free value),
-    each table row carrying its roll."""
+    """Every solution of target ``index`` of the goal at each roll (S,) (and, for a redundant arm, each of the
+    family's free values: rows roll-major), verified against the direction target: one verified row per (roll,
+    free value), each table row carrying its roll."""
+    if family.family is None:
+        return _solved_at(robot, family, goal, index, rolls, None, reference)
+    free = family.free
+    return _solved_at(robot, family, goal, index, np.repeat(rolls, len(free)), np.tile(free, (len(rolls), 1)),
+                      reference)
+
+
+def _solved_at(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,
+               free: np.ndarray | None, reference: np.ndarray | None) -> Verified:
+    """Every solution of target ``index`` of the goal at each roll (K,), a redundant arm's free joints at
+    ``free`` (K, f) row by row, verified against the direction target (one row each), each table row carrying
+    its roll (read off its FK)."""
     poses = roll_poses(goal.tool_axis, goal.positions[index], goal.directions[index], rolls)
     held, label_codes = None, None
     if family.family is None:
         candidates, label_codes = family.plan.solve(poses, reference), family.plan.label_codes
     else:
-        free = family.free
-        candidates = family.family.solve_rows(np.repeat(poses, len(free), axis=0), np.tile(free, (len(rolls), 1)),
-                                              reference)
+        candidates = family.family.solve_rows(poses, free, reference)
         held = np.zeros(robot.dof, dtype=bool)
         held[list(family.free_joints)] = True
-    rows = len(candidates.valid)
-    verified = verify(robot, goal.take(np.full(rows, index)), candidates, reference, label_codes, held=held)
+    verified = verify(robot, goal.take(np.full(len(rolls), index)), candidates, reference, label_codes, held=held)
     table = verified.table
     R = forward_kinematics(robot, table.joints)[:, :3, :3]
-    roll = rolls_of(goal.tool_axis, goal.directions[index], R)
-    return replace(verified, table=table.with_roll(roll))
+    return replace(verified, table=table.with_roll(rolls_of(goal.tool_axis, goal.directions[index], R)))

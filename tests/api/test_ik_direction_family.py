@@ -21,7 +21,7 @@ from service.kinematics import forward_kinematics
 from tests.conftest import assert_problem, catalogue_robot
 from tests.ik_helpers import find, fk_matrix, joints_of
 
-SIX = ["puma560_standard", "ur5", "kuka_kr6_r900_2"]
+SIX = ["puma560_standard", "ur5", "kuka_kr6_r900_2", "kinova_jaco2"]
 SEVEN = "franka_panda"
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -142,6 +142,20 @@ def test_beyond_reach_is_unreachable_and_the_detail_says_so(client):
         "target": {"position": [5.0, 0.0, 0.0], "orientation": {"type": "direction", "world_direction": [0, 0, 1]}}
     }).json()
     assert answer["status"] == "unreachable" and "outside the workspace" in answer["detail"]
+
+
+def test_no_solution_at_the_rolls_solved_is_not_found_not_unreachable(client):
+    """A UR5 with its tool x axis as the direction axis: the roll moves the wrist, and this target (made by FK)
+    is out of reach at the roll −1.5 rad but not at 1.0 rad."""
+    T = fk_matrix(client, "ur5", [0.0, -0.2, 0.02, 0.0, 0.7, 0.0])
+    target = {"position": T[:3, 3].tolist(), "orientation": {"type": "direction", "tool_axis": [1, 0, 0],
+                                                             "world_direction": T[:3, 0].tolist()}}
+    target["orientation"]["roll_values"] = [-1.5]
+    answer = client.post("/v1/robots/ur5/ik", json={"target": target}).json()
+    assert answer["status"] == "not_found" and answer["solver"]["complete"] is True
+    assert "other rolls may reach it" in answer["detail"]
+    target["orientation"]["roll_values"] = [-1.5, 1.0]
+    assert client.post("/v1/robots/ur5/ik", json={"target": target}).json()["status"] == "ok"
 
 
 @pytest.mark.parametrize("orientation, loc", [

@@ -18,7 +18,7 @@ from ..collision import model_for
 from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_collisions, _at_free_joints,
                       direction_groups)
 from ._closed_form import cached_plan, plan_is_kept
-from ._direction import direction_plan, roll_family, roll_rows
+from ._direction import direction_plan, refined_rows, roll_family, roll_rows
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit,
                            equivalents_per_solution, worst_answer_per_target)
 from ._free_search import REFINED_MINIMA
@@ -93,12 +93,12 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
                 with _at_free_joints():
                     free = free_joints_for(robot, options.free_joints)
             family = roll_family(robot, free)
-            refined = REFINED_MINIMA if options.reference is not None and robot.dof == 6 else 0
             for _, _, rolls in direction_groups(targets, np.flatnonzero(rows)):
                 solves = roll_rows(robot, rolls, free)
                 if family is not None:
-                    most = max(most, (solves + refined * family.free_rows) * family.generic_count)
-                    free_values = max(free_values, solves + refined * family.free_rows)
+                    solves += refined_rows(family, options.reference is not None)
+                    most = max(most, solves * family.generic_count)
+                    free_values = max(free_values, solves)
             continue
         if kind == DIRECTION:
             for axis in np.unique(np.asarray(targets.tool_axes)[rows], axis=0):

@@ -286,6 +286,17 @@ def roll_rows(robot: Robot, rolls: np.ndarray, free_joints: list[FreeJoint] | No
     return rows
 
 
+def refined_rows(family: RollFamily, reference_given: bool) -> int:
+    """The most pose solves a reference adds per target (each one row: a roll, and a free value): the points of
+    :func:`_projected_members` and, over a 6-joint arm's roll, the minima :func:`~._free_search.refine_over`
+    refines."""
+    from ._free_search import REFINED_MINIMA
+
+    if not reference_given:
+        return 0
+    return PROJECTION_STARTS + (REFINED_MINIMA if family.family is None else 0)
+
+
 @dataclass(frozen=True)
 class RollVerified:
     """The roll family's answer for N direction targets: ``verified`` (each target's solutions over every roll,

@@ -46,7 +46,7 @@ from .._forward import forward_kinematics
 from .._robot import Robot
 from .._rotations import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
-from ._closed_form import cached_plan
+from ._closed_form import cached_plan, joined
 from ._goals import DirectionGoal
 from ._plan import Plan, geometry_of, plan_for_geometry
 from ._redundant import MAX_FREE_VALUES, FreeJoint, FreeJointFamily, family_for, free_value_grid, grid_size
@@ -313,7 +313,7 @@ def solve_roll_family(robot: Robot, family: RollFamily, goal: DirectionGoal, rol
     """Every solution of each of the goal's N targets at each roll of ``rolls`` (S,) (and each free value), each
     verified by FK against the direction target; with a reference, also at the rolls (and free values) where a
     branch comes nearest it between samples: :func:`_projected_members` and, over the roll of a 6-joint arm,
-    :func:`~._free_search.refine_over`. ``budget`` is checked before each target."""
+    :func:`~._free_search.refine_over`. ``budget`` is checked before each target and each chunk of its grid."""
     from ._free_search import REFINE_ROUNDS, REFINED_MINIMA, _evenly_over_a_turn, refine_over
 
     tables, complete, nearest, flags, unpromised, refined = [], [], [], [], [], []
@@ -321,7 +321,7 @@ def solve_roll_family(robot: Robot, family: RollFamily, goal: DirectionGoal, rol
         budget.check("the roll family")
 
         def solve(chosen: np.ndarray, index: int = index) -> Verified:
-            return _at_rolls(robot, family, goal, index, chosen, reference)
+            return _at_rolls(robot, family, goal, index, chosen, reference, budget)
 
         grid = solve(rolls)
         parts = [grid]
@@ -433,16 +433,28 @@ def _projected_nearest(robot: Robot, goal: DirectionGoal, q: np.ndarray, referen
     return q, np.abs(goal.error(robot, q, rows)).max(axis=1) <= 1e-9
 
 
+#: Pose solves per chunk of a roll family's grid: the request's budget is checked between chunks, so a large grid
+#: of a slow family (general 6R: ~2 ms a pose) stops near the deadline.
+ROLL_CHUNK = 256
+
+
 def _at_rolls(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,
-              reference: np.ndarray | None) -> Verified:
+              reference: np.ndarray | None, budget: Budget = UNLIMITED) -> Verified:
     """Every solution of target ``index`` of the goal at each roll (S,) (and, for a redundant arm, each of the
     family's free values: rows roll-major), verified against the direction target: one verified row per (roll,
-    free value), each table row carrying its roll."""
+    free value), each table row carrying its roll. Solved :data:`ROLL_CHUNK` rows at a time, ``budget`` checked
+    before each."""
     if family.family is None:
-        return _solved_at(robot, family, goal, index, rolls, None, reference)
-    free = family.free
-    return _solved_at(robot, family, goal, index, np.repeat(rolls, len(free)), np.tile(free, (len(rolls), 1)),
-                      reference)
+        all_rolls, free = rolls, None
+    else:
+        all_rolls, free = np.repeat(rolls, family.free_rows), np.tile(family.free, (len(rolls), 1))
+    parts = []
+    for start in range(0, len(all_rolls), ROLL_CHUNK):
+        budget.check("the roll family")
+        chunk = slice(start, start + ROLL_CHUNK)
+        parts.append(_solved_at(robot, family, goal, index, all_rolls[chunk], None if free is None else free[chunk],
+                                reference))
+    return parts[0] if len(parts) == 1 else joined(parts, robot.dof)
 
 
 def _solved_at(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,

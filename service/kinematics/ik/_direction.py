@@ -151,10 +151,17 @@ def rotations_to(tool_axis: np.ndarray, world_directions: np.ndarray) -> np.ndar
     axis = np.where(opposite[:, None], _perpendicular(a), axis / np.where(opposite, 1.0, sine)[:, None])
     angle = np.arctan2(sine, cosine)
     angle = np.where(opposite & (cosine < 0), np.pi, angle)
-    K = np.zeros((len(d), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -axis[:, 2], axis[:, 1], -axis[:, 0]
+    return about_axes(axis, angle)
+
+
+def about_axes(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
+    """Rotations (N, 3, 3) by ``angles`` (N,) about the unit ``axes`` (N, 3), or one axis (3,) for all
+    (Rodrigues: ``I + sin θ K + (1 − cos θ) K²``, K the cross-product matrix of the axis)."""
+    axes = np.broadcast_to(axes, (len(angles), 3))
+    K = np.zeros((len(angles), 3, 3))
+    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -axes[:, 2], axes[:, 1], -axes[:, 0]
     K = K - np.swapaxes(K, 1, 2)
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    s, c = np.sin(angles)[:, None, None], np.cos(angles)[:, None, None]
     return np.eye(3) + s * K + (1 - c) * K @ K
 
 
@@ -201,20 +208,13 @@ def roll_samples(count: int) -> np.ndarray:
     return -np.pi + 2 * np.pi * np.arange(count) / count
 
 
-def about_axis(axis: np.ndarray, angles: np.ndarray) -> np.ndarray:
-    """Rotations (S, 3, 3) by ``angles`` (S,) about the unit ``axis`` (3,) (Rodrigues)."""
-    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    s, c = np.sin(angles)[:, None, None], np.cos(angles)[:, None, None]
-    return np.eye(3) + s * K + (1 - c) * (K @ K)
-
-
 def roll_poses(tool_axis: np.ndarray, position: np.ndarray, direction: np.ndarray, rolls: np.ndarray) -> np.ndarray:
     """The full poses ``world_T_tool`` (S, 4, 4) of one direction target at each roll (S,):
     rotation ``R_t · Rot(a, ψ)`` (``R_t``: :func:`rotations_to` of the tool axis onto the direction), origin at
     ``position`` (3,). Each turns ``tool_axis`` (3,, unit, tool frame) onto ``direction`` (3,, unit, world)."""
     R_t = rotations_to(tool_axis, direction[None])[0]
     poses = np.zeros((len(rolls), 4, 4))
-    poses[:, :3, :3] = R_t @ about_axis(tool_axis, rolls)
+    poses[:, :3, :3] = R_t @ about_axes(tool_axis, rolls)
     poses[:, :3, 3] = position
     poses[:, 3, 3] = 1.0
     return poses

@@ -87,3 +87,43 @@ def test_the_cost_model_counts_rolls_times_solutions(catalogue):
     assert estimate(robot, targets(roll_samples(MAX_ROLL_ROWS)), AnswerOptions()).free_values == MAX_ROLL_ROWS
     with pytest.raises(InvalidInputError, match="pose solves per direction target"):
         estimate(robot, targets(roll_samples(MAX_ROLL_ROWS + 1)), AnswerOptions())
+
+
+def _random_arms():
+    """Random arms of each 6R family, with random base and tool (so the tool axis is not the last joint's)."""
+    from tests.kinematics.ik.test_general_6r import random_arm as general_arm
+    from tests.kinematics.ik.test_one_pose_families import random_arm as family_arm
+
+    for seed in range(3):
+        yield f"spherical_wrist-{seed}", family_arm("intersecting_shoulder+spherical_wrist", "standard", seed)
+        yield f"three_parallel-{seed}", family_arm("three_parallel", "modified", seed)
+        yield f"general_6r-{seed}", general_arm(np.random.default_rng(seed), "standard")
+
+
+@pytest.mark.parametrize("name, robot", list(_random_arms()), ids=lambda value: value if isinstance(value, str)
+                         else "")
+def test_promise_audit_of_direction_targets_on_random_arms(name, robot):
+    """FK-made targets: never unreachable at the default rolls; with the generating roll among the rolls
+    solved, the generating configuration among the solutions (complete or not), each within 1e-9."""
+    from service.kinematics.ik import answer_ik, unlimited
+
+    rng = np.random.default_rng(101)
+    axis = np.array([0.0, 0.0, 1.0])
+    q = rng.uniform(-np.pi, np.pi, (4, 6))
+    T = forward_kinematics(robot, q)
+    M = np.tile(np.eye(4), (len(q), 1, 1))
+    M[:, :3, 3] = T[:, :3, 3]
+    directions = T[:, :3, :3] @ axis
+    own = [np.array([rolls_of(axis, d, R[None])[0], 0.3]) for d, R in zip(directions, T[:, :3, :3])]
+    options = AnswerOptions(limits=unlimited(robot), filter_limits=False)
+    kinds, axes = np.full(len(q), DIRECTION), np.tile(axis, (len(q), 1))
+    at_default = answer_ik(robot, IKTargets(M, kinds, axes, directions), options)
+    assert (at_default.status != "unreachable").all(), list(at_default.detail)
+    at_own = answer_ik(robot, IKTargets(M, kinds, axes, directions, own), options)
+    start, stop = at_own.solutions.bounds(len(q))
+    for row in range(len(q)):
+        joints = at_own.solutions.joints[start[row]:stop[row]]
+        assert len(joints) and np.abs(np.angle(np.exp(1j * (joints - q[row])))).max(axis=1).min() < 1e-6, name
+        reached = forward_kinematics(robot, joints)
+        assert np.abs(reached[:, :3, 3] - T[row, :3, 3]).max() <= 1e-9 * max(1.0, robot.characteristic_length)
+        assert np.abs(reached[:, :3, :3] @ axis - directions[row]).max() <= 1e-9

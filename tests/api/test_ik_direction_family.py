@@ -179,3 +179,23 @@ def test_too_many_rolls_times_free_values_are_refused_before_solving(client):
                                                                 "roll_samples": 2048}},
         "free_joints": [{"joint": 6, "samples": 2}]})
     assert_problem(response, 422, loc=["body", "target", "orientation"], match="pose solves per direction target")
+
+
+def test_an_arm_of_eight_joints_samples_fewer_free_values_per_roll(client):
+    """Two free joints at the default rolls: 36 rolls × 32² free values would pass the cap of 2048 pose solves,
+    so each free joint is sampled 4 times; with the generating configuration as reference it comes first."""
+    import json
+    from pathlib import Path
+
+    iiwa = json.loads((Path(__file__).parents[1] / "data" / "redundant_and_deficient_arms.json").read_text())["iiwa14"]
+    eight = {key: value for key, value in iiwa.items() if key not in ("name", "source")}
+    eight.update(id="eight", angle_unit="rad", joints=[
+        {"type": "revolute", "a": 0.3, "alpha": 0, "theta": 0, "d": 0.2},
+        *({**joint, "alpha": np.radians(joint["alpha"]), "theta": np.radians(joint["theta"]), "limits": None}
+          for joint in iiwa["joints"])])
+    q = [0.2, 0.4, -0.5, 0.7, -0.9, 1.1, -1.2, 0.3]
+    T = np.array(client.post("/v1/fk", json={"robot": eight, "joints": q}).json()["pose"]["matrix"])
+    answer = client.post("/v1/ik", json={"robot": eight, "target": _target(T), "reference": q}).json()
+    assert answer["status"] == "ok" and answer["solver"]["complete"] is True and len(answer["free_joints"]) == 2
+    assert np.abs(np.array(answer["solutions"][0]["joints"]) - q).max() <= 1e-6
+    assert set(answer["solutions"][0]["free_values"]) == {*map(str, answer["free_joints"]), "roll"}

@@ -31,8 +31,8 @@ from .._limits import Limits
 from .._robot import Robot
 from ..collision import CollisionRequest, clearances
 from ._closed_form import cached_plan, solve_closed_form
-from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, roll_family, roll_rows,
-                         roll_samples, solve_roll_family, tool_roll)
+from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, roll_family, roll_free_joints,
+                         roll_rows, roll_samples, solve_roll_family, tool_roll)
 from ._goals import DirectionGoal, PoseGoal
 from ._idealised import IdealisedPlan
 from ._numeric import NumericOptions, search
@@ -403,24 +403,29 @@ def direction_groups(targets: IKTargets, rows: np.ndarray) -> list[tuple[np.ndar
             for members in groups.values()]
 
 
+def direction_free_joints(robot: Robot, requested, most_rolls: int) -> list[FreeJoint] | None:
+    """The free joints of direction targets solved at up to ``most_rolls`` rolls: a redundant arm's, as the request
+    names them or by default (:func:`~._direction.roll_free_joints`); None on a 6-joint arm, which refuses any, as
+    a pose target does."""
+    if requested is not None:
+        with _at_free_joints():
+            return free_joints_for(robot, requested)
+    return roll_free_joints(robot, most_rolls) if robot.dof > 6 else None
+
+
 def _roll_families(robot: Robot, targets: IKTargets, directions: np.ndarray, options: AnswerOptions,
                    timings: list[SolveTiming]) -> list[_Part]:
     """Direction targets of an arm of 6 or more joints: the family over the free roll (and a redundant arm's free
     joints), solved completely at each sampled roll."""
-    free = None
-    if robot.dof > 6:
-        with _at_free_joints():
-            free = free_joints_for(robot, options.free_joints)
-    elif options.free_joints is not None:
-        with _at_free_joints():
-            free_joints_for(robot, options.free_joints)  # refuses free joints of a 6-joint arm as a pose would
+    groups = direction_groups(targets, directions)
+    free = direction_free_joints(robot, options.free_joints, max(len(rolls) for _, _, rolls in groups))
     family = roll_family(robot, free)
     if family is None:
         raise UnsupportedTargetError(
             "no closed-form family covers this arm's pose problem" + (" with the free joints locked" if robot.dof > 6
                                                                       else ""))
     parts = []
-    for rows, axis, rolls in direction_groups(targets, directions):
+    for rows, axis, rolls in groups:
         started = time.perf_counter()
         roll_rows(robot, rolls, free)
         goal = _direction_goal(targets, rows, axis)

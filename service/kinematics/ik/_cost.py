@@ -16,7 +16,7 @@ from .._limits import Limits
 from .._robot import Robot
 from ..collision import model_for
 from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_collisions, _at_free_joints,
-                      direction_groups)
+                      direction_free_joints, direction_groups)
 from ._closed_form import cached_plan, plan_is_kept
 from ._direction import direction_plan, refined_rows, roll_family, roll_rows
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit,
@@ -88,12 +88,10 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
     for kind in np.unique(kinds).tolist():
         rows = kinds == kind
         if kind == DIRECTION and robot.dof >= 6:  # the family over the free roll: rolls × free values × solutions
-            free = None
-            if robot.dof > 6:
-                with _at_free_joints():
-                    free = free_joints_for(robot, options.free_joints)
+            groups = direction_groups(targets, np.flatnonzero(rows))
+            free = direction_free_joints(robot, options.free_joints, max(len(rolls) for _, _, rolls in groups))
             family = roll_family(robot, free)
-            for _, _, rolls in direction_groups(targets, np.flatnonzero(rows)):
+            for _, _, rolls in groups:
                 solves = roll_rows(robot, rolls, free)
                 if family is not None:
                     solves += refined_rows(family, options.reference is not None)

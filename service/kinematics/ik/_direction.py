@@ -49,7 +49,8 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._closed_form import cached_plan, joined
 from ._goals import DirectionGoal
 from ._plan import Plan, geometry_of, plan_for_geometry
-from ._redundant import MAX_FREE_VALUES, FreeJoint, FreeJointFamily, family_for, free_value_grid, grid_size
+from ._redundant import (MAX_FREE_VALUES, FreeJoint, FreeJointFamily, default_free_joints, family_for,
+                         free_joints_for, free_value_grid, grid_size)
 from ._structure import Geometry, arm_size
 from ._table import SolutionTable
 from ._types import Candidates, SingularFlags, Singularity
@@ -250,12 +251,28 @@ class RollFamily:
 
     @property
     def free_joints(self) -> tuple[int, ...]:
-        return () if self.family is None else self.family.free
+        """The joints the answer lists as free: a redundant arm's, or those the 6-joint plan holds (coaxial)."""
+        return tuple(self.plan.free_joints) if self.family is None else self.family.free
 
     @property
     def free_rows(self) -> int:
         """Free values per roll: 1 for a 6-joint arm."""
         return 1 if self.free is None else len(self.free)
+
+
+def roll_free_joints(robot: Robot, most_rolls: int) -> list[FreeJoint] | None:
+    """A redundant arm's default free joints under direction targets of up to ``most_rolls`` rolls: the default
+    choice sampled so that rolls × free values stay within :data:`MAX_ROLL_ROWS` (32 per free joint on a 7-joint
+    arm at the default rolls). Raises :class:`InvalidInputError` when that leaves fewer than two samples per free
+    joint; None when no locking leaves a closed-form family."""
+    most = MAX_ROLL_ROWS // max(most_rolls, 1)
+    free = free_joints_for(robot, None, most=most)
+    if free is None and default_free_joints(robot) is not None:
+        raise InvalidInputError(f"{most_rolls} rolls leave room for {most} free values per roll (at most "
+                                f"{MAX_ROLL_ROWS} pose solves per direction target): too few to sample this arm's "
+                                f"{robot.dof - 6} free joint(s) twice each; ask for fewer rolls",
+                                location=("target", "orientation"))
+    return free
 
 
 def roll_family(robot: Robot, free_joints: list[FreeJoint] | None) -> RollFamily | None:

@@ -273,9 +273,11 @@ def sample_values(robot: Robot, joint: int, samples: int) -> np.ndarray:
 Requested = list[tuple[int, list[float] | None, int | None]]
 
 
-def free_joints_for(robot: Robot, requested: Requested | None) -> list[FreeJoint] | None:
+def free_joints_for(robot: Robot, requested: Requested | None, *, most: int = MAX_FREE_VALUES
+                    ) -> list[FreeJoint] | None:
     """The free joints and values to solve at, from a request's ``(joint, values, samples)`` entries (radians /
-    length units) or, when there are none, the default choice sampled :data:`DEFAULT_SAMPLES` times.
+    length units) or, when there are none, the default choice sampled :data:`DEFAULT_SAMPLES` times (fewer when
+    the grid would hold more than ``most`` values: a direction target solves the grid at each of its rolls).
 
     Returns None when the request names none and no locking leaves a family. Raises :class:`InvalidInputError`
     for a request that does not name exactly n − 6 distinct joints of the arm (:class:`NotRedundantError` for an
@@ -288,7 +290,7 @@ def free_joints_for(robot: Robot, requested: Requested | None) -> list[FreeJoint
         if chosen is None:
             return None
         family = family_for(robot, chosen)
-        samples = _default_samples(len(chosen), MAX_FREE_VALUES if family.ends_only else MAX_PLANNED_VALUES)
+        samples = _default_samples(len(chosen), min(most, MAX_FREE_VALUES if family.ends_only else MAX_PLANNED_VALUES))
         if samples == 0:
             return None  # too many free joints to sample each: the numeric search answers
         return [FreeJoint(j, sample_values(robot, j, samples)) for j in chosen]

@@ -193,7 +193,8 @@ class IKRequestOptions(RequestFrames):
         None, description="arms with more than 6 joints: the n − 6 free joints and where to solve them. Each "
                           "value's locked 6-joint problem is solved completely. Without it the service picks the "
                           "joint(s) whose locking leaves a closed-form family (the last, the first, then the third "
-                          "joint are tried first) and samples each 32 times. With "
+                          "joint are tried first) and samples each 32 times (fewer under a position + direction "
+                          "target, whose rolls × free values stay within 2048). With "
                           "`reference` the free joints are also searched continuously between the samples, so "
                           "the first solution is the nearest over the whole family.")
     collisions: CollisionOptions | None = Field(

@@ -50,9 +50,8 @@ from ._closed_form import cached_plan, joined
 from ._goals import DirectionGoal
 from ._plan import Plan, geometry_of, plan_for_geometry
 from ._redundant import (MAX_FREE_VALUES, FreeJoint, FreeJointFamily, default_free_joints, family_for,
-                         free_joints_for, free_value_grid, grid_size)
+                         free_joints_for, free_value_grid, gathered, grid_size, one_target)
 from ._structure import Geometry, arm_size
-from ._table import SolutionTable
 from ._types import Candidates, SingularFlags, Singularity
 from ._verify import Verified, distance_to_reference, joint_difference, verify
 
@@ -333,7 +332,7 @@ def solve_roll_family(robot: Robot, family: RollFamily, goal: DirectionGoal, rol
     :func:`~._free_search.refine_over`. ``budget`` is checked before each target and each chunk of its grid."""
     from ._free_search import REFINE_ROUNDS, REFINED_MINIMA, _evenly_over_a_turn, refine_over
 
-    tables, complete, nearest, flags, unpromised, refined = [], [], [], [], [], []
+    targets, unpromised, refined = [], [], []
     for index in range(len(goal)):
         budget.check("the roll family")
 
@@ -350,25 +349,11 @@ def solve_roll_family(robot: Robot, family: RollFamily, goal: DirectionGoal, rol
             parts += [extra for extra in extras if extra is not None]
         refined.append(sum(len(part.complete) for part in parts[1:]))
         unpromised.append(sum(int((~part.complete).sum()) for part in parts))
-        table = SolutionTable.concat([part.table.with_targets(np.zeros(len(part.table), dtype=np.int64))
-                                      for part in parts], robot.dof)
-        if reference is not None:  # nearest the reference first over the whole family
-            table = table.take(np.argsort(distance_to_reference(robot, table.joints, reference), kind="stable"))
-        tables.append(table.with_targets(np.full(len(table), index)))
-        complete.append(all(part.complete.all() for part in parts))
-        nearest.append(min(float(part.nearest.min(initial=np.inf)) for part in parts))
-        met = SingularFlags(1)
-        for part in parts:
-            solved = part.count > 0
-            for mask, flag in part.singularities.entries:
-                if (mask & solved).any():
-                    met.add(np.ones(1, dtype=bool), flag)
-        flags.append(met)
+        targets.append(one_target(robot, parts, index, reference))
     missing = 0 if family.family is None or family.family.ends_only else sum(
         family.family.locked_plan(row) is None for row in family.free)
-    verified = Verified(SolutionTable.concat(tables, robot.dof), np.array(complete, dtype=bool) & (missing == 0),
-                        np.array(nearest), SingularFlags.concat(flags) if flags else SingularFlags(0))
-    return RollVerified(verified, np.array(unpromised, dtype=int), np.array(refined, dtype=int))
+    return RollVerified(gathered(robot, targets, missing == 0), np.array(unpromised, dtype=int),
+                        np.array(refined, dtype=int))
 
 
 #: Steps of the projected descent towards the reference along the family, the largest joint move (rad, or

@@ -130,11 +130,13 @@ def test_a_redundant_arm_samples_its_free_joint_at_each_roll(client):
 def test_the_arrays_form_carries_the_roll_in_the_request_unit(client):
     T = fk_matrix(client, "puma560_standard", [0.3, -0.5, 0.4, 0.7, -0.6, 1.1])
     body = client.post("/v1/robots/puma560_standard/ik/batch", json={
-        "targets": [_target(T, roll_values=[30.0, 90.0])], "format": "arrays", "angle_unit": "deg",
-        "filter_limits": False}).json()
+        "targets": [_target(T, roll_values=[30.0, 90.0]), _target(T, roll_values=[30.0, 90.0, 390.0])],
+        "format": "arrays", "angle_unit": "deg", "filter_limits": False}).json()
     rolls = body["solutions"]["free_values"]["roll"]
     assert len(rolls) == len(body["solutions"]["joints"]) > 0
     assert {round(r, 6) for r in rolls} == {30.0, 90.0}
+    first, second = body["targets"]["solution_count"]
+    assert first == second  # 390° is 30° again: each solution once
 
 
 def test_beyond_reach_is_unreachable_and_the_detail_says_so(client):

@@ -31,8 +31,8 @@ from .._limits import Limits
 from .._robot import Robot
 from ..collision import CollisionRequest, clearances
 from ._closed_form import cached_plan, solve_closed_form
-from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, roll_family, roll_free_joints,
-                         roll_rows, roll_samples, solve_roll_family, tool_roll)
+from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, distinct_rolls, roll_family,
+                         roll_free_joints, roll_rows, roll_samples, solve_roll_family, tool_roll)
 from ._goals import DirectionGoal, PoseGoal
 from ._idealised import IdealisedPlan
 from ._numeric import NumericOptions, search
@@ -70,9 +70,9 @@ class IKTargets:
     rolls: Sequence[np.ndarray | None] | None = None
 
     def rolls_of(self, row: int) -> np.ndarray:
-        """The rolls (S,) radians that direction row ``row`` is solved at."""
+        """The rolls (S,) radians that direction row ``row`` is solved at, each once."""
         asked = None if self.rolls is None else self.rolls[row]
-        return roll_samples(DEFAULT_ROLL_SAMPLES) if asked is None else np.asarray(asked, dtype=float)
+        return roll_samples(DEFAULT_ROLL_SAMPLES) if asked is None else distinct_rolls(asked)
 
     @classmethod
     def poses(cls, world_T_targets: np.ndarray, *, constrain_orientation: bool = True) -> "IKTargets":

@@ -154,6 +154,13 @@ def rotations_to(tool_axis: np.ndarray, world_directions: np.ndarray) -> np.ndar
     return about_axes(axis, angle)
 
 
+def distinct_rolls(rolls: np.ndarray) -> np.ndarray:
+    """The rolls (S,) a request gives, each once: wrapped to (−π, π], in the order given, dropping any within
+    ``DUPLICATE_TOLERANCE`` of an earlier one (0 and 2π are one roll, and would list each solution twice)."""
+    wrapped = wrap_angle(np.asarray(rolls, dtype=float))
+    return wrapped[first_of_each_point(wrapped[:, None])]
+
+
 def about_axes(axes: np.ndarray, angles: np.ndarray) -> np.ndarray:
     """Rotations (N, 3, 3) by ``angles`` (N,) about the unit ``axes`` (N, 3), or one axis (3,) for all
     (Rodrigues: ``I + sin θ K + (1 − cos θ) K²``, K the cross-product matrix of the axis)."""

@@ -23,10 +23,14 @@ Arms of 6 or more joints (:class:`RollFamily`): the target leaves one more freed
 tool's roll ψ about ``a``. Each roll gives a full pose, ``R(ψ) = R_t · Rot(a, ψ)`` with ``R_t`` the shortest turn
 of ``a`` onto ``d`` (:func:`rotations_to`), which the arm's closed form solves completely: the pose plan of a
 6-joint arm, or a redundant arm's free-joint family (:mod:`._redundant`) at each of its free values. The family is
-sampled at :data:`DEFAULT_ROLL_SAMPLES` rolls evenly over the turn (or the rolls a request gives); with a
-reference, the roll is also searched continuously between the samples (:func:`~._free_search.refine_over`), so
-the nearest member of the whole family is listed. Each solution carries its roll (:func:`rolls_of`, read from
-its FK), as a free joint carries its value.
+sampled at :data:`DEFAULT_ROLL_SAMPLES` rolls evenly over the turn (or the rolls a request gives), at most
+:data:`MAX_ROLL_ROWS` pose solves (rolls × free values) per target. With a reference the family is also searched
+continuously, so that the nearest member of the whole family is listed: from the grid solutions of the branches
+nearest the reference, a descent along the family (the goal's null space, :func:`_projected_members`) reaches each
+branch's nearest point, and over a 6-joint arm's roll the free-joint search's bracketing
+(:func:`~._free_search.refine_over`) runs too; the rolls (and free values) found are solved completely. Each
+solution carries its roll (:func:`rolls_of`, read from its FK), as a free joint carries its value. A target with
+no solution at the rolls solved is not proven unreachable (other rolls may reach it).
 
 Every solution is checked by the real arm's FK (:func:`~._verify.verify` with a
 :class:`~._goals.DirectionGoal`): position within ``ACCEPT_RESIDUAL`` times its

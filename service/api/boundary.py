@@ -219,7 +219,7 @@ def ik_targets_to_core(targets: Sequence[PoseTarget] | MatrixRows, unit: AngleUn
         with at(index):
             matrices[index], constrained = target_matrix(target, unit)
         kinds[index] = POSE if constrained else POSITION
-    return IKTargets(matrices, kinds, tool_axes, world_directions, rolls)
+    return IKTargets(matrices, kinds, tool_axes, world_directions, rolls, indexed)
 
 
 def free_joints_to_core(robot: Robot, choices: Sequence | None, unit: AngleUnit

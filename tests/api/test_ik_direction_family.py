@@ -201,3 +201,12 @@ def test_an_arm_of_eight_joints_samples_fewer_free_values_per_roll(client):
     assert answer["status"] == "ok" and answer["solver"]["complete"] is True and len(answer["free_joints"]) == 2
     assert np.abs(np.array(answer["solutions"][0]["joints"]) - q).max() <= 1e-6
     assert set(answer["solutions"][0]["free_values"]) == {*map(str, answer["free_joints"]), "roll"}
+
+
+def test_in_a_batch_the_refusal_names_the_target(client):
+    fine = {"position": [0.4, 0.1, 0.4], "orientation": {"type": "direction", "world_direction": [0, 0, -1]}}
+    many = {"position": [0.4, 0.1, 0.4], "orientation": {"type": "direction", "world_direction": [0, 0, -1],
+                                                         "roll_samples": 2048}}
+    response = client.post(f"/v1/robots/{SEVEN}/ik/batch", json={
+        "targets": [fine, many], "free_joints": [{"joint": 6, "samples": 2}]})
+    assert_problem(response, 422, loc=["body", "targets", 1, "orientation"], match="pose solves per direction target")

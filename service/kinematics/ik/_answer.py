@@ -68,6 +68,12 @@ class IKTargets:
     tool_axes: np.ndarray | None = None
     world_directions: np.ndarray | None = None
     rolls: Sequence[np.ndarray | None] | None = None
+    indexed: bool = False
+
+    def at(self, row: int, *field: str) -> tuple:
+        """Where an error about target ``row`` is located in the request: ``("target", *field)`` for a single
+        target, ``("targets", row, *field)`` for a batch's (``indexed``)."""
+        return ("targets", row, *field) if self.indexed else ("target", *field)
 
     def rolls_of(self, row: int) -> np.ndarray:
         """The rolls (S,) radians that direction row ``row`` is solved at, each once."""
@@ -355,9 +361,11 @@ def _directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timing
     directions = np.flatnonzero(np.asarray(targets.kinds) == DIRECTION)
     if robot.dof >= 6:
         return _roll_families(robot, targets, directions, options, timings)
-    if targets.rolls is not None and any(targets.rolls[row] is not None for row in directions.tolist()):
-        raise InvalidInputError(f"roll_samples and roll_values apply to arms of 6 or more joints, whose roll about "
-                                f"the tool axis is free; this one has {robot.dof}", location=("target", "orientation"))
+    for row in directions.tolist():
+        if targets.rolls is not None and targets.rolls[row] is not None:
+            raise InvalidInputError(f"roll_samples and roll_values apply to arms of 6 or more joints, whose roll "
+                                    f"about the tool axis is free; this one has {robot.dof}",
+                                    location=targets.at(row, "orientation"))
     axes, group = np.unique(np.asarray(targets.tool_axes)[directions], axis=0, return_inverse=True)
     parts = []
     for number in range(len(axes)):
@@ -403,14 +411,14 @@ def direction_groups(targets: IKTargets, rows: np.ndarray) -> list[tuple[np.ndar
             for members in groups.values()]
 
 
-def direction_free_joints(robot: Robot, requested, most_rolls: int) -> list[FreeJoint] | None:
+def direction_free_joints(robot: Robot, requested, most_rolls: int, location: tuple) -> list[FreeJoint] | None:
     """The free joints of direction targets solved at up to ``most_rolls`` rolls: a redundant arm's, as the request
-    names them or by default (:func:`~._direction.roll_free_joints`); None on a 6-joint arm, which refuses any, as
-    a pose target does."""
+    names them or by default (:func:`~._direction.roll_free_joints`, its errors at ``location``); None on a
+    6-joint arm, which refuses any, as a pose target does."""
     if requested is not None:
         with _at_free_joints():
             return free_joints_for(robot, requested)
-    return roll_free_joints(robot, most_rolls) if robot.dof > 6 else None
+    return roll_free_joints(robot, most_rolls, location) if robot.dof > 6 else None
 
 
 def _roll_families(robot: Robot, targets: IKTargets, directions: np.ndarray, options: AnswerOptions,
@@ -418,7 +426,8 @@ def _roll_families(robot: Robot, targets: IKTargets, directions: np.ndarray, opt
     """Direction targets of an arm of 6 or more joints: the family over the free roll (and a redundant arm's free
     joints), solved completely at each sampled roll."""
     groups = direction_groups(targets, directions)
-    free = direction_free_joints(robot, options.free_joints, max(len(rolls) for _, _, rolls in groups))
+    free = direction_free_joints(robot, options.free_joints, max(len(rolls) for _, _, rolls in groups),
+                                 targets.at(int(directions[0]), "orientation"))
     family = roll_family(robot, free)
     if family is None:
         raise UnsupportedTargetError(
@@ -427,7 +436,7 @@ def _roll_families(robot: Robot, targets: IKTargets, directions: np.ndarray, opt
     parts = []
     for rows, axis, rolls in groups:
         started = time.perf_counter()
-        roll_rows(robot, rolls, free)
+        roll_rows(robot, rolls, free, targets.at(int(rows[0]), "orientation"))
         goal = _direction_goal(targets, rows, axis)
         answer = solve_roll_family(robot, family, goal, rolls, options.reference, budget=options.budget)
         part = _Part(rows, answer.verified, "analytic", family.structure, family.free_joints,

@@ -89,10 +89,11 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
         rows = kinds == kind
         if kind == DIRECTION and robot.dof >= 6:  # the family over the free roll: rolls × free values × solutions
             groups = direction_groups(targets, np.flatnonzero(rows))
-            free = direction_free_joints(robot, options.free_joints, max(len(rolls) for _, _, rolls in groups))
+            free = direction_free_joints(robot, options.free_joints, max(len(rolls) for _, _, rolls in groups),
+                                         targets.at(int(np.flatnonzero(rows)[0]), "orientation"))
             family = roll_family(robot, free)
-            for _, _, rolls in groups:
-                solves = roll_rows(robot, rolls, free)
+            for members, _, rolls in groups:
+                solves = roll_rows(robot, rolls, free, targets.at(int(members[0]), "orientation"))
                 if family is not None:
                     solves += refined_rows(family, options.reference is not None)
                     most = max(most, solves * family.generic_count)

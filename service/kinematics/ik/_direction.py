@@ -270,7 +270,8 @@ class RollFamily:
         return 1 if self.free is None else len(self.free)
 
 
-def roll_free_joints(robot: Robot, most_rolls: int) -> list[FreeJoint] | None:
+def roll_free_joints(robot: Robot, most_rolls: int, location: tuple = ("target", "orientation")
+                     ) -> list[FreeJoint] | None:
     """A redundant arm's default free joints under direction targets of up to ``most_rolls`` rolls: the default
     choice sampled so that rolls × free values stay within :data:`MAX_ROLL_ROWS` (32 per free joint on a 7-joint
     arm at the default rolls). Raises :class:`InvalidInputError` when that leaves fewer than two samples per free
@@ -280,8 +281,7 @@ def roll_free_joints(robot: Robot, most_rolls: int) -> list[FreeJoint] | None:
     if free is None and default_free_joints(robot) is not None:
         raise InvalidInputError(f"{most_rolls} rolls leave room for {most} free values per roll (at most "
                                 f"{MAX_ROLL_ROWS} pose solves per direction target): too few to sample this arm's "
-                                f"{robot.dof - 6} free joint(s) twice each; ask for fewer rolls",
-                                location=("target", "orientation"))
+                                f"{robot.dof - 6} free joint(s) twice each; ask for fewer rolls", location=location)
     return free
 
 
@@ -301,15 +301,16 @@ def roll_family(robot: Robot, free_joints: list[FreeJoint] | None) -> RollFamily
                       family.generic_count)
 
 
-def roll_rows(robot: Robot, rolls: np.ndarray, free_joints: list[FreeJoint] | None) -> int:
-    """Pose solves per direction target: rolls × free values; :class:`InvalidInputError` past
+def roll_rows(robot: Robot, rolls: np.ndarray, free_joints: list[FreeJoint] | None,
+              location: tuple = ("target", "orientation")) -> int:
+    """Pose solves per direction target: rolls × free values; :class:`InvalidInputError` (at ``location``) past
     :data:`MAX_ROLL_ROWS`."""
     values = 1 if free_joints is None else grid_size([len(f.values) for f in free_joints])
     rows = len(rolls) * values
     if rows > MAX_ROLL_ROWS:
         raise InvalidInputError(f"{len(rolls)} roll samples × {values} free values = {rows} pose solves per "
                                 f"direction target; at most {MAX_ROLL_ROWS} (lower roll_samples or the free "
-                                f"joints' samples)", location=("target", "orientation"))
+                                f"joints' samples)", location=location)
     return rows
 
 

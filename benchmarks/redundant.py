@@ -8,6 +8,9 @@ Rows, each timed on seeded poses from the arm's own FK and reported as the media
 * a 7-DOF full pose with its free joint sampled 32 times (the issue's goal: < 20 ms of solve time), without and
   with a reference (the continuous nearest-solution search), on the iiwa 14, the Gen3 and the Panda;
 * a 5-DOF position + direction target (SO-101-like arm, jaw axis and roll axis);
+* position + direction targets of 6- and 7-DOF arms (PUMA 560, UR5, iiwa 14): the family over the free roll at
+  its 36 default rolls, without a reference, and with the generating joint vector as the reference (recall:
+  the fraction of poses where it is the first solution, the nearest over the whole family);
 * the anchor: the same 7-DOF request at one value of the free joint (one locked 6-DOF solve), in the same run.
 
 Beside each time: solutions per request and recall (the fraction of poses whose generating joint vector is among
@@ -115,6 +118,7 @@ def main(argv: list[str] | None = None) -> int:
         recall = np.mean([_recovered(a.joints[0, :a.count[0]], expected[i]) for i, a in enumerate(answers)])
         print(_row("SO-101-like", f"position + direction, {axis_name}", times,
                    float(np.mean([a.count[0] for a in answers])), float(recall)))
+    _roll_family_rows(rng, poses)
     print()
     for (label, with_reference), median in medians.items():
         if with_reference is None:
@@ -123,6 +127,31 @@ def main(argv: list[str] | None = None) -> int:
         print(f"- {label}, {args.samples} samples, {kind}: {median * 1000:.2f} ms of solve time, "
               f"{median / medians[(label, None)]:.1f}x one locked 6-DOF solve (goal: < 20 ms sampled only)")
     return 0
+
+
+def _roll_family_rows(rng: np.random.Generator, poses: int) -> None:
+    """Rows of direction targets on 6- and 7-DOF arms: the family over the free roll (tool axis z)."""
+    from service.robots.catalogue import load_catalogue
+
+    catalogue = load_catalogue([Path(__file__).parents[1] / "robots"], max_joints=16)
+    axis = np.array([0.0, 0.0, 1.0])
+    for label, robot in (("PUMA 560", catalogue.get("puma560_standard").robot), ("UR5", catalogue.get("ur5").robot),
+                         ("iiwa 14", _arm("iiwa14"))):
+        lower = np.maximum(np.where(np.isfinite(robot.lower), robot.lower, -np.pi), -np.pi)
+        upper = np.minimum(np.where(np.isfinite(robot.upper), robot.upper, np.pi), np.pi)
+        q = lower + (upper - lower) * rng.uniform(0.05, 0.95, (poses, robot.dof))
+        T = forward_kinematics(robot, q)
+        solve_direction(robot, T[:1, :3, 3], T[:1, :3, :3] @ axis, axis, None)  # warm-up: the plans
+        for with_reference in (False, True):
+            def call(i: int):
+                return solve_direction(robot, T[i:i + 1, :3, 3], T[i:i + 1, :3, :3] @ axis, axis,
+                                       q[i] if with_reference else None)
+            times, answers = _timed(call, poses)
+            recall = (np.mean([_recovered(a.joints[0, :1], q[i]) for i, a in enumerate(answers)])
+                      if with_reference else float("nan"))
+            print(_row(label, f"position + direction, 36 rolls" + (", the generating vector as reference"
+                                                                   if with_reference else ""),
+                       times, float(np.mean([a.count[0] for a in answers])), float(recall)))
 
 
 if __name__ == "__main__":

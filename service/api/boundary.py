@@ -29,7 +29,8 @@ from ..kinematics import (
     matrix_from_quaternion,
     quaternions_from_matrices,
 )
-from ..kinematics.ik import DIRECTION, POSE, POSITION, IKTargets, NotRedundantError, Ordering, check_ordering
+from ..kinematics.ik import (DIRECTION, POSE, POSITION, IKTargets, NotRedundantError, Ordering, check_ordering,
+                             roll_samples)
 from ..kinematics.collision import CollisionRequest, Obstacle, clearances, frame_index
 from ..robots.build import bounds as _bounds
 from ..robots.geometry import shape_from_wire
@@ -130,9 +131,10 @@ def _check_pose_agrees(T: np.ndarray, position: Sequence[float] | None, wxyz: Se
             raise InvalidInputError(f"quaternion_wxyz {list(wxyz)} disagrees with the matrix's rotation, whose "
                                     f"quaternion (w, x, y, z) is {np.round(expected, 9).tolist()}; send one of "
                                     f"them, or both equal", location=("quaternion_wxyz",))
-def target_direction(target: PoseTarget) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """(position, tool axis, world direction), each (3,), of a position + direction target, or None for another
-    kind. Zero vectors are refused."""
+def target_direction(target: PoseTarget, unit: AngleUnit
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None] | None:
+    """(position, tool axis, world direction), each (3,), and the rolls to solve at (radians (S,), None for the
+    default samples) of a position + direction target, or None for another kind. Zero vectors are refused."""
     orientation = target.orientation
     if not isinstance(orientation, DirectionOrientation):
         return None
@@ -142,7 +144,12 @@ def target_direction(target: PoseTarget) -> tuple[np.ndarray, np.ndarray, np.nda
         if not np.linalg.norm(vector) > 1e-9:
             raise InvalidInputError(f"{name} must be a non-zero vector", location=("orientation", name))
         vectors.append(vector / np.linalg.norm(vector))
-    return np.asarray(target.position, dtype=float), vectors[0], vectors[1]
+    rolls = None
+    if orientation.roll_values is not None:
+        rolls = np.asarray(orientation.roll_values, dtype=float) * (_DEGREE if unit == "deg" else 1.0)
+    elif orientation.roll_samples is not None:
+        rolls = roll_samples(orientation.roll_samples)
+    return np.asarray(target.position, dtype=float), vectors[0], vectors[1], rolls
 
 
 def target_matrices(targets: Sequence[PoseTarget], unit: AngleUnit, *prefix: str | int) -> tuple[np.ndarray, np.ndarray]:
@@ -196,7 +203,7 @@ def ik_targets_to_core(targets: Sequence[PoseTarget] | MatrixRows, unit: AngleUn
     directions = {}
     for index, target in enumerate(targets):
         with at(index):
-            direction = target_direction(target)
+            direction = target_direction(target, unit)
         if direction is not None:
             directions[index] = direction
     if not directions and indexed:
@@ -204,14 +211,15 @@ def ik_targets_to_core(targets: Sequence[PoseTarget] | MatrixRows, unit: AngleUn
         return IKTargets(matrices, np.where(constrained, POSE, POSITION))
     matrices, kinds = np.tile(np.eye(4), (len(targets), 1, 1)), np.full(len(targets), DIRECTION)
     tool_axes, world_directions = np.zeros((len(targets), 3)), np.zeros((len(targets), 3))
+    rolls: list[np.ndarray | None] = [None] * len(targets)
     for index, target in enumerate(targets):
         if index in directions:
-            matrices[index, :3, 3], tool_axes[index], world_directions[index] = directions[index]
+            matrices[index, :3, 3], tool_axes[index], world_directions[index], rolls[index] = directions[index]
             continue
         with at(index):
             matrices[index], constrained = target_matrix(target, unit)
         kinds[index] = POSE if constrained else POSITION
-    return IKTargets(matrices, kinds, tool_axes, world_directions)
+    return IKTargets(matrices, kinds, tool_axes, world_directions, rolls, indexed)
 
 
 def free_joints_to_core(robot: Robot, choices: Sequence | None, unit: AngleUnit

@@ -2,7 +2,7 @@
 
 Objects: one dict per target (``status``, ``detail``, ``solutions``,
 ``rejected``, ``solver``, …), each solution a dict with its ``violations`` and
-``free_values``. Arrays: the per-target fields and the two solution tables as
+``free_values`` (a direction target's roll about the tool axis under ``"roll"``). Arrays: the per-target fields and the two solution tables as
 columns, solvers and singularity reports listed once and referred to by index.
 """
 
@@ -14,7 +14,7 @@ import numpy as np
 
 from ..kinematics import Budget, Robot
 from ..kinematics.ik import IKAnswer, SolutionTable
-from .boundary import WIRE_NOTES, _unit_scale
+from .boundary import _DEGREE, WIRE_NOTES, _unit_scale
 
 
 def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget: Budget) -> list[dict]:
@@ -25,8 +25,9 @@ def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
                 "time_budget_exhausted": s.time_budget_exhausted} for s in answer.solvers]
     reports = [_report(report) for report in answer.singularity_reports]
     free_of_target = [list(answer.solvers[index].free_joints) for index in answer.solver.tolist()]
-    kept = _solution_dicts(answer.solutions, answer.solution_violations, answer, scale, free_of_target)
-    rejected = _solution_dicts(answer.rejected, answer.rejected_violations, answer, scale, free_of_target)
+    angle = _DEGREE if unit == "deg" else 1.0
+    kept = _solution_dicts(answer.solutions, answer.solution_violations, answer, scale, free_of_target, angle)
+    rejected = _solution_dicts(answer.rejected, answer.rejected_violations, answer, scale, free_of_target, angle)
     status, truncated, detail = answer.status.tolist(), answer.truncated.tolist(), answer.details(WIRE_NOTES)
     trimmed, available = answer.trimmed.tolist(), answer.available.tolist()
     answers = []
@@ -43,8 +44,9 @@ def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
 
 
 def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer, scale: np.ndarray,
-                    free_of_target: list[list[int]]) -> list[list[dict]]:
-    """Each target's rows of ``table`` as solution dicts; ``outside`` (S, n) marks the joints a row violates."""
+                    free_of_target: list[list[int]], angle: float) -> list[list[dict]]:
+    """Each target's rows of ``table`` as solution dicts; ``outside`` (S, n) marks the joints a row violates;
+    ``angle``: radians per unit of the request's angles (for the roll)."""
     joints = (table.joints / scale).tolist()
     position = table.position.tolist()
     orientation = [None if missing else value
@@ -66,11 +68,20 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
             "within_limits": within[k], "violations": violations.get(k, []),
             "residual": {"position": position[k], "orientation": orientation[k]},
             "free_values": {str(j): joints[k][j] for j in free_of_target[target]}})
+    if table.roll is not None:
+        for solution, roll in zip((s for rows in per_target for s in rows), _rolls(table, angle)):
+            if roll is not None:
+                solution["free_values"]["roll"] = roll
     if table.clearance is not None:
         for solution, clearance, contacts in zip((s for rows in per_target for s in rows), _clearances(table),
                                                  _contacts(table)):
             solution["clearance"], solution["collisions"] = clearance, contacts
     return per_target
+
+
+def _rolls(table: SolutionTable, angle: float) -> list[float | None]:
+    """Each row's roll about the tool axis in the request's angle unit; None where the row has none."""
+    return [None if math.isnan(value) else value for value in (table.roll / angle).tolist()]
 
 
 def _clearances(table: SolutionTable) -> list[float | None]:
@@ -104,14 +115,15 @@ def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
                     "trimmed": answer.trimmed, "available": answer.available,
                     "solution_count": np.bincount(answer.solutions.target, minlength=n_targets),
                     "rejected_count": np.bincount(answer.rejected.target, minlength=n_targets)},
-        "solutions": _columns(answer.solutions, scale, answer),
-        "rejected": _columns(answer.rejected, scale, answer),
+        "solutions": _columns(answer.solutions, scale, answer, _DEGREE if unit == "deg" else 1.0),
+        "rejected": _columns(answer.rejected, scale, answer, _DEGREE if unit == "deg" else 1.0),
     }
 
 
-def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer) -> dict:
+def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer, angle: float) -> dict:
     """One table as columns; ``free_values``: per free joint, each row's value of it, or None where the row's
-    target has no such free joint."""
+    target has no such free joint; ``"roll"``: each row's roll about the tool axis (``angle``: radians per unit),
+    or None."""
     joints = table.joints / scale
     orientation = table.orientation
     if np.isnan(orientation).any():
@@ -124,6 +136,8 @@ def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer) -> dict:
         rows = joints.tolist()
         free_values = {str(j): [row[j] if j in free else None for row, free in zip(rows, free_of_row)]
                        for j in sorted({j for free in free_of_row for j in free})}
+    if table.roll is not None:
+        free_values["roll"] = _rolls(table, angle)
     columns = {"target": table.target, "joints": joints, "within_limits": table.within_limits,
                "residual_position": table.position, "residual_orientation": orientation, "branch": branch,
                "free_values": free_values}

@@ -43,9 +43,16 @@ def test_the_roll_axis_leaves_the_roll_joint_free_at_the_reference(client):
 
 
 def test_direction_targets_are_refused_where_they_are_not_solved(client):
-    T = fk_inline(client, ARMS["iiwa14"], [0.1] * 7)
-    assert_problem(client.post("/v1/ik", json={"robot": ARMS["iiwa14"], "target": _target(T, [0, 0, 1])}), 422,
-                   loc=["body", "target", "orientation"], match="5 joints")
+    # a 7-joint arm is solved over its free roll (tests/api/test_ik_direction_family.py); 4 joints are too few
+    four = {"id": "four", "convention": "standard", "angle_unit": "rad",
+            "joints": [{"type": "revolute", "a": 0.3, "alpha": 0, "theta": 0, "d": 0}] * 4}
+    T = fk_inline(client, four, [0.1] * 4)
+    assert_problem(client.post("/v1/ik", json={"robot": four, "target": _target(T, [0, 0, 1])}), 422,
+                   loc=["body", "target", "orientation"], match="at least 5 joints")
+    rolls = _target(T, [0, 0, 1])
+    rolls["orientation"]["roll_samples"] = 8
+    assert_problem(client.post("/v1/ik", json={"robot": SO101, "target": rolls}), 422,
+                   loc=["body", "target", "orientation"], match="6 or more joints")
     zero = {"position": [0.1, 0, 0.1], "orientation": {"type": "direction", "world_direction": [0, 0, 0]}}
     assert_problem(client.post("/v1/ik", json={"robot": SO101, "target": zero}), 422,
                    loc=["body", "target", "orientation", "world_direction"])
@@ -53,4 +60,4 @@ def test_direction_targets_are_refused_where_they_are_not_solved(client):
 
 def test_get_robot_lists_target_kinds(client):
     body = client.get("/v1/robots/ur5").json()
-    assert body["target_kinds"] == ["pose", "position"]
+    assert body["target_kinds"] == ["pose", "position", "position_direction"]

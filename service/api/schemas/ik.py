@@ -193,7 +193,8 @@ class IKRequestOptions(RequestFrames):
         None, description="arms with more than 6 joints: the n − 6 free joints and where to solve them. Each "
                           "value's locked 6-joint problem is solved completely. Without it the service picks the "
                           "joint(s) whose locking leaves a closed-form family (the last, the first, then the third "
-                          "joint are tried first) and samples each 32 times. With "
+                          "joint are tried first) and samples each 32 times (fewer under a position + direction "
+                          "target, whose rolls × free values stay within 2048). With "
                           "`reference` the free joints are also searched continuously between the samples, so "
                           "the first solution is the nearest over the whole family.")
     collisions: CollisionOptions | None = Field(
@@ -250,7 +251,10 @@ class IKSolution(ApiModel):
     residual: Residual = Field(description="forward-kinematics error of this solution")
     free_values: dict[str, float] = Field(
         default_factory=dict, description="the value of each free joint in this solution (its joint value), "
-                                          "keyed by joint index, e.g. {\"2\": 0.5}")
+                                          "keyed by joint index, e.g. {\"2\": 0.5}; for a position + tool "
+                                          "direction target of an arm of 6 or more joints also \"roll\": the "
+                                          "tool's roll about the tool axis, in the request's angle unit, in "
+                                          "(−π, π] (see DirectionOrientation), e.g. {\"roll\": 0.35}")
     clearance: float | None = CLEARANCE_FIELD
     collisions: list[CollisionPair] | None = COLLISIONS_FIELD
 
@@ -309,7 +313,8 @@ class IKResponse(ApiModel):
     free_joints: list[int] = Field(default_factory=list,
                                    description="joints the target does not determine: a redundant arm's free "
                                                "joints (see each solution's free_values), or joints held at the "
-                                               "reference or 0")
+                                               "reference or 0. A direction target's free roll is no joint: it "
+                                               "is listed in free_values only, as \"roll\"")
     truncated: bool = Field(False, description="max_equivalents left out some of the solutions that fit")
     trimmed: int = Field(0, description="solutions left out by max_solutions or max_joint_move")
     available: int = Field(0, ge=0, le=2**53 - 1,
@@ -361,8 +366,9 @@ class SolutionColumns(ApiModel):
         description="one column per branch label that applies; null where a row has no such label")
     free_values: dict[str, list[float | None]] = Field(
         default_factory=dict, description="one column per free joint (keyed by joint index, as each solution's "
-                                          "free_values in the objects form); null where the row's target has no "
-                                          "such free joint")
+                                          "free_values in the objects form), and \"roll\" when a direction "
+                                          "target was solved over its free roll; null where the row's target "
+                                          "has no such free joint or roll")
     clearance: list[float | None] | None = Field(None, description="with collisions: each row's clearance, as in "
                                                                    "the objects form")
     collisions: list[list[CollisionPair]] | None = Field(None, description="with collisions: each row's pairs "

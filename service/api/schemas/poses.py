@@ -8,17 +8,44 @@ from pydantic import Field, field_validator, model_validator
 from pydantic_core import PydanticCustomError
 
 from ...robots.orientations import EulerZYZOrientation, MatrixOrientation, QuaternionOrientation, RPYOrientation
+from ...kinematics.ik import DEFAULT_ROLL_SAMPLES, MAX_ROLL_ROWS
 from .common import ApiModel, Matrix4, Number, RealMatrix4, RealVector3, RealVector4, Vector3, Vector4
 
 
 class DirectionOrientation(ApiModel):
-    """Position + tool direction (IK targets of 5-joint arms): the tool axis `tool_axis` (tool frame) must point
-    along `world_direction` (world frame); the roll about it is left free. Neither needs to be a unit vector."""
+    """Position + tool direction (IK targets of arms of 5 joints or more): the tool axis `tool_axis` (tool frame)
+    must point along `world_direction` (world frame); the roll about it is left free. Neither needs to be a unit
+    vector.
+
+    An arm of 6 or more joints reaches such a target along a continuous family over the roll ψ of the tool about
+    `tool_axis`. It is solved completely at sampled rolls (`roll_samples`, or `roll_values`): at each roll the
+    full pose with rotation R_t · Rot(tool_axis, ψ), where R_t is the shortest rotation taking `tool_axis` onto
+    `world_direction` (a half turn about an axis perpendicular to `tool_axis` when the two are opposite). Each
+    solution reports its roll in `free_values` under the key `"roll"` (the request's angle unit, in (−π, π]);
+    `solver.complete` means every solution at each sampled roll; with `reference` the roll is also searched
+    continuously between the samples, so the first solution is the nearest over the whole family. A redundant arm
+    samples its free joints (`free_joints`) at each roll as well. An answer with no solution is `not_found` (other
+    rolls may reach the target), unless the position is beyond the arm's reach (`unreachable`)."""
 
     type: Literal["direction"] = Field(description="position + tool direction")
     tool_axis: Vector3 = Field(default_factory=lambda: [0.0, 0.0, 1.0],
                                description="the tool axis to align, in the tool frame (default z)")
     world_direction: Vector3 = Field(description="where the tool axis must point, in the world frame")
+    roll_samples: int | None = Field(
+        None, ge=1, le=MAX_ROLL_ROWS,
+        description=f"arms of 6 or more joints: how many rolls about the tool axis to solve at, evenly over the "
+                    f"turn from −π (default {DEFAULT_ROLL_SAMPLES}, 10° apart). Rolls × a redundant arm's free "
+                    f"values: at most {MAX_ROLL_ROWS} per target. Not for 5-joint arms, whose roll is not free.")
+    roll_values: list[Number] | None = Field(
+        None, min_length=1, max_length=MAX_ROLL_ROWS,
+        description="arms of 6 or more joints: the rolls about the tool axis to solve at, in the request's angle "
+                    "unit, instead of roll_samples")
+
+    @model_validator(mode="after")
+    def _one_roll_form(self) -> "DirectionOrientation":
+        if self.roll_samples is not None and self.roll_values is not None:
+            raise ValueError("give either 'roll_samples' or 'roll_values', not both")
+        return self
 
 
 Orientation = Annotated[

@@ -15,7 +15,7 @@ from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKAnswer, IKOpti
                       SolverReport, SolveTiming, TargetAnswer, UnsupportedTargetError, answer_ik)
 from ._closed_form import cached_plan, plan_is_kept
 from ._cost import SMALL_ROWS, Cost, estimate, is_small
-from ._direction import target_kinds
+from ._direction import DEFAULT_ROLL_SAMPLES, MAX_ROLL_ROWS, roll_samples, target_kinds
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit,
                            equivalents_per_solution, worst_answer_per_target)
 from ._numeric import NumericOptions
@@ -29,10 +29,12 @@ from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
 
 __all__ = [
+    "DEFAULT_ROLL_SAMPLES",
     "DIRECTION",
     "MAX_COMBINATIONS_PER_SOLUTION",
     "MAX_EQUIVALENTS",
     "MAX_FREE_VALUES",
+    "MAX_ROLL_ROWS",
     "NOTE_WORDING",
     "POSE",
     "POSITION",
@@ -75,6 +77,7 @@ __all__ = [
     "plan_for",
     "plan_is_kept",
     "result_of",
+    "roll_samples",
     "select",
     "solve_ik",
     "solve_ik_arrays",

@@ -31,7 +31,8 @@ from .._limits import Limits
 from .._robot import Robot
 from ..collision import CollisionRequest, clearances
 from ._closed_form import cached_plan, solve_closed_form
-from ._direction import direction_candidates, direction_plan, tool_roll
+from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, distinct_rolls, roll_family,
+                         roll_free_joints, roll_rows, roll_samples, solve_roll_family, tool_roll)
 from ._goals import DirectionGoal, PoseGoal
 from ._idealised import IdealisedPlan
 from ._numeric import NumericOptions, search
@@ -57,13 +58,27 @@ class IKTargets:
     ``matrices`` (N, 4, 4) ``world_T_tool``: for a position-only or a direction target only the position (last
     column) counts. ``kinds`` (N,) int: :data:`POSE`, :data:`POSITION` or :data:`DIRECTION`. For direction rows,
     ``tool_axes`` (N, 3) is the unit tool axis (tool frame) and ``world_directions`` (N, 3) the unit direction it
-    must point along (world frame); other rows of them are ignored.
+    must point along (world frame); other rows of them are ignored. ``rolls`` (N entries, optional): for a
+    direction row of an arm of 6 or more joints, the tool rolls (radians, (S,)) to solve at, None for the
+    default :data:`~._direction.DEFAULT_ROLL_SAMPLES` samples.
     """
 
     matrices: np.ndarray
     kinds: np.ndarray
     tool_axes: np.ndarray | None = None
     world_directions: np.ndarray | None = None
+    rolls: Sequence[np.ndarray | None] | None = None
+    indexed: bool = False
+
+    def at(self, row: int, *field: str) -> tuple:
+        """Where an error about target ``row`` is located in the request: ``("target", *field)`` for a single
+        target, ``("targets", row, *field)`` for a batch's (``indexed``)."""
+        return ("targets", row, *field) if self.indexed else ("target", *field)
+
+    def rolls_of(self, row: int) -> np.ndarray:
+        """The rolls (S,) radians that direction row ``row`` is solved at, each once."""
+        asked = None if self.rolls is None else self.rolls[row]
+        return roll_samples(DEFAULT_ROLL_SAMPLES) if asked is None else distinct_rolls(asked)
 
     @classmethod
     def poses(cls, world_T_targets: np.ndarray, *, constrain_orientation: bool = True) -> "IKTargets":
@@ -216,7 +231,9 @@ class _Part:
     """Targets ``rows`` (k,) answered by one solver: their verified solutions (``verified``, k targets), the
     solver, and per local row the words before the selection's notes (``details``) and after them
     (``remarks``). ``reported`` (k,) says where the solver's singular conditions are reported (default: the rows
-    with a solution); ``unfinished`` (k,) where the numeric search's iteration cap stopped starts."""
+    with a solution); ``unfinished`` (k,) where the numeric search's iteration cap stopped starts; ``sampled``
+    (k,) where the solver answered complete at sampled values of a continuous freedom (the roll), so an empty
+    answer proves nothing: ``not_found`` rather than ``unreachable``."""
 
     rows: np.ndarray
     verified: Verified
@@ -227,6 +244,7 @@ class _Part:
     remarks: dict[int, str] = field(default_factory=dict)
     reported: np.ndarray | None = None
     unfinished: np.ndarray | None = None
+    sampled: np.ndarray | None = None
 
 
 def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerOptions()) -> IKAnswer:
@@ -338,8 +356,16 @@ def _positions(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: An
 
 def _directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timings: list[SolveTiming]
                 ) -> list[_Part]:
-    """Position + direction targets, one closed-form solve per tool axis."""
+    """Position + direction targets: one closed-form solve per tool axis on a 5-joint arm, the family over the
+    free roll on an arm of 6 or more (one part per tool axis and set of rolls)."""
     directions = np.flatnonzero(np.asarray(targets.kinds) == DIRECTION)
+    if robot.dof >= 6:
+        return _roll_families(robot, targets, directions, options, timings)
+    for row in directions.tolist():
+        if targets.rolls is not None and targets.rolls[row] is not None:
+            raise InvalidInputError(f"roll_samples and roll_values apply to arms of 6 or more joints, whose roll "
+                                    f"about the tool axis is free; this one has {robot.dof}",
+                                    location=targets.at(row, "orientation"))
     axes, group = np.unique(np.asarray(targets.tool_axes)[directions], axis=0, return_inverse=True)
     parts = []
     for number in range(len(axes)):
@@ -349,9 +375,7 @@ def _directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timing
         if plan is None:
             raise UnsupportedTargetError("no closed-form family covers position + tool direction targets of this "
                                          "arm with this tool axis")
-        world = np.asarray(targets.world_directions, dtype=float)[rows]
-        goal = DirectionGoal(targets.matrices[rows, :3, 3], world / np.linalg.norm(world, axis=-1, keepdims=True),
-                             plan.tool_axis)
+        goal = _direction_goal(targets, rows, plan.tool_axis)
         options.budget.check("the analytic solve")
         verified = verify(robot, goal, direction_candidates(robot, plan, goal, options.reference), options.reference)
         roll = tool_roll(plan)
@@ -365,6 +389,72 @@ def _directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timing
                 if bool(beyond_reach(robot, goal.positions[local])) else
                 "No joint vector puts the tool at this position with its axis along the direction (every "
                 "solution of the closed form was checked).")
+        parts.append(_timed(timings, part, started))
+    return parts
+
+
+def _direction_goal(targets: IKTargets, rows: np.ndarray, tool_axis: np.ndarray) -> DirectionGoal:
+    """The direction goal of ``rows`` (k,) of the targets, their directions made unit."""
+    world = np.asarray(targets.world_directions, dtype=float)[rows]
+    return DirectionGoal(targets.matrices[rows, :3, 3], world / np.linalg.norm(world, axis=-1, keepdims=True),
+                         tool_axis)
+
+
+def direction_groups(targets: IKTargets, rows: np.ndarray) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The direction rows (k,) grouped by tool axis and rolls: (rows, unit tool axis (3,), rolls (S,)) each."""
+    groups: dict[tuple[bytes, bytes], list[int]] = {}
+    axes = np.asarray(targets.tool_axes, dtype=float)
+    for row in rows.tolist():
+        key = (np.round(axes[row] / np.linalg.norm(axes[row]), 12).tobytes(), targets.rolls_of(row).tobytes())
+        groups.setdefault(key, []).append(row)
+    return [(np.array(members), axes[members[0]] / np.linalg.norm(axes[members[0]]), targets.rolls_of(members[0]))
+            for members in groups.values()]
+
+
+def direction_free_joints(robot: Robot, requested, most_rolls: int, location: tuple) -> list[FreeJoint] | None:
+    """The free joints of direction targets solved at up to ``most_rolls`` rolls: a redundant arm's, as the request
+    names them or by default (:func:`~._direction.roll_free_joints`, its errors at ``location``); None on a
+    6-joint arm, which refuses any, as a pose target does."""
+    if requested is not None:
+        with _at_free_joints():
+            return free_joints_for(robot, requested)
+    return roll_free_joints(robot, most_rolls, location) if robot.dof > 6 else None
+
+
+def _roll_families(robot: Robot, targets: IKTargets, directions: np.ndarray, options: AnswerOptions,
+                   timings: list[SolveTiming]) -> list[_Part]:
+    """Direction targets of an arm of 6 or more joints: the family over the free roll (and a redundant arm's free
+    joints), solved completely at each sampled roll."""
+    groups = direction_groups(targets, directions)
+    free = direction_free_joints(robot, options.free_joints, max(len(rolls) for _, _, rolls in groups),
+                                 targets.at(int(directions[0]), "orientation"))
+    family = roll_family(robot, free)
+    if family is None:
+        raise UnsupportedTargetError(
+            "no closed-form family covers this arm's pose problem" + (" with the free joints locked" if robot.dof > 6
+                                                                      else ""))
+    parts = []
+    for rows, axis, rolls in groups:
+        started = time.perf_counter()
+        roll_rows(robot, rolls, free, targets.at(int(rows[0]), "orientation"))
+        goal = _direction_goal(targets, rows, axis)
+        answer = solve_roll_family(robot, family, goal, rolls, options.reference, budget=options.budget)
+        part = _Part(rows, answer.verified, "analytic", family.structure, family.free_joints,
+                     sampled=np.ones(len(rows), dtype=bool))
+        for local in np.flatnonzero(answer.verified.count == 0).tolist():
+            if bool(beyond_reach(robot, goal.positions[local])):
+                part.details[local] = ("The target position is outside the workspace (farther from the base than "
+                                       "the arm can reach).")
+                part.sampled[local] = False
+            else:
+                part.details[local] = (
+                    f"No joint vector puts the tool at this position with its axis along the direction at any of "
+                    f"the {len(rolls)} rolls about the tool axis solved"
+                    + (f" (with {family.free_rows} values of the free joints each)" if family.free_rows > 1 else "")
+                    + "; each was solved completely, but other rolls may reach it.")
+        for local in np.flatnonzero(answer.unpromised > 0).tolist():
+            part.remarks[local] = (f"At {answer.unpromised[local]} of the rolls solved the closed form could not "
+                                   f"promise every solution (a singular condition), so the answer may miss some.")
         parts.append(_timed(timings, part, started))
     return parts
 
@@ -556,6 +646,7 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
     """The parts' tables laid end to end and selected once, with each target's solver, conditions and words."""
     owner, local_of = np.full(n_targets, -1), np.zeros(n_targets, dtype=int)
     complete = np.ones(n_targets, dtype=bool)
+    sampled = np.zeros(n_targets, dtype=bool)
     reports: list[SolverReport] = []
     report_of = np.zeros(n_targets, dtype=int)
     singular_of: dict[int, list[Singularity]] = {}
@@ -564,6 +655,8 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
         owner[part.rows], local_of[part.rows] = number, np.arange(len(part.rows))
         verified = part.verified
         complete[part.rows] = verified.complete
+        if part.sampled is not None:
+            sampled[part.rows] = part.sampled
         flags = 2 * verified.complete.astype(int)  # (complete, unfinished) as one code per target: 0 … 3
         if part.unfinished is not None:
             flags += part.unfinished
@@ -594,7 +687,7 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
                                reference=options.reference, ordering=options.ordering,
                                max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget)
     status = chosen.status.copy()
-    status[(status == "unreachable") & ~complete] = "not_found"
+    status[(status == "unreachable") & (~complete | sampled)] = "not_found"
     # solver reports numbered by first appearance in target order
     by_appearance = list(dict.fromkeys(report_of.tolist()))
     renumber = np.zeros(max(len(reports), 1), dtype=int)

@@ -15,9 +15,10 @@ import numpy as np
 from .._limits import Limits
 from .._robot import Robot
 from ..collision import model_for
-from ._answer import DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_collisions, _at_free_joints
+from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_collisions, _at_free_joints,
+                      direction_free_joints, direction_groups)
 from ._closed_form import cached_plan, plan_is_kept
-from ._direction import direction_plan
+from ._direction import direction_plan, refined_rows, roll_family, roll_rows
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit,
                            equivalents_per_solution, worst_answer_per_target)
 from ._free_search import REFINED_MINIMA
@@ -33,8 +34,11 @@ class Cost:
     """What an IK request costs, counted before any solving.
 
     ``solutions_per_target``: the most verified solutions one target can have before expansion (a family's
-    generic count; over a redundant arm's free values; the numeric search's starts). ``numeric_starts``: the
-    numeric search's starts in all (every target it may answer, every combination of held free values).
+    generic count; over a redundant arm's free values; over a direction target's sampled rolls (and the rolls the
+    continuous search adds with a reference), times the free values of a redundant arm; the numeric search's
+    starts). ``free_values``: the most values of the free parameters (joints, roll) solved per target.
+    ``numeric_starts``: the numeric search's starts in all (every target it may answer, every combination of held
+    free values).
     ``equivalents``: the most 2π-equivalents of one solution within the limits; ``kept``: the most kept per
     target (``max_equivalents``, ``max_solutions``, lowered to :func:`~._equivalents.enumerable_limit` when a
     default asks more than can be ranked: ``lowered``); ``ranked``: the combinations ranked per solution to keep
@@ -83,6 +87,18 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
     small = is_small(robot, targets, options)  # before anything is built
     for kind in np.unique(kinds).tolist():
         rows = kinds == kind
+        if kind == DIRECTION and robot.dof >= 6:  # the family over the free roll: rolls × free values × solutions
+            groups = direction_groups(targets, np.flatnonzero(rows))
+            free = direction_free_joints(robot, options.free_joints, max(len(rolls) for _, _, rolls in groups),
+                                         targets.at(int(np.flatnonzero(rows)[0]), "orientation"))
+            family = roll_family(robot, free)
+            for members, _, rolls in groups:
+                solves = roll_rows(robot, rolls, free, targets.at(int(members[0]), "orientation"))
+                if family is not None:
+                    solves += refined_rows(family, options.reference is not None)
+                    most = max(most, solves * family.generic_count)
+                    free_values = max(free_values, solves)
+            continue
         if kind == DIRECTION:
             for axis in np.unique(np.asarray(targets.tool_axes)[rows], axis=0):
                 plan = direction_plan(robot, axis)

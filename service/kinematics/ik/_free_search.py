@@ -10,6 +10,8 @@ refined value, so the answer stays complete for every free value it lists.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from .._robot import Robot
@@ -50,6 +52,30 @@ def refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, va
     ``values`` (S,) are the grid's values of the one free joint; ``grid`` its answer, row s at ``values[s]``.
     """
     joint = family.free[0]
+
+    def solve(chosen: np.ndarray) -> Verified:
+        return solve_at(robot, family, target, chosen[:, None], reference)
+
+    track = None if family.ends_only else (lambda seeds, points: _track_branch(robot, family, target, seeds, points))
+    periodic = bool(robot.is_revolute[joint]) and _evenly_over_a_turn(values)
+    return refine_over(robot, values, grid, reference, minima_kept, rounds, solve, track, periodic,
+                       lambda chosen: _wrapped(robot, joint, chosen))
+
+
+def _evenly_over_a_turn(values: np.ndarray) -> bool:
+    """Whether sorted ``values`` (S,) sample a whole turn evenly (the last one a step short of the first + 2π)."""
+    v = np.sort(values)
+    return len(v) > 2 and bool(np.isclose(v[-1] - v[0] + 2 * np.pi / len(v), 2 * np.pi))
+
+
+def refine_over(robot: Robot, values: np.ndarray, grid: Verified, reference: np.ndarray, minima_kept: int,
+                rounds: int, solve: Callable[[np.ndarray], Verified],
+                track: Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]] | None, periodic: bool,
+                wrap: Callable[[np.ndarray], np.ndarray]) -> Verified | None:
+    """:func:`refine_nearest` for any one-parameter family: ``solve(v)`` answers completely at the values v (K,),
+    one verified row each; ``track(seeds (K, n), v (K,))`` follows branches by Newton steps (None: ``solve`` is
+    cheap enough to call at every point, the closed form in one batch); ``periodic``: the values wrap around a
+    turn; ``wrap`` maps refined values into the parameter's range."""
     table = grid.table
     if not len(table):
         return None
@@ -60,8 +86,6 @@ def refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, va
     distance = distance_to_reference(robot, table.joints, reference)
     keys = branch_keys(table.labels, len(table))
     position = rank[table.target]  # each solution's value, by its rank among the sorted values
-    periodic = bool(robot.is_revolute[joint]) and len(values) > 2 and np.isclose(
-        v_sorted[-1] - v_sorted[0] + 2 * np.pi / len(values), 2 * np.pi)
     minima = []  # (distance, low, high, its solution, its value, its branch)
     for key in np.unique(keys):
         on_branch = np.flatnonzero(keys == key)
@@ -99,11 +123,10 @@ def refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, va
     for _ in range(rounds):  # each round: REFINE_POINTS values across each bracket, then a bracket 8× narrower
         points = low[:, None] + (high - low)[:, None] * np.linspace(0.0, 1.0, REFINE_POINTS)[None, :]
         seeds = np.repeat(start, REFINE_POINTS, axis=0)
-        if family.ends_only:  # one plan for every value: the closed form at all the points in one batch
-            tracked, ok = _on_branch(robot, family, target, points.ravel(), np.repeat(keys_chosen, REFINE_POINTS),
-                                     seeds, reference)
+        if track is None:  # the closed form at all the points in one batch
+            tracked, ok = _on_branch(robot, solve, points.ravel(), np.repeat(keys_chosen, REFINE_POINTS), seeds)
         else:
-            tracked, ok = _track_branch(robot, family, target, seeds, points.ravel())
+            tracked, ok = track(seeds, points.ravel())
         distance = np.where(ok, distance_to_reference(robot, tracked, reference), np.inf).reshape(count, -1)
         pick = distance.argmin(axis=1)
         found = distance[np.arange(count), pick]
@@ -114,19 +137,19 @@ def refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, va
         spacing = (high - low) / (REFINE_POINTS - 1)
         low, high = np.maximum(low, best_value - spacing), np.minimum(high, best_value + spacing)
     best = best_value[np.isfinite(best_distance)]
-    best = np.unique(_wrapped(robot, joint, best))
+    best = np.unique(wrap(best))
     best = best[np.abs(best[:, None] - values[None, :]).min(axis=1) > DUPLICATE_TOLERANCE]  # not already on the grid
     if not len(best):
         return None
-    return solve_at(robot, family, target, best[:, None], reference)
+    return solve(best)
 
 
-def _on_branch(robot: Robot, family: FreeJointFamily, target: np.ndarray, values: np.ndarray, keys: np.ndarray,
-               seeds: np.ndarray, reference: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _on_branch(robot: Robot, solve: Callable[[np.ndarray], Verified], values: np.ndarray, keys: np.ndarray,
+               seeds: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The solution on branch ``keys[i]`` (:func:`branch_keys`) at each free value ``values[i]`` (K,), by the
     closed form, or the one nearest ``seeds[i]`` where no solution carries that branch's labels. Returns the joint
     vectors (K, n) and which rows have a solution (K,)."""
-    table: SolutionTable = solve_at(robot, family, target, values[:, None], reference).table
+    table: SolutionTable = solve(values).table
     rows = np.arange(len(values))
     joints, ok = np.zeros((len(values), robot.dof)), np.zeros(len(values), dtype=bool)
     if not len(table):

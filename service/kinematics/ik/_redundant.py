@@ -273,9 +273,11 @@ def sample_values(robot: Robot, joint: int, samples: int) -> np.ndarray:
 Requested = list[tuple[int, list[float] | None, int | None]]
 
 
-def free_joints_for(robot: Robot, requested: Requested | None) -> list[FreeJoint] | None:
+def free_joints_for(robot: Robot, requested: Requested | None, *, most: int = MAX_FREE_VALUES
+                    ) -> list[FreeJoint] | None:
     """The free joints and values to solve at, from a request's ``(joint, values, samples)`` entries (radians /
-    length units) or, when there are none, the default choice sampled :data:`DEFAULT_SAMPLES` times.
+    length units) or, when there are none, the default choice sampled :data:`DEFAULT_SAMPLES` times (fewer when
+    the grid would hold more than ``most`` values: a direction target solves the grid at each of its rolls).
 
     Returns None when the request names none and no locking leaves a family. Raises :class:`InvalidInputError`
     for a request that does not name exactly n − 6 distinct joints of the arm (:class:`NotRedundantError` for an
@@ -288,7 +290,7 @@ def free_joints_for(robot: Robot, requested: Requested | None) -> list[FreeJoint
         if chosen is None:
             return None
         family = family_for(robot, chosen)
-        samples = _default_samples(len(chosen), MAX_FREE_VALUES if family.ends_only else MAX_PLANNED_VALUES)
+        samples = _default_samples(len(chosen), min(most, MAX_FREE_VALUES if family.ends_only else MAX_PLANNED_VALUES))
         if samples == 0:
             return None  # too many free joints to sample each: the numeric search answers
         return [FreeJoint(j, sample_values(robot, j, samples)) for j in chosen]
@@ -383,7 +385,7 @@ def solve_family(robot: Robot, family: FreeJointFamily, goal: PoseGoal, free: li
     from ._free_search import REFINE_ROUNDS, REFINED_MINIMA, refine_nearest
 
     values = free_value_grid(free, family)
-    tables, complete, nearest, flags, refined = [], [], [], [], []
+    targets, refined = [], []
     for index, target in enumerate(goal.world_T_targets):
         budget.check("the free-joint family")
         grid = solve_at(robot, family, target, values, reference)
@@ -395,25 +397,38 @@ def solve_family(robot: Robot, family: FreeJointFamily, goal: PoseGoal, free: li
             if extra is not None:
                 parts.append(extra)
         refined.append(sum(len(part.complete) for part in parts[1:]))
-        table = SolutionTable.concat([part.table.with_targets(np.zeros(len(part.table), dtype=np.int64))
-                                      for part in parts], robot.dof)
-        if reference is not None:  # nearest the reference first over the whole family (ties: by free value)
-            table = table.take(np.argsort(distance_to_reference(robot, table.joints, reference), kind="stable"))
-        tables.append(table.with_targets(np.full(len(table), index)))
-        complete.append(all(part.complete.all() for part in parts))
-        nearest.append(min(float(part.nearest.min(initial=np.inf)) for part in parts))
-        met = SingularFlags(1)
-        for part in parts:
-            solved = part.count > 0
-            for mask, flag in part.singularities.entries:
-                if (mask & solved).any():
-                    met.add(np.ones(1, dtype=bool), flag)
-        flags.append(met)
+        targets.append(one_target(robot, parts, index, reference))
     missing = 0 if family.ends_only else sum(family.locked_plan(row) is None for row in values)
-    n_targets = len(goal)
-    verified = Verified(SolutionTable.concat(tables, robot.dof), np.array(complete, dtype=bool) & (missing == 0),
-                        np.array(nearest), SingularFlags.concat(flags) if flags else SingularFlags(0))
-    return FamilyVerified(verified, values, np.full(n_targets, missing), np.array(refined, dtype=int))
+    return FamilyVerified(gathered(robot, targets, missing == 0), values, np.full(len(goal), missing),
+                          np.array(refined, dtype=int))
+
+
+def one_target(robot: Robot, parts: list[Verified], index: int, reference: np.ndarray | None) -> Verified:
+    """Target ``index``'s answer over a family: the solutions of its parts (each a Verified of rows at free
+    values) laid end to end, nearest the reference first over the whole family (ties: in part order), complete
+    when every row of every part is, the nearest miss of any, and the conditions met where a row solved."""
+    table = SolutionTable.concat([part.table.with_targets(np.zeros(len(part.table), dtype=np.int64))
+                                  for part in parts], robot.dof)
+    if reference is not None:
+        table = table.take(np.argsort(distance_to_reference(robot, table.joints, reference), kind="stable"))
+    met = SingularFlags(1)
+    for part in parts:
+        solved = part.count > 0
+        for mask, flag in part.singularities.entries:
+            if (mask & solved).any():
+                met.add(np.ones(1, dtype=bool), flag)
+    return Verified(table.with_targets(np.full(len(table), index)),
+                    np.array([all(part.complete.all() for part in parts)]),
+                    np.array([min(float(part.nearest.min(initial=np.inf)) for part in parts)]), met)
+
+
+def gathered(robot: Robot, targets: list[Verified], promised: bool = True) -> Verified:
+    """The answers of :func:`one_target`, one per target in order, as one; complete only where ``promised``."""
+    if not targets:
+        return Verified(SolutionTable.empty(robot.dof), np.zeros(0, dtype=bool), np.zeros(0), SingularFlags(0))
+    return Verified(SolutionTable.concat([t.table for t in targets], robot.dof),
+                    np.concatenate([t.complete for t in targets]) & promised,
+                    np.concatenate([t.nearest for t in targets]), SingularFlags.concat([t.singularities for t in targets]))
 
 
 def solve_free_joint_family(robot: Robot, world_T_targets: np.ndarray, free: list[FreeJoint],

@@ -37,6 +37,10 @@ class SolutionTable:
     clearance, contacts : ndarrays, shape (S,), optional
         With a collision check (:mod:`service.kinematics.collision`): the smallest signed distance over the
         checked pairs, and each row's pairs closer than the margin (a tuple of (a, b, distance)). None without.
+    roll : ndarray, shape (S,), optional
+        A direction target solved over its free roll (:mod:`._direction`): the row's roll of the tool about the
+        tool axis, radians in (−π, π] (:func:`~._direction.rolls_of`); NaN for rows of other targets. None when
+        no row has one.
     """
 
     target: np.ndarray
@@ -47,6 +51,7 @@ class SolutionTable:
     labels: LabelCodes
     clearance: np.ndarray | None = None
     contacts: np.ndarray | None = None
+    roll: np.ndarray | None = None
 
     @classmethod
     def empty(cls, dof: int) -> "SolutionTable":
@@ -63,7 +68,8 @@ class SolutionTable:
                              self.position[index], self.orientation[index],
                              {name: (values, codes[index]) for name, (values, codes) in self.labels.items()},
                              None if self.clearance is None else self.clearance[index],
-                             None if self.contacts is None else self.contacts[index])
+                             None if self.contacts is None else self.contacts[index],
+                             None if self.roll is None else self.roll[index])
 
     def with_targets(self, target: np.ndarray) -> "SolutionTable":
         """The same rows numbered by other targets (``target`` (S,) non-decreasing), as when a part's rows
@@ -74,6 +80,10 @@ class SolutionTable:
     def with_clearances(self, clearance: np.ndarray, contacts: np.ndarray) -> "SolutionTable":
         """The same rows with their collision check (see the class docstring)."""
         return replace(self, clearance=clearance, contacts=contacts)
+
+    def with_roll(self, roll: np.ndarray) -> "SolutionTable":
+        """The same rows with each one's tool roll (S,), radians (see the class docstring)."""
+        return replace(self, roll=np.asarray(roll, dtype=float))
 
     @classmethod
     def concat(cls, tables: list["SolutionTable"], dof: int) -> "SolutionTable":
@@ -92,7 +102,9 @@ class SolutionTable:
                     np.concatenate([t.clearance if t.clearance is not None else np.full(len(t), np.inf)
                                     for t in tables]) if checked else None,
                     np.concatenate([t.contacts if t.contacts is not None else _no_contacts(len(t))
-                                    for t in tables]) if checked else None)
+                                    for t in tables]) if checked else None,
+                    np.concatenate([t.roll if t.roll is not None else np.full(len(t), np.nan) for t in tables])
+                    if any(t.roll is not None for t in tables) else None)
         if (np.diff(table.target) < 0).any():
             table = table.take(np.argsort(table.target, kind="stable"))
         return table

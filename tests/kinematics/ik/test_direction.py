@@ -65,6 +65,6 @@ def test_rotations_to_take_the_axis_onto_the_direction_also_when_opposite():
     assert np.allclose(R @ np.swapaxes(R, 1, 2), np.eye(3)) and np.allclose(np.linalg.det(R), 1.0)
 
 
-def test_target_kinds_name_the_direction_kind_for_five_joint_arms():
+def test_target_kinds_name_the_direction_kind_for_arms_of_five_joints_or_more():
     assert target_kinds(arm("so101_like")) == ["pose", "position", "position_direction"]
-    assert target_kinds(arm("iiwa14")) == ["pose", "position"]
+    assert target_kinds(arm("iiwa14")) == ["pose", "position", "position_direction"]

@@ -90,6 +90,12 @@ class CoaxialPlan:
     def free_joints(self) -> list[int]:
         return sorted([self._full_index(k) for k in self.inner.free_joints] + [self.second])
 
+    @property
+    def coaxial_held(self) -> list[int]:
+        """The joints held at the reference value (or 0) because the target fixes only a coaxial pair's relation:
+        joint j, and those of the pairs the inner plan holds (an arm with more than one pair)."""
+        return sorted([self._full_index(k) for k in getattr(self.inner, "coaxial_held", [])] + [self.second])
+
     def _full_index(self, k: int) -> int:
         return k + 1 if k >= self.second else k
 

@@ -91,8 +91,8 @@ def audit(robot: Robot, q: np.ndarray, pair: int, reversed_axes: bool, constrain
     return broken
 
 
-#: (planar, dof): planar 3R and 4R, spatial 5R and 6R.
-ARMS = [(True, 3), (True, 4), (False, 5), (False, 6)]
+#: (planar, dof): planar 3R and 4R, spatial 5R and 6R, a redundant 7R.
+ARMS = [(True, 3), (True, 4), (False, 5), (False, 6), (False, 7)]
 
 
 @pytest.mark.parametrize("convention", ["standard", "modified"])

@@ -9,7 +9,9 @@ same motion), the locked arm goes to the ordinary plan dispatch, and each of its
 solutions ``σ`` is split back with joint j at the reference value (or 0):
 ``q_j = v``, ``q_i = σ ∓ v``. The answer is complete up to that relation, which
 every row reports (kind ``"coaxial"``, relation ``"sum"`` or ``"difference"``), and
-joint j is listed among the free joints.
+joint j is listed among the free joints. A 7-joint arm whose one degree of redundancy
+is such a pair is answered the same way, not as a family sampled over a free joint
+(``coaxial_redundancy`` in :mod:`._answer`).
 """
 
 from __future__ import annotations

@@ -66,6 +66,7 @@ from .ik import (
     IKTargets,
     Singularity,
     answer_ik,
+    coaxial_redundancy,
     distance_to_reference,
     free_joints_for,
     joint_difference,
@@ -318,7 +319,7 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
     plan = plan_for(robot, constrain_orientation=constrain_orientation, reference=reference)
     # a redundant arm (issue 14): the free joint held continuous along the path, its rate 0
     family = follow_free_joints(robot, targets, reference, options.ik) \
-        if constrain_orientation and robot.dof > 6 else None
+        if constrain_orientation and robot.dof > 6 and not coaxial_redundancy(robot) else None
     task = task_space(robot, constrain_orientation=constrain_orientation,
                       free_joints=family[1] if family is not None else
                       plan.free_joints if plan is not None else ())

@@ -82,6 +82,7 @@ from .ik import (
     IKTargets,
     Singularity,
     answer_ik,
+    coaxial_redundancy,
     distance_to_reference,
     free_joints_for,
     joint_difference,
@@ -340,9 +341,11 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
 
     plan = plan_for(robot, constrain_orientation=constrain_orientation, reference=reference)
     # a redundant arm (issue 14): the free joints held continuous along the path, their rates 0; the ones the
-    # request names, where it names them (as single IK takes them)
+    # request names, where it names them (as single IK takes them). A 7-joint arm whose redundancy is a coaxial
+    # pair takes its six-joint closed form instead, unless the request names free joints
     family = None
-    if constrain_orientation and (robot.dof > 6 or options.free_joints is not None):
+    if constrain_orientation and (options.free_joints is not None
+                                  or (robot.dof > 6 and not coaxial_redundancy(robot))):
         try:
             family = follow_free_joints(robot, targets, reference, options.ik, options.free_joints)
         except InvalidInputError as error:

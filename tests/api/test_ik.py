@@ -420,7 +420,6 @@ REACHABLE = [
     # skew RPR start of SKEW_PRISMATIC can: its position targets are solved in closed form, skew_axes_with_slide.)
     (PLANAR_START, [0.4, 0.3, -1.1, 0.2, 2.0, -0.6], "position"),
     (SKEW_2R, [1.0, -0.5], "position"),
-    (ONE_JOINT, [0.7], "position"),
 ]
 
 #: (robot, target): out of reach (or only an orientation the arm cannot give)
@@ -459,6 +458,18 @@ def test_the_numeric_fallback_never_fails_and_never_returns_a_wrong_solution(cli
         error = np.abs(reached - T).max() if kind == "pose" else np.abs(reached[:3, 3] - T[:3, 3]).max()
         assert error < 1e-9 * _scale(robot)
         assert solution["residual"]["position"] < 1e-9 * _scale(robot)
+
+
+def test_a_one_joint_arm_places_its_point_in_closed_form(client):
+    """One revolute joint places a point by subproblem 1 (it was the numeric search). This arm's tool point is on
+    its axis (modified DH, no offset after the joint): every value reaches it, so the joint is free and takes the
+    reference value."""
+    T = _fk_pose(client, ONE_JOINT, [0.7])
+    result = _inline_ik(client, ONE_JOINT, {"position": T[:3, 3].tolist()}, reference=[-0.4])
+    assert result["status"] == "ok" and result["solver"]["method"] == "analytic"
+    assert result["solver"]["complete"] is True
+    assert [s["joints"] for s in result["solutions"]] == [[pytest.approx(-0.4, abs=1e-12)]]
+    assert any(s["kind"] == "shoulder" and s["relation"] == "free" for s in result["singularities"])
 
 
 @pytest.mark.parametrize("robot, target", UNREACHABLE)

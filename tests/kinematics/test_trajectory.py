@@ -342,3 +342,23 @@ def test_the_continuation_is_the_nearest_to_the_extrapolated_joints_not_to_the_l
     on_path = [fake([([0.1 * k, 0.5 - 0.1 * k], {})]) for k in range(3)]  # moving by (0.1, -0.1) a sample
     samples = follow_fake(on_path + [fake([([0.22, 0.32], {}), ([0.3, 0.2], {})])])
     np.testing.assert_allclose(samples[3].joints, [0.3, 0.2])
+
+
+def test_a_seven_joint_arm_with_a_coaxial_pair_follows_its_path_with_the_pair_held():
+    """A UR5 with a joint added on its first axis: the redundancy is the pair's split, so every sample is the
+    UR5's closed form with q2 held at the reference (issue 22 item 1). The generating path comes back up to that
+    split: q1 + q2 and joints 3–7 as generated, q2 constant."""
+    rows = [(0.0, 0.0, 0.05), (0.0, np.pi / 2, 0.039159), (-0.425, 0.0, 0.0), (-0.39225, 0.0, 0.0),
+            (0.0, np.pi / 2, 0.10915), (0.0, -np.pi / 2, 0.09465), (0.0, 0.0, 0.0823)]
+    arm = Robot([Joint(f"q{k + 1}", "revolute", a, alpha, d, 0.0) for k, (a, alpha, d) in enumerate(rows)])
+    start, velocity = np.array([0.4, -0.9, -1.2, 1.0, 0.6, -0.8, 2.1]), np.array([0.3, 0.2, 0.1, -0.2, 0.1, 0.2, -0.1])
+    times = np.linspace(0.0, 1.0, 12)
+    path = start + times[:, None] * velocity
+    result = follow_trajectory(arm, times, forward_kinematics(arm, path), options=TrajectoryOptions(reference=start))
+    assert result.method == "analytic" and "coaxial" in result.structure
+    assert all(sample.status == "ok" for sample in result.samples)
+    joints = np.array([sample.joints for sample in result.samples])
+    np.testing.assert_allclose(joints[:, 1], start[1], atol=1e-12)
+    split = joints[:, 0] + joints[:, 1] - path[:, 0] - path[:, 1]
+    np.testing.assert_allclose(np.angle(np.exp(1j * split)), 0.0, atol=1e-9)
+    np.testing.assert_allclose(joints[:, 2:], path[:, 2:], atol=1e-9)

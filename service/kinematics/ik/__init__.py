@@ -12,7 +12,7 @@ Python callers; :func:`estimate` counts a request's cost before any solving.
 """
 
 from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKAnswer, IKOptions, IKTargets, PerTarget,
-                      SolverReport, SolveTiming, TargetAnswer, UnsupportedTargetError, answer_ik)
+                      SolverReport, SolveTiming, TargetAnswer, UnsupportedTargetError, answer_ik, coaxial_redundancy)
 from ._closed_form import cached_plan, plan_is_kept
 from ._cost import SMALL_ROWS, Cost, estimate, is_small
 from ._direction import DEFAULT_ROLL_SAMPLES, MAX_ROLL_ROWS, roll_samples, target_kinds
@@ -64,6 +64,7 @@ __all__ = [
     "beyond_reach",
     "cached_plan",
     "check_ordering",
+    "coaxial_redundancy",
     "combinations_to_rank",
     "distance_to_reference",
     "enumerable_limit",

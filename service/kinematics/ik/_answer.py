@@ -31,6 +31,7 @@ from .._limits import Limits
 from .._robot import Robot
 from ..collision import CollisionRequest, clearances
 from ._closed_form import cached_plan, solve_closed_form
+from ._coaxial import CoaxialPlan, coaxial_pair
 from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, distinct_rolls, roll_family,
                          roll_free_joints, roll_rows, roll_samples, solve_roll_family, tool_roll)
 from ._goals import DirectionGoal, PoseGoal
@@ -296,7 +297,7 @@ def _poses(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: Answer
     promises, the numeric search elsewhere."""
     goal = PoseGoal(matrices[rows])
     started = time.perf_counter()
-    if options.free_joints is not None or robot.dof > 6:
+    if answered_by_family(robot, options):
         with _at_free_joints():
             free = free_joints_for(robot, options.free_joints)
         if free is not None:
@@ -309,6 +310,23 @@ def _poses(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: Answer
     verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
     closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
     return _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan), plan.label_codes)
+
+
+def answered_by_family(robot: Robot, options: AnswerOptions) -> bool:
+    """Whether full poses are answered as a family over free joints: those the request names, or a redundant
+    arm's (n > 6) unless its one degree of redundancy is a coaxial pair's split (:func:`coaxial_redundancy`)."""
+    return options.free_joints is not None or (robot.dof > 6 and not coaxial_redundancy(robot))
+
+
+def coaxial_redundancy(robot: Robot) -> bool:
+    """Whether a 7-joint arm's redundancy is the split of two coaxial joints (:mod:`._coaxial`) whose arm
+    without the second joint a closed form covers. Every value of a free joint would give the same solutions up
+    to that split, so the arm is answered as a six-joint one with a coaxial pair: the second joint held at the
+    reference value (or 0), listed free, and the relation stated (api.md: at a singularity the family is
+    represented and the coupling is stated)."""
+    if robot.dof != 7 or coaxial_pair(geometry_of(robot)) is None:
+        return False
+    return isinstance(cached_plan(robot, constrain_orientation=True, reference=None), CoaxialPlan)
 
 
 def _positions(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: AnswerOptions,
@@ -477,7 +495,7 @@ def _family(robot: Robot, goal: PoseGoal, rows: np.ndarray, free: list[FreeJoint
         return [_timed(timings, part, started)]
     with _at_free_joints():
         answer = solve_family(robot, family, goal, free, options.reference, budget=options.budget)
-    part = _Part(rows, answer.verified, "analytic", family.structure, family.free)
+    part = _Part(rows, answer.verified, "analytic", family.structure, family.free_joints)
     for local in np.flatnonzero(answer.verified.count == 0).tolist():
         part.details[local] = no_solution_detail(robot, free, goal.world_T_targets[local, :3, 3])
     for local in np.flatnonzero(answer.missing > 0).tolist():

@@ -9,7 +9,9 @@ same motion), the locked arm goes to the ordinary plan dispatch, and each of its
 solutions ``σ`` is split back with joint j at the reference value (or 0):
 ``q_j = v``, ``q_i = σ ∓ v``. The answer is complete up to that relation, which
 every row reports (kind ``"coaxial"``, relation ``"sum"`` or ``"difference"``), and
-joint j is listed among the free joints.
+joint j is listed among the free joints. A 7-joint arm whose one degree of redundancy
+is such a pair is answered the same way, not as a family sampled over a free joint
+(``coaxial_redundancy`` in :mod:`._answer`).
 """
 
 from __future__ import annotations
@@ -89,6 +91,12 @@ class CoaxialPlan:
     @property
     def free_joints(self) -> list[int]:
         return sorted([self._full_index(k) for k in self.inner.free_joints] + [self.second])
+
+    @property
+    def coaxial_held(self) -> list[int]:
+        """The joints held at the reference value (or 0) because the target fixes only a coaxial pair's relation:
+        joint j, and those of the pairs the inner plan holds (an arm with more than one pair)."""
+        return sorted([self._full_index(k) for k in getattr(self.inner, "coaxial_held", [])] + [self.second])
 
     def _full_index(self, k: int) -> int:
         return k + 1 if k >= self.second else k

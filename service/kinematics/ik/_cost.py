@@ -16,7 +16,7 @@ from .._limits import Limits
 from .._robot import Robot
 from ..collision import model_for
 from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_collisions, _at_free_joints,
-                      direction_free_joints, direction_groups)
+                      direction_free_joints, direction_groups, answered_by_family)
 from ._closed_form import cached_plan, plan_is_kept
 from ._direction import direction_plan, refined_rows, roll_family, roll_rows
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit,
@@ -106,10 +106,11 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
             continue
         constrained = kind == POSE
         free = None
-        if constrained and (options.free_joints is not None or robot.dof > 6):
+        family_asked = constrained and answered_by_family(robot, options)
+        if family_asked:
             with _at_free_joints():
                 free = free_joints_for(robot, options.free_joints)
-        if free is not None or (constrained and robot.dof > 6):
+        if free is not None or family_asked:
             family = None if free is None else family_for(robot, tuple(sorted(f.joint for f in free)))
             values = 1 if free is None else grid_size([len(f.values) for f in free])
             if family is not None and family.available:

@@ -174,6 +174,7 @@ def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
                 continue  # consecutive coincident axes turn the tool about one line: not a 3-DOF wrist
             wrist = SphericalWrist(geometry, wrist_joints)
         elif len(wrist_joints) == 1:
+            # a roll: the joints before it place a point of its axis (one joint before it: OneRevolute)
             if not model.is_revolute[k]:
                 continue
             point, wrist = geometry.point(k), Roll(geometry, k)

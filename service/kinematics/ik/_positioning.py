@@ -772,12 +772,48 @@ class ParallelShoulder(Positioner):
         return {"assembly_mode": ((1, 2), side_codes(side, size))}
 
 
+class OneRevolute(Positioner):
+    """One revolute joint placing a point on the circle it sweeps: ``R(ω, q)(w − p) = x − p``, subproblem 1.
+
+    One solution where x is on that circle (the point's height along ω and its distance from the axis
+    kept), none elsewhere. The positioner of a two-joint arm whose second joint is a roll placing a full
+    pose: the roll keeps the points of its axis, so the target fixes where one of them goes. Such an arm is,
+    for instance, a planar three-joint arm with two coaxial joints once one of them is held
+    (:mod:`._coaxial`). With the point on the axis every q keeps it there: the joint is free (the reference
+    value, or 0) and flagged, and a full pose's orientation then fixes it (``DecoupledPlan``).
+    """
+
+    name = "one_revolute"
+    generic_count = 1
+
+    @classmethod
+    def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "OneRevolute | None":
+        if len(joints) != 1 or geometry.kinds(joints) != "R":
+            return None
+        return cls(geometry, joints, point)
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        """Joint values (N, 1, 1) carrying the point to targets (N, 3), valid (N, 1) where on the circle."""
+        g, (i,) = self.geometry, self.joints
+        turn = subproblem_1(g.direction(i), self.point - g.point(i), targets - g.point(i))
+        free = turn.degenerate  # (N,): the point (or the target) on the axis
+        q = np.where(free[:, None], 0.0 if reference is None else reference[i], turn.theta)
+        singular = SingularFlags(len(targets))
+        _flag_rows(free, Singularity("shoulder", (i,), "free", f"the point is on axis {i + 1}; joint {i + 1} is "
+                                     "set to the reference value (or 0)"), singular)
+        return PositionerResult(q[..., None], turn.exact, singular)
+
+
 class PlanarTwoLink(Positioner):
     """Two revolute joints with parallel axes placing a point in their plane (Spong Example 3.1).
 
     The distance from axis 1 fixes q₂ (subproblem 3, elbow up/down), then q₁ by
     subproblem 1. The point's height along the axes cannot change: a target
     off that plane is unreachable.
+
+    With the point on axis 2 (a link of length 0, as in a planar arm with two coaxial joints once one is
+    held, :mod:`._coaxial`) q₂ never moves it: subproblem 3 is degenerate for every target, q₂ is a free
+    joint (the reference value, or 0) and one solution remains.
     """
 
     name = "planar_two_link"
@@ -787,7 +823,11 @@ class PlanarTwoLink(Positioner):
     def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "PlanarTwoLink | None":
         if len(joints) != 2 or geometry.kinds(joints) != "RR" or not geometry.parallel(*joints):
             return None
-        return cls(geometry, joints, point)
+        solver = cls(geometry, joints, point)
+        if geometry.on_axis(joints[1], solver.point):
+            solver.free_joints = (joints[1],)  # subproblem 3 is degenerate for every target
+            solver.generic_count = 1
+        return solver
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, (i, j) = self.geometry, self.joints
@@ -798,15 +838,20 @@ class PlanarTwoLink(Positioner):
         in_plane_projector = np.eye(3) - np.outer(u, u)
         elbow = subproblem_3(g.direction(j), in_plane_projector @ (self.point - g.point(j)),
                              in_plane_projector @ (g.point(i) - g.point(j)), reach)
-        w2 = g.point(j) + rotate_about(g.direction(j), elbow.theta, self.point - g.point(j))
+        q2 = elbow.theta  # (N, 2)
+        if self.free_joints:  # degenerate: the representative is the reference value (or 0), not SP3's 0
+            q2 = np.where(elbow.valid, 0.0 if reference is None else reference[j], q2)
+        w2 = g.point(j) + rotate_about(g.direction(j), q2, self.point - g.point(j))
         first = subproblem_1(u, w2 - g.point(i), (targets - g.point(i))[:, None, :])
         q1 = first.theta[..., 0]
         free = first.degenerate
         if free.any():
             q1 = np.where(free, 0.0 if reference is None else reference[i], q1)
-        joints = np.stack([q1, elbow.theta], axis=-1)
+        joints = np.stack([q1, q2], axis=-1)
         valid = elbow.valid & elbow.exact & first.exact[..., 0] & in_plane[:, None]
         valid[:, 1] &= ~free[:, 1]
+        if self.free_joints:
+            valid[:, 1] = False  # one representative of the free elbow
         singular = SingularFlags(len(targets))
         _flag_rows(elbow.merged, Singularity("elbow", (j,), "stretched_or_folded",
                                              "the arm is fully stretched or folded"), singular)
@@ -1099,7 +1144,7 @@ def _quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale:
 
 
 POSITIONERS = (IntersectingShoulder, ParallelShoulder, OneRevoluteTwoPrismatic, Cartesian, PlanarTwoLink,
-               IntersectingPair,
+               IntersectingPair, OneRevolute,
                OffsetShoulderParallelElbow, OffsetShoulderIntersectingElbow, SkewAxes, SkewAxesWithSlide)
 
 

@@ -129,6 +129,14 @@ class FreeJointFamily:
         # a class can be recognised yet degenerate (a locked elbow): it must solve a real pose
         self.available = available and self._recovers_probe_pose()
 
+    @property
+    def free_joints(self) -> tuple[int, ...]:
+        """The joints an answer lists free, in the arm's numbering: the locked ones (at the free values) and
+        those the locked plan leaves free and holds at the reference value or 0 (the second joint of a coaxial
+        pair, a joint the target never determines)."""
+        left_free = () if self.plan is None else self.plan.free_joints
+        return tuple(sorted({*self.free, *(int(self.kept[k]) for k in left_free)}))
+
     def _plan_locked_at(self, locked: dict[int, float]) -> Plan | None:
         return plan_for_geometry(locked_geometry(self.geometry, locked), constrain_orientation=True,
                                  reference=None)
@@ -142,14 +150,24 @@ class FreeJointFamily:
             dict(zip(self.free, values.tolist()))), MAX_PLANNED_VALUES)
 
     def _recovers_probe_pose(self) -> bool:
-        """Whether the locked problem recovers the joint vector a pose was generated from (a fixed generic one)."""
+        """Whether the locked problem recovers the joint vector a pose was generated from (a fixed generic one).
+
+        The second joint of a coaxial pair in the locked arm takes that vector's value from the reference, as it
+        takes a request's: the target fixes only the pair's relation (:mod:`._coaxial`). Other joints the locked
+        plan would hold (a locked elbow leaves the shoulder free) get no reference: such a class is degenerate.
+        """
         from .._forward import forward_kinematics
 
         robot = self.robot
         q = np.random.default_rng(7).uniform(-1.0, 1.0, robot.dof)
         q[list(self.free)] = _PROBE_VALUES[0]
         targets = forward_kinematics(robot, q)[None]
-        found = verify(robot, PoseGoal(targets), self.solve_rows(targets, q[list(self.free)][None], None)).table
+        held = self.kept[getattr(self.plan, "coaxial_held", [])]
+        reference = None
+        if len(held):
+            reference = np.zeros(robot.dof)
+            reference[held] = q[held]
+        found = verify(robot, PoseGoal(targets), self.solve_rows(targets, q[list(self.free)][None], reference)).table
         gap = np.abs(wrap_revolute(robot, found.joints - q)).max(axis=1)
         return bool((gap < DUPLICATE_TOLERANCE).any())
 

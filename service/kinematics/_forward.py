@@ -20,19 +20,24 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ._conventions import link_transforms
 from ._cache import memo
 from ._robot import Robot
+
+
+def _dh_variables(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The (theta, d) columns at joint values q, shape (..., n) each."""
+    theta = robot.theta + np.where(robot.is_revolute, q, 0.0)
+    d = robot.d + np.where(robot.is_revolute, 0.0, q)
+    return theta, d
 
 
 def link_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
     """Poses of every DH frame in the world frame.
 
-    A DH robot's frames are read off its :class:`ChainProgram` as it runs (the same column operations as
-    :func:`tool_columns`, over the whole batch at once).
-
     Parameters
     ----------
-    q : ndarray, shape (n,) or (..., n)
+    q : ndarray, shape (n,) or (N, n)
 
     Returns
     -------
@@ -42,16 +47,13 @@ def link_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
     q = np.asarray(q, dtype=float)
     if robot.chain_transforms is not None:
         return _chain_frames(robot, q)[..., [0, *range(2, robot.dof + 2)], :, :]
-    program = chain_program(robot)
-    rows = q.reshape(-1, robot.dof)
-    _, after_rows = _run_program(program, rows.T, program.link_ends)
-    frames = np.empty((len(rows), robot.dof + 1, 4, 4))
-    frames[:, 0] = robot.world_T_base
-    if after_rows:  # (n, 4 columns, 3, N) gathered, then placed in one strided copy
-        frames[:, 1:, :3, :] = np.array(after_rows).transpose(3, 0, 2, 1)
-    frames[:, 1:, 3, :3] = 0.0
-    frames[:, 1:, 3, 3] = 1.0
-    return frames.reshape(q.shape[:-1] + (robot.dof + 1, 4, 4))
+    theta, d = _dh_variables(robot, q)
+    prev_T_link = link_transforms(robot.convention, robot.a, robot.alpha, d, theta)
+    frames = np.empty(q.shape[:-1] + (robot.dof + 1, 4, 4))
+    frames[..., 0, :, :] = robot.world_T_base
+    for i in range(robot.dof):
+        frames[..., i + 1, :, :] = frames[..., i, :, :] @ prev_T_link[..., i, :, :]
+    return frames
 
 
 def _chain_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
@@ -158,7 +160,6 @@ class ChainProgram(NamedTuple):
     start: tuple[float, ...]  # world_T_base (· F_0 for a screws robot): columns x, y, z, p flattened
     operations: tuple[tuple[int, int, object], ...]
     joint_steps: tuple[int, ...]  # per joint, the index of the operation that reads its value
-    link_ends: tuple[int, ...] = ()  # a DH robot's: per row i, the operations up to frame i (the tool's after)
 
 
 def chain_program(robot: Robot) -> ChainProgram:
@@ -181,7 +182,6 @@ def _chain_program(robot: Robot) -> ChainProgram:
             operations.append((_FIXED, -1, _columns(fixed)))
         return _program(_columns(robot.world_T_base @ chain[0]), operations)
     standard = robot.convention == "standard"
-    link_ends: list[int] = []
     for i, step in enumerate(_chain_steps(robot)):
         if step.revolute:
             about_z = [(_TURN, i, step.theta)] + ([(_MOVE_Z, -1, step.d)] if step.d != 0.0 else [])
@@ -195,16 +195,14 @@ def _chain_program(robot: Robot) -> ChainProgram:
                            else (_TWIST, -1, (step.cos_alpha, step.sin_alpha)))
         # standard DH: A = Rz(θ) Tz(d) Tx(a) Rx(α); Craig and Khalil: T = Rx(α) Tx(a) Rz(θ) Tz(d)
         operations += about_z + about_x if standard else about_x + about_z
-        link_ends.append(len(operations))
     if not np.array_equal(tool, _IDENTITY):
         operations.append((_FIXED, -1, _columns(tool)))
-    return _program(_columns(robot.world_T_base), operations, link_ends)
+    return _program(_columns(robot.world_T_base), operations)
 
 
-def _program(start: tuple[float, ...], operations: list[tuple[int, int, object]],
-             link_ends: list[int] = ()) -> ChainProgram:
+def _program(start: tuple[float, ...], operations: list[tuple[int, int, object]]) -> ChainProgram:
     joint_steps = tuple(i for i, (kind, _, _) in enumerate(operations) if kind in (_TURN, _SLIDE))
-    return ChainProgram(start, tuple(operations), joint_steps, tuple(link_ends))
+    return ChainProgram(start, tuple(operations), joint_steps)
 
 
 def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -220,18 +218,12 @@ def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
     x, y, z, p : ndarrays, shape (3, N)
         The rotation's columns and the position of the tool, in the world frame.
     """
-    return _run_program(chain_program(robot), np.asarray(q, dtype=float).T)[0]
-
-
-def _run_program(program: ChainProgram, qt: np.ndarray, stops: tuple[int, ...] = ()):
-    """Run ``program`` on joint values ``qt`` (n, N): the columns x, y, z, p (3, N each) at the end, and a list of
-    them after each operation count in ``stops`` (ascending; the arrays are never written in place, so a
-    snapshot stays as it was)."""
+    program = chain_program(robot)
+    qt = np.asarray(q, dtype=float).T  # (n, N)
     count = qt.shape[1]
     start = np.array(program.start).reshape(4, 3, 1)
     x, y, z, p = (np.repeat(column, count, axis=1) for column in start)
-    snapshots, stops_left = [], list(stops)
-    for done, (kind, joint, value) in enumerate(program.operations, start=1):
+    for kind, joint, value in program.operations:
         if kind == _TURN:
             angle = qt[joint] + value if value != 0.0 else qt[joint]
             c, s = np.cos(angle), np.sin(angle)
@@ -254,10 +246,7 @@ def _run_program(program: ChainProgram, qt: np.ndarray, stops: tuple[int, ...] =
             a0, a1, a2, b0, b1, b2, c0, c1, c2, t0, t1, t2 = value
             p = p + x * t0 + y * t1 + z * t2
             x, y, z = x * a0 + y * a1 + z * a2, x * b0 + y * b1 + z * b2, x * c0 + y * c1 + z * c2
-        while stops_left and stops_left[0] == done:
-            snapshots.append((x, y, z, p))
-            stops_left.pop(0)
-    return (x, y, z, p), snapshots
+    return x, y, z, p
 
 
 _IDENTITY = np.eye(4)

@@ -338,7 +338,7 @@ def _each_once(table: SolutionTable, n_targets: int, turns: np.ndarray, max_equi
 def _listed(rows: SolutionTable, joints: np.ndarray, within: np.ndarray) -> SolutionTable:
     """``rows`` at the equivalents ``joints`` (K, n) listed, flagged ``within`` the limits (K,)."""
     return SolutionTable(rows.target, joints, within, rows.position, rows.orientation, rows.labels, rows.clearance,
-                         rows.contacts)
+                         rows.contacts, rows.roll)
 
 
 def _within_move(robot: Robot, limits: Limits, q: np.ndarray, first: np.ndarray, last: np.ndarray,

@@ -75,7 +75,7 @@ class SolutionTable:
         """The same rows numbered by other targets (``target`` (S,) non-decreasing), as when a part's rows
         take their place among a whole answer's."""
         return SolutionTable(np.asarray(target, dtype=np.int64), self.joints, self.within_limits, self.position,
-                             self.orientation, self.labels, self.clearance, self.contacts)
+                             self.orientation, self.labels, self.clearance, self.contacts, self.roll)
 
     def with_clearances(self, clearance: np.ndarray, contacts: np.ndarray) -> "SolutionTable":
         """The same rows with their collision check (see the class docstring)."""

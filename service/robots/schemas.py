@@ -159,8 +159,8 @@ class LinkBox(ApiModel):
 SHAPE_KINDS = ("capsule", "sphere", "box")
 
 
-def _shape_tag(value: Any) -> str | None:
-    """The variant of a link shape: the one shape key it has (None when it has none or several)."""
+def shape_kind(value: Any) -> str | None:
+    """The variant of a link shape or an obstacle: the one shape key it has (None when it has none or several)."""
     if isinstance(value, dict):
         kinds = [kind for kind in SHAPE_KINDS if kind in value]
         return kinds[0] if len(kinds) == 1 else None
@@ -170,7 +170,7 @@ def _shape_tag(value: Any) -> str | None:
 LinkShapeDescription = Annotated[
     Union[Annotated[LinkCapsule, Tag("capsule")], Annotated[LinkSphere, Tag("sphere")],
           Annotated[LinkBox, Tag("box")]],
-    Discriminator(_shape_tag, custom_error_type="link_shape",
+    Discriminator(shape_kind, custom_error_type="link_shape",
                   custom_error_message="a link shape has exactly one of 'capsule', 'sphere' or 'box'"),
 ]
 AnyLinkShapeDescription = LinkCapsule | LinkSphere | LinkBox

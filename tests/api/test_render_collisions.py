@@ -174,8 +174,7 @@ def test_a_picture_of_too_many_shapes_is_413_before_drawing(client):
     balls = [{"name": f"ball {i}", "sphere": {"center": [1.0, 0.1 * i, 0.0], "radius": 0.01}} for i in range(100)]
     body = {"joints": [PUMA_Q] * 256, "collisions": {"obstacles": balls}}  # 256 × (100 + the PUMA's shapes)
     shapes = len(client.get("/v1/robots/puma560_standard").json()["collision"])
-    if 256 * (100 + shapes) <= MAX_PICTURE_SHAPES:
-        pytest.skip("the cap is above what one render request may ask")
+    assert 256 * (100 + shapes) > MAX_PICTURE_SHAPES, "the body must ask for more shapes than the cap"
     assert_problem(client.post("/v1/robots/puma560_standard/render", json=body), 413, match="shapes")
     assert client.post("/v1/robots/puma560_standard/render",
                        json={**body, "joints": [PUMA_Q] * 8}).status_code == 200

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Union
+from typing import Annotated, Union
 
 from pydantic import Discriminator, Field, Tag
 
-from ...robots.schemas import SHAPE_KINDS, BoxGeometry, CapsuleGeometry, LinkRef, SphereGeometry
+from ...robots.schemas import BoxGeometry, CapsuleGeometry, LinkRef, SphereGeometry, shape_kind
 from .common import ApiModel, Flag, Number
 
 #: Most obstacles and ignored pairs one request may name.
@@ -37,18 +37,10 @@ class BoxObstacle(ApiModel):
     box: BoxGeometry = Field(description="the centre, full edge lengths and orientation, in the world frame")
 
 
-def _obstacle_tag(value: Any) -> str | None:
-    """The variant of an obstacle: the one shape key it has (None when it has none or several)."""
-    if isinstance(value, dict):
-        kinds = [kind for kind in SHAPE_KINDS if kind in value]
-        return kinds[0] if len(kinds) == 1 else None
-    return next((kind for kind in SHAPE_KINDS if hasattr(value, kind)), None)
-
-
 Obstacle = Annotated[
     Union[Annotated[CapsuleObstacle, Tag("capsule")], Annotated[SphereObstacle, Tag("sphere")],
           Annotated[BoxObstacle, Tag("box")]],
-    Discriminator(_obstacle_tag, custom_error_type="obstacle",
+    Discriminator(shape_kind, custom_error_type="obstacle",
                   custom_error_message="an obstacle has exactly one of 'capsule', 'sphere' or 'box'"),
 ]
 AnyObstacle = CapsuleObstacle | SphereObstacle | BoxObstacle

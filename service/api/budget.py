@@ -223,6 +223,24 @@ def check_picture_cost(panels: int, robot: Robot, obstacles: int) -> None:
                            f"obstacles.")
 
 
+def check_collision_cost(settings: Settings, cost: Cost) -> None:
+    """413 when the collision check of a request (IK targets or trajectory samples) would compare more shape
+    pairs per solution than KIN_MAX_COLLISION_PAIRS, or compute more distances than KIN_MAX_COLLISION_CHECKS."""
+    if cost.collision_pairs > settings.max_collision_pairs:
+        raise ProblemError(413, "too-much-work", "Too much work",
+                           f"The collision check would compare up to {cost.collision_pairs:,} pairs of shapes, "
+                           f"{cost.collision_pairs - settings.max_collision_pairs:,} more than "
+                           f"KIN_MAX_COLLISION_PAIRS = {settings.max_collision_pairs:,}. Give the links fewer "
+                           f"shapes, name fewer obstacles, or ignore link pairs.")
+    if cost.collision_checks > settings.max_collision_checks:
+        raise ProblemError(413, "too-much-work", "Too much work",
+                           f"The collision check would compute {cost.collision_checks:,} distances ({cost.targets:,} "
+                           f"targets × up to {cost.solutions_per_target} solutions × {cost.collision_pairs:,} pairs), "
+                           f"{cost.collision_checks - settings.max_collision_checks:,} more than "
+                           f"KIN_MAX_COLLISION_CHECKS = {settings.max_collision_checks:,}. Send fewer targets or "
+                           f"samples, or check fewer pairs.")
+
+
 def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, cost: Cost, *, form: str = "objects") -> None:
     """The caps on an IK request's cost (:func:`~service.kinematics.ik.estimate`, counted before any solving):
     turns per joint (422), the numeric search's starts, the combinations ranked per solution and the answer's
@@ -235,19 +253,7 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, cost: Cost, 
                            f"held free values), {cost.numeric_starts - settings.max_numeric_starts:,} more than "
                            f"KIN_MAX_NUMERIC_STARTS = {settings.max_numeric_starts:,}. Send fewer targets, fewer "
                            f"numeric.starts or fewer free values.")
-    if cost.collision_pairs > settings.max_collision_pairs:
-        raise ProblemError(413, "too-much-work", "Too much work",
-                           f"The collision check would compare up to {cost.collision_pairs:,} pairs of shapes, "
-                           f"{cost.collision_pairs - settings.max_collision_pairs:,} more than "
-                           f"KIN_MAX_COLLISION_PAIRS = {settings.max_collision_pairs:,}. Give the links fewer "
-                           f"shapes, name fewer obstacles, or ignore link pairs.")
-    if cost.collision_checks > settings.max_collision_checks:
-        raise ProblemError(413, "too-much-work", "Too much work",
-                           f"The collision check would compute {cost.collision_checks:,} distances ({cost.targets:,} "
-                           f"targets × up to {cost.solutions_per_target} solutions × {cost.collision_pairs:,} pairs), "
-                           f"{cost.collision_checks - settings.max_collision_checks:,} more than "
-                           f"KIN_MAX_COLLISION_CHECKS = {settings.max_collision_checks:,}. Send fewer targets, or "
-                           f"check fewer pairs.")
+    check_collision_cost(settings, cost)
     if cost.too_many_to_rank:
         most = enumerable_limit(robot.dof)
         raise ProblemError(413, "too-much-work", "Too much work",

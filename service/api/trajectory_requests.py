@@ -10,10 +10,11 @@ import numpy as np
 from fastapi import Request
 
 from ..kinematics import Budget, InvalidInputError, Robot, TrajectoryOptions, TrajectoryResult
-from ..kinematics.ik import IKOptions
-from .boundary import free_joints_to_core, joints_from_core, joints_to_core, located, target_matrix, violation_to_wire
-from .budget import budget_of
-from .deps import RobotRef, check_batch_size, with_request_frames
+from ..kinematics.ik import AnswerOptions, IKOptions, IKTargets, estimate
+from .boundary import (collisions_to_core, free_joints_to_core, joints_from_core, joints_to_core, located,
+                       target_matrix, violation_to_wire)
+from .budget import budget_of, check_collision_cost
+from .deps import RobotRef, check_batch_size, settings_of, with_request_frames
 from .schemas.trajectory import TrajectoryRequest
 
 
@@ -65,10 +66,17 @@ def trajectory_in_core(request: Request, ref: RobotRef, body: TrajectoryRequest)
     if body.reference is not None:
         with located("body", "reference"):
             reference = joints_to_core(robot, body.reference, unit)
+    free_joints = free_joints_to_core(robot, body.free_joints, unit)
+    collisions = collisions_to_core(robot, body.collisions, unit)
+    if collisions is not None:  # the distances of every sample's solutions, counted as single IK counts them
+        with located("body"):
+            cost = estimate(robot, IKTargets.poses(np.array(matrices), constrain_orientation=constrained[0]),
+                            AnswerOptions(reference=reference, free_joints=free_joints, collisions=collisions))
+        check_collision_cost(settings_of(request), cost)
     options = TrajectoryOptions(
         branch=None if body.branch is None else body.branch.model_dump(), reference=reference,
         singularity_tolerance=body.singularity_tolerance, damping=body.damping, ik=IKOptions(budget=budget),
-        free_joints=free_joints_to_core(robot, body.free_joints, unit))
+        free_joints=free_joints, collisions=collisions)
     return AskedTrajectory(ref, [s.time for s in body.samples], np.array(matrices), constrained[0],
                            np.array([_cartesian(s.twist, angle) for s in body.samples]),
                            np.array([_cartesian(s.acceleration, angle) for s in body.samples]), options, budget)
@@ -88,7 +96,7 @@ def trajectory_to_wire(asked: AskedTrajectory, result: TrajectoryResult, body: T
     for k, s in enumerate(result.samples):
         if k % 256 == 0:
             budget.check("encoding")
-        samples.append({
+        sample = {
             "time": s.time,
             "status": s.status,
             "joints": _vector(robot, s.joints, unit),
@@ -109,8 +117,20 @@ def trajectory_to_wire(asked: AskedTrajectory, result: TrajectoryResult, body: T
                 "velocities": _vector(robot, s.paper.velocities, unit, paper_scale),
                 "accelerations": _vector(robot, s.paper.accelerations, unit, paper_scale),
                 "case": s.paper.case},
-        })
+        }
+        if asked.options.collisions is not None:
+            checked = s.clearance
+            sample["clearance"] = None if checked is None else checked.clearance
+            sample["collisions"] = None if checked is None else [{"a": a, "b": b, "distance": distance}
+                                                                 for a, b, distance in checked.contacts]
+            sample["collision_forced"] = s.collision_forced
+        samples.append(sample)
     summary = result.summary
+    collision_summary = {} if asked.options.collisions is None else {
+        "colliding_samples": summary.colliding_samples,
+        "collision_branch_changes": summary.collision_branch_changes,
+        "smallest_clearance": {"value": summary.smallest_clearance, "sample": summary.smallest_clearance_at},
+    }
     step = joints_from_core(robot, summary.largest_joint_step, unit)
     return {
         "robot_id": asked.ref.id,
@@ -126,6 +146,7 @@ def trajectory_to_wire(asked: AskedTrajectory, result: TrajectoryResult, body: T
             "singular_samples": summary.singular_samples,
             "branch_changes": summary.branch_changes,
             "unreachable_samples": summary.unreachable_samples,
+            **collision_summary,
         },
         "solver": {"positions": result.method, "structure": result.structure, "complete": result.complete,
                    "rates": result.rates, "task_rows": list(result.task.names), "solve": result.task.solve,

@@ -75,6 +75,8 @@ from ._forward import geometric_jacobian
 from ._rates import TaskSpace, joint_rates, rate_residuals, task_jacobian, task_space
 from ._robot import Robot, check_joint_values
 from ._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, RATE_SINGULARITY_TOLERANCE
+from ._trajectory_collisions import SampleClearance, collision_free_pool, forced_by_collision, sample_clearances
+from .collision import CollisionRequest, at_collisions, model_for
 from .ik import (
     AnswerOptions,
     IKOptions,
@@ -149,6 +151,9 @@ class TrajectoryOptions:
     free_joints : list of (joint, values or None, samples or None), optional
         A redundant arm's free joints and where to solve them, radians / length units, as single IK takes them
         (:class:`~.ik.AnswerOptions`); None lets the trajectory choose and hold them continuous.
+    collisions : CollisionRequest, optional
+        Check each sample's joints; with its ``filter``, stay on collision-free solutions
+        (:mod:`._trajectory_collisions`).
     """
 
     branch: Mapping[str, str | int] | None = None
@@ -158,6 +163,7 @@ class TrajectoryOptions:
     damping: float | None = None
     ik: IKOptions = field(default_factory=IKOptions)
     free_joints: list[tuple[int, list[float] | None, int | None]] | None = None
+    collisions: CollisionRequest | None = None
 
 
 @dataclass(frozen=True)
@@ -172,10 +178,12 @@ class PaperJoints:
 
 @dataclass
 class SampleResult:
-    """One sample of the trajectory. Arrays have shape (n,); rates are NaN where not computed."""
+    """One sample of the trajectory. Arrays have shape (n,); rates are NaN where not computed. With a collision
+    check, ``clearance`` holds the reached joints' check, and ``collision_forced`` says the sample left its
+    branch because the continuation collides."""
 
     time: float
-    status: Literal["ok", "unreachable", "not_found", "branch_unavailable"]
+    status: Literal["ok", "unreachable", "not_found", "branch_unavailable", "no_collision_free_solution"]
     joints: np.ndarray | None = None
     velocities: np.ndarray | None = None
     accelerations: np.ndarray | None = None
@@ -188,6 +196,8 @@ class SampleResult:
     velocity_residual: float | None = None
     acceleration_residual: float | None = None
     paper: PaperJoints | None = None
+    clearance: SampleClearance | None = None
+    collision_forced: bool = False
 
     @property
     def reached(self) -> bool:
@@ -201,7 +211,10 @@ class TrajectorySummary:
     ``largest_joint_step`` (n,) is the largest |q_i(k) − q_i(k−1)| over
     consecutive samples that were both reached (NaN if there are none), and
     ``largest_joint_step_at`` the sample k where it happens. The smallest
-    distance to a singularity is over the reached samples.
+    distance to a singularity is over the reached samples. With a collision
+    check: the reached samples whose joints collide, those whose branch
+    change a collision forced, and the smallest clearance (None without a
+    check, or when nothing is checked) and where.
     """
 
     largest_joint_step: np.ndarray
@@ -212,6 +225,10 @@ class TrajectorySummary:
     singular_samples: list[int]
     branch_changes: list[int]
     unreachable_samples: list[int]
+    colliding_samples: list[int] = field(default_factory=list)
+    collision_branch_changes: list[int] = field(default_factory=list)
+    smallest_clearance: float | None = None
+    smallest_clearance_at: int | None = None
 
 
 @dataclass
@@ -338,6 +355,9 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
     if options.damping is not None and not (np.isfinite(options.damping) and options.damping > 0):
         raise InvalidInputError("damping must be a positive number", location=("damping",))
     limits = options.limits or Limits.of(robot)
+    if options.collisions is not None:
+        with at_collisions():
+            model_for(robot, options.collisions)  # compiled once, kept: an error in it is the request's
 
     plan = plan_for(robot, constrain_orientation=constrain_orientation, reference=reference)
     # a redundant arm (issue 14): the free joints held continuous along the path, their rates 0; the ones the
@@ -367,7 +387,7 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
     if plan is not None and robot.dof <= 6:
         labels = plan.label_codes
     samples = _follow(robot, times, targets, results, held, reference, limits, constrain_orientation, options.ik,
-                      Tracking(twist, task, labels, acceleration))
+                      Tracking(twist, task, labels, acceleration), options.collisions)
     assur = assur_scara_of(robot)
     reached = np.array([k for k, s in enumerate(samples) if s.reached], dtype=int)
     if len(reached):
@@ -376,6 +396,12 @@ def follow_trajectory(robot: Robot, times, world_T_targets, *, constrain_orienta
     for sample in samples:
         if sample.reached:
             sample.violations = violations(robot, limits, sample.joints)
+    if options.collisions is not None:
+        options.ik.budget.check("the collision check")
+        reached_samples = [s for s in samples if s.reached]
+        checked = sample_clearances(robot, options.collisions, np.array([s.joints for s in reached_samples]))
+        for sample, clearance in zip(reached_samples, checked):
+            sample.clearance = clearance
     first = results[0]
     return TrajectoryResult(samples, _summary(robot, samples), first.method, first.structure,
                             all(r.complete for r in results), "assur_group" if assur else "jacobian", task, assur)
@@ -574,7 +600,8 @@ def _labels_of(label_codes, q: np.ndarray) -> dict:
 
 def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[IKResult], held: dict,
             reference: np.ndarray | None, limits: Limits, constrain_orientation: bool,
-            ik_options: IKOptions, tracking: Tracking | None = None) -> list[SampleResult]:
+            ik_options: IKOptions, tracking: Tracking | None = None,
+            collisions: CollisionRequest | None = None) -> list[SampleResult]:
     """Choose one solution per sample (the branch rules of the module docstring).
 
     Each sample after the first takes the solution nearest to the previous sample's joints carried forward
@@ -584,6 +611,7 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
     or a search stops at a residual that leaves the joints off by residual / σmin). A sample whose solution is
     not clearly the continuation (another solution about as near the prediction, or none within a few joint
     steps of it) reports ``branch_changed``, as one whose labels differ from the previous sample's does.
+    ``collisions`` with its filter keeps the path on collision-free solutions (:mod:`._trajectory_collisions`).
     """
     weights = np.where(robot.is_revolute, 1.0, 1.0 / robot.characteristic_length)
     moving = np.ones(robot.dof, dtype=bool)
@@ -629,7 +657,10 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
             samples.append(SampleResult(float(times[k]), "unreachable" if result.complete else "not_found"))
             continue
         matching = _matching(branches, held, ambiguous)
-        pool = matching or list(range(len(joints)))
+        allowed = matching or list(range(len(joints)))
+        collision = collision_free_pool(robot, collisions, joints, allowed)
+        pool = collision.pool
+        forced = previous is not None and forced_by_collision(collision, allowed, to_prediction)
         distances = None
         choice = pool[0]
         if predicted is not None:
@@ -672,17 +703,19 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
             # the held labels chose the jump, which the summary's largest step shows)
             jumped = scale is not None and nearest > max(JUMP_FACTOR * scale, floor)
             left_branch = (jumped and not (held and matching)) or (unsure and not jumped)
+        status = ("branch_unavailable" if held and not matching
+                  else "no_collision_free_solution" if collision.blocked else "ok")
         samples.append(SampleResult(
-            float(times[k]), "ok" if matching or not held else "branch_unavailable", q, branch=branch,
-            branch_changed=previous is not None and (branch != previous_branch or left_branch),
-            singularities=list(result.singularities)))
+            float(times[k]), status, q, branch=branch,
+            branch_changed=previous is not None and (branch != previous_branch or left_branch or forced),
+            singularities=list(result.singularities), collision_forced=forced))
         rates = (None, None)
         if rates_of is not None and choice < len(rates_of[0]):  # a listed solution: rates known (2π-invariant)
             rates = (rates_of[0][choice], rates_of[1][choice])
         elif tracking is not None and tracking.twists is not None and not np.isnan(tracking.twists[k]).all():
             rates = _rates_at(robot, q, tracking.twists[k], None if tracking.accelerations is None or np.isnan(
                 tracking.accelerations[k]).all() else tracking.accelerations[k], tracking.task)
-        if left_branch or jumped:  # a jump is no base for extrapolating the next step
+        if left_branch or jumped or forced:  # a jump is no base for extrapolating the next step
             history = []
         history = [*history[-2:], _Reached(q, float(times[k]), *rates)]
         previous_branch = branch
@@ -905,6 +938,9 @@ def _summary(robot: Robot, samples: list[SampleResult]) -> TrajectorySummary:
     distances = [(s.distance_to_singularity, k) for k, s in enumerate(samples)
                  if s.distance_to_singularity is not None]
     smallest = min(distances) if distances else (None, None)
+    clearances = [(s.clearance.clearance, k) for k, s in enumerate(samples)
+                  if s.clearance is not None and s.clearance.clearance is not None]
+    closest = min(clearances) if clearances else (None, None)
     return TrajectorySummary(
         largest_joint_step=largest,
         largest_joint_step_at=at,
@@ -914,4 +950,8 @@ def _summary(robot: Robot, samples: list[SampleResult]) -> TrajectorySummary:
         singular_samples=[k for k, s in enumerate(samples) if s.singularities],
         branch_changes=[k for k, s in enumerate(samples) if s.branch_changed],
         unreachable_samples=[k for k, s in enumerate(samples) if not s.reached],
+        colliding_samples=[k for k, s in enumerate(samples) if s.clearance is not None and s.clearance.colliding],
+        collision_branch_changes=[k for k, s in enumerate(samples) if s.collision_forced],
+        smallest_clearance=closest[0],
+        smallest_clearance_at=closest[1],
     )

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 from typing import Annotated, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, model_serializer, model_validator
 
 from ...kinematics import RATE_SINGULARITY_TOLERANCE
 from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId,
                      Vector3)
+from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair
 from .ik import Branch, FreeJointChoice, SingularityReport
 from .limits import LimitViolation
 from .poses import PoseTarget
@@ -71,6 +72,11 @@ class TrajectoryRequest(RequestFrames):
     damping: Number | None = Field(
         None, gt=0, description="λ for damped least-squares rates at singular samples; without it their "
                                 "velocities and accelerations are null")
+    collisions: CollisionOptions | None = Field(
+        None, description="check each sample's joints against the arm's link shapes and these obstacles: every "
+                          "sample then carries clearance and collisions; with filter (the default) the trajectory "
+                          "stays on collision-free solutions, and a branch change a collision forces is reported "
+                          "(collision_forced). Only the samples are checked, not the motion between them")
     free_joints: list[FreeJointChoice] | None = Field(
         None, description="arms with more than 6 joints: the n − 6 free joints and where to solve them, as in "
                           "single IK; each sample is answered over them and continues from the previous one, and "
@@ -106,15 +112,29 @@ class RateResidual(ApiModel):
                                                    "without accelerations")
 
 
+#: The fields a trajectory answer has only with a collision check.
+COLLISION_SAMPLE_FIELDS = ("clearance", "collisions", "collision_forced")
+COLLISION_SUMMARY_FIELDS = ("colliding_samples", "collision_branch_changes", "smallest_clearance")
+
+
+def _without_absent(fields: dict, names: tuple[str, ...]) -> dict:
+    """``fields`` without ``names`` when none of them has a value (the request asked for no collision check)."""
+    if all(fields.get(name) is None for name in names):
+        for name in names:
+            fields.pop(name, None)
+    return fields
+
+
 class TrajectorySampleResult(ApiModel):
     """The joint solution at one sample, on the branch being followed."""
 
     time: float = Field(description="the sample's time, seconds")
-    status: Literal["ok", "unreachable", "not_found", "branch_unavailable"] = Field(
+    status: Literal["ok", "unreachable", "not_found", "branch_unavailable", "no_collision_free_solution"] = Field(
         description="unreachable: no solution exists (proved: joints null); not_found: a search that cannot "
                     "promise completeness found none (joints null; the pose may be reachable); "
                     "branch_unavailable: no solution on the requested branch, the sample continues on the nearest "
-                    "one")
+                    "one; no_collision_free_solution (collisions with filter): every solution the branch allows "
+                    "collides, the sample continues on the nearest one and lists its collisions")
     joints: list[float] | None = Field(description="joint values, request's angle unit; null when unreachable")
     velocities: list[float] | None = Field(description="null without a twist, or at a singular sample without "
                                                        "damping")
@@ -137,6 +157,16 @@ class TrajectorySampleResult(ApiModel):
     residual: RateResidual | None = Field(description="how well the rates reproduce the twist and acceleration")
     paper: PaperJoints | None = Field(
         None, description="only for the paper's SCARA: joints, rates and accelerations as the paper states them")
+    clearance: float | None = CLEARANCE_FIELD
+    collisions: list[CollisionPair] | None = COLLISIONS_FIELD
+    collision_forced: bool | None = Field(
+        None, description="with 'collisions': the branch's continuation collides, so (filter) the sample moved to "
+                          "the nearest collision-free solution (branch_changed is then true); absent without")
+
+    @model_serializer(mode="wrap")
+    def _checked_only(self, handler):
+        """The collision fields appear only when the request asked for a collision check."""
+        return _without_absent(handler(self), COLLISION_SAMPLE_FIELDS)
 
 
 class JointStep(ApiModel):
@@ -160,6 +190,14 @@ class SampleViolation(LimitViolation):
     sample: int = Field(description="index of the sample")
 
 
+class ClearanceAt(ApiModel):
+    """How close the trajectory comes to a collision, and where."""
+
+    value: float | None = Field(description="the smallest clearance over the reached samples, length unit "
+                                            "(negative in overlap); null when nothing is checked")
+    sample: int | None = Field(description="index of that sample; null when none")
+
+
 class TrajectorySummary(ApiModel):
     """What a planner checks first: steps, nearness to singularities, limits, branch changes, misses."""
 
@@ -170,6 +208,20 @@ class TrajectorySummary(ApiModel):
     singular_samples: list[int] = Field(description="samples closer to a singularity than the tolerance")
     branch_changes: list[int] = Field(description="samples whose branch_changed is true")
     unreachable_samples: list[int] = Field(description="samples with no solution")
+    colliding_samples: list[int] | None = Field(
+        None, description="with 'collisions': the reached samples whose joints collide (a pair closer than the "
+                          "margin); absent without")
+    collision_branch_changes: list[int] | None = Field(
+        None, description="with 'collisions' (filter): the samples whose branch change a collision forced; absent "
+                          "without")
+    smallest_clearance: ClearanceAt | None = Field(
+        None, description="with 'collisions': the smallest clearance over the reached samples, and where; absent "
+                          "without")
+
+    @model_serializer(mode="wrap")
+    def _checked_only(self, handler):
+        """The collision fields appear only when the request asked for a collision check."""
+        return _without_absent(handler(self), COLLISION_SUMMARY_FIELDS)
 
 
 class TrajectorySolver(ApiModel):

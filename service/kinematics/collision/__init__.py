@@ -16,7 +16,7 @@ from ._distances import (
     separation,
     sphere_sphere,
 )
-from ._clearance import Clearances, CollisionRequest, clearances, frame_index, link_names, model_for
+from ._clearance import Clearances, CollisionRequest, at_collisions, clearances, frame_index, link_names, model_for
 from ._model import CollisionCheck, CollisionModel, ShapePair, collision_model
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere, restated, scaled
 
@@ -33,6 +33,7 @@ __all__ = [
     "Shape",
     "ShapePair",
     "Sphere",
+    "at_collisions",
     "box_box",
     "box_capsule",
     "box_sphere",

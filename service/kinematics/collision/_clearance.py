@@ -8,7 +8,9 @@ a revolute joint moves no link, so an IK solution's clearance is that of every e
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from typing import Iterator
 
 import numpy as np
 
@@ -42,6 +44,18 @@ class CollisionRequest:
         """What the compiled model depends on, as a hashable value (the margin and the filter are not)."""
         return (self.self_collision, tuple(sorted(self.ignore)), tuple(_shape_key(o.name, o.shape)
                                                                         for o in self.obstacles))
+
+
+@contextmanager
+def at_collisions() -> Iterator[None]:
+    """Locate the errors about a collision check at the option that asks for it (``collisions``); those about
+    the robot's own shapes stay at its description."""
+    try:
+        yield
+    except InvalidInputError as error:
+        if error.location[:1] == ("robot",):
+            raise
+        raise error.relocated("collisions") from None
 
 
 def _shape_key(name: str, shape) -> tuple:

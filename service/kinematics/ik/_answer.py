@@ -29,7 +29,7 @@ from .._budget import UNLIMITED, Budget
 from .._errors import InvalidInputError, KinematicsError
 from .._limits import Limits
 from .._robot import Robot
-from ..collision import CollisionRequest, clearances
+from ..collision import CollisionRequest, at_collisions, clearances
 from ._closed_form import cached_plan, solve_closed_form
 from ._coaxial import CoaxialPlan, coaxial_pair
 from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, distinct_rolls, roll_family,
@@ -262,18 +262,6 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
     if (kinds == POSITION).any():
         parts += _positions(robot, matrices, np.flatnonzero(kinds == POSITION), options, timings)
     return _assembled(robot, len(kinds), parts, limits, options, timings)
-
-
-@contextmanager
-def _at_collisions() -> Iterator[None]:
-    """Locate the errors about the collision check at the option that asks for it (``collisions``); those about
-    the robot's own shapes stay at its description."""
-    try:
-        yield
-    except InvalidInputError as error:
-        if error.location[:1] == ("robot",):
-            raise
-        raise error.relocated("collisions") from None
 
 
 @contextmanager
@@ -697,7 +685,7 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
     excluded = None
     if options.collisions is not None:  # a 2π-equivalent moves no link: each distinct solution is checked once
         options.budget.check("the collision check")
-        with _at_collisions():
+        with at_collisions():
             checked = clearances(robot, options.collisions, table.joints)
         table = table.with_clearances(checked.clearance, checked.contacts)
         excluded = checked.colliding if options.collisions.filter else None

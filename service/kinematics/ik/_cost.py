@@ -14,8 +14,8 @@ import numpy as np
 
 from .._limits import Limits
 from .._robot import Robot
-from ..collision import model_for
-from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_collisions, _at_free_joints,
+from ..collision import at_collisions, model_for
+from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_free_joints,
                       direction_free_joints, direction_groups, answered_by_family)
 from ._closed_form import cached_plan, plan_is_kept
 from ._direction import direction_plan, refined_rows, roll_family, roll_rows
@@ -143,7 +143,7 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
     if options.collisions is not None:
         pairs = collision_pair_bound(robot, options.collisions)
         if pairs <= COMPILED_PAIRS:  # few enough to compile (and count exactly) now
-            with _at_collisions():
+            with at_collisions():
                 pairs = len(model_for(robot, options.collisions).pairs)
     return Cost(count, most, numeric_starts, free_values, equivalents, kept, lowered, ranked, rows_per_target,
                 rejected, count * rows_per_target, small, pairs,

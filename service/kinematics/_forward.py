@@ -48,12 +48,16 @@ def link_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
     if robot.chain_transforms is not None:
         return _chain_frames(robot, q)[..., [0, *range(2, robot.dof + 2)], :, :]
     theta, d = _dh_variables(robot, q)
-    prev_T_link = link_transforms(robot.convention, robot.a, robot.alpha, d, theta)
-    frames = np.empty(q.shape[:-1] + (robot.dof + 1, 4, 4))
-    frames[..., 0, :, :] = robot.world_T_base
+    # joints first: each joint's transforms, and each frame, one contiguous block (the products on strided
+    # views cost half as much again; the arithmetic, and so every bit of the result, is the same)
+    per_joint = (-1,) + (1,) * (q.ndim - 1)
+    prev_T_link = link_transforms(robot.convention, robot.a.reshape(per_joint), robot.alpha.reshape(per_joint),
+                                  np.moveaxis(d, -1, 0), np.moveaxis(theta, -1, 0))
+    frames = np.empty((robot.dof + 1,) + q.shape[:-1] + (4, 4))
+    frames[0] = robot.world_T_base
     for i in range(robot.dof):
-        frames[..., i + 1, :, :] = frames[..., i, :, :] @ prev_T_link[..., i, :, :]
-    return frames
+        np.matmul(frames[i], prev_T_link[i], out=frames[i + 1])
+    return np.moveaxis(frames, 0, -3)
 
 
 def _chain_frames(robot: Robot, q: np.ndarray) -> np.ndarray:

@@ -313,3 +313,48 @@ def test_the_ur5_solution_counts_the_page_states(client):
         fits = [sum(abs(v + 2 * k * np.pi) <= 2 * np.pi + 1e-9 for k in range(-2, 3)) for v in branches.ravel()]
         assert len(answer["solutions"]) == int(np.prod(np.reshape(fits, branches.shape), axis=1).sum())
     assert stated == counted
+
+
+# ------------------------------------------------------------------------------ the commands the pages name
+
+#: ``python -m module`` or ``python script.py`` with its flags, in a block or in inline code.
+_COMMAND = re.compile(r"(?:\.venv/bin/)?python3? (?:-m ([\w.]+)|([\w/]+\.py))((?: --?[\w-]+(?: [^\s`|&#-][^\s`|&#]*)?)*)")
+
+
+def _project_commands() -> list[tuple[str, str, list[str]]]:
+    """(page, module or script, flags) of every command that runs this repository's code."""
+    found = []
+    for page in pages():
+        for module, script, flags in _COMMAND.findall(text(page)):
+            if (module or script).split(".")[0].split("/")[0] in ("service", "benchmarks"):
+                found.append((page.name, module or script, re.findall(r"--[\w-]+", flags)))
+    return found
+
+
+def test_the_commands_the_pages_name_exist_with_their_flags():
+    import importlib.util
+
+    commands = _project_commands()
+    assert any(target == "benchmarks.core" for _, target, _ in commands)
+    helps: dict[str, str] = {}
+    for page, target, flags in commands:
+        if target.endswith(".py"):
+            assert (ROOT / target).is_file(), f"{page}: {target} does not exist"
+        else:
+            assert importlib.util.find_spec(target) is not None, f"{page}: no module {target}"
+        if flags:
+            if target not in helps:
+                argv = [sys.executable, target] if target.endswith(".py") else [sys.executable, "-m", target]
+                helps[target] = subprocess.run([*argv, "--help"], cwd=ROOT, capture_output=True, text=True,
+                                               timeout=120, check=True).stdout
+            for flag in flags:
+                assert re.search(re.escape(flag) + r"(?![\w-])", helps[target]), f"{page}: {target} has no {flag}"
+
+
+def test_the_extras_the_pages_install_exist():
+    import tomllib
+
+    extras = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]["optional-dependencies"]
+    named = {name for page in pages() for group in re.findall(r"-e '\.\[([\w,]+)\]'", text(page))
+             for name in group.split(",")}
+    assert named and named <= set(extras), named - set(extras)

@@ -28,7 +28,7 @@ def section(page: Path | str, heading: str) -> str:
     body, in_code = [], False
     for line in text(page).split(f"\n{heading}\n", 1)[1].split("\n"):
         in_code ^= line.startswith("```")
-        if not in_code and re.match(r"#{1,%d} " % level, line):
+        if not in_code and re.match(rf"#{{1,{level}}} ", line):
             break
         body.append(line)
     return "\n".join(body)

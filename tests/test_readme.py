@@ -178,7 +178,7 @@ def _check_claims(answer: dict, claims: str, where: str) -> None:
             [result["status"] for result in answer.get("results", []) if "solutions" in result]
         assert set(statuses) <= {"ok"}, f"{where}: status {statuses}"
     value = r'("[^"]*"|true|false|null|-?\d+(?:\.\d+)?(?![\d.eE])|\[[^\[\]]*\])'
-    for key, shown in re.findall(r'"?(%s)"?:? %s' % ("|".join(CLAIMED_KEYS), value), claims):
+    for key, shown in re.findall(rf'"?({"|".join(CLAIMED_KEYS)})"?:? {value}', claims):
         actual = _first(answer, key)
         assert _same_as_shown(actual, shown), f"{where}: {key} is {actual!r}, the page shows {shown}"
     kept = re.search(r"(\d+) solutions", claims)
@@ -318,7 +318,8 @@ def test_the_ur5_solution_counts_the_page_states(client):
 # ------------------------------------------------------------------------------ the commands the pages name
 
 #: ``python -m module`` or ``python script.py`` with its flags, in a block or in inline code.
-_COMMAND = re.compile(r"(?:\.venv/bin/)?python3? (?:-m ([\w.]+)|([\w/]+\.py))((?: --?[\w-]+(?: [^\s`|&#-][^\s`|&#]*)?)*)")
+_COMMAND = re.compile(r"(?:\.venv/bin/)?python3? (?:-m ([\w.]+)|([\w/]+\.py))"
+                      r"((?: --?[\w-]+(?: [^\s`|&#-][^\s`|&#]*)?)*)")
 
 
 def _project_commands() -> list[tuple[str, str, list[str]]]:

@@ -26,6 +26,7 @@ from service.robots.catalogue import load_catalogue
 from service.config import BUILTIN_ROBOTS_DIR
 from service.kinematics import forward_kinematics
 from service.openapi import SPEC_PATH
+from tests.doc_pages import section
 from tests.live import serve
 
 if importlib.util.find_spec("openapi_python_client") is None:
@@ -310,8 +311,8 @@ def test_a_plain_client_with_the_header_works_with_a_key(sdk, client):
 
 
 def _readme_sdk_section() -> str:
-    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
-    return readme.split("### Python SDK", 1)[1].split("\n### ", 1)[0]
+    """The "Python SDK" section of docs/python-library.md (tests/test_readme.py leaves its script to this file)."""
+    return section("python-library.md", "## Python SDK")
 
 
 def test_the_readme_sdk_script_runs_and_prints_what_the_readme_says(sdk, open_server):

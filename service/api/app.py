@@ -36,7 +36,7 @@ Forward kinematics and **every** inverse-kinematics solution of serial robots, w
 * Standard DH (Spong), modified DH (Craig) and Khalil–Kleinfinger tables are accepted.
 * All angles are radians unless the request says `"angle_unit": "deg"`; lengths are in the robot's length unit.
 * Every error is `application/problem+json` (RFC 9457) with field-level `errors`.
-* Every number in a request must be finite and within ±1e6 (see the README's "Limits of input").
+* Every number in a request must be finite and within ±1e6 (see docs/api-guide.md, "Limits of input").
 * When the service runs with `KIN_API_KEY`, every `/v1` operation needs the `X-API-Key` header.
 * Bounded work: every `POST /v1/...` request has a deadline (`KIN_REQUEST_TIMEOUT_MS`; the header
   `X-Request-Timeout-Ms` may lower it) and stops when its client disconnects. Past the deadline it is answered

@@ -52,7 +52,7 @@ _PLANAR_RR = {"id": "planar_rr", "name": "Two-link planar elbow arm (Spong Examp
                           "limits": {"lower": -170, "upper": 170}, "d": 0},
                          {"name": "theta2", "type": "revolute", "a": 0.5, "alpha": 0, "theta": 0,
                           "limits": {"lower": -150, "upper": 150}, "d": 0}]}
-#: The paper's spiral on the Assur SCARA (textbook §4.4), at t = 0 and 1 s (README, "Trajectories").
+#: The paper's spiral on the Assur SCARA (textbook §4.4), at t = 0 and 1 s (docs/trajectories.md).
 _SPIRAL = [{"time": 0.0, "pose": {"position": [100, -20, 50]},
             "twist": {"linear": [31.415927, 0, 10]}, "acceleration": {"linear": [0, 49.348022, 0]}},
            {"time": 1.0, "pose": {"position": [120, 0, 60]},

@@ -4,8 +4,8 @@ Geometry is checked against forward kinematics computed here: in the top view a 
 are world (x, −y) times one scale shared by every panel, so the base-to-tool vector of each panel must be
 the FK tool position (minus the base) times that scale.
 
-``python -m tests.api.test_render`` rewrites the README's pictures (docs/puma560_ik_solutions.svg and
-docs/puma560_over_table.svg).
+``python -m tests.api.test_render`` rewrites the pictures of the README and docs/api-guide.md
+(docs/puma560_over_table.svg and docs/puma560_ik_solutions.svg).
 """
 
 from __future__ import annotations
@@ -20,11 +20,12 @@ import pytest
 
 from service.kinematics import forward_kinematics
 from tests.conftest import assert_problem, catalogue_robot
+from tests.doc_pages import README, pages, text
 
 SVG = "{http://www.w3.org/2000/svg}"
 ROOT = Path(__file__).resolve().parent.parent.parent
 README_PICTURE = ROOT / "docs" / "puma560_ik_solutions.svg"
-#: The README's picture: every IK solution of a PUMA 560 target, nearest to the configuration it came from.
+#: docs/api-guide.md's picture: every IK solution of a PUMA 560 target, nearest to the configuration it came from.
 README_Q_DEG = [20.0, 60.0, -60.0, 10.0, 35.0, -15.0]
 UR5_Q = [0.1, -1.2, 1.0, 0.3, 1.5, 0.2]
 
@@ -192,8 +193,8 @@ def test_the_readme_pictures_are_what_the_service_draws(client, name):
     committed, drawn = _numbers_and_text(path.read_text(encoding="utf-8")), _numbers_and_text(draw(client))
     assert committed[1] == drawn[1], f"docs/{name} is stale: python -m tests.api.test_render"
     np.testing.assert_allclose(committed[0], drawn[0], atol=0.02)
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    assert f"](docs/{name})" in readme
+    shown_by = [page for page in pages() if f"]({'docs/' if page == README else ''}{name})" in text(page)]
+    assert shown_by, f"neither the README nor a docs/ page shows docs/{name}"
 
 
 if __name__ == "__main__":

@@ -7,7 +7,6 @@ import json
 import os
 import signal
 import socket
-import subprocess
 import sys
 import threading
 import time
@@ -16,7 +15,7 @@ from pathlib import Path
 import httpx
 import pytest
 
-from tests.live import ROOT, free_port
+from tests.live import LiveServer
 
 pytestmark = pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs /proc")
 
@@ -38,48 +37,16 @@ def peak_rss_mb(pid: int) -> float:
     raise RuntimeError("no VmHWM")
 
 
-class Server:
-    """``python -m service`` with its stdout (the JSON log) in a file."""
-
-    def __init__(self, tmp_path: Path, **settings: str) -> None:
-        self.port = free_port()
-        self.url = f"http://127.0.0.1:{self.port}"
-        self.log = tmp_path / f"server-{self.port}.log"
-        env = {**os.environ, "HOST": "127.0.0.1", "PORT": str(self.port), "KIN_LOG_LEVEL": "info", **settings}
-        env.pop("PROMETHEUS_MULTIPROC_DIR", None)
-        self._out = self.log.open("wb")
-        self.process = subprocess.Popen([sys.executable, "-m", "service"], cwd=ROOT, env=env, stdout=self._out,
-                                        stderr=subprocess.STDOUT)
-        deadline = time.monotonic() + 60
-        while True:
-            try:
-                if httpx.get(f"{self.url}/readyz", timeout=2).status_code == 200:
-                    break
-            except httpx.HTTPError:
-                pass
-            if self.process.poll() is not None or time.monotonic() > deadline:
-                self.stop()  # never leave a server behind: with several workers it outlives the test run
-                raise RuntimeError(f"the service did not start: {self.log.read_text()}")
-            time.sleep(0.2)
-
-    def stop(self) -> int:
-        if self.process.poll() is None:
-            self.process.send_signal(signal.SIGTERM)
-            try:
-                self.process.wait(timeout=30)
-            except subprocess.TimeoutExpired:
-                self.process.kill()
-                self.process.wait()
-        self._out.close()
-        return self.process.returncode
-
-    def lines(self) -> list[str]:
-        return [line for line in self.log.read_text().splitlines() if line.strip()]
+def info_server(tmp_path: Path, **settings: str) -> LiveServer:
+    """A live server logging at info into a new file of ``tmp_path`` (these tests read its access and uvicorn
+    lines)."""
+    log = tmp_path / f"server-{len(list(tmp_path.glob('server-*.log')))}.log"
+    return LiveServer(log, log_level="info", **settings)
 
 
 @pytest.fixture
 def server(tmp_path):
-    started = Server(tmp_path, KIN_MAX_TURNS_PER_JOINT="1000000", KIN_HEADER_TIMEOUT_S="1",
+    started = info_server(tmp_path, KIN_MAX_TURNS_PER_JOINT="1000000", KIN_HEADER_TIMEOUT_S="1",
                      KIN_REQUEST_TIMEOUT_MS="4000")
     yield started
     started.stop()
@@ -163,7 +130,7 @@ def test_slow_clients_are_cut_off_and_logged_and_every_log_line_is_json(server):
 
 
 def test_sigterm_during_a_request_finishes_or_refuses_it_cleanly(tmp_path):
-    server = Server(tmp_path, KIN_REQUEST_TIMEOUT_MS="3000", KIN_MAX_IK_TIME_MS="600000")
+    server = info_server(tmp_path, KIN_REQUEST_TIMEOUT_MS="3000", KIN_MAX_IK_TIME_MS="600000")
     answer: dict = {}
 
     def slow_request() -> None:
@@ -192,7 +159,7 @@ def test_a_saturated_server_stays_ready_sheds_each_request_past_the_limit_and_is
     200 (in_flight 1) and a new request gets a 503 problem with Retry-After; once SIGTERM arrives, the readiness
     probe never answers 200 again (refused: uvicorn closes its listening socket; or 503), while the slow request
     still ends cleanly."""
-    server = Server(tmp_path, KIN_MAX_IN_FLIGHT="1", KIN_REQUEST_TIMEOUT_MS="3000", KIN_MAX_IK_TIME_MS="600000")
+    server = info_server(tmp_path, KIN_MAX_IN_FLIGHT="1", KIN_REQUEST_TIMEOUT_MS="3000", KIN_MAX_IK_TIME_MS="600000")
     answer: dict = {}
 
     def slow_request() -> None:
@@ -235,7 +202,7 @@ def test_a_saturated_server_stays_ready_sheds_each_request_past_the_limit_and_is
 def test_a_connection_over_the_cap_gets_a_problem_and_is_logged(tmp_path):
     """KIN_MAX_CONNECTIONS = 3: with three connections open, a fourth is answered 503 application/problem+json
     with Retry-After and closed (uvicorn's own limit answered text/plain); once one closes, requests pass again."""
-    server = Server(tmp_path, KIN_MAX_CONNECTIONS="3", KIN_HEADER_TIMEOUT_S="30")
+    server = info_server(tmp_path, KIN_MAX_CONNECTIONS="3", KIN_HEADER_TIMEOUT_S="30")
     held = [socket.create_connection(("127.0.0.1", server.port)) for _ in range(3)]
     try:
         time.sleep(0.3)  # the server has taken all three
@@ -262,7 +229,7 @@ def test_with_two_workers_a_new_connection_during_shutdown_is_refused_at_once(tm
     arrived): uvicorn's parent kept the shared listening socket open until every worker had finished, so the
     kernel accepted new connections that no one served (they hung for the whole graceful shutdown, then were
     reset). Now the parent closes it at once: a new connection is refused or answered, never left hanging."""
-    server = Server(tmp_path, KIN_WORKERS="2", KIN_BODY_TIMEOUT_S="8", KIN_REQUEST_TIMEOUT_MS="4000")
+    server = info_server(tmp_path, KIN_WORKERS="2", KIN_BODY_TIMEOUT_S="8", KIN_REQUEST_TIMEOUT_MS="4000")
     held = socket.create_connection(("127.0.0.1", server.port))
     try:
         held.sendall(b"POST /v1/robots/ur5/fk HTTP/1.1\r\nHost: x\r\nContent-Type: application/json\r\n"

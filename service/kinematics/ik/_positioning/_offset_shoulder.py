@@ -12,8 +12,14 @@ from ..._tolerances import GEOMETRY_TOLERANCE
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
-from ..subproblems import prismatic_to_distance, prismatic_to_plane, subproblem_1, subproblem_2_chain, subproblem_3, \
-    subproblem_4
+from ..subproblems import (
+    prismatic_to_distance,
+    prismatic_to_plane,
+    subproblem_1,
+    subproblem_2_chain,
+    subproblem_3,
+    subproblem_4,
+)
 from ._base import Needs, Positioner, PositionerResult, _common_normal_feet, _flag_rows, _slot_grid, _unit, side_codes
 
 

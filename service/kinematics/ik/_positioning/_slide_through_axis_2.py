@@ -66,7 +66,7 @@ class SlideThroughAxis2:
         """The shoulder and its slide together (see the class for the frame and the equations): the joints
         (i, j, k) of ``geometry`` about ``centre`` (3,), the shoulder's axes' crossing.
 
-        ``targets`` (N, 3) in the world frame. The slide's displacement from the crossing, ``t u`` with
+        ``targets`` (N, 3) in the world self. The slide's displacement from the crossing, ``t u`` with
         ``u = R(k2, q2) v``, is ``B n1 + a n2``: ``B`` follows from the target's height along axis 1 (first
         order in t), ``a`` only through ``a² = ‖y‖² − h² − B²`` (the fold where the two shoulder solutions
         ±a meet). Then ``q2 = atan2(a, B) − ψ0`` with ``t = +‖(B, a)‖``, or ``q2 + π`` with ``−t``, and q1
@@ -78,19 +78,18 @@ class SlideThroughAxis2:
         is on axis 2 and joint 2 is free (reference value or 0).
         """
         g, (i, j, k) = geometry, joints
-        frame = self
         k1, n_targets = g.direction(i), len(targets)
         y = targets - centre  # (N, 3)
         height = y @ k1
         radius = np.linalg.norm(y - height[:, None] * k1, axis=-1)  # from axis 1
-        h = frame.height
-        along = (height - h * frame.cos_alpha) / frame.sin_alpha  # B (N,)
+        h = self.height
+        along = (height - h * self.cos_alpha) / self.sin_alpha  # B (N,)
         # a² = ‖y‖² − h² − B² = radius² − (h sin α − B cos α)²: a difference only where ±a meet
-        inner = np.abs(h * frame.sin_alpha - along * frame.cos_alpha)
+        inner = np.abs(h * self.sin_alpha - along * self.cos_alpha)
         across_squared = (radius - inner) * (radius + inner)  # (N,)
         # the target's coordinates carry rounding relative to their size and the arm's
         rounding = ROUNDING_TOLERANCE * (g.length_scale + np.linalg.norm(targets, axis=-1))
-        band_along = rounding / frame.sin_alpha
+        band_along = rounding / self.sin_alpha
         band_squared = 2 * rounding * (radius + inner + band_along)
         met = across_squared <= band_squared  # the two shoulder solutions ±a meet: a = 0 represents them
         free = met & (np.abs(along) <= band_along)  # the point on axis 2: joint 2 does not move it
@@ -102,9 +101,9 @@ class SlideThroughAxis2:
         free |= at_centre
         across = np.where(met, 0.0, np.sqrt(np.maximum(across_squared, 0.0)))
         first_sign = np.ones(n_targets)
-        free_angle = frame.psi0 + (0.0 if reference is None else reference[j])
+        free_angle = self.psi0 + (0.0 if reference is None else reference[j])
         if reference is not None:
-            t_ref = reference[k] - frame.foot
+            t_ref = reference[k] - self.foot
             along_ref, across_ref = t_ref * np.cos(free_angle), t_ref * np.sin(free_angle)
             along = np.where(np.abs(along - along_ref) <= band_along, along_ref, along)
             in_band = np.abs(across_ref * across_ref - across_squared) <= band_squared
@@ -115,8 +114,8 @@ class SlideThroughAxis2:
         t = along[:, None] * np.cos(psi) + across_pair * np.sin(psi)  # the displacement along u(ψ)
         psi = np.stack([psi, psi + np.pi], axis=-1)  # (N, 2 shoulder, 2 slide signs)
         t = np.stack([t, -t], axis=-1)
-        turned = h * g.direction(j) + t[..., None] * (np.cos(psi)[..., None] * frame.n1
-                                                      + np.sin(psi)[..., None] * frame.n2)
+        turned = h * g.direction(j) + t[..., None] * (np.cos(psi)[..., None] * self.n1
+                                                      + np.sin(psi)[..., None] * self.n2)
         first = subproblem_1(k1, turned, y[:, None, None, :], free_below=rounding[:, None, None])
         q1 = first.theta[..., 0]
         free_first = first.degenerate | at_centre[:, None, None]  # the target on axis 1 (a polar arm without offset)
@@ -125,7 +124,7 @@ class SlideThroughAxis2:
             q1 = np.where(free_first | (np.abs(wrap_angle(q1 - reference[i])) <= band_first), reference[i], q1)
         else:
             q1 = np.where(free_first, 0.0, q1)
-        joints = np.stack([q1, wrap_angle(psi - frame.psi0), frame.foot + t], axis=-1)
+        joints = np.stack([q1, wrap_angle(psi - self.psi0), self.foot + t], axis=-1)
         # exact to the arm's size (subproblem 1 measures against the point's own, tiny near the centre)
         miss = np.linalg.norm(rotate_about(k1, q1, turned) - y[:, None, None, :], axis=-1)
         valid = miss <= GEOMETRY_TOLERANCE * g.length_scale

@@ -9,13 +9,13 @@ from ..budget import budget_of
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, kept_inline_robot
 from ..ik_encoding import ik_columns, ik_objects
 from ..ik_requests import AskedIK, answered, ik_request_in_core
+from ..pictures import IK_PICTURE_RESPONSE, ik_answer_svg, svg_response, wants_svg
 from ..problems import problem_responses
 from ..responses import FastJSONResponse
 from ..routing import FastJSONRoute, computed, small_first
 from ..schemas.ik import (IKBatchArraysResponse, IKBatchRequest, IKBatchResponse, IKInlineRequest, IKRequest,
                           IKResponse)
 from ..schemas.render import RenderView
-from .render import IK_PICTURE_RESPONSE, ik_picture, wants_svg
 
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["inverse kinematics"])
 RENDER_QUERY = Query(None, description="answer with an SVG picture of every distinct solution (those that differ "
@@ -64,8 +64,8 @@ def _single_response(request: Request, asked: AskedIK, body: IKRequest, render: 
                         budget_of(request))[0]
     if not picture:
         return FastJSONResponse(answer)  # built to IKResponse field by field (a test validates it), as it stands
-    return ik_picture(ref.robot, ref.id, answer, body.angle_unit, render or "iso", body.reference is not None,
-                      asked.options.collisions)
+    return svg_response(ik_answer_svg(ref.robot, ref.id, answer, body.angle_unit, render or "iso",
+                                      body.reference is not None, asked.options.collisions))
 
 
 @router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch",

@@ -1,131 +1,28 @@
-"""Pictures: the arm at joint vectors, and every IK solution of a target, as SVG small multiples."""
+"""Pictures: the arm at joint vectors as SVG small multiples (the work is in :mod:`service.api.pictures`)."""
 
 from __future__ import annotations
 
-from xml.sax.saxutils import escape
-
-import numpy as np
 from fastapi import APIRouter, Depends, Request
 from fastapi.responses import Response
 
-from ...drawing import arm_poses, render_svg
-from ...kinematics import InvalidInputError, Robot
-from ...kinematics.ik import wrap_revolute
-from ...kinematics.collision import CollisionRequest
-from ..boundary import collisions_to_core, joints_to_core, located, _unit_scale
-from ..budget import check_picture_cost
-from ..deps import RobotRef, catalogue_robot, inline_robot, with_request_frames
+from ..deps import RobotRef, catalogue_robot, inline_robot
+from ..pictures import SVG_RESPONSE, render_request_svg, svg_response
 from ..problems import problem_responses
 from ..routing import FastJSONRoute
 from ..schemas.render import RenderInlineRequest, RenderRequest
 
 router = APIRouter(prefix="/v1", route_class=FastJSONRoute, tags=["pictures"])
 
-SVG_MEDIA_TYPE = "image/svg+xml"
-#: The 200 answer of the picture operations (and the SVG alternative of the IK operations) in the spec.
-SVG_RESPONSE = {"description": "An SVG picture: one panel per configuration, captioned with its labels and "
-                               "its limit status (class `configuration` on each panel's group); with "
-                               "`collisions`, the obstacles and link shapes too (class `solid`), colliding ones "
-                               "and their panels with class `colliding`",
-                "content": {SVG_MEDIA_TYPE: {"schema": {"type": "string"}}}}
-#: The SVG alternative of the IK operations' 200 answer.
-IK_PICTURE_RESPONSE = {"description": "Every solution (JSON), or with `render` or `Accept: image/svg+xml`, a "
-                                      "picture of every distinct solution (with `collisions`, the obstacles and "
-                                      "link shapes too, colliding ones red)",
-                       "content": {SVG_MEDIA_TYPE: {"schema": {"type": "string"}}}}
-
-
-def svg_response(text: str) -> Response:
-    return Response(text, media_type=SVG_MEDIA_TYPE)
-
-
-def wants_svg(request: Request) -> bool:
-    """Whether the client asked for the picture: ``Accept: image/svg+xml`` before any JSON type."""
-    accept = request.headers.get("accept", "")
-    return SVG_MEDIA_TYPE in accept and "json" not in accept.split(SVG_MEDIA_TYPE, 1)[0]
-
-
-def _render(ref: RobotRef, body: RenderRequest) -> Response:
-    ref = with_request_frames(ref, body)
-    robot = ref.robot
-    with located("body", "joints"):
-        q = joints_to_core(robot, body.joints, body.angle_unit, batch=True)
-    if body.captions is not None and len(body.captions) != len(body.joints):
-        raise InvalidInputError(f"expected {len(body.joints)} captions, one per joint vector, got "
-                                f"{len(body.captions)}", location=("body", "captions"))
-    captions = None if body.captions is None else [caption.split("\n") for caption in body.captions]
-    collisions = collisions_to_core(robot, body.collisions, body.angle_unit)
-    if collisions is not None:
-        check_picture_cost(len(q), robot, len(collisions.obstacles))
-    with located("body", "collisions"):
-        poses = arm_poses(robot, q, captions, collisions=collisions)
-    return svg_response(render_svg(poses, view=body.view, columns=body.columns, panel=body.panel_size,
-                                   title=body.title or ""))
-
 
 @router.post("/robots/{robot_id}/render", operation_id="render", response_class=Response,
              responses={200: SVG_RESPONSE, **problem_responses(404, 413, 422)})
 def render(body: RenderRequest, ref: RobotRef = Depends(catalogue_robot)) -> Response:
     """An SVG of the arm in each configuration, side by side: links, joint axes, base and tool frames."""
-    return _render(ref, body)
+    return svg_response(render_request_svg(ref, body))
 
 
 @router.post("/render", operation_id="render_inline", response_class=Response,
              responses={200: SVG_RESPONSE, **problem_responses(413, 422)})
 def render_inline(request: Request, body: RenderInlineRequest) -> Response:
     """An SVG of a robot described in the request body, in each configuration."""
-    return _render(inline_robot(request, body.robot), body)
-
-
-def ik_picture(robot: Robot, robot_id: str, answer: dict, unit: str, view: str, reference_given: bool,
-               collisions: CollisionRequest | None = None) -> Response:
-    """Every distinct arm configuration of an IK answer (``solutions`` then ``rejected``) as one picture.
-
-    Solutions that differ only by whole turns of revolute joints put the arm in the same place: they share
-    one panel, whose caption says how many of the answer's solutions it stands for. With ``collisions`` (the
-    request's, in core terms), each panel draws the obstacles and link shapes, marked by the answer's own
-    ``collisions`` of that solution.
-    """
-    scale = _unit_scale(robot, unit)
-    groups: dict[tuple, dict] = {}
-    for kind in ("solutions", "rejected"):
-        for solution in answer[kind]:
-            q = np.asarray(solution["joints"], dtype=float) * scale
-            wrapped = wrap_revolute(robot, q)
-            key = (kind, tuple(np.round(wrapped, 6).tolist()), tuple(sorted(solution["branch"].items())))
-            group = groups.setdefault(key, {"q": q, "solution": solution, "count": 0, "kind": kind})
-            group["count"] += 1
-    captions, rows = [], []
-    for number, group in enumerate(groups.values(), start=1):
-        labels = " · ".join(f"{name} {value}" for name, value in group["solution"]["branch"].items())
-        nearest = number == 1 and reference_given and group["kind"] == "solutions"
-        lines = [f"#{number}" + (" (nearest the reference)" if nearest else "")]
-        if labels:
-            lines.append(labels)
-        if group["count"] > 1:
-            lines.append(f"{group['count']} solutions (whole turns of the joints)")
-        captions.append(lines)
-        rows.append(group["q"])
-    title = f"{robot_id}: {answer['status']}, {len(answer['solutions'])} solutions"
-    if answer["rejected"] and collisions is None:
-        title += f", {len(answer['rejected'])} outside the limits"
-    elif answer["rejected"]:
-        outside = sum(bool(s["violations"]) for s in answer["rejected"])
-        colliding = sum(bool(s["collisions"]) for s in answer["rejected"])
-        title += f", {len(answer['rejected'])} rejected ({outside} outside the limits, {colliding} colliding)"
-    if not rows:
-        return svg_response(_empty_svg(title))
-    violated = [[v["joint"] for v in group["solution"]["violations"]] for group in groups.values()]
-    if collisions is not None:
-        check_picture_cost(len(rows), robot, len(collisions.obstacles))
-    checked = None if collisions is None else [
-        (group["solution"]["clearance"], [(c["a"], c["b"], c["distance"]) for c in group["solution"]["collisions"]])
-        for group in groups.values()]
-    poses = arm_poses(robot, np.array(rows), captions, violated=violated, collisions=collisions, checked=checked)
-    return svg_response(render_svg(poses, view=view, title=title))
-
-
-def _empty_svg(title: str) -> str:
-    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="480" height="40" viewBox="0 0 480 40" '
-            f'font-family="DejaVu Sans, Arial, sans-serif" font-size="14"><text x="8" y="24">{escape(title)}'
-            f"</text></svg>\n")
+    return svg_response(render_request_svg(inline_robot(request, body.robot), body))

@@ -69,7 +69,7 @@ Modules
 -------
 * ``_records``: the solution records and the constants that merge two roots into one.
 * ``_vectors``: input checks, axis frames (bounded caches) and the small vector algebra.
-* ``_roots``: the harmonic equation and the trigonometric quartic.
+* ``_roots``: the harmonic equation, the quadratic and the trigonometric quartic.
 * ``_paden_kahan``: subproblems 1-4 and the planar two-link elbow.
 * ``_sp5``, ``_sp6``: IK-Geo subproblems 5 and 6.
 * ``_prismatic``: the slide to a distance or a plane, and subproblem 5 with a slide.
@@ -92,6 +92,7 @@ from ._records import (
     DisplacementSolutions,
     TurnSlideSolutions,
 )
+from ._roots import quadratic_roots
 from ._sp5 import subproblem_5
 from ._sp6 import subproblem_6
 
@@ -104,6 +105,7 @@ __all__ = [
     "planar_two_link_elbow",
     "prismatic_to_distance",
     "prismatic_to_plane",
+    "quadratic_roots",
     "subproblem_1",
     "subproblem_2",
     "subproblem_2_chain",

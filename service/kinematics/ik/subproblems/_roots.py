@@ -2,6 +2,8 @@
 
 * The harmonic equation ``a cos(theta) + b sin(theta) = c`` (:func:`_harmonic`): subproblems 3 and 4, the
   two-link elbow, the degenerate rows of the quartic and of subproblem 6, and the turn-slide split.
+* The quadratic ``A t² + B t + C = 0`` with a rounding band for its double root (:func:`quadratic_roots`): the
+  cylindrical positioners' slides.
 * The trigonometric quartic ``alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t = 0``
   (:func:`_trig_quartic_roots`, :func:`_vanishes`): subproblems 5 and 6 and the turn-slide subproblem 5, through
   the companion matrix of a quartic in ``exp(i t)``.
@@ -13,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._rotations import wrap_angle
-from ..._tolerances import GEOMETRY_TOLERANCE
+from ..._tolerances import GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
 from ._records import _MERGE_COS_GAP, AngleSolutions
 from ._vectors import _hypot, _pair
 
@@ -56,6 +58,38 @@ def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> Ang
         degenerate=np.array(degenerate),
         merged=np.asarray(merged),
     )
+
+
+def quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale: float
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Real roots of ``A t² + B t + C = 0`` per row, B and C (N,), A (N,) or a number: (N, 2) roots, their
+    validity (N, 2), and merged flags (N,) where the two are one (the midpoint, in the first slot).
+
+    A row with ``|A| <= 1e-12`` is linear: one root. ``scale`` is the length the coefficients are built from
+    (t is a length): it floors the discriminant's rounding band, within which the roots are one.
+    """
+    A = np.broadcast_to(np.asarray(A, dtype=float), B.shape)
+    roots = np.full(B.shape + (2,), np.nan)
+    valid = np.zeros(B.shape + (2,), dtype=bool)
+    merged = np.zeros(B.shape, dtype=bool)
+    linear = np.abs(A) <= 1e-12
+    with np.errstate(divide="ignore", invalid="ignore"):
+        roots[linear, 0] = -C[linear] / B[linear]
+        valid[linear, 0] = np.abs(B[linear]) > 1e-12
+        quad = ~linear
+        discriminant = B[quad] ** 2 - 4 * A[quad] * C[quad]
+        # the discriminant's rounding: a double root only within it. (SINGULARITY_TOLERANCE here merged roots
+        # ±1e-10 of the scale apart and kept the + one: the cylindrical arm's radial slide at −1e-10 came back
+        # at +1e-10 with joint 1 turned by π.)
+        tolerance = ROUNDING_TOLERANCE * (B[quad] ** 2 + np.abs(4 * A[quad] * C[quad]) + scale ** 2 * 1e-12)
+        touching = np.abs(discriminant) <= tolerance
+        root = np.sqrt(np.maximum(discriminant, 0.0)) * ~touching  # a double root: the midpoint
+        roots[quad, 0] = (-B[quad] + root) / (2 * A[quad])
+        roots[quad, 1] = (-B[quad] - root) / (2 * A[quad])
+        valid[quad, 0] = discriminant >= -tolerance
+        valid[quad, 1] = (discriminant >= -tolerance) & ~touching
+        merged[quad] = touching
+    return roots, valid, merged
 
 
 # A root z of a trigonometric quartic (:func:`_trig_quartic_roots`) counts as a real angle when | |z| - 1 | is at

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .collision import CollisionRequest, clearances
+from ..collision import CollisionRequest, clearances
 
 
 @dataclass(frozen=True)

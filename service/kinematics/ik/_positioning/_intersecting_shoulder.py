@@ -1,0 +1,207 @@
+"""The intersecting shoulder: revolute joints 1 and 2 whose axes meet, then a revolute or prismatic joint 3
+(the elbow arms, the PUMA, the Stanford and polar arms), with its left/right and up/down labels."""
+
+from __future__ import annotations
+
+from functools import cached_property
+
+import numpy as np
+
+from ..._tolerances import GEOMETRY_TOLERANCE
+from .._screws import chain_rotation, rotate_about
+from .._structure import Geometry
+from .._types import LabelCodes, SingularFlags, Singularity
+from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3
+from ._base import Needs, Positioner, PositionerResult, _flag_rows, _unit, side_codes
+from ._slide_through_axis_2 import SlideThroughAxis2
+
+
+class IntersectingShoulder(Positioner):
+    """Revolute joints 1 and 2 with intersecting axes, then a revolute or prismatic joint 3.
+
+    The elbow arm (with or without shoulder offset), the Stanford and polar
+    arms, and the PUMA's first three joints. With c the intersection point,
+    joint 2 turns about an axis through c, so ``‖x − c‖ = ‖exp([S_3] q_3) w − c‖``
+    depends on q_3 alone: subproblem 3 (revolute) or a quadratic (prismatic),
+    up to 2 roots. Then ``R(ω1, q1) R(ω2, q2) (w_3 − c) = x − c`` is
+    subproblem 2, up to 2 roots: 4 in all.
+
+    When joint 3 turns about an axis through the point or through c (the
+    spherical wrist placing its tool point), subproblem 3 is degenerate for
+    every target: q_3 does not change ‖w_3 − c‖, the target does not determine
+    it, and it is a free joint (reference value or 0); 2 solutions remain.
+
+    A slide normal to axis 2 whose line crosses it (the Stanford and polar arms) is solved together with
+    the shoulder instead (:meth:`SlideThroughAxis2.solve`): from the reach alone its value near the
+    crossing is known only to the square root of the target's rounding, and without its sign.
+
+    Labels: ``shoulder`` left/right is the sign of the arm's reach along the
+    forward direction of link 1 (the textbook's left/right arm; "front" is left);
+    ``elbow`` up/down (revolute joint 3) is the side of the shoulder–point line
+    the elbow lies on, seen along the up-pointing axis 1. See :meth:`labels`.
+    """
+
+    name = "intersecting_shoulder"
+    generic_count = 4
+    needs = Needs(kinds=("RR?",), meeting=(0, 1))
+    #: the frame of a slide normal to axis 2 through it (the Stanford and polar arms), else None
+    slide_through_axis_2: SlideThroughAxis2 | None = None
+
+    @classmethod
+    def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
+             ) -> "IntersectingShoulder":
+        solver = cls(geometry, joints, point, centre)
+        k = joints[2]
+        if geometry.model.is_revolute[k] and (geometry.on_axis(k, solver.point) or geometry.on_axis(k, centre)):
+            solver.free_joints = (k,)  # subproblem 3 is degenerate for every target
+            solver.generic_count = 2
+        solver.slide_through_axis_2 = SlideThroughAxis2.of(geometry, joints, solver.point, centre)
+        return solver
+
+    def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
+        g, (i, j, k) = self.geometry, self.joints
+        if self.slide_through_axis_2 is not None:
+            return self.slide_through_axis_2.solve(g, self.joints, self.centre, targets, reference)
+        c, w = self.centre, self.point
+        n_targets = len(targets)
+        reach = np.linalg.norm(targets - c, axis=-1)
+        if g.model.is_revolute[k]:
+            third = subproblem_3(g.direction(k), w - g.point(k), c - g.point(k), reach)
+            q3 = third.theta
+            if self.free_joints:  # degenerate: the representative is the reference value (or 0), not SP3's 0
+                q3 = np.where(third.valid, 0.0 if reference is None else reference[k], q3)
+            w3 = g.point(k) + rotate_about(g.direction(k), q3, w - g.point(k))
+        else:
+            third = prismatic_to_distance(w, g.direction(k), c, reach)
+            q3 = third.s
+            w3 = w + g.direction(k) * q3[..., None]
+        pair = subproblem_2_chain(g.direction(i), g.direction(j), w3 - c, (targets - c)[:, None, :])
+        q1, q2 = pair.theta1, pair.theta2  # (N, 2 third roots, 2 pair roots)
+        singular = SingularFlags(n_targets)
+        free_shoulder = pair.degenerate  # (N, 2): target on axis 1
+        free_both = np.zeros_like(free_shoulder)
+        if free_shoulder.any():
+            start = 0.0 if reference is None else reference[i]
+            back = rotate_about(g.direction(i), -start, (targets - c)[:, None, :])
+            second = subproblem_1(g.direction(j), w3 - c, back)
+            # the point at the shoulder centre itself (zero-length links): joint 2 is free as well
+            free_both = free_shoulder & second.degenerate
+            q2_free = np.where(free_both, 0.0 if reference is None else reference[j], second.theta[..., 0])
+            _flag_rows(free_both.any(axis=1), Singularity(
+                "shoulder", (i, j), "free", "the point is at the shoulder's centre; joints 1 and 2 are set to the "
+                                            "reference values (or 0)"), singular)
+            q1 = np.where(free_shoulder[..., None], start, q1)
+            q2 = np.where(free_shoulder[..., None], q2_free[..., None], q2)
+        joints = np.zeros((n_targets, 2, 2, 3))
+        joints[..., 0], joints[..., 1] = q1, q2
+        joints[..., 2] = q3[:, :, None]
+        valid = third.valid[:, :, None] & pair.valid & third.exact[:, :, None] & pair.exact
+        valid[:, :, 1] &= ~free_shoulder  # one representative when the shoulder is free
+        _flag_rows(free_shoulder.any(axis=1) & ~free_both.any(axis=1),
+                   Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "
+                               "joint 1 is set to the reference value (or 0)"), singular)
+        _flag_rows((pair.merged & ~free_shoulder & third.valid & third.exact).any(axis=1),
+                   Singularity("shoulder", (i, j), "boundary", "the two shoulder solutions meet: the point is as "
+                               "near axis 1 as the shoulder allows"), singular)
+        if g.model.is_revolute[k] and third.merged.any():  # (no elbow flag to set otherwise)
+            stretched = self._stretched(q3[:, 0], w, c)
+            _flag_rows(third.merged & stretched, Singularity("elbow", (k,), "stretched",
+                                                             "the arm is fully stretched"), singular)
+            _flag_rows(third.merged & ~stretched, Singularity("elbow", (k,), "folded",
+                                                              "the arm is fully folded"), singular)
+        elif not g.model.is_revolute[k]:
+            _flag_rows(third.merged, Singularity("reach", (k,), "boundary",
+                                                 "the point is at the nearest reach of the prismatic joint"), singular)
+        return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
+
+    def _stretched(self, q3: np.ndarray, w: np.ndarray, c: np.ndarray) -> np.ndarray:
+        g, k = self.geometry, self.joints[2]
+        at = g.point(k) + rotate_about(g.direction(k), q3, w - g.point(k))
+        opposite = g.point(k) + rotate_about(g.direction(k), q3 + np.pi, w - g.point(k))
+        return np.linalg.norm(at - c, axis=-1) >= np.linalg.norm(opposite - c, axis=-1)
+
+    def _offset(self) -> np.ndarray | None:
+        """The shoulder offset at q = 0, shape (3,): the point's displacement from the centre along axis 2.
+
+        Joint 2 keeps that component, and so does joint 3 when it turns about an
+        axis parallel to axis 2 or slides perpendicular to it (the elbow, PUMA,
+        Stanford and polar arms). None when it is zero or not constant.
+        """
+        g, (_, j, k) = self.geometry, self.joints
+        axis = g.direction(j)
+        constant = g.parallel(j, k) if g.model.is_revolute[k] \
+            else abs(float(g.direction(k) @ axis)) <= GEOMETRY_TOLERANCE
+        along = float((self.point - self.centre) @ axis)
+        if not constant or abs(along) <= GEOMETRY_TOLERANCE * g.length_scale:
+            return None
+        return along * axis
+
+    def _forward_direction(self) -> np.ndarray:
+        """Link 1's forward direction at q = 0, perpendicular to axis 1: it decides left (front) from right (back).
+
+        * With a shoulder offset (the PUMA, the Stanford arm, textbook §3.3),
+          forward is ``offset × up``: the left arm is the one whose offset lies to
+          the left of its reach, seen from above. This is a property of the
+          arm, the same in every description of it (textbook §3.3: left arm
+          θ1 = φ − atan2(d, u0), reach u = +u0 along x1, offset +d along y1).
+        * Without an offset the arm is mirror-symmetric and the textbook's
+          "front" is a convention of its frames: θ1 = atan2(yc, xc) puts the
+          wrist centre along x1 (§3.2, §3.4). Forward is then the x axis of link
+          frame 1 at q = 0.
+        """
+        g, (i, j, _) = self.geometry, self.joints
+        axis = g.direction(i)
+        offset = self._offset()
+        if offset is not None:
+            forward = _unit(np.cross(offset, g.upward(axis)))
+            if forward is not None:
+                return forward
+        if g.link_x is not None:
+            forward = _unit(g.link_x[i] - (g.link_x[i] @ axis) * axis)
+            if forward is not None:
+                return forward
+        normal = _unit(np.cross(axis, g.direction(j)))
+        return normal if normal is not None else self.point - self.centre
+
+    @cached_property
+    def label_constants(self) -> tuple[np.ndarray, bool, np.ndarray]:
+        """What :meth:`label_codes` needs of the geometry alone, computed once per plan: link 1's forward
+        direction at q = 0, whether axes 2 and 3 are parallel, and the up-pointing axis 1."""
+        g, (i, j, k) = self.geometry, self.joints
+        return self._forward_direction(), bool(g.parallel(j, k)), g.upward(g.direction(i))
+
+    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+        """Shoulder left/right: the sign of the reach along link 1's forward direction (see
+        :meth:`_forward_direction`); none when the point is on axis 1. Elbow up/down (revolute joint 3,
+        unless it is free): the side of the shoulder–point line the elbow lies on, along the robot's up
+        direction, measured in the arm's plane (normal to axis 2) when axes 2 and 3 are parallel, so that
+        the choice of point on axis 3 does not matter. With the point on axis 1 the line is vertical and
+        the front configuration's limit is used (textbook §3.2: front, θ3 < 0 is up: the elbow behind).
+        """
+        g, (i, j, k) = self.geometry, self.joints
+        forward_home, in_plane, up = self.label_constants
+        forward = rotate_about(g.direction(i), joints[:, i], forward_home)
+        point = self._moved(joints, k + 1, self.point)
+        reach = point - self.centre
+        axis = g.direction(i)
+        sideways = reach - np.outer(reach @ axis, axis)
+        on_axis = np.linalg.norm(sideways, axis=-1) <= GEOMETRY_TOLERANCE * 10 * g.length_scale
+        along = np.einsum("mi,mi->m", reach, forward)
+        # on axis 1 (the shoulder singularity) front and back are one family, and at the boundary
+        # (the point as near axis 1 as the offset allows) left and right meet: no shoulder label
+        codes: LabelCodes = {"shoulder": (("left", "right"), side_codes(along, np.linalg.norm(reach, axis=-1)))}
+        if g.model.is_revolute[k] and not self.free_joints:
+            elbow = self._moved(joints, k, g.point(k)) - self.centre
+            if in_plane:  # work in the arm's plane, normal to axis 2
+                m = self.model
+                normal = np.einsum("mij,j->mi", chain_rotation(m.directions[:j], m.is_revolute[:j], joints[:, :j]),
+                                   g.direction(j))
+                elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
+                reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
+            line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
+            rejection = elbow - np.einsum("mi,mi->m", elbow, line)[:, None] * line
+            side = rejection @ up
+            # line along axis 1: "above" is undefined; take the limit from the front (the elbow behind is up)
+            side = np.where(on_axis, -(line @ up) * np.einsum("mi,mi->m", elbow, forward), side)
+            codes["elbow"] = (("up", "down"), side_codes(side, np.linalg.norm(elbow, axis=-1)))
+        return codes

@@ -175,6 +175,12 @@ async def budget_exhausted(request: Request, exc: BudgetExhausted) -> JSONRespon
 # --------------------------------------------------------------------------- the cost model's caps
 
 
+def too_much_work(detail: str) -> ProblemError:
+    """The 413 of a request whose counted work passes a cap: ``detail`` names the cap, by how much, and what
+    lowers it."""
+    return ProblemError(413, "too-much-work", "Too much work", detail)
+
+
 def check_turns(settings: Settings, robot: Robot, limits: Limits, location: tuple) -> None:
     """422 when a revolute joint's limits span more turns than ``KIN_MAX_TURNS_PER_JOINT``."""
     cap = settings.max_turns_per_joint
@@ -216,29 +222,29 @@ def check_picture_cost(panels: int, robot: Robot, obstacles: int) -> None:
     """413 when a picture with collisions would draw more than :data:`MAX_PICTURE_SHAPES` shapes."""
     shapes = panels * (obstacles + len(robot.collision))
     if shapes > MAX_PICTURE_SHAPES:
-        raise ProblemError(413, "too-much-work", "Too much work",
-                           f"The picture would draw {shapes:,} shapes ({panels:,} panels × ({obstacles:,} obstacles "
-                           f"+ {len(robot.collision):,} link shapes)), {shapes - MAX_PICTURE_SHAPES:,} more than the "
-                           f"{MAX_PICTURE_SHAPES:,} one picture may. Draw fewer configurations or name fewer "
-                           f"obstacles.")
+        raise too_much_work(
+            f"The picture would draw {shapes:,} shapes ({panels:,} panels × ({obstacles:,} obstacles "
+            f"+ {len(robot.collision):,} link shapes)), {shapes - MAX_PICTURE_SHAPES:,} more than the "
+            f"{MAX_PICTURE_SHAPES:,} one picture may. Draw fewer configurations or name fewer "
+            f"obstacles.")
 
 
 def check_collision_cost(settings: Settings, cost: Cost) -> None:
     """413 when the collision check of a request (IK targets or trajectory samples) would compare more shape
     pairs per solution than KIN_MAX_COLLISION_PAIRS, or compute more distances than KIN_MAX_COLLISION_CHECKS."""
     if cost.collision_pairs > settings.max_collision_pairs:
-        raise ProblemError(413, "too-much-work", "Too much work",
-                           f"The collision check would compare up to {cost.collision_pairs:,} pairs of shapes, "
-                           f"{cost.collision_pairs - settings.max_collision_pairs:,} more than "
-                           f"KIN_MAX_COLLISION_PAIRS = {settings.max_collision_pairs:,}. Give the links fewer "
-                           f"shapes, name fewer obstacles, or ignore link pairs.")
+        raise too_much_work(
+            f"The collision check would compare up to {cost.collision_pairs:,} pairs of shapes, "
+            f"{cost.collision_pairs - settings.max_collision_pairs:,} more than "
+            f"KIN_MAX_COLLISION_PAIRS = {settings.max_collision_pairs:,}. Give the links fewer "
+            f"shapes, name fewer obstacles, or ignore link pairs.")
     if cost.collision_checks > settings.max_collision_checks:
-        raise ProblemError(413, "too-much-work", "Too much work",
-                           f"The collision check would compute {cost.collision_checks:,} distances ({cost.targets:,} "
-                           f"targets × up to {cost.solutions_per_target} solutions × {cost.collision_pairs:,} pairs), "
-                           f"{cost.collision_checks - settings.max_collision_checks:,} more than "
-                           f"KIN_MAX_COLLISION_CHECKS = {settings.max_collision_checks:,}. Send fewer targets or "
-                           f"samples, or check fewer pairs.")
+        raise too_much_work(
+            f"The collision check would compute {cost.collision_checks:,} distances ({cost.targets:,} "
+            f"targets × up to {cost.solutions_per_target} solutions × {cost.collision_pairs:,} pairs), "
+            f"{cost.collision_checks - settings.max_collision_checks:,} more than "
+            f"KIN_MAX_COLLISION_CHECKS = {settings.max_collision_checks:,}. Send fewer targets or "
+            f"samples, or check fewer pairs.")
 
 
 def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, cost: Cost, *, form: str = "objects") -> None:
@@ -247,20 +253,20 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, cost: Cost, 
     size (413), each refusal naming the cap, by how much, and what lowers it."""
     check_turns(settings, robot, limits, ("body", "limits"))
     if cost.numeric_starts > settings.max_numeric_starts:
-        raise ProblemError(413, "too-much-work", "Too much work",
-                           f"The numeric search would run {cost.numeric_starts:,} starts ({cost.targets:,} targets × "
-                           f"{cost.numeric_starts // max(cost.targets, 1):,} starts each, over every combination of "
-                           f"held free values), {cost.numeric_starts - settings.max_numeric_starts:,} more than "
-                           f"KIN_MAX_NUMERIC_STARTS = {settings.max_numeric_starts:,}. Send fewer targets, fewer "
-                           f"numeric.starts or fewer free values.")
+        raise too_much_work(
+            f"The numeric search would run {cost.numeric_starts:,} starts ({cost.targets:,} targets × "
+            f"{cost.numeric_starts // max(cost.targets, 1):,} starts each, over every combination of "
+            f"held free values), {cost.numeric_starts - settings.max_numeric_starts:,} more than "
+            f"KIN_MAX_NUMERIC_STARTS = {settings.max_numeric_starts:,}. Send fewer targets, fewer "
+            f"numeric.starts or fewer free values.")
     check_collision_cost(settings, cost)
     if cost.too_many_to_rank:
         most = enumerable_limit(robot.dof)
-        raise ProblemError(413, "too-much-work", "Too much work",
-                           f"Keeping the nearest {cost.kept:,} of up to {cost.equivalents:,} 2π-equivalents per "
-                           f"solution would rank {cost.ranked:,} combinations of this {robot.dof}-joint arm's turns "
-                           f"per solution, more than the {MAX_COMBINATIONS_PER_SOLUTION:,} one answer may. Ask for "
-                           f"at most {most:,} (max_equivalents or max_solutions), or narrow multi-turn limits.")
+        raise too_much_work(
+            f"Keeping the nearest {cost.kept:,} of up to {cost.equivalents:,} 2π-equivalents per "
+            f"solution would rank {cost.ranked:,} combinations of this {robot.dof}-joint arm's turns "
+            f"per solution, more than the {MAX_COMBINATIONS_PER_SOLUTION:,} one answer may. Ask for "
+            f"at most {most:,} (max_equivalents or max_solutions), or narrow multi-turn limits.")
     check_answer_size(settings, robot, rows=cost.rows, form=form,
                       what=f"{cost.targets:,} targets × up to {cost.rows_per_target:,} each: "
                            f"{cost.solutions_per_target} solutions × {cost.equivalents:,} 2π-equivalents with at most "

@@ -101,7 +101,7 @@ class RequestGate:
             await self.app(scope, receive, send)
             return
         incoming = None
-        for name, value in scope["headers"]:
+        for name, value in scope.get("headers", ()):
             if name == _REQUEST_ID:
                 incoming = value.decode("latin-1")
                 break
@@ -150,7 +150,7 @@ class RequestGate:
         provided = b""
         declared: bytes | None = None
         timeouts: list[bytes] = []
-        for name, value in scope["headers"]:
+        for name, value in scope.get("headers", ()):
             if name == b"content-length":
                 declared = value
             elif name == _API_KEY:

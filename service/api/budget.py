@@ -50,7 +50,7 @@ class InFlight:
 
 
 def budget_of(request: Request) -> Budget:
-    """The request's budget (no deadline outside the middleware, e.g. a GET)."""
+    """The request's budget (no deadline where the gate gives none, e.g. a GET)."""
     return getattr(request.state, BUDGET_STATE_KEY, UNLIMITED)
 
 

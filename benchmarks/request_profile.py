@@ -1,17 +1,27 @@
-"""Where the time of one single-IK request goes, stage by stage, in process.
+"""Where the time of one request goes, stage by stage, in process, beside a bare FastAPI POST of the same body.
 
-    python -m benchmarks.request_profile                      # PUMA 560, 500 requests per row
-    python -m benchmarks.request_profile --robot ur5 --requests 200
+    python -m benchmarks.request_profile                         # PUMA 560: FK, IK, a batch of 10,000 targets
+    python -m benchmarks.request_profile --requests 200 --batch 1000 --robot ur5
 
-The whole request goes through the ASGI application as uvicorn calls it (middleware, routing, the hand-over to a
-work loop, validation, the endpoint, encoding), one request at a time, with no network: beside ``GET /healthz``
-through the same application, it is the framework's share that wrk cannot separate from the server's. A bare
-FastAPI application (a GET, and a POST of the FK body validated by a pydantic model) gives the framework's own
-floor. The stages
-of the IK request are then timed alone on the same body: the JSON parse and body validation, the boundary's
-conversion to core arrays and the cost model, the core's answer (and within it the solve alone), and the
-encoding. What the stages do not account for is the framework and the hand-over. Best of three rounds per row;
-read the shares, the absolute times move with the machine's load.
+Three requests, each sent whole through the service's ASGI application as uvicorn calls it (the service's ASGI layer,
+routing, dependencies, validation, the endpoint, encoding), one at a time, with no network: a single FK, a single
+IK and an IK batch of ``--batch`` targets (``{"matrices": [...]}`` rows, answered as columns). Each request's
+stages are then timed alone on the same body, in the order the route runs them:
+
+* receive + parse: the body's bytes to Python objects (orjson, as the work routes parse);
+* validate: the request model (pydantic);
+* dependencies: the catalogue robot the path names;
+* boundary: units converted, targets, limits and options in core terms;
+* cost check: where the work runs (small or not) and the cost model's caps (IK), the batch-size cap (batch);
+* core answer: the core's call (``forward_kinematics``, ``answer_ik``; the solve alone below it);
+* encode: the answer to wire dicts or columns, then to JSON bytes (orjson);
+* send: the response object and its ASGI messages.
+
+What the stages do not account for is the framework (Starlette's and FastAPI's layers, routing) and the service's
+ASGI layer. Beside each request: a bare FastAPI application with one POST route taking the same body (parsed and
+validated by FastAPI as it does by default, answering a constant), and the same bare application with the service's
+ASGI layer (:class:`~service.api.gate.RequestGate`) added, so that layer's own cost shows. Best of three rounds per
+row; read the shares, the absolute times move with the machine's load.
 """
 
 from __future__ import annotations
@@ -20,29 +30,58 @@ import argparse
 import asyncio
 import gc
 import time
-from typing import Callable
+from collections.abc import Awaitable, Callable
+from dataclasses import dataclass
+from typing import Any
 
-import numpy as np
 import orjson
 from fastapi import FastAPI
-from pydantic import BaseModel
+from starlette.requests import Request
+from starlette.responses import Response
 
 from service.api import routing
 from service.api.app import _tune_collector, create_app
-from service.api.boundary import free_joints_to_core, ik_selection_to_core, ik_targets_to_core
-from service.api.budget import check_ik_cost
-from service.api.ik_encoding import ik_objects
+from service.api.boundary import joints_to_core, pose_from_matrix
+from service.api.budget import InFlight, check_ik_cost
+from service.api.deps import catalogue_robot, check_batch_size, settings_of
+from service.api.gate import RequestGate
+from service.api.ik_encoding import ik_columns, ik_objects
+from service.api.ik_requests import ik_request_in_core
+from service.api.responses import encoded
 from service.api.schemas.fk import FKRequest
-from service.api.schemas.ik import IKRequest
+from service.api.schemas.ik import IKBatchRequest, IKRequest
 from service.config import Settings
 from service.kinematics import UNLIMITED, forward_kinematics
-from service.kinematics.ik import AnswerOptions, IKOptions, NumericOptions, answer_ik, cached_plan, estimate, solve_ik
+from service.kinematics.ik import answer_ik, estimate, is_small, solve_ik, solve_ik_arrays
 
 from .core import machine, sample_configurations
 
 
+def _scope(method: str, path: str, body: bytes, app: Any = None) -> dict:
+    scope = {"type": "http", "asgi": {"version": "3.0"}, "http_version": "1.1", "method": method, "scheme": "http",
+             "path": path, "raw_path": path.encode(), "query_string": b"", "root_path": "",
+             "headers": [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())],
+             "client": ("127.0.0.1", 1), "server": ("127.0.0.1", 80)}
+    if app is not None:
+        scope["app"] = app
+    return scope
+
+
+async def _best_of_three(call: Callable[[], Awaitable[object]], count: int) -> float:
+    """Seconds per call, best of three rounds of ``count`` calls (after a warm-up)."""
+    for _ in range(min(20, count)):
+        await call()
+    best = float("inf")
+    for _ in range(3):
+        started = time.perf_counter()
+        for _ in range(count):
+            await call()
+        best = min(best, (time.perf_counter() - started) / count)
+    return best
+
+
 def _asgi_seconds(app, method: str, path: str, body: bytes, count: int) -> float:
-    """Seconds per request through the application, one at a time (best of three rounds)."""
+    """Seconds per request through the application, one at a time, its lifespan running (best of three rounds)."""
     async def once() -> None:
         sent: list[dict] = []
 
@@ -52,46 +91,142 @@ def _asgi_seconds(app, method: str, path: str, body: bytes, count: int) -> float
         async def send(message: dict) -> None:
             sent.append(message)
 
-        scope = {"type": "http", "asgi": {"version": "3.0"}, "http_version": "1.1", "method": method,
-                 "scheme": "http", "path": path, "raw_path": path.encode(), "query_string": b"", "root_path": "",
-                 "headers": [(b"content-type", b"application/json"), (b"content-length", str(len(body)).encode())],
-                 "client": ("127.0.0.1", 1), "server": ("127.0.0.1", 80)}
-        await app(scope, receive, send)
+        await app(_scope(method, path, body), receive, send)
         assert sent[0]["status"] == 200, sent
 
     async def rounds() -> float:
         async with app.router.lifespan_context(app):
-            for _ in range(min(50, count)):
-                await once()
-            best = float("inf")
-            for _ in range(3):
-                started = time.perf_counter()
-                for _ in range(count):
-                    await once()
-                best = min(best, (time.perf_counter() - started) / count)
-            return best
+            return await _best_of_three(once, count)
 
     return asyncio.run(rounds())
 
 
-class _Joints(BaseModel):
-    joints: list[float]
+def _seconds(function: Callable[[], object], count: int) -> float:
+    async def call() -> None:
+        function()
+
+    return asyncio.run(_best_of_three(call, count))
 
 
-def _bare_application() -> FastAPI:
-    """A FastAPI application with nothing of this service: the framework's own cost of a GET and of a POST whose
-    body (the FK body) is validated by a pydantic model."""
+def _async_seconds(make: Callable[[], Awaitable[object]], count: int) -> float:
+    return asyncio.run(_best_of_three(make, count))
+
+
+def _bare_application(model: type | None, path: str, gated: bool = False) -> FastAPI:
+    """A FastAPI application with nothing of this service: a GET (``model`` None) or a POST whose body FastAPI parses
+    and validates as ``model``, answering a constant; ``gated``: with the service's ASGI layer in front."""
     bare = FastAPI()
-
-    @bare.get("/healthz")
-    async def healthz() -> dict:
-        return {"status": "ok"}
-
-    @bare.post("/fk")
-    async def fk(body: _Joints) -> dict:
-        return {"joints": body.joints}
-
+    if model is None:
+        @bare.get(path)
+        async def get() -> dict:
+            return {"status": "ok"}
+    else:
+        async def post(body) -> dict:
+            return {"ok": True}
+        post.__annotations__["body"] = model  # the class itself: a string annotation would not resolve here
+        bare.post(path)(post)
+    if gated:
+        settings = Settings(_env_file=None, log_level="warning")
+        bare.add_middleware(RequestGate, settings=settings, in_flight=InFlight(settings.max_in_flight))
     return bare
+
+
+async def _sent(response: Response) -> None:
+    """The response's ASGI messages, to a send that keeps nothing."""
+    async def receive() -> dict:
+        return {"type": "http.disconnect"}
+
+    async def send(message: dict) -> None:
+        pass
+
+    await response({"type": "http"}, receive, send)
+
+
+@dataclass
+class Profile:
+    """One request: its whole time, its stages alone, and the bare framework's time for the same body."""
+
+    name: str
+    whole: float
+    stages: dict[str, float]
+    within_core: tuple[str, float] | None
+    bare_post: float
+    gated_post: float | None
+
+
+def _profile_fk(app, robot_id: str, robot, q, count: int) -> Profile:
+    path, body = f"/v1/robots/{robot_id}/fk", orjson.dumps({"joints": q.tolist()})
+    request = Request(_scope("POST", path, body, app))
+    parsed = orjson.loads(body)
+    model = FKRequest.model_validate(parsed)
+    ref = asyncio.run(catalogue_robot(request, robot_id))
+    joints = joints_to_core(robot, model.joints, model.angle_unit)
+    pose = forward_kinematics(robot, joints)
+    wire = encoded({"robot_id": ref.id, "joint_names": robot.joint_names, "pose": pose_from_matrix(pose)})
+    stages = {
+        "receive + parse (orjson)": _seconds(lambda: orjson.loads(body), count),
+        "validate (FKRequest)": _seconds(lambda: FKRequest.model_validate(parsed), count),
+        "dependencies (catalogue robot)": _async_seconds(lambda: catalogue_robot(request, robot_id), count),
+        "boundary (joints to radians, checked)": _seconds(
+            lambda: joints_to_core(robot, model.joints, model.angle_unit), count),
+        "core answer (forward_kinematics)": _seconds(lambda: forward_kinematics(robot, joints), count),
+        "encode (pose dict, orjson)": _seconds(lambda: encoded(
+            {"robot_id": ref.id, "joint_names": robot.joint_names, "pose": pose_from_matrix(pose)}), count),
+        "send (response object, ASGI messages)": _async_seconds(
+            lambda: _sent(Response(wire, media_type="application/json")), count),
+    }
+    return Profile("POST fk, one configuration", _asgi_seconds(app, "POST", path, body, count), stages, None,
+                   _asgi_seconds(_bare_application(FKRequest, path), "POST", path, body, count),
+                   _asgi_seconds(_bare_application(FKRequest, path, gated=True), "POST", path, body, count))
+
+
+def _profile_ik(app, robot_id: str, robot, T, count: int, *, batch: bool) -> Profile:
+    path = f"/v1/robots/{robot_id}/ik" + ("/batch" if batch else "")
+    body = orjson.dumps({"targets": {"matrices": T.reshape(-1, 16).tolist()}, "format": "arrays"} if batch
+                        else {"target": {"matrix": T[0].tolist()}})
+    schema, form = (IKBatchRequest, "arrays") if batch else (IKRequest, "objects")
+    request = Request(_scope("POST", path, body, app))
+    settings = settings_of(request)
+    parsed = orjson.loads(body)
+    model = schema.model_validate(parsed)
+    ref = asyncio.run(catalogue_robot(request, robot_id))
+    asked = ik_request_in_core(request, ref, model)
+
+    def cost_check() -> None:
+        if batch:
+            check_batch_size(request, model.target_count, "targets")
+        small = is_small(robot, asked.targets, asked.options)
+        check_ik_cost(settings, robot, asked.options.limits,
+                      estimate(robot, asked.targets, asked.options, kept_asked=asked.kept_asked, small=small),
+                      form=form)
+
+    def wire_answer(answer) -> object:
+        if batch:
+            return ik_columns(ref.id, robot, answer, model.angle_unit, UNLIMITED)
+        return ik_objects(ref.id, robot, answer, model.angle_unit, UNLIMITED)[0]
+
+    answer = answer_ik(robot, asked.targets, asked.options)
+    wire = encoded(wire_answer(answer))
+    stages = {
+        "receive + parse (orjson)": _seconds(lambda: orjson.loads(body), count),
+        f"validate ({schema.__name__})": _seconds(lambda: schema.model_validate(parsed), count),
+        "dependencies (catalogue robot)": _async_seconds(lambda: catalogue_robot(request, robot_id), count),
+        "boundary (units, targets, limits, options)": _seconds(lambda: ik_request_in_core(request, ref, model),
+                                                               count),
+        "cost check (small or not, the cost model's caps)": _seconds(cost_check, count),
+        "core answer (answer_ik)": _seconds(lambda: answer_ik(robot, asked.targets, asked.options), count),
+        f"encode ({'ik_columns' if batch else 'ik_objects'}, orjson)": _seconds(
+            lambda: encoded(wire_answer(answer)), count),
+        "send (response object, ASGI messages)": _async_seconds(
+            lambda: _sent(Response(wire, media_type="application/json")), count),
+    }
+    within = (("the solve alone (solve_ik_arrays)", _seconds(lambda: solve_ik_arrays(robot, T), count)) if batch
+              else ("the solve alone (solve_ik)", _seconds(lambda: solve_ik(robot, T[0]), count)))
+    name = f"POST ik/batch, {len(T):,} targets as matrix rows, arrays form" if batch else "POST ik, one pose"
+    return Profile(name, _asgi_seconds(app, "POST", path, body, count), stages, within,
+                   _asgi_seconds(_bare_application(schema, path), "POST", path, body, count),
+                   None if batch else _asgi_seconds(_bare_application(schema, path, gated=True), "POST", path,
+                                                    body, count))
 
 
 def _collector_passes() -> tuple[float, float]:
@@ -107,9 +242,9 @@ def _collector_passes() -> tuple[float, float]:
     def full_pass() -> float:
         best = float("inf")
         for _ in range(3):
-            started = time.perf_counter()
+            begun = time.perf_counter()
             gc.collect()
-            best = min(best, time.perf_counter() - started)
+            best = min(best, time.perf_counter() - begun)
         return best
 
     tracked = full_pass()
@@ -123,100 +258,97 @@ def _collector_passes() -> tuple[float, float]:
     return tracked, frozen
 
 
-def _seconds(function: Callable[[], object], count: int) -> float:
-    for _ in range(min(50, count)):
-        function()
-    best = float("inf")
-    for _ in range(3):
-        started = time.perf_counter()
-        for _ in range(count):
-            function()
-        best = min(best, (time.perf_counter() - started) / count)
-    return best
+def _print(profile: Profile) -> None:
+    whole = profile.whole
+    print(f"\n**{profile.name}**\n")
+    print("| stage | µs | share of the request |")
+    print("|---|---:|---:|")
+    print(f"| whole request through the application | {whole * 1e6:,.1f} | 1.00 |")
+    for name, seconds in profile.stages.items():
+        print(f"|   {name} | {seconds * 1e6:,.1f} | {seconds / whole:.2f} |")
+        if name.startswith("core answer") and profile.within_core is not None:
+            label, solve = profile.within_core
+            print(f"|     of which {label} | {solve * 1e6:,.1f} | {solve / whole:.2f} |")
+    rest = whole - sum(profile.stages.values())
+    print(f"|   framework, the service's ASGI layer, routing (the rest) | {rest * 1e6:,.1f} | {rest / whole:.2f} |")
+    print(f"| bare FastAPI: POST of this body, validated | {profile.bare_post * 1e6:,.1f} | "
+          f"{profile.bare_post / whole:.2f} |")
+    if profile.gated_post is not None:
+        print(f"| bare FastAPI + the service's ASGI layer (RequestGate): POST of this body | "
+              f"{profile.gated_post * 1e6:,.1f} | {profile.gated_post / whole:.2f} |")
 
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks.request_profile", description=__doc__.splitlines()[0])
     parser.add_argument("--robot", default="puma560_standard", help="catalogue id (default puma560_standard)")
-    parser.add_argument("--requests", type=int, default=500, help="requests per row and round (default 500)")
+    parser.add_argument("--requests", type=int, default=500, help="single requests per row and round (default 500)")
+    parser.add_argument("--batch", type=int, default=10_000, help="targets in the batch request (default 10,000)")
+    parser.add_argument("--batch-requests", type=int, default=2, help="batch requests per row and round (default 2)")
     args = parser.parse_args(argv)
 
-    settings = Settings(log_level="warning")
+    settings = Settings(_env_file=None, log_level="warning", max_batch=max(args.batch, 10_000),
+                        max_body_bytes=64 << 20, request_timeout_ms=300_000)
     app = create_app(settings)
     from service.robots.catalogue import load_catalogue
-    robot = load_catalogue([settings.builtin_robots_dir], max_joints=settings.max_joints).get(args.robot).robot
-    q = sample_configurations(robot, 1, seed=5)[0]
+    catalogue = load_catalogue([settings.builtin_robots_dir], max_joints=settings.max_joints)
+    robot = catalogue.get(args.robot).robot
+    q = sample_configurations(robot, max(args.batch, 1), seed=5)
     T = forward_kinematics(robot, q)
-    ik_body = orjson.dumps({"target": {"matrix": T.tolist()}})
-    fk_body = orjson.dumps({"joints": q.tolist()})
     count = args.requests
 
-    bare = _bare_application()
-    bare_get = _asgi_seconds(bare, "GET", "/healthz", b"", count)
-    bare_post = _asgi_seconds(bare, "POST", "/fk", fk_body, count)
     healthz = _asgi_seconds(app, "GET", "/healthz", b"", count)
-    fk = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/fk", fk_body, count)
-    ik = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/ik", ik_body, count)
-    # the same requests handed to a work loop, as every request was before small work ran where it arrives
+    bare_get = _asgi_seconds(_bare_application(None, "/healthz"), "GET", "/healthz", b"", count)
+    def as_served() -> None:
+        """The stages alone read the catalogue as the routes do, with the collector tuned as the lifespan tunes it
+        (each whole request's lifespan drops both at its end): untuned, a large answer's encoding triggers full
+        passes over everything start-up built."""
+        app.state.catalogue = catalogue
+        _tune_collector()
+
+    thresholds = gc.get_threshold()
+    try:
+        as_served()
+        fk = _profile_fk(app, args.robot, robot, q[0], count)
+        as_served()
+        ik = _profile_ik(app, args.robot, robot, T[:1], count, batch=False)
+        as_served()
+        ik_batch = _profile_ik(app, args.robot, robot, T, args.batch_requests, batch=True)
+    finally:  # this process's collector as it was (the smoke test runs in pytest's process)
+        gc.unfreeze()
+        gc.set_threshold(*thresholds)
+    # the same single requests handed to a work loop, as every request was before small work ran where it arrives
     small_body_bytes, routing.SMALL_BODY_BYTES = routing.SMALL_BODY_BYTES, -1
     try:
-        fk_handed = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/fk", fk_body, count)
-        ik_handed = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/ik", ik_body, count)
+        fk_handed = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/fk", orjson.dumps({"joints": q[0].tolist()}),
+                                  count)
+        ik_handed = _asgi_seconds(app, "POST", f"/v1/robots/{args.robot}/ik",
+                                  orjson.dumps({"target": {"matrix": T[0].tolist()}}), count)
     finally:
         routing.SMALL_BODY_BYTES = small_body_bytes
     tracked_pass, frozen_pass = _collector_passes()
 
-    # the IK request's stages, alone, on the same body (as the router runs them)
-    body = IKRequest.model_validate(orjson.loads(ik_body))
-    targets = ik_targets_to_core([body.target], body.angle_unit, "body", "target", indexed=False)
-    reference, limits, ordering = ik_selection_to_core(robot, body)
-    options = AnswerOptions(reference, limits, body.filter_limits, ordering, body.max_equivalents,
-                            IKOptions(NumericOptions(starts=body.numeric.starts,
-                                                     max_iterations=body.numeric.iterations), budget=UNLIMITED),
-                            free_joints_to_core(robot, body.free_joints, body.angle_unit), UNLIMITED)
-    answer = answer_ik(robot, targets, options)
-    plan = cached_plan(robot, constrain_orientation=True, reference=None)
-
-    def boundary() -> None:
-        ik_targets_to_core([body.target], body.angle_unit, "body", "target", indexed=False)
-        ik_selection_to_core(robot, body)
-        check_ik_cost(settings, robot, limits, estimate(robot, targets, options))
-
-    stages = {
-        "parse + validate the body": _seconds(lambda: IKRequest.model_validate(orjson.loads(ik_body)), count),
-        "boundary: units, targets, limits, cost model": _seconds(boundary, count),
-        "core answer (answer_ik)": _seconds(lambda: answer_ik(robot, targets, options), count),
-        "encode (ik_objects + orjson)": _seconds(
-            lambda: orjson.dumps(ik_objects(args.robot, robot, answer, "rad", UNLIMITED)[0]), count),
-    }
-    solve = _seconds(lambda: solve_ik(robot, T), count)
-    fk_core = _seconds(lambda: forward_kinematics(robot, q), count)
-    fk_validate = _seconds(lambda: FKRequest.model_validate(orjson.loads(fk_body)), count)
-
     print(f"machine: {machine()}")
-    print(f"robot {args.robot}, {count} requests per row, best of 3 rounds, in process (no network)\n")
-    print("| what | µs | share of the IK request |")
-    print("|---|---:|---:|")
-    print(f"| GET /healthz through the application | {healthz * 1e6:,.1f} | {healthz / ik:.2f} |")
-    print(f"| POST fk, whole request | {fk * 1e6:,.1f} | {fk / ik:.2f} |")
-    print(f"|   of which FK in the core | {fk_core * 1e6:,.1f} | |")
-    print(f"|   of which parse + validate the body | {fk_validate * 1e6:,.1f} | |")
-    print(f"| POST ik, whole request | {ik * 1e6:,.1f} | 1.00 |")
-    for name, seconds in stages.items():
-        print(f"|   {name} | {seconds * 1e6:,.1f} | {seconds / ik:.2f} |")
-        if name.startswith("core"):
-            print(f"|     of which the solve alone (solve_ik) | {solve * 1e6:,.1f} | {solve / ik:.2f} |")
-    rest = ik - sum(stages.values())
-    print(f"|   framework, middleware, hand-over (the rest) | {rest * 1e6:,.1f} | {rest / ik:.2f} |")
-    print(f"| POST fk, whole request, handed to a work loop | {fk_handed * 1e6:,.1f} | {fk_handed / ik:.2f} |")
-    print(f"| POST ik, whole request, handed to a work loop | {ik_handed * 1e6:,.1f} | {ik_handed / ik:.2f} |")
-    print(f"| bare FastAPI: GET | {bare_get * 1e6:,.1f} | |")
-    print(f"| bare FastAPI: POST of the FK body, validated | {bare_post * 1e6:,.1f} | |")
-    print(f"\n- bare FastAPI, POST / GET: {bare_post / bare_get:.1f} (its share of GET is at most {bare_get / bare_post:.2f})")
-    print(f"- whole IK request / GET /healthz, in process: {ik / healthz:.1f} (wrk's share of /healthz is bounded by "
-          f"its inverse, {healthz / ik:.2f}, before the network)")
-    print(f"- whole FK request / GET /healthz, in process: {fk / healthz:.1f} (bound {healthz / fk:.2f})")
-    print(f"- handed to a work loop / where it arrives: FK {fk_handed / fk:.2f}, IK {ik_handed / ik:.2f}")
+    print(f"robot {args.robot}; {count} single requests and {args.batch_requests} batch requests per row, best of 3 "
+          f"rounds, in process (no network)")
+    for profile in (fk, ik, ik_batch):
+        _print(profile)
+    print("\n**Beside them**\n")
+    print("| what | µs |")
+    print("|---|---:|")
+    print(f"| GET /healthz through the application | {healthz * 1e6:,.1f} |")
+    print(f"| bare FastAPI: GET | {bare_get * 1e6:,.1f} |")
+    print(f"| POST fk, whole request, handed to a work loop | {fk_handed * 1e6:,.1f} |")
+    print(f"| POST ik, whole request, handed to a work loop | {ik_handed * 1e6:,.1f} |")
+    print(f"\n- whole request / bare FastAPI POST of the same body: FK {fk.whole / fk.bare_post:.1f}, IK "
+          f"{ik.whole / ik.bare_post:.1f}, batch {ik_batch.whole / ik_batch.bare_post:.2f}")
+    print(f"- the service's ASGI layer on a bare POST: FK body +{(fk.gated_post - fk.bare_post) * 1e6:,.1f} µs, "
+          f"IK body +{(ik.gated_post - ik.bare_post) * 1e6:,.1f} µs")
+    print(f"- whole request / GET /healthz, in process: FK {fk.whole / healthz:.1f}, IK {ik.whole / healthz:.1f} "
+          f"(wrk's share of /healthz is bounded by the inverse, FK {healthz / fk.whole:.2f}, IK "
+          f"{healthz / ik.whole:.2f}, before the network)")
+    print(f"- batch per target: whole request {ik_batch.whole / args.batch * 1e6:,.2f} µs, core answer "
+          f"{ik_batch.stages['core answer (answer_ik)'] / args.batch * 1e6:,.2f} µs")
+    print(f"- handed to a work loop / where it arrives: FK {fk_handed / fk.whole:.2f}, IK {ik_handed / ik.whole:.2f}")
     print(f"- one full garbage-collector pass in this process: {tracked_pass * 1e3:,.1f} ms with the start-up "
           f"objects tracked, {frozen_pass * 1e3:,.1f} ms with them frozen (the lifespan's _tune_collector)")
     return 0

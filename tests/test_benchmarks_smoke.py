@@ -29,10 +29,19 @@ def test_core_benchmark_runs_with_tiny_sizes(capsys):
 
 
 def test_request_profile_runs_with_tiny_sizes(capsys):
-    assert request_profile.main(["--requests", "3"]) == 0
+    assert request_profile.main(["--requests", "3", "--batch", "20", "--batch-requests", "1"]) == 0
     out = capsys.readouterr().out
-    assert "| POST ik, whole request |" in out and "|     of which the solve alone (solve_ik) |" in out
-    assert "| bare FastAPI: POST of the FK body, validated |" in out
+    for request in ("POST fk, one configuration", "POST ik, one pose",
+                    "POST ik/batch, 20 targets as matrix rows, arrays form"):
+        assert f"**{request}**" in out
+    for stage in ("receive + parse (orjson)", "validate (IKRequest)", "validate (IKBatchRequest)",
+                  "dependencies (catalogue robot)", "cost check (small or not, the cost model's caps)",
+                  "core answer (answer_ik)", "encode (ik_objects, orjson)", "encode (ik_columns, orjson)",
+                  "send (response object, ASGI messages)", "framework, the service's ASGI layer, routing (the rest)"):
+        assert f"|   {stage} |" in out
+    assert "|     of which the solve alone (solve_ik) |" in out
+    assert out.count("| bare FastAPI: POST of this body, validated |") == 3
+    assert "| bare FastAPI + the service's ASGI layer (RequestGate): POST of this body |" in out
 
 
 def test_wrist_classes_benchmark_runs_with_tiny_sizes(capsys):

@@ -10,22 +10,21 @@ from typing import AsyncIterator
 from typing import Any
 
 from fastapi import FastAPI
-from fastapi.middleware.cors import CORSMiddleware
 from fastapi.routing import APIRoute
 
 from .. import __version__
 from ..robots.catalogue import load_catalogue
 from ..config import Settings
 from ..kinematics import BudgetExhausted
-from .budget import TIMEOUT_HEADER, InFlight, WorkLimits, budget_exhausted
-from .body_size import BodySizeLimit
+from .budget import InFlight, budget_exhausted
+from .gate import RequestGate
 from .robot_cache import RobotCache
-from .observability import REQUEST_ID_HEADER, RequestContextMiddleware, configure_logging, metrics_router
+from .observability import configure_logging, metrics_router
 from .examples import add_examples
 from .pages import install_pages
 from .problems import PROBLEM_MEDIA_TYPE, Problem, install_problem_handlers
 from .routers import fk, health, ik, limits, render, robots, trajectory
-from .security import API_KEY_HEADER, API_KEY_SCHEME, ApiKeyMiddleware, is_protected
+from .security import API_KEY_HEADER, API_KEY_SCHEME, is_protected
 
 logger = logging.getLogger("service")
 
@@ -116,18 +115,9 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     configure_logging(settings.log_level)
     install_problem_handlers(app)
     app.add_exception_handler(BudgetExhausted, budget_exhausted)
-    # add_middleware wraps what is already there: the last added runs first. Order of a request:
-    # request id + access log + metrics → CORS (answers preflights itself) → API key → body size → work limits
-    # (deadline, cancellation, in-flight) → routes.
-    app.add_middleware(WorkLimits, settings=settings, in_flight=app.state.in_flight)
-    app.add_middleware(BodySizeLimit, max_body_bytes=settings.max_body_bytes)
-    if settings.api_key is not None:
-        app.add_middleware(ApiKeyMiddleware, api_key=settings.api_key.get_secret_value())
-    if settings.cors_origins:
-        app.add_middleware(CORSMiddleware, allow_origins=settings.cors_origins, allow_methods=["GET", "POST"],
-                           allow_headers=["Content-Type", API_KEY_HEADER, REQUEST_ID_HEADER, TIMEOUT_HEADER],
-                           expose_headers=[REQUEST_ID_HEADER], max_age=600)
-    app.add_middleware(RequestContextMiddleware)
+    # One ASGI layer in front of the routes: request id + access log + metrics → CORS (when configured; answers
+    # preflights itself) → API key (when configured) → body size → work limits (deadline, cancellation, in-flight).
+    app.add_middleware(RequestGate, settings=settings, in_flight=app.state.in_flight)
     for module in (health, robots, fk, ik, limits, trajectory):
         app.include_router(module.router)
     app.include_router(metrics_router)

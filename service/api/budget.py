@@ -1,11 +1,11 @@
 """Bounded work, the HTTP side: each request's budget, the in-flight limit, and the cost model checked before work.
 
-* :class:`WorkLimits` (pure ASGI middleware) gives every ``POST /v1/...`` request a core
+* The service's ASGI layer (:class:`~.gate.RequestGate`) gives every ``POST /v1/...`` request a core
   :class:`~service.kinematics.Budget`: a deadline of ``KIN_REQUEST_TIMEOUT_MS`` (or the lower value of the
   request's ``X-Request-Timeout-Ms`` header), cancelled when the client disconnects. It refuses work beyond
-  ``KIN_MAX_IN_FLIGHT`` requests at once with 503 and ``Retry-After``. Load is shed here, request by request:
-  ``/readyz`` stays 200 while saturated (a fleet whose every pod left its Service at a peak would refuse
-  connections instead of answering this 503), and reports the count as ``in_flight``.
+  ``KIN_MAX_IN_FLIGHT`` requests at once (:class:`InFlight`) with 503 and ``Retry-After``. Load is shed there,
+  request by request: ``/readyz`` stays 200 while saturated (a fleet whose every pod left its Service at a peak
+  would refuse connections instead of answering this 503), and reports the count as ``in_flight``.
 * The routers call :func:`check_ik_cost` before solving: the core's cost estimate (the worst-case answer,
   targets × solutions per target × 2π-equivalents per solution, and the numeric starts) is held against
   ``KIN_MAX_SOLUTIONS_PER_RESPONSE`` and ``KIN_MAX_RESPONSE_BYTES``, and each joint's limits against
@@ -15,21 +15,16 @@
 
 from __future__ import annotations
 
-import asyncio
-import json
 import logging
-import math
 
 import numpy as np
 from fastapi import Request
 from fastapi.responses import JSONResponse
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from ..config import Settings
 from ..kinematics.ik import MAX_COMBINATIONS_PER_SOLUTION, Cost, enumerable_limit
 from ..kinematics import UNLIMITED, Budget, BudgetExhausted, Limits, Robot
-from .problems import PROBLEM_MEDIA_TYPE, PROBLEM_TYPE_BASE, ProblemError, problem_response
-from .routing import CORE_TURNS
+from .problems import ProblemError, problem_response
 
 logger = logging.getLogger("service.budget")
 
@@ -54,106 +49,8 @@ class InFlight:
         return self.count >= self.capacity
 
 
-def _is_work(scope: Scope) -> bool:
-    return scope.get("method") == "POST" and scope.get("path", "").startswith("/v1/")
-
-
-class WorkLimits:
-    """Per-request budget, cancellation on disconnect and the in-flight limit (see the module docstring)."""
-
-    def __init__(self, app: ASGIApp, settings: Settings, in_flight: InFlight) -> None:
-        self.app = app
-        self.timeout_seconds = settings.request_timeout_ms / 1000.0
-        self.in_flight = in_flight
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http" or not _is_work(scope):
-            await self.app(scope, receive, send)
-            return
-        timeout = self.timeout_seconds
-        for name, value in scope.get("headers", ()):
-            if name == TIMEOUT_HEADER.lower().encode():
-                try:
-                    asked = float(value)
-                except ValueError:
-                    asked = math.nan
-                if not (asked > 0 and math.isfinite(asked)):
-                    await _send_problem(send, 422, "validation-error", "Request is not valid",
-                                        f"{TIMEOUT_HEADER} must be a positive number of milliseconds.",
-                                        scope, errors=[{"loc": ["header", TIMEOUT_HEADER],
-                                                        "msg": "must be a positive number", "type": "value_error"}])
-                    return
-                timeout = min(timeout, asked / 1000.0)  # a request may lower its deadline, never raise it
-        if self.in_flight.saturated:
-            logger.warning("refused: %d requests in flight (KIN_MAX_IN_FLIGHT)", self.in_flight.count,
-                           extra={"fields": {"path": scope.get("path"), "in_flight": self.in_flight.count}})
-            await _send_problem(send, 503, "overloaded", "Too many requests in flight",
-                                f"The service is working on {self.in_flight.count} requests, its limit "
-                                f"(KIN_MAX_IN_FLIGHT = {self.in_flight.capacity}); retry after "
-                                f"{RETRY_AFTER_SECONDS} s.", scope, retry_after=True)
-            return
-        budget = Budget(timeout, between_chunks=CORE_TURNS.pass_on)
-        scope.setdefault("state", {})[BUDGET_STATE_KEY] = budget
-        disconnected = asyncio.Event()
-        body_done = False
-        watcher: asyncio.Task | None = None
-
-        async def watch() -> None:
-            # After the body, the server's receive() returns only when the client goes or the response is done.
-            message = await receive()
-            if message["type"] == "http.disconnect" and not response_done:
-                budget.cancel()
-                logger.info("client disconnected: cancelling the request at its next chunk",
-                            extra={"fields": {"path": scope.get("path")}})
-            disconnected.set()
-
-        async def receive_watched() -> Message:
-            nonlocal body_done, watcher
-            if body_done:
-                await disconnected.wait()
-                return {"type": "http.disconnect"}
-            message = await receive()
-            if message["type"] == "http.disconnect":
-                budget.cancel()
-                disconnected.set()
-            elif not message.get("more_body", False):
-                body_done = True
-                watcher = asyncio.get_running_loop().create_task(watch())
-            return message
-
-        response_done = False
-
-        async def send_tracked(message: Message) -> None:
-            nonlocal response_done
-            if message["type"] == "http.response.body" and not message.get("more_body", False):
-                response_done = True
-            await send(message)
-
-        self.in_flight.count += 1
-        try:
-            await self.app(scope, receive_watched, send_tracked)
-        finally:
-            self.in_flight.count -= 1
-            if watcher is not None:
-                watcher.cancel()
-
-
-async def _send_problem(send: Send, status: int, slug: str, title: str, detail: str, scope: Scope, *,
-                        retry_after: bool = False, errors: list | None = None) -> None:
-    body = {"type": PROBLEM_TYPE_BASE + slug, "title": title, "status": status, "detail": detail,
-            "instance": scope.get("path", "")}
-    if errors is not None:
-        body["errors"] = errors
-    encoded = json.dumps(body).encode()
-    headers = [(b"content-type", PROBLEM_MEDIA_TYPE.encode()), (b"content-length", str(len(encoded)).encode())]
-    if retry_after:
-        headers.append((b"retry-after", str(RETRY_AFTER_SECONDS).encode()))
-    await send({"type": "http.response.start", "status": status, "headers": headers})
-    await send({"type": "http.response.body", "body": encoded})
-
-
 def budget_of(request: Request) -> Budget:
-    """The request's budget (no deadline outside the middleware, e.g. a GET)."""
+    """The request's budget (no deadline where the gate gives none, e.g. a GET)."""
     return getattr(request.state, BUDGET_STATE_KEY, UNLIMITED)
 
 

@@ -47,6 +47,8 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
                     free_of_target: list[list[int]], angle: float) -> list[list[dict]]:
     """Each target's rows of ``table`` as solution dicts; ``outside`` (S, n) marks the joints a row violates;
     ``angle``: radians per unit of the request's angles (for the roll)."""
+    if not len(table.target):  # the usual rejected table: none of the columns' conversions below is needed
+        return [[] for _ in free_of_target]
     joints = (table.joints / scale).tolist()
     position = table.position.tolist()
     orientation = [None if missing else value

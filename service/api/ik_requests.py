@@ -46,11 +46,12 @@ def ik_request_in_core(request: Request, ref: RobotRef, body: IKRequest | IKBatc
     return AskedIK(ref, targets, options, bool({"max_equivalents", "max_solutions"} & body.model_fields_set))
 
 
-def answered(request: Request, asked: AskedIK, form: str) -> IKAnswer:
-    """The cost model's caps (before any solving), then the core's answer."""
+def answered(request: Request, asked: AskedIK, form: str, *, small: bool | None = None) -> IKAnswer:
+    """The cost model's caps (before any solving), then the core's answer. ``small``: the work's
+    :func:`~service.kinematics.ik.is_small`, when the route has decided it already."""
     robot = asked.ref.robot
     with located("body"):
-        cost = estimate(robot, asked.targets, asked.options, kept_asked=asked.kept_asked)
+        cost = estimate(robot, asked.targets, asked.options, kept_asked=asked.kept_asked, small=small)
     check_ik_cost(settings_of(request), robot, asked.options.limits, cost, form=form)
     try:
         with located("body"):

@@ -1,9 +1,11 @@
 """Request ids, structured JSON logs and Prometheus metrics.
 
 * Every request gets an id: the client's ``X-Request-ID`` when it is sane
-  (1–128 characters of ``[A-Za-z0-9._:-]``), otherwise a fresh UUID. It is
+  (1–128 characters of ``[A-Za-z0-9._:-]``), otherwise a fresh one of 32 hex digits. It is
   echoed in the ``X-Request-ID`` response header and carried by every log line
   written while the request is handled.
+  The service's ASGI layer (:class:`~.gate.RequestGate`) gives the ids, writes the access log and counts the
+  HTTP metrics; this module holds what they are.
 * One JSON access-log line per request on the ``service.access`` logger:
   method, path, route template, status, duration, request id.
 * Metrics at ``/metrics`` (prometheus-client): request counts and latency by
@@ -25,8 +27,6 @@ import logging
 import os
 import re
 import sys
-import time
-import uuid
 from contextvars import ContextVar
 from datetime import datetime, timezone
 
@@ -34,8 +34,6 @@ from fastapi import APIRouter
 from fastapi.responses import Response
 from prometheus_client import CONTENT_TYPE_LATEST, REGISTRY, CollectorRegistry, Counter, Histogram, generate_latest
 from prometheus_client import multiprocess
-from starlette.datastructures import MutableHeaders
-from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 REQUEST_ID_HEADER = "X-Request-ID"
 #: Where the request id is kept in the ASGI scope, for handlers that run outside the middleware (the 500 handler).
@@ -131,54 +129,8 @@ def configure_logging(level: str) -> None:
     logger.propagate = False
 
 
-# --------------------------------------------------------------------------- middleware
+# --------------------------------------------------------------------------- request ids (the gate gives them)
 
 
 def sane_request_id(value: str | None) -> str | None:
     return value if value is not None and _SANE_REQUEST_ID.match(value) else None
-
-
-class RequestContextMiddleware:
-    """Request id, access log and HTTP metrics for every request; the outermost of the service's middleware."""
-
-    def __init__(self, app: ASGIApp) -> None:
-        self.app = app
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
-        incoming = None
-        for name, value in scope.get("headers", ()):
-            if name == b"x-request-id":
-                incoming = value.decode("latin-1")
-                break
-        request_id = sane_request_id(incoming) or uuid.uuid4().hex
-        scope[REQUEST_ID_SCOPE_KEY] = request_id
-        token = request_id_var.set(request_id)
-        status = 500  # unless a response starts: an exception escaped and the server error handler answers
-        started = time.perf_counter()
-
-        async def send_with_id(message: Message) -> None:
-            nonlocal status
-            if message["type"] == "http.response.start":
-                status = message["status"]
-                MutableHeaders(scope=message).append(REQUEST_ID_HEADER, request_id)
-            await send(message)
-
-        try:
-            await self.app(scope, receive, send_with_id)
-        finally:
-            duration = time.perf_counter() - started
-            route = getattr(scope.get("route"), "path", None) or UNMATCHED_ROUTE
-            method = scope.get("method", "")
-            HTTP_REQUESTS.labels(method, route, str(status)).inc()
-            HTTP_LATENCY.labels(method, route).observe(duration)
-            client = scope.get("client")
-            access_logger.info(
-                "%s %s %d", method, scope.get("path", ""), status,
-                extra={"fields": {"method": method, "path": scope.get("path", ""), "route": route,
-                                  "status": status, "duration_ms": round(duration * 1000.0, 3),
-                                  "client": client[0] if client else None}},
-            )
-            request_id_var.reset(token)

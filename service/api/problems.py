@@ -125,8 +125,8 @@ async def _http_error(request: Request, exc: StarletteHTTPException) -> JSONResp
 
 
 async def _unexpected_error(request: Request, exc: Exception) -> JSONResponse:
-    # Runs in Starlette's outermost middleware, after the request-id middleware has unwound: take the id from
-    # the scope, so that the log line and the response still carry it.
+    # Runs in Starlette's outermost middleware, after the service's ASGI layer (RequestGate) has unwound: take the
+    # id from the scope, so that the log line and the response still carry it.
     request_id = request.scope.get(REQUEST_ID_SCOPE_KEY)
     logger.error("unhandled error on %s %s", request.method, request.url.path, exc_info=exc,
                  extra={"request_id": request_id})

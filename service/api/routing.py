@@ -167,7 +167,7 @@ class WorkLoops:
 
     A request never waits for another's loop: with a fixed number of loops, a single IK that arrived while long
     batches ran waited for a batch to end (past its own deadline, in the soak). Who computes when is
-    :class:`CoreTurns`'. How many loops there are at once is bounded by KIN_MAX_IN_FLIGHT (the middleware refuses
+    :class:`CoreTurns`'. How many loops there are at once is bounded by KIN_MAX_IN_FLIGHT (the gate refuses
     requests beyond it).
     """
 

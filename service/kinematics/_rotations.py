@@ -394,13 +394,13 @@ def _matrices_from_quaternions(q: np.ndarray) -> np.ndarray:
 
 
 def _canonical_sign(q: np.ndarray) -> np.ndarray:
-    """Flip (..., 4) quaternions so that w >= 0; if w == 0, the first nonzero of x, y, z is > 0."""
-    vector = q[..., 1:]
-    first_nonzero = np.take_along_axis(vector, np.argmax(vector != 0.0, axis=-1)[..., None], axis=-1)[..., 0]
-    w = q[..., 0]
+    """Flip (M, 4) quaternions so that w >= 0; if w == 0, the first nonzero of x, y, z is > 0."""
+    vector = q[:, 1:]
+    first_nonzero = vector[np.arange(len(q)), np.argmax(vector != 0.0, axis=-1)]
+    w = q[:, 0]
     flip = (w < 0.0) | ((w == 0.0) & (first_nonzero < 0.0))
-    q = np.where(flip[..., None], -q, q)
-    q[..., 0] = np.abs(q[..., 0])  # turn a -0.0 into 0.0
+    q = np.where(flip[:, None], -q, q)
+    q[:, 0] = np.abs(q[:, 0])  # turn a -0.0 into 0.0
     return q
 
 
@@ -411,27 +411,24 @@ def _quaternions_from_matrices(R: np.ndarray) -> np.ndarray:
     largest diagonal entry ``4 q_k^2`` is at least 1 (the diagonal sums to 4), so
     ``q = K[k] / (2 sqrt(K[k, k]))`` divides by a number no smaller than 2 and
     stays accurate for every rotation, including those near 180 degrees where
-    ``1 + trace`` vanishes.
+    ``1 + trace`` vanishes. ``K`` is stacked from its sixteen entries at once, over the rotations flattened to
+    (M, 3, 3): a few numpy calls whatever M, so that one rotation costs little more than the call.
     """
-    r = R
-    trace = r[..., 0, 0] + r[..., 1, 1] + r[..., 2, 2]
-    K = np.empty(R.shape[:-2] + (4, 4))
-    K[..., 0, 0] = 1.0 + trace
-    K[..., 1, 1] = 1.0 + r[..., 0, 0] - r[..., 1, 1] - r[..., 2, 2]
-    K[..., 2, 2] = 1.0 - r[..., 0, 0] + r[..., 1, 1] - r[..., 2, 2]
-    K[..., 3, 3] = 1.0 - r[..., 0, 0] - r[..., 1, 1] + r[..., 2, 2]
-    K[..., 0, 1] = K[..., 1, 0] = r[..., 2, 1] - r[..., 1, 2]
-    K[..., 0, 2] = K[..., 2, 0] = r[..., 0, 2] - r[..., 2, 0]
-    K[..., 0, 3] = K[..., 3, 0] = r[..., 1, 0] - r[..., 0, 1]
-    K[..., 1, 2] = K[..., 2, 1] = r[..., 0, 1] + r[..., 1, 0]
-    K[..., 1, 3] = K[..., 3, 1] = r[..., 0, 2] + r[..., 2, 0]
-    K[..., 2, 3] = K[..., 3, 2] = r[..., 1, 2] + r[..., 2, 1]
-    k = np.argmax(np.diagonal(K, axis1=-2, axis2=-1), axis=-1)
-    row = np.take_along_axis(K, k[..., None, None], axis=-2)[..., 0, :]
-    pivot = np.take_along_axis(row, k[..., None], axis=-1)
-    q = row / (2.0 * np.sqrt(pivot))
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = R.reshape(-1, 9).T
+    trace = r00 + r11 + r22
+    diagonal = (1.0 + trace, 1.0 + r00 - r11 - r22, 1.0 - r00 + r11 - r22, 1.0 - r00 - r11 + r22)
+    zx, xy_, xz_ = r21 - r12, r02 - r20, r10 - r01  # K[0, 1:]: 4 w (x, y, z)
+    xy, xz, yz = r01 + r10, r02 + r20, r12 + r21  # K[1, 2], K[1, 3], K[2, 3]
+    K = np.stack([diagonal[0], zx, xy_, xz_,
+                  zx, diagonal[1], xy, xz,
+                  xy_, xy, diagonal[2], yz,
+                  xz_, xz, yz, diagonal[3]], axis=-1).reshape(-1, 4, 4)
+    rows = np.arange(len(K))
+    k = np.argmax(np.stack(diagonal, axis=-1), axis=-1)
+    row = K[rows, k]
+    q = row / (2.0 * np.sqrt(row[rows, k]))[:, None]
     q /= np.linalg.norm(q, axis=-1, keepdims=True)  # inputs are orthonormal only within a tolerance
-    return _canonical_sign(q)
+    return _canonical_sign(q).reshape(*R.shape[:-2], 4)
 
 
 def matrix_from_quaternion(wxyz: ArrayLike) -> np.ndarray:

@@ -16,7 +16,8 @@ import pytest
 from fastapi.testclient import TestClient
 
 from service.api.app import create_app
-from service.api.budget import InFlight, WorkLimits, budget_of
+from service.api.budget import InFlight, budget_of
+from service.api.gate import RequestGate
 from service.api.routers import health
 from service.config import Settings
 from service.kinematics import COUNT_CAP, Budget, BudgetExhausted, Limits
@@ -340,7 +341,7 @@ def test_a_disconnect_cancels_the_request_budget():
     async def send(message):
         pass
 
-    middleware = WorkLimits(app, Settings(_env_file=None), InFlight(4))
+    middleware = RequestGate(app, Settings(_env_file=None), InFlight(4))
     scope = {"type": "http", "method": "POST", "path": "/v1/ik", "headers": []}
     asyncio.run(middleware(scope, receive, send))
     assert seen["reason"] == "cancelled"

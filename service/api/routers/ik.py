@@ -46,11 +46,13 @@ async def inverse_kinematics_inline(request: Request, body: IKInlineRequest, ren
 
 
 async def _answer_or_picture(request: Request, ref: RobotRef, body: IKRequest, render: RenderView | None):
-    """A single IK's answer (or picture), computed where the request is when its work is small."""
+    """A single IK's answer (or picture), computed where the request is when its work is small (decided once,
+    here, after validation)."""
     asked = ik_request_in_core(request, ref, body)
     picture = render is not None or wants_svg(request)
-    return await computed(lambda: _single_response(request, asked, body, render, picture),
-                          small=not picture and is_small(asked.ref.robot, asked.targets, asked.options))
+    small = is_small(asked.ref.robot, asked.targets, asked.options)
+    return await computed(lambda: _single_response(request, asked, body, render, picture, small),
+                          small=small and not picture)
 
 
 def _single_answer(request: Request, ref: RobotRef, body: IKRequest, render: RenderView | None):
@@ -58,9 +60,10 @@ def _single_answer(request: Request, ref: RobotRef, body: IKRequest, render: Ren
                             render is not None or wants_svg(request))
 
 
-def _single_response(request: Request, asked: AskedIK, body: IKRequest, render: RenderView | None, picture: bool):
+def _single_response(request: Request, asked: AskedIK, body: IKRequest, render: RenderView | None, picture: bool,
+                     small: bool | None = None):
     ref = asked.ref
-    answer = ik_objects(ref.id, ref.robot, answered(request, asked, "objects"), body.angle_unit,
+    answer = ik_objects(ref.id, ref.robot, answered(request, asked, "objects", small=small), body.angle_unit,
                         budget_of(request))[0]
     if not picture:
         return FastJSONResponse(answer)  # built to IKResponse field by field (a test validates it), as it stands

@@ -73,9 +73,11 @@ class Cost:
         return self.ranked > MAX_COMBINATIONS_PER_SOLUTION
 
 
-def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_asked: bool = True) -> Cost:
+def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_asked: bool = True,
+             small: bool | None = None) -> Cost:
     """The cost of answering ``targets`` with ``options`` (see :class:`Cost`). ``kept_asked``: the client chose
-    ``max_equivalents`` or ``max_solutions`` (a default too large to rank is lowered, not refused).
+    ``max_equivalents`` or ``max_solutions`` (a default too large to rank is lowered, not refused). ``small``:
+    :func:`is_small` of the same arguments when the caller has it already (it decides where to compute first).
 
     Raises :class:`~.._errors.InvalidInputError` (located at ``free_joints``) for free joints the arm cannot
     take, as :func:`~._answer.answer_ik` would.
@@ -84,7 +86,8 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
     limits = Limits.of(robot) if options.limits is None else options.limits
     starts = options.search.numeric.starts
     most, numeric_targets, numeric_per_target, free_values = 0, 0, starts, 1
-    small = is_small(robot, targets, options)  # before anything is built
+    if small is None:
+        small = is_small(robot, targets, options)  # before anything is built
     for kind in np.unique(kinds).tolist():
         rows = kinds == kind
         if kind == DIRECTION and robot.dof >= 6:  # the family over the free roll: rolls × free values × solutions

@@ -17,9 +17,10 @@ from pydantic import TypeAdapter
 from service.robots import robot_from_description
 from service.robots.schemas import RobotDescription
 from service.kinematics import InvalidInputError, forward_kinematics
-from service.kinematics.ik import FreeJoint, distance_to_reference, free_joints_for, solve_free_joint_family
-from service.kinematics.ik._redundant import beyond_reach, default_free_joints, family_for, sample_values
-from tests.ik_helpers import find
+from service.kinematics.ik import (FreeJoint, beyond_reach, distance_to_reference, free_joints_for,
+                                   solve_free_joint_family)
+from service.kinematics.ik._redundant import default_free_joints, family_for, sample_values
+from tests.ik_helpers import angle_gap, find
 
 ARMS = json.loads((Path(__file__).parents[2] / "data" / "redundant_and_deficient_arms.json").read_text())
 
@@ -73,7 +74,7 @@ def test_generating_vector_comes_back_and_every_solution_is_verified(name, joint
         answer = solve_free_joint_family(robot, target[None], [FreeJoint(joint, grid)], None)
         solutions = solutions_of(answer)
         assert_fk_verified(robot, solutions, target)
-        gap = np.abs(np.angle(np.exp(1j * (solutions[:, joint, None] - grid[None, :])))).min(axis=1)
+        gap = angle_gap(solutions[:, joint, None], grid[None, :]).min(axis=1)
         assert gap.max() <= 1e-9  # every solution sits at one of the values asked for (mod 2π)
         recovered += find(robot, solutions, q) is not None
     assert recovered == 25
@@ -160,7 +161,7 @@ def test_trajectory_of_a_redundant_arm_keeps_the_free_joint_continuous():
     assert free_steps.max() < 0.25 and np.ptp(joints[:, 0]) > 0.5  # q1 moves continuously, as the path needs
     # the answer is the greedy nearest one: each step no larger than to the generating path's next sample
     for k in range(1, len(t)):
-        to_generating = np.abs(np.angle(np.exp(1j * (path[k] - joints[k - 1])))).max()
+        to_generating = angle_gap(path[k], joints[k - 1]).max()
         assert steps[k - 1] <= to_generating + 1e-9
 
 

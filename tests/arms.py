@@ -4,9 +4,18 @@ an arm given by its screws, whatever offsets that takes)."""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
+from pydantic import TypeAdapter
 
 from service.kinematics import Joint, Robot, ScrewJoint
+from service.robots import robot_from_description
+from service.robots.schemas import RobotDescription
+
+#: redundant and deficient arms from published parameters: name → inline description (DH table, limits)
+PUBLISHED_ARMS = json.loads((Path(__file__).parent / "data" / "redundant_and_deficient_arms.json").read_text())
 
 #: three-parallel case → (structure, 0-based standard-DH twists set to 0 or π (axes i+1 ∥ i+2), link lengths a_i
 #: set to 0 (axes i+1 and i+2 intersect), the middle parallel joint)
@@ -19,6 +28,12 @@ THREE_PARALLEL_CASES = {
     "at_base_123": ("three_parallel_at_base", (0, 1), (), 1),
     "at_base_123_with_5_6_intersecting": ("three_parallel_at_base", (0, 1), (4,), 1),  # EAIK's 3 ∥ + 2 ∩
 }
+
+
+def published_arm(name: str) -> Robot:
+    """A :data:`PUBLISHED_ARMS` arm, built from its inline description as the service builds one."""
+    description = TypeAdapter(RobotDescription).validate_python({"id": name.replace("_", "-"), **PUBLISHED_ARMS[name]})
+    return robot_from_description(description, max_joints=16)
 
 
 def random_rotation(rng: np.random.Generator) -> np.ndarray:

@@ -1,6 +1,6 @@
-"""Arms the tests build: seeded random arms of each IK family (with a random base and tool), and arms stated the
-way CAD exports and vendors state them (rounded DH values, rounded base and tool quaternions, the exact DH table of
-an arm given by its screws, whatever offsets that takes)."""
+"""Arms the tests build: redundant and deficient arms from published parameters, seeded random arms of each IK
+family (with a random base and tool), and arms stated the way CAD exports and vendors state them (rounded DH values,
+rounded base and tool quaternions, the exact DH table of an arm given by its screws, whatever offsets that takes)."""
 
 from __future__ import annotations
 

@@ -1,10 +1,11 @@
-"""Shared fixtures: an in-process client for the ASGI app, with the lifespan run."""
+"""Shared fixtures: an in-process client for the ASGI app, with the lifespan run, and a seeded random generator."""
 
 from __future__ import annotations
 
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 
@@ -18,6 +19,12 @@ DATA = Path(__file__).parent / "data"
 def client() -> TestClient:
     with TestClient(create_app(Settings())) as test_client:
         yield test_client
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    """A generator seeded with 0, fresh for each test: a test draws the same numbers whatever runs before it."""
+    return np.random.default_rng(0)
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,4 @@
-"""Helpers shared by the IK tests: requests, random configurations and matching solutions mod 2π."""
+"""Helpers shared by the IK tests: requests, random configurations, angles wrapped and matching solutions mod 2π."""
 
 from __future__ import annotations
 
@@ -8,6 +8,16 @@ from service.kinematics.ik import joint_difference
 
 #: Two joint vectors are the same solution when every joint agrees to this (rad, or length units).
 SAME = 1e-7
+
+
+def wrapped(angle) -> np.ndarray:
+    """``angle`` (radians, any shape) wrapped into (−π, π]."""
+    return np.pi - np.mod(np.pi - np.asarray(angle), 2 * np.pi)
+
+
+def angle_gap(a, b) -> np.ndarray:
+    """|a − b| modulo 2π, in [0, π] (a and b broadcast)."""
+    return np.abs(wrapped(np.asarray(a) - np.asarray(b)))
 
 
 def random_configurations(robot, count: int, seed: int) -> np.ndarray:

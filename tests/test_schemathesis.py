@@ -82,8 +82,8 @@ import numpy as np  # noqa: E402
 from hypothesis import given  # noqa: E402
 
 from service.robots.export import screws_description  # noqa: E402
-from service.kinematics import forward_kinematics, quaternions_from_matrices  # noqa: E402
-from service.kinematics._rotations import euler_zyz_from_matrix, rpy_from_matrix  # noqa: E402
+from service.kinematics import forward_kinematics, quaternions_from_matrices, rpy_from_matrix  # noqa: E402
+from service.kinematics._rotations import euler_zyz_from_matrix  # noqa: E402
 
 CATALOGUE = load_catalogue([BUILTIN_ROBOTS_DIR], max_joints=32)
 

@@ -155,9 +155,8 @@ def test_forward_kinematics(client):
 
 
 def _targets(models, T: np.ndarray):
-    from service.kinematics._rotations import euler_zyz_from_matrix, rpy_from_matrix
-
-    from service.kinematics import quaternions_from_matrices
+    from service.kinematics import quaternions_from_matrices, rpy_from_matrix
+    from service.kinematics._rotations import euler_zyz_from_matrix
 
     R, p = T[:3, :3], T[:3, 3].tolist()
     return {

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import assert_problem, catalogue_robot
-from tests.ik_helpers import find, joints_of, unlimited
+from tests.ik_helpers import angle_gap, find, joints_of, unlimited, wrapped
 from tests.oracles.closed_forms import CLOSED_FORMS
 
 def dh_fk(a, alpha, d, q) -> np.ndarray:
@@ -129,7 +129,7 @@ def test_puma_wrist_singularity(client, theta5, relation, combined):
         assert_fk_reaches(PUMA, result, T)
         solutions = joints_of(result)
         assert len(solutions) == 7
-        arm = np.abs(np.angle(np.exp(1j * (solutions[:, :3] - q[:3])))).max(axis=1)
+        arm = angle_gap(solutions[:, :3], q[:3]).max(axis=1)
         family = np.flatnonzero(arm < 1e-7)
         assert len(family) == 1  # the singular arm branch: one representative
         representative = solutions[family[0]]
@@ -487,10 +487,6 @@ def test_unreachable_targets_of_any_arm_are_a_plain_answer(client, robot, target
 # --------------------------------------------------------------------------
 
 
-def _wrapped(q):
-    return np.pi - np.mod(np.pi - np.asarray(q), 2 * np.pi)
-
-
 @pytest.mark.parametrize("norm", ["linf", "l2"])
 def test_reference_orders_nearest_first_across_the_wrap(client, norm):
     """Continuous joints (no limits): distances are measured across the 2π wrap. The reference is one solution
@@ -507,7 +503,7 @@ def test_reference_orders_nearest_first_across_the_wrap(client, norm):
         ordered = _pose_ik(client, ELBOW, T, reference=reference.tolist(), ordering={"norm": norm})
         solutions = joints_of(ordered)
         assert find(robot, solutions[:1], plain[chosen]) == 0
-        difference = np.abs(_wrapped(solutions - reference))
+        difference = np.abs(wrapped(solutions - reference))
         distance = difference.max(axis=1) if norm == "linf" else np.linalg.norm(difference, axis=1)
         assert np.all(np.diff(distance) >= 0)
         assert distance[0] <= (0.05 if norm == "linf" else 0.05 * np.sqrt(6)) + 1e-12
@@ -565,8 +561,8 @@ def _dense_search(target: np.ndarray, starts: int = 600, iterations: int = 60, s
         q[better], e[better], cost[better] = trial[better], trial_error[better], trial_cost[better]
         damping = np.where(better, np.maximum(damping * 0.3, 1e-12), damping * 10)
     found: list[np.ndarray] = []
-    for candidate in _wrapped(q[np.sqrt(cost) < 1e-10]):
-        if not any(np.abs(_wrapped(candidate - other)).max() < 1e-4 for other in found):
+    for candidate in wrapped(q[np.sqrt(cost) < 1e-10]):
+        if not any(np.abs(wrapped(candidate - other)).max() < 1e-4 for other in found):
             found.append(candidate)
     return np.array(found)
 

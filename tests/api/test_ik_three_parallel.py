@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.arms import THREE_PARALLEL_CASES as CASES, random_three_parallel_arm
 from tests.ik_helpers import find, fk_inline, joints_of
-from tests.kinematics.ik.test_three_parallel import CASES, random_arm
 
 
 def _description(robot) -> dict:
@@ -18,7 +18,7 @@ def _description(robot) -> dict:
 
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_an_inline_arm_of_each_class_is_solved_in_closed_form(client, case):
-    robot = random_arm(case, "modified", seed=71)
+    robot = random_three_parallel_arm(case, "modified", seed=71)
     description = _description(robot)
     for q in np.random.default_rng(71).uniform(-np.pi, np.pi, (4, 6)):
         T = fk_inline(client, description, q)

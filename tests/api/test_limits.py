@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import assert_problem, catalogue_robot
+from tests.ik_helpers import wrapped
 
 DEG = math.pi / 180
 TOL = 1e-9  # the documented inclusive-bound tolerance (radians; times the robot's size for slides)
@@ -91,10 +92,6 @@ def assert_same_vectors(actual: np.ndarray, expected: np.ndarray, tol: float = 1
         return
     close = np.abs(actual[:, None, :] - expected[None, :, :]).max(axis=-1) <= tol
     assert (close.sum(axis=1) == 1).all() and (close.sum(axis=0) == 1).all()
-
-
-def wrapped(x: np.ndarray) -> np.ndarray:
-    return np.pi - np.mod(np.pi - x, 2 * np.pi)
 
 
 def assert_within(q: np.ndarray, lower, upper) -> None:

@@ -14,8 +14,7 @@ from fastapi.testclient import TestClient
 
 from service.api.app import create_app
 from service.config import Settings
-from service.kinematics import forward_kinematics
-from service.kinematics._trajectory import TrajectoryOptions, follow_trajectory
+from service.kinematics import TrajectoryOptions, follow_trajectory, forward_kinematics
 from tests.conftest import DATA, assert_problem, catalogue_robot
 from tests.oracles.paths import difference_jacobian, scaled_sigma_min, spiral, wobble
 

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from tests.collision_check import independent_check
+from tests.ik_helpers import wrapped
 
 ROBOT = "puma560_standard"
 START = [0.4, 0.6, -2.0, 0.7, 1.1, -0.5]  # elbow up
@@ -17,10 +18,6 @@ SAMPLES = 21
 #: A lamp the elbow-up branch's upper arm meets two thirds of the way (found by a search over random spheres
 #: near the arm; the elbow-down branch passes it).
 LAMP = {"name": "lamp", "sphere": {"center": [0.362, 0.138, 0.390], "radius": 0.03}}
-
-
-def _wrapped(angle: np.ndarray) -> np.ndarray:
-    return (angle + np.pi) % (2 * np.pi) - np.pi
 
 
 @pytest.fixture(scope="module")
@@ -64,7 +61,7 @@ def test_a_collision_forces_a_branch_change_and_says_so(client, path):
     solutions = client.post(f"/v1/robots/{ROBOT}/ik", json={"target": path[k]["pose"], "filter_limits": False}
                             ).json()["solutions"]
     previous = np.array(samples[k - 1]["joints"])
-    continuation = min(solutions, key=lambda s: np.linalg.norm(_wrapped(np.array(s["joints"]) - previous)))
+    continuation = min(solutions, key=lambda s: np.linalg.norm(wrapped(np.array(s["joints"]) - previous)))
     assert independent_check(client, ROBOT, continuation["joints"], [LAMP], 0.0, self_collision=False)[0] < 0
     for sample, pose in zip(samples, path):
         assert sample["status"] == "ok" and _reaches(client, sample["joints"], pose["pose"])

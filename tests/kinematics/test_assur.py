@@ -13,7 +13,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.kinematics import _assur, _assur_functions
+from service.kinematics import InvalidInputError, _assur, _assur_functions
 from service.kinematics._assur import (
     RRRCase,
     angle_function,
@@ -22,7 +22,6 @@ from service.kinematics._assur import (
     distance_function,
     rrr_group,
 )
-from service.kinematics._errors import InvalidInputError
 from service.kinematics._tolerances import SINGULARITY_TOLERANCE
 
 DATA = json.loads((Path(__file__).resolve().parents[1] / "data" / "assur_spiral_tables.json").read_text())

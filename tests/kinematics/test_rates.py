@@ -13,9 +13,9 @@ import pytest
 
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
-from service.kinematics import Joint, Robot, forward_kinematics, geometric_jacobian
-from service.kinematics import _rates
-from service.kinematics._rates import jacobian_derivative, joint_rates, task_jacobian, task_space
+from service.kinematics import (Joint, Robot, _rates, forward_kinematics, geometric_jacobian, jacobian_derivative,
+                                joint_rates, task_space)
+from service.kinematics._rates import task_jacobian
 
 CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 ROBOT_IDS = sorted(entry.description.id for entry in CATALOGUE.entries())
@@ -257,7 +257,7 @@ def test_rates_along_a_smooth_path_match_differences_of_the_position_ik(robot_id
     Each of 25 points t is surrounded by t ± h, t ± 2h in one trajectory, so the branch is the same for all
     five; q̇ and q̈ at t are compared with the five-point differences of the joint positions.
     """
-    from service.kinematics._trajectory import TrajectoryOptions, follow_trajectory
+    from service.kinematics import TrajectoryOptions, follow_trajectory
     from tests.oracles.paths import wobble
 
     arm = robot(robot_id)

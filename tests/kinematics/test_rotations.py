@@ -13,33 +13,24 @@ import math
 import numpy as np
 import pytest
 
-from service.kinematics import _rotations
-from service.kinematics._errors import InvalidInputError
-from service.kinematics._rotations import (
+from service.kinematics import (
+    InvalidInputError,
+    _rotations,
     check_rotation,
     check_transform,
     check_transforms,
     check_unit_quaternion,
-    euler_zyz_from_matrix,
     matrix_from_euler_zyz,
     matrix_from_quaternion,
     matrix_from_rpy,
     quaternions_from_matrices,
-    rot_x,
-    rot_y,
-    rot_z,
     rpy_from_matrix,
-    wrap_angle,
 )
+from service.kinematics._rotations import euler_zyz_from_matrix, rot_x, rot_y, rot_z, wrap_angle
 from service.kinematics._tolerances import SINGULARITY_TOLERANCE
 
 N = 1000
 PI = math.pi
-
-
-@pytest.fixture
-def rng() -> np.random.Generator:
-    return np.random.default_rng(0)
 
 
 def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:

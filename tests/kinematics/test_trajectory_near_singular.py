@@ -15,13 +15,12 @@ import numpy as np
 import pytest
 
 from service.config import Settings
-from service.kinematics import forward_kinematics
-from service.kinematics._trajectory import TrajectoryOptions, follow_trajectory
+from service.kinematics import TrajectoryOptions, follow_trajectory, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik
 from service.robots.catalogue import load_catalogue
 from tests.conftest import DATA
 from tests.oracles.paths import difference_jacobian, near_singular_path, sigma_ratio
-from tests.rounding import standard_dh_from_screws, urdf_chain_screws
+from tests.arms import standard_dh_from_screws, urdf_chain_screws
 
 CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 TIMES = np.linspace(0.0, 1.0, 199)  # sample 99 is the path's middle

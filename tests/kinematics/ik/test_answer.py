@@ -8,7 +8,7 @@ from service.config import Settings
 from service.kinematics import Limits, forward_kinematics
 from service.kinematics.ik import DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, answer_ik
 from service.robots.catalogue import load_catalogue
-from tests.kinematics.ik.test_redundant import arm
+from tests.arms import published_arm
 
 PUMA = load_catalogue([Settings().builtin_robots_dir], max_joints=32).get("puma560_standard").robot
 TOOL_AXIS = np.array([0.0, 1.0, 0.0])
@@ -45,7 +45,7 @@ def _assert_same_target(batch, single) -> None:
 
 
 def test_mixed_kinds_in_one_batch_each_row_as_if_alone():
-    robot = arm("widowx250_like")
+    robot = published_arm("widowx250_like")
     q = np.random.default_rng(7).uniform(-np.pi, np.pi, (6, robot.dof))
     targets = _targets(robot, q, [POSE, POSITION, DIRECTION, POSE, DIRECTION, POSITION])
     answer = answer_ik(robot, targets, AnswerOptions(filter_limits=False))
@@ -67,7 +67,7 @@ def test_mixed_kinds_in_one_batch_each_row_as_if_alone():
 
 
 def test_numeric_rows_enter_the_same_tables_as_the_analytic_ones():
-    robot = arm("iiwa14")
+    robot = published_arm("iiwa14")
     q = np.array([[0.3, 0.5, -0.7, 1.1, 0.2, -0.4, 0.9]] * 2)
     targets = _targets(robot, q, [POSITION, POSE])
     # q4 locked leaves no closed-form family: the full pose goes to the numeric search; the position alone is
@@ -85,7 +85,7 @@ def test_numeric_rows_enter_the_same_tables_as_the_analytic_ones():
 
 
 def test_a_position_the_held_joints_miss_is_searched_over_every_joint_in_the_same_tables():
-    robot = arm("iiwa14")
+    robot = published_arm("iiwa14")
     q = np.array([[0.3, 0.5, -0.7, 1.1, 0.2, -0.4, 0.9], [0.0] * 7])
     targets = _targets(robot, q, [POSITION, POSE])
     answer = answer_ik(robot, targets, AnswerOptions(filter_limits=False))  # held at 0: q[0]'s point is missed

@@ -17,12 +17,9 @@ from service.kinematics import forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik
 from service.robots.build import robot_from_description
 from service.robots.schemas import DHRobot
+from tests.ik_helpers import wrapped
 
 HALF = np.pi / 2
-
-
-def _wrapped(angle: np.ndarray) -> np.ndarray:
-    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
 
 
 def _coaxial_puma(rng: np.random.Generator, pair_start: int, reversed_axes: bool):
@@ -62,7 +59,7 @@ def test_coaxial_pairs_report_the_relation_and_return_the_generating_configurati
                 held = 0.0 if reference is None else q[second]
                 np.testing.assert_allclose(solutions[:, second], held, atol=1e-12)
                 d = joint_difference(robot, solutions, q)
-                combined = np.abs(_wrapped(d[:, first] + sign * d[:, second]))
+                combined = np.abs(wrapped(d[:, first] + sign * d[:, second]))
                 others = np.delete(np.abs(d), [first, second], axis=1).max(axis=1)
                 assert np.any((combined <= 1e-7) & (others <= 1e-7)), (arm, trial, reference is None)
                 if reference is not None:  # the held joint at the generating value: the whole configuration
@@ -70,7 +67,7 @@ def test_coaxial_pairs_report_the_relation_and_return_the_generating_configurati
                 # one representative per relation: no two solutions differ only in the split
                 reduced = np.delete(solutions, second, axis=1)
                 reduced[:, first] = solutions[:, first] + sign * solutions[:, second]
-                gaps = np.abs(_wrapped(reduced[:, None] - reduced[None])).max(axis=-1)
+                gaps = np.abs(wrapped(reduced[:, None] - reduced[None])).max(axis=-1)
                 assert (gaps[np.triu_indices(len(reduced), 1)] > 1e-6).all()
 
 

@@ -17,7 +17,7 @@ import pytest
 
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik
-from tests.ik_helpers import find
+from tests.ik_helpers import find, wrapped
 
 
 def coaxial_arm(rng: np.random.Generator, dof: int, pair: int, convention: str, *, planar: bool,
@@ -61,7 +61,7 @@ def _split_free_match(robot: Robot, solutions: np.ndarray, q: np.ndarray, first:
     if not len(solutions):
         return False
     d = joint_difference(robot, solutions, q)
-    combined = np.abs(np.angle(np.exp(1j * (d[:, first] + sign * d[:, second]))))
+    combined = np.abs(wrapped(d[:, first] + sign * d[:, second]))
     others = np.abs(np.delete(d, [first, second], axis=1)).max(axis=1)
     return bool(np.any((combined <= 1e-7) & (others <= 1e-7)))
 

@@ -15,7 +15,7 @@ from service.kinematics import forward_kinematics
 from service.kinematics.ik import solve_direction, target_kinds
 from service.kinematics.ik._direction import rotations_to
 from tests.ik_helpers import find
-from tests.kinematics.ik.test_redundant import arm
+from tests.arms import published_arm
 
 AXES = {"roll axis z": [0.0, 0.0, 1.0], "jaw axis y": [0.0, 1.0, 0.0], "side axis x": [1.0, 0.0, 0.0],
         "oblique": [0.3, -0.5, 0.8]}
@@ -24,7 +24,7 @@ AXES = {"roll axis z": [0.0, 0.0, 1.0], "jaw axis y": [0.0, 1.0, 0.0], "side axi
 @pytest.mark.parametrize("name", ["widowx250_like", "so101_like"])
 @pytest.mark.parametrize("axis_name", list(AXES))
 def test_recall_of_direction_targets_is_complete(name, axis_name):
-    robot = arm(name)
+    robot = published_arm(name)
     axis = np.array(AXES[axis_name]) / np.linalg.norm(AXES[axis_name])
     rng = np.random.default_rng(51)
     q = rng.uniform(-np.pi, np.pi, (150, 5))
@@ -49,7 +49,7 @@ def test_recall_of_direction_targets_is_complete(name, axis_name):
 
 
 def test_an_unreachable_direction_gives_no_solution():
-    robot = arm("widowx250_like")
+    robot = published_arm("widowx250_like")
     T = forward_kinematics(robot, np.array([0.3, 0.2, -0.4, 0.5, 0.6]))
     # the gripper axis of this arm stays in the vertical plane through the base axis: a sideways one is out
     sideways = np.cross([0.0, 0.0, 1.0], T[:3, 3])
@@ -66,5 +66,5 @@ def test_rotations_to_take_the_axis_onto_the_direction_also_when_opposite():
 
 
 def test_target_kinds_name_the_direction_kind_for_arms_of_five_joints_or_more():
-    assert target_kinds(arm("so101_like")) == ["pose", "position", "position_direction"]
-    assert target_kinds(arm("iiwa14")) == ["pose", "position", "position_direction"]
+    assert target_kinds(published_arm("so101_like")) == ["pose", "position", "position_direction"]
+    assert target_kinds(published_arm("iiwa14")) == ["pose", "position", "position_direction"]

@@ -14,14 +14,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.kinematics import forward_kinematics
-from service.kinematics._errors import InvalidInputError
-from service.kinematics.ik import DIRECTION, AnswerOptions, IKTargets, estimate, solve_ik
-from service.kinematics.ik._direction import (DEFAULT_ROLL_SAMPLES, MAX_ROLL_ROWS, roll_family, roll_poses,
-                                              roll_samples, rolls_of, solve_roll_family)
+from service.kinematics import InvalidInputError, forward_kinematics
+from service.kinematics.ik import (DEFAULT_ROLL_SAMPLES, DIRECTION, MAX_ROLL_ROWS, AnswerOptions, IKTargets, estimate,
+                                   roll_samples, solve_ik)
+from service.kinematics.ik._direction import roll_family, roll_poses, rolls_of, solve_roll_family
 from service.kinematics.ik._goals import DirectionGoal
 from service.robots.catalogue import load_catalogue
-from tests.ik_helpers import same_set
+from tests.arms import random_family_arm, random_general_arm
+from tests.ik_helpers import angle_gap, same_set
 
 ROBOTS = Path(__file__).parents[3] / "robots"
 
@@ -60,7 +60,7 @@ def test_complete_means_every_solution_at_each_sampled_roll(catalogue, robot_id)
     assert answer.verified.complete.all()
     table = answer.verified.table
     for roll, pose in zip(rolls, roll_poses(axis, goal.positions[0], goal.directions[0], rolls)):
-        at_roll = table.joints[np.abs(np.angle(np.exp(1j * (table.roll - roll)))) < 1e-9]
+        at_roll = table.joints[angle_gap(table.roll, roll) < 1e-9]
         closed = solve_ik(robot, pose)
         assert closed.complete
         assert same_set(robot, at_roll, np.array([s.joints for s in closed.solutions]).reshape(-1, robot.dof))
@@ -91,13 +91,10 @@ def test_the_cost_model_counts_rolls_times_solutions(catalogue):
 
 def _random_arms():
     """Random arms of each 6R family, with random base and tool (so the tool axis is not the last joint's)."""
-    from tests.kinematics.ik.test_general_6r import random_arm as general_arm
-    from tests.kinematics.ik.test_one_pose_families import random_arm as family_arm
-
     for seed in range(3):
-        yield f"spherical_wrist-{seed}", family_arm("intersecting_shoulder+spherical_wrist", "standard", seed)
-        yield f"three_parallel-{seed}", family_arm("three_parallel", "modified", seed)
-        yield f"general_6r-{seed}", general_arm(np.random.default_rng(seed), "standard")
+        yield f"spherical_wrist-{seed}", random_family_arm("intersecting_shoulder+spherical_wrist", "standard", seed)
+        yield f"three_parallel-{seed}", random_family_arm("three_parallel", "modified", seed)
+        yield f"general_6r-{seed}", random_general_arm(np.random.default_rng(seed), "standard")
 
 
 @pytest.mark.parametrize("name, robot", list(_random_arms()), ids=lambda value: value if isinstance(value, str)
@@ -123,7 +120,7 @@ def test_promise_audit_of_direction_targets_on_random_arms(name, robot):
     start, stop = at_own.solutions.bounds(len(q))
     for row in range(len(q)):
         joints = at_own.solutions.joints[start[row]:stop[row]]
-        assert len(joints) and np.abs(np.angle(np.exp(1j * (joints - q[row])))).max(axis=1).min() < 1e-6, name
+        assert len(joints) and angle_gap(joints, q[row]).max(axis=1).min() < 1e-6, name
         reached = forward_kinematics(robot, joints)
         assert np.abs(reached[:, :3, 3] - T[row, :3, 3]).max() <= 1e-9 * max(1.0, robot.characteristic_length)
         assert np.abs(reached[:, :3, :3] @ axis - directions[row]).max() <= 1e-9

@@ -16,30 +16,14 @@ from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Joint, Robot, forward_kinematics, geometric_jacobian
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_batch
-from service.kinematics.ik import solve_ik_arrays
 from service.kinematics.ik._general_6r import General6RPlan, _solve_arrangement, is_pieper
-from service.kinematics.ik._plan import geometry_of, plan_for
+from service.kinematics.ik import plan_for, solve_ik_arrays
+from service.kinematics.ik._plan import geometry_of
 from service.kinematics.ik._verify import residuals
+from tests.arms import random_general_arm, random_rotation
+from tests.ik_helpers import SAME, angle_gap, wrapped
 
 CONVENTIONS = ("standard", "modified", "khalil")
-#: A generating vector is found when some solution equals it to this (radians, modulo 2π).
-SAME = 1e-7
-
-
-def random_arm(rng: np.random.Generator, convention: str) -> Robot:
-    """A random 6R arm (DH entries uniform in ±1, in the given convention) with a random base and tool."""
-    joints = [Joint(f"q{i + 1}", "revolute", *rng.uniform(-1, 1, 4)) for i in range(6)]
-    base, tool = np.eye(4), np.eye(4)
-    base[:3, :3] = _rotation(rng)
-    base[:3, 3] = rng.uniform(-1, 1, 3)
-    tool[:3, :3] = _rotation(rng)
-    tool[:3, 3] = rng.uniform(-0.3, 0.3, 3)
-    return Robot(joints, convention=convention, world_T_base=base, flange_T_tool=tool)
-
-
-def _rotation(rng: np.random.Generator) -> np.ndarray:
-    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    return Q * np.sign(np.linalg.det(Q))
 
 
 def found(robot: Robot, solutions: np.ndarray, q: np.ndarray, tolerance: float = SAME) -> bool:
@@ -75,7 +59,7 @@ def test_every_generating_vector_comes_back_on_random_general_arms(convention):
     rng = np.random.default_rng(CONVENTIONS.index(convention) + 100)
     total = complete = 0
     for _ in range(4):
-        robot = random_arm(rng, convention)
+        robot = random_general_arm(rng, convention)
         q = rng.uniform(-np.pi, np.pi, (90, 6))
         arrays = check_answers(robot, q)
         total += len(q)
@@ -88,7 +72,7 @@ def test_every_generating_vector_comes_back_on_random_general_arms(convention):
 def test_the_same_arm_in_three_conventions_gets_the_same_solution_sets():
     """Craig's modified table of a standard-DH arm describes the same screws; the answers must agree."""
     rng = np.random.default_rng(7)
-    standard = random_arm(rng, "standard")
+    standard = random_general_arm(rng, "standard")
     # the same chain in Craig's form: row i of the modified table holds a_{i-1}, α_{i-1}, d_i, θ_i
     a, alpha = np.r_[0.0, standard.a[:-1]], np.r_[0.0, standard.alpha[:-1]]
     last = np.eye(4)
@@ -139,10 +123,10 @@ def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.
         q[better], error[better] = trial[better], trial_error[better]
         damping = np.where(better, damping / 10, damping * 10).clip(1e-12, 1e6)
     converged = q[np.abs(error).max(axis=1) < 1e-11]
-    converged = np.angle(np.exp(1j * converged))
+    converged = wrapped(converged)
     distinct: list[np.ndarray] = []
     for candidate in converged:
-        if not any(np.abs(np.angle(np.exp(1j * (candidate - other)))).max() < 1e-6 for other in distinct):
+        if not any(angle_gap(candidate, other).max() < 1e-6 for other in distinct):
             distinct.append(candidate)
     return np.array(distinct).reshape(-1, 6)
 
@@ -151,7 +135,7 @@ def test_solution_counts_agree_with_a_dense_multistart_search():
     rng = np.random.default_rng(11)
     counts = []
     for convention in CONVENTIONS:
-        robot = random_arm(rng, convention)
+        robot = random_general_arm(rng, convention)
         q = rng.uniform(-np.pi, np.pi, (4, 6))
         for result, generator in zip(solve_ik_batch(robot, forward_kinematics(robot, q)), q):
             oracle = multistart_solutions(robot, forward_kinematics(robot, generator), 1500, rng)
@@ -239,7 +223,7 @@ def test_roots_at_pi_and_a_singular_leading_matrix():
     and still return the solution; every joint at or within 1e-12…1e-6 of π is exercised."""
     rng = np.random.default_rng(3)
     for convention in CONVENTIONS:
-        robot = random_arm(rng, convention)
+        robot = random_general_arm(rng, convention)
         plan = plan_for(robot, constrain_orientation=True, reference=None)
         q = rng.uniform(-np.pi, np.pi, (6 * 4, 6))
         for joint in range(6):
@@ -258,7 +242,7 @@ def test_near_singular_configurations_are_found_and_said_incomplete_or_counted()
     """At a configuration where det J = 0 two solutions merge (a double root): the generating vector must still
     come back, and the answer may not claim completeness unless its count is consistent."""
     rng = np.random.default_rng(5)
-    robot = random_arm(rng, "standard")
+    robot = random_general_arm(rng, "standard")
     for trial in range(6):
         start, end = rng.uniform(-np.pi, np.pi, (2, 6))
         det = lambda t: np.linalg.det(geometric_jacobian(robot, start + t * (end - start)))
@@ -316,7 +300,7 @@ def test_pieper_arms_are_never_routed_to_the_general_solver():
 
 
 def test_general_arms_are_routed_to_the_general_solver_with_no_labels():
-    robot = random_arm(np.random.default_rng(9), "khalil")
+    robot = random_general_arm(np.random.default_rng(9), "khalil")
     plan = plan_for(robot, constrain_orientation=True, reference=None)
     assert plan.structure == "general_6r" and plan.generic_count == 16
     q = np.random.default_rng(1).uniform(-np.pi, np.pi, 6)
@@ -356,12 +340,12 @@ def test_unreachable_is_a_promise_the_multistart_search_cannot_break():
     """Random targets within the arm's reach sphere: where the answer is `unreachable` and complete, a dense
     search finds no solution either; where it is not, the search's solutions are among ours."""
     rng = np.random.default_rng(21)
-    robot = random_arm(rng, "modified")
+    robot = random_general_arm(rng, "modified")
     reach = robot.characteristic_length
     unreachable = 0
     for _ in range(8):
         target = np.eye(4)
-        target[:3, :3] = _rotation(rng)
+        target[:3, :3] = random_rotation(rng)
         target[:3, 3] = robot.world_T_base[:3, 3] + rng.uniform(-0.5, 0.5, 3) * reach
         result = solve_ik(robot, target)
         assert result.structure == "general_6r" and result.complete
@@ -376,7 +360,7 @@ def test_unreachable_is_a_promise_the_multistart_search_cannot_break():
 def test_targets_beyond_the_reach_bound_are_unreachable_and_complete(distance):
     """Every turn keeps the distance to a point of its axis, so no tool position is farther from axis 1's point
     than |home − p6| + Σ|p_i+1 − p_i|; beyond it the answer is a certain `unreachable`."""
-    robot = random_arm(np.random.default_rng(8), "standard")
+    robot = random_general_arm(np.random.default_rng(8), "standard")
     target = np.eye(4)
     target[:3, 3] = [distance * robot.characteristic_length, 0.0, 0.0]
     result = solve_ik(robot, target)
@@ -388,7 +372,7 @@ def test_a_batch_larger_than_a_chunk_is_answered_in_one_piece():
     """The solver gives each chunk of targets only the slots it needs; chunks of different widths are merged."""
     from service.kinematics.ik import _closed_form
 
-    robot = random_arm(np.random.default_rng(12), "standard")
+    robot = random_general_arm(np.random.default_rng(12), "standard")
     q = np.random.default_rng(13).uniform(-np.pi, np.pi, (3 * 64 + 5, 6))
     chunk = _closed_form.CHUNK
     _closed_form.CHUNK = 64
@@ -423,7 +407,7 @@ def test_the_api_reports_the_general_solvers_completeness_per_target(client):
     """An arm given inline: the response's solver block says general_6r, and `complete` is the core's promise for
     that very target (false at a singular configuration found by bisection on det J, true elsewhere)."""
     rng = np.random.default_rng(5)
-    robot = random_arm(rng, "standard")
+    robot = random_general_arm(rng, "standard")
     robot = Robot(robot.joints, convention="standard")  # the inline description below has no base or tool
     body = {"convention": "standard", "angle_unit": "rad",
             "joints": [{"a": j.a, "alpha": j.alpha, "d": j.d, "theta": j.theta} for j in robot.joints]}

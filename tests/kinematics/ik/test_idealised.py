@@ -17,15 +17,14 @@ from collections import Counter
 import numpy as np
 import pytest
 
-from service.kinematics import Joint, Robot
-from service.kinematics._forward import forward_kinematics
+from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik_arrays, solve_ik_batch
 from service.kinematics.ik._plan import geometry_of
 from service.kinematics.ik._screws import rotate_about
 from tests.api.test_ik_recall import GENERIC
 from tests.conftest import DATA, catalogue_robot
+from tests.arms import rounded, standard_dh_from_screws, urdf_chain_screws
 from tests.ik_helpers import random_configurations, same_set
-from tests.rounding import rounded, standard_dh_from_screws, urdf_chain_screws
 
 POSES = 1000
 

@@ -7,9 +7,9 @@ import pytest
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import forward_kinematics
-from service.kinematics.ik import _verify, joint_difference, solve_ik
+from service.kinematics.ik import _verify, joint_difference, solve_ik, wrap_revolute
 from service.kinematics.ik import cached_plan
-from service.kinematics.ik._verify import accepted, residual_arrays, wrap_revolute
+from service.kinematics.ik._verify import accepted, residual_arrays
 
 from tests.ik_helpers import random_configurations
 

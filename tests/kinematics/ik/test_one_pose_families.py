@@ -7,46 +7,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import Joint, Robot, forward_kinematics
+from service.kinematics import Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik._screws import move_point
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
-from tests.kinematics.ik.test_spherical_wrist_classes import _random_rigid
+from tests.arms import random_family_arm
 
 FAMILIES = ("intersecting_shoulder+spherical_wrist", "three_parallel")
 CONVENTIONS = ("standard", "modified", "khalil")
-
-
-def random_arm(family: str, convention: str, seed: int, wrist_singular: bool = False) -> Robot:
-    """A random arm of the family (standard DH rows a, alpha, d, theta), restated in ``convention`` (Craig's rows
-    shift a_i and alpha_i down one joint, the last pair going into the tool), with a random base and tool.
-    ``wrist_singular`` (three-parallel family): the twists of axes 4–5 and 5–6 equal in size, so that axis 6 can
-    lie along the parallel axes, as on the UR arms (the same random draws otherwise)."""
-    rng = np.random.default_rng(seed)
-    a, d, theta = rng.uniform(0.1, 0.5, 6) * rng.choice([-1, 1], 6), rng.uniform(-0.4, 0.4, 6), \
-        rng.uniform(-np.pi, np.pi, 6)
-    alpha = rng.uniform(0.3, 2.8, 6) * rng.choice([-1, 1], 6)
-    if family == "intersecting_shoulder+spherical_wrist":
-        a[0] = 0.0  # axes 1 and 2 meet
-        a[3] = a[4] = d[4] = 0.0  # axes 4, 5 and 6 meet
-        alpha[4] = abs(alpha[3]) * rng.choice([-1, 1])  # equal wrist twists, as in every real wrist
-    else:
-        alpha[1] = rng.choice([0.0, np.pi])  # axes 2 ∥ 3 ∥ 4 (π: a reversed axis)
-        alpha[2] = rng.choice([0.0, np.pi])
-        a[4] = 0.0  # axes 5 and 6 meet
-        if wrist_singular:
-            alpha[4] = abs(alpha[3]) * np.sign(alpha[4])
-    base, tool = _random_rigid(rng, 0.5), _random_rigid(rng, 0.2)
-    if convention == "standard":
-        rows = zip(a, alpha, d, theta)
-    else:  # Craig's frames; a Khalil row holds the same numbers renamed
-        rows = zip(np.r_[0.0, a[:5]], np.r_[0.0, alpha[:5]], d, theta)
-        c, s = np.cos(alpha[5]), np.sin(alpha[5])
-        tool = np.array([[1, 0, 0, a[5]], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]]) @ tool
-    joints = [Joint(f"j{i + 1}", "revolute", *row) for i, row in enumerate(rows)]
-    return Robot(joints, convention=convention, world_T_base=base, flange_T_tool=tool)
 
 
 def _array_path(monkeypatch, plan) -> None:
@@ -84,7 +54,7 @@ def test_random_arms_of_the_families_answer_alike_on_both_paths(family, conventi
     array form (solve_ik_arrays of one pose) holds the same solutions as the object form."""
     answered = 0
     for seed in range(4):
-        robot = random_arm(family, convention, seed)
+        robot = random_family_arm(family, convention, seed)
         plan = cached_plan(robot, constrain_orientation=True, reference=None)
         assert plan.structure == family
         rng = np.random.default_rng(seed)

@@ -12,14 +12,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import Joint, Robot
-from service.kinematics._forward import forward_kinematics
+from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik.subproblems import subproblem_5_prismatic
+from tests.arms import random_rigid
+from tests.ik_helpers import wrapped
 from tests.kinematics.ik.test_spherical_wrist_classes import (
     _positioner_singular_configurations,
-    _random_rigid,
     _reverse_axis,
     assert_every_solution,
     configurations,
@@ -103,10 +103,10 @@ def statements(kind: str, seed: int, limits: tuple[float, float] | None = None) 
     table, kinds = _rows(kind, rng)
     n = len(kinds)
     rows = [list(row) for row in table]
-    base = _random_rigid(rng, 0.5)
+    base = random_rigid(rng, 0.5)
     for joint in np.flatnonzero(rng.random(n) < 0.4):
         base = _reverse_axis(rows, int(joint), base)
-    tool = _random_rigid(rng, 0.2)
+    tool = random_rigid(rng, 0.2)
     joint_kind = {"R": "revolute", "P": "prismatic"}
     bounds = [limits if (k == "P" and limits) else (-np.inf, np.inf) for k in kinds]
     standard = Robot([Joint(f"j{i + 1}", joint_kind[k], *row, *bound)
@@ -235,8 +235,7 @@ def test_subproblem_5_prismatic_agrees_with_a_dense_scan():
             p2 = R(k2, phi) @ (p0 + R(k, theta) @ p1) - s * v
         sol = subproblem_5_prismatic(k2, k, p0, p1, p2, v, slide_turns=turns)
         found = np.stack([sol.phi, sol.theta, sol.s], axis=-1)[sol.valid & sol.exact]
-        gaps = np.abs(np.stack([np.angle(np.exp(1j * (found[:, 0] - phi))),
-                                np.angle(np.exp(1j * (found[:, 1] - theta))), found[:, 2] - s], axis=-1))
+        gaps = np.abs(np.stack([wrapped(found[:, 0] - phi), wrapped(found[:, 1] - theta), found[:, 2] - s], axis=-1))
         assert gaps.max(axis=1).min() < 1e-9
         for f in found:  # every candidate solves the vector equation
             lhs = p2 if turns else p2 + f[2] * v
@@ -378,7 +377,7 @@ def _with_slide_cosine(robot: Robot, q: np.ndarray, cosine: float) -> np.ndarray
     ok = np.abs(cosine - C) < reach
     side = np.where(np.arange(len(q)) % 2 == 0, 1.0, -1.0)
     out = q.copy()
-    out[:, 4] = np.angle(np.exp(1j * (np.arctan2(B, A) + side * np.arccos(np.clip((cosine - C) / reach, -1, 1)))))
+    out[:, 4] = wrapped(np.arctan2(B, A) + side * np.arccos(np.clip((cosine - C) / reach, -1, 1)))
     return out[ok]
 
 

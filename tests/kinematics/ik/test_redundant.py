@@ -7,27 +7,16 @@ so the generating vector must come back. Every solution is checked here by an in
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
 
 import numpy as np
 import pytest
-from pydantic import TypeAdapter
 
-from service.robots import robot_from_description
-from service.robots.schemas import RobotDescription
 from service.kinematics import InvalidInputError, forward_kinematics
-from service.kinematics.ik import FreeJoint, distance_to_reference, free_joints_for, solve_free_joint_family
-from service.kinematics.ik._redundant import beyond_reach, default_free_joints, family_for, sample_values
-from tests.ik_helpers import find
-
-ARMS = json.loads((Path(__file__).parents[2] / "data" / "redundant_and_deficient_arms.json").read_text())
-
-
-def arm(name: str):
-    description = TypeAdapter(RobotDescription).validate_python({"id": name.replace("_", "-"), **ARMS[name]})
-    return robot_from_description(description, max_joints=16)
-
+from service.kinematics.ik import (FreeJoint, beyond_reach, distance_to_reference, free_joints_for,
+                                   solve_free_joint_family)
+from service.kinematics.ik._redundant import default_free_joints, family_for, sample_values
+from tests.arms import published_arm
+from tests.ik_helpers import angle_gap, find
 
 def solutions_of(answer, row: int = 0) -> np.ndarray:
     table = answer.verified.table
@@ -47,21 +36,22 @@ def test_default_free_joint_is_an_end_joint_whose_locking_leaves_a_family():
     # iiwa and Panda with q7 locked: the shoulder (axes 1-3 through one point) is a spherical wrist at the base.
     # The Gen3's shoulder axes do not meet (d2 = -0.0118 m), so its q7 leaves no family; q1 leaves the
     # intersecting shoulder + spherical wrist.
-    assert default_free_joints(arm("iiwa14")) == (6,)
-    assert default_free_joints(arm("panda")) == (6,)
-    assert default_free_joints(arm("gen3")) == (0,)
-    assert family_for(arm("iiwa14"), (0,)).ends_only and not family_for(arm("iiwa14"), (2,)).ends_only
+    assert default_free_joints(published_arm("iiwa14")) == (6,)
+    assert default_free_joints(published_arm("panda")) == (6,)
+    assert default_free_joints(published_arm("gen3")) == (0,)
+    assert family_for(published_arm("iiwa14"), (0,)).ends_only
+    assert not family_for(published_arm("iiwa14"), (2,)).ends_only
 
 
 def test_a_locked_class_that_is_degenerate_is_not_chosen():
     # iiwa with q4 locked: the shoulder-to-wrist distance is fixed, so generic poses are out of reach
-    assert not family_for(arm("iiwa14"), (3,)).available
+    assert not family_for(published_arm("iiwa14"), (3,)).available
 
 
 @pytest.mark.parametrize("name, joint", [("iiwa14", 2), ("iiwa14", 0), ("gen3", 2), ("gen3", 0),
                                          ("panda", 6)])
 def test_generating_vector_comes_back_and_every_solution_is_verified(name, joint):
-    robot = arm(name)
+    robot = published_arm(name)
     rng = np.random.default_rng(14)
     grid = sample_values(robot, joint, 16)
     recovered = 0
@@ -73,7 +63,7 @@ def test_generating_vector_comes_back_and_every_solution_is_verified(name, joint
         answer = solve_free_joint_family(robot, target[None], [FreeJoint(joint, grid)], None)
         solutions = solutions_of(answer)
         assert_fk_verified(robot, solutions, target)
-        gap = np.abs(np.angle(np.exp(1j * (solutions[:, joint, None] - grid[None, :])))).min(axis=1)
+        gap = angle_gap(solutions[:, joint, None], grid[None, :]).min(axis=1)
         assert gap.max() <= 1e-9  # every solution sits at one of the values asked for (mod 2π)
         recovered += find(robot, solutions, q) is not None
     assert recovered == 25
@@ -81,7 +71,7 @@ def test_generating_vector_comes_back_and_every_solution_is_verified(name, joint
 
 def test_each_value_is_solved_completely():
     """At one free value the answer equals the locked 6-DOF family's complete set (8 for this SRS pose)."""
-    robot = arm("iiwa14")
+    robot = published_arm("iiwa14")
     q = np.array([0.4, 0.7, -0.3, 1.2, 0.5, -0.8, 0.2])
     target = forward_kinematics(robot, q)
     answer = solve_free_joint_family(robot, target[None], [FreeJoint(2, np.array([-0.3]))], None)
@@ -94,7 +84,7 @@ def test_each_value_is_solved_completely():
 @pytest.mark.parametrize("name, joint", [("iiwa14", 0), ("iiwa14", 2), ("gen3", 0),
                                          ("panda", 6)])
 def test_nearest_to_reference_is_at_least_as_near_as_a_dense_grid(name, joint):
-    robot = arm(name)
+    robot = published_arm(name)
     rng = np.random.default_rng(3)
     dense = sample_values(robot, joint, 1440)
     for trial in range(6):
@@ -120,7 +110,7 @@ def test_nearest_to_reference_is_at_least_as_near_as_a_dense_grid(name, joint):
 
 
 def test_free_joints_for_checks_the_request():
-    robot = arm("iiwa14")
+    robot = published_arm("iiwa14")
     with pytest.raises(ValueError, match="1 free joint"):
         free_joints_for(robot, [(1, [0.0], None), (2, [0.0], None)])
     with pytest.raises(ValueError, match="0…6"):
@@ -132,7 +122,7 @@ def test_free_joints_for_checks_the_request():
 
 
 def test_reach_sphere_is_a_proof():
-    robot = arm("iiwa14")
+    robot = published_arm("iiwa14")
     rng = np.random.default_rng(0)
     reachable = forward_kinematics(robot, rng.uniform(-np.pi, np.pi, (2000, 7)))[:, :3, 3]
     assert not beyond_reach(robot, reachable).any()
@@ -142,7 +132,7 @@ def test_reach_sphere_is_a_proof():
 def test_trajectory_of_a_redundant_arm_keeps_the_free_joint_continuous():
     from service.kinematics import TrajectoryOptions, follow_trajectory
 
-    robot = arm("iiwa14")
+    robot = published_arm("iiwa14")
     t = np.linspace(0.0, 1.0, 41)
     start, end = np.array([0.2, 0.6, -0.4, 1.3, 0.3, -0.7, 0.1]), np.array([0.9, 0.2, 0.5, 0.7, -0.4, 0.5, 1.2])
     path = start + (end - start) * t[:, None] ** 2 * (3 - 2 * t[:, None])
@@ -160,7 +150,7 @@ def test_trajectory_of_a_redundant_arm_keeps_the_free_joint_continuous():
     assert free_steps.max() < 0.25 and np.ptp(joints[:, 0]) > 0.5  # q1 moves continuously, as the path needs
     # the answer is the greedy nearest one: each step no larger than to the generating path's next sample
     for k in range(1, len(t)):
-        to_generating = np.abs(np.angle(np.exp(1j * (path[k] - joints[k - 1])))).max()
+        to_generating = angle_gap(path[k], joints[k - 1]).max()
         assert steps[k - 1] <= to_generating + 1e-9
 
 
@@ -172,7 +162,7 @@ def assert_fk_verified_each(robot, joints: np.ndarray, targets: np.ndarray) -> N
 def test_values_whose_locked_arm_has_no_plan_are_counted(monkeypatch):
     from service.kinematics.ik._redundant import FreeJointFamily
 
-    robot = arm("iiwa14")
+    robot = published_arm("iiwa14")
     original = FreeJointFamily.locked_plan
     monkeypatch.setattr(FreeJointFamily, "locked_plan",
                         lambda self, values: None if values[0] > 1.0 else original(self, values))
@@ -190,7 +180,7 @@ def test_free_joint_errors_are_located_in_the_request_and_worded_in_the_core_ter
     from service.kinematics.ik import AnswerOptions, IKTargets, NotRedundantError, answer_ik
     from service.robots.catalogue import load_catalogue
 
-    robot = arm("iiwa14")
+    robot = published_arm("iiwa14")
     with pytest.raises(InvalidInputError) as caught:
         free_joints_for(robot, [(9, [0.0], None)])
     assert caught.value.location == (0, "joint")

@@ -67,8 +67,7 @@ import numpy as np
 import pytest
 
 from service.config import BUILTIN_ROBOTS_DIR
-from service.kinematics import forward_kinematics
-from service.kinematics._forward import geometric_jacobian, joint_screws
+from service.kinematics import forward_kinematics, geometric_jacobian, joint_screws
 from service.kinematics._tolerances import DUPLICATE_TOLERANCE
 from service.kinematics.ik import joint_difference, solve_ik
 from service.robots.catalogue import load_catalogue

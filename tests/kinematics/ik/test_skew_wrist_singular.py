@@ -23,13 +23,13 @@ import pytest
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
+from tests.arms import random_ur_type_arm
 from tests.kinematics.ik.test_three_parallel_arcs import (
     RESOLVED,
     arc_holding,
     arcs_of,
     fk_miss,
     reachable_sixth,
-    ur_type_arm,
 )
 
 WRIST_ANGLES = (0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-6, -1e-6, 1e-3, -1e-3)
@@ -41,7 +41,7 @@ COUPLED = np.array([False, True, True, True, False, True])
 def skew_wrist_arm(seed: int, convention: str) -> Robot:
     """A random UR-type arm whose axes 5 and 6 are skew (a5 ≠ 0), with a random base and tool; the offset d5 long
     (two arcs of q6 possible) for odd seeds, short for even ones."""
-    return ur_type_arm(seed, convention, two_arcs=bool(seed % 2), skew=True)
+    return random_ur_type_arm(seed, convention, two_arcs=bool(seed % 2), skew=True)
 
 
 def ur5_with_skew_wrist() -> Robot:

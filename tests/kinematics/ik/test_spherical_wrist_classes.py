@@ -17,11 +17,11 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.kinematics import Joint, Robot
-from service.kinematics._forward import forward_kinematics, joint_screws, link_frames, screw_model
+from service.kinematics import Joint, Robot, forward_kinematics, joint_screws, link_frames, screw_model
 from service.kinematics.ik import _numeric, joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik.subproblems import subproblem_1
+from tests.arms import random_rigid
 
 DEG = np.pi / 180
 POSES = 400  # per statement; three statements (conventions) per class
@@ -106,23 +106,15 @@ def _reverse_axis(rows: list[list[float]], joint: int, base: np.ndarray) -> np.n
     return base
 
 
-def _random_rigid(rng: np.random.Generator, scale: float) -> np.ndarray:
-    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    T = np.eye(4)
-    T[:3, :3] = q * np.sign(np.linalg.det(q))
-    T[:3, 3] = rng.uniform(-scale, scale, 3)
-    return T
-
-
 def statements(kind: str, seed: int) -> list[Robot]:
     """One random arm of the class in the standard, modified and Khalil conventions (same base, tool, FK)."""
     rng = np.random.default_rng(seed)
     table, kinds = _rows(kind, rng)
     rows = [list(row) for row in table]
-    base = _random_rigid(rng, 0.5)
+    base = random_rigid(rng, 0.5)
     for joint in np.flatnonzero(rng.random(6) < 0.4):
         base = _reverse_axis(rows, int(joint), base)
-    tool = _random_rigid(rng, 0.2)
+    tool = random_rigid(rng, 0.2)
     joint_kind = {"R": "revolute", "P": "prismatic"}
     standard = Robot([Joint(f"j{i + 1}", joint_kind[k], *row) for i, (row, k) in enumerate(zip(rows, kinds))],
                      convention="standard", world_T_base=base, flange_T_tool=tool)

@@ -14,60 +14,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.kinematics import forward_kinematics
-from service.kinematics._robot import Joint, Robot
+from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik._plan import geometry_of
 
+from tests.arms import THREE_PARALLEL_CASES as CASES, random_three_parallel_arm
 from tests.ik_helpers import SAME
 
 POSES = 1000
-
-#: case → (structure, 0-based standard-DH twists set to 0 or π (axes i+1 ∥ i+2), link lengths a_i set to 0
-#: (axes i+1 and i+2 intersect), the middle parallel joint)
-CASES = {
-    "skew_wrist_234": ("three_parallel_skew_wrist", (1, 2), (), 2),
-    "skew_shoulder_345": ("three_parallel_skew_shoulder", (2, 3), (), 3),
-    "intersecting_shoulder_345": ("three_parallel_intersecting_shoulder", (2, 3), (0,), 3),
-    "at_end_456": ("three_parallel_at_end", (3, 4), (), 4),
-    "at_end_456_with_1_2_intersecting": ("three_parallel_at_end", (3, 4), (0,), 4),
-    "at_base_123": ("three_parallel_at_base", (0, 1), (), 1),
-    "at_base_123_with_5_6_intersecting": ("three_parallel_at_base", (0, 1), (4,), 1),  # EAIK's 3 ∥ + 2 ∩
-}
 CONVENTIONS = ("standard", "modified", "khalil")
-
-
-def _transform(rng: np.random.Generator) -> np.ndarray:
-    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    T = np.eye(4)
-    T[:3, :3] = q * np.sign(np.linalg.det(q))
-    T[:3, 3] = rng.uniform(-0.3, 0.3, 3)
-    return T
-
-
-def _x_motion(a: float, alpha: float) -> np.ndarray:
-    c, s = np.cos(alpha), np.sin(alpha)
-    return np.array([[1, 0, 0, a], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]])
-
-
-def random_arm(case: str, convention: str, seed: int) -> Robot:
-    """A random arm of the case's class in standard DH, restated in ``convention`` (Craig's rows shift a_i and
-    alpha_i down one joint, the last pair going into the tool), with a random base and tool."""
-    _, parallel, intersecting, _ = CASES[case]
-    rng = np.random.default_rng(seed)
-    alpha = rng.choice([-1, 1], 6) * rng.uniform(0.3, 2.8, 6)
-    a, d, theta = rng.uniform(-0.4, 0.4, 6), rng.uniform(-0.4, 0.4, 6), rng.uniform(-np.pi, np.pi, 6)
-    alpha[list(parallel)] = rng.choice([0.0, np.pi], len(parallel))  # π: anti-parallel, a reversed axis
-    a[list(intersecting)] = 0.0
-    base, tool = _transform(rng), _transform(rng)
-    if convention == "standard":
-        rows = zip(a, alpha, d, theta)
-    else:  # Craig's frames; a Khalil row holds the same numbers renamed
-        rows = zip(np.r_[0.0, a[:5]], np.r_[0.0, alpha[:5]], d, theta)
-        tool = _x_motion(a[5], alpha[5]) @ tool
-    joints = [Joint(f"j{i + 1}", "revolute", *row) for i, row in enumerate(rows)]
-    return Robot(joints, convention=convention, world_T_base=base, flange_T_tool=tool)
 
 
 def _hits(robot: Robot, joints: np.ndarray, valid: np.ndarray, q: np.ndarray, tolerance: float) -> np.ndarray:
@@ -87,7 +43,7 @@ def _fk_misses(robot: Robot, joints: np.ndarray, valid: np.ndarray, targets: np.
 def test_the_three_conventions_state_the_same_arm():
     q = np.random.default_rng(1).uniform(-np.pi, np.pi, (20, 6))
     for case in CASES:
-        poses = [forward_kinematics(random_arm(case, c, seed=7), q) for c in CONVENTIONS]
+        poses = [forward_kinematics(random_three_parallel_arm(case, c, seed=7), q) for c in CONVENTIONS]
         assert np.allclose(poses[0], poses[1], atol=1e-12) and np.allclose(poses[0], poses[2], atol=1e-12)
 
 
@@ -96,7 +52,7 @@ def test_the_three_conventions_state_the_same_arm():
 def test_every_pose_from_the_arms_fk_gets_its_generating_vector_back(case, convention):
     structure = CASES[case][0]
     for seed in (11, 12):
-        robot = random_arm(case, convention, seed)
+        robot = random_three_parallel_arm(case, convention, seed)
         plan = cached_plan(robot, constrain_orientation=True, reference=None)
         assert plan is not None and plan.structure == structure
         q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (POSES // 2, 6))
@@ -112,7 +68,7 @@ def test_every_pose_from_the_arms_fk_gets_its_generating_vector_back(case, conve
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_single_poses_are_complete_and_analytic(case):
     """One pose at a time (the path a single request takes): complete, analytic, the generating vector back."""
-    robot = random_arm(case, "modified", seed=21)
+    robot = random_three_parallel_arm(case, "modified", seed=21)
     q = np.random.default_rng(21).uniform(-np.pi, np.pi, (25, 6))
     for row, T in zip(q, forward_kinematics(robot, q)):
         result = solve_ik(robot, T)
@@ -135,7 +91,7 @@ def _in_line_value(robot: Robot, middle: int) -> float:
 
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_stretched_and_folded_poses_report_the_elbow_and_keep_their_vector(case):
-    robot = random_arm(case, "standard", seed=31)
+    robot = random_three_parallel_arm(case, "standard", seed=31)
     middle = CASES[case][3]
     rng = np.random.default_rng(31)
     q = rng.uniform(-np.pi, np.pi, (200, 6))
@@ -158,7 +114,7 @@ def test_stretched_and_folded_poses_report_the_elbow_and_keep_their_vector(case)
 def test_poses_with_joints_at_special_values_are_reached(case):
     """Joints snapped to 0, ±π/2, π (singular and special poses): never unreachable, every solution verified,
     and the generating vector back wherever no joint was reported free."""
-    robot = random_arm(case, "khalil", seed=41)
+    robot = random_three_parallel_arm(case, "khalil", seed=41)
     rng = np.random.default_rng(41)
     q = rng.uniform(-np.pi, np.pi, (400, 6))
     snap = rng.random(q.shape) < 0.4
@@ -173,7 +129,7 @@ def test_poses_with_joints_at_special_values_are_reached(case):
 
 
 def test_the_ur_type_is_still_its_own_family():
-    robot = random_arm("skew_wrist_234", "standard", seed=51)
+    robot = random_three_parallel_arm("skew_wrist_234", "standard", seed=51)
     a = robot.a.copy()
     a[4] = 0.0
     joints = [Joint(j.name, j.kind, a[i], j.alpha, j.d, j.theta) for i, j in enumerate(robot.joints)]
@@ -185,7 +141,7 @@ def test_the_ur_type_is_still_its_own_family():
 def test_the_generic_count_of_eight_is_reached(case):
     """8 distinct FK-verified solutions for some pose of some arm of the class: the bound 4 × 2 is attained."""
     for seed in range(60, 70):
-        robot = random_arm(case, "standard", seed)
+        robot = random_three_parallel_arm(case, "standard", seed)
         q = np.random.default_rng(seed).uniform(-np.pi, np.pi, (300, 6))
         if solve_ik_arrays(robot, forward_kinematics(robot, q)).count.max() == 8:
             return
@@ -204,7 +160,7 @@ def _labels_of_generating_vector(robot: Robot, q: np.ndarray) -> list[dict]:
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_branch_labels_mean_the_same_in_every_convention(case):
     q = np.random.default_rng(81).uniform(-np.pi, np.pi, (200, 6))
-    labels = [_labels_of_generating_vector(random_arm(case, c, seed=81), q) for c in CONVENTIONS]
+    labels = [_labels_of_generating_vector(random_three_parallel_arm(case, c, seed=81), q) for c in CONVENTIONS]
     assert labels[0] == labels[1] == labels[2]
     if CASES[case][1] == (0, 1):  # axes 1-3 along the base z: no up in their plane, so no elbow label
         assert not any("elbow" in row for row in labels[0])
@@ -242,7 +198,7 @@ def test_axis_one_parallel_to_the_triple_is_a_free_base_with_verified_representa
     from service.kinematics.ik.subproblems import subproblem_2_chain
 
     for seed in range(100, 140):
-        robot = random_arm(case, "standard", seed)
+        robot = random_three_parallel_arm(case, "standard", seed)
         m = geometry_of(robot).model
         # (turning joint, turning joint, the axis turned, the axis it is turned parallel to)
         order = (1, 2, 3, 0) if case.startswith("at_end") else (3, 4, 5, 0)
@@ -266,7 +222,7 @@ def test_a_sweep_towards_the_stretched_elbow_down_to_1e_12(case):
     """The middle parallel joint ε from stretched, ε = 1e-2 … 1e-12: always reached, every solution verified, and
     the generating vector back: exactly while the two elbow roots are apart, within the split of a double root
     (1e-4) once they are not."""
-    robot = random_arm(case, "modified", seed=61)
+    robot = random_three_parallel_arm(case, "modified", seed=61)
     middle = CASES[case][3]
     q = np.random.default_rng(61).uniform(-np.pi, np.pi, (11, 6))
     q[:, middle] = _in_line_value(robot, middle) + 10.0 ** -np.arange(2, 13)
@@ -301,7 +257,7 @@ def _axis_six_on_axis_one(robot: Robot, rng: np.random.Generator) -> np.ndarray 
 def test_axis_six_on_axis_one_frees_the_sum_of_joints_one_and_six():
     """The skew-wrist class's shoulder singularity: axis 6 on axis 1, where subproblem 6 leaves q1 free. q1 takes
     the reference value, q6 the rest of the sum, and the pose is reached."""
-    robot = random_arm("skew_wrist_234", "standard", seed=0)
+    robot = random_three_parallel_arm("skew_wrist_234", "standard", seed=0)
     q = _axis_six_on_axis_one(robot, np.random.default_rng(0))
     assert q is not None
     target = forward_kinematics(robot, q[None])

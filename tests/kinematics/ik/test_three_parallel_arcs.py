@@ -17,48 +17,18 @@ import numpy as np
 import pytest
 
 from service.config import Settings
-from service.kinematics import Joint, Robot, forward_kinematics
-from service.kinematics._forward import joint_screws
+from service.kinematics import Robot, forward_kinematics, joint_screws
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.robots.catalogue import load_catalogue
-from tests.kinematics.ik.test_spherical_wrist_classes import _random_rigid
+from tests.arms import random_ur_type_arm
+from tests.ik_helpers import wrapped
 
 GRID = 7200  # q6 samples on [−π, π): 0.05° apart
 #: an arc shorter than this many samples, or a q6 this close to an arc's end, is not resolved by the grid
 RESOLVED = 8
 WRIST_OFFSETS = (0.0, 1e-12, -1e-12)
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
-
-
-def ur_type_arm(seed: int, convention: str, two_arcs: bool, skew: bool = False) -> Robot:
-    """A random UR-type arm (standard DH rows a, alpha, d, theta, restated in ``convention``) whose axis 6 lies
-    along axes 2–4 at q5 = 0 exactly (the twists of rows 4 and 5 cancel, or add to π: anti-parallel), with a
-    random base and tool. ``two_arcs``: the offset between axes 4 and 6 (d5) longer than the shorter planar link,
-    so that the reachable q6 can form two arcs; else shorter than half of it (the UR5's proportions: one arc).
-    ``skew``: axes 5 and 6 skew (a5 ≠ 0, the three_parallel_skew_wrist family)."""
-    rng = np.random.default_rng(seed)
-    upper, fore = rng.uniform(0.3, 0.5) * rng.choice([-1, 1]), rng.uniform(0.1, 0.25) * rng.choice([-1, 1])
-    wrist = rng.uniform(0.3, 0.45) if two_arcs else rng.uniform(0.02, 0.5 * abs(fore))
-    a = np.array([0.0, upper, fore, 0.0, 0.0, 0.0])
-    if skew:
-        a[4] = rng.uniform(0.03, 0.12) * rng.choice([-1, 1])
-    d = np.r_[rng.uniform(0.05, 0.2), rng.uniform(-0.1, 0.1, 2), rng.uniform(0.05, 0.2), wrist * rng.choice([-1, 1]),
-              rng.uniform(0.05, 0.2)]
-    twist = rng.uniform(0.3, 2.8) * rng.choice([-1, 1])
-    alpha = np.array([rng.uniform(0.3, 2.8) * rng.choice([-1, 1]), rng.choice([0.0, np.pi]), rng.choice([0.0, np.pi]),
-                      twist, rng.choice([-twist, np.pi - twist]), rng.uniform(-2.8, 2.8)])
-    theta = rng.uniform(-np.pi, np.pi, 6)
-    theta[4] = 0.0  # the singular wrist at q5 = 0
-    base, tool = _random_rigid(rng, 0.5), _random_rigid(rng, 0.2)
-    if convention == "standard":
-        rows = zip(a, alpha, d, theta)
-    else:  # Craig's frames; the last row's a and alpha go into the tool
-        rows = zip(np.r_[0.0, a[:5]], np.r_[0.0, alpha[:5]], d, theta)
-        c, s = np.cos(alpha[5]), np.sin(alpha[5])
-        tool = np.array([[1, 0, 0, a[5]], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]]) @ tool
-    return Robot([Joint(f"j{i + 1}", "revolute", *row) for i, row in enumerate(rows)], convention=convention,
-                 world_T_base=base, flange_T_tool=tool)
 
 
 def _planar(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
@@ -119,10 +89,6 @@ def arc_holding(arcs: list[np.ndarray], q6: float) -> int | None:
     return None
 
 
-def _wrapped(angle: np.ndarray) -> np.ndarray:
-    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
-
-
 def _check(robot: Robot, q: np.ndarray, arcs: list[np.ndarray], solutions: np.ndarray, complete: bool,
            given: float) -> str | None:
     """What is wrong with an answer at the singular wrist of q, or None. The singular branch (q1 and q5 as q's)
@@ -133,11 +99,11 @@ def _check(robot: Robot, q: np.ndarray, arcs: list[np.ndarray], solutions: np.nd
     miss = fk_miss(robot, solutions, forward_kinematics(robot, q)).max()
     if miss > 1e-9:
         return f"FK miss {miss:.1e}"
-    branch = solutions[(np.abs(_wrapped(solutions[:, 0] - q[0])) <= 1e-6)
-                       & (np.abs(_wrapped(solutions[:, 4] - q[4])) <= 1e-6)]
+    branch = solutions[(np.abs(wrapped(solutions[:, 0] - q[0])) <= 1e-6)
+                       & (np.abs(wrapped(solutions[:, 4] - q[4])) <= 1e-6)]
     values = []
     for q6 in branch[:, 5]:
-        if not any(abs(_wrapped(q6 - v)) <= 1e-6 for v in values):
+        if not any(abs(wrapped(q6 - v)) <= 1e-6 for v in values):
             values.append(q6)
     held = {arc_holding(arcs, v) for v in values}
     if len(values) != len(arcs) or held != set(range(len(arcs))):
@@ -145,7 +111,7 @@ def _check(robot: Robot, q: np.ndarray, arcs: list[np.ndarray], solutions: np.nd
     generating = arc_holding(arcs, q[5])
     if generating not in held:
         return "the generating arc is missing"
-    if arc_holding(arcs, given) is not None and not any(abs(_wrapped(v - given)) <= 1e-9 for v in values):
+    if arc_holding(arcs, given) is not None and not any(abs(wrapped(v - given)) <= 1e-9 for v in values):
         return f"the given q6 {given:.4f} reaches but is not kept"
     return None
 
@@ -167,7 +133,7 @@ def _poses(robot: Robot, seed: int, count: int) -> list[tuple[np.ndarray, list[n
 
 
 def _nearest_to_zero(arcs: list[np.ndarray]) -> int:
-    distance = [np.abs(_wrapped(grid()[arc])).min() for arc in arcs]
+    distance = [np.abs(wrapped(grid()[arc])).min() for arc in arcs]
     return int(np.argmin(distance))
 
 
@@ -182,7 +148,7 @@ def test_each_arc_of_q6_the_elbow_reaches_with_has_a_solution(seed, convention):
     generating configuration as reference, and with a reference on the other arc) and all in one batch
     (solve_ik_arrays, no reference). Before, only the arc of the reference (or 0), or of the nearer middle value,
     came back, with ``complete: true``."""
-    robot = ur_type_arm(seed, convention, two_arcs=True)
+    robot = random_ur_type_arm(seed, convention, two_arcs=True)
     assert cached_plan(robot, constrain_orientation=True, reference=None).structure == "three_parallel"
     poses = _poses(robot, 100 + seed, 30)
     kinds = {"two arcs, generating on the arc nearest 0": 0, "two arcs, generating on the other": 0, "one arc": 0}
@@ -222,7 +188,7 @@ def test_one_arc_geometries_keep_their_single_representative(seed, convention):
     """Arms with the UR5's proportions (d5 short) and the UR5 itself: the reachable q6 are always one arc, and the
     singular branch keeps its one q6 value: the reference (or 0) where the elbow reaches with it, as before."""
     robot = _CATALOGUE.get("ur5").robot if seed == 0 and convention == "standard" else \
-        ur_type_arm(seed, convention, two_arcs=False)
+        random_ur_type_arm(seed, convention, two_arcs=False)
     poses = _poses(robot, 200 + seed, 20)
     batch = solve_ik_arrays(robot, forward_kinematics(robot, np.array([q for q, _ in poses])))
     failures = []

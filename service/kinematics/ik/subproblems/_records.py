@@ -97,6 +97,6 @@ _MERGE_COS_GAP = 1.0 - math.cos(DUPLICATE_TOLERANCE / 2.0)
 # The same angle criterion for two crossings of circles of radius rho, half an angle asin(sqrt(g) / rho) apart:
 # g < rho**2 sin(DUPLICATE_TOLERANCE / 2)**2.
 _MERGE_SIN_SQUARED = math.sin(DUPLICATE_TOLERANCE / 2.0) ** 2
-# Rounding error of that g relative to rho: exact tangencies give |g| up to 86 ulps of rho (tests/kinematics/
-# test_subproblems.py's tangent cones); this bound keeps a factor 3 above it.
+# Rounding error of that g relative to rho: exact tangencies give |g| up to 86 ulps of rho (tests/kinematics/ik/
+# subproblems/test_subproblems.py's tangent cones); this bound keeps a factor 3 above it.
 _GAP_ROUNDING = 256 * np.finfo(float).eps

@@ -8,6 +8,7 @@ import pytest
 
 from service.kinematics.ik._screws import rotate_about
 from service.kinematics.ik.subproblems import subproblem_6
+from tests.ik_helpers import angle_gap
 
 
 def _unit(x: np.ndarray) -> np.ndarray:
@@ -37,14 +38,10 @@ def _solve(k1, k2, H, P, d1, d2):
     return subproblem_6(k1, k2, H[0], P[0], H[1], P[1], d1, H[2], P[2], H[3], P[3], d2)
 
 
-def _wrapped(x):
-    return np.abs(np.angle(np.exp(1j * x)))
-
-
 def test_the_generating_angles_are_among_the_roots_and_every_root_solves_both_equations():
     k1, k2, H, P, t1, t2, d1, d2 = _instances(seed=0, count=5000)
     sol = _solve(k1, k2, H, P, d1, d2)
-    hit = (sol.valid & (_wrapped(sol.theta1 - t1[:, None]) < 1e-7) & (_wrapped(sol.theta2 - t2[:, None]) < 1e-7))
+    hit = (sol.valid & (angle_gap(sol.theta1, t1[:, None]) < 1e-7) & (angle_gap(sol.theta2, t2[:, None]) < 1e-7))
     assert hit.any(axis=1).all()
     assert (sol.exact == sol.valid).all()  # every instance has its generating root, so no least-squares slot
     e1, e2 = _sides(k1, k2, [h[:, None] for h in H], [p[:, None] for p in P],
@@ -81,7 +78,7 @@ def _newton_roots(k1, k2, H, P, d1, d2, seeds: int = 16) -> list[np.ndarray]:
     for row in range(len(d1)):
         distinct: list[np.ndarray] = []
         for pair in t[row][good[row]]:
-            if all(_wrapped(pair - other).max() > 1e-5 for other in distinct):
+            if all(angle_gap(pair, other).max() > 1e-5 for other in distinct):
                 distinct.append(pair)
         roots.append(np.array(distinct).reshape(-1, 2))
     return roots
@@ -95,7 +92,7 @@ def test_the_root_count_agrees_with_a_multistart_newton_search():
         found = np.stack([sol.theta1[row], sol.theta2[row]], -1)[sol.valid[row]]
         assert len(found) == len(roots), row
         for pair in roots:
-            assert (_wrapped(found - pair).max(axis=1) < 1e-6).any()
+            assert (angle_gap(found, pair).max(axis=1) < 1e-6).any()
 
 
 def test_decoupled_equations_give_every_combination():

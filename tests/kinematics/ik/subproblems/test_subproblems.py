@@ -21,7 +21,7 @@ import pkgutil
 import numpy as np
 import pytest
 
-from service.kinematics._errors import InvalidInputError
+from service.kinematics import InvalidInputError
 from service.kinematics._tolerances import DUPLICATE_TOLERANCE
 from service.kinematics.ik import subproblems
 from service.kinematics.ik.subproblems import _roots
@@ -38,17 +38,13 @@ from service.kinematics.ik.subproblems import (
     subproblem_3,
     subproblem_4,
 )
+from tests.ik_helpers import angle_gap, wrapped
 
 N_AXES = 10  # axes are constant per call: 10 random axes x 100 rows = 1,000 instances
 N_ROWS = 100
 GRID = np.linspace(-np.pi, np.pi, 10_000, endpoint=False)
 RESIDUAL = 1e-12  # relative residual every exact candidate must meet
 ANGLE = 1e-8  # radians: recovering the known angle
-
-
-@pytest.fixture
-def rng() -> np.random.Generator:
-    return np.random.default_rng(0)
 
 
 # ---------------------------------------------------------------------------
@@ -71,11 +67,6 @@ def unit(v):
 
 def random_unit(rng, *shape):
     return unit(rng.normal(size=(*shape, 3)))
-
-
-def angle_gap(a, b):
-    """|a - b| modulo 2 pi, in [0, pi]."""
-    return np.abs(np.angle(np.exp(1j * (np.asarray(a) - np.asarray(b)))))
 
 
 def gap_to_candidates(theta, valid, known):
@@ -832,7 +823,7 @@ def test_sp5_quartic_that_drops_to_a_quadratic():
         np.array([-0.25]), np.array([0.6]), np.array([0.8]), np.array([0.0]), np.array([0.0]))
     phi, half = np.arctan2(0.8, 0.6), np.arccos(0.25)
     assert valid.sum() == 2 and not double[0]
-    assert np.allclose(np.sort(theta[valid]), np.sort(np.angle(np.exp(1j * np.array([phi + half, phi - half])))))
+    assert np.allclose(np.sort(theta[valid]), np.sort(wrapped([phi + half, phi - half])))
     # and the constant left when g vanishes too: identically zero (free) or never
     zeros = np.zeros(2)
     theta, valid, _ = _roots._trig_quartic_roots(np.array([0.0, 0.5]), zeros, zeros, zeros, zeros)

@@ -1,11 +1,136 @@
-"""Arms stated the way CAD exports and vendors state them: rounded DH values, rounded base and tool quaternions,
-and the exact DH table of an arm given by its screws (whatever offsets that takes)."""
+"""Arms the tests build: redundant and deficient arms from published parameters, seeded random arms of each IK
+family (with a random base and tool), and arms stated the way CAD exports and vendors state them (rounded DH values,
+rounded base and tool quaternions, the exact DH table of an arm given by its screws, whatever offsets that takes)."""
 
 from __future__ import annotations
 
+import json
+from pathlib import Path
+
 import numpy as np
+from pydantic import TypeAdapter
 
 from service.kinematics import Joint, Robot, ScrewJoint
+from service.robots import robot_from_description
+from service.robots.schemas import RobotDescription
+
+#: redundant and deficient arms from published parameters: name → inline description (DH table, limits)
+PUBLISHED_ARMS = json.loads((Path(__file__).parent / "data" / "redundant_and_deficient_arms.json").read_text())
+
+#: three-parallel case → (structure, 0-based standard-DH twists set to 0 or π (axes i+1 ∥ i+2), link lengths a_i
+#: set to 0 (axes i+1 and i+2 intersect), the middle parallel joint)
+THREE_PARALLEL_CASES = {
+    "skew_wrist_234": ("three_parallel_skew_wrist", (1, 2), (), 2),
+    "skew_shoulder_345": ("three_parallel_skew_shoulder", (2, 3), (), 3),
+    "intersecting_shoulder_345": ("three_parallel_intersecting_shoulder", (2, 3), (0,), 3),
+    "at_end_456": ("three_parallel_at_end", (3, 4), (), 4),
+    "at_end_456_with_1_2_intersecting": ("three_parallel_at_end", (3, 4), (0,), 4),
+    "at_base_123": ("three_parallel_at_base", (0, 1), (), 1),
+    "at_base_123_with_5_6_intersecting": ("three_parallel_at_base", (0, 1), (4,), 1),  # EAIK's 3 ∥ + 2 ∩
+}
+
+
+def published_arm(name: str) -> Robot:
+    """A :data:`PUBLISHED_ARMS` arm, built from its inline description as the service builds one."""
+    description = TypeAdapter(RobotDescription).validate_python({"id": name.replace("_", "-"), **PUBLISHED_ARMS[name]})
+    return robot_from_description(description, max_joints=16)
+
+
+def random_rotation(rng: np.random.Generator) -> np.ndarray:
+    """A random rotation matrix (3, 3): the orthogonal factor of a Gaussian matrix, turned proper."""
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    return q * np.sign(np.linalg.det(q))
+
+
+def random_rigid(rng: np.random.Generator, scale: float) -> np.ndarray:
+    """A random rigid transform (4, 4): :func:`random_rotation`, then a translation uniform in ±``scale``."""
+    T = np.eye(4)
+    T[:3, :3] = random_rotation(rng)
+    T[:3, 3] = rng.uniform(-scale, scale, 3)
+    return T
+
+
+def restated_6r(a: np.ndarray, alpha: np.ndarray, d: np.ndarray, theta: np.ndarray, convention: str,
+                world_T_base: np.ndarray, flange_T_tool: np.ndarray) -> Robot:
+    """The 6R arm of standard-DH rows (a, alpha, d, theta: each shape (6,)) with the given base and tool, restated
+    in ``convention``: Craig's rows shift a_i and alpha_i down one joint, the last pair going into the tool; a
+    Khalil row holds the same numbers as a Craig row, renamed. The same arm (the same FK) in every convention."""
+    tool = flange_T_tool
+    if convention == "standard":
+        rows = zip(a, alpha, d, theta)
+    else:
+        rows = zip(np.r_[0.0, a[:5]], np.r_[0.0, alpha[:5]], d, theta)
+        c, s = np.cos(alpha[5]), np.sin(alpha[5])
+        tool = np.array([[1, 0, 0, a[5]], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]]) @ tool
+    joints = [Joint(f"j{i + 1}", "revolute", *row) for i, row in enumerate(rows)]
+    return Robot(joints, convention=convention, world_T_base=world_T_base, flange_T_tool=tool)
+
+
+def random_general_arm(rng: np.random.Generator, convention: str) -> Robot:
+    """A random 6R arm with no decomposable geometry (DH entries uniform in ±1, in the given convention) with a
+    random base (translation in ±1) and tool (translation in ±0.3)."""
+    joints = [Joint(f"q{i + 1}", "revolute", *rng.uniform(-1, 1, 4)) for i in range(6)]
+    base, tool = random_rigid(rng, 1.0), random_rigid(rng, 0.3)
+    return Robot(joints, convention=convention, world_T_base=base, flange_T_tool=tool)
+
+
+def random_three_parallel_arm(case: str, convention: str, seed: int) -> Robot:
+    """A random arm of a :data:`THREE_PARALLEL_CASES` class, with anti-parallel axes among the parallel ones, in
+    standard DH restated in ``convention``, with a random base and tool."""
+    _, parallel, intersecting, _ = THREE_PARALLEL_CASES[case]
+    rng = np.random.default_rng(seed)
+    alpha = rng.choice([-1, 1], 6) * rng.uniform(0.3, 2.8, 6)
+    a, d, theta = rng.uniform(-0.4, 0.4, 6), rng.uniform(-0.4, 0.4, 6), rng.uniform(-np.pi, np.pi, 6)
+    alpha[list(parallel)] = rng.choice([0.0, np.pi], len(parallel))  # π: anti-parallel, a reversed axis
+    a[list(intersecting)] = 0.0
+    base, tool = random_rigid(rng, 0.3), random_rigid(rng, 0.3)
+    return restated_6r(a, alpha, d, theta, convention, base, tool)
+
+
+def random_family_arm(family: str, convention: str, seed: int, wrist_singular: bool = False) -> Robot:
+    """A random arm of one of the scalar path's two families, ``"intersecting_shoulder+spherical_wrist"`` or
+    ``"three_parallel"`` (axes 2 ∥ 3 ∥ 4, axes 5 and 6 meeting), in standard DH restated in ``convention``, with
+    a random base and tool. ``wrist_singular`` (three-parallel family): the twists of axes 4–5 and 5–6 equal in
+    size, so that axis 6 can lie along the parallel axes, as on the UR arms (the same random draws otherwise)."""
+    rng = np.random.default_rng(seed)
+    a, d, theta = rng.uniform(0.1, 0.5, 6) * rng.choice([-1, 1], 6), rng.uniform(-0.4, 0.4, 6), \
+        rng.uniform(-np.pi, np.pi, 6)
+    alpha = rng.uniform(0.3, 2.8, 6) * rng.choice([-1, 1], 6)
+    if family == "intersecting_shoulder+spherical_wrist":
+        a[0] = 0.0  # axes 1 and 2 meet
+        a[3] = a[4] = d[4] = 0.0  # axes 4, 5 and 6 meet
+        alpha[4] = abs(alpha[3]) * rng.choice([-1, 1])  # equal wrist twists, as in every real wrist
+    else:
+        alpha[1] = rng.choice([0.0, np.pi])  # axes 2 ∥ 3 ∥ 4 (π: a reversed axis)
+        alpha[2] = rng.choice([0.0, np.pi])
+        a[4] = 0.0  # axes 5 and 6 meet
+        if wrist_singular:
+            alpha[4] = abs(alpha[3]) * np.sign(alpha[4])
+    base, tool = random_rigid(rng, 0.5), random_rigid(rng, 0.2)
+    return restated_6r(a, alpha, d, theta, convention, base, tool)
+
+
+def random_ur_type_arm(seed: int, convention: str, two_arcs: bool, skew: bool = False) -> Robot:
+    """A random UR-type arm (standard DH rows a, alpha, d, theta, restated in ``convention``) whose axis 6 lies
+    along axes 2–4 at q5 = 0 exactly (the twists of rows 4 and 5 cancel, or add to π: anti-parallel), with a
+    random base and tool. ``two_arcs``: the offset between axes 4 and 6 (d5) longer than the shorter planar link,
+    so that the reachable q6 can form two arcs; else shorter than half of it (the UR5's proportions: one arc).
+    ``skew``: axes 5 and 6 skew (a5 ≠ 0, the three_parallel_skew_wrist family)."""
+    rng = np.random.default_rng(seed)
+    upper, fore = rng.uniform(0.3, 0.5) * rng.choice([-1, 1]), rng.uniform(0.1, 0.25) * rng.choice([-1, 1])
+    wrist = rng.uniform(0.3, 0.45) if two_arcs else rng.uniform(0.02, 0.5 * abs(fore))
+    a = np.array([0.0, upper, fore, 0.0, 0.0, 0.0])
+    if skew:
+        a[4] = rng.uniform(0.03, 0.12) * rng.choice([-1, 1])
+    d = np.r_[rng.uniform(0.05, 0.2), rng.uniform(-0.1, 0.1, 2), rng.uniform(0.05, 0.2), wrist * rng.choice([-1, 1]),
+              rng.uniform(0.05, 0.2)]
+    twist = rng.uniform(0.3, 2.8) * rng.choice([-1, 1])
+    alpha = np.array([rng.uniform(0.3, 2.8) * rng.choice([-1, 1]), rng.choice([0.0, np.pi]), rng.choice([0.0, np.pi]),
+                      twist, rng.choice([-twist, np.pi - twist]), rng.uniform(-2.8, 2.8)])
+    theta = rng.uniform(-np.pi, np.pi, 6)
+    theta[4] = 0.0  # the singular wrist at q5 = 0
+    base, tool = random_rigid(rng, 0.5), random_rigid(rng, 0.2)
+    return restated_6r(a, alpha, d, theta, convention, base, tool)
 
 
 def rounded(robot: Robot, seed: int, *, base_and_tool: bool = True) -> Robot:

@@ -21,6 +21,8 @@ from service.kinematics._tolerances import DUPLICATE_TOLERANCE
 from service.kinematics.ik import joint_difference, solve_ik
 from service.kinematics.ik.subproblems import subproblem_2_chain
 from service.kinematics.ik._screws import rotate_about
+from tests.arms import random_family_arm
+from tests.ik_helpers import wrapped
 
 EPSILONS = [1e-3, 1e-5, 1e-7, 3e-8, 1e-8, 5e-9, 3e-9, 2e-9, 1e-9, 1e-10, 1e-12, 0.0]
 #: robot id → (first wrist joint, middle wrist joint, last wrist joint)
@@ -39,13 +41,9 @@ def _recovered(robot, solutions: np.ndarray, q: np.ndarray, wrist: tuple[int, in
     d = joint_difference(robot, solutions, q)
     others = np.delete(np.abs(d), [first, last], axis=1).max(axis=1) if robot.dof > 3 else np.zeros(len(d))
     # near the singularity only q_first ± q_last is determined (the sign depends on the axes' directions)
-    combined = np.minimum(np.abs(_wrapped(d[:, first] + d[:, last])), np.abs(_wrapped(d[:, first] - d[:, last])))
+    combined = np.minimum(np.abs(wrapped(d[:, first] + d[:, last])), np.abs(wrapped(d[:, first] - d[:, last])))
     split = np.abs(d[:, first]) * max(abs(np.sin(eps)), 1e-300)
     return bool(np.any((others <= 1e-7) & (combined <= 1e-7) & ((np.abs(d[:, first]) <= 1e-7) | (split <= 1e-9))))
-
-
-def _wrapped(angle: np.ndarray) -> np.ndarray:
-    return np.pi - np.mod(np.pi - angle, 2 * np.pi)
 
 
 @pytest.mark.parametrize("robot_id", sorted(WRISTS))
@@ -262,7 +260,7 @@ def test_coincident_first_axes_are_not_taken_for_a_spherical_wrist():
         assert 1 in result.free_joints
         solutions = np.array([s.joints for s in result.solutions])
         d = joint_difference(robot, solutions, q)
-        same_sum = np.abs(_wrapped(d[:, 0] + d[:, 1])) <= 1e-7
+        same_sum = np.abs(wrapped(d[:, 0] + d[:, 1])) <= 1e-7
         others = np.abs(d[:, 2:]).max(axis=1) <= 1e-7 if constrain_orientation else np.ones(len(d), bool)
         assert np.any(same_sum & others)
         np.testing.assert_allclose([forward_kinematics(robot, s)[:3, 3] for s in solutions],
@@ -310,7 +308,6 @@ def test_ur_type_arms_near_their_singularities_return_the_generating_configurati
     self-motion; q1 and q5 still hold). Before subproblem 2 gave the wrist, its roots came from the height
     ω_p·R ω6 = cos q5, which merged ±q5 below 5e-7 into q5 = 0, where q6 was set to 0 whether the elbow reached
     or not: the UR5 lost a whole shoulder branch (4 of 8 solutions) with ``complete: true``."""
-    from tests.kinematics.ik.test_one_pose_families import random_arm
     from service.kinematics.ik import solve_ik_arrays
     from service.kinematics.ik import cached_plan
 
@@ -318,7 +315,7 @@ def test_ur_type_arms_near_their_singularities_return_the_generating_configurati
         robot = catalogue.get("ur5").robot
     else:
         convention, seed = arm.split("-")
-        robot = random_arm("three_parallel", convention, int(seed), wrist_singular=True)
+        robot = random_family_arm("three_parallel", convention, int(seed), wrist_singular=True)
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     assert plan.structure == "three_parallel"
     rng = np.random.default_rng(7)

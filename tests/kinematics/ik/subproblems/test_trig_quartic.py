@@ -9,13 +9,9 @@ import numpy as np
 import pytest
 
 from service.kinematics.ik.subproblems._roots import _ON_UNIT_CIRCLE, _trig_quartic_roots, _vanishes
+from tests.ik_helpers import angle_gap
 
 DOUBLE_ROOT = 1e-7  # a double root is found to about sqrt(eps)
-
-
-@pytest.fixture
-def rng():
-    return np.random.default_rng(0)
 
 
 def coefficients(p0, m1, q0, m2):
@@ -30,17 +26,13 @@ def value(alphas, t):
     return a0 + a1 * np.cos(t) + b1 * np.sin(t) + a2 * np.cos(2 * t) + b2 * np.sin(2 * t)
 
 
-def gap(a, b):
-    return np.abs(np.angle(np.exp(1j * (np.asarray(a) - np.asarray(b)))))
-
-
 def test_four_simple_roots_of_random_equations_are_all_found(rng):
     m1, m2 = rng.uniform(-np.pi, np.pi, (2, 500))
     p0, q0 = rng.uniform(-0.99, 0.99, (2, 500))
     theta, on_circle, double = _trig_quartic_roots(*coefficients(p0, m1, q0, m2))
     truth = np.stack([m1 + np.arccos(p0), m1 - np.arccos(p0), m2 + np.arccos(q0), m2 - np.arccos(q0)], -1)
     assert on_circle.all() and not double.any()
-    nearest = gap(theta[:, :, None], truth[:, None, :]).min(axis=1)  # each true root: its nearest slot
+    nearest = angle_gap(theta[:, :, None], truth[:, None, :]).min(axis=1)  # each true root: its nearest slot
     assert (nearest < 1e-9).all()
 
 
@@ -50,7 +42,7 @@ def test_roots_at_zero_and_pi_are_ordinary():
     theta, on_circle, _ = _trig_quartic_roots(*alphas)
     found = theta[on_circle]
     for root in (0.0, np.pi, np.pi - 0.6):
-        assert gap(found, root).min() < DOUBLE_ROOT
+        assert angle_gap(found, root).min() < DOUBLE_ROOT
 
 
 @pytest.mark.parametrize("where", [0.0, np.pi, 1.234, -2.5])
@@ -58,7 +50,7 @@ def test_a_double_root_is_found_on_the_circle(where):
     """(1 - cos(t - m)) touches 0 at m: a double root that rounding splits by about sqrt(eps)."""
     theta, on_circle, _ = _trig_quartic_roots(*coefficients(1.0, where, 3.0, 0.7))
     assert on_circle.sum() >= 1
-    assert (gap(theta[on_circle], where) < DOUBLE_ROOT).all()
+    assert (angle_gap(theta[on_circle], where) < DOUBLE_ROOT).all()
     assert np.abs(value(coefficients(1.0, where, 3.0, 0.7), theta[on_circle])).max() < 1e-12
 
 
@@ -68,7 +60,7 @@ def test_two_double_roots_and_a_quadruple_root():
     # (1 - cos(t - 0.4))²: a quadruple root splits by about eps ** (1/4) ~ 1e-4, beyond the acceptance radius,
     # so it is not taken for real; its four angles still point at it (subproblem 6 keeps the nearest candidate)
     theta, on_circle, _ = _trig_quartic_roots(*coefficients(1.0, 0.4, 1.0, 0.4))
-    assert not on_circle.any() and (gap(theta, 0.4) < 1e-3).all()
+    assert not on_circle.any() and (angle_gap(theta, 0.4) < 1e-3).all()
 
 
 @pytest.mark.parametrize("beyond, real", [(1e-14, True), (1e-12, True), (1e-8, False), (1e-4, False)])
@@ -79,7 +71,7 @@ def test_the_circle_boundary_a_tangent_just_missed(beyond, real):
     assert (np.sqrt(2 * beyond) <= _ON_UNIT_CIRCLE) == real
     theta, on_circle, _ = _trig_quartic_roots(*alphas)
     assert on_circle.any() == real
-    assert gap(theta, 1.0).min() < DOUBLE_ROOT  # the nearest angle is there either way, for the caller
+    assert angle_gap(theta, 1.0).min() < DOUBLE_ROOT  # the nearest angle is there either way, for the caller
 
 
 @pytest.mark.parametrize("lead", [0.0, 1e-14, 1e-10, 1e-9, 1e-7, 1e-5])
@@ -92,21 +84,21 @@ def test_a_nearly_vanishing_degree_two_part(lead):
     phi, half = np.arctan2(0.8, 0.6), np.arccos(0.25)
     assert on_circle.sum() == 2 and not double
     for root in (phi + half, phi - half):
-        assert gap(theta[on_circle], root).min() < 10 * lead + 1e-12
+        assert angle_gap(theta[on_circle], root).min() < 10 * lead + 1e-12
     assert (np.abs(value(alphas, theta[on_circle])) < 10 * lead + 1e-12).all()
 
 
 def test_the_harmonic_tangent_is_one_double_root():
     """cos t = 1 with no degree-2 part: one root, flagged double."""
     theta, on_circle, double = _trig_quartic_roots(*(np.array(x) for x in (-1.0, 1.0, 0.0, 0.0, 0.0)))
-    assert double and on_circle.sum() == 1 and gap(theta[on_circle], 0.0).max() < DOUBLE_ROOT
+    assert double and on_circle.sum() == 1 and angle_gap(theta[on_circle], 0.0).max() < DOUBLE_ROOT
 
 
 def test_no_real_root_still_gives_the_nearest_angles():
     alphas = coefficients(1.5, 0.3, -2.0, 1.1)  # both factors keep away from 0
     theta, on_circle, _ = _trig_quartic_roots(*alphas)
     assert not on_circle.any()
-    assert gap(theta, 0.3).min() < 1e-9  # the pair off the circle lies at the angle where 1.5 − cos is least
+    assert angle_gap(theta, 0.3).min() < 1e-9  # the pair off the circle lies at the angle where 1.5 − cos is least
 
 
 def test_batches_of_any_shape_and_a_vanishing_equation(rng):

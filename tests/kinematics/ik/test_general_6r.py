@@ -112,13 +112,16 @@ def test_the_same_arm_in_three_conventions_gets_the_same_solution_sets():
 # ---------------------------------------------------------------------------
 
 
-def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.random.Generator) -> np.ndarray:
-    """Every distinct solution a dense Levenberg–Marquardt search finds from ``starts`` random seeds.
+def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.random.Generator,
+                         slide_range: tuple[float, float] = (-np.pi, np.pi)) -> np.ndarray:
+    """Every distinct solution a dense Levenberg–Marquardt search finds from ``starts`` random seeds (revolute
+    joints uniform in ±π, prismatic ones in ``slide_range``).
 
     Knows nothing of the elimination: FK and the geometric Jacobian only, error in units of the robot's size.
     """
     scale = robot.characteristic_length
     q = rng.uniform(-np.pi, np.pi, (starts, 6))
+    q[:, ~robot.is_revolute] = rng.uniform(*slide_range, (starts, int((~robot.is_revolute).sum())))
     damping = np.full(starts, 1e-2)
     def error_of(q):
         T = forward_kinematics(robot, q)
@@ -139,10 +142,11 @@ def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.
         q[better], error[better] = trial[better], trial_error[better]
         damping = np.where(better, damping / 10, damping * 10).clip(1e-12, 1e6)
     converged = q[np.abs(error).max(axis=1) < 1e-11]
-    converged = np.angle(np.exp(1j * converged))
+    revolute = robot.is_revolute
+    converged[:, revolute] = np.angle(np.exp(1j * converged[:, revolute]))
     distinct: list[np.ndarray] = []
     for candidate in converged:
-        if not any(np.abs(np.angle(np.exp(1j * (candidate - other)))).max() < 1e-6 for other in distinct):
+        if not any(np.abs(joint_difference(robot, candidate[None], other)).max() < 1e-6 for other in distinct):
             distinct.append(candidate)
     return np.array(distinct).reshape(-1, 6)
 

@@ -31,17 +31,21 @@ Conditioning
     chain read forwards with q_a = q_3, q_2, q_1 or backwards with q_a = q_4, q_5, q_6) the plan keeps the one
     that recovers random configurations most accurately.
 One slide (5R1P)
-    The slide is joint a (the one arrangement that puts it there). Then p = d k + p_0(q_b, q_c) with d its
-    value and k its unit direction, and l does not depend on d, so p, l, p·l and p×l are linear in d and p·p
-    and l(p·p) − 2p(p·l) quadratic: the left coefficients are taken in the powers (1, d, d²) instead of
-    (1, c_a, s_a), interpolated at d = −1, 0, 1. The d² coefficients come from those two quantities only (4 of
-    the 14 rows), so Σ's leading matrix in d has rank 8 of 12 whatever the scale or origin of d: 8 of the 24
-    roots are at d → ∞. Hence the same Möbius map as for a revolute joint: per target, an interval
-    centre ± w that holds every solution's d (:func:`_slide_interval`, from d = k·p_R − k·p_0) is mapped to
-    θ ∈ [−π/2, π/2] by d = centre + w tan(θ/2), which makes Σ a quadratic in (1, cos θ, sin θ) like a revolute
-    joint's, and the shifts φ ≠ 0 put its leading matrix at a finite d. Roots outside the interval (among them
-    the ones at d → ∞, which rounding spreads by ~ε^¼ around θ = π and may make real) are no solution's and
-    are dropped; there are no roots at ±i.
+    A slide by d along its unit direction k moves points by d k and turns nothing. As joint b, c, e or f, the
+    14 quantities stay linear in the other joints' (1, cos, sin) and become quadratic in d, so the slide's basis
+    is (1, d, d²) (interpolated at d = −1, 0, 1) in place of (1, cos q, sin q): Σ's powers of x_b, x_c are then
+    d itself for a slide (no half-angle), its value comes back as the ratio of consecutive powers, and e's or
+    f's as its linear monomial. As joint a, p = d k + p_0(q_b, q_c) and l does not depend on d, so p, l, p·l and
+    p×l are linear in d and p·p and l(p·p) − 2p(p·l) quadratic; only those four rows have a d² part, so Σ's
+    leading matrix in d has rank 8 of 12 whatever the scale or origin of d: 8 of the 24 roots are at d → ∞.
+    Hence the same Möbius map as for a revolute joint: per target, an interval centre ± w that holds every
+    solution's d (:func:`_slide_interval`, from d = k·p_R − k·p_0) is mapped to θ ∈ [−π/2, π/2] by
+    d = centre + w tan(θ/2), which makes Σ a quadratic in (1, cos θ, sin θ) like a revolute joint's, and the
+    shifts φ ≠ 0 put its leading matrix at a finite d. Roots outside the interval (among them the ones at
+    d → ∞, which rounding spreads by ~ε^¼ around θ = π and may make real) are no solution's and are dropped.
+    Joint d is never the slide (q_d is recovered as a turn), which leaves five of the six arrangements; as for
+    a 6R arm, the plan keeps the most accurate (an arm with two parallel axes among e, f, or among b, c, d, needs
+    another arrangement than the slide-first one).
 Back-substitution
     q_b, q_c from the eigenvector (runs of three powers give cos and sin, so x → ∞ is just an angle of π);
     q_e, q_f from the linear right-hand monomials; q_d from the remaining rotation. Every root is then polished
@@ -69,7 +73,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._rotations import wrap_angle
-from ._screws import chain_motion, invert
+from ._screws import chain_motion, invert, joint_motion
 from ._structure import Geometry
 from ._types import Candidates, LabelCodes, SingularFlags
 
@@ -103,7 +107,6 @@ _GRID = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
 _TRIG = np.stack([np.ones(3), np.cos(_GRID), np.sin(_GRID)], axis=1)  # (3 samples, 3 basis)
 #: (1, cos, sin)·(1 + x²) in the powers (1, x, x²).
 _HALF = np.array([[1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [0.0, 2.0, 0.0]])
-_HALF2 = np.kron(_HALF, _HALF)  # (9 trig products, 9 power products)
 #: Shifts φ of the half-angle origin tried, in order, until the leading matrix is well conditioned.
 _SHIFTS = (0.0, 1.0, -1.3, 2.1, -2.6, 0.45)
 #: A slide's roots with |tan(θ/2)| above this lie outside the interval that holds every solution's slide value
@@ -138,16 +141,6 @@ def _rodrigues(k: np.ndarray | tuple[np.ndarray, np.ndarray], q: np.ndarray) -> 
     return _EYE3 + np.sin(q) * K + (1.0 - np.cos(q)) * KK
 
 
-def _motion(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """The turn by q about the line (k, p): (..., 4, 4)."""
-    R = _rodrigues(k, q)
-    T = np.zeros(R.shape[:-2] + (4, 4))
-    T[..., :3, :3] = R
-    T[..., :3, 3] = p - R @ p
-    T[..., 3, 3] = 1.0
-    return T
-
-
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """a × b along the last axis (np.cross without its axis bookkeeping)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
@@ -167,7 +160,7 @@ class _Arrangement:
 
     ``reverse`` reads the chain backwards (joints 6…1, axes negated, target A⁻¹); ``first`` (0, 1 or 2) is the
     index, in the chain as read, of joint a. ``order`` maps the chain's joints (a, b, c, d, e, f) to the robot's.
-    Joint a may be a slide (``slide``); the other five are revolute.
+    Any of them but d may be a slide (``revolute`` (6,), as read); ``slide`` tells whether joint a is one.
     """
 
     def __init__(self, directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, reverse: bool,
@@ -176,15 +169,18 @@ class _Arrangement:
             directions, points, revolute = -directions[::-1], points[::-1], revolute[::-1]
         self.reverse, self.first = reverse, first
         self.directions, self.points, self.revolute = directions, points, revolute
-        self.slide = not revolute[first]
-        # a slide's leading matrix at d → ∞ (φ = 0) is singular by construction: its shifts start at the next
-        self.shifts = _SHIFTS[1:] if self.slide else _SHIFTS
         self.cross = [_cross_matrix(k) for k in directions]
         a, d = first, first + 3
         # the target's side: joints (e, f) and where they stand around A
         self.rhs = {2: (0, 1), 1: (0, 5), 0: (5, 4)}[first]
         chain = [a, a + 1, a + 2, d, *self.rhs]
         self.order = np.array([5 - j if reverse else j for j in chain])
+        self.kinds = revolute[chain]  # (6,): which of a, b, c, d, e, f turn
+        self.slide = not self.kinds[0]
+        # a slide's leading matrix at d → ∞ (φ = 0) is singular by construction: its shifts start at the next
+        self.shifts = _SHIFTS[1:] if self.slide else _SHIFTS
+        # basis(q_b) ⊗ basis(q_c) times (1 + x²) per revolute joint → the powers x_b^i x_c^j (9, 9)
+        self.powers = np.kron(_HALF if self.kinds[1] else _EYE3, _HALF if self.kinds[2] else _EYE3)
         self.line_point, self.line_direction = points[d], directions[d]
         # the point o on axis a nearest the other axes' points (any point of the axis keeps the structure)
         k = directions[a]
@@ -194,21 +190,24 @@ class _Arrangement:
         self._prepare_right()
 
     def first_basis(self, q: np.ndarray) -> np.ndarray:
-        """The basis in joint a's value of the left coefficients: (1, cos q, sin q), or (1, d, d²) for a slide."""
-        return np.stack([np.ones_like(q), q, q * q], axis=-1) if self.slide else _trig(q)
+        """Joint a's basis of the left coefficients at its values q (...,): (..., 3)."""
+        return _basis(q, self.kinds[0])
+
+    def middle_basis(self, qb: np.ndarray, qc: np.ndarray) -> np.ndarray:
+        """basis(q_b) ⊗ basis(q_c): (..., 9), index 3i + j."""
+        return _basis2(qb, qc, self.kinds[1], self.kinds[2])
 
     def _fit_left(self) -> None:
-        """The left side's coefficients C (3, 14, 9): F_L = (C_0, C_1, C_2) · first_basis(q_a) · t(q_b) ⊗ t(q_c),
+        """The left side's coefficients C (3, 14, 9): F_L = Σ_k C_k basis_k(q_a) · basis(q_b) ⊗ basis(q_c),
         interpolated on the grid of each joint's basis and checked at random values."""
-        first = _POWERS if self.slide else _TRIG
-        g = np.array(np.meshgrid(_SLIDE_GRID if self.slide else _GRID, _GRID, _GRID, indexing="ij"))
-        g = g.reshape(3, -1).T  # (27, 3)
-        basis = np.kron(np.kron(first, _TRIG), _TRIG)  # (27 samples, 27 basis)
+        grids, samples = zip(*(_sampling(kind) for kind in self.kinds[:3]))
+        g = np.array(np.meshgrid(*grids, indexing="ij")).reshape(3, -1).T  # (27, 3)
+        basis = np.kron(np.kron(samples[0], samples[1]), samples[2])  # (27 samples, 27 basis)
         coefficients = np.linalg.solve(basis, self.left_values(g)).T  # (14, 27)
         self.left = coefficients.reshape(14, 3, 9).transpose(1, 0, 2).copy()
         check = np.random.default_rng(7).uniform(-np.pi, np.pi, (8, 3))
         predicted = np.einsum("kem,nk,nm->ne", self.left, self.first_basis(check[:, 0]),
-                              _trig2(check[:, 1], check[:, 2]))
+                              self.middle_basis(check[:, 1], check[:, 2]))
         self.left_fit_error = float(np.abs(predicted - self.left_values(check)).max())
 
     def left_values(self, q: np.ndarray) -> np.ndarray:
@@ -222,9 +221,10 @@ class _Arrangement:
     def _prepare_right(self) -> None:
         """The nine rigid motions Left_k, Right_k of the 3 × 3 sample grid of (q_e, q_f), and the fit matrix."""
         e, f = self.rhs
-        ge, gf = (m.reshape(-1) for m in np.meshgrid(_GRID, _GRID, indexing="ij"))
-        Ge = _motion(self.directions[e], self.points[e], -ge)  # G_e⁻¹ at the samples
-        Gf = _motion(self.directions[f], self.points[f], -gf)
+        (grid_e, samples_e), (grid_f, samples_f) = _sampling(self.kinds[4]), _sampling(self.kinds[5])
+        ge, gf = (m.reshape(-1) for m in np.meshgrid(grid_e, grid_f, indexing="ij"))
+        Ge = joint_motion(self.directions[e], self.points[e], bool(self.kinds[4]), -ge)  # G_e⁻¹ at the samples
+        Gf = joint_motion(self.directions[f], self.points[f], bool(self.kinds[5]), -gf)
         eye = np.broadcast_to(np.eye(4), Ge.shape)
         # G_2⁻¹ G_1⁻¹ A | G_1⁻¹ A G_6⁻¹ | A G_6⁻¹ G_5⁻¹ (chain as read, 0-based joints)
         left, right = {2: (Gf @ Ge, eye), 1: (Ge, Gf), 0: (eye, Ge @ Gf)}[self.first]
@@ -232,7 +232,7 @@ class _Arrangement:
         self.sample_right_point = np.einsum("kij,j->ki", right[:, :3, :3], self.line_point) + right[:, :3, 3]
         self.sample_right_direction = np.einsum("kij,j->ki", right[:, :3, :3], self.line_direction)
         # B = values · (basis⁻¹)ᵀ: with basis (9 samples, 9 products)
-        self.right_fit = np.linalg.inv(np.kron(_TRIG, _TRIG)).T  # values (.., 9 samples) → coefficients
+        self.right_fit = np.linalg.inv(np.kron(samples_e, samples_f)).T  # values (.., 9 samples) → coefficients
 
     def right_coefficients(self, A: np.ndarray) -> np.ndarray:
         """The right side's coefficients B (N, 14, 9) for chain targets A (N, 4, 4) (normalised lengths)."""
@@ -250,9 +250,20 @@ def _trig(q: np.ndarray) -> np.ndarray:
     return np.stack([np.ones_like(q), np.cos(q), np.sin(q)], axis=-1)
 
 
-def _trig2(qb: np.ndarray, qc: np.ndarray) -> np.ndarray:
-    """t(q_b) ⊗ t(q_c): (..., 9), index 3i + j."""
-    return (_trig(qb)[..., :, None] * _trig(qc)[..., None, :]).reshape(qb.shape + (9,))
+def _basis(q: np.ndarray, revolute: bool) -> np.ndarray:
+    """A joint's basis at its values q (...,): (1, cos q, sin q) for a revolute joint, (1, d, d²) for a slide."""
+    return _trig(q) if revolute else np.stack([np.ones_like(q), q, q * q], axis=-1)
+
+
+def _basis2(q1: np.ndarray, q2: np.ndarray, revolute1: bool = True, revolute2: bool = True) -> np.ndarray:
+    """basis(q1) ⊗ basis(q2): (..., 9), index 3i + j."""
+    return (_basis(q1, revolute1)[..., :, None] * _basis(q2, revolute2)[..., None, :]).reshape(q1.shape + (9,))
+
+
+def _sampling(revolute: bool) -> tuple[np.ndarray, np.ndarray]:
+    """A joint's interpolation grid (3,) and its basis there (3 samples, 3 basis): angles 0, ±2π/3, or a slide's
+    values −1, 0, 1 (normalised lengths)."""
+    return (_GRID, _TRIG) if revolute else (_SLIDE_GRID, _POWERS)
 
 
 class _Roots:
@@ -296,7 +307,7 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
             break
         c, s = np.cos(phi), np.sin(phi)
         E0, E1, E2 = E[rows, 0], c * E[rows, 1] + s * E[rows, 2], -s * E[rows, 1] + c * E[rows, 2]
-        D = np.stack([E0 + E1, 2.0 * E2, E0 - E1], axis=1) @ _HALF2  # (R, 3, 6, 9): powers 1, y, y²
+        D = np.stack([E0 + E1, 2.0 * E2, E0 - E1], axis=1) @ arr.powers  # (R, 3, 6, 9): powers 1, y, y²
         D /= np.abs(D).max(axis=(1, 3), keepdims=True)  # row equilibration
         S = np.zeros((len(rows), 3, 12, 12))
         S[:, :, :6, :9] = D
@@ -363,17 +374,18 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     top, bottom = vectors[:, :12, :], vectors[:, 12:, :]
     monomials = np.where((np.abs(y) <= 1.0)[:, None, :], top, bottom)  # (N, 12, m)
     monomials = np.swapaxes(monomials, 1, 2).reshape(n, m, 4, 3)
-    qb = _monomial_angle(monomials)
-    qc = _monomial_angle(np.swapaxes(monomials, -1, -2))
+    qb = _monomial_value(monomials, arr.kinds[1])
+    qc = _monomial_value(np.swapaxes(monomials, -1, -2), arr.kinds[2])
     # right-hand monomials by least squares, then q_e, q_f from the linear ones
     if arr.slide:
         qa = centre[:, None] + half_width[:, None] * np.tan(0.5 * qa)
-    left = np.einsum("ntk,kem,ntm->nte", arr.first_basis(qa), arr.left, _trig2(qb, qc))  # (N, m, 14)
+    left = np.einsum("ntk,kem,ntm->nte", arr.first_basis(qa), arr.left, arr.middle_basis(qb, qc))  # (N, m, 14)
     inverse_sigma = np.where(sigma > CONDITION_FLOOR * sigma[:, :1], 1.0 / np.maximum(sigma, 1e-300), 0.0)
     pinv = np.einsum("nji,nj,nej->nie", Vt, inverse_sigma, U[:, :, :8])  # (N, 8, 14)
     mono = np.einsum("nie,nte->nti", pinv, left - b1[:, None, :])  # (N, m, 8): index m − 1 of 3i + j
-    qe = np.arctan2(mono[..., 5], mono[..., 2])  # s_e (m = 6), c_e (m = 3)
-    qf = np.arctan2(mono[..., 1], mono[..., 0])  # s_f (m = 2), c_f (m = 1)
+    # (c_e, s_e) at m = 3, 6 and (c_f, s_f) at m = 1, 2; a slide's value at m = 3 or 1
+    qe = np.arctan2(mono[..., 5], mono[..., 2]) if arr.kinds[4] else mono[..., 2]
+    qf = np.arctan2(mono[..., 1], mono[..., 0]) if arr.kinds[5] else mono[..., 0]
     chain = np.stack([qa, qb, qc, np.zeros_like(qa), qe, qf], axis=-1)  # joints (a, b, c, d, e, f)
     chain[..., 3] = _last_joint(arr, chain_A, chain)
     joints = np.empty_like(chain)
@@ -404,6 +416,16 @@ def _slide_to_angle(E: np.ndarray, centre: np.ndarray, half_width: np.ndarray) -
     Q1 = w[:, 0] * (E[:, 1] + 2.0 * c[:, 0] * E[:, 2])
     Q2 = w[:, 0] ** 2 * E[:, 2]
     return 0.5 * np.stack([Q0 + Q2, Q0 - Q2, Q1], axis=1)
+
+
+def _monomial_value(m: np.ndarray, revolute: bool) -> np.ndarray:
+    """A joint's value from its powers along the second-last axis, m (..., P ≥ 3, Q) ∝ x^i · (…): the angle of
+    :func:`_monomial_angle`, or a slide's d from the runs m_i+1 = d m_i (least squares, the largest entries
+    weighing most)."""
+    if revolute:
+        return _monomial_angle(m)
+    low, high = m[..., :-1, :], m[..., 1:, :]
+    return (high * low.conj()).real.sum(axis=(-2, -1)) / (np.abs(low) ** 2).sum(axis=(-2, -1))
 
 
 def _monomial_angle(m: np.ndarray) -> np.ndarray:
@@ -550,12 +572,12 @@ class General6RPlan:
         return best, best_error
 
     def _arrangements(self) -> list[tuple[bool, int]]:
-        """(reverse, first) of the arrangements to try: all six for a 6R arm; for an arm with a slide, the one
-        with the slide as joint a (as joint b … f the quantities would not keep the elimination's structure)."""
-        if self.revolute.all():
-            return [(reverse, first) for reverse in (False, True) for first in (2, 1, 0)]
-        slide = int(np.flatnonzero(~self.revolute)[0])
-        return [(False, slide)] if slide <= 2 else [(True, 5 - slide)]
+        """(reverse, first) of the arrangements to try: all six, but the ones that make a slide joint d (q_d is
+        recovered as a turn about d's axis)."""
+        every = [(reverse, first) for reverse in (False, True) for first in (2, 1, 0)]
+        slides = np.flatnonzero(~self.revolute)
+        return [(reverse, first) for reverse, first in every
+                if not len(slides) or (5 - (first + 3) if reverse else first + 3) != slides[0]]
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         n = len(world_T_targets)

@@ -47,14 +47,14 @@ def found(robot: Robot, solutions: np.ndarray, q: np.ndarray, tolerance: float =
         np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= tolerance)
 
 
-def check_answers(robot: Robot, q: np.ndarray, plan: General6RPlan | None = None):
+def check_answers(robot: Robot, q: np.ndarray, plan: General6RPlan | None = None, structure: str = "general_6r"):
     """Solve FK(q) for each row of q; assert recall, no wrong solution, no `unreachable`. Returns the arrays.
 
-    Without ``plan`` the router must choose the general solver; with it, that plan is used (for a real arm a
-    closed-form family may one day claim)."""
+    Without ``plan`` the router must choose the general solver (``structure``); with it, that plan is used (for a
+    real arm a closed-form family may one day claim)."""
     targets = forward_kinematics(robot, q)
     arrays = solve_ik_arrays(robot, targets, plan=plan)
-    assert arrays is not None and arrays.structure == "general_6r"
+    assert arrays is not None and arrays.structure == structure
     assert (arrays.count > 0).all(), "an FK pose was answered unreachable"
     for row in range(len(q)):
         solutions = arrays.joints[row, :arrays.count[row]]

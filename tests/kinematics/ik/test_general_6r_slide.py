@@ -15,13 +15,14 @@ import pytest
 
 from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics._forward import joint_screws
-from service.kinematics.ik import solve_ik, solve_ik_arrays
+from service.kinematics.ik import solve_ik
 from service.kinematics.ik._answer import AnswerOptions, IKTargets, answer_ik
 from service.kinematics.ik._general_6r import GENERAL_5R1P, General6RPlan
 from service.kinematics.ik._plan import geometry_of, plan_for
 from service.kinematics.ik._solve import unlimited
 from service.kinematics.ik._verify import residuals
-from tests.kinematics.ik.test_general_6r import CONVENTIONS, _rotation, found, multistart_solutions
+from tests.kinematics.ik.test_general_6r import (CONVENTIONS, _rotation, check_answers, found,
+                                                 multistart_solutions)
 
 #: Geometry rounded as CAD exports round it (metres to the micrometre).
 CAD = 6
@@ -62,18 +63,9 @@ def configurations(rng: np.random.Generator, robot: Robot, count: int) -> np.nda
 
 
 def check_every_vector_returns(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Solve FK(q) for each row of q with the router's plan; assert the general solver answered, every generating
-    vector came back, no `unreachable` and no wrong solution. Returns which answers are complete (N,)."""
-    targets = forward_kinematics(robot, q)
-    arrays = solve_ik_arrays(robot, targets)
-    assert arrays is not None and arrays.structure == GENERAL_5R1P
-    assert (arrays.count > 0).all(), "an FK pose was answered unreachable"
-    for row in range(len(q)):
-        solutions = arrays.joints[row, :arrays.count[row]]
-        assert found(robot, solutions, q[row]), f"pose {row}: generating vector missing"
-        position, orientation = residuals(robot, solutions, targets[row])
-        assert position.max() <= 1e-9 * robot.characteristic_length and orientation.max() <= 1e-9
-    return arrays.complete
+    """``check_answers`` of the 6R tests with the slide's structure: every generating vector back, no wrong
+    solution, no `unreachable`, an even count. Returns which answers are complete (N,)."""
+    return check_answers(robot, q, structure=GENERAL_5R1P).complete
 
 
 # ---------------------------------------------------------------------------

@@ -120,6 +120,21 @@ def test_every_generating_vector_comes_back_with_the_slide_anywhere(convention):
     assert complete == total
 
 
+@pytest.mark.parametrize("slide, pair", [(0, 4), (0, 2), (3, 0), (3, 4), (5, 0), (2, 0)])
+def test_arms_with_two_parallel_axes_are_solved_by_another_arrangement(slide, pair):
+    """Joints ``pair`` and ``pair + 1`` parallel (standard DH: α = 0 in row ``pair``). With the slide as joint a
+    some of these make the right-hand coefficients or Σ singular (parallel e, f; parallel c, d); the plan must
+    find an arrangement that puts the slide elsewhere and still answer every pose completely."""
+    rng = np.random.default_rng(50 + 6 * slide + pair)
+    robot = slide_arm(rng, slide, "standard")
+    rows = [Joint(j.name, j.kind, j.a, 0.0 if i == pair else j.alpha, j.d, j.theta) for i, j in enumerate(robot.joints)]
+    robot = Robot(rows, convention="standard", world_T_base=robot.world_T_base, flange_T_tool=robot.flange_T_tool)
+    geometry = geometry_of(robot)
+    assert geometry.parallel(pair, pair + 1)
+    q = configurations(rng, robot, 30)
+    assert check_every_vector_returns(robot, q).all()
+
+
 def test_solution_sets_agree_with_a_dense_multistart_search():
     rng = np.random.default_rng(17)
     counts = []

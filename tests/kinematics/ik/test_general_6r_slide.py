@@ -17,7 +17,7 @@ from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics._forward import joint_screws
 from service.kinematics.ik import solve_ik
 from service.kinematics.ik._answer import AnswerOptions, IKTargets, answer_ik
-from service.kinematics.ik._general_6r import GENERAL_5R1P, General6RPlan
+from service.kinematics.ik._general_6r import GENERAL_5R1P, General6RPlan, _Arrangement
 from service.kinematics.ik._plan import geometry_of, plan_for
 from service.kinematics.ik._solve import unlimited
 from service.kinematics.ik._verify import residuals
@@ -118,6 +118,22 @@ def test_every_generating_vector_comes_back_with_the_slide_anywhere(convention):
     assert total == 240  # 6 positions of the slide × 40 poses, per convention
     # measured: every one of the 720 answers is complete (no ambiguous root, every real root verified)
     assert complete == total
+
+
+@pytest.mark.parametrize("slide", [0, 2, 3, 5])
+def test_the_slide_as_joint_a_with_its_interval_map(slide):
+    """The arrangement with the slide as joint a (Σ quadratic in d with a rank-deficient d² part, mapped per target
+    to a half-angle over an interval that holds every solution's d), forced even where the plan prefers another:
+    every pose comes back, complete."""
+    rng = np.random.default_rng(60 + slide)
+    robot = slide_arm(rng, slide, "standard")
+    plan = General6RPlan(geometry_of(robot))
+    reverse = slide > 2
+    plan.arrangement = _Arrangement(plan.directions, plan.points, plan.revolute, reverse, 5 - slide if reverse else slide)
+    assert plan.arrangement.slide and plan.arrangement.order[0] == slide
+    q = configurations(rng, robot, 40)
+    arrays = check_answers(robot, q, plan=plan, structure=GENERAL_5R1P)
+    assert arrays.complete.all()  # measured: all 160 complete
 
 
 @pytest.mark.parametrize("slide, pair", [(0, 4), (0, 2), (3, 0), (3, 4), (5, 0), (2, 0)])

@@ -255,7 +255,7 @@ def _basis(q: np.ndarray, revolute: bool) -> np.ndarray:
     return _trig(q) if revolute else np.stack([np.ones_like(q), q, q * q], axis=-1)
 
 
-def _basis2(q1: np.ndarray, q2: np.ndarray, revolute1: bool = True, revolute2: bool = True) -> np.ndarray:
+def _basis2(q1: np.ndarray, q2: np.ndarray, revolute1: bool, revolute2: bool) -> np.ndarray:
     """basis(q1) ⊗ basis(q2): (..., 9), index 3i + j."""
     return (_basis(q1, revolute1)[..., :, None] * _basis(q2, revolute2)[..., None, :]).reshape(q1.shape + (9,))
 
@@ -411,10 +411,10 @@ def _slide_interval(arr: _Arrangement, B: np.ndarray) -> tuple[np.ndarray, np.nd
 def _slide_to_angle(E: np.ndarray, centre: np.ndarray, half_width: np.ndarray) -> np.ndarray:
     """Coefficients E (N, 3, …) in the powers (1, d, d²) of a slide → coefficients in (1, cos θ, sin θ) of
     cos²(θ/2) times the same polynomial at d = centre + half_width · tan(θ/2)."""
-    c, w = centre[:, None, None, None], half_width[:, None, None, None]
-    Q0 = E[:, 0] + c[:, 0] * E[:, 1] + c[:, 0] ** 2 * E[:, 2]
-    Q1 = w[:, 0] * (E[:, 1] + 2.0 * c[:, 0] * E[:, 2])
-    Q2 = w[:, 0] ** 2 * E[:, 2]
+    c, w = centre[:, None, None], half_width[:, None, None]
+    Q0 = E[:, 0] + c * E[:, 1] + c ** 2 * E[:, 2]  # the powers (1, u, u²) of u = tan(θ/2)
+    Q1 = w * (E[:, 1] + 2.0 * c * E[:, 2])
+    Q2 = w ** 2 * E[:, 2]
     return 0.5 * np.stack([Q0 + Q2, Q0 - Q2, Q1], axis=1)
 
 

@@ -184,6 +184,18 @@ def test_a_torso_lift_under_a_general_5r_arm():
         assert all(found(robot, mine, s, 1e-6) for s in oracle) and len(mine) == len(oracle)
 
 
+def test_a_long_rail_under_a_small_arm():
+    """A 10 m horizontal rail under a 5R arm of ~1 m: slide values many times the arm's size (its length unit)."""
+    rng = np.random.default_rng(27)
+    rows = np.round(np.column_stack([rng.uniform(0.05, 0.3, 5), rng.uniform(-np.pi, np.pi, 5),
+                                     rng.uniform(-0.1, 0.1, 5), rng.uniform(-1, 1, 5)]), CAD)
+    rail = Joint("rail", "prismatic", 0.0, np.pi / 2, 0.5, 0.0, lower=-10.0, upper=10.0)
+    robot = Robot([rail, *(Joint(f"arm_{i + 1}", "revolute", *rows[i]) for i in range(5))], convention="standard")
+    q = configurations(rng, robot, 40)
+    assert np.abs(q[:, 0]).max() > 8.0
+    assert check_every_vector_returns(robot, q).all()
+
+
 def test_unreachable_is_a_promise_the_multistart_search_cannot_break():
     """A slide has no reach bound: `unreachable` with `complete` must come from the eigenproblem alone."""
     rng = np.random.default_rng(29)

@@ -539,8 +539,8 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
 def _fallback_note(plan) -> str:
     """Why the numeric search completed a target the plan could not promise."""
     if plan.structure.startswith(GENERAL_STRUCTURES):
-        return ("The general solver (6R, or 5R with one slide) cannot promise every solution for this target (an ill-conditioned "
-                "eigenproblem or a near-double root), so the numeric search completed its answer.")
+        return ("The general solver (6R, or 5R with one slide) cannot promise every solution for this target (an "
+                "ill-conditioned eigenproblem or a near-double root), so the numeric search completed its answer.")
     if isinstance(plan, IdealisedPlan):
         return (f"The arm is within rounding of the {plan.structure} family but not exactly of it; its closed "
                 f"form, refined on the arm as given, cannot promise every solution for this target (a pair of "

@@ -129,7 +129,8 @@ def test_the_slide_as_joint_a_with_its_interval_map(slide):
     robot = slide_arm(rng, slide, "standard")
     plan = General6RPlan(geometry_of(robot))
     reverse = slide > 2
-    plan.arrangement = _Arrangement(plan.directions, plan.points, plan.revolute, reverse, 5 - slide if reverse else slide)
+    first = 5 - slide if reverse else slide
+    plan.arrangement = _Arrangement(plan.directions, plan.points, plan.revolute, reverse, first)
     assert plan.arrangement.slide and plan.arrangement.order[0] == slide
     q = configurations(rng, robot, 40)
     arrays = check_answers(robot, q, plan=plan, structure=GENERAL_5R1P)

@@ -372,8 +372,8 @@ def test_numeric_time_budget_refuses_rather_than_cuts(client):
     that needs longer is a 503 with Retry-After, never a partial answer that depends on the server's load."""
     import time
 
-    # five skew revolute joints and a slide: no family (nor the general 6R solver) covers it, so the numeric
-    # search answers
+    # four skew revolute joints and two slides: no family (nor the general solver, which takes one slide at most)
+    # covers it, so the numeric search answers
     T = _fk_pose(client, NUMERIC_ARM, [0.3, 0.4, 0.8, 0.2, -0.4, 0.1])
     start = time.perf_counter()
     cut = client.post("/v1/ik", json={"robot": NUMERIC_ARM, "target": {"matrix": T.tolist()},
@@ -395,7 +395,7 @@ def _revolute(a, alpha, d, kind="revolute"):
 
 
 NUMERIC_ARM = {"convention": "modified", "joints": [
-    _revolute(a, alpha, d, kind) for kind, a, alpha, d in zip(["revolute"] * 5 + ["prismatic"],
+    _revolute(a, alpha, d, kind) for kind, a, alpha, d in zip(["revolute"] * 4 + ["prismatic"] * 2,
                                                               [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
                                                               [0.5, -0.9, 1.1, 0.7, -1.3, 0.4],
                                                               [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
@@ -414,7 +414,7 @@ ONE_JOINT = {"convention": "modified", "joints": [_revolute(0.3, 0.7, 0.1)]}
 
 #: (robot, joint vector whose FK is the target, target kind): every one reachable
 REACHABLE = [
-    (NUMERIC_ARM, [0.3, -0.2, 0.9, 1.4, -0.7, 0.2], "pose"),  # five skew revolute joints and a slide
+    (NUMERIC_ARM, [0.3, -0.2, 0.9, 1.4, -0.7, 0.2], "pose"),  # four skew revolute joints and two slides
     (SKEW_PRISMATIC, [0.4, 0.3, -1.1, 0.2, 2.0, -0.6], "pose"),
     # 3 joints more than the target fixes, and joints 1–3 (planar: axes 1 ∥ 2 ∥ 3) cannot place a point alone. (The
     # skew RPR start of SKEW_PRISMATIC can: its position targets are solved in closed form, skew_axes_with_slide.)

@@ -123,3 +123,37 @@ def test_a_target_out_of_reach_of_a_urdf_arm_is_unreachable_not_a_500(client, ro
     batch = client.post(f"/v1/robots/{robot_id}/ik/batch", json={"targets": [far, far]})
     assert batch.status_code == 200, batch.text
     assert [r["status"] for r in batch.json()["results"]] == ["unreachable", "unreachable"]
+
+
+#: A mobile manipulator's torso lift (0…0.6 m) under a 6R arm of general geometry (issue 22, 5.1): locking an arm
+#: joint leaves a slide and five revolute joints, which no closed-form family covers and the general solver does.
+TORSO_ARM = {"convention": "standard", "angle_unit": "rad", "length_unit": "m", "joints": [
+    {"type": "prismatic", "a": 0.0, "alpha": 0.0, "d": 0.35, "theta": 0.0, "limits": {"lower": 0.0, "upper": 0.6}},
+    {"type": "revolute", "a": 0.12, "alpha": -1.4, "d": 0.05, "theta": 0.3},
+    {"type": "revolute", "a": 0.31, "alpha": 0.6, "d": -0.08, "theta": -0.2},
+    {"type": "revolute", "a": 0.05, "alpha": 1.9, "d": 0.27, "theta": 0.9},
+    {"type": "revolute", "a": 0.22, "alpha": -0.7, "d": 0.02, "theta": 0.1},
+    {"type": "revolute", "a": 0.08, "alpha": 1.2, "d": 0.11, "theta": -0.6},
+    {"type": "revolute", "a": 0.03, "alpha": -0.5, "d": 0.09, "theta": 0.4}]}
+TORSO_Q = [0.27, 0.4, -0.9, 1.3, -0.5, 0.8, -1.1]
+
+
+class _TorsoArm:
+    is_revolute = np.array([False] + [True] * 6)
+
+
+def test_a_torso_lift_and_6r_arm_with_an_arm_joint_free_is_solved_in_closed_form_at_the_values_asked(client):
+    T = fk_inline(client, TORSO_ARM, TORSO_Q)
+    values = [TORSO_Q[2], -0.3, 2.0]
+    answer = client.post("/v1/ik", json={"robot": TORSO_ARM, "target": {"matrix": T.tolist()}, "filter_limits": False,
+                                         "free_joints": [{"joint": 2, "values": values}]})
+    assert answer.status_code == 200, answer.text
+    answer = answer.json()
+    assert answer["solver"]["method"] == "analytic" and answer["solver"]["complete"] is True
+    assert answer["solver"]["structure"] == "general_5r1p with q3 free" and answer["free_joints"] == [2]
+    joints = np.array([s["joints"] for s in answer["solutions"]])
+    assert find(_TorsoArm(), joints, np.array(TORSO_Q)) is not None
+    for solution in answer["solutions"]:  # every solution holds one of the values asked, and reaches the target
+        assert solution["free_values"]["2"] == solution["joints"][2]
+        assert min(abs(solution["joints"][2] - v) for v in values) == 0.0
+        assert np.abs(fk_inline(client, TORSO_ARM, solution["joints"]) - T).max() < 1e-9

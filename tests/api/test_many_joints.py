@@ -82,9 +82,9 @@ def test_the_numeric_search_works_in_chunks_of_bounded_memory():
 
 
 def test_free_values_a_client_sends_hold_in_every_solution(client):
-    """Item 5: a prismatic torso lift under a 6R arm, with an arm joint named free. No closed form covers the
-    arm with that joint locked, so the numeric search answers at each value asked, the joint held there: every
-    solution carries the value, and the answer says the search cannot promise completeness."""
+    """Item 5: a prismatic torso lift under a 6R arm, with an arm joint named free. The arm with that joint locked
+    (a slide and five revolute joints, no decomposable geometry) is the general solver's: it answers at each value
+    asked, the joint held there, every solution carries the value, and the answer is complete."""
     arm = {"id": "lift-arm", "convention": "standard", "angle_unit": "rad", "joints": [
         {"type": "prismatic", "a": 0.0, "alpha": 0.0, "theta": 0.0, "d": 0.3, "limits": {"lower": 0.0, "upper": 0.6}},
         {"type": "revolute", "a": 0.0, "alpha": 1.5708, "theta": 0.0, "d": 0.0892},
@@ -106,7 +106,9 @@ def test_free_values_a_client_sends_hold_in_every_solution(client):
         assert solution["free_values"] == {"2": solution["joints"][2]}
         assert _fk_error(arm, solution["joints"], target) <= 1e-8
     assert any(np.allclose(s["joints"], q, atol=1e-6) for s in answer["solutions"])
-    assert answer["solver"]["complete"] is False and answer["free_joints"] == [2]
+    assert answer["solver"] == {**answer["solver"], "method": "analytic", "structure": "general_5r1p with q3 free",
+                                "complete": True}
+    assert answer["free_joints"] == [2]
 
 
 def test_a_trajectory_on_many_joints_never_says_unreachable_without_a_proof(client):

@@ -143,3 +143,31 @@ def test_cad_rounded_arms_inline_keep_their_promises(client, robot_id, dust):
         answer = client.post("/v1/ik", json={"robot": inline, "target": target, "limits": [None] * dof})
         assert answer.status_code == 200, answer.text
         _kept_promise(robot, answer.json(), qi, "inline single, rounded")
+
+
+class _Kinds:
+    """What matching modulo 2π needs of an inline arm: its joint kinds."""
+
+    def __init__(self, kinds: str) -> None:
+        self.is_revolute = np.array([kind == "R" for kind in kinds])
+
+
+@pytest.mark.parametrize("slide, convention", [(0, "standard"), (3, "modified")])
+def test_six_joint_arms_with_a_slide_of_general_geometry_answer_complete(client, slide, convention):
+    """A slide and five revolute joints that no closed form covers (CAD-rounded DH entries, sent inline): the
+    general solver answers, and its promise holds, with the generating configuration in every answer."""
+    rng = np.random.default_rng(40 + slide)
+    rows = np.round(rng.uniform(-1, 1, (6, 4)), 6)
+    inline = {"convention": convention, "angle_unit": "rad", "joints": [
+        {"type": "prismatic" if i == slide else "revolute", "a": a, "alpha": alpha, "d": d, "theta": theta}
+        for i, (a, alpha, d, theta) in enumerate(rows.tolist())]}
+    q = rng.uniform(-np.pi, np.pi, (CONFIGURATIONS, 6))
+    arm = _Kinds("".join("P" if i == slide else "R" for i in range(6)))
+    for qi in q:
+        target = client.post("/v1/fk", json={"robot": inline, "joints": qi.tolist()}).json()["pose"]["matrix"]
+        answer = client.post("/v1/ik", json={"robot": inline, "target": {"matrix": target}, "limits": [None] * 6})
+        assert answer.status_code == 200, answer.text
+        body = answer.json()
+        assert body["solver"] == {**body["solver"], "method": "analytic", "structure": "general_5r1p",
+                                  "complete": True}
+        _kept_promise(arm, body, qi, "inline single, general 5R1P")

@@ -34,6 +34,7 @@ from ._closed_form import cached_plan, solve_closed_form
 from ._coaxial import CoaxialPlan, coaxial_pair
 from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, distinct_rolls, roll_family,
                          roll_free_joints, roll_rows, roll_samples, solve_roll_family, tool_roll)
+from ._general_6r import GENERAL_STRUCTURES
 from ._goals import DirectionGoal, PoseGoal
 from ._idealised import IdealisedPlan
 from ._numeric import NumericOptions, search
@@ -525,9 +526,9 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
 
 def _fallback_note(plan) -> str:
     """Why the numeric search completed a target the plan could not promise."""
-    if plan.structure.startswith("general_6r"):
-        return ("The general 6R solver cannot promise every solution for this target (an ill-conditioned "
-                "eigenproblem or a near-double root), so the numeric search completed its answer.")
+    if plan.structure.startswith(GENERAL_STRUCTURES):
+        return ("The general solver (6R, or 5R with one slide) cannot promise every solution for this target (an "
+                "ill-conditioned eigenproblem or a near-double root), so the numeric search completed its answer.")
     if isinstance(plan, IdealisedPlan):
         return (f"The arm is within rounding of the {plan.structure} family but not exactly of it; its closed "
                 f"form, refined on the arm as given, cannot promise every solution for this target (a pair of "

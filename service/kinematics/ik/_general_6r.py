@@ -1,4 +1,5 @@
-"""Every solution of a general 6R arm: the Raghavan–Roth elimination solved as Manocha and Canny solve it.
+"""Every solution of a general 6R arm, or of a 6-joint arm with one slide: the Raghavan–Roth elimination solved as
+Manocha and Canny solve it.
 
 Notation: the screw model ``world_T_tool = G_1(q_1) ⋯ G_6(q_6) · home``, A = world_T_target · home⁻¹. All
 lengths are divided by the robot's size, so every coefficient below is of order one.
@@ -29,6 +30,22 @@ Conditioning
     at q_a = π is then an ordinary finite eigenvalue. Of the six arrangements (each joint in turn as q_a: the
     chain read forwards with q_a = q_3, q_2, q_1 or backwards with q_a = q_4, q_5, q_6) the plan keeps the one
     that recovers random configurations most accurately.
+One slide (5R1P)
+    A slide by d along its unit direction k moves points by d k and turns nothing. As joint b, c, e or f, the
+    14 quantities stay linear in the other joints' (1, cos, sin) and become quadratic in d, so the slide's basis
+    is (1, d, d²) (interpolated at d = −1, 0, 1) in place of (1, cos q, sin q): Σ's powers of x_b, x_c are then
+    d itself for a slide (no half-angle), its value comes back as the ratio of consecutive powers, and e's or
+    f's as its linear monomial. As joint a, p = d k + p_0(q_b, q_c) and l does not depend on d, so p, l, p·l and
+    p×l are linear in d and p·p and l(p·p) − 2p(p·l) quadratic; only those four rows have a d² part, so Σ's
+    leading matrix in d has rank 8 of 12 whatever the scale or origin of d: 8 of the 24 roots are at d → ∞.
+    Hence the same Möbius map as for a revolute joint: per target, an interval centre ± w that holds every
+    solution's d (:func:`_slide_interval`, from d = k·p_R − k·p_0) is mapped to θ ∈ [−π/2, π/2] by
+    d = centre + w tan(θ/2), which makes Σ a quadratic in (1, cos θ, sin θ) like a revolute joint's, and the
+    shifts φ ≠ 0 put its leading matrix at a finite d. Roots outside the interval (among them the ones at
+    d → ∞, which rounding spreads by ~ε^¼ around θ = π and may make real) are no solution's and are dropped.
+    Joint d is never the slide (q_d is recovered as a turn), which leaves five of the six arrangements; as for
+    a 6R arm, the plan keeps the most accurate (an arm with two parallel axes among e, f, or among b, c, d, needs
+    another arrangement than the slide-first one).
 Back-substitution
     q_b, q_c from the eigenvector (runs of three powers give cos and sin, so x → ∞ is just an angle of π);
     q_e, q_f from the linear right-hand monomials; q_d from the remaining rotation. Every root is then polished
@@ -39,8 +56,9 @@ Completeness
     coefficients have full rank 8, the leading matrix is well conditioned, no eigenvalue is ambiguous (an
     imaginary part within :data:`AMBIGUITY_FACTOR` times its first-order error bound: a root pair about to merge
     or split), at most 16 roots are real, and (checked after verification) every real root gave one distinct
-    verified solution. Anything else is answered with ``complete: false``. A target farther from axis 1 than
-    the arm's reach bound is a certain ``unreachable`` (complete) whatever the conditioning.
+    verified solution. Anything else is answered with ``complete: false``. A 6R arm's target farther from axis 1
+    than the arm's reach bound is a certain ``unreachable`` (complete) whatever the conditioning (a slide has no
+    such bound).
 
 Pieper-class arms (three consecutive axes through one point, or parallel) make Σ singular for every x in some
 arrangements (and give double eigenvalues, solutions that share q_a, in others); they are the closed-form
@@ -55,9 +73,15 @@ from __future__ import annotations
 import numpy as np
 
 from .._rotations import wrap_angle
-from ._screws import invert
+from ._screws import chain_motion, invert, joint_motion
 from ._structure import Geometry
 from ._types import Candidates, LabelCodes, SingularFlags
+
+#: The plan's structure names: a 6R arm, and one with a slide.
+GENERAL_6R = "general_6r"
+GENERAL_5R1P = "general_5r1p"
+GENERAL_STRUCTURES = (GENERAL_6R, GENERAL_5R1P)
+
 
 #: A complex root whose angle's imaginary part is within this many times its error bound of the real axis
 #: (a pair about to become two real roots, or two real roots split by rounding) is ambiguous.
@@ -83,9 +107,15 @@ _GRID = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
 _TRIG = np.stack([np.ones(3), np.cos(_GRID), np.sin(_GRID)], axis=1)  # (3 samples, 3 basis)
 #: (1, cos, sin)·(1 + x²) in the powers (1, x, x²).
 _HALF = np.array([[1.0, 0.0, 1.0], [1.0, 0.0, -1.0], [0.0, 2.0, 0.0]])
-_HALF2 = np.kron(_HALF, _HALF)  # (9 trig products, 9 power products)
 #: Shifts φ of the half-angle origin tried, in order, until the leading matrix is well conditioned.
 _SHIFTS = (0.0, 1.0, -1.3, 2.1, -2.6, 0.45)
+#: A slide's roots with |tan(θ/2)| above this lie outside the interval that holds every solution's slide value
+#: (see :func:`_slide_interval`; the margin covers rounding): among them the spurious ones at d → ∞.
+SLIDE_OUTSIDE = 1.0 + 1e-6
+#: Slide values (normalised lengths) at which a slide's left coefficients are interpolated, and the basis
+#: (1, d, d²) there: rows are samples.
+_SLIDE_GRID = np.array([-1.0, 0.0, 1.0])
+_POWERS = np.stack([np.ones(3), _SLIDE_GRID, _SLIDE_GRID ** 2], axis=1)
 
 
 def _cross_matrix(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -111,16 +141,6 @@ def _rodrigues(k: np.ndarray | tuple[np.ndarray, np.ndarray], q: np.ndarray) -> 
     return _EYE3 + np.sin(q) * K + (1.0 - np.cos(q)) * KK
 
 
-def _motion(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """The turn by q about the line (k, p): (..., 4, 4)."""
-    R = _rodrigues(k, q)
-    T = np.zeros(R.shape[:-2] + (4, 4))
-    T[..., :3, :3] = R
-    T[..., :3, 3] = p - R @ p
-    T[..., 3, 3] = 1.0
-    return T
-
-
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """a × b along the last axis (np.cross without its axis bookkeeping)."""
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
@@ -140,19 +160,27 @@ class _Arrangement:
 
     ``reverse`` reads the chain backwards (joints 6…1, axes negated, target A⁻¹); ``first`` (0, 1 or 2) is the
     index, in the chain as read, of joint a. ``order`` maps the chain's joints (a, b, c, d, e, f) to the robot's.
+    Any of them but d may be a slide (``revolute`` (6,), as read); ``slide`` tells whether joint a is one.
     """
 
-    def __init__(self, directions: np.ndarray, points: np.ndarray, reverse: bool, first: int) -> None:
+    def __init__(self, directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, reverse: bool,
+                 first: int) -> None:
         if reverse:
-            directions, points = -directions[::-1], points[::-1]
+            directions, points, revolute = -directions[::-1], points[::-1], revolute[::-1]
         self.reverse, self.first = reverse, first
-        self.directions, self.points = directions, points
+        self.directions, self.points, self.revolute = directions, points, revolute
         self.cross = [_cross_matrix(k) for k in directions]
         a, d = first, first + 3
         # the target's side: joints (e, f) and where they stand around A
         self.rhs = {2: (0, 1), 1: (0, 5), 0: (5, 4)}[first]
         chain = [a, a + 1, a + 2, d, *self.rhs]
         self.order = np.array([5 - j if reverse else j for j in chain])
+        self.kinds = revolute[chain]  # (6,): which of a, b, c, d, e, f turn
+        self.slide = not self.kinds[0]
+        # a slide's leading matrix at d → ∞ (φ = 0) is singular by construction: its shifts start at the next
+        self.shifts = _SHIFTS[1:] if self.slide else _SHIFTS
+        # basis(q_b) ⊗ basis(q_c) times (1 + x²) per revolute joint → the powers x_b^i x_c^j (9, 9)
+        self.powers = np.kron(_HALF if self.kinds[1] else _EYE3, _HALF if self.kinds[2] else _EYE3)
         self.line_point, self.line_direction = points[d], directions[d]
         # the point o on axis a nearest the other axes' points (any point of the axis keeps the structure)
         k = directions[a]
@@ -161,23 +189,31 @@ class _Arrangement:
         self._fit_left()
         self._prepare_right()
 
+    def first_basis(self, q: np.ndarray) -> np.ndarray:
+        """Joint a's basis of the left coefficients at its values q (...,): (..., 3)."""
+        return _basis(q, self.kinds[0])
+
+    def middle_basis(self, qb: np.ndarray, qc: np.ndarray) -> np.ndarray:
+        """basis(q_b) ⊗ basis(q_c): (..., 9), index 3i + j."""
+        return _basis2(qb, qc, self.kinds[1], self.kinds[2])
+
     def _fit_left(self) -> None:
-        """The left side's coefficients C (3, 14, 9): F_L = (C_0 + C_1 cos q_a + C_2 sin q_a) · t(q_b) ⊗ t(q_c)."""
-        g = np.array(np.meshgrid(_GRID, _GRID, _GRID, indexing="ij")).reshape(3, -1).T  # (27, 3)
-        values = self.left_values(g)  # (27, 14)
-        basis = np.kron(np.kron(_TRIG, _TRIG), _TRIG)  # (27 samples, 27 basis)
-        coefficients = np.linalg.solve(basis, values).T  # (14, 27)
+        """The left side's coefficients C (3, 14, 9): F_L = Σ_k C_k basis_k(q_a) · basis(q_b) ⊗ basis(q_c),
+        interpolated on the grid of each joint's basis and checked at random values."""
+        grids, samples = zip(*(_sampling(kind) for kind in self.kinds[:3]))
+        g = np.array(np.meshgrid(*grids, indexing="ij")).reshape(3, -1).T  # (27, 3)
+        basis = np.kron(np.kron(samples[0], samples[1]), samples[2])  # (27 samples, 27 basis)
+        coefficients = np.linalg.solve(basis, self.left_values(g)).T  # (14, 27)
         self.left = coefficients.reshape(14, 3, 9).transpose(1, 0, 2).copy()
         check = np.random.default_rng(7).uniform(-np.pi, np.pi, (8, 3))
-        predicted = np.einsum("kem,nk,nm->ne", self.left, _trig(check[:, 0]), _trig2(check[:, 1], check[:, 2]))
+        predicted = np.einsum("kem,nk,nm->ne", self.left, self.first_basis(check[:, 0]),
+                              self.middle_basis(check[:, 1], check[:, 2]))
         self.left_fit_error = float(np.abs(predicted - self.left_values(check)).max())
 
     def left_values(self, q: np.ndarray) -> np.ndarray:
         """The 14 left-hand quantities at (q_a, q_b, q_c) of shape (M, 3): (M, 14)."""
         a = self.first
-        T = np.eye(4)
-        for i in range(3):
-            T = T @ _motion(self.directions[a + i], self.points[a + i], q[:, i])
+        T = chain_motion(self.directions[a:a + 3], self.points[a:a + 3], self.revolute[a:a + 3], q)
         p = np.einsum("mij,j->mi", T[:, :3, :3], self.line_point) + T[:, :3, 3] - self.origin
         l = np.einsum("mij,j->mi", T[:, :3, :3], self.line_direction)
         return _fourteen(p, l)
@@ -185,9 +221,10 @@ class _Arrangement:
     def _prepare_right(self) -> None:
         """The nine rigid motions Left_k, Right_k of the 3 × 3 sample grid of (q_e, q_f), and the fit matrix."""
         e, f = self.rhs
-        ge, gf = (m.reshape(-1) for m in np.meshgrid(_GRID, _GRID, indexing="ij"))
-        Ge = _motion(self.directions[e], self.points[e], -ge)  # G_e⁻¹ at the samples
-        Gf = _motion(self.directions[f], self.points[f], -gf)
+        (grid_e, samples_e), (grid_f, samples_f) = _sampling(self.kinds[4]), _sampling(self.kinds[5])
+        ge, gf = (m.reshape(-1) for m in np.meshgrid(grid_e, grid_f, indexing="ij"))
+        Ge = joint_motion(self.directions[e], self.points[e], bool(self.kinds[4]), -ge)  # G_e⁻¹ at the samples
+        Gf = joint_motion(self.directions[f], self.points[f], bool(self.kinds[5]), -gf)
         eye = np.broadcast_to(np.eye(4), Ge.shape)
         # G_2⁻¹ G_1⁻¹ A | G_1⁻¹ A G_6⁻¹ | A G_6⁻¹ G_5⁻¹ (chain as read, 0-based joints)
         left, right = {2: (Gf @ Ge, eye), 1: (Ge, Gf), 0: (eye, Ge @ Gf)}[self.first]
@@ -195,7 +232,7 @@ class _Arrangement:
         self.sample_right_point = np.einsum("kij,j->ki", right[:, :3, :3], self.line_point) + right[:, :3, 3]
         self.sample_right_direction = np.einsum("kij,j->ki", right[:, :3, :3], self.line_direction)
         # B = values · (basis⁻¹)ᵀ: with basis (9 samples, 9 products)
-        self.right_fit = np.linalg.inv(np.kron(_TRIG, _TRIG)).T  # values (.., 9 samples) → coefficients
+        self.right_fit = np.linalg.inv(np.kron(samples_e, samples_f)).T  # values (.., 9 samples) → coefficients
 
     def right_coefficients(self, A: np.ndarray) -> np.ndarray:
         """The right side's coefficients B (N, 14, 9) for chain targets A (N, 4, 4) (normalised lengths)."""
@@ -213,9 +250,20 @@ def _trig(q: np.ndarray) -> np.ndarray:
     return np.stack([np.ones_like(q), np.cos(q), np.sin(q)], axis=-1)
 
 
-def _trig2(qb: np.ndarray, qc: np.ndarray) -> np.ndarray:
-    """t(q_b) ⊗ t(q_c): (..., 9), index 3i + j."""
-    return (_trig(qb)[..., :, None] * _trig(qc)[..., None, :]).reshape(qb.shape + (9,))
+def _basis(q: np.ndarray, revolute: bool) -> np.ndarray:
+    """A joint's basis at its values q (...,): (1, cos q, sin q) for a revolute joint, (1, d, d²) for a slide."""
+    return _trig(q) if revolute else np.stack([np.ones_like(q), q, q * q], axis=-1)
+
+
+def _basis2(q1: np.ndarray, q2: np.ndarray, revolute1: bool, revolute2: bool) -> np.ndarray:
+    """basis(q1) ⊗ basis(q2): (..., 9), index 3i + j."""
+    return (_basis(q1, revolute1)[..., :, None] * _basis(q2, revolute2)[..., None, :]).reshape(q1.shape + (9,))
+
+
+def _sampling(revolute: bool) -> tuple[np.ndarray, np.ndarray]:
+    """A joint's interpolation grid (3,) and its basis there (3 samples, 3 basis): angles 0, ±2π/3, or a slide's
+    values −1, 0, 1 (normalised lengths)."""
+    return (_GRID, _TRIG) if revolute else (_SLIDE_GRID, _POWERS)
 
 
 class _Roots:
@@ -245,18 +293,21 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     null = np.swapaxes(U[:, :, 8:], 1, 2)  # (N, 6, 14)
     E = np.einsum("nre,kem->nkrm", null, arr.left)  # (N, 3, 6, 9)
     E[:, 0, :, 0] -= np.einsum("nre,ne->nr", null, b1)
+    if arr.slide:  # powers of d → trigonometric form in θ, d = centre + half_width · tan(θ/2)
+        centre, half_width = _slide_interval(arr, B)
+        E = _slide_to_angle(E, centre, half_width)
     # Σ for each shift, keep the first shift with a well-conditioned leading matrix
     shift = np.zeros(n)
     pending = np.ones(n, dtype=bool)
     companions = np.zeros((n, 24, 24))
     lead_ok = np.zeros(n, dtype=bool)
-    for phi in _SHIFTS:
+    for phi in arr.shifts:
         rows = np.flatnonzero(pending)
         if not len(rows):
             break
         c, s = np.cos(phi), np.sin(phi)
         E0, E1, E2 = E[rows, 0], c * E[rows, 1] + s * E[rows, 2], -s * E[rows, 1] + c * E[rows, 2]
-        D = np.stack([E0 + E1, 2.0 * E2, E0 - E1], axis=1) @ _HALF2  # (R, 3, 6, 9): powers 1, y, y²
+        D = np.stack([E0 + E1, 2.0 * E2, E0 - E1], axis=1) @ arr.powers  # (R, 3, 6, 9): powers 1, y, y²
         D /= np.abs(D).max(axis=(1, 3), keepdims=True)  # row equilibration
         S = np.zeros((len(rows), 3, 12, 12))
         S[:, :, :6, :9] = D
@@ -264,12 +315,12 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
         lead = S[:, 2]
         singular = np.linalg.svd(lead, compute_uv=False)
         good = singular[:, -1] > CONDITION_FLOOR * singular[:, 0]
-        if phi == _SHIFTS[-1]:
+        if phi == arr.shifts[-1]:
             good[:] = True
         rows, S, lead = rows[good], S[good], lead[good]
         lead_ok[rows] = (singular[good, -1] > CONDITION_FLOOR * singular[good, 0])
         rhs = np.concatenate([S[:, 0], S[:, 1]], axis=2)
-        if phi == _SHIFTS[-1] and not lead_ok[rows].all():  # no shift helped: least squares, marked incomplete
+        if phi == arr.shifts[-1] and not lead_ok[rows].all():  # no shift helped: least squares, marked incomplete
             tail = np.linalg.pinv(lead) @ rhs
         else:
             tail = np.linalg.solve(lead, rhs)  # (R, 12, 24)
@@ -286,13 +337,19 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     with np.errstate(divide="ignore", invalid="ignore"):  # a spurious root exactly at ±i
         angle = 2.0 * np.arctan(y.astype(complex))
         imaginary = np.abs(angle.imag)  # NaN at exactly ±i: never real, never ambiguous, sorted last
-    real = y.imag == 0.0  # LAPACK returns the real eigenvalues of a real matrix with no imaginary part
+    # the spurious roots: for a revolute joint a at ±i (of the (1 + x²) factors, a defective quadruple pair, so
+    # rounding spreads them by ~ε^¼: far from real, never ambiguous); for a slide at d → ∞ (θ = π: the d²
+    # coefficients have rank 4 at most, so Σ's leading matrix in d is singular), which rounding may make real
+    if arr.slide:  # and any root outside the interval that holds every solution
+        with np.errstate(invalid="ignore"):
+            spurious = ~(np.abs(np.tan(0.5 * (shift[:, None] + angle))) <= SLIDE_OUTSIDE)
+        imaginary[spurious] = np.inf
+    else:
+        spurious = np.abs(1.0 + y * y) < SPURIOUS_RADIUS
+    real = (y.imag == 0.0) & ~spurious  # LAPACK returns a real matrix's real eigenvalues with no imaginary part
     real_count = real.sum(axis=1)
     # first-order error bound of each eigenvalue (backward-stable QR: ~ n ε ‖M‖ times its condition number,
     # from the left eigenvectors, the rows of V⁻¹), carried to the angle: dq = 2 dy / |1 + y²|
-    # the spurious roots at ±i (of the (1 + x²) factors, a defective quadruple pair, so rounding spreads them
-    # by ~ε^¼) are far from real and never ambiguous
-    spurious = np.abs(1.0 + y * y) < SPURIOUS_RADIUS
     with np.errstate(invalid="ignore"):
         suspect = ~real & ~spurious & (imaginary < SUSPECT_IMAGINARY)
     near = np.zeros_like(real)
@@ -317,20 +374,58 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     top, bottom = vectors[:, :12, :], vectors[:, 12:, :]
     monomials = np.where((np.abs(y) <= 1.0)[:, None, :], top, bottom)  # (N, 12, m)
     monomials = np.swapaxes(monomials, 1, 2).reshape(n, m, 4, 3)
-    qb = _monomial_angle(monomials)
-    qc = _monomial_angle(np.swapaxes(monomials, -1, -2))
+    qb = _monomial_value(monomials, arr.kinds[1])
+    qc = _monomial_value(np.swapaxes(monomials, -1, -2), arr.kinds[2])
     # right-hand monomials by least squares, then q_e, q_f from the linear ones
-    left = np.einsum("ntk,kem,ntm->nte", _trig(qa), arr.left, _trig2(qb, qc))  # (N, m, 14)
+    if arr.slide:
+        qa = centre[:, None] + half_width[:, None] * np.tan(0.5 * qa)
+    left = np.einsum("ntk,kem,ntm->nte", arr.first_basis(qa), arr.left, arr.middle_basis(qb, qc))  # (N, m, 14)
     inverse_sigma = np.where(sigma > CONDITION_FLOOR * sigma[:, :1], 1.0 / np.maximum(sigma, 1e-300), 0.0)
     pinv = np.einsum("nji,nj,nej->nie", Vt, inverse_sigma, U[:, :, :8])  # (N, 8, 14)
     mono = np.einsum("nie,nte->nti", pinv, left - b1[:, None, :])  # (N, m, 8): index m − 1 of 3i + j
-    qe = np.arctan2(mono[..., 5], mono[..., 2])  # s_e (m = 6), c_e (m = 3)
-    qf = np.arctan2(mono[..., 1], mono[..., 0])  # s_f (m = 2), c_f (m = 1)
+    # (c_e, s_e) at m = 3, 6 and (c_f, s_f) at m = 1, 2; a slide's value at m = 3 or 1
+    qe = np.arctan2(mono[..., 5], mono[..., 2]) if arr.kinds[4] else mono[..., 2]
+    qf = np.arctan2(mono[..., 1], mono[..., 0]) if arr.kinds[5] else mono[..., 0]
     chain = np.stack([qa, qb, qc, np.zeros_like(qa), qe, qf], axis=-1)  # joints (a, b, c, d, e, f)
     chain[..., 3] = _last_joint(arr, chain_A, chain)
     joints = np.empty_like(chain)
     joints[..., arr.order] = chain
     return _Roots(joints, valid, real_count, ambiguous, rank_ok & lead_ok, shift)
+
+
+def _slide_interval(arr: _Arrangement, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per target, an interval centre ± half-width (N,) that holds the slide value d of every solution.
+
+    The points agree, d k + p_0(q_b, q_c) = p_R(q_e, q_f) (k the slide's unit direction), so
+    d = k·p_R − k·p_0; each is a constant plus monomials of sines and cosines (at most 1 in size) whose
+    coefficients bound the rest.
+    """
+    k = arr.directions[arr.first]
+    right = np.einsum("i,nim->nm", k, B[:, :3, :])  # (N, 9)
+    left = k @ arr.left[0, :3, :]  # (9,): the d⁰ part of k·p
+    centre = right[:, 0] - left[0]
+    half_width = np.abs(right[:, 1:]).sum(axis=1) + np.abs(left[1:]).sum()
+    return centre, np.maximum(half_width, 1e-3)
+
+
+def _slide_to_angle(E: np.ndarray, centre: np.ndarray, half_width: np.ndarray) -> np.ndarray:
+    """Coefficients E (N, 3, …) in the powers (1, d, d²) of a slide → coefficients in (1, cos θ, sin θ) of
+    cos²(θ/2) times the same polynomial at d = centre + half_width · tan(θ/2)."""
+    c, w = centre[:, None, None], half_width[:, None, None]
+    Q0 = E[:, 0] + c * E[:, 1] + c ** 2 * E[:, 2]  # the powers (1, u, u²) of u = tan(θ/2)
+    Q1 = w * (E[:, 1] + 2.0 * c * E[:, 2])
+    Q2 = w ** 2 * E[:, 2]
+    return 0.5 * np.stack([Q0 + Q2, Q0 - Q2, Q1], axis=1)
+
+
+def _monomial_value(m: np.ndarray, revolute: bool) -> np.ndarray:
+    """A joint's value from its powers along the second-last axis, m (..., P ≥ 3, Q) ∝ x^i · (…): the angle of
+    :func:`_monomial_angle`, or a slide's d from the runs m_i+1 = d m_i (least squares, the largest entries
+    weighing most)."""
+    if revolute:
+        return _monomial_angle(m)
+    low, high = m[..., :-1, :], m[..., 1:, :]
+    return (high * low.conj()).real.sum(axis=(-2, -1)) / (np.abs(low) ** 2).sum(axis=(-2, -1))
 
 
 def _monomial_angle(m: np.ndarray) -> np.ndarray:
@@ -353,6 +448,7 @@ def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarr
     a = arr.first
     for slot, joint in enumerate((a, a + 1, a + 2, a + 3, *arr.rhs)):
         q[..., joint] = chain[..., slot]
+    q *= arr.revolute  # a slide turns nothing
     d = a + 3
     R_before = _rodrigues(arr.cross[0], q[..., 0])
     for j in range(1, d):
@@ -370,9 +466,10 @@ def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarr
     return np.arctan2(turned @ _cross(k, u), turned @ u)
 
 
-def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q: np.ndarray,
-            steps: int = NEWTON_STEPS) -> np.ndarray:
-    """Newton's method on G_1 ⋯ G_6 = A for candidates q (K, 6) and targets A (K, 4, 4), normalised lengths.
+def _newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_targets: np.ndarray,
+            q: np.ndarray, steps: int = NEWTON_STEPS) -> np.ndarray:
+    """Newton's method on G_1 ⋯ G_6 = A for candidates q (K, 6) and targets A (K, 4, 4), normalised lengths
+    (``revolute`` (6,) tells turns from slides).
 
     Steps the candidates whose error twist is above :data:`NEWTON_TOLERANCE` (roots come from the eigenproblem
     to about 1e-12, so one step, or none, usually suffices); singular candidates get a tiny damping instead of a
@@ -384,11 +481,15 @@ def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q
     for _ in range(steps + 1):
         R = np.broadcast_to(_EYE3, q.shape[:-1] + (3, 3))
         p = np.zeros(q.shape[:-1] + (3,))
-        axes = np.empty(q.shape + (3,))
-        through = np.empty(q.shape + (3,))
+        twists = np.zeros(q.shape + (6,))  # spatial joint twists (ω, v): (ω, p × ω) of a turn, (0, k) of a slide
         for j in range(6):
-            axes[:, j] = R @ directions[j]
-            through[:, j] = R @ points[j] + p
+            axis = R @ directions[j]
+            if not revolute[j]:
+                twists[:, j, 3:] = axis
+                p = p + axis * q[:, j, None]
+                continue
+            twists[:, j, :3] = axis
+            twists[:, j, 3:] = _cross(R @ points[j] + p, axis)
             turn = _rodrigues(cross[j], q[:, j])
             p = p + (R @ (points[j] - turn @ points[j])[..., None])[..., 0]
             R = R @ turn
@@ -400,24 +501,25 @@ def _newton(directions: np.ndarray, points: np.ndarray, A_targets: np.ndarray, q
         active = np.abs(error).max(axis=1) > NEWTON_TOLERANCE
         if _ == steps or not active.any():
             break
-        J = np.concatenate([axes[active], _cross(through[active], axes[active])], axis=-1)  # rows ω, p × ω
+        J = twists[active]
         JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6)  # (K, joints, joints) = Jᵀ J of the twist map
         q[active] += np.linalg.solve(JJt, (J @ error[active][..., None]))[..., 0]
     return q
 
 
 class General6RPlan:
-    """Every solution of a 6R arm with no decomposable geometry, by the elimination of this module."""
+    """Every solution of a 6-joint arm with no decomposable geometry, 6R or with one slide (5R1P), by the
+    elimination of this module."""
 
     method = "analytic"
-    structure = "general_6r"
     generic_count = 16
     free_joints: list[int] = []
 
     @classmethod
     def match(cls, geometry: Geometry) -> "General6RPlan | None":
-        """The plan for a 6R arm, or None for other arms, Pieper-class arms and arms no arrangement solves."""
-        if geometry.dof != 6 or geometry.kinds() != "RRRRRR" or is_pieper(geometry):
+        """The plan for a 6-joint arm of at most one slide, or None for other arms, Pieper-class arms and arms no
+        arrangement solves."""
+        if geometry.dof != 6 or geometry.kinds().count("P") > 1 or is_pieper(geometry):
             return None
         plan = cls(geometry)
         return plan if plan.arrangement is not None else None
@@ -425,15 +527,18 @@ class General6RPlan:
     def __init__(self, geometry: Geometry) -> None:
         model = geometry.model
         self.scale = geometry.length_scale
+        self.revolute = model.is_revolute.astype(bool)
+        self.structure = GENERAL_6R if self.revolute.all() else GENERAL_5R1P
         self.directions = model.directions / np.linalg.norm(model.directions, axis=1, keepdims=True)
         self.points = model.points / self.scale
         home = model.home.copy()
         home[:3, 3] /= self.scale
         self.home_inverse = invert(home)
         # no tool position is farther than this from the point on axis 1: each turn keeps the distance to a point
-        # of its axis, so |x − p_1| ≤ |home − p_6| + Σ |p_i+1 − p_i| (normalised lengths)
+        # of its axis, so |x − p_1| ≤ |home − p_6| + Σ |p_i+1 − p_i| (normalised lengths); a slide has no bound
         self.reach = float(np.linalg.norm(home[:3, 3] - self.points[5])
-                           + np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum())
+                           + np.linalg.norm(np.diff(self.points, axis=0), axis=1).sum()) \
+            if self.revolute.all() else np.inf
         self.arrangement, self.accuracy = self._choose()
 
     def _choose(self) -> tuple[_Arrangement | None, float]:
@@ -445,33 +550,34 @@ class General6RPlan:
         """
         rng = np.random.default_rng(20260601)
         q = rng.uniform(-np.pi, np.pi, (6, 6))
-        A = self._chain_targets(q)
+        A = chain_motion(self.directions, self.points, self.revolute, q)
         best, best_error = None, np.inf
-        for reverse in (False, True):
-            for first in (2, 1, 0):
-                arrangement = _Arrangement(self.directions, self.points, reverse, first)
-                if arrangement.left_fit_error > 1e-9:
-                    continue
-                roots = _solve_arrangement(arrangement, A)
-                if not roots.conditioned.all():
-                    continue
-                gap = np.abs(wrap_angle(roots.joints - q[:, None, :])).max(axis=-1)
-                gap = np.where(roots.valid, gap, np.inf)
-                error = float(gap.min(axis=1).max())
-                if error < best_error:
-                    best, best_error = arrangement, error
-                if best_error <= GOOD_ENOUGH:
-                    return best, best_error
+        for reverse, first in self._arrangements():
+            arrangement = _Arrangement(self.directions, self.points, self.revolute, reverse, first)
+            if arrangement.left_fit_error > 1e-9:
+                continue
+            roots = _solve_arrangement(arrangement, A)
+            if not roots.conditioned.all():
+                continue
+            difference = roots.joints - q[:, None, :]
+            gap = np.abs(np.where(self.revolute, wrap_angle(difference), difference)).max(axis=-1)
+            gap = np.where(roots.valid, gap, np.inf)
+            error = float(gap.min(axis=1).max())
+            if error < best_error:
+                best, best_error = arrangement, error
+            if best_error <= GOOD_ENOUGH:
+                return best, best_error
         if best_error > PLAN_ACCURACY:
             return None, best_error
         return best, best_error
 
-    def _chain_targets(self, q: np.ndarray) -> np.ndarray:
-        """A = G_1 ⋯ G_6 (normalised lengths) at configurations q (N, 6)."""
-        T = np.broadcast_to(np.eye(4), (len(q), 4, 4))
-        for j in range(6):
-            T = T @ _motion(self.directions[j], self.points[j], q[:, j])
-        return T
+    def _arrangements(self) -> list[tuple[bool, int]]:
+        """(reverse, first) of the arrangements to try: all six, but the ones that make a slide joint d (q_d is
+        recovered as a turn about d's axis)."""
+        every = [(reverse, first) for reverse in (False, True) for first in (2, 1, 0)]
+        slides = np.flatnonzero(~self.revolute)
+        return [(reverse, first) for reverse, first in every
+                if not len(slides) or (5 - (first + 3) if reverse else first + 3) != slides[0]]
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         n = len(world_T_targets)
@@ -483,7 +589,8 @@ class General6RPlan:
         rows, slots = np.nonzero(valid)
         if len(rows):
             start = np.nan_to_num(joints[rows, slots])
-            joints[rows, slots] = _newton(self.directions, self.points, A[rows], start)
+            joints[rows, slots] = _newton(self.directions, self.points, self.revolute, A[rows], start)
+        joints[..., ~self.revolute] *= self.scale
         complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
         # out of reach by the bound: certainly no solution, however the eigenproblem was conditioned
         offset = targets[:, :3, 3] - self.points[0]

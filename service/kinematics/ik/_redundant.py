@@ -32,6 +32,7 @@ from .._cache import DerivedStore, bounded_memo, memo
 from .._errors import InvalidInputError
 from .._robot import Robot
 from .._tolerances import DUPLICATE_TOLERANCE
+from ._general_6r import GENERAL_STRUCTURES
 from ._goals import PoseGoal
 from ._plan import Plan, geometry_of, plan_for_geometry
 from ._screws import joint_motion
@@ -268,7 +269,7 @@ def default_free_joints(robot: Robot) -> tuple[int, ...] | None:
         for free in candidates:
             family = family_for(robot, tuple(sorted(free)))
             if family.available:
-                if family.plan.structure != "general_6r":
+                if family.plan.structure not in GENERAL_STRUCTURES:
                     return family.free
                 general = general or family.free
         return general

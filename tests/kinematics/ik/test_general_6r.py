@@ -21,7 +21,7 @@ from service.kinematics.ik import plan_for, solve_ik_arrays
 from service.kinematics.ik._plan import geometry_of
 from service.kinematics.ik._verify import residuals
 from tests.arms import random_general_arm, random_rotation
-from tests.ik_helpers import SAME, angle_gap, wrapped
+from tests.ik_helpers import SAME, wrapped
 
 CONVENTIONS = ("standard", "modified", "khalil")
 
@@ -31,14 +31,14 @@ def found(robot: Robot, solutions: np.ndarray, q: np.ndarray, tolerance: float =
         np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= tolerance)
 
 
-def check_answers(robot: Robot, q: np.ndarray, plan: General6RPlan | None = None):
+def check_answers(robot: Robot, q: np.ndarray, plan: General6RPlan | None = None, structure: str = "general_6r"):
     """Solve FK(q) for each row of q; assert recall, no wrong solution, no `unreachable`. Returns the arrays.
 
-    Without ``plan`` the router must choose the general solver; with it, that plan is used (for a real arm a
-    closed-form family may one day claim)."""
+    Without ``plan`` the router must choose the general solver (``structure``); with it, that plan is used (for a
+    real arm a closed-form family may one day claim)."""
     targets = forward_kinematics(robot, q)
     arrays = solve_ik_arrays(robot, targets, plan=plan)
-    assert arrays is not None and arrays.structure == "general_6r"
+    assert arrays is not None and arrays.structure == structure
     assert (arrays.count > 0).all(), "an FK pose was answered unreachable"
     for row in range(len(q)):
         solutions = arrays.joints[row, :arrays.count[row]]
@@ -96,13 +96,16 @@ def test_the_same_arm_in_three_conventions_gets_the_same_solution_sets():
 # ---------------------------------------------------------------------------
 
 
-def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.random.Generator) -> np.ndarray:
-    """Every distinct solution a dense Levenberg–Marquardt search finds from ``starts`` random seeds.
+def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.random.Generator,
+                         slide_range: tuple[float, float] = (-np.pi, np.pi)) -> np.ndarray:
+    """Every distinct solution a dense Levenberg–Marquardt search finds from ``starts`` random seeds (revolute
+    joints uniform in ±π, prismatic ones in ``slide_range``).
 
     Knows nothing of the elimination: FK and the geometric Jacobian only, error in units of the robot's size.
     """
     scale = robot.characteristic_length
     q = rng.uniform(-np.pi, np.pi, (starts, 6))
+    q[:, ~robot.is_revolute] = rng.uniform(*slide_range, (starts, int((~robot.is_revolute).sum())))
     damping = np.full(starts, 1e-2)
     def error_of(q):
         T = forward_kinematics(robot, q)
@@ -123,10 +126,11 @@ def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.
         q[better], error[better] = trial[better], trial_error[better]
         damping = np.where(better, damping / 10, damping * 10).clip(1e-12, 1e6)
     converged = q[np.abs(error).max(axis=1) < 1e-11]
-    converged = wrapped(converged)
+    revolute = robot.is_revolute
+    converged[:, revolute] = wrapped(converged[:, revolute])
     distinct: list[np.ndarray] = []
     for candidate in converged:
-        if not any(angle_gap(candidate, other).max() < 1e-6 for other in distinct):
+        if not any(np.abs(joint_difference(robot, candidate[None], other)).max() < 1e-6 for other in distinct):
             distinct.append(candidate)
     return np.array(distinct).reshape(-1, 6)
 

@@ -55,9 +55,6 @@ def _most_singular(robot, q: np.ndarray, joint: int, solved: slice) -> np.ndarra
 KNOWN_BROKEN = {
     ("ufactory_xarm7", 1): "q2 = 0 makes q1 and q3 coaxial: the raw arm (general 6R, q7 held) answers complete "
                            "with a representative 0.01-0.02 rad away and reports no singularity",
-    ("kuka_iiwa14", 3): "the stretched elbow (q4 = 0): subproblem 2 of the shoulder is inexact, so the answer is "
-                        "not_found at delta <= 1e-9 and a false 'unreachable' at 1e-6",
-    ("kinova_jaco2", 4): "the wrist at q5 = 1e-9: no singularity reported, q4 and q6 0.017 rad off",
 }
 CASES = [pytest.param(robot_id, joint, marks=pytest.mark.xfail(strict=True, reason=KNOWN_BROKEN[(robot_id, joint)]))
          if (robot_id, joint) in KNOWN_BROKEN else (robot_id, joint) for robot_id in ARMS for joint in range(6)]

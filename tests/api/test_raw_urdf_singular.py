@@ -53,8 +53,6 @@ def _most_singular(robot, q: np.ndarray, joint: int, solved: slice) -> np.ndarra
 
 #: (arm, joint) cases that still break the promise (issue 22.6, open): strict, so a fix makes them fail loudly.
 KNOWN_BROKEN = {
-    ("ufactory_xarm7", 1): "q2 = 0 makes q1 and q3 coaxial: the raw arm (general 6R, q7 held) answers complete "
-                           "with a representative 0.01-0.02 rad away and reports no singularity",
 }
 CASES = [pytest.param(robot_id, joint, marks=pytest.mark.xfail(strict=True, reason=KNOWN_BROKEN[(robot_id, joint)]))
          if (robot_id, joint) in KNOWN_BROKEN else (robot_id, joint) for robot_id in ARMS for joint in range(6)]

@@ -110,10 +110,11 @@ class SphericalWrist:
     @cached_property
     def free_below(self) -> float:
         """The radius of ``R_w ω_c`` about ω_a (unit vectors) at or below which q_a is held as free: where the
-        arm's deviation from exact relations (its idealisation's, at most ``GEOMETRY_TOLERANCE``: the plan
-        matched it within that), over the radius, would move q_a by more than ``DUPLICATE_TOLERANCE``. An exact
-        arm keeps subproblem 2's own test, ``GEOMETRY_TOLERANCE``."""
-        deviation = min(idealised(self.geometry).deviation, GEOMETRY_TOLERANCE)
+        arm's deviation from the relations exact recognition accepted (those within ``10 GEOMETRY_TOLERANCE``, as
+        :meth:`Geometry.parallel`; relations rounded more coarsely, which this plan does not assume, do not
+        count), over the radius, would move q_a by more than ``DUPLICATE_TOLERANCE``. An exact arm keeps
+        subproblem 2's own test, ``GEOMETRY_TOLERANCE``."""
+        deviation = idealised(self.geometry, 10 * GEOMETRY_TOLERANCE).deviation
         return max(GEOMETRY_TOLERANCE, deviation / DUPLICATE_TOLERANCE)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:

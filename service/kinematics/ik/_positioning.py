@@ -10,14 +10,13 @@ validity mask, plus per-target singular flags.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import (ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE,
-                          ROUNDING_TOLERANCE)
+from .._tolerances import (ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, FOLD_TOLERANCE, GEOMETRY_TOLERANCE,
+                          RECOGNITION_TOLERANCE, ROUNDING_TOLERANCE)
 from .._rotations import wrap_angle
 from ._screws import chain_motion, chain_rotation, move_point, rotate_about
 from ._structure import Geometry
@@ -346,20 +345,19 @@ class IntersectingShoulder(Positioner):
         return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
 
     def _near_axis_2_at_fold(self, third, point: np.ndarray, scale: np.ndarray) -> np.ndarray:
-        """Which points (N, 2) joint 2 cannot place: within ``sqrt(GEOMETRY_TOLERANCE)`` of axis 2 (relative to
+        """Which points (N, 2) joint 2 cannot place: within ``FOLD_TOLERANCE`` of axis 2 (relative to
         ``scale`` (N, 2)), from a joint-3 root pair that is as close to meeting (its roots ``phi ± half``,
-        ``|half| <= sqrt(GEOMETRY_TOLERANCE)``, or merged). There joint 3 is known only to the square root of the
+        ``|half| <= FOLD_TOLERANCE``, or merged). There joint 3 is known only to the square root of the
         decoupling's error (a reach through axes that intersect within ``GEOMETRY_TOLERANCE``), the point
         ``point`` (N, 2, 3) to as much, and joint 2's angle to that over the point's radius: an O(1) error. Joint 2
         is held like a free one, and verification refines the representative onto the arm."""
         g, j = self.geometry, self.joints[1]
-        near = math.sqrt(GEOMETRY_TOLERANCE)
         if not g.model.is_revolute[self.joints[2]]:
             return np.zeros(point.shape[:2], dtype=bool)
         half = 0.5 * np.abs(wrap_angle(third.theta[:, 0] - third.theta[:, 1]))
-        at_fold = third.merged | (np.nan_to_num(half, nan=0.0) <= near)  # (N,)
+        at_fold = third.merged | (np.nan_to_num(half, nan=0.0) <= FOLD_TOLERANCE)  # (N,)
         radius = np.linalg.norm(np.cross(g.direction(j), point), axis=-1)
-        return at_fold[:, None] & (radius <= near * scale)
+        return at_fold[:, None] & (radius <= FOLD_TOLERANCE * scale)
 
     def _stretched(self, q3: np.ndarray, w: np.ndarray, c: np.ndarray) -> np.ndarray:
         g, k = self.geometry, self.joints[2]

@@ -12,7 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from ..._tolerances import DUPLICATE_TOLERANCE, FOLD_TOLERANCE
 
 
 class AngleSolutions(NamedTuple):
@@ -102,6 +102,6 @@ _MERGE_SIN_SQUARED = math.sin(DUPLICATE_TOLERANCE / 2.0) ** 2
 _GAP_ROUNDING = 256 * np.finfo(float).eps
 # Two cones (subproblem 2) that miss by at most this gap on the unit sphere are a tangency that an error of the
 # inputs split: an angle found upstream at a double root (subproblem 3 at its fold: a stretched elbow) is known
-# only to the square root of its inputs' error, GEOMETRY_TOLERANCE, and moves the point by that much. Their
+# only to the square root of its inputs' error (FOLD_TOLERANCE), and moves the point by that much. Their
 # closest directions are then the touching root, reported ``merged`` (not ``exact``) for the caller to refine.
-_NEAR_TANGENT_GAP = math.sqrt(GEOMETRY_TOLERANCE)
+_NEAR_TANGENT_GAP = FOLD_TOLERANCE

@@ -167,33 +167,3 @@ def test_general_6r_with_nearly_coaxial_joints_1_and_3(seed, offset):
     q[1] = 0.0
     structures = _check_promises(robot, q, 1, held=False)
     assert "general_6r" in structures, structures
-
-
-#: Configurations of the catalogue's xArm 6 (general 6R) at a fold of the elimination (σ_min/σ_max ~ 1e-17, two
-#: roots meeting), where it answered complete with the generating configuration 2-3e-6 away and no singularity.
-XARM6_FOLDS = [(2, [-0.2863, -0.9045, -0.8952, 0.241, -0.6039, 0.516]),
-               (1, [0.3462, -2.1367, 1.4916, 1.4425, 0.5566, 0.4514])]
-
-
-@pytest.mark.parametrize("joint, q", XARM6_FOLDS)
-def test_general_6r_at_a_fold_promises_only_what_it_found(joint, q):
-    """The configurations are moved (as the issue's sweep does) to the most singular point along ``joint``."""
-    from service.config import BUILTIN_ROBOTS_DIR
-    from service.kinematics import geometric_jacobian
-    from service.robots.catalogue import load_catalogue
-
-    robot = next(e.robot for e in load_catalogue([BUILTIN_ROBOTS_DIR], max_joints=32).entries()
-                 if e.path.name == "ufactory_xarm6.yaml")
-    q = np.array(q)
-    lo, hi = q[joint] - 0.01, q[joint] + 0.01
-    for _ in range(40):  # narrow the bracket around σ_min/σ_max's minimum
-        values = np.linspace(lo, hi, 21)
-        scan = np.tile(q, (21, 1))
-        scan[:, joint] = values
-        s = np.linalg.svd(geometric_jacobian(robot, scan), compute_uv=False)
-        best = values[int(np.argmin(s[:, -1] / s[:, 0]))]
-        lo, hi = best - (hi - lo) / 20, best + (hi - lo) / 20
-    q[joint] = best
-    assert s[:, -1].min() / s[:, 0].max() < 1e-6
-    structures = _check_promises(robot, q, joint, held=False)
-    assert "general_6r" in structures or "general" in structures, structures

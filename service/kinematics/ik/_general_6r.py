@@ -436,15 +436,15 @@ def _chain_axes(directions: np.ndarray, points: np.ndarray, q: np.ndarray
 
 
 def _coaxial_motion(directions: np.ndarray, points: np.ndarray, q: np.ndarray
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Where two joints' axes coincide at q (K, 6) (the xArm's joints 1 and 3 at q2 = 0), or nearly (the
     smallest singular value of the twist Jacobian within :data:`FAMILY_CONDITION` of the largest): turning one by
     t and the other by ∓t moves the tool by at most that ratio times t, so the target fixes only their sum or
     difference to the acceptance tolerance.
 
-    Returns ``found`` (K,) bool, the pair (K, 2) int (lower joint first), the null motion (K, 6): unit, ±1/√2
-    on the pair (+ on the first joint), 0 elsewhere; and ``fold`` (K,) bool: as singular, with another null
-    motion (two roots meeting: a double root of the eliminant, which rounding may have moved off the real line).
+    Returns ``found`` (K,) bool, the pair (K, 2) int (lower joint first), and the null motion (K, 6): unit, ±1/√2
+    on the pair (+ on the first joint), 0 elsewhere. Other null motions (a fold, where roots meet) are not a
+    family and are not reported here: the elimination's own conditioning speaks for them.
     """
     _, _, axes, through = _chain_axes(directions, points, q)
     J = np.concatenate([axes, _cross(through, axes)], axis=-1)  # (K, joints, twist)
@@ -454,10 +454,10 @@ def _coaxial_motion(directions: np.ndarray, points: np.ndarray, q: np.ndarray
     pair = np.sort(order[:, :2], axis=-1)
     top = np.take_along_axis(null, pair, axis=-1)
     on_pair = np.abs(np.abs(top) - np.sqrt(0.5)).max(axis=-1) <= 1e-3
-    singular = sigma[:, -1] <= FAMILY_CONDITION * sigma[:, 0]
+    found = (sigma[:, -1] <= FAMILY_CONDITION * sigma[:, 0]) & on_pair
     motion = np.zeros_like(null)
     np.put_along_axis(motion, pair, np.sqrt(0.5) * np.sign(top) * np.sign(top[:, :1]), axis=-1)
-    return singular & on_pair, pair, motion, singular & ~on_pair
+    return found, pair, motion
 
 
 class General6RPlan:
@@ -541,8 +541,7 @@ class General6RPlan:
         complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
         singular = SingularFlags(n)
         if len(rows):
-            at_fold = self._represent_coaxial_families(joints, valid, rows, slots, A, reference, singular)
-            complete[at_fold] = False
+            self._represent_coaxial_families(joints, valid, rows, slots, A, reference, singular)
         # out of reach by the bound: certainly no solution, however the eigenproblem was conditioned
         offset = targets[:, :3, 3] - self.points[0]
         beyond = np.einsum("ni,ni->n", offset, offset) > (self.reach * (1.0 + 1e-9)) ** 2
@@ -552,7 +551,7 @@ class General6RPlan:
 
     def _represent_coaxial_families(self, joints: np.ndarray, valid: np.ndarray, rows: np.ndarray,
                                     slots: np.ndarray, A: np.ndarray, reference: np.ndarray | None,
-                                    singular: SingularFlags) -> np.ndarray:
+                                    singular: SingularFlags) -> None:
         """Roots (``joints[rows, slots]`` of targets ``A``) where two axes coincide, or nearly
         (:func:`_coaxial_motion`): the target fixes only the pair's sum or difference to the acceptance tolerance,
         and the elimination's roots are arbitrary members of that family (four, 0.004-0.02 rad apart, on a raw
@@ -560,16 +559,10 @@ class General6RPlan:
         give it: the member with the pair's first joint at the reference value, where Newton's steps with that
         joint held reach the target (the family holds there); else the root itself. The other roots of the
         family (differing along the null motion only) are no longer candidates (``valid`` (N, m), in place), so
-        that every valid slot still gives a distinct solution (the promise of :meth:`solve` needs it).
-
-        Returns the targets (indices) with a root at a fold instead: there two roots meet, the eliminant's double
-        root may have split off the real line unflagged (a raw xArm 7 at its elbow lost the generating root, 1.2
-        rad from any listed), and a root found there is pinned only to the square root of its residual, so
-        their answers are not promised complete."""
-        found, pair, motion, fold = _coaxial_motion(self.directions, self.points, joints[rows, slots])
-        at_fold = np.unique(rows[fold])
+        that every valid slot still gives a distinct solution (the promise of :meth:`solve` needs it)."""
+        found, pair, motion = _coaxial_motion(self.directions, self.points, joints[rows, slots])
         if not found.any():
-            return at_fold
+            return
         rows, slots, pair, motion = rows[found], slots[found], pair[found], motion[found]
         index = np.arange(len(rows))
         first = pair[:, 0]
@@ -600,7 +593,6 @@ class General6RPlan:
                         "coaxial", (i, j), relation, f"joints {i + 1} and {j + 1} are coaxial here: only "
                         f"q{i + 1} {sign} q{j + 1} is determined; q{i + 1} is set to the reference value where "
                         f"the family reaches the target"))
-        return at_fold
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return {}

@@ -17,6 +17,10 @@ ORTHONORMAL_TOLERANCE = 1e-6
 #: intersecting axes, zero-length projections).
 GEOMETRY_TOLERANCE = 1e-9
 
+#: What an angle found at a double root (a fold: a stretched elbow, two cones that touch) is known to when its
+#: inputs are known to GEOMETRY_TOLERANCE: the square root of it (relative).
+FOLD_TOLERANCE = float(np.sqrt(GEOMETRY_TOLERANCE))
+
 #: Geometry as CAD exports and vendors state it: axes within this angle (radians) of parallel, intersecting or
 #: perpendicular, or lines within this fraction of the arm's size of meeting, are recognised as exactly so.
 #: The closed form then solves the idealised arm and every candidate is refined and verified on the true arm

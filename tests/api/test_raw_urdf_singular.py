@@ -53,11 +53,6 @@ def _most_singular(robot, q: np.ndarray, joint: int, solved: slice) -> np.ndarra
 
 #: (arm, joint) cases that still break the promise (issue 22.6, open): strict, so a fix makes them fail loudly.
 KNOWN_BROKEN = {
-    ("ufactory_xarm7", 1): "q2 = 0 makes q1 and q3 coaxial: the raw arm (general 6R, q7 held) answers complete "
-                           "with a representative 0.01-0.02 rad away and reports no singularity",
-    ("kuka_iiwa14", 3): "the stretched elbow (q4 = 0): subproblem 2 of the shoulder is inexact, so the answer is "
-                        "not_found at delta <= 1e-9 and a false 'unreachable' at 1e-6",
-    ("kinova_jaco2", 4): "the wrist at q5 = 1e-9: no singularity reported, q4 and q6 0.017 rad off",
 }
 CASES = [pytest.param(robot_id, joint, marks=pytest.mark.xfail(strict=True, reason=KNOWN_BROKEN[(robot_id, joint)]))
          if (robot_id, joint) in KNOWN_BROKEN else (robot_id, joint) for robot_id in ARMS for joint in range(6)]
@@ -98,3 +93,27 @@ def test_raw_urdf_arms_keep_their_promises_near_singularities(client, robot_id, 
             solutions = np.array([s["joints"] for s in again["solutions"]]).reshape(-1, robot.dof)
             tolerance = 2 * DUPLICATE_TOLERANCE if merged else 1e-6
             assert find(robot, solutions, moved, tolerance) is not None, (*where, answer["singularities"])
+
+
+#: The raw xArm 7 (q7 held, general 6R) at its elbow, q4 = -0.4407 (σ_min/σ_max ~ 1e-17, null motion over q1, q2,
+#: q3, q5), found by a wider sweep than the one above (issue 22.6, open).
+XARM7_ELBOW = [-0.25603245193298774, 0.7034507153661882, 0.6334286339692494, -0.4407119403217023,
+               -1.1552021001572843, 0.6870453512289281, 1.2822717858736796]
+
+
+@pytest.mark.xfail(strict=True, reason="open: the general 6R's eliminant loses the singular root (4 roots listed, "
+                                       "none within 1e-2..1.4 rad of the generating one), complete, no singularity")
+def test_raw_xarm7_elbow_keeps_its_promise(client):
+    description = _description("ufactory_xarm7")
+    robot = robot_from_description(TypeAdapter(RobotDescription).validate_python(description), max_joints=32)
+    for delta in DELTAS[:4]:
+        moved = np.array(XARM7_ELBOW)
+        moved[3] += delta
+        target = client.post("/v1/fk", json={"robot": description, "joints": moved.tolist()}).json()
+        answer = client.post("/v1/ik", json={
+            "robot": description, "target": {"matrix": target["pose"]["matrix"]}, "limits": [None] * 7,
+            "filter_limits": False, "free_joints": [{"joint": 6, "values": [float(moved[6])]}]}).json()
+        assert answer["status"] != "unreachable", (delta, answer["detail"])
+        if answer["solver"]["complete"] and not answer["singularities"]:
+            solutions = np.array([s["joints"] for s in answer["solutions"]]).reshape(-1, robot.dof)
+            assert find(robot, solutions, moved, 1e-6) is not None, (delta, len(solutions))

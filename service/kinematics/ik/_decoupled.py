@@ -215,7 +215,7 @@ class _ShoulderWristOnePose:
                                   self.elbow_turn.coordinates(scalar.sub(c, p2)))
         self.centre_to_3 = scalar.sub(p2, c)
         self.shoulder = scalar.TwoTurns(d[0], d[1])
-        self.wrist, self.wrist_axes = scalar.TwoTurns(a, b), (a, b)
+        self.wrist, self.wrist_axes = scalar.TwoTurns(a, b, wrist.free_below), (a, b)
         self.wrist_start = self.wrist.start(axis_c)
         self.last_turn = scalar.Turn(axis_c)
         self.last_normal = self.last_turn.coordinates(scalar.vector_of(wrist.normal))

@@ -73,9 +73,10 @@ from __future__ import annotations
 import numpy as np
 
 from .._rotations import wrap_angle
+from .._tolerances import DUPLICATE_TOLERANCE
 from ._screws import chain_motion, invert, joint_motion
 from ._structure import Geometry
-from ._types import Candidates, LabelCodes, SingularFlags
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity
 
 #: The plan's structure names: a 6R arm, and one with a slide.
 GENERAL_6R = "general_6r"
@@ -101,6 +102,17 @@ NEWTON_TOLERANCE = 1e-13
 PLAN_ACCURACY = 1e-4
 #: An arrangement this accurate on the test configurations is taken without trying the others.
 GOOD_ENOUGH = 1e-10
+
+#: Two joints whose null motion (one turned by t, the other by ∓t) moves the tool by less than this ratio of the
+#: Jacobian's largest singular value are one family: the elimination's roots satisfy the loop to about
+#: ELIMINATION_RESIDUAL before Newton's steps, which pins them along that motion only to
+#: ELIMINATION_RESIDUAL / FAMILY_CONDITION = DUPLICATE_TOLERANCE; below it they land anywhere on the family (on a
+#: raw xArm 7 at q2 = 0, four roots 0.004-0.02 rad apart, each verified at ACCEPT_RESIDUAL).
+ELIMINATION_RESIDUAL = 1e-12
+FAMILY_CONDITION = ELIMINATION_RESIDUAL / DUPLICATE_TOLERANCE
+#: Two roots of such a family differ along its null motion; across it, by no more than this (radians): the
+#: xArm's four differed by 1.4e-5 in q2, where the Jacobian's σ_min is ~1e-8 of σ_max.
+SAME_FAMILY = 1e-4
 
 #: Trigonometric basis (1, cos, sin) sampled at 0, 2π/3, 4π/3: rows are samples.
 _GRID = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
@@ -467,44 +479,85 @@ def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarr
 
 
 def _newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_targets: np.ndarray,
-            q: np.ndarray, steps: int = NEWTON_STEPS) -> np.ndarray:
+            q: np.ndarray, steps: int = NEWTON_STEPS, held: np.ndarray | None = None) -> np.ndarray:
     """Newton's method on G_1 ⋯ G_6 = A for candidates q (K, 6) and targets A (K, 4, 4), normalised lengths
-    (``revolute`` (6,) tells turns from slides).
+    (``revolute`` (6,) tells turns from slides); ``held`` (K,), a joint per candidate that keeps its value
+    (Gauss–Newton on the other five).
 
     Steps the candidates whose error twist is above :data:`NEWTON_TOLERANCE` (roots come from the eigenproblem
     to about 1e-12, so one step, or none, usually suffices); singular candidates get a tiny damping instead of a
-    failed solve.
+    failure.
     """
     q = q.copy()
     R_A, p_A = A_targets[:, :3, :3], A_targets[:, :3, 3]
-    cross = [_cross_matrix(k) for k in directions]
     for _ in range(steps + 1):
-        R = np.broadcast_to(_EYE3, q.shape[:-1] + (3, 3))
-        p = np.zeros(q.shape[:-1] + (3,))
-        twists = np.zeros(q.shape + (6,))  # spatial joint twists (ω, v): (ω, p × ω) of a turn, (0, k) of a slide
-        for j in range(6):
-            axis = R @ directions[j]
-            if not revolute[j]:
-                twists[:, j, 3:] = axis
-                p = p + axis * q[:, j, None]
-                continue
-            twists[:, j, :3] = axis
-            twists[:, j, 3:] = _cross(R @ points[j] + p, axis)
-            turn = _rodrigues(cross[j], q[:, j])
-            p = p + (R @ (points[j] - turn @ points[j])[..., None])[..., 0]
-            R = R @ turn
-        # spatial error twist (ω, v): A ≈ exp([ξ]) T
-        R_err = R_A @ np.swapaxes(R, -1, -2)
-        omega = 0.5 * np.stack([R_err[:, 2, 1] - R_err[:, 1, 2], R_err[:, 0, 2] - R_err[:, 2, 0],
-                                R_err[:, 1, 0] - R_err[:, 0, 1]], axis=-1)
-        error = np.concatenate([omega, p_A - p - _cross(omega, p)], axis=-1)  # (K, 6)
+        R, p, twists = _chain_twists(directions, points, revolute, q)
+        error = _error_twist(R, p, R_A, p_A)
         active = np.abs(error).max(axis=1) > NEWTON_TOLERANCE
         if _ == steps or not active.any():
             break
         J = twists[active]
-        JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6)  # (K, joints, joints) = Jᵀ J of the twist map
+        fixed = np.zeros(J.shape[:2])
+        if held is not None:
+            J[np.arange(len(J)), held[active]] = 0.0
+            fixed[np.arange(len(J)), held[active]] = 1.0
+        JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6) + fixed[..., None] * np.eye(6)
         q[active] += np.linalg.solve(JJt, (J @ error[active][..., None]))[..., 0]
     return q
+
+
+def _error_twist(R: np.ndarray, p: np.ndarray, R_A: np.ndarray, p_A: np.ndarray) -> np.ndarray:
+    """The spatial error twist (ω, v) (K, 6) with A ≈ exp([ξ]) T, of T = (R, p) against A = (R_A, p_A)."""
+    R_err = R_A @ np.swapaxes(R, -1, -2)
+    omega = 0.5 * np.stack([R_err[:, 2, 1] - R_err[:, 1, 2], R_err[:, 0, 2] - R_err[:, 2, 0],
+                            R_err[:, 1, 0] - R_err[:, 0, 1]], axis=-1)
+    return np.concatenate([omega, p_A - p - _cross(omega, p)], axis=-1)
+
+
+def _chain_twists(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, q: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """G_1 ⋯ G_6 at q (K, 6) as its rotation (K, 3, 3) and translation (K, 3), and the spatial joint twists
+    (K, 6, 6) at q, (ω, v): (ω, p × ω) of a turn through p, (0, k) of a slide along k; normalised lengths."""
+    cross = [_cross_matrix(k) for k in directions]
+    R = np.broadcast_to(_EYE3, q.shape[:-1] + (3, 3))
+    p = np.zeros(q.shape[:-1] + (3,))
+    twists = np.zeros(q.shape + (6,))
+    for j in range(6):
+        axis = R @ directions[j]
+        if not revolute[j]:
+            twists[:, j, 3:] = axis
+            p = p + axis * q[:, j, None]
+            continue
+        twists[:, j, :3] = axis
+        twists[:, j, 3:] = _cross(R @ points[j] + p, axis)
+        turn = _rodrigues(cross[j], q[:, j])
+        p = p + (R @ (points[j] - turn @ points[j])[..., None])[..., 0]
+        R = R @ turn
+    return R, p, twists
+
+
+def _coaxial_motion(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, q: np.ndarray
+                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Where two joints' axes coincide at q (K, 6) (the xArm's joints 1 and 3 at q2 = 0), or nearly (the
+    smallest singular value of the twist Jacobian within :data:`FAMILY_CONDITION` of the largest): turning one by
+    t and the other by ∓t moves the tool by at most that ratio times t, so the target fixes only their sum or
+    difference to the acceptance tolerance.
+
+    Returns ``found`` (K,) bool, the pair (K, 2) int (lower joint first), and the null motion (K, 6): unit, ±1/√2
+    on the pair (+ on the first joint), 0 elsewhere. Other null motions (a fold, where roots meet) are not a
+    family and are not reported here: the elimination's own conditioning speaks for them.
+    """
+    _, _, J = _chain_twists(directions, points, revolute, q)  # (K, joints, twist)
+    u, sigma, _ = np.linalg.svd(J)
+    null = u[..., -1]  # (K, 6): the joint motion of the smallest singular value
+    order = np.argsort(-np.abs(null), axis=-1)
+    pair = np.sort(order[:, :2], axis=-1)
+    top = np.take_along_axis(null, pair, axis=-1)
+    on_pair = np.abs(np.abs(top) - np.sqrt(0.5)).max(axis=-1) <= 1e-3
+    found = (sigma[:, -1] <= FAMILY_CONDITION * sigma[:, 0]) & on_pair
+    motion = np.zeros_like(null)
+    np.put_along_axis(motion, pair, np.sqrt(0.5) * np.sign(top) * np.sign(top[:, :1]), axis=-1)
+    return found, pair, motion
 
 
 class General6RPlan:
@@ -592,12 +645,61 @@ class General6RPlan:
             joints[rows, slots] = _newton(self.directions, self.points, self.revolute, A[rows], start)
         joints[..., ~self.revolute] *= self.scale
         complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
+        singular = SingularFlags(n)
+        if len(rows):
+            self._represent_coaxial_families(joints, valid, rows, slots, A, reference, singular)
         # out of reach by the bound: certainly no solution, however the eigenproblem was conditioned
         offset = targets[:, :3, 3] - self.points[0]
         beyond = np.einsum("ni,ni->n", offset, offset) > (self.reach * (1.0 + 1e-9)) ** 2
         valid[beyond] = False
         complete[beyond] = True
-        return Candidates(joints, valid, SingularFlags(n), complete=complete, promise_needs_every_slot=True)
+        return Candidates(joints, valid, singular, complete=complete, promise_needs_every_slot=True)
+
+    def _represent_coaxial_families(self, joints: np.ndarray, valid: np.ndarray, rows: np.ndarray,
+                                    slots: np.ndarray, A: np.ndarray, reference: np.ndarray | None,
+                                    singular: SingularFlags) -> None:
+        """Roots (``joints[rows, slots]`` of targets ``A``) where two axes coincide, or nearly
+        (:func:`_coaxial_motion`): the target fixes only the pair's sum or difference to the acceptance tolerance,
+        and the elimination's roots are arbitrary members of that family (four, 0.004-0.02 rad apart, on a raw
+        xArm 7 at q2 = 0). The condition is reported and the family has one representative, as the closed forms
+        give it: the member with the pair's first joint at the reference value, where Newton's steps with that
+        joint held reach the target (the family holds there); else the root itself. The other roots of the
+        family (differing along the null motion only) are no longer candidates (``valid`` (N, m), in place), so
+        that every valid slot still gives a distinct solution (the promise of :meth:`solve` needs it)."""
+        found, pair, motion = _coaxial_motion(self.directions, self.points, self.revolute, joints[rows, slots])
+        if not found.any():
+            return
+        rows, slots, pair, motion = rows[found], slots[found], pair[found], motion[found]
+        index = np.arange(len(rows))
+        first = pair[:, 0]
+        if reference is not None:
+            q = joints[rows, slots]
+            wanted = np.asarray(reference, dtype=float)[first]
+            along = wrap_angle(wanted - q[index, first]) / motion[index, first]
+            moved = _newton(self.directions, self.points, self.revolute, A[rows], q + along[:, None] * motion,
+                            held=first)
+            R, p, _ = _chain_twists(self.directions, self.points, self.revolute, moved)
+            reached = np.abs(_error_twist(R, p, A[rows, :3, :3], A[rows, :3, 3])).max(axis=1) <= 10 * NEWTON_TOLERANCE
+            joints[rows[reached], slots[reached]] = moved[reached]
+        for row in np.unique(rows).tolist():  # one representative per family: the first slot's
+            members = np.flatnonzero(rows == row)
+            for position, k in enumerate(members.tolist()):
+                for other in members[:position].tolist():
+                    step = wrap_angle(joints[row, slots[k]] - joints[row, slots[other]])
+                    across = step - (step @ motion[other]) * motion[other]
+                    if valid[row, slots[other]] and np.abs(across).max() <= SAME_FAMILY:
+                        valid[row, slots[k]] = False
+                        break
+        for i, j in {(int(a), int(b)) for a, b in pair}:
+            for relation, sign in (("sum", "+"), ("difference", "−")):
+                chosen = (first == i) & (pair[:, 1] == j) & ((motion[:, j] < 0) == (relation == "sum"))
+                if chosen.any():
+                    mask = np.zeros(singular.count, dtype=bool)
+                    mask[rows[chosen]] = True
+                    singular.add(mask, Singularity(
+                        "coaxial", (i, j), relation, f"joints {i + 1} and {j + 1} are coaxial here: only "
+                        f"q{i + 1} {sign} q{j + 1} is determined; q{i + 1} is set to the reference value where "
+                        f"the family reaches the target"))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return {}

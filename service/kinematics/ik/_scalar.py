@@ -27,6 +27,7 @@ import math
 import numpy as np
 
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .subproblems._records import _NEAR_TANGENT_GAP
 from .subproblems._vectors import axis_frame
 from ._types import LabelCodes, SingularFlags
 
@@ -292,8 +293,11 @@ class TwoTurns:
     R(k1, θ1) R(k2, θ2) start = goal, that is :func:`.subproblems.subproblem_2` on (goal, start) with θ1 negated.
     The vectors enter as :meth:`start` and :meth:`goal` (those of fixed vectors computed once per plan)."""
 
-    def __init__(self, k1: Vector, k2: Vector) -> None:
+    def __init__(self, k1: Vector, k2: Vector, free_below: float = GEOMETRY_TOLERANCE) -> None:
+        """``free_below``: the radius (relative to the vectors' size) at or below which the array solver holds a
+        joint as free (a spherical wrist of an arm with rounding dust holds more than subproblem 2 does)."""
         self.k1, self.k2 = k1, k2
+        self.free_below = free_below
         self.normal = cross(k1, k2)
         self.sin2 = dot(self.normal, self.normal)
         self.cos, self.sin = dot(k1, k2), math.sqrt(self.sin2)
@@ -324,8 +328,9 @@ class TwoTurns:
         array solver gives it, for the FK check to reject) and None for the empty slot."""
         p1, pn, d1, radius_p, norm_p = goal
         q2, qn, e2, radius_q, norm_q = start
-        tol = GEOMETRY_TOLERANCE * (norm_p if norm_p > norm_q else norm_q)
-        if not (radius_p > MARGIN * tol and radius_q > MARGIN * tol and abs(norm_p - norm_q) * MARGIN <= tol):
+        size = norm_p if norm_p > norm_q else norm_q
+        tol, free = GEOMETRY_TOLERANCE * size, self.free_below * size
+        if not (radius_p > MARGIN * free and radius_q > MARGIN * free and abs(norm_p - norm_q) * MARGIN <= tol):
             raise NotGeneric
         cos, sin, sin2 = self.cos, self.sin, self.sin2
         h1, h2 = p1 / norm_p, q2 / norm_q
@@ -340,7 +345,9 @@ class TwoTurns:
         s1, c1, s2, c2 = -beta * pn, beta * d1, alpha * qn, alpha * e2
         margin = MARGIN * _MERGE_RESIDUAL * rho1 * rho2
         if not g * (rho1 + rho2) > margin:
-            if g * (rho1 + rho2) < -margin:  # the cones clearly miss: the least-squares pair and an empty slot
+            # the cones clearly miss, beyond a near tangency (subproblems._records._NEAR_TANGENT_GAP, which the
+            # array solver reports merged): the least-squares pair and an empty slot
+            if g * (rho1 + rho2) < -margin and -g > 2 * MARGIN * _NEAR_TANGENT_GAP * (rho1 + rho2):
                 return (wrap(-wrap(atan2(s1, c1))), wrap(atan2(s2, c2))), None
             raise NotGeneric
         gamma = math.sqrt(g) / sin

@@ -11,12 +11,13 @@ model.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import GEOMETRY_TOLERANCE
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._screws import rotate_about
-from ._structure import Geometry
+from ._structure import Geometry, idealised
 from .subproblems import subproblem_1, subproblem_2_chain
 from ._types import LabelCodes, SingularFlags, Singularity
 
@@ -58,7 +59,11 @@ class SphericalWrist:
     b (two roots: the wrist flip), then subproblem 1 finds q_c from a vector
     normal to ω_c. When ``R_w ω_c`` lies on ω_a (the middle joint aligns the
     outer axes), only q_a ± q_c is determined: q_a takes the reference value
-    (or 0) and the singularity is reported.
+    (or 0) and the singularity is reported. "Lies on" allows for the arm's
+    own error: an arm whose relations hold within ``GEOMETRY_TOLERANCE`` but
+    not exactly (a URDF's π/2 written to 11 digits) gives ``R_w`` with that
+    error, and q_a, seen on the radius of ``R_w ω_c`` about ω_a, with that
+    error over the radius (see :attr:`free_below`).
 
     Labels: see :func:`wrist_codes`.
     """
@@ -77,7 +82,7 @@ class SphericalWrist:
         target_axis = R_w @ c  # (..., 3)
         pair = subproblem_2_chain(a, b, c, target_axis[..., None, :])
         qa, qb = pair.theta1[..., 0, :], pair.theta2[..., 0, :]  # (..., 2)
-        free = pair.degenerate[..., 0]
+        free = pair.degenerate[..., 0] | (np.linalg.norm(np.cross(a, target_axis), axis=-1) <= self.free_below)
         if free.any():
             start = 0.0 if reference is None else reference[self.joints[0]]
             back = rotate_about(a, -start, target_axis)
@@ -101,6 +106,16 @@ class SphericalWrist:
                     f"{'+' if relation == 'sum' else '−'} q{self.joints[2] + 1} is determined; "
                     f"q{self.joints[0] + 1} is set to the reference value (or 0)"))
         return WristResult(joints, valid, singular)
+
+    @cached_property
+    def free_below(self) -> float:
+        """The radius of ``R_w ω_c`` about ω_a (unit vectors) at or below which q_a is held as free: where the
+        arm's deviation from the relations exact recognition accepted (those within ``10 GEOMETRY_TOLERANCE``, as
+        :meth:`Geometry.parallel`; relations rounded more coarsely, which this plan does not assume, do not
+        count), over the radius, would move q_a by more than ``DUPLICATE_TOLERANCE``. An exact arm keeps
+        subproblem 2's own test, ``GEOMETRY_TOLERANCE``."""
+        deviation = idealised(self.geometry, 10 * GEOMETRY_TOLERANCE).deviation
+        return max(GEOMETRY_TOLERANCE, deviation / DUPLICATE_TOLERANCE)
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return wrist_codes(joints[:, self.joints[1]])

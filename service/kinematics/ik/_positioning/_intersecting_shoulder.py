@@ -7,7 +7,8 @@ from functools import cached_property
 
 import numpy as np
 
-from ..._tolerances import GEOMETRY_TOLERANCE
+from ..._rotations import wrap_angle
+from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE
 from .._screws import chain_rotation, rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -78,7 +79,22 @@ class IntersectingShoulder(Positioner):
         pair = subproblem_2_chain(g.direction(i), g.direction(j), w3 - c, (targets - c)[:, None, :])
         q1, q2 = pair.theta1, pair.theta2  # (N, 2 third roots, 2 pair roots)
         singular = SingularFlags(n_targets)
-        free_shoulder = pair.degenerate  # (N, 2): target on axis 1
+        # subproblem 2 is degenerate when the target is on axis 1 (joint 1 free), or when the point is on axis 2
+        # (joint 2 free: an elbow that lines the point up with it, as the stretched elbow of a 7R arm does)
+        reach_scale = np.maximum(reach[:, None], np.linalg.norm(w3 - c, axis=-1))  # (N, 2)
+        on_axis_1 = (np.linalg.norm(np.cross(g.direction(i), targets - c), axis=-1)[:, None]
+                     <= GEOMETRY_TOLERANCE * reach_scale)
+        free_shoulder = pair.degenerate & on_axis_1  # (N, 2)
+        free_second = (pair.degenerate | self._near_axis_2_at_fold(third, w3 - c, reach_scale)) & ~on_axis_1
+        if free_second.any():  # joint 2 at the reference value (or 0); joint 1 turns the point so placed
+            q2_held = np.where(free_second, 0.0 if reference is None else reference[j], q2[..., 0])
+            turned = rotate_about(g.direction(j), q2_held, w3 - c)
+            q1_held = subproblem_1(g.direction(i), turned, (targets - c)[:, None, :]).theta[..., 0]
+            q1 = np.where(free_second[..., None], q1_held[..., None], q1)
+            q2 = np.where(free_second[..., None], q2_held[..., None], q2)
+        _flag_rows(free_second.any(axis=1), Singularity(
+            "shoulder", (j,), "free", "the point is on the second joint's axis; joint 2 is set to the reference "
+                                      "value (or 0)"), singular)
         free_both = np.zeros_like(free_shoulder)
         if free_shoulder.any():
             start = 0.0 if reference is None else reference[i]
@@ -95,8 +111,10 @@ class IntersectingShoulder(Positioner):
         joints = np.zeros((n_targets, 2, 2, 3))
         joints[..., 0], joints[..., 1] = q1, q2
         joints[..., 2] = q3[:, :, None]
-        valid = third.valid[:, :, None] & pair.valid & third.exact[:, :, None] & pair.exact
-        valid[:, :, 1] &= ~free_shoulder  # one representative when the shoulder is free
+        # a near tangency (merged, not exact) is the touching root: verification refines it
+        valid = third.valid[:, :, None] & third.exact[:, :, None] & (
+            (pair.valid & (pair.exact | pair.merged[..., None])) | free_second[..., None])
+        valid[:, :, 1] &= ~(free_shoulder | free_second)  # one representative when a shoulder joint is free
         _flag_rows(free_shoulder.any(axis=1) & ~free_both.any(axis=1),
                    Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "
                                "joint 1 is set to the reference value (or 0)"), singular)
@@ -113,6 +131,21 @@ class IntersectingShoulder(Positioner):
             _flag_rows(third.merged, Singularity("reach", (k,), "boundary",
                                                  "the point is at the nearest reach of the prismatic joint"), singular)
         return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
+
+    def _near_axis_2_at_fold(self, third, point: np.ndarray, scale: np.ndarray) -> np.ndarray:
+        """Which points (N, 2) joint 2 cannot place: within ``FOLD_TOLERANCE`` of axis 2 (relative to
+        ``scale`` (N, 2)), from a joint-3 root pair that is as close to meeting (its roots ``phi ± half``,
+        ``|half| <= FOLD_TOLERANCE``, or merged). There joint 3 is known only to the square root of the
+        decoupling's error (a reach through axes that intersect within ``GEOMETRY_TOLERANCE``), the point
+        ``point`` (N, 2, 3) to as much, and joint 2's angle to that over the point's radius: an O(1) error. Joint 2
+        is held like a free one, and verification refines the representative onto the arm."""
+        g, j = self.geometry, self.joints[1]
+        if not g.model.is_revolute[self.joints[2]]:
+            return np.zeros(point.shape[:2], dtype=bool)
+        half = 0.5 * np.abs(wrap_angle(third.theta[:, 0] - third.theta[:, 1]))
+        at_fold = third.merged | (np.nan_to_num(half, nan=0.0) <= FOLD_TOLERANCE)  # (N,)
+        radius = np.linalg.norm(np.cross(g.direction(j), point), axis=-1)
+        return at_fold[:, None] & (radius <= FOLD_TOLERANCE * scale)
 
     def _stretched(self, q3: np.ndarray, w: np.ndarray, c: np.ndarray) -> np.ndarray:
         g, k = self.geometry, self.joints[2]

@@ -15,7 +15,7 @@ from numpy.typing import ArrayLike
 from ..._errors import InvalidInputError
 from ..._rotations import wrap_angle
 from ..._tolerances import GEOMETRY_TOLERANCE
-from ._records import _GAP_ROUNDING, _MERGE_SIN_SQUARED, AnglePairSolutions, AngleSolutions
+from ._records import _GAP_ROUNDING, _MERGE_SIN_SQUARED, _NEAR_TANGENT_GAP, AnglePairSolutions, AngleSolutions
 from ._roots import _harmonic
 from ._vectors import _coords, _cross3, _distances, _hypot, _norm, _pair, _points, _rotate_onto, _unit, axis_frame
 
@@ -121,7 +121,12 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
     ``| ||p|| - ||q|| | <= tol L``. When the cones miss, it also needs the gap
     between the closest directions to be at most ``GEOMETRY_TOLERANCE`` (on the
     unit sphere). A gap that small means the cones touch, and the candidate is
-    then ``merged``. ``theta1`` is free (degenerate, representative 0) when
+    then ``merged``. A larger gap up to ``sqrt(GEOMETRY_TOLERANCE)`` (with the
+    norms as close, relative to L) is a tangency that an error of the inputs
+    split (an angle found upstream at a double root, such as a stretched
+    elbow, carries the square root of its inputs' error): the closest pair is
+    the touching root, ``merged`` but not ``exact``, for the caller to refine
+    and verify, never a proof that there is no solution. ``theta1`` is free (degenerate, representative 0) when
     ``p`` lies on ``k1``, or ``p = 0``. ``theta2`` is then the subproblem 1
     answer for ``R(k2, theta2) q = p``. The case ``q`` on ``k2`` is the mirror
     image.
@@ -215,7 +220,10 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
         side2 = np.sign(alpha) * rho2
         gap = _hypot(h1 - cos * h2 - sin * side2, side1 - sin * h2 + cos * side2)
         touch = touch | (~meet & (gap <= GEOMETRY_TOLERANCE))
-    merged = touch & ~degenerate
+        near_miss = ~meet & (gap <= _NEAR_TANGENT_GAP) & (np.abs(norm_p - norm_q) <= _NEAR_TANGENT_GAP * scale)
+        merged = (touch | near_miss) & ~degenerate
+    else:
+        merged = touch & ~degenerate
     exact_first = norms_match & (meet | touch)
 
     if degenerate.any():

@@ -12,7 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..._tolerances import DUPLICATE_TOLERANCE
+from ..._tolerances import DUPLICATE_TOLERANCE, FOLD_TOLERANCE
 
 
 class AngleSolutions(NamedTuple):
@@ -100,3 +100,8 @@ _MERGE_SIN_SQUARED = math.sin(DUPLICATE_TOLERANCE / 2.0) ** 2
 # Rounding error of that g relative to rho: exact tangencies give |g| up to 86 ulps of rho (tests/kinematics/ik/
 # subproblems/test_subproblems.py's tangent cones); this bound keeps a factor 3 above it.
 _GAP_ROUNDING = 256 * np.finfo(float).eps
+# Two cones (subproblem 2) that miss by at most this gap on the unit sphere are a tangency that an error of the
+# inputs split: an angle found upstream at a double root (subproblem 3 at its fold: a stretched elbow) is known
+# only to the square root of its inputs' error (FOLD_TOLERANCE), and moves the point by that much. Their
+# closest directions are then the touching root, reported ``merged`` (not ``exact``) for the caller to refine.
+_NEAR_TANGENT_GAP = FOLD_TOLERANCE

@@ -326,6 +326,35 @@ def test_sp2_tangent_cones_merge(rng):
         assert (res <= RESIDUAL * radius[keep, 0]).all()
 
 
+@pytest.mark.parametrize("split", [1e-12, 1e-9, 1e-7, 1e-6])
+def test_sp2_tangency_split_by_rounding_returns_the_touching_root(rng, split):
+    """Cones of half-angle 45° about z and x touch at (1, 0, 1)/√2; the cone of q made ``split`` narrower (a
+    tangency an upstream error split, issue 22.6): the first slot is the touching pair, its residual within
+    the split, reported merged, and never an empty answer. p and q start anywhere on their circles."""
+    k1, k2 = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    p = rotate(k1, rng.uniform(-np.pi, np.pi, N_ROWS), np.array([1.0, 0.0, 1.0]) / np.sqrt(2))
+    q = rotate(k2, rng.uniform(-np.pi, np.pi, N_ROWS), np.array([np.cos(np.pi / 4 - split),
+                                                                 np.sin(np.pi / 4 - split), 0.0]))
+    sol = subproblem_2(k1, k2, p, q)
+    assert sol.merged.all() and not sol.degenerate.any()
+    assert sol.valid[:, 0].all() and not sol.valid[:, 1].any()
+    res = sp2_residual(k1, k2, sol.theta1[:, 0], sol.theta2[:, 0], p, q)
+    assert (res <= 2 * split + RESIDUAL).all()
+    # the touching direction: both turned onto (1, 0, 1)/√2 within the split
+    turned = rotate(k1, sol.theta1[:, 0], p)
+    assert np.abs(turned - np.array([1.0, 0.0, 1.0]) / np.sqrt(2)).max() <= 2 * split + 1e-12
+
+
+def test_sp2_clear_miss_is_not_a_tangency(rng):
+    """Cones apart by 1e-3 (far beyond sqrt(GEOMETRY_TOLERANCE)) are a miss: least squares, not merged."""
+    k1, k2 = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    # both cones of half-angle 45° touch at (1, 0, 1)/√2; tilt q's cone 1e-3 narrower
+    p = np.array([1.0, 0.0, 1.0]) / np.sqrt(2)
+    q = np.array([np.cos(np.pi / 4 - 1e-3), np.sin(np.pi / 4 - 1e-3), 0.0])
+    sol = subproblem_2(k1, k2, p, q)
+    assert not sol.merged and not sol.exact.any() and sol.valid.tolist() == [True, False]
+
+
 def test_sp2_free_joint_is_degenerate(rng):
     k1, k2 = random_axis_pair(rng)
     theta2 = rng.uniform(-np.pi, np.pi, 20)

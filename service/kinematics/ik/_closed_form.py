@@ -22,6 +22,7 @@ from ._plan import Plan, plan_for
 from ._table import SolutionTable
 from ._types import Candidates, SingularFlags
 from ._verify import Verified, verify
+from ._types import Sealed
 
 #: Targets solved together: large enough that per-operation overhead is small, small enough that the
 #: (chunk × m × n) temporaries stay in cache and memory is bounded whatever the batch size.
@@ -37,7 +38,15 @@ def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndar
     key = _plan_key(robot, constrain_orientation, reference)
     if key is None:
         return plan_for(robot, constrain_orientation=False, reference=reference)
-    return memo(robot, key, lambda: plan_for(robot, constrain_orientation=constrain_orientation, reference=None))
+    return memo(robot, key, lambda: _sealed(plan_for(robot, constrain_orientation=constrain_orientation,
+                                                      reference=None)))
+
+
+def _sealed(plan: Plan | None) -> Plan | None:
+    """A plan to keep and share: sealed (:class:`~._types.Sealed`), so that no call can leave state on it."""
+    if isinstance(plan, Sealed):
+        plan.seal()
+    return plan
 
 
 def plan_is_kept(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> bool:

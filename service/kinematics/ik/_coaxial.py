@@ -22,7 +22,7 @@ import numpy as np
 
 from .._rotations import wrap_angle
 from ._structure import Geometry
-from ._types import Candidates, LabelCodes, SingularFlags, Singularity
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 
 
 def coaxial_pair(geometry: Geometry) -> tuple[int, int, str] | None:
@@ -69,7 +69,7 @@ def coaxial_report(pair: tuple[int, int, str]) -> Singularity:
                        f"is set to the reference value (or 0)")
 
 
-class CoaxialPlan:
+class CoaxialPlan(Sealed):
     """The plan of the arm with the second of two coaxial joints removed, answering for the arm itself.
 
     ``pair`` is ``(i, j, relation)`` of :func:`coaxial_pair`; ``inner`` plans the arm without joint j (n − 1

@@ -20,11 +20,11 @@ from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, Positioner
 from ._screws import apply, chain_rotation, invert, rotation_about
 from .subproblems import subproblem_1
-from ._types import Candidates, LabelCodes, SingularFlags
+from ._types import Candidates, LabelCodes, SingularFlags, Sealed
 from ._wrist import Roll, SphericalWrist, _perpendicular_unit
 
 
-class DecoupledPlan:
+class DecoupledPlan(Sealed):
     """A positioner over joints 0…k−1 and an optional wrist over joints k…n−1."""
 
     method = "analytic"

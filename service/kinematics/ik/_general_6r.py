@@ -76,7 +76,7 @@ from .._rotations import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE
 from ._screws import chain_motion, invert, joint_motion
 from ._structure import Geometry
-from ._types import Candidates, LabelCodes, SingularFlags, Singularity
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 
 #: The plan's structure names: a 6R arm, and one with a slide.
 GENERAL_6R = "general_6r"
@@ -560,7 +560,7 @@ def _coaxial_motion(directions: np.ndarray, points: np.ndarray, revolute: np.nda
     return found, pair, motion
 
 
-class General6RPlan:
+class General6RPlan(Sealed):
     """Every solution of a 6-joint arm with no decomposable geometry, 6R or with one slide (5R1P), by the
     elimination of this module."""
 

@@ -54,7 +54,7 @@ from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL
 from ._screws import chain_motion
 from ._structure import arm_size
-from ._types import Candidates, LabelCodes
+from ._types import Candidates, LabelCodes, Sealed
 from ._gauss_newton import gauss_newton
 from ._goals import PoseGoal
 from ._verify import POLISH_FROM, first_of_each, residual_arrays, wrap_revolute
@@ -80,7 +80,7 @@ SINGULAR_MARGIN = 10.0
 REFINE_STEPS = 6
 
 
-class IdealisedPlan:
+class IdealisedPlan(Sealed):
     """A family's plan for the idealised arm, answering for the true ``robot``."""
 
     method = "analytic"

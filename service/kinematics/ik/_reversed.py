@@ -19,7 +19,7 @@ from .._forward import ScrewModel
 from ._decoupled import DecoupledPlan
 from ._screws import invert
 from ._structure import Geometry
-from ._types import Candidates, LabelCodes, SingularFlags, Singularity
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 
 
 def reversed_geometry(geometry: Geometry) -> Geometry:
@@ -30,7 +30,7 @@ def reversed_geometry(geometry: Geometry) -> Geometry:
     return Geometry(reversed_model, geometry.length_scale, up=geometry.up)
 
 
-class ReversedPlan:
+class ReversedPlan(Sealed):
     """A plan of the inverse chain (decoupled, or three parallel axes), answering for the chain itself."""
 
     method = "analytic"

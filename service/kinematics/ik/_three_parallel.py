@@ -41,11 +41,11 @@ from ._positioning import _flag_rows, _unit, side_codes
 from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
-from ._types import Candidates, LabelCodes, SingularFlags, Singularity
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 from ._wrist import _perpendicular_unit, wrist_codes
 
 
-class _AxesTwoToFourParallel:
+class _AxesTwoToFourParallel(Sealed):
     """What the families with axes 2 ∥ 3 ∥ 4 share: steps 3–5 from candidate pairs (q1, q5), and the labels.
     A family supplies ``match`` and ``_shoulder_and_wrist`` (steps 1 and 2)."""
 

@@ -29,12 +29,12 @@ from ._positioning import side_codes
 from ._screws import apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_3, subproblem_6
-from ._types import Candidates, LabelCodes, SingularFlags, Singularity
+from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 from ._three_parallel import _split_double_root
 from ._wrist import _perpendicular_unit
 
 
-class ThreeParallelAtEndPlan:
+class ThreeParallelAtEndPlan(Sealed):
     """Axes 4 ∥ 5 ∥ 6, axes 1–3 of any other geometry (axis 3 not parallel to them)."""
 
     method = "analytic"

@@ -151,3 +151,27 @@ class IKResult:
     free_joints: list[int] = field(default_factory=list)
     detail: str = ""
     search_exhausted_budget: bool = False
+
+
+class Sealed:
+    """An object that concurrent requests share once built (a plan and its parts): attributes are set while it
+    is built, and :meth:`seal` ends that. Setting one afterwards (per-call state kept on a shared object) raises
+    AttributeError. A ``functools.cached_property`` stays allowed: it writes the instance's dict directly, a value
+    derived from what was built, the same whichever call computes it first."""
+
+    _sealed = False
+
+    def seal(self):
+        """Seal this object and every :class:`Sealed` object it holds (its positioner, wrist, inner plan);
+        returns it."""
+        if not self._sealed:
+            object.__setattr__(self, "_sealed", True)
+            for value in vars(self).values():
+                if isinstance(value, Sealed):
+                    value.seal()
+        return self
+
+    def __setattr__(self, name: str, value) -> None:
+        if self._sealed:
+            raise AttributeError(f"{type(self).__name__} is shared once built: {name!r} cannot be set on it")
+        object.__setattr__(self, name, value)

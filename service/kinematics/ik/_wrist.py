@@ -19,7 +19,7 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._screws import rotate_about
 from ._structure import Geometry, idealised
 from .subproblems import subproblem_1, subproblem_2_chain
-from ._types import LabelCodes, SingularFlags, Singularity
+from ._types import LabelCodes, SingularFlags, Singularity, Sealed
 
 
 @dataclass
@@ -52,7 +52,7 @@ def wrist_codes(middle: np.ndarray) -> LabelCodes:
     return {"wrist": (("no_flip", "flip"), codes)}
 
 
-class SphericalWrist:
+class SphericalWrist(Sealed):
     """Three revolute joints meeting at the wrist centre (Spong §4.2–4.4, done with subproblems).
 
     Subproblem 2 turns ω_c's home direction onto ``R_w ω_c`` with joints a and
@@ -142,7 +142,7 @@ class Roll:
         return {}
 
 
-class TwoAxisWrist:
+class TwoAxisWrist(Sealed):
     """Two revolute joints whose axes meet at the wrist centre (not parallel): ``R(ω_a, q_a) R(ω_b, q_b) = R_w``.
 
     ``R(ω_b, q_b)`` keeps ω_b, so ``R(ω_a, q_a) ω_b = R_w ω_b`` (subproblem 1) gives q_a, and q_b follows by

@@ -70,3 +70,14 @@ def test_one_cached_plan_answers_eight_threads_as_it_answers_each_alone(catalogu
     assert all(len(results) == ROUNDS for results in together)
     for thread in range(THREADS):
         assert together[thread] == alone[thread], f"thread {thread}: an answer changed when solved concurrently"
+
+
+@pytest.mark.parametrize("robot_id", ARMS)
+def test_a_kept_plan_and_its_parts_refuse_new_state(catalogue, robot_id):
+    """The kept plan is sealed with the parts it holds: a call that tried to keep something on it would raise
+    instead of leaking into the next call."""
+    plan = cached_plan(catalogue.get(robot_id).robot, constrain_orientation=True, reference=None)
+    parts = [plan, *(value for value in vars(plan).values() if hasattr(value, "seal"))]
+    for part in parts:
+        with pytest.raises(AttributeError, match="shared once built"):
+            part.last_targets = np.zeros((1, 4, 4))

@@ -16,7 +16,7 @@ import numpy as np
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from .._screws import chain_motion, move_point
 from .._structure import Geometry
-from .._types import LabelCodes, SingularFlags, Singularity
+from .._types import LabelCodes, SingularFlags, Singularity, Sealed
 
 
 @dataclass
@@ -82,7 +82,7 @@ class Needs:
     parallel: tuple[tuple[int, int], ...] = ()
 
 
-class Positioner:
+class Positioner(Sealed):
     """Base class: the joints it moves, its generic solution count and its labels."""
 
     name: str = ""

@@ -28,7 +28,7 @@ def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
     angle = _DEGREE if unit == "deg" else 1.0
     kept = _solution_dicts(answer.solutions, answer.solution_violations, answer, scale, free_of_target, angle)
     rejected = _solution_dicts(answer.rejected, answer.rejected_violations, answer, scale, free_of_target, angle)
-    status, truncated, detail = answer.status.tolist(), answer.truncated.tolist(), answer.details(WIRE_NOTES)
+    status, truncated, detail = answer.status.tolist(), answer.truncated.tolist(), answer.detail_list(WIRE_NOTES)
     trimmed, available = answer.trimmed.tolist(), answer.available.tolist()
     answers = []
     for row, solver in enumerate(answer.solver.tolist()):
@@ -111,7 +111,7 @@ def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
         "format": "arrays",
         "solvers": solvers,
         "singularity_reports": [_report(report) for report in answer.singularity_reports],
-        "targets": {"status": answer.status.tolist(), "detail": list(answer.details(WIRE_NOTES)),
+        "targets": {"status": answer.status.tolist(), "detail": answer.detail_list(WIRE_NOTES),
                     "solver": answer.solver,
                     "singularities": list(answer.singularities), "truncated": answer.truncated,
                     "trimmed": answer.trimmed, "available": answer.available,

@@ -208,6 +208,8 @@ class IKAnswer:
     timings: list[SolveTiming]
     detail_of: Callable[[int, Mapping[str, str]], str | None] = field(default=lambda row, wording: None,
                                                                       repr=False, compare=False)
+    every_detail: Callable[[Mapping[str, str]], list[str | None]] | None = field(default=None, repr=False,
+                                                                                  compare=False)
 
     def __len__(self) -> int:
         return len(self.status)
@@ -216,6 +218,12 @@ class IKAnswer:
         """Each target's detail (str or None), the selection's notes in ``wording``: the keys and fields of
         :data:`NOTE_WORDING`, a boundary's words for the options (``detail`` reads in the core's)."""
         return PerTarget(len(self), lambda row: self.detail_of(row, wording))
+
+    def detail_list(self, wording: Mapping[str, str] = NOTE_WORDING) -> list[str | None]:
+        """:meth:`details`, every one made at once (what an encoder of the whole batch wants)."""
+        if self.every_detail is None:
+            return list(self.details(wording))
+        return self.every_detail(wording)
 
     def target(self, index: int) -> TargetAnswer:
         """Target ``index``'s answer as one object (its table rows sliced out, nothing recomputed)."""
@@ -708,15 +716,23 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
     def detail_of(row: int, wording: Mapping[str, str]) -> str | None:
         if owner[row] < 0:
             return None
-        part, local = parts[int(owner[row])], int(local_of[row])
         notes = chosen.notes.worded(row, wording) if row in chosen.notes else []
-        words = [part.details.get(local), *notes, part.remarks.get(local)]
-        return " ".join(filter(None, words)) or None
+        return _detail(parts[int(owner[row])], int(local_of[row]), notes)
+
+    def every_detail(wording: Mapping[str, str]) -> list[str | None]:
+        notes = chosen.notes.worded_every(wording)
+        return [None if part < 0 else _detail(parts[part], local, notes.get(row, ()))
+                for row, (part, local) in enumerate(zip(owner.tolist(), local_of.tolist()))]
 
     return IKAnswer(status, PerTarget(n_targets, lambda row: detail_of(row, NOTE_WORDING)), solver, solvers,
                     singularities, list(distinct), chosen.truncated, chosen.trimmed, chosen.available,
                     chosen.solutions, chosen.rejected, _violations(robot, limits, chosen.solutions),
-                    _violations(robot, limits, chosen.rejected), limits, timings, detail_of)
+                    _violations(robot, limits, chosen.rejected), limits, timings, detail_of, every_detail)
+
+
+def _detail(part, local: int, notes) -> str | None:
+    """One target's detail: its solver part's words, the selection's notes, the part's remarks."""
+    return " ".join(filter(None, [part.details.get(local), *notes, part.remarks.get(local)])) or None
 
 
 def _violations(robot: Robot, limits: Limits, table: SolutionTable) -> np.ndarray:

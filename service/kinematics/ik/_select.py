@@ -468,9 +468,17 @@ class TargetNotes(Mapping):
         """Target ``row``'s notes in ``wording`` (the keys and fields of :data:`NOTE_WORDING`)."""
         if row not in self:
             raise KeyError(row)
-        status, *counts = self._columns
-        status, (rejected, outside, truncated, available, kept, with_all_moves, collided) = (
-            status[row], (column[row].item() for column in counts))
+        return self._words(wording, *(value.item() if isinstance(value, np.generic) else value
+                                      for value in (column[row] for column in self._columns)))
+
+    def worded_every(self, wording: Mapping[str, str]) -> dict[int, list[str]]:
+        """:meth:`worded` of every target with notes, keyed by target: the columns read once, as lists (a batch
+        may have thousands)."""
+        columns = [column.tolist() if isinstance(column, np.ndarray) else list(column) for column in self._columns]
+        return {row: self._words(wording, *(column[row] for column in columns)) for row in self.rows.tolist()}
+
+    def _words(self, wording: Mapping[str, str], status: str, rejected: int, outside: int, truncated: bool,
+               available: int, kept: int, with_all_moves: int, collided: int) -> list[str]:
         notes = []
         if status == "no_solution_within_limits":
             notes.append(wording["no_fit"].format(rejected=rejected))

@@ -170,3 +170,23 @@ def test_a_redundant_arms_family_stops_at_the_requests_budget():
     with pytest.raises(BudgetExhausted) as stopped:
         answer_ik(robot, targets, AnswerOptions(budget=budget))
     assert stopped.value.stage == "the free-joint family"
+
+
+def test_every_detail_at_once_is_each_detail_read_alone():
+    """detail_list (what the batch encoders read) words every target as details() does one by one: with limits
+    that reject some targets' solutions, flagged rows, capped equivalents and targets out of reach."""
+    from service.api.boundary import WIRE_NOTES
+
+    worded = set()
+    q = np.random.default_rng(11).uniform(-np.pi, np.pi, (60, PUMA.dof))
+    T = forward_kinematics(PUMA, q)
+    T[::7, :3, 3] *= 5.0  # out of reach
+    for options in (AnswerOptions(), AnswerOptions(filter_limits=False), AnswerOptions(max_equivalents=1),
+                    AnswerOptions(limits=Limits(np.full(6, -2 * np.pi), np.full(6, 2 * np.pi)), max_equivalents=3)):
+        answer = answer_ik(PUMA, IKTargets.poses(T), options)
+        for wording in ({}, WIRE_NOTES):
+            alone = list(answer.details(wording)) if wording else list(answer.details())
+            at_once = answer.detail_list(wording) if wording else answer.detail_list()
+            assert at_once == alone
+        worded.update(detail is not None for detail in alone)
+    assert worded == {True, False}

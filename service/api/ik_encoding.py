@@ -54,8 +54,7 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
     orientation = [None if missing else value
                    for value, missing in zip(table.orientation.tolist(), np.isnan(table.orientation).tolist())]
     within = table.within_limits.tolist()
-    branch = [(name, np.array([*values, None], dtype=object)[codes].tolist())
-              for name, (values, codes) in table.labels.items()]
+    branches = _branch_dicts(table)
     lower = [None if np.isinf(value) else value for value in (answer.limits.lower / scale).tolist()]
     upper = [None if np.isinf(value) else value for value in (answer.limits.upper / scale).tolist()]
     violations: dict[int, list[dict]] = {}
@@ -66,7 +65,7 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
     per_target: list[list[dict]] = [[] for _ in free_of_target]
     for k, target in enumerate(targets):
         per_target[target].append({
-            "joints": joints[k], "branch": {name: column[k] for name, column in branch if column[k] is not None},
+            "joints": joints[k], "branch": branches[k],
             "within_limits": within[k], "violations": violations.get(k, []),
             "residual": {"position": position[k], "orientation": orientation[k]},
             "free_values": {str(j): joints[k][j] for j in free_of_target[target]}})
@@ -79,6 +78,22 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
                                                  _contacts(table)):
             solution["clearance"], solution["collisions"] = clearance, contacts
     return per_target
+
+
+def _branch_dicts(table: SolutionTable) -> list[dict]:
+    """Each row's branch labels as a dict (a label left out where its code is −1). Rows with the same codes share
+    one dict: an answer has a handful of distinct branches among thousands of rows, and the dicts are only
+    encoded."""
+    if not table.labels:
+        empty: dict = {}
+        return [empty] * len(table.target)
+    names = list(table.labels)
+    codes = np.stack([table.labels[name][1] for name in names], axis=1).astype(np.int64) + 1  # (S, L), 0 = none
+    keys = codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)
+    distinct, first, row_of = np.unique(keys, return_index=True, return_inverse=True)
+    shared = [{name: table.labels[name][0][code - 1] for name, code in zip(names, codes[row].tolist()) if code}
+              for row in first.tolist()]
+    return [shared[i] for i in row_of.reshape(-1).tolist()]
 
 
 def _rolls(table: SolutionTable, angle: float) -> list[float | None]:

@@ -88,8 +88,9 @@ def random_three_parallel_arm(case: str, convention: str, seed: int) -> Robot:
 
 
 def random_family_arm(family: str, convention: str, seed: int, wrist_singular: bool = False) -> Robot:
-    """A random arm of one of the scalar path's two families, ``"intersecting_shoulder+spherical_wrist"`` or
-    ``"three_parallel"`` (axes 2 ∥ 3 ∥ 4, axes 5 and 6 meeting), in standard DH restated in ``convention``, with
+    """A random arm of one of the scalar path's families, ``"intersecting_shoulder+spherical_wrist"``,
+    ``"offset_shoulder_parallel_elbow+spherical_wrist"`` (axes 2 ∥ 3, a spherical wrist) or ``"three_parallel"``
+    (axes 2 ∥ 3 ∥ 4, axes 5 and 6 meeting), in standard DH restated in ``convention``, with
     a random base and tool. ``wrist_singular`` (three-parallel family): the twists of axes 4–5 and 5–6 equal in
     size, so that axis 6 can lie along the parallel axes, as on the UR arms (the same random draws otherwise)."""
     rng = np.random.default_rng(seed)
@@ -100,6 +101,10 @@ def random_family_arm(family: str, convention: str, seed: int, wrist_singular: b
         a[0] = 0.0  # axes 1 and 2 meet
         a[3] = a[4] = d[4] = 0.0  # axes 4, 5 and 6 meet
         alpha[4] = abs(alpha[3]) * rng.choice([-1, 1])  # equal wrist twists, as in every real wrist
+    elif family == "offset_shoulder_parallel_elbow+spherical_wrist":
+        alpha[1] = rng.choice([0.0, np.pi])  # axes 2 ∥ 3, axis 1 offset from axis 2 by a[0] (the OPW arms)
+        a[3] = a[4] = d[4] = 0.0
+        alpha[4] = abs(alpha[3]) * rng.choice([-1, 1])
     else:
         alpha[1] = rng.choice([0.0, np.pi])  # axes 2 ∥ 3 ∥ 4 (π: a reversed axis)
         alpha[2] = rng.choice([0.0, np.pi])

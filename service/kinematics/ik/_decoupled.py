@@ -17,7 +17,7 @@ import numpy as np
 
 from .._tolerances import GEOMETRY_TOLERANCE
 from . import _scalar as scalar
-from ._positioning import IntersectingShoulder, Positioner
+from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
 from ._screws import apply, chain_rotation, invert, rotation_about
 from .subproblems import subproblem_1
 from ._types import Candidates, LabelCodes, SingularFlags, Sealed
@@ -177,48 +177,95 @@ class DecoupledPlan(Sealed):
             return None
 
     @cached_property
-    def _one_pose(self) -> "_ShoulderWristOnePose | None":
-        """The scalar solver when joints 1–3 are an intersecting shoulder with a revolute joint 3 and joints 4–6 a
-        spherical wrist (the PUMA type), else None."""
+    def _one_pose(self) -> "_SphericalWristOnePose | None":
+        """The scalar solver when joints 4–6 are a spherical wrist and joints 1–3 an intersecting shoulder with a
+        revolute joint 3 (the PUMA type) or an offset shoulder with joints 2 ∥ 3, all revolute (the OPW type:
+        KUKA, ABB, Fanuc), else None."""
         positioner = self.positioner
-        if (isinstance(positioner, IntersectingShoulder) and isinstance(self.wrist, SphericalWrist)
-                and not self.fixed and not positioner.free_joints and positioner.joints == (0, 1, 2)
-                and self.wrist.joints == (3, 4, 5) and bool(positioner.model.is_revolute[2])):
+        if not (positioner is not None and isinstance(self.wrist, SphericalWrist) and not self.fixed
+                and not positioner.free_joints
+                and positioner.joints == (0, 1, 2) and self.wrist.joints == (3, 4, 5)):
+            return None
+        if isinstance(positioner, IntersectingShoulder) and bool(positioner.model.is_revolute[2]):
             return _ShoulderWristOnePose(self)
+        if (isinstance(positioner, OffsetShoulderParallelElbow) and bool(positioner.model.is_revolute[:3].all())
+                and positioner.forward is not None):
+            return _OffsetShoulderWristOnePose(self)
         return None
 
 
-class _ShoulderWristOnePose:
-    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` (revolute joint 3) and a spherical wrist, step
-    for step, with the plan's constants as floats (built once per plan)."""
+class _SphericalWristOnePose:
+    """What the scalar one-pose paths of :class:`DecoupledPlan` share: the spherical wrist (joints 4–6), step for
+    step, with the plan's constants as floats (built once per plan), and the labels' names."""
 
     names = ("shoulder", "elbow", "wrist")
     values = (("left", "right"), ("up", "down"), ("no_flip", "flip"))
 
     def __init__(self, plan: DecoupledPlan) -> None:
-        positioner, wrist, model = plan.positioner, plan.wrist, plan.positioner.model
-        d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
-        p2 = scalar.vector_of(model.points[2])
-        c, w = scalar.vector_of(positioner.centre), scalar.vector_of(plan.point)
-        self.centre = c
+        wrist = plan.wrist
         home_inverse = plan.home_inverse
         a, b, axis_c = (scalar.vector_of(axis) for axis in wrist.axes)
         # the wrist point, and the wrist's last axis and its normal, at home: home⁻¹ applied once here
         self.point_home = scalar.vector_of(home_inverse[:3, :3] @ plan.point + home_inverse[:3, 3])
         self.axis_c_home = scalar.vector_of(home_inverse[:3, :3] @ wrist.axes[2])
         self.normal_home = scalar.vector_of(home_inverse[:3, :3] @ wrist.normal)
+        # subproblem 2 about the wrist's first two axes, 1 about its last (the normal)
+        self.wrist, self.wrist_axes = scalar.TwoTurns(a, b, wrist.free_below), (a, b)
+        self.wrist_start = self.wrist.start(axis_c)
+        self.last_turn = scalar.Turn(axis_c)
+        self.last_normal = self.last_turn.coordinates(scalar.vector_of(wrist.normal))
+        self.dof = plan.dof
+
+    def _target(self, T: np.ndarray) -> tuple[scalar.Vector, scalar.Vector, scalar.Vector]:
+        """The wrist point (T · home⁻¹ · point), and the wrist's last axis and normal as the target (4, 4) turns
+        them."""
+        top = T[:3].tolist()
+        R_T = (top[0][:3], top[1][:3], top[2][:3])
+        point_world = scalar.add(scalar.mv(R_T, self.point_home), (top[0][3], top[1][3], top[2][3]))
+        return point_world, scalar.mv(R_T, self.axis_c_home), scalar.mv(R_T, self.normal_home)
+
+    def _wrist_rows(self, R_G: scalar.Matrix, axis_c: scalar.Vector, normal: scalar.Vector, arm: list[float],
+                    arm_codes: tuple[int | None, int | None], rows: list, codes: list) -> None:
+        """The wrist's two slots for one arm branch (joints ``arm``, turning the wrist by R_G): what is left to
+        the wrist, R_Gᵀ · R_target, applied to its last axis and normal."""
+        wanted = scalar.mtv(R_G, normal)
+        a, b = self.wrist_axes
+        for roots in self.wrist.angles(self.wrist_start, self.wrist.goal(scalar.mtv(R_G, axis_c))):
+            if roots is None:
+                rows.append(None)
+                codes.append((None, None, None))
+                continue
+            qa, qb = roots
+            unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
+            qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))
+            rows.append([*arm, qa, qb, qc])
+            codes.append((*arm_codes, scalar.wrist_code(qb)))
+
+    @staticmethod
+    def _empty(rows: list, codes: list, count: int) -> None:
+        """``count`` empty slots: an arm branch that does not exist, and its wrist's."""
+        rows += [None] * count
+        codes += [(None, None, None)] * count
+
+
+class _ShoulderWristOnePose(_SphericalWristOnePose):
+    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` (revolute joint 3) and a spherical wrist."""
+
+    def __init__(self, plan: DecoupledPlan) -> None:
+        super().__init__(plan)
+        positioner, model = plan.positioner, plan.positioner.model
+        d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
+        p2 = scalar.vector_of(model.points[2])
+        c, w = scalar.vector_of(positioner.centre), scalar.vector_of(plan.point)
+        self.centre = c
         # subproblem 3 about axis 3 (the wrist point's distance from the centre), 2 about axes 1 and 2 (where the
-        # arm turns it), 2 about the wrist's first two axes and 1 about its last (the normal)
+        # arm turns it)
         self.elbow_turn = scalar.Turn(d[2])
         self.point_from_3 = scalar.sub(w, p2)
         self.elbow_coordinates = (self.elbow_turn.coordinates(self.point_from_3),
                                   self.elbow_turn.coordinates(scalar.sub(c, p2)))
         self.centre_to_3 = scalar.sub(p2, c)
         self.shoulder = scalar.TwoTurns(d[0], d[1])
-        self.wrist, self.wrist_axes = scalar.TwoTurns(a, b, wrist.free_below), (a, b)
-        self.wrist_start = self.wrist.start(axis_c)
-        self.last_turn = scalar.Turn(axis_c)
-        self.last_normal = self.last_turn.coordinates(scalar.vector_of(wrist.normal))
         # the labels' constants
         forward, self.in_plane, up = positioner.label_constants
         self.forward, self.up = scalar.vector_of(forward), scalar.vector_of(up)
@@ -228,16 +275,11 @@ class _ShoulderWristOnePose:
         elbow = scalar.sub(p2, c)
         self.elbow = scalar.reject(elbow, d[1]) if self.in_plane else elbow
         self.elbow_length = scalar.norm(self.elbow)
-        self.dof = plan.dof
 
     def solve(self, T: np.ndarray) -> scalar.OnePose:
         """The eight slots for a target (4, 4), or NotGeneric."""
-        top = T[:3].tolist()
-        R_T = (top[0][:3], top[1][:3], top[2][:3])
-        # the wrist point (T · home⁻¹ · point), and the wrist's last axis and normal as the target turns them
-        point_world = scalar.add(scalar.mv(R_T, self.point_home), (top[0][3], top[1][3], top[2][3]))
-        axis_c, normal = scalar.mv(R_T, self.axis_c_home), scalar.mv(R_T, self.normal_home)
-        d, c, shoulder, wrist = self.directions, self.centre, self.shoulder, self.wrist
+        point_world, axis_c, normal = self._target(T)
+        d, c, shoulder = self.directions, self.centre, self.shoulder
         target = scalar.sub(point_world, c)
         goal = shoulder.goal(target)
         rows, codes = [], []
@@ -248,26 +290,12 @@ class _ShoulderWristOnePose:
             elbow_side = self._elbow_side(reach_local)
             for pair in shoulder.angles(shoulder.start(reach_local), goal):
                 if pair is None:  # no arm branch here: its wrist slots are empty too
-                    rows += [None, None]
-                    codes += [(None, None, None)] * 2
+                    self._empty(rows, codes, 2)
                     continue
                 q1, q2 = pair
                 R_1, R_2 = scalar.rotation(d[0], q1), scalar.rotation(d[1], q2)
-                R_G = scalar.mm(scalar.mm(R_1, R_2), R_3)
-                shoulder_code, elbow_code = self._arm_codes(R_2, reach_local, elbow_side)
-                # what is left to the wrist, R_Gᵀ · R_target, applied to its last axis and normal
-                wanted = scalar.mtv(R_G, normal)
-                a, b = self.wrist_axes
-                for roots in wrist.angles(self.wrist_start, wrist.goal(scalar.mtv(R_G, axis_c))):
-                    if roots is None:
-                        rows.append(None)
-                        codes.append((None, None, None))
-                        continue
-                    qa, qb = roots
-                    unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
-                    qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))
-                    rows.append([q1, q2, q3, qa, qb, qc])
-                    codes.append((shoulder_code, elbow_code, scalar.wrist_code(qb)))
+                self._wrist_rows(scalar.mm(scalar.mm(R_1, R_2), R_3), axis_c, normal, [q1, q2, q3],
+                                 self._arm_codes(R_2, reach_local, elbow_side), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
     def _elbow_side(self, reach_local: scalar.Vector) -> scalar.Vector:
@@ -288,4 +316,78 @@ class _ShoulderWristOnePose:
             return None, None  # the point near axis 1: the array labeller decides
         return (scalar.side_code(scalar.dot(reach, self.forward), length),
                 scalar.side_code(scalar.dot(scalar.mv(R_2, elbow_side), self.up), self.elbow_length))
+
+
+class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
+    """:class:`DecoupledPlan` with an :class:`OffsetShoulderParallelElbow` (joints 1–3 revolute, 2 ∥ 3: the OPW
+    arms) and a spherical wrist: subproblem 4 for joint 1 (front and back), 3 for joint 3 (elbow up and down), 1
+    for joint 2, in the positioner's slot order, and its labels, all in the frame of the arm before joint 1 turns
+    it (joint 1 leaves its axis, and the up direction along it, where they are)."""
+
+    def __init__(self, plan: DecoupledPlan) -> None:
+        super().__init__(plan)
+        positioner, model = plan.positioner, plan.positioner.model
+        d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
+        o, p2, p3 = (scalar.vector_of(model.points[j]) for j in range(3))
+        u, w = d[1], scalar.vector_of(plan.point)
+        self.origin, self.point_2, self.point_3 = o, p2, p3
+        # u · R(axis 1, −q1)(x − o) = u · (w − o): subproblem 4 for θ = −q1
+        self.front_back, self.height = scalar.Height(u, d[0]), scalar.dot(u, scalar.sub(w, o))
+        # in the plane normal to u: subproblem 3 about axis 3 for the distance from axis 2, then 1 about axis 2
+        in_plane = lambda v: scalar.reject(v, u)  # noqa: E731
+        self.elbow_turn, self.second_turn = scalar.Turn(d[2]), scalar.Turn(u)
+        self.elbow_coordinates = (self.elbow_turn.coordinates(in_plane(scalar.sub(w, p3))),
+                                  self.elbow_turn.coordinates(in_plane(scalar.sub(p2, p3))))
+        self.point_from_3 = scalar.sub(w, p3)
+        # the labels' constants: the forward direction (along the shoulder offset), the shoulder (axis 2's foot of
+        # the common normal) and the up direction along axis 1
+        self.forward, self.shoulder = scalar.vector_of(positioner.forward), scalar.vector_of(positioner.shoulder)
+        self.up = scalar.vector_of(positioner.geometry.upward(model.directions[0]))
+        self.elbow_from_2 = scalar.sub(p3, p2)
+
+    def solve(self, T: np.ndarray) -> scalar.OnePose:
+        """The eight slots for a target (4, 4), or NotGeneric."""
+        point_world, axis_c, normal = self._target(T)
+        d, o, p2, p3 = self.directions, self.origin, self.point_2, self.point_3
+        from_origin = scalar.sub(point_world, o)
+        thetas = scalar.Height.angles(self.front_back.of(from_origin), self.height)
+        if math.isnan(thetas[1]):  # clearly out of reach: the array path words why
+            raise scalar.NotGeneric
+        rows, codes = [], []
+        for theta in thetas:
+            q1 = scalar.wrap(-theta)
+            # the target with joint 1 undone, and what the labels measure there
+            y_from_origin = scalar.rotate(d[0], theta, from_origin)
+            y_from_2 = scalar.sub(scalar.add(o, y_from_origin), p2)
+            reach = scalar.norm(scalar.reject(y_from_2, d[1]))
+            shoulder_code = scalar.side_code(scalar.dot(y_from_origin, self.forward), scalar.norm(from_origin))
+            target_2 = self.second_turn.coordinates(y_from_2)
+            elbows = self.elbow_turn.angles_at_distance(*self.elbow_coordinates, reach, out_of_reach=True)
+            if math.isnan(elbows[1]):  # this side clearly out of reach: the least-squares root is no solution
+                self._empty(rows, codes, 4)
+                continue
+            for q3 in elbows:
+                point_3 = scalar.add(scalar.sub(p3, p2), scalar.rotate(d[2], q3, self.point_from_3))
+                q2 = self.second_turn.angle(self.second_turn.coordinates(point_3), target_2)
+                R_2 = scalar.rotation(d[1], q2)
+                elbow_code = self._elbow_code(R_2, y_from_origin)
+                R_G = scalar.mm(scalar.mm(scalar.rotation(d[0], q1), R_2), scalar.rotation(d[2], q3))
+                self._wrist_rows(R_G, axis_c, normal, [q1, q2, q3], (shoulder_code, elbow_code), rows, codes)
+        if not any(rows):  # out of reach on both sides: the array path words why
+            raise scalar.NotGeneric
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
+
+    def _elbow_code(self, R_2: scalar.Matrix, y_from_origin: scalar.Vector) -> int | None:
+        """:meth:`OffsetShoulderParallelElbow.label_codes`' elbow before joint 1 turns the arm: the side of the
+        shoulder–point line the elbow (axis 3) lies on, in the arm's plane, along the up direction."""
+        u = self.directions[1]
+        elbow = scalar.reject(scalar.add(scalar.sub(self.point_2, self.shoulder), scalar.mv(R_2, self.elbow_from_2)),
+                              u)
+        line = scalar.reject(scalar.sub(scalar.add(self.origin, y_from_origin), self.shoulder), u)
+        length = scalar.norm(line)
+        if length <= 1e-300:
+            return None
+        line = (line[0] / length, line[1] / length, line[2] / length)
+        rejection = scalar.reject(elbow, line)
+        return scalar.side_code(scalar.dot(rejection, self.up), scalar.norm(elbow))
 

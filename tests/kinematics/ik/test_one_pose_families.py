@@ -15,7 +15,7 @@ from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from tests.arms import random_family_arm
 
-FAMILIES = ("intersecting_shoulder+spherical_wrist", "three_parallel")
+FAMILIES = ("intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist", "three_parallel")
 CONVENTIONS = ("standard", "modified", "khalil")
 
 

@@ -334,10 +334,9 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
         # u · R(axis 1, −q1)(x − o) = u · (w − o): subproblem 4 for θ = −q1
         self.front_back, self.height = scalar.Height(u, d[0]), scalar.dot(u, scalar.sub(w, o))
         # in the plane normal to u: subproblem 3 about axis 3 for the distance from axis 2, then 1 about axis 2
-        in_plane = lambda v: scalar.reject(v, u)  # noqa: E731
         self.elbow_turn, self.second_turn = scalar.Turn(d[2]), scalar.Turn(u)
-        self.elbow_coordinates = (self.elbow_turn.coordinates(in_plane(scalar.sub(w, p3))),
-                                  self.elbow_turn.coordinates(in_plane(scalar.sub(p2, p3))))
+        self.elbow_coordinates = (self.elbow_turn.coordinates(scalar.reject(scalar.sub(w, p3), u)),
+                                  self.elbow_turn.coordinates(scalar.reject(scalar.sub(p2, p3), u)))
         self.point_from_3 = scalar.sub(w, p3)
         # the labels' constants: the forward direction (along the shoulder offset), the shoulder (axis 2's foot of
         # the common normal) and the up direction along axis 1

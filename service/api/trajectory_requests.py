@@ -67,17 +67,18 @@ def trajectory_in_core(request: Request, ref: RobotRef, body: TrajectoryRequest)
         with located("body", "reference"):
             reference = joints_to_core(robot, body.reference, unit)
     free_joints = free_joints_to_core(robot, body.free_joints, unit)
+    world_T_targets = np.array(matrices)
     collisions = collisions_to_core(robot, body.collisions, unit)
     if collisions is not None:  # the distances of every sample's solutions, counted as single IK counts them
         with located("body"):
-            cost = estimate(robot, IKTargets.poses(np.array(matrices), constrain_orientation=constrained[0]),
+            cost = estimate(robot, IKTargets.poses(world_T_targets, constrain_orientation=constrained[0]),
                             AnswerOptions(reference=reference, free_joints=free_joints, collisions=collisions))
         check_collision_cost(settings_of(request), cost)
     options = TrajectoryOptions(
         branch=None if body.branch is None else body.branch.model_dump(), reference=reference,
         singularity_tolerance=body.singularity_tolerance, damping=body.damping, ik=IKOptions(budget=budget),
         free_joints=free_joints, collisions=collisions)
-    return AskedTrajectory(ref, [s.time for s in body.samples], np.array(matrices), constrained[0],
+    return AskedTrajectory(ref, [s.time for s in body.samples], world_T_targets, constrained[0],
                            np.array([_cartesian(s.twist, angle) for s in body.samples]),
                            np.array([_cartesian(s.acceleration, angle) for s in body.samples]), options, budget)
 

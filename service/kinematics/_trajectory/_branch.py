@@ -23,7 +23,7 @@ from ._continuation import (
     _Reached,
 )
 from ..collision import CollisionRequest
-from ._collisions import collision_free_pool, forced_by_collision
+from ._collisions import collision_free_pool, forced_by_collision, listed_collisions
 from ._records import SampleResult
 
 #: The branch labels that a singularity of each kind makes ambiguous (their two values meet there). With the
@@ -95,6 +95,7 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
     history: list[_Reached] = []  # the continuous stretch of reached samples that the next one continues
     to_polish: list[tuple[int, int, list[np.ndarray], np.ndarray]] = []
     listed_rates = _listed_rates(robot, results, tracking)
+    listed_hits = listed_collisions(robot, collisions, results)
     previous_branch: dict | None = None
     samples: list[SampleResult] = []
     for k, result in enumerate(results):
@@ -104,11 +105,12 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
         predicted, scale = (reference, None) if previous is None else _prediction(history, float(times[k]),
                                                                                   weights)
         rates_of = None if listed_rates is None else listed_rates[k]
+        known_hits = None if listed_hits is None else listed_hits[k]
         if previous is not None and _has_free_joint(result):
             # the joint the pose leaves free keeps the previous sample's value
             result = solve_ik(robot, targets[k], constrain_orientation=constrain_orientation, reference=previous.q,
                               options=ik_options)
-            rates_of = None
+            rates_of = known_hits = None
         joints = np.array([s.joints for s in result.solutions], dtype=float).reshape(-1, robot.dof)
         branches = [dict(s.branch) for s in result.solutions]
         ambiguous = ambiguous_labels(result.singularities)
@@ -131,7 +133,7 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
             continue
         matching = _matching(branches, held, ambiguous)
         allowed = matching or list(range(len(joints)))
-        collision = collision_free_pool(robot, collisions, joints, allowed)
+        collision = collision_free_pool(robot, collisions, joints, allowed, known_hits)
         pool = collision.pool
         forced = previous is not None and forced_by_collision(collision, allowed, to_prediction)
         distances = None

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..collision import CollisionRequest, clearances
+from ..collision import CollisionRequest, clearances, colliding
 
 
 @dataclass(frozen=True)
@@ -29,16 +29,30 @@ class CollisionChoice:
     colliding: np.ndarray | None
 
 
-def collision_free_pool(robot, request: CollisionRequest | None, joints: np.ndarray,
-                        allowed: list[int]) -> CollisionChoice:
+def listed_collisions(robot, request: CollisionRequest | None, results) -> list[np.ndarray] | None:
+    """Which of each sample's listed IK solutions collide, (m_k,) bool per sample, in one check of them all; None
+    without a filtering ``request``."""
+    if request is None or not request.filter:
+        return None
+    listed = [np.array([s.joints for s in result.solutions], dtype=float).reshape(-1, robot.dof)
+              for result in results]
+    hits = colliding(robot, request, np.concatenate(listed))
+    return np.split(hits, np.cumsum([len(joints) for joints in listed])[:-1])
+
+
+def collision_free_pool(robot, request: CollisionRequest | None, joints: np.ndarray, allowed: list[int],
+                        known: np.ndarray | None = None) -> CollisionChoice:
     """The candidates (m, n) of one sample that the path may continue on: of ``allowed`` (the held labels'
     choice), those that do not collide under a filtering ``request``; all of ``allowed`` without one, or when
-    each of them collides."""
+    each of them collides. ``known``: whether the first candidates collide, already checked
+    (:func:`listed_collisions`); only the others are checked here."""
     if request is None or not request.filter or not allowed:
         return CollisionChoice(allowed, False, None)
-    colliding = clearances(robot, request, joints).colliding
-    free = [i for i in allowed if not colliding[i]]
-    return CollisionChoice(free or allowed, not free, colliding)
+    known = np.zeros(0, dtype=bool) if known is None else known
+    rest = joints[len(known):]
+    hits = np.concatenate([known, colliding(robot, request, rest) if len(rest) else np.zeros(0, dtype=bool)])
+    free = [i for i in allowed if not hits[i]]
+    return CollisionChoice(free or allowed, not free, hits)
 
 
 def forced_by_collision(choice: CollisionChoice, allowed: list[int], to_prediction: np.ndarray | None) -> bool:

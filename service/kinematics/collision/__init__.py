@@ -16,7 +16,7 @@ from ._distances import (
     separation,
     sphere_sphere,
 )
-from ._clearance import Clearances, CollisionRequest, at_collisions, clearances, frame_index, link_names, model_for
+from ._clearance import Clearances, CollisionRequest, at_collisions, clearances, colliding, frame_index, link_names, model_for
 from ._model import CollisionCheck, CollisionModel, ShapePair, collision_model
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere, restated, scaled
 
@@ -40,6 +40,7 @@ __all__ = [
     "capsule_capsule",
     "capsule_sphere",
     "clearances",
+    "colliding",
     "collision_model",
     "frame_index",
     "link_names",

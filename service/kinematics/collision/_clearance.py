@@ -17,7 +17,7 @@ import numpy as np
 from .._cache import bounded_memo, memo
 from .._errors import InvalidInputError
 from .._forward import link_frames
-from ._model import CollisionModel, collision_model
+from ._model import CollisionCheck, CollisionModel, collision_model
 from ._shapes import Box, Capsule, Obstacle, Sphere
 
 #: Compiled models kept per robot (one per distinct set of obstacles and rules a request names).
@@ -165,14 +165,25 @@ def _as_objects(items: list) -> np.ndarray:
     return array
 
 
-def clearances(robot, request: CollisionRequest, joints: np.ndarray) -> Clearances:
-    """The collision check of joint vectors (S, n) under ``request`` (see :class:`Clearances`)."""
+def _checked(robot, request: CollisionRequest, joints: np.ndarray) -> tuple[CollisionModel, CollisionCheck]:
+    """The compiled model and its check of joint vectors (S, n)."""
     model = model_for(robot, request)
     joints = np.asarray(joints, dtype=float).reshape(-1, robot.dof)
-    check = model.check(link_frames(robot, joints), request.margin)
-    contacts = np.empty(len(joints), dtype=object)
-    contacts[:] = [_NO_CONTACTS] * len(joints)
-    colliding = np.flatnonzero(check.colliding)
-    if len(colliding):
-        contacts[colliding] = _as_objects(check.close_pairs_of(model, colliding.tolist()))
+    return model, model.check(link_frames(robot, joints), request.margin)
+
+
+def colliding(robot, request: CollisionRequest, joints: np.ndarray) -> np.ndarray:
+    """Which joint vectors (S, n) have a pair closer than the margin, (S,) bool, without wording the pairs."""
+    return _checked(robot, request, joints)[1].colliding
+
+
+def clearances(robot, request: CollisionRequest, joints: np.ndarray) -> Clearances:
+    """The collision check of joint vectors (S, n) under ``request`` (see :class:`Clearances`)."""
+    model, check = _checked(robot, request, joints)
+    count = len(check.clearance)
+    contacts = np.empty(count, dtype=object)
+    contacts[:] = [_NO_CONTACTS] * count
+    rows = np.flatnonzero(check.colliding)
+    if len(rows):
+        contacts[rows] = _as_objects(check.close_pairs_of(model, rows.tolist()))
     return Clearances(check.clearance, check.colliding, contacts)

@@ -208,8 +208,8 @@ class IKAnswer:
     timings: list[SolveTiming]
     detail_of: Callable[[int, Mapping[str, str]], str | None] = field(default=lambda row, wording: None,
                                                                       repr=False, compare=False)
-    every_detail: Callable[[Mapping[str, str]], list[str | None]] | None = field(default=None, repr=False,
-                                                                                  compare=False)
+    every_detail: Callable[[Mapping[str, str]], list[str | None]] = field(default=lambda wording: [], repr=False,
+                                                                           compare=False)
 
     def __len__(self) -> int:
         return len(self.status)
@@ -221,8 +221,6 @@ class IKAnswer:
 
     def detail_list(self, wording: Mapping[str, str] = NOTE_WORDING) -> list[str | None]:
         """:meth:`details`, every one made at once (what an encoder of the whole batch wants)."""
-        if self.every_detail is None:
-            return list(self.details(wording))
         return self.every_detail(wording)
 
     def target(self, index: int) -> TargetAnswer:

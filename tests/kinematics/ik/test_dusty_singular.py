@@ -140,7 +140,8 @@ PUMA_CAD_BROKEN = pytest.mark.xfail(strict=True, reason=(
     "representative lies 4e-6 from the generating configuration with no singularity reported"))
 
 
-@pytest.mark.parametrize("dust", [pytest.param(1e-6, marks=PUMA_CAD_BROKEN), pytest.param(1e-5, marks=PUMA_CAD_BROKEN)])
+@PUMA_CAD_BROKEN  # at both dust levels
+@pytest.mark.parametrize("dust", [1e-6, 1e-5])
 def test_puma_like_wrist_with_cad_rounding(dust):
     rng = np.random.default_rng(int(dust * 1e7) + 1)
     robot = _puma_like(rng, dust)

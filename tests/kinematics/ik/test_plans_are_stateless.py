@@ -14,20 +14,14 @@ import threading
 import numpy as np
 import pytest
 
-from service.config import BUILTIN_ROBOTS_DIR
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, cached_plan
-from service.robots.catalogue import load_catalogue
+from tests.conftest import catalogue_robot
 from tests.ik_helpers import random_configurations
 
 ARMS = ["puma560_standard", "ur5", "kuka_kr6_r900_2", "ufactory_xarm6"]
 THREADS = 8
 ROUNDS = 6
-
-
-@pytest.fixture(scope="module")
-def catalogue():
-    return load_catalogue([BUILTIN_ROBOTS_DIR], max_joints=64)
 
 
 def _fingerprint(answer) -> tuple:
@@ -43,8 +37,8 @@ def _fingerprint(answer) -> tuple:
 
 @pytest.mark.parametrize("robot_id", ARMS)
 @pytest.mark.parametrize("batch", [1, 16], ids=["single", "batch"])
-def test_one_cached_plan_answers_eight_threads_as_it_answers_each_alone(catalogue, robot_id, batch):
-    robot = catalogue.get(robot_id).robot
+def test_one_cached_plan_answers_eight_threads_as_it_answers_each_alone(client, robot_id, batch):
+    robot = catalogue_robot(client, robot_id)
     assert cached_plan(robot, constrain_orientation=True, reference=None) is not None  # built, kept, shared
     options = AnswerOptions()
     work = []  # per thread: ROUNDS target sets of ``batch`` poses each, different in every thread and round
@@ -73,10 +67,10 @@ def test_one_cached_plan_answers_eight_threads_as_it_answers_each_alone(catalogu
 
 
 @pytest.mark.parametrize("robot_id", ARMS)
-def test_a_kept_plan_and_its_parts_refuse_new_state(catalogue, robot_id):
+def test_a_kept_plan_and_its_parts_refuse_new_state(client, robot_id):
     """The kept plan is sealed with the parts it holds: a call that tried to keep something on it would raise
     instead of leaking into the next call."""
-    plan = cached_plan(catalogue.get(robot_id).robot, constrain_orientation=True, reference=None)
+    plan = cached_plan(catalogue_robot(client, robot_id), constrain_orientation=True, reference=None)
     parts = [plan, *(value for value in vars(plan).values() if hasattr(value, "seal"))]
     for part in parts:
         with pytest.raises(AttributeError, match="shared once built"):

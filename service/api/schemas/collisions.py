@@ -77,3 +77,12 @@ CLEARANCE_FIELD = Field(None, description="with 'collisions' in the request: the
                                           "the checked pairs, length unit (negative in overlap); null without")
 COLLISIONS_FIELD = Field(None, description="with 'collisions' in the request: each pair closer than the margin; "
                                            "null without")
+
+
+def without_unchecked(fields: dict, names: tuple[str, ...] = ("clearance", "collisions")) -> dict:
+    """An answer's serialised ``fields`` without the collision fields ``names`` when none of them has a value:
+    they appear only when the request asked for a collision check."""
+    if all(fields.get(name) is None for name in names):
+        for name in names:
+            fields.pop(name, None)
+    return fields

@@ -8,7 +8,7 @@ from typing import Annotated, Literal
 from pydantic import Discriminator, Field, Tag, model_serializer, model_validator
 
 from ...kinematics.ik import MAX_EQUIVALENTS, MAX_FREE_VALUES
-from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair
+from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair, without_unchecked
 from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames,
                      RobotId)
 from .limits import JointLimitsOverride, LimitViolation
@@ -261,14 +261,7 @@ class IKSolution(ApiModel):
     @model_serializer(mode="wrap")
     def _checked_only(self, handler):
         """clearance and collisions appear only when the request asked for a collision check."""
-        return _without_unchecked(handler(self))
-
-
-def _without_unchecked(fields: dict) -> dict:
-    if fields.get("collisions") is None and fields.get("clearance") is None:
-        fields.pop("clearance", None)
-        fields.pop("collisions", None)
-    return fields
+        return without_unchecked(handler(self))
 
 
 class SolverInfo(ApiModel):
@@ -377,7 +370,7 @@ class SolutionColumns(ApiModel):
     @model_serializer(mode="wrap")
     def _checked_only(self, handler):
         """clearance and collisions appear only when the request asked for a collision check."""
-        return _without_unchecked(handler(self))
+        return without_unchecked(handler(self))
 
 
 class IKBatchArraysResponse(ApiModel):

@@ -9,7 +9,7 @@ from pydantic import Field, model_serializer, model_validator
 from ...kinematics import RATE_SINGULARITY_TOLERANCE
 from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId,
                      Vector3)
-from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair
+from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair, without_unchecked
 from .ik import Branch, FreeJointChoice, SingularityReport
 from .limits import LimitViolation
 from .poses import PoseTarget
@@ -117,14 +117,6 @@ COLLISION_SAMPLE_FIELDS = ("clearance", "collisions", "collision_forced")
 COLLISION_SUMMARY_FIELDS = ("colliding_samples", "collision_branch_changes", "smallest_clearance")
 
 
-def _without_absent(fields: dict, names: tuple[str, ...]) -> dict:
-    """``fields`` without ``names`` when none of them has a value (the request asked for no collision check)."""
-    if all(fields.get(name) is None for name in names):
-        for name in names:
-            fields.pop(name, None)
-    return fields
-
-
 class TrajectorySampleResult(ApiModel):
     """The joint solution at one sample, on the branch being followed."""
 
@@ -166,7 +158,7 @@ class TrajectorySampleResult(ApiModel):
     @model_serializer(mode="wrap")
     def _checked_only(self, handler):
         """The collision fields appear only when the request asked for a collision check."""
-        return _without_absent(handler(self), COLLISION_SAMPLE_FIELDS)
+        return without_unchecked(handler(self), COLLISION_SAMPLE_FIELDS)
 
 
 class JointStep(ApiModel):
@@ -221,7 +213,7 @@ class TrajectorySummary(ApiModel):
     @model_serializer(mode="wrap")
     def _checked_only(self, handler):
         """The collision fields appear only when the request asked for a collision check."""
-        return _without_absent(handler(self), COLLISION_SUMMARY_FIELDS)
+        return without_unchecked(handler(self), COLLISION_SUMMARY_FIELDS)
 
 
 class TrajectorySolver(ApiModel):

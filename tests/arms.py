@@ -295,3 +295,17 @@ def _rot(axis: str, angle: float) -> np.ndarray:
     return {"x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
             "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
             "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
+
+
+def screw_exponential(direction, point, revolute, q):
+    """exp([S] q) for a unit screw, written independently of the core (Rodrigues)."""
+    T = np.eye(4)
+    if revolute:
+        k = np.array([[0, -direction[2], direction[1]], [direction[2], 0, -direction[0]],
+                      [-direction[1], direction[0], 0]])
+        R = np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * k @ k
+        T[:3, :3] = R
+        T[:3, 3] = (np.eye(3) - R) @ point
+    else:
+        T[:3, 3] = direction * q
+    return T

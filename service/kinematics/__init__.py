@@ -13,6 +13,7 @@ from ._forward import (
     forward_kinematics,
     geometric_jacobian,
     joint_screws,
+    link_frame_columns,
     link_frames,
     screw_model,
 )
@@ -83,6 +84,7 @@ __all__ = [
     "jacobian_derivative",
     "joint_rates",
     "joint_screws",
+    "link_frame_columns",
     "link_frames",
     "link_transforms",
     "nearest_fitting_equivalent",

@@ -15,6 +15,7 @@ from service.kinematics import (
     link_transforms,
     screw_model,
 )
+from tests.arms import screw_exponential
 
 
 def _rot(axis: str, angle: float) -> np.ndarray:
@@ -120,20 +121,6 @@ def test_every_link_frame_is_the_product_of_the_elementary_motions_before_it(con
             np.testing.assert_allclose(frames[index][i + 1], expected, atol=1e-13)
 
 
-def _exp_twist(direction, point, revolute, q):
-    """exp([S] q) for a unit screw, written independently of the core (Rodrigues)."""
-    T = np.eye(4)
-    if revolute:
-        k = np.array([[0, -direction[2], direction[1]], [direction[2], 0, -direction[0]],
-                      [-direction[1], direction[0], 0]])
-        R = np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * k @ k
-        T[:3, :3] = R
-        T[:3, 3] = (np.eye(3) - R) @ point
-    else:
-        T[:3, 3] = direction * q
-    return T
-
-
 @pytest.mark.parametrize("convention,kinds", [("standard", "RRPRRR"), ("modified", "PRRRPR"), ("khalil", "RRRRRR")])
 def test_product_of_exponentials_reproduces_dh_forward_kinematics(convention, kinds):
     rng = np.random.default_rng(3)
@@ -145,7 +132,7 @@ def test_product_of_exponentials_reproduces_dh_forward_kinematics(convention, ki
     for q in rng.uniform(-np.pi, np.pi, (30, robot.dof)):
         T = np.eye(4)
         for direction, point, revolute, value in zip(model.directions, model.points, model.is_revolute, q):
-            T = T @ _exp_twist(direction, point, revolute, value)
+            T = T @ screw_exponential(direction, point, revolute, value)
         np.testing.assert_allclose(T @ model.home, forward_kinematics(robot, q), atol=1e-12)
 
 

@@ -16,6 +16,7 @@ from service.kinematics import (
     link_frames,
     screw_model,
 )
+from tests.arms import screw_exponential
 
 
 def _random_dh_arm(rng, convention: str) -> Robot:
@@ -91,3 +92,28 @@ def test_bad_screws_are_refused_with_their_location(axis, point, match, where):
     with pytest.raises(InvalidInputError) as error:
         Robot.from_screws(joints[:1], np.diag([1.0, 2.0, 1.0, 1.0]))
     assert error.value.location[:1] == ("home",)
+
+
+def test_every_link_frame_of_a_screw_robot_moves_by_the_exponentials_before_it():
+    """Link frame i of a screws robot at q is world_T_base · exp([S_1] q_1) ⋯ exp([S_i] q_i) · (frame i at q = 0)
+    (the product of exponentials written out here, Rodrigues' formula), and at q = 0 frame i carries the axis of
+    joint i + 1 as its z axis through its point; the last frame is the flange."""
+    rng = np.random.default_rng(11)
+    for _ in range(10):
+        screws = _as_screws(_random_dh_arm(rng, "standard"))
+        model = screw_model(screws.with_frames(np.eye(4), np.eye(4)))
+        at_zero = link_frames(screws.with_frames(np.eye(4), np.eye(4)), np.zeros(screws.dof))
+        for i in range(screws.dof - 1):
+            np.testing.assert_allclose(at_zero[i + 1][:3, 2], model.directions[i + 1], atol=1e-13)
+            np.testing.assert_allclose(np.cross(at_zero[i + 1][:3, 3] - model.points[i + 1], model.directions[i + 1]),
+                                       0.0, atol=1e-13)
+        np.testing.assert_allclose(at_zero[-1], model.home, atol=1e-13)
+        q = rng.uniform(-3, 3, (4, screws.dof))
+        frames = link_frames(screws, q)
+        for row, values in enumerate(q):
+            moved = screws.world_T_base.copy()
+            np.testing.assert_allclose(frames[row][0], moved, atol=1e-15)
+            for i in range(screws.dof):
+                moved = moved @ screw_exponential(model.directions[i], model.points[i], model.is_revolute[i], values[i])
+                np.testing.assert_allclose(frames[row][i + 1], moved @ at_zero[i + 1], atol=1e-12)
+

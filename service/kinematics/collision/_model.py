@@ -76,6 +76,12 @@ class _Group(NamedTuple):
     radius_a: np.ndarray  # (P_k, 1): a round shape's radius (0 for a box)
     radius_b: np.ndarray
     swapped: np.ndarray  # (P_k,) bool
+    levels: np.ndarray  # (P_k,) ascending: the deepest link frame the pair reads (it moves with joints 1 … level)
+
+    def part(self, low: int, high: int) -> tuple:
+        """The kernel's inputs for the group's pairs [low, high): the rows (m, P) and the four sizes."""
+        return (self.rows[low:high].T, self.half_size_a[:, low:high], self.half_size_b[:, low:high],
+                self.radius_a[low:high], self.radius_b[low:high])
 
 
 class CollisionCheck(NamedTuple):
@@ -107,21 +113,19 @@ class CollisionCheck(NamedTuple):
         """:meth:`close_pairs` of several configurations, each as a tuple (one pass over plain lists: a batch
         may have tens of thousands of colliding configurations)."""
         names = model.body_pairs
-        pairs, distances, offsets = self.body_pairs.tolist(), self.distances.tolist(), self.offsets.tolist()
-        return [tuple((names[pair][0], names[pair][1], distance)
-                      for pair, distance in zip(pairs[offsets[row]:offsets[row + 1]],
-                                                distances[offsets[row]:offsets[row + 1]]))
-                for row in configurations]
+        offsets = self.offsets.tolist()
+        entries = [(*names[pair], distance) for pair, distance in zip(self.body_pairs.tolist(), self.distances.tolist())]
+        return [tuple(entries[offsets[row]:offsets[row + 1]]) for row in configurations]
 
 
 class _LinkRows(NamedTuple):
-    """The reference rows fixed to one link: rows [first, end) of the world block, and the (12, 3 k) matrix
-    that takes the link's frame (its top 3 × 4, flattened) to their world coordinates."""
+    """The reference rows fixed to one link: rows [first, end) of the world block, and their homogeneous
+    coordinates in the link's frame, (4, k): x, y, z and w (1 for a point, 0 for a direction)."""
 
     link: int
     first: int
     end: int
-    placing: np.ndarray
+    local: np.ndarray
 
 
 @dataclass(frozen=True, eq=False)
@@ -151,6 +155,7 @@ class CollisionModel:
     _link_rows: tuple[_LinkRows, ...]
     _world_rows_fixed: np.ndarray  # (3, K_obstacles): the obstacles' rows, already in the world
     _groups: tuple[_Group, ...]
+    _pairs_up_to_level: np.ndarray  # (n + 1,): how many pairs read no link frame beyond each
 
     # --- evaluation -------------------------------------------------------------------------------------------
 
@@ -173,9 +178,9 @@ class CollisionModel:
             Frames of the wrong shape (location ``("frames",)``), or not finite where a shape sits (location
             ``("frames", configuration, link)``, without the configuration for a single one).
         """
-        frames, single = self._checked_frames(world_T_frames)
-        result = self._distances(frames)
-        self._check_finite(frames, result, single)
+        columns, single = self._checked_frames(world_T_frames)
+        result = self._distances(columns)
+        self._check_finite(columns, result, single)
         return result[0] if single else result
 
     def check(self, world_T_frames: np.ndarray, margin: float = 0.0) -> CollisionCheck:
@@ -185,10 +190,19 @@ class CollisionModel:
         finite length (location ``("margin",)``); a pair is close when its signed distance is < margin, so with
         margin 0 touching shapes are not reported and overlapping ones are.
         """
+        columns, single = self._checked_frames(world_T_frames)
+        return self.check_frame_columns(columns, margin, single=single)
+
+    def check_frame_columns(self, frame_columns: np.ndarray, margin: float = 0.0, *, single: bool = False,
+                            run_starts: np.ndarray | None = None) -> CollisionCheck:
+        """:meth:`check` of link frames laid out as :func:`~service.kinematics.link_frame_columns` gives them,
+        shape (n + 1, 12, S), without their copy into 4 × 4 matrices (``single``: locate errors as for one
+        configuration). ``run_starts`` (S, n + 1), from :func:`prefix_run_starts` of the joint vectors: the
+        pairs of links that configurations share are measured once per run of equal joints (as an IK answer's
+        wrist flips share the arm's first joints)."""
         margin_value = _finite_number(margin, ("margin",))
-        frames, single = self._checked_frames(world_T_frames)
-        pair_distances = self._distances(frames)
-        self._check_finite(frames, pair_distances, single)
+        pair_distances = self._distances(frame_columns, run_starts)
+        self._check_finite(frame_columns, pair_distances, single)
         return _close_pairs(pair_distances, self.body_pair_of, len(self.body_pairs), margin_value)
 
     def witnesses(self, world_T_frames: np.ndarray, configurations: Sequence[int] | np.ndarray,
@@ -199,10 +213,10 @@ class CollisionModel:
 
         Returns a :class:`~._distances.Separation` of batch shape (len(pairs),).
         """
-        frames, _ = self._checked_frames(world_T_frames)
+        columns, _ = self._checked_frames(world_T_frames)
         configuration = np.asarray(configurations).reshape(-1)
         column = np.asarray(pairs).reshape(-1)
-        for values, name, size in ((configuration, "configurations", frames.shape[0]),
+        for values, name, size in ((configuration, "configurations", columns.shape[2]),
                                    (column, "pairs", len(self.pairs))):
             if values.size and not (np.issubdtype(values.dtype, np.integer) and 0 <= values.min()
                                     and values.max() < size):
@@ -216,7 +230,7 @@ class CollisionModel:
             if chosen.size == 0:
                 continue
             local = column[chosen] - group.start
-            world = self._world_rows(frames[configuration[chosen]])
+            world = self._world_rows(columns[:, :, configuration[chosen]])
             # entry k is pair local[k] in configuration k of this block: gather one (3, m) per entry
             rows = world[:, group.rows[local].T, np.arange(chosen.size)][:, :, None]
             with _quiet():
@@ -233,6 +247,8 @@ class CollisionModel:
     # --- internals --------------------------------------------------------------------------------------------
 
     def _checked_frames(self, world_T_frames) -> tuple[np.ndarray, bool]:
+        """Frames (S, n + 1, 4, 4) or (n + 1, 4, 4) checked, as frame columns (n + 1, 12, S), and whether one
+        configuration was given."""
         try:
             frames = np.asarray(world_T_frames, dtype=float)
         except (TypeError, ValueError) as error:
@@ -244,37 +260,71 @@ class CollisionModel:
             raise InvalidInputError(
                 f"frames must have shape (S, {self.link_count}, 4, 4) or ({self.link_count}, 4, 4), "
                 f"got {np.shape(world_T_frames)}", location=("frames",))
-        return frames, single
+        columns = np.ascontiguousarray(frames[:, :, :3, :].transpose(1, 3, 2, 0))
+        return columns.reshape(self.link_count, 12, frames.shape[0]), single
 
-    def _check_finite(self, frames: np.ndarray, result: np.ndarray, single: bool) -> None:
+    def _check_finite(self, columns: np.ndarray, result: np.ndarray, single: bool) -> None:
         if np.isfinite(result).all():
             return
         configuration = int(np.flatnonzero(~np.isfinite(result).all(axis=1))[0])
         where = () if single else (configuration,)
         for rows in self._link_rows:
-            if not np.isfinite(frames[configuration, rows.link]).all():
+            if not np.isfinite(columns[rows.link, :, configuration]).all():
                 raise InvalidInputError(f"link frame {rows.link} is not finite",
                                         location=("frames", *where, rows.link))
         raise InvalidInputError("link frames too large: the distances overflow", location=("frames", *where))
 
-    def _distances(self, frames: np.ndarray) -> np.ndarray:
-        count = frames.shape[0]
+    def _distances(self, columns: np.ndarray, run_starts: np.ndarray | None = None) -> np.ndarray:
+        count = columns.shape[2]
         result = np.empty((count, len(self.pairs)))
         if count == 0 or not self.pairs:
             return result
-        widest = max(group.stop - group.start for group in self._groups)
-        block = max(1, min(count, _BLOCK_ELEMENTS // widest))
+        level = self._shared_level(run_starts, count)
+        if level is None:
+            self._evaluate(columns, result, [(group, 0, group.stop - group.start) for group in self._groups])
+            return result
+        # the pairs up to ``level`` once per run of equal joints 1 … level, then spread over the run
+        first_of_run = np.flatnonzero(run_starts[:, level])
+        run_of = np.cumsum(run_starts[:, level]) - 1
+        splits = [int(np.searchsorted(group.levels, level, side="right")) for group in self._groups]
+        shared = np.empty((len(first_of_run), len(self.pairs)))
+        self._evaluate(columns[:level + 1][:, :, first_of_run], shared,
+                       [(group, 0, split) for group, split in zip(self._groups, splits)], up_to_link=level)
+        for group, split in zip(self._groups, splits):
+            result[:, group.start:group.start + split] = shared[run_of, group.start:group.start + split]
+        self._evaluate(columns, result, [(group, split, group.stop - group.start)
+                                         for group, split in zip(self._groups, splits)])
+        return result
+
+    def _shared_level(self, run_starts: np.ndarray | None, count: int) -> int | None:
+        """The link level whose runs of equal joints save the most pair evaluations, or None when sharing would
+        save less than a tenth of them."""
+        if run_starts is None:
+            return None
+        runs = run_starts.sum(axis=0)  # per level
+        saved = (count - runs) * self._pairs_up_to_level
+        level = int(np.argmax(saved))
+        return level if saved[level] >= 0.1 * count * len(self.pairs) else None
+
+    def _evaluate(self, columns: np.ndarray, result: np.ndarray, parts: list[tuple[_Group, int, int]],
+                  up_to_link: int | None = None) -> None:
+        """Distances of the groups' pairs [low, high) into their columns of ``result`` (S, P), for the frame
+        columns (L, 12, S); only links up to ``up_to_link`` are placed."""
+        parts = [(group.start + low, group.start + high, group.kernel, group.part(low, high))
+                 for group, low, high in parts if high > low]
+        if not parts:
+            return
+        count = columns.shape[2]
+        block = max(1, min(count, _BLOCK_ELEMENTS // max(stop - start for start, stop, _, _ in parts)))
         world = self._world_buffer(block)
         with _quiet():
             for begin in range(0, count, block):
                 end = min(begin + block, count)
-                part = world[:, :, : end - begin]
-                self._world_rows(frames[begin:end], part)
-                for group in self._groups:
-                    rows = np.take(part, group.rows.T, axis=1)  # (3, m, P_k, B): each row a contiguous block
-                    distances = group.kernel(rows, *group[4:8], witness=False)
-                    result[begin:end, group.start:group.stop] = distances.T
-        return result
+                placed = world[:, :, : end - begin]
+                self._world_rows(columns[:, :, begin:end], placed, up_to_link)
+                for start, stop, kernel, (rows, *sizes) in parts:
+                    gathered = np.take(placed, rows, axis=1)  # (3, m, P_k, B): each row a contiguous block
+                    result[begin:end, start:stop] = kernel(gathered, *sizes, witness=False).T
 
     def _world_buffer(self, block: int) -> np.ndarray:
         """(3, K, block): room for every reference row of a block of configurations, the obstacles' filled in."""
@@ -283,17 +333,19 @@ class CollisionModel:
         world[:, links:, :] = self._world_rows_fixed[:, :, None]
         return world
 
-    def _world_rows(self, frames: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """World coordinates (3, K, B) of every reference row for the configurations of ``frames`` (B, L, 4, 4):
-        x_world = world_T_link · x_link, homogeneous (w = 1 for points, 0 for directions)."""
+    def _world_rows(self, columns: np.ndarray, out: np.ndarray | None = None,
+                    up_to_link: int | None = None) -> np.ndarray:
+        """World coordinates (3, K, B) of every reference row for the frame columns (L, 12, B) of B
+        configurations: x_world = world_T_link · x_link, homogeneous (w = 1 for points, 0 for directions). With
+        ``up_to_link``, only the rows of links up to it (the others are left as they were)."""
+        count = columns.shape[2]
         if out is None:
-            out = self._world_buffer(frames.shape[0])
-        count = frames.shape[0]
-        for link, first, end, placing in self._link_rows:
-            # the top 3 × 4 of world_T_link, 12 numbers a configuration (a view), times the matrix that places
-            # the link's rows: (B, 12) @ (12, 3 k), small enough for one thread of any BLAS
-            product = frames[:, link, :3, :].reshape(count, 12) @ placing
-            out[:, first:end, :] = product.reshape(count, 3, end - first).transpose(1, 2, 0)
+            out = self._world_buffer(count)
+        for link, first, end, local in self._link_rows:
+            if up_to_link is not None and link > up_to_link:
+                break
+            # x_world = x X + y Y + z Z + w P with the frame's columns X, Y, Z, P
+            out[:, first:end, :] = np.einsum("jcb,jk->ckb", columns[link].reshape(4, 3, count), local)
         return out
 
 
@@ -328,20 +380,28 @@ def _close_pairs(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_coun
                  margin: float) -> CollisionCheck:
     count, pairs = pair_distances.shape
     clearance = pair_distances.min(axis=1) if pairs else np.full(count, np.inf)
-    rows, columns = np.nonzero(pair_distances < margin)
-    values = pair_distances[rows, columns]
-    bodies = body_pair_of[columns]
-    if bodies.size and body_count < pairs:  # some body pairs have several shape pairs: keep each one's smallest
-        order = np.lexsort((values, bodies, rows))
+    body_distances = _body_distances(pair_distances, body_pair_of, body_count)
+    rows, bodies = np.nonzero(body_distances < margin)  # by configuration, then by body pair
+    values = body_distances[rows, bodies]
+    if rows.size and (rows[1:] == rows[:-1]).any():  # some configuration has several: nearest first
+        order = np.lexsort((bodies, values, rows))
         rows, bodies, values = rows[order], bodies[order], values[order]
-        first = np.ones(rows.size, dtype=bool)
-        first[1:] = (rows[1:] != rows[:-1]) | (bodies[1:] != bodies[:-1])
-        rows, bodies, values = rows[first], bodies[first], values[first]
-    order = np.lexsort((bodies, values, rows))  # by configuration, then nearest first
-    rows, bodies, values = rows[order], bodies[order], values[order]
     offsets = np.zeros(count + 1, dtype=np.intp)
     np.cumsum(np.bincount(rows, minlength=count), out=offsets[1:])
     return CollisionCheck(clearance, pair_distances, offsets, bodies, values)
+
+
+def _body_distances(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_count: int) -> np.ndarray:
+    """(S, B): each body pair's signed distance, the smallest over its shape pairs (the columns of
+    ``pair_distances`` (S, P) that ``body_pair_of`` maps to it)."""
+    if body_count == len(body_pair_of) and (body_pair_of == np.arange(body_count)).all():
+        return pair_distances
+    first_column = np.unique(body_pair_of, return_index=True)[1]  # each body pair's first shape pair
+    body_distances = pair_distances[:, first_column]
+    for column in np.flatnonzero(first_column[body_pair_of] != np.arange(len(body_pair_of))).tolist():
+        body = body_pair_of[column]
+        np.minimum(body_distances[:, body], pair_distances[:, column], out=body_distances[:, body])
+    return body_distances
 
 
 # --- compilation ----------------------------------------------------------------------------------------------
@@ -406,12 +466,8 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
     link_rows, first_row, position = [], {}, 0
     for link in sorted(by_link):
         rows = np.array(by_link[link])  # (k, 4)
-        # component c of row r in the world is Σ_j world_T_link[c, j] x_r[j]: entry (4 c + j, c k + r)
-        placing = np.zeros((3, 4, 3, len(rows)))
-        for c in range(3):
-            placing[c, :, c, :] = rows.T
         first_row[link] = position
-        link_rows.append(_LinkRows(link, position, position + len(rows), placing.reshape(12, -1)))
+        link_rows.append(_LinkRows(link, position, position + len(rows), rows.T.copy()))
         position += len(rows)
     shape_rows = [[first_row[item.link] + k for k in positions] for item, positions in zip(shapes, local_positions)]
     obstacle_rows, fixed = [], []
@@ -447,18 +503,41 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
     for family, kernel in _KERNELS.items():
         if not members[family]:
             continue
+        members[family].sort(key=_level)  # stable: the pairs of a level keep their order
         start = len(pairs)
         pairs.extend(member[0] for member in members[family])
         firsts = [member[2] for member in members[family]]
         seconds = [member[3] for member in members[family]]
         groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in members[family]]),
                              _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
-                             np.array([member[4] for member in members[family]], dtype=bool)))
+                             np.array([member[4] for member in members[family]], dtype=bool),
+                             np.array([_level(member) for member in members[family]], dtype=np.intp)))
     body_pairs: dict[tuple[str, str], int] = {}
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)
+    levels = np.bincount([max(pair.link_a, pair.link_b or 0) for pair in pairs], minlength=count)
     return CollisionModel(count, tuple(shapes), tuple(obstacle_list), tuple(pairs), tuple(body_pairs),
-                          body_pair_of, tuple(link_rows), np.array(fixed).T.reshape(3, -1), tuple(groups))
+                          body_pair_of, tuple(link_rows), np.array(fixed).T.reshape(3, -1), tuple(groups),
+                          np.cumsum(levels))
+
+
+def _level(member) -> int:
+    """The deepest link frame a pair reads (a member of a kernel's group: the pair first)."""
+    pair = member[0]
+    return max(pair.link_a, pair.link_b or 0)
+
+
+def prefix_run_starts(joints: np.ndarray) -> np.ndarray:
+    """Where runs of equal leading joints start in joint vectors (S, n): (S, n + 1) bool, column k true where
+    row s differs from row s - 1 in one of joints 1 … k (always on row 0; column 0 only there). Link frame k
+    moves with joints 1 … k only, so within a run of column k every link up to k is where it was."""
+    joints = np.asarray(joints, dtype=float)
+    count, dof = joints.shape
+    starts = np.zeros((count, dof + 1), dtype=bool)
+    if count:
+        starts[0] = True
+        np.logical_or.accumulate(joints[1:] != joints[:-1], axis=1, out=starts[1:, 1:])
+    return starts
 
 
 def _local_rows(shape: Shape) -> list[list[float]]:

@@ -11,8 +11,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.kinematics import InvalidInputError, link_frames
-from service.kinematics.collision import Box, Capsule, LinkShape, Obstacle, Sphere, collision_model
+from service.kinematics import InvalidInputError, Joint, Robot, link_frame_columns, link_frames
+from service.kinematics.collision import Box, Capsule, LinkShape, Obstacle, Sphere, collision_model, prefix_run_starts
 from service.kinematics.collision import _model
 from service.robots.catalogue import load_robot_file
 from tests.oracles.collision import signed_distance, signed_distances
@@ -358,3 +358,26 @@ def test_witnesses_of_entries_that_do_not_exist_raise_located_errors(configurati
 
 def test_docstring_examples():
     assert doctest.testmod(_model).failed == 0
+
+
+def test_runs_of_equal_leading_joints_are_measured_once_with_the_same_result():
+    """IK solutions come in runs that share the arm's first joints (wrist flips). A 5-joint arm's joint vectors
+    in such runs: the check that measures the shared links' pairs once per run gives every distance, the
+    clearance and the close pairs bit for bit as the check of every vector, and as the reference."""
+    rng = np.random.default_rng(5)
+    robot = Robot([Joint(f"q{i + 1}", "revolute", *rng.uniform(-0.4, 0.4, 1), *rng.uniform(-np.pi, np.pi, 1),
+                         *rng.uniform(-0.3, 0.3, 1), 0.0) for i in range(5)])
+    model = collision_model(arm_shapes(), 6, OBSTACLES)
+    leading = rng.uniform(-np.pi, np.pi, (300, 3))
+    joints = np.concatenate([np.repeat(leading, 4, axis=0), rng.uniform(-np.pi, np.pi, (1200, 2))], axis=1)
+    joints[::7, 0] += 0.5  # some runs broken at the first joint
+    starts = prefix_run_starts(joints)
+    assert starts[:, 0].tolist() == [True] + [False] * 1199
+    assert 300 < starts[:, 3].sum() < 600 and starts[:, 4].all()
+    assert model._shared_level(starts, len(joints)) == 3  # the shared pass runs
+    columns = link_frame_columns(robot, joints)
+    shared, every = model.check_frame_columns(columns, 0.05, run_starts=starts), model.check_frame_columns(columns, 0.05)
+    for field in shared._fields:
+        np.testing.assert_array_equal(getattr(shared, field), getattr(every, field), err_msg=field)
+    frames = link_frames(robot, joints[:40])
+    np.testing.assert_allclose(shared.pair_distances[:40], reference_distances(model, frames), rtol=0, atol=1e-9)

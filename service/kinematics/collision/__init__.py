@@ -17,7 +17,7 @@ from ._distances import (
     sphere_sphere,
 )
 from ._clearance import Clearances, CollisionRequest, at_collisions, clearances, colliding, frame_index, link_names, model_for
-from ._model import CollisionCheck, CollisionModel, ShapePair, collision_model, prefix_run_starts
+from ._model import CollisionCheck, CollisionModel, ShapePair, collision_model
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere, restated, scaled
 
 __all__ = [
@@ -44,7 +44,6 @@ __all__ = [
     "collision_model",
     "frame_index",
     "link_names",
-    "prefix_run_starts",
     "model_for",
     "restated",
     "scaled",

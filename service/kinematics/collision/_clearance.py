@@ -17,7 +17,7 @@ import numpy as np
 from .._cache import bounded_memo, memo
 from .._errors import InvalidInputError
 from .._forward import link_frame_columns, link_frames
-from ._model import CollisionCheck, CollisionModel, collision_model, prefix_run_starts
+from ._model import CollisionCheck, CollisionModel, collision_model
 from ._shapes import Box, Capsule, Obstacle, Sphere
 
 #: Compiled models kept per robot (one per distinct set of obstacles and rules a request names).
@@ -169,8 +169,7 @@ def _checked(robot, request: CollisionRequest, joints: np.ndarray) -> tuple[Coll
     """The compiled model and its check of joint vectors (S, n)."""
     model = model_for(robot, request)
     joints = np.asarray(joints, dtype=float).reshape(-1, robot.dof)
-    return model, model.check_frame_columns(link_frame_columns(robot, joints), request.margin,
-                                            run_starts=prefix_run_starts(joints))
+    return model, model.check_frame_columns(link_frame_columns(robot, joints), request.margin)
 
 
 def colliding(robot, request: CollisionRequest, joints: np.ndarray) -> np.ndarray:

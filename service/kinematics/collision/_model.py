@@ -29,13 +29,14 @@ from typing import Callable, NamedTuple, Sequence
 import numpy as np
 
 from .._errors import InvalidInputError
-from ._distances import Separation, _box_box, _box_segment, _quiet, _segment_segment, _swept
+from ._distances import Separation, _box_box, _box_point_local, _box_segment, _dot, _quiet, _segment_segment, _swept
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 
-#: Pair evaluations per block (configurations × pairs of one group). Large enough that numpy's cost per call is
-#: small against the arithmetic, small enough that a block's temporaries stay in the core's cache (measured:
-#: 4096 to 16384 are alike, 1024 and 65536 slower).
-_BLOCK_ELEMENTS = 8192
+#: Pair evaluations per block (configurations × pairs of the widest group). Large enough that numpy's cost per
+#: call is small against the arithmetic (the bounds leave a third of the pairs to measure, in smaller arrays),
+#: small enough that a block's temporaries stay in cache (measured on 80,000 PUMA configurations and 34 pairs:
+#: 32768 and 65536 alike, 8192 a third slower).
+_BLOCK_ELEMENTS = 32768
 
 #: The order in which pairs name the kinds of their shapes, and in which the kernels take them.
 _KIND_ORDER = (Box, Capsule, Sphere)
@@ -76,19 +77,20 @@ class _Group(NamedTuple):
     radius_a: np.ndarray  # (P_k, 1): a round shape's radius (0 for a box)
     radius_b: np.ndarray
     swapped: np.ndarray  # (P_k,) bool
-    levels: np.ndarray  # (P_k,) ascending: the deepest link frame the pair reads (it moves with joints 1 … level)
+    bounds: Callable | None  # the kernel's cheap bounds (None: none, every pair is measured)
+    reach: np.ndarray  # (P_k, 1): half the round shapes' lengths, summed: what the bounds leave open
 
-    def part(self, low: int, high: int) -> tuple:
-        """The kernel's inputs for the group's pairs [low, high): the rows (m, P) and the four sizes."""
-        return (self.rows[low:high].T, self.half_size_a[:, low:high], self.half_size_b[:, low:high],
-                self.radius_a[low:high], self.radius_b[low:high])
+    def inputs(self) -> tuple:
+        """The kernel's inputs: the rows (m, P_k) and the four sizes."""
+        return self.rows.T, self.half_size_a, self.half_size_b, self.radius_a, self.radius_b
 
 
 class CollisionCheck(NamedTuple):
     """The outcome of :meth:`CollisionModel.check` for S configurations, in columns.
 
     ``clearance`` (S,): the smallest signed distance over the model's pairs (+inf when it has none).
-    ``pair_distances`` (S, P): every pair's signed distance, in the order of :attr:`CollisionModel.pairs`.
+    ``pair_distances`` (S, P): in the order of :attr:`CollisionModel.pairs`, each pair's signed distance where
+    it can be the clearance or closer than the margin; elsewhere a lower bound of it, at least both.
     The close body pairs, those closer than the margin, are listed for configuration i at positions
     ``offsets[i]:offsets[i + 1]`` of ``body_pairs`` (indices into :attr:`CollisionModel.body_pairs`) and
     ``distances`` (their signed distance: the smallest over their shape pairs), nearest first.
@@ -155,7 +157,6 @@ class CollisionModel:
     _link_rows: tuple[_LinkRows, ...]
     _world_rows_fixed: np.ndarray  # (3, K_obstacles): the obstacles' rows, already in the world
     _groups: tuple[_Group, ...]
-    _pairs_up_to_level: np.ndarray  # (n + 1,): how many pairs read no link frame beyond each
 
     # --- evaluation -------------------------------------------------------------------------------------------
 
@@ -193,15 +194,13 @@ class CollisionModel:
         columns, single = self._checked_frames(world_T_frames)
         return self.check_frame_columns(columns, margin, single=single)
 
-    def check_frame_columns(self, frame_columns: np.ndarray, margin: float = 0.0, *, single: bool = False,
-                            run_starts: np.ndarray | None = None) -> CollisionCheck:
+    def check_frame_columns(self, frame_columns: np.ndarray, margin: float = 0.0, *,
+                            single: bool = False) -> CollisionCheck:
         """:meth:`check` of link frames laid out as :func:`~service.kinematics.link_frame_columns` gives them,
         shape (n + 1, 12, S), without their copy into 4 × 4 matrices (``single``: locate errors as for one
-        configuration). ``run_starts`` (S, n + 1), from :func:`prefix_run_starts` of the joint vectors: the
-        pairs of links that configurations share are measured once per run of equal joints (as an IK answer's
-        wrist flips share the arm's first joints)."""
+        configuration)."""
         margin_value = _finite_number(margin, ("margin",))
-        pair_distances = self._distances(frame_columns, run_starts)
+        pair_distances = self._distances(frame_columns, margin_value)
         self._check_finite(frame_columns, pair_distances, single)
         return _close_pairs(pair_distances, self.body_pair_of, len(self.body_pairs), margin_value)
 
@@ -274,57 +273,50 @@ class CollisionModel:
                                         location=("frames", *where, rows.link))
         raise InvalidInputError("link frames too large: the distances overflow", location=("frames", *where))
 
-    def _distances(self, columns: np.ndarray, run_starts: np.ndarray | None = None) -> np.ndarray:
-        count = columns.shape[2]
-        result = np.empty((count, len(self.pairs)))
-        if count == 0 or not self.pairs:
-            return result
-        level = self._shared_level(run_starts, count)
-        if level is None:
-            self._evaluate(columns, result, [(group, 0, group.stop - group.start) for group in self._groups])
-            return result
-        # the pairs up to ``level`` once per run of equal joints 1 … level, then spread over the run
-        first_of_run = np.flatnonzero(run_starts[:, level])
-        run_of = np.cumsum(run_starts[:, level]) - 1
-        splits = [int(np.searchsorted(group.levels, level, side="right")) for group in self._groups]
-        shared = np.empty((len(first_of_run), len(self.pairs)))
-        self._evaluate(columns[:level + 1][:, :, first_of_run], shared,
-                       [(group, 0, split) for group, split in zip(self._groups, splits)], up_to_link=level)
-        for group, split in zip(self._groups, splits):
-            result[:, group.start:group.start + split] = shared[run_of, group.start:group.start + split]
-        self._evaluate(columns, result, [(group, split, group.stop - group.start)
-                                         for group, split in zip(self._groups, splits)])
+    def _distances(self, columns: np.ndarray, margin: float | None = None) -> np.ndarray:
+        """Every pair's distance (S, P) for frame columns (L, 12, S); with a ``margin``, only where a pair can
+        be the configuration's clearance or closer than the margin (see :meth:`_evaluate`)."""
+        result = np.empty((columns.shape[2], len(self.pairs)))
+        if columns.shape[2] and self.pairs:
+            self._evaluate(columns, result, margin)
         return result
 
-    def _shared_level(self, run_starts: np.ndarray | None, count: int) -> int | None:
-        """The link level whose runs of equal joints save the most pair evaluations, or None when sharing would
-        save less than a tenth of them."""
-        if run_starts is None:
-            return None
-        runs = run_starts.sum(axis=0)  # per level
-        saved = (count - runs) * self._pairs_up_to_level
-        level = int(np.argmax(saved))
-        return level if saved[level] >= 0.1 * count * len(self.pairs) else None
+    def _evaluate(self, columns: np.ndarray, result: np.ndarray, margin: float | None) -> None:
+        """Distances of the pairs into ``result`` (S, P), for the frame columns (L, 12, S).
 
-    def _evaluate(self, columns: np.ndarray, result: np.ndarray, parts: list[tuple[_Group, int, int]],
-                  up_to_link: int | None = None) -> None:
-        """Distances of the groups' pairs [low, high) into their columns of ``result`` (S, P), for the frame
-        columns (L, 12, S); only links up to ``up_to_link`` are placed."""
-        parts = [(group.start + low, group.start + high, group.kernel, group.part(low, high))
-                 for group, low, high in parts if high > low]
-        if not parts:
-            return
+        With a ``margin``, a pair is measured only where it can matter: each pair's cheap bounds (a shape's
+        round core inside the ball about its middle, and around it) give every configuration an upper bound U
+        of its clearance over these pairs, and a pair whose lower bound is at least max(U, margin) can be
+        neither the clearance nor a close pair (a pair that attains U is measured, unless its bounds meet). Such
+        a pair keeps its lower bound in ``result``.
+        """
+        parts = [(group.start, group.stop, group.kernel, group.bounds, group.inputs(),
+                  group.reach) for group in self._groups]
         count = columns.shape[2]
-        block = max(1, min(count, _BLOCK_ELEMENTS // max(stop - start for start, stop, _, _ in parts)))
+        block = max(1, min(count, _BLOCK_ELEMENTS // max(part[1] - part[0] for part in parts)))
         world = self._world_buffer(block)
         with _quiet():
             for begin in range(0, count, block):
                 end = min(begin + block, count)
                 placed = world[:, :, : end - begin]
-                self._world_rows(columns[:, :, begin:end], placed, up_to_link)
-                for start, stop, kernel, (rows, *sizes) in parts:
-                    gathered = np.take(placed, rows, axis=1)  # (3, m, P_k, B): each row a contiguous block
-                    result[begin:end, start:stop] = kernel(gathered, *sizes, witness=False).T
+                self._world_rows(columns[:, :, begin:end], placed)
+                # (3, m, P_k, B): each row a contiguous block
+                gathered = [np.take(placed, rows, axis=1) for _, _, _, _, (rows, *_), _ in parts]
+                if margin is None:
+                    for (start, stop, kernel, _, (_, *sizes), _), rows in zip(parts, gathered):
+                        result[begin:end, start:stop] = kernel(rows, *sizes, witness=False).T
+                    continue
+                bounds = [None if bound is None else bound(rows, *sizes, reach)
+                          for (_, _, _, bound, (_, *sizes), reach), rows in zip(parts, gathered)]
+                upper = np.full(end - begin, np.inf)
+                for bound in bounds:
+                    if bound is not None:
+                        np.fmin(upper, bound[1].min(axis=0), out=upper)
+                # rounding: the bounds are as accurate as the coordinates; keep a pair they leave in doubt
+                cutoff = np.maximum(upper, margin) + _BOUND_SLACK * (1.0 + np.abs(placed).max())
+                for (start, stop, kernel, _, (_, *sizes), _), rows, bound in zip(parts, gathered, bounds):
+                    result[begin:end, start:stop] = _measured(kernel, rows, sizes, bound, cutoff).T
+
 
     def _world_buffer(self, block: int) -> np.ndarray:
         """(3, K, block): room for every reference row of a block of configurations, the obstacles' filled in."""
@@ -333,17 +325,13 @@ class CollisionModel:
         world[:, links:, :] = self._world_rows_fixed[:, :, None]
         return world
 
-    def _world_rows(self, columns: np.ndarray, out: np.ndarray | None = None,
-                    up_to_link: int | None = None) -> np.ndarray:
+    def _world_rows(self, columns: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """World coordinates (3, K, B) of every reference row for the frame columns (L, 12, B) of B
-        configurations: x_world = world_T_link · x_link, homogeneous (w = 1 for points, 0 for directions). With
-        ``up_to_link``, only the rows of links up to it (the others are left as they were)."""
+        configurations: x_world = world_T_link · x_link, homogeneous (w = 1 for points, 0 for directions)."""
         count = columns.shape[2]
         if out is None:
             out = self._world_buffer(count)
         for link, first, end, local in self._link_rows:
-            if up_to_link is not None and link > up_to_link:
-                break
             # x_world = x X + y Y + z Z + w P with the frame's columns X, Y, Z, P
             out[:, first:end, :] = np.einsum("jcb,jk->ckb", columns[link].reshape(4, 3, count), local)
         return out
@@ -373,6 +361,57 @@ def _box_box_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witne
 _KERNELS = {("round", "round"): _round_round, ("box", "round"): _box_round, ("box", "box"): _box_box_kernel}
 
 
+def _measured(kernel, rows: np.ndarray, sizes: list[np.ndarray], bound, cutoff: np.ndarray) -> np.ndarray:
+    """(P_k, B): the kernel's distances where the pair's lower bound is below the configuration's ``cutoff``
+    (B,), its lower bound elsewhere."""
+    if bound is None:
+        return kernel(rows, *sizes, witness=False)
+    lower = bound[0]
+    pairs, configurations = np.nonzero(lower < cutoff)
+    if pairs.size > _MEASURE_ALL * lower.size:  # the compaction would cost more than it saves
+        return kernel(rows, *sizes, witness=False)
+    if pairs.size == 1:  # einsum sums a lone element in another order: measure it twice, for a batch's bits
+        pairs, configurations = np.repeat(pairs, 2), np.repeat(configurations, 2)
+    # np.take keeps the layout the kernels see in a whole block (components first, contiguous), so that each
+    # distance has the same bits either way; indexing would lay the entries out first
+    entries = np.take(rows.reshape(rows.shape[0], rows.shape[1], -1), pairs * lower.shape[1] + configurations, axis=2)
+    lower[pairs, configurations] = kernel(entries, *(np.take(size[..., 0], pairs, axis=-1) for size in sizes),
+                                          witness=False)
+    return lower
+
+
+#: Above this share of pairs in doubt, a block measures them all.
+_MEASURE_ALL = 0.6
+
+#: Slack of the bounds' test, relative to the largest coordinate of a block (length unit): far above their
+#: rounding (a few ulps of the coordinates), far below any clearance a request states.
+_BOUND_SLACK = 1e-9
+
+
+def _round_round_bounds(rows, half_size_a, half_size_b, radius_a, radius_b, reach):
+    """Lower and upper bounds (P, B) of capsules' and spheres' distances from their middles: the balls of
+    radius r about the middles lie inside the shapes, the shapes inside the balls of radius r + half length."""
+    between = rows[:, 0] + rows[:, 1]
+    between -= rows[:, 2]
+    between -= rows[:, 3]  # twice the middles' difference
+    upper = np.sqrt(_dot(between, between))
+    upper *= 0.5
+    upper -= radius_a + radius_b
+    return upper - reach, upper
+
+
+def _box_round_bounds(rows, half_size_a, half_size_b, radius_a, radius_b, reach):
+    """Lower and upper bounds (P, B) of a box's distance to a capsule or sphere from the box's signed distance
+    at the round shape's middle (the same balls as :func:`_round_round_bounds`)."""
+    middle = rows[:, 4] + rows[:, 5]
+    middle *= 0.5
+    middle -= rows[:, 0]
+    local = np.einsum("ij...,i...->j...", rows[:, 1:4], middle)  # R^T (middle - centre)
+    upper = _box_point_local(local, half_size_a)
+    upper -= radius_b
+    return upper - reach, upper
+
+
 # --- the close pairs ------------------------------------------------------------------------------------------
 
 
@@ -380,9 +419,11 @@ def _close_pairs(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_coun
                  margin: float) -> CollisionCheck:
     count, pairs = pair_distances.shape
     clearance = pair_distances.min(axis=1) if pairs else np.full(count, np.inf)
-    body_distances = _body_distances(pair_distances, body_pair_of, body_count)
+    close = np.flatnonzero(clearance < margin)  # the configurations that have a close pair
+    body_distances = _body_distances(pair_distances[close], body_pair_of, body_count)
     rows, bodies = np.nonzero(body_distances < margin)  # by configuration, then by body pair
     values = body_distances[rows, bodies]
+    rows = close[rows]
     if rows.size and (rows[1:] == rows[:-1]).any():  # some configuration has several: nearest first
         order = np.lexsort((bodies, values, rows))
         rows, bodies, values = rows[order], bodies[order], values[order]
@@ -402,6 +443,10 @@ def _body_distances(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_c
         body = body_pair_of[column]
         np.minimum(body_distances[:, body], pair_distances[:, column], out=body_distances[:, body])
     return body_distances
+
+
+#: The cheap bounds of each pair of families (two boxes have none: they are always measured).
+_BOUNDS = {("round", "round"): _round_round_bounds, ("box", "round"): _box_round_bounds}
 
 
 # --- compilation ----------------------------------------------------------------------------------------------
@@ -503,7 +548,6 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
     for family, kernel in _KERNELS.items():
         if not members[family]:
             continue
-        members[family].sort(key=_level)  # stable: the pairs of a level keep their order
         start = len(pairs)
         pairs.extend(member[0] for member in members[family])
         firsts = [member[2] for member in members[family]]
@@ -511,33 +555,12 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
         groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in members[family]]),
                              _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
                              np.array([member[4] for member in members[family]], dtype=bool),
-                             np.array([_level(member) for member in members[family]], dtype=np.intp)))
+                             _BOUNDS.get(family), _reaches(firsts, seconds)))
     body_pairs: dict[tuple[str, str], int] = {}
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)
-    levels = np.bincount([max(pair.link_a, pair.link_b or 0) for pair in pairs], minlength=count)
     return CollisionModel(count, tuple(shapes), tuple(obstacle_list), tuple(pairs), tuple(body_pairs),
-                          body_pair_of, tuple(link_rows), np.array(fixed).T.reshape(3, -1), tuple(groups),
-                          np.cumsum(levels))
-
-
-def _level(member) -> int:
-    """The deepest link frame a pair reads (a member of a kernel's group: the pair first)."""
-    pair = member[0]
-    return max(pair.link_a, pair.link_b or 0)
-
-
-def prefix_run_starts(joints: np.ndarray) -> np.ndarray:
-    """Where runs of equal leading joints start in joint vectors (S, n): (S, n + 1) bool, column k true where
-    row s differs from row s - 1 in one of joints 1 … k (always on row 0; column 0 only there). Link frame k
-    moves with joints 1 … k only, so within a run of column k every link up to k is where it was."""
-    joints = np.asarray(joints, dtype=float)
-    count, dof = joints.shape
-    starts = np.zeros((count, dof + 1), dtype=bool)
-    if count:
-        starts[0] = True
-        np.logical_or.accumulate(joints[1:] != joints[:-1], axis=1, out=starts[1:, 1:])
-    return starts
+                          body_pair_of, tuple(link_rows), np.array(fixed).T.reshape(3, -1), tuple(groups))
 
 
 def _local_rows(shape: Shape) -> list[list[float]]:
@@ -557,6 +580,13 @@ def _kernel_rows(shape: Shape, rows: list[int]) -> list[int]:
 
 def _family(shape: Shape) -> str:
     return "box" if isinstance(shape, Box) else "round"
+
+
+def _reaches(firsts: list[Shape], seconds: list[Shape]) -> np.ndarray:
+    """(P_k, 1): half the length of each pair's capsules, summed (0 for spheres and boxes)."""
+    def half_length(shape: Shape) -> float:
+        return 0.5 * float(np.linalg.norm(shape.end - shape.start)) if isinstance(shape, Capsule) else 0.0
+    return np.array([half_length(a) + half_length(b) for a, b in zip(firsts, seconds)])[:, None]
 
 
 def _half_sizes(shapes: list[Shape]) -> np.ndarray:

@@ -19,8 +19,9 @@ reference (``tests/kinematics/ik/test_one_pose.py`` and
 ``test_one_pose_families.py`` hold these paths to it). The subproblems' float
 forms live beside their array code and share its constants and thresholds
 (:func:`.subproblems._roots._harmonic_clear`,
-:func:`.subproblems._paden_kahan._subproblem_2_chain_clear` and
-:func:`~.subproblems._paden_kahan._distance_equation`), as the angle wraps do
+:func:`.subproblems._paden_kahan._subproblem_2_chain_clear`,
+:func:`~.subproblems._paden_kahan._distance_equation` and
+:func:`.subproblems._vectors._rotate_onto_clear`), as the angle wraps do
 (:func:`~service.kinematics._rotations.wrap_float`); this module reduces a
 plan's fixed vectors to the coordinates they take.
 """
@@ -31,12 +32,11 @@ import math
 
 import numpy as np
 
-from .._rotations import wrap_float
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._types import LabelCodes, SingularFlags
 from .subproblems._paden_kahan import _distance_equation, _subproblem_2_chain_clear
 from .subproblems._roots import _harmonic_clear
-from .subproblems._vectors import axis_frame
+from .subproblems._vectors import _rotate_onto_clear, axis_frame
 
 #: How far (as a multiple of each tolerance) a quantity must be from the array solver's threshold for the
 #: scalar path to decide the pose; closer than that, the array path decides.
@@ -217,12 +217,10 @@ class Turn:
     def angle(p: tuple[float, ...], q: tuple[float, ...]) -> float:
         """Subproblem 1: θ with R(k, θ) p = q (least squares), p and q as :meth:`coordinates`; non-degenerate
         only."""
-        px, py, _, radius_p, length_p = p
-        qx, qy, _, radius_q, length_q = q
-        tol = GEOMETRY_TOLERANCE * (length_p if length_p > length_q else length_q)
-        if not (radius_p > MARGIN * tol and radius_q > MARGIN * tol):
+        theta = _rotate_onto_clear(p, q, MARGIN)
+        if theta is None:
             raise NotGeneric
-        return wrap_float(math.atan2(px * qy - py * qx, px * qx + py * qy))
+        return theta
 
     @staticmethod
     def angles_at_distance(p: tuple[float, ...], q: tuple[float, ...], delta: float,

@@ -5,7 +5,7 @@ an example for a ``/v1/robots/{robot_id}/...`` operation names its robot in ``x-
 the example of the ``robot_id`` parameter. Each request schema gets its first example as a schema example.
 Responses: the answer the service gives to each operation's first example, with long lists cut to their first
 entries, is in ``response_examples.json`` beside this file (``python -m service.api.examples`` rewrites it from
-the running code; ``tests/test_examples.py`` checks that it still is the service's answer and that every request
+the running code; ``tests/api/test_examples.py`` checks that it still is the service's answer and that every request
 example is answered with a 2xx).
 """
 

@@ -740,3 +740,23 @@ def wrap_angle(x: ArrayLike) -> np.float64 | np.ndarray:
         with np.errstate(invalid="ignore"):
             wrapped = np.where(far, np.pi - np.mod(np.pi - a, _TWO_PI), wrapped)
     return wrapped[()]  # a 0-d result as a numpy float, as numpy's own functions return it
+
+
+_PI, _THREE_PI = math.pi, 3.0 * math.pi
+
+
+def wrap_float(theta: float) -> float:
+    """:func:`wrap_angle` of one float in (−3π, 3π] (a sum of two wrapped angles), bit for bit, without numpy's
+    per-call cost: the one-pose paths wrap each angle they compute."""
+    if theta > _PI:
+        return theta - _TWO_PI
+    if theta <= -_PI:
+        return theta + _TWO_PI
+    return theta
+
+
+def wrap_any_float(theta: float) -> float:
+    """:func:`wrap_angle` of one float of any size (as :func:`wrap_float` within three half-turns)."""
+    if -_THREE_PI < theta < _THREE_PI:
+        return wrap_float(theta)
+    return _PI - (_PI - theta) % _TWO_PI

@@ -26,7 +26,15 @@ from service.kinematics import (
     quaternions_from_matrices,
     rpy_from_matrix,
 )
-from service.kinematics._rotations import euler_zyz_from_matrix, rot_x, rot_y, rot_z, wrap_angle
+from service.kinematics._rotations import (
+    euler_zyz_from_matrix,
+    rot_x,
+    rot_y,
+    rot_z,
+    wrap_angle,
+    wrap_any_float,
+    wrap_float,
+)
 from service.kinematics._tolerances import SINGULARITY_TOLERANCE
 
 N = 1000
@@ -408,6 +416,20 @@ def test_wrap_angle_is_vectorized_and_in_range(rng):
     np.testing.assert_allclose(turns, np.round(turns), atol=1e-12)
     inside = rng.uniform(-PI, PI, 100)
     np.testing.assert_array_equal(wrap_angle(inside), inside)
+
+
+def test_float_wraps_are_wrap_angle_bit_for_bit(rng):
+    """The one-pose paths' float wraps give wrap_angle's value, sign of zero included (wrap_float within
+    three half-turns, wrap_any_float anywhere)."""
+    near = [PI, -PI, np.nextafter(PI, 4.0), np.nextafter(-PI, -4.0), 3 * PI, np.nextafter(-3 * PI, 0.0), 0.0, -0.0]
+    far = [-3 * PI, np.nextafter(5 * PI, 0.0), -5 * PI, 100.0, -1e9]
+    within = near + rng.uniform(-3 * PI, 3 * PI, 2000).tolist()
+    for x in within:
+        assert wrap_float(x) == wrap_angle(x), x
+        assert math.copysign(1.0, wrap_float(x)) == math.copysign(1.0, wrap_angle(x)), x
+    for x in within + far + rng.uniform(-50, 50, 2000).tolist():
+        assert wrap_any_float(x) == wrap_angle(x), x
+        assert math.copysign(1.0, wrap_any_float(x)) == math.copysign(1.0, wrap_angle(x)), x
 
 
 # ---------------------------------------------------------------------------

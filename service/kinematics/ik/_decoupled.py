@@ -15,6 +15,7 @@ from functools import cached_property
 
 import numpy as np
 
+from .._rotations import wrap_float
 from .._tolerances import GEOMETRY_TOLERANCE
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
@@ -354,7 +355,7 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
             raise scalar.NotGeneric
         rows, codes = [], []
         for theta in thetas:
-            q1 = scalar.wrap(-theta)
+            q1 = wrap_float(-theta)
             # the target with joint 1 undone, and what the labels measure there
             y_from_origin = scalar.rotate(d[0], theta, from_origin)
             y_from_2 = scalar.sub(scalar.add(o, y_from_origin), p2)

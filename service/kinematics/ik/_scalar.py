@@ -16,8 +16,14 @@ an empty slot), each clearly (by :data:`MARGIN` times the tolerance) away from
 the threshold where the array solver would decide otherwise. Anything else
 raises :class:`NotGeneric` and the pose takes the array path, which is the
 reference (``tests/kinematics/ik/test_one_pose.py`` and
-``test_one_pose_families.py`` hold these paths to it). The formulas are those
-of :mod:`.subproblems` (same slot order, same roots).
+``test_one_pose_families.py`` hold these paths to it). The subproblems' float
+forms live beside their array code and share its constants and thresholds
+(:func:`.subproblems._roots._harmonic_clear`,
+:func:`.subproblems._paden_kahan._subproblem_2_chain_clear`,
+:func:`~.subproblems._paden_kahan._distance_equation` and
+:func:`.subproblems._vectors._rotate_onto_clear`), as the angle wraps do
+(:func:`~service.kinematics._rotations.wrap_float`); this module reduces a
+plan's fixed vectors to the coordinates they take.
 """
 
 from __future__ import annotations
@@ -27,17 +33,14 @@ import math
 import numpy as np
 
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
-from .subproblems._records import _NEAR_TANGENT_GAP
-from .subproblems._vectors import axis_frame
 from ._types import LabelCodes, SingularFlags
+from .subproblems._paden_kahan import _distance_equation, _subproblem_2_chain_clear
+from .subproblems._roots import _harmonic_clear
+from .subproblems._vectors import _rotate_onto_clear, axis_frame
 
 #: How far (as a multiple of each tolerance) a quantity must be from the array solver's threshold for the
 #: scalar path to decide the pose; closer than that, the array path decides.
 MARGIN = 10.0
-
-_PI, _TWO_PI, _THREE_PI = math.pi, 2.0 * math.pi, 3.0 * math.pi
-_MERGE_RESIDUAL = DUPLICATE_TOLERANCE ** 2
-_MERGE_COS_GAP = 1.0 - math.cos(DUPLICATE_TOLERANCE / 2.0)
 
 Vector = tuple[float, float, float]
 Matrix = tuple[Vector, Vector, Vector]  # rows
@@ -108,13 +111,6 @@ def wrist_code(middle: float) -> int | None:
     if abs(sine) <= MARGIN * 10 * GEOMETRY_TOLERANCE:
         return None
     return 0 if sine > 0 else 1
-
-
-def wrap_any(theta: float) -> float:
-    """:func:`~service.kinematics._rotations.wrap_angle` of one float: (−π, π], −π to π."""
-    if -_THREE_PI < theta < _THREE_PI:
-        return wrap(theta)
-    return _PI - (_PI - theta) % _TWO_PI
 
 
 def reject(v: Vector, unit: Vector) -> Vector:
@@ -194,39 +190,12 @@ def rotate(k: Vector, theta: float, v: Vector) -> Vector:
             vz * c + (kx * vy - ky * vx) * s + kz * along)
 
 
-def wrap(theta: float) -> float:
-    """As :func:`service.kinematics._rotations.wrap_angle`: (−3π, 3π] to (−π, π]."""
-    if theta > _PI:
-        return theta - _TWO_PI
-    if theta <= -_PI:
-        return theta + _TWO_PI
-    return theta
-
-
 # --- the subproblems, generic case only ------------------------------------------------------------------
 
 def plane_axes(k: Vector) -> tuple[Vector, Vector]:
     """e1, e2 of :func:`.subproblems._vectors.axis_frame` (k completes the right-handed frame); built once per plan."""
     frame = axis_frame(np.asarray(k, dtype=float))
     return tuple(frame[:, 0].tolist()), tuple(frame[:, 1].tolist())
-
-
-def harmonic(a: float, b: float, c: float, scale: float, out_of_reach: bool = False) -> tuple[float, float]:
-    """The two roots of a cos θ + b sin θ = c, φ + half first; NotGeneric unless clearly two.
-
-    With ``out_of_reach``, a clearly unreachable c gives the least-squares root and NaN (one valid slot),
-    as the array solver does.
-    """
-    tol = GEOMETRY_TOLERANCE * scale
-    rho = math.sqrt(a * a + b * b)
-    excess = abs(c) - rho
-    phi = math.atan2(b, a)
-    if out_of_reach and rho > MARGIN * tol and excess > MARGIN * tol:
-        return wrap(phi + math.atan2(0.0, c)), math.nan
-    if not (rho > MARGIN * tol and -excess > MARGIN * (rho * _MERGE_COS_GAP + tol)):
-        raise NotGeneric
-    half = math.atan2(math.sqrt(-excess * (rho + abs(c))), c)
-    return wrap(phi + half), wrap(phi - half)
 
 
 class Turn:
@@ -248,24 +217,23 @@ class Turn:
     def angle(p: tuple[float, ...], q: tuple[float, ...]) -> float:
         """Subproblem 1: θ with R(k, θ) p = q (least squares), p and q as :meth:`coordinates`; non-degenerate
         only."""
-        px, py, _, radius_p, length_p = p
-        qx, qy, _, radius_q, length_q = q
-        tol = GEOMETRY_TOLERANCE * (length_p if length_p > length_q else length_q)
-        if not (radius_p > MARGIN * tol and radius_q > MARGIN * tol):
+        theta = _rotate_onto_clear(p, q, MARGIN)
+        if theta is None:
             raise NotGeneric
-        return wrap(math.atan2(px * qy - py * qx, px * qx + py * qy))
+        return theta
 
     @staticmethod
     def angles_at_distance(p: tuple[float, ...], q: tuple[float, ...], delta: float,
                            out_of_reach: bool = False) -> tuple[float, float]:
-        """Subproblem 3: the two θ with |R(k, θ) p − q| = δ, p and q as :meth:`coordinates` (see :func:`harmonic`
-        for ``out_of_reach``)."""
+        """Subproblem 3: the two θ with |R(k, θ) p − q| = δ, p and q as :meth:`coordinates` (see
+        :func:`.subproblems._roots._harmonic_clear` for ``out_of_reach``)."""
         px, py, pz, _, _ = p
         qx, qy, qz, _, _ = q
-        rp2, rq2, delta2 = px * px + py * py, qx * qx + qy * qy, delta * delta
-        c = 0.5 * (rp2 + rq2 + (pz - qz) ** 2 - delta2)
-        return harmonic(px * qx + py * qy, px * qy - py * qx, c, rp2 + rq2 + pz * pz + qz * qz + delta2,
-                        out_of_reach)
+        a, b, c, scale = _distance_equation(px, py, pz, qx, qy, qz, delta)
+        roots = _harmonic_clear(a, b, c, scale, MARGIN, out_of_reach)
+        if roots is None:
+            raise NotGeneric
+        return roots
 
 
 class Height:
@@ -285,7 +253,10 @@ class Height:
     def angles(p: tuple[float, float, float, float], delta: float) -> tuple[float, float]:
         """The two roots; where δ is clearly out of reach, the least-squares root and NaN (as the array solver)."""
         a, b, along, length = p
-        return harmonic(a, b, delta - along, length + abs(delta), out_of_reach=True)
+        roots = _harmonic_clear(a, b, delta - along, length + abs(delta), MARGIN, True)
+        if roots is None:
+            raise NotGeneric
+        return roots
 
 
 class TwoTurns:
@@ -325,32 +296,9 @@ class TwoTurns:
 
     def angles(self, start: tuple[float, ...], goal: tuple[float, ...]) -> tuple[tuple[float, float] | None, ...]:
         """The two pairs, the +γ crossing first; where the cones clearly miss, the least-squares pair (as the
-        array solver gives it, for the FK check to reject) and None for the empty slot."""
-        p1, pn, d1, radius_p, norm_p = goal
-        q2, qn, e2, radius_q, norm_q = start
-        size = norm_p if norm_p > norm_q else norm_q
-        tol, free = GEOMETRY_TOLERANCE * size, self.free_below * size
-        if not (radius_p > MARGIN * free and radius_q > MARGIN * free and abs(norm_p - norm_q) * MARGIN <= tol):
+        array solver gives it, for the FK check to reject) and None for the empty slot
+        (:func:`.subproblems._paden_kahan._subproblem_2_chain_clear`)."""
+        pairs = _subproblem_2_chain_clear(goal, start, self.cos, self.sin, self.sin2, self.free_below, MARGIN)
+        if pairs is None:
             raise NotGeneric
-        cos, sin, sin2 = self.cos, self.sin, self.sin2
-        h1, h2 = p1 / norm_p, q2 / norm_q
-        rho1, rho2 = radius_p / norm_p, radius_q / norm_q
-        alpha, beta = (h1 - cos * h2) / sin2, (h2 - cos * h1) / sin2
-        # subproblems._paden_kahan._crossing_gap, in scalar form
-        if rho1 <= rho2:
-            g = (rho1 - abs(beta * sin)) * (rho1 + abs(beta * sin))
-        else:
-            g = (rho2 - abs(alpha * sin)) * (rho2 + abs(alpha * sin))
-        atan2 = math.atan2
-        s1, c1, s2, c2 = -beta * pn, beta * d1, alpha * qn, alpha * e2
-        margin = MARGIN * _MERGE_RESIDUAL * rho1 * rho2
-        if not g * (rho1 + rho2) > margin:
-            # the cones clearly miss, beyond a near tangency (subproblems._records._NEAR_TANGENT_GAP, which the
-            # array solver reports merged): the least-squares pair and an empty slot
-            if g * (rho1 + rho2) < -margin and -g > 2 * MARGIN * _NEAR_TANGENT_GAP * (rho1 + rho2):
-                return (wrap(-wrap(atan2(s1, c1))), wrap(atan2(s2, c2))), None
-            raise NotGeneric
-        gamma = math.sqrt(g) / sin
-        t1, u1, t2, u2 = gamma * d1, gamma * pn, gamma * e2, gamma * qn
-        return ((wrap(-wrap(atan2(s1 + t1, c1 + u1))), wrap(atan2(s2 - t2, c2 + u2))),
-                (wrap(-wrap(atan2(s1 - t1, c1 - u1))), wrap(atan2(s2 + t2, c2 - u2))))
+        return pairs

@@ -35,7 +35,7 @@ from functools import cached_property
 import numpy as np
 
 from . import _scalar as scalar
-from .._rotations import wrap_angle
+from .._rotations import wrap_angle, wrap_any_float
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
 from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
@@ -540,7 +540,7 @@ class _ThreeParallelOnePose:
         d, p, w_p = self.directions, self.points, self.omega_p
         c_world = scalar.add(scalar.mv(R_A, self.centre), t_A)  # as the array solver: A · centre
         s2, s3, s4 = self.signs
-        wrap, Turn = scalar.wrap_any, scalar.Turn
+        wrap, Turn = wrap_any_float, scalar.Turn
         rows: list[list[float] | None] = []
         codes: list[tuple[int | None, ...]] = []
         for theta1 in self.shoulder.angles(self.shoulder.of(scalar.sub(c_world, p[0])), self.height):

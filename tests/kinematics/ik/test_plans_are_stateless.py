@@ -14,8 +14,12 @@ import threading
 import numpy as np
 import pytest
 
-from service.kinematics import forward_kinematics
+from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, cached_plan
+from service.kinematics.ik._plan import plan_for
+from service.kinematics.ik._positioning import POSITIONERS, Positioner
+from service.kinematics.ik._types import Sealed
+from tests.arms import PUBLISHED_ARMS, published_arm
 from tests.conftest import catalogue_robot
 from tests.ik_helpers import random_configurations
 
@@ -75,3 +79,49 @@ def test_a_kept_plan_and_its_parts_refuse_new_state(client, robot_id):
     for part in parts:
         with pytest.raises(AttributeError, match="shared once built"):
             part.last_targets = np.zeros((1, 4, 4))
+
+
+#: standard-DH rows (a, alpha, d, theta) and joint kinds of small arms whose positioners the catalogue lacks
+SMALL_ARMS = {
+    "Cartesian": ([(0.2, 0.7, 0.3, 0.4), (0.3, -1.1, 0.2, -0.6), (0.1, 0.9, 0.4, 1.3)], "PPP"),
+    "SkewAxes": ([(0.2, 0.7, 0.3, 0.4), (0.3, -1.1, 0.2, -0.6), (0.1, 0.9, 0.4, 1.3)], "RRR"),
+    "SkewAxesWithSlide": ([(0.2, 0.7, 0.3, 0.4), (0.3, -1.1, 0.2, -0.6), (0.1, 0.9, 0.4, 1.3)], "RRP"),
+    "OffsetShoulderIntersectingElbow": ([(0.2, 0.7, 0.3, 0.4), (0.0, -1.1, 0.2, -0.6), (0.1, 0.9, 0.4, 1.3)],
+                                        "RRR"),
+    "IntersectingPair": ([(0.0, 0.7, 0.3, 0.4), (0.3, -1.1, 0.2, -0.6)], "RR"),
+}
+
+
+def test_positioners_are_complete_when_their_constructor_returns(client, monkeypatch):
+    """A positioning family's fit computes its constants and passes them to the constructor: nothing is set on a
+    positioner once its constructor has returned (so a plan's parts are whole before they are sealed). Every
+    positioner that the plans of the catalogue's arms, the published redundant and deficient arms and
+    :data:`SMALL_ARMS` build, position-only and pose, is watched; every family is built at least once."""
+    built: set[str] = set()
+
+    def watched(family):
+        construct = family.__init__
+
+        def __init__(self, *args, **kwargs):
+            construct(self, *args, **kwargs)
+            if type(self) is family:
+                object.__setattr__(self, "_constructed", True)
+                built.add(family.__name__)
+        return __init__
+
+    def refuse_late(self, name, value):
+        assert not vars(self).get("_constructed"), f"{type(self).__name__}.{name} set after its constructor"
+        Sealed.__setattr__(self, name, value)
+
+    for family in POSITIONERS:
+        monkeypatch.setattr(family, "__init__", watched(family))
+    monkeypatch.setattr(Positioner, "__setattr__", refuse_late)
+    kind_names = {"R": "revolute", "P": "prismatic"}
+    robots = [entry.robot for entry in client.app.state.catalogue.entries()]
+    robots += [published_arm(name) for name in PUBLISHED_ARMS if not name.startswith("_")]
+    robots += [Robot([Joint(f"j{i + 1}", kind_names[kind], *row) for i, (row, kind) in enumerate(zip(rows, kinds))])
+               for rows, kinds in SMALL_ARMS.values()]
+    for robot in robots:
+        for constrain_orientation in (True, False):
+            plan_for(robot, constrain_orientation=constrain_orientation, reference=None)
+    assert built == {family.__name__ for family in POSITIONERS}

@@ -3,7 +3,8 @@ of several families (label codes from a side, singular-flag rows, unit vectors, 
 
 A family declares what it needs of its joints in a :class:`Needs` (joint kinds, axes that meet, axes that are
 parallel); :meth:`Positioner.match` checks that table the same way for every family and then asks the family's
-own :meth:`Positioner._fit` for the conditions no table states.
+own :meth:`Positioner._fit` for the conditions no table states. ``_fit`` computes the family's constants and
+passes them to the constructor, so a positioner is complete when built and nothing is set on it afterwards.
 """
 
 from __future__ import annotations
@@ -86,20 +87,24 @@ class Positioner(Sealed):
     """Base class: the joints it moves, its generic solution count and its labels."""
 
     name: str = ""
+    #: the family's generic solution count (an arm whose fit finds a structurally free joint has fewer)
     generic_count: int = 0
     #: what the family needs of its joints (:meth:`match` checks it)
     needs: Needs = Needs(kinds=())
-    #: joints the target never determines (structurally free): set to the reference value or 0
-    free_joints: tuple[int, ...] = ()
 
     def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray,
-                 centre: np.ndarray | None = None) -> None:
+                 centre: np.ndarray | None = None, *, generic_count: int | None = None,
+                 free_joints: tuple[int, ...] = ()) -> None:
         self.geometry = geometry
         self.joints = joints
         self.point = np.asarray(point, dtype=float)
         self.model = geometry.model
         #: the crossing (3,) of the axes ``needs.meeting`` names, world frame at q = 0; None without
         self.centre = centre
+        #: this arm's generic solution count: the family's unless its fit says fewer
+        self.generic_count = type(self).generic_count if generic_count is None else generic_count
+        #: joints the target never determines (structurally free): set to the reference value or 0
+        self.free_joints = free_joints
 
     @classmethod
     def match(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray) -> "Positioner | None":

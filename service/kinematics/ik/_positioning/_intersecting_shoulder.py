@@ -45,19 +45,23 @@ class IntersectingShoulder(Positioner):
     name = "intersecting_shoulder"
     generic_count = 4
     needs = Needs(kinds=("RR?",), meeting=(0, 1))
-    #: the frame of a slide normal to axis 2 through it (the Stanford and polar arms), else None
-    slide_through_axis_2: SlideThroughAxis2 | None = None
+
+    def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray, *,
+                 slide_through_axis_2: SlideThroughAxis2 | None, generic_count: int | None = None,
+                 free_joints: tuple[int, ...] = ()) -> None:
+        super().__init__(geometry, joints, point, centre, generic_count=generic_count, free_joints=free_joints)
+        #: the frame of a slide normal to axis 2 through it (the Stanford and polar arms), else None
+        self.slide_through_axis_2 = slide_through_axis_2
 
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "IntersectingShoulder":
-        solver = cls(geometry, joints, point, centre)
         k = joints[2]
-        if geometry.model.is_revolute[k] and (geometry.on_axis(k, solver.point) or geometry.on_axis(k, centre)):
-            solver.free_joints = (k,)  # subproblem 3 is degenerate for every target
-            solver.generic_count = 2
-        solver.slide_through_axis_2 = SlideThroughAxis2.of(geometry, joints, solver.point, centre)
-        return solver
+        slide = SlideThroughAxis2.of(geometry, joints, point, centre)
+        if geometry.model.is_revolute[k] and (geometry.on_axis(k, point) or geometry.on_axis(k, centre)):
+            # subproblem 3 is degenerate for every target
+            return cls(geometry, joints, point, centre, slide_through_axis_2=slide, generic_count=2, free_joints=(k,))
+        return cls(geometry, joints, point, centre, slide_through_axis_2=slide)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, (i, j, k) = self.geometry, self.joints

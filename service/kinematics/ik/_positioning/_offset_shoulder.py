@@ -46,6 +46,14 @@ class OffsetShoulderParallelElbow(Positioner):
     generic_count = 4
     needs = Needs(kinds=("?R?",))
 
+    def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, *, shoulder: np.ndarray,
+                 forward: np.ndarray | None, generic_count: int | None = None) -> None:
+        super().__init__(geometry, joints, point, generic_count=generic_count)
+        #: axis 2's foot (3,) of the common normal from axis 1 (a slide 1: a point of axis 2)
+        self.shoulder = shoulder
+        #: link 1's forward direction (3,), the shoulder offset normal to axis 1; None for a slide 1
+        self.forward = forward
+
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "OffsetShoulderParallelElbow | None":
@@ -61,15 +69,13 @@ class OffsetShoulderParallelElbow(Positioner):
                 return None
         elif abs(float(geometry.direction(i) @ u)) <= GEOMETRY_TOLERANCE:
             return None
-        solver = cls(geometry, joints, point)
         if geometry.model.is_revolute[i]:
-            shoulder_on_1, solver.shoulder = _common_normal_feet(geometry.point(i), geometry.direction(i),
-                                                                 geometry.point(j), u)
-            offset = solver.shoulder - shoulder_on_1
-            solver.forward = _unit(offset - (offset @ geometry.direction(i)) * geometry.direction(i))
-        else:
-            solver.generic_count, solver.shoulder, solver.forward = 2, geometry.point(j), None
-        return solver
+            shoulder_on_1, shoulder = _common_normal_feet(geometry.point(i), geometry.direction(i),
+                                                          geometry.point(j), u)
+            offset = shoulder - shoulder_on_1
+            forward = _unit(offset - (offset @ geometry.direction(i)) * geometry.direction(i))
+            return cls(geometry, joints, point, shoulder=shoulder, forward=forward)
+        return cls(geometry, joints, point, shoulder=geometry.point(j), forward=None, generic_count=2)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, (i, j, k) = self.geometry, self.joints

@@ -61,11 +61,9 @@ class PlanarTwoLink(Positioner):
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "PlanarTwoLink":
-        solver = cls(geometry, joints, point)
-        if geometry.on_axis(joints[1], solver.point):
-            solver.free_joints = (joints[1],)  # subproblem 3 is degenerate for every target
-            solver.generic_count = 1
-        return solver
+        if geometry.on_axis(joints[1], point):  # subproblem 3 is degenerate for every target
+            return cls(geometry, joints, point, generic_count=1, free_joints=(joints[1],))
+        return cls(geometry, joints, point)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, (i, j) = self.geometry, self.joints
@@ -170,16 +168,20 @@ class SkewAxes(Positioner):
     generic_count = 4
     needs = Needs(kinds=("RRR",))
 
+    def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, *,
+                 feet: tuple[np.ndarray, np.ndarray]) -> None:
+        super().__init__(geometry, joints, point)
+        #: the feet (3,) on axes 2 and 3 of their common normal
+        self.feet = feet
+
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "SkewAxes | None":
         _, j, k = joints
         if geometry.parallel(j, k) or geometry.intersection(j, k) is not None or geometry.on_axis(k, point):
             return None
-        solver = cls(geometry, joints, point)
-        solver.feet = _common_normal_feet(geometry.point(j), geometry.direction(j), geometry.point(k),
-                                          geometry.direction(k))
-        return solver
+        return cls(geometry, joints, point, feet=_common_normal_feet(geometry.point(j), geometry.direction(j),
+                                                                     geometry.point(k), geometry.direction(k)))
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, (i, j, k) = self.geometry, self.joints

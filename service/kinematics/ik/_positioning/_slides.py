@@ -90,18 +90,23 @@ class OneRevoluteTwoPrismatic(Positioner):
     generic_count = 2
     needs = Needs(kinds=("RPP", "PRP", "PPR"))
 
+    def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, *, revolute: int,
+                 slides: tuple[int, int]) -> None:
+        super().__init__(geometry, joints, point)
+        #: the revolute joint and the two slides (indices into the arm)
+        self.revolute, self.slides = revolute, slides
+
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "OneRevoluteTwoPrismatic | None":
         kinds = geometry.kinds(joints)
-        solver = cls(geometry, joints, point)
-        solver.revolute = joints[kinds.index("R")]
-        solver.slides = tuple(joint for joint in joints if joint != solver.revolute)
-        omega = geometry.direction(solver.revolute)
-        axial = np.array([omega @ geometry.direction(s) for s in solver.slides])
+        revolute = joints[kinds.index("R")]
+        slides = tuple(joint for joint in joints if joint != revolute)
+        omega = geometry.direction(revolute)
+        axial = np.array([omega @ geometry.direction(s) for s in slides])
         if np.abs(axial).max() <= GEOMETRY_TOLERANCE:
             return None  # no slide along the axis: the height equation does not fix them
-        return solver
+        return cls(geometry, joints, point, revolute=revolute, slides=slides)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, r = self.geometry, self.revolute
@@ -161,15 +166,19 @@ class Cartesian(Positioner):
     generic_count = 1
     needs = Needs(kinds=("PPP",))
 
+    def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, *,
+                 inverse: np.ndarray) -> None:
+        super().__init__(geometry, joints, point)
+        #: the inverse (3, 3) of the slides' directions as columns
+        self.inverse = inverse
+
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "Cartesian | None":
         V = np.stack([geometry.direction(j) for j in joints], axis=1)
         if abs(np.linalg.det(V)) < GEOMETRY_TOLERANCE:
             return None
-        solver = cls(geometry, joints, point)
-        solver.inverse = np.linalg.inv(V)
-        return solver
+        return cls(geometry, joints, point, inverse=np.linalg.inv(V))
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         joints = (targets - self.point) @ self.inverse.T
@@ -204,6 +213,12 @@ class SkewAxesWithSlide(Positioner):
     generic_count = 4
     needs = Needs(kinds=("RRP", "RPR", "PRR"))
 
+    def __init__(self, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, *, kinds: str, slide: int,
+                 revolute: tuple[int, int], generic_count: int | None = None) -> None:
+        super().__init__(geometry, joints, point, generic_count=generic_count)
+        #: the joints' kinds ("RRP", "RPR" or "PRR"), the slide and the two revolute joints in chain order
+        self.kinds, self.slide, self.revolute = kinds, slide, revolute
+
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "SkewAxesWithSlide | None":
@@ -226,11 +241,8 @@ class SkewAxesWithSlide(Positioner):
         if GEOMETRY_TOLERANCE < along <= RECOGNITION_TOLERANCE \
                 or 10 * GEOMETRY_TOLERANCE < turn <= RECOGNITION_TOLERANCE:
             return None  # nearly special (a rounded SCARA): the idealised family answers, refined on this arm
-        solver = cls(geometry, joints, point)
-        solver.kinds, solver.slide, solver.revolute = kinds, slide, tuple(revolute)
-        if geometry.parallel(eliminated, circle) and not normal:
-            solver.generic_count = 2
-        return solver
+        return cls(geometry, joints, point, kinds=kinds, slide=slide, revolute=tuple(revolute),
+                   generic_count=2 if geometry.parallel(eliminated, circle) and not normal else None)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, kinds = self.geometry, self.kinds

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._errors import InvalidInputError
-from ..._rotations import wrap_angle
+from ..._rotations import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE
 from ._records import _GAP_ROUNDING, _MERGE_SIN_SQUARED, _NEAR_TANGENT_GAP, AnglePairSolutions, AngleSolutions
 from ._roots import _harmonic
@@ -255,9 +255,56 @@ def _crossing_gap(rho1, rho2, alpha_sin, beta_sin):
     carries an absolute error of about 1e-16: near a wrist singularity (a radius ``eps``, ``g ~ eps**2``) that
     moved the roots by ``1e-16 / eps`` and, below ``eps ~ 1e-8``, merged the two roots into one wrong one.
     """
-    first = (rho1 - np.abs(beta_sin)) * (rho1 + np.abs(beta_sin))
-    second = (rho2 - np.abs(alpha_sin)) * (rho2 + np.abs(alpha_sin))
-    return np.where(rho1 <= rho2, first, second)
+    return np.where(rho1 <= rho2, _circle_gap(rho1, beta_sin), _circle_gap(rho2, alpha_sin))
+
+
+def _circle_gap(rho, offset):
+    """``rho**2 - offset**2`` as ``(rho - |offset|) (rho + |offset|)``, on floats or arrays: :func:`_crossing_gap`
+    on the circle of radius ``rho``, the crossings' offset ``offset`` from the axes' plane."""
+    return (rho - abs(offset)) * (rho + abs(offset))
+
+
+def _subproblem_2_chain_clear(p: tuple[float, ...], q: tuple[float, ...], cos: float, sin: float, sin2: float,
+                              free_below: float, margin: float
+                              ) -> tuple[tuple[float, float], tuple[float, float] | None] | None:
+    """:func:`subproblem_2_chain` on floats where its answer is clear, for the one-pose paths (numpy's per-call
+    cost would exceed the arithmetic): :func:`subproblem_2` with ``theta1`` negated.
+
+    ``p`` (the chain's goal) is ``(p1, pn, d1, radius_p, norm_p)`` and ``q`` (its start) ``(q2, qn, e2, radius_q,
+    norm_q)``, as :func:`subproblem_2` names them; ``cos``, ``sin`` and ``sin2`` are ``k1 . k2``, ``||k1 x k2||``
+    and its square as :func:`subproblem_2` computes them; ``free_below`` the radius (relative to the vectors'
+    size) at or below which the caller holds a joint free. Returns the two ``(theta1, theta2)`` slots, the
+    +gamma crossing first; where the cones clearly miss (beyond a near tangency,
+    :data:`._records._NEAR_TANGENT_GAP`, that :func:`subproblem_2` reports merged) the least-squares pair and
+    None; and None where a quantity is within ``margin`` times its band of one of :func:`subproblem_2`'s
+    thresholds (a free joint, norms that differ, crossings that merge).
+    """
+    p1, pn, d1, radius_p, norm_p = p
+    q2, qn, e2, radius_q, norm_q = q
+    size = norm_p if norm_p > norm_q else norm_q
+    tol, free = GEOMETRY_TOLERANCE * size, free_below * size
+    if not (radius_p > margin * free and radius_q > margin * free and abs(norm_p - norm_q) * margin <= tol):
+        return None
+    h1, h2 = p1 / norm_p, q2 / norm_q
+    rho1, rho2 = radius_p / norm_p, radius_q / norm_q
+    alpha, beta = (h1 - cos * h2) / sin2, (h2 - cos * h1) / sin2
+    if rho1 <= rho2:
+        rho, g = rho1, _circle_gap(rho1, beta * sin)
+    else:
+        rho, g = rho2, _circle_gap(rho2, alpha * sin)
+    merge_below = _MERGE_SIN_SQUARED * rho
+    if merge_below < _GAP_ROUNDING:
+        merge_below = _GAP_ROUNDING
+    atan2, wrap = math.atan2, wrap_float
+    s1, c1, s2, c2 = -beta * pn, beta * d1, alpha * qn, alpha * e2
+    if not g > margin * merge_below * rho:
+        if -g > 2 * margin * _NEAR_TANGENT_GAP * (rho1 + rho2):
+            return (wrap(-wrap(atan2(s1, c1))), wrap(atan2(s2, c2))), None
+        return None
+    gamma = math.sqrt(g) / sin
+    t1, u1, t2, u2 = gamma * d1, gamma * pn, gamma * e2, gamma * qn
+    return ((wrap(-wrap(atan2(s1 + t1, c1 + u1))), wrap(atan2(s2 - t2, c2 + u2))),
+            (wrap(-wrap(atan2(s1 - t1, c1 - u1))), wrap(atan2(s2 + t2, c2 - u2))))
 
 
 def subproblem_2_chain(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> AnglePairSolutions:
@@ -342,14 +389,18 @@ def subproblem_3(k: ArrayLike, p: ArrayLike, q: ArrayLike, delta: ArrayLike) -> 
     q = _points(q, "q")
     delta = _distances(delta, "delta")
     frame = axis_frame(k)
-    px, py, pz = _coords(p, frame)
-    qx, qy, qz = _coords(q, frame)
+    return _harmonic(*_distance_equation(*_coords(p, frame), *_coords(q, frame), delta))
+
+
+def _distance_equation(px, py, pz, qx, qy, qz, delta):
+    """Subproblem 3 as the harmonic equation ``a cos(theta) + b sin(theta) = c``: ``(a, b, c, scale)`` from the
+    coordinates of ``p`` and ``q`` in the axis frame, on floats or arrays (see :func:`subproblem_3`)."""
     rp2 = px * px + py * py
     rq2 = qx * qx + qy * qy
     delta2 = delta * delta
     c = 0.5 * (rp2 + rq2 + (pz - qz) ** 2 - delta2)
     scale = rp2 + rq2 + pz * pz + qz * qz + delta2
-    return _harmonic(px * qx + py * qy, px * qy - py * qx, c, scale)
+    return px * qx + py * qy, px * qy - py * qx, c, scale
 
 
 def subproblem_4(h: ArrayLike, k: ArrayLike, p: ArrayLike, delta: ArrayLike) -> AngleSolutions:

@@ -1,7 +1,8 @@
 """Roots of the scalar equations the subproblems reduce to.
 
 * The harmonic equation ``a cos(theta) + b sin(theta) = c`` (:func:`_harmonic`): subproblems 3 and 4, the
-  two-link elbow, the degenerate rows of the quartic and of subproblem 6, and the turn-slide split.
+  two-link elbow, the degenerate rows of the quartic and of subproblem 6, and the turn-slide split; on floats,
+  where its answer is clear, :func:`_harmonic_clear` (the one-pose paths).
 * The quadratic ``A t² + B t + C = 0`` with a rounding band for its double root (:func:`quadratic_roots`): the
   cylindrical positioners' slides.
 * The trigonometric quartic ``alpha0 + alpha1 cos t + beta1 sin t + alpha2 cos 2t + beta2 sin 2t = 0``
@@ -11,10 +12,12 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._rotations import wrap_angle
+from ..._rotations import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
 from ._records import _MERGE_COS_GAP, AngleSolutions
 from ._vectors import _hypot, _pair
@@ -58,6 +61,27 @@ def _harmonic(a: ArrayLike, b: ArrayLike, c: ArrayLike, scale: ArrayLike) -> Ang
         degenerate=np.array(degenerate),
         merged=np.asarray(merged),
     )
+
+
+def _harmonic_clear(a: float, b: float, c: float, scale: float, margin: float,
+                    out_of_reach: bool = False) -> tuple[float, float] | None:
+    """:func:`_harmonic` on floats where its answer is clear, for the one-pose paths (numpy's per-call cost
+    would exceed the arithmetic): the two roots ``phi + half`` and ``phi - half``, or None where a quantity is
+    within ``margin`` times its band of one of :func:`_harmonic`'s thresholds (degenerate, exact, merged).
+
+    With ``out_of_reach``, a ``c`` clearly out of reach gives :func:`_harmonic`'s least-squares root and NaN
+    (its empty second slot); without it, None.
+    """
+    tol = GEOMETRY_TOLERANCE * scale
+    rho = math.sqrt(a * a + b * b)
+    excess = abs(c) - rho
+    phi = math.atan2(b, a)
+    if out_of_reach and rho > margin * tol and excess > margin * tol:
+        return wrap_float(phi + math.atan2(0.0, c)), math.nan
+    if not (rho > margin * tol and -excess > margin * (rho * _MERGE_COS_GAP + tol)):
+        return None
+    half = math.atan2(math.sqrt(-excess * (rho + abs(c))), c)
+    return wrap_float(phi + half), wrap_float(phi - half)
 
 
 def quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale: float

@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._errors import InvalidInputError
-from ..._rotations import wrap_angle
+from ..._rotations import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
 
 
@@ -179,3 +179,15 @@ def _rotate_onto(
     free_below = tol if free_below is None else free_below
     degenerate = (radius_p <= free_below) | (radius_q <= free_below)
     return np.where(degenerate, 0.0, wrap_angle(theta)), exact, degenerate
+
+
+def _rotate_onto_clear(p: tuple[float, ...], q: tuple[float, ...], margin: float) -> float | None:
+    """:func:`_rotate_onto` on floats where its answer is clear, for the one-pose paths (numpy's per-call cost
+    would exceed the arithmetic): ``p`` and ``q`` as ``(x, y, z, radius, length)`` in the axis frame; theta, or
+    None where either lies within ``margin`` times the tolerance of the axis (degenerate)."""
+    px, py, _, radius_p, length_p = p
+    qx, qy, _, radius_q, length_q = q
+    tol = GEOMETRY_TOLERANCE * (length_p if length_p > length_q else length_q)
+    if not (radius_p > margin * tol and radius_q > margin * tol):
+        return None
+    return wrap_float(math.atan2(px * qy - py * qx, px * qx + py * qy))

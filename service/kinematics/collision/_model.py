@@ -420,7 +420,7 @@ def _close_pairs(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_coun
     count, pairs = pair_distances.shape
     clearance = pair_distances.min(axis=1) if pairs else np.full(count, np.inf)
     close = np.flatnonzero(clearance < margin)  # the configurations that have a close pair
-    body_distances = _body_distances(pair_distances[close], body_pair_of, body_count)
+    body_distances = _body_distances(np.take(pair_distances, close, axis=0), body_pair_of, body_count)
     rows, bodies = np.nonzero(body_distances < margin)  # by configuration, then by body pair
     values = body_distances[rows, bodies]
     rows = close[rows]
@@ -438,7 +438,7 @@ def _body_distances(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_c
     if body_count == len(body_pair_of) and (body_pair_of == np.arange(body_count)).all():
         return pair_distances
     first_column = np.unique(body_pair_of, return_index=True)[1]  # each body pair's first shape pair
-    body_distances = pair_distances[:, first_column]
+    body_distances = np.take(pair_distances, first_column, axis=1)
     for column in np.flatnonzero(first_column[body_pair_of] != np.arange(len(body_pair_of))).tolist():
         body = body_pair_of[column]
         np.minimum(body_distances[:, body], pair_distances[:, column], out=body_distances[:, body])

@@ -107,8 +107,17 @@ def _clearances(table: SolutionTable) -> list[float | None]:
 
 
 def _contacts(table: SolutionTable) -> list[list[dict]]:
-    """Each row's pairs closer than the margin, as the wire names them."""
-    return [[{"a": a, "b": b, "distance": distance} for a, b, distance in row] for row in table.contacts]
+    """Each row's pairs closer than the margin, as the wire names them (worded once, from the columns)."""
+    contacts = table.contacts
+    listed = contacts.pairs >= 0
+    names = contacts.names
+    entries = [{"a": names[pair][0], "b": names[pair][1], "distance": distance}
+               for pair, distance in zip(contacts.pairs[listed].tolist(), contacts.distances[listed].tolist())]
+    rows, start = [], 0
+    for count in listed.sum(axis=1).tolist():
+        rows.append(entries[start:start + count])
+        start += count
+    return rows
 
 
 def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget: Budget) -> dict:

@@ -16,7 +16,7 @@ from ._distances import (
     separation,
     sphere_sphere,
 )
-from ._clearance import Clearances, CollisionRequest, at_collisions, clearances, colliding, frame_index, link_names, model_for
+from ._clearance import Clearances, CollisionRequest, Contacts, at_collisions, clearances, colliding, frame_index, link_names, model_for
 from ._model import CollisionCheck, CollisionModel, ShapePair, collision_model
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere, restated, scaled
 
@@ -27,6 +27,7 @@ __all__ = [
     "CollisionRequest",
     "CollisionCheck",
     "CollisionModel",
+    "Contacts",
     "LinkShape",
     "Obstacle",
     "Separation",

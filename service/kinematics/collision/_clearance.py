@@ -143,26 +143,74 @@ def _compiled(robot, obstacles, *, self_collision: bool, ignore) -> CollisionMod
         raise
 
 
+@dataclass(frozen=True, eq=False)
+class Contacts:
+    """Each of S rows' body pairs closer than the margin, nearest first, as columns of a common width C (the
+    most any row has): ``pairs`` (S, C) indices into ``names`` (the bodies (a, b) of each pair), −1 past a row's
+    last; ``distances`` (S, C), their signed distances (NaN past the last).
+
+    Rows are taken and laid end to end as numbers (:meth:`take`, :meth:`concat`); a row is worded only when
+    read: ``contacts[i]`` is row i's tuple of (a, b, distance), and iterating gives every row's.
+    """
+
+    names: tuple[tuple[str, str], ...]
+    pairs: np.ndarray
+    distances: np.ndarray
+
+    @classmethod
+    def none(cls, count: int) -> "Contacts":
+        """``count`` rows without a close pair."""
+        return cls((), np.zeros((count, 0), dtype=np.intp), np.zeros((count, 0)))
+
+    @classmethod
+    def of_check(cls, check: CollisionCheck, model: CollisionModel) -> "Contacts":
+        """The close pairs of a model's check, from its per-configuration lists."""
+        counts = np.diff(check.offsets)
+        count, width = len(counts), int(counts.max(initial=0))
+        pairs, distances = np.full((count, width), -1, dtype=np.intp), np.full((count, width), np.nan)
+        if width:
+            rows = np.repeat(np.arange(count), counts)
+            slots = np.arange(len(rows)) - check.offsets[rows]
+            pairs[rows, slots], distances[rows, slots] = check.body_pairs, check.distances
+        return cls(model.body_pairs, pairs, distances)
+
+    def __len__(self) -> int:
+        return len(self.pairs)
+
+    def __getitem__(self, row: int) -> tuple[tuple[str, str, float], ...]:
+        return tuple((*self.names[pair], distance) for pair, distance in
+                     zip(self.pairs[row].tolist(), self.distances[row].tolist()) if pair >= 0)
+
+    def __iter__(self):
+        return (self[row] for row in range(len(self)))
+
+    def take(self, index: np.ndarray) -> "Contacts":
+        """The rows ``index`` (indices or a boolean mask), in that order."""
+        return Contacts(self.names, self.pairs[index], self.distances[index])
+
+    @classmethod
+    def concat(cls, parts: list["Contacts"]) -> "Contacts":
+        """The rows of ``parts`` in turn, on one list of names (in order of first appearance)."""
+        names: dict[tuple[str, str], int] = {}
+        width = max((part.pairs.shape[1] for part in parts), default=0)
+        pairs, distances = [], []
+        for part in parts:
+            lookup = np.array([*(names.setdefault(name, len(names)) for name in part.names), -1], dtype=np.intp)
+            padding = width - part.pairs.shape[1]
+            pairs.append(np.pad(lookup[part.pairs], ((0, 0), (0, padding)), constant_values=-1))
+            distances.append(np.pad(part.distances, ((0, 0), (0, padding)), constant_values=np.nan))
+        return cls(tuple(names), np.concatenate(pairs), np.concatenate(distances))
+
+
 @dataclass(frozen=True)
 class Clearances:
     """The collision check of S joint vectors: ``clearance`` (S,), the smallest signed distance over the checked
     pairs (length unit, negative in overlap, +inf when nothing is checked); ``colliding`` (S,), a pair closer
-    than the margin; ``contacts`` (S,) object, each a tuple of (a, b, distance) for the pairs closer than the
-    margin, nearest first."""
+    than the margin; ``contacts``, those pairs (:class:`Contacts`)."""
 
     clearance: np.ndarray
     colliding: np.ndarray
-    contacts: np.ndarray
-
-
-_NO_CONTACTS: tuple = ()
-
-
-def _as_objects(items: list) -> np.ndarray:
-    """A 1-D object array of ``items`` (tuples stay elements; numpy would make a 2-D array of equal-length ones)."""
-    array = np.empty(len(items), dtype=object)
-    array[:] = items
-    return array
+    contacts: Contacts
 
 
 def _checked(robot, request: CollisionRequest, joints: np.ndarray) -> tuple[CollisionModel, CollisionCheck]:
@@ -180,10 +228,4 @@ def colliding(robot, request: CollisionRequest, joints: np.ndarray) -> np.ndarra
 def clearances(robot, request: CollisionRequest, joints: np.ndarray) -> Clearances:
     """The collision check of joint vectors (S, n) under ``request`` (see :class:`Clearances`)."""
     model, check = _checked(robot, request, joints)
-    count = len(check.clearance)
-    contacts = np.empty(count, dtype=object)
-    contacts[:] = [_NO_CONTACTS] * count
-    rows = np.flatnonzero(check.colliding)
-    if len(rows):
-        contacts[rows] = _as_objects(check.close_pairs_of(model, rows.tolist()))
-    return Clearances(check.clearance, check.colliding, contacts)
+    return Clearances(check.clearance, check.colliding, Contacts.of_check(check, model))

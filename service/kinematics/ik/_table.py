@@ -14,6 +14,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from ..collision import Contacts
 from ._types import LabelCodes
 
 
@@ -34,9 +35,11 @@ class SolutionTable:
         target; NaN for a position-only target).
     labels : dict
         Branch labels: name → (values, codes (S,) int8), ``values[code]`` the row's label, −1 where it has none.
-    clearance, contacts : ndarrays, shape (S,), optional
+    clearance : ndarray, shape (S,), optional
+    contacts : Contacts, optional
         With a collision check (:mod:`service.kinematics.collision`): the smallest signed distance over the
-        checked pairs, and each row's pairs closer than the margin (a tuple of (a, b, distance)). None without.
+        checked pairs, and each row's pairs closer than the margin (:class:`~..collision.Contacts`, S rows).
+        None without.
     roll : ndarray, shape (S,), optional
         A direction target solved over its free roll (:mod:`._direction`): the row's roll of the tool about the
         tool axis, radians in (−π, π] (:func:`~._direction.rolls_of`); NaN for rows of other targets. None when
@@ -50,7 +53,7 @@ class SolutionTable:
     orientation: np.ndarray
     labels: LabelCodes
     clearance: np.ndarray | None = None
-    contacts: np.ndarray | None = None
+    contacts: Contacts | None = None
     roll: np.ndarray | None = None
 
     @classmethod
@@ -68,7 +71,7 @@ class SolutionTable:
                              self.position[index], self.orientation[index],
                              {name: (values, codes[index]) for name, (values, codes) in self.labels.items()},
                              None if self.clearance is None else self.clearance[index],
-                             None if self.contacts is None else self.contacts[index],
+                             None if self.contacts is None else self.contacts.take(index),
                              None if self.roll is None else self.roll[index])
 
     def with_targets(self, target: np.ndarray) -> "SolutionTable":
@@ -77,7 +80,7 @@ class SolutionTable:
         return SolutionTable(np.asarray(target, dtype=np.int64), self.joints, self.within_limits, self.position,
                              self.orientation, self.labels, self.clearance, self.contacts, self.roll)
 
-    def with_clearances(self, clearance: np.ndarray, contacts: np.ndarray) -> "SolutionTable":
+    def with_clearances(self, clearance: np.ndarray, contacts: Contacts) -> "SolutionTable":
         """The same rows with their collision check (see the class docstring)."""
         return replace(self, clearance=clearance, contacts=contacts)
 
@@ -101,8 +104,8 @@ class SolutionTable:
                     merged_labels([t.labels for t in tables], [len(t) for t in tables]),
                     np.concatenate([t.clearance if t.clearance is not None else np.full(len(t), np.inf)
                                     for t in tables]) if checked else None,
-                    np.concatenate([t.contacts if t.contacts is not None else _no_contacts(len(t))
-                                    for t in tables]) if checked else None,
+                    Contacts.concat([t.contacts if t.contacts is not None else Contacts.none(len(t))
+                                     for t in tables]) if checked else None,
                     np.concatenate([t.roll if t.roll is not None else np.full(len(t), np.nan) for t in tables])
                     if any(t.roll is not None for t in tables) else None)
         if (np.diff(table.target) < 0).any():
@@ -144,8 +147,3 @@ def merged_labels(pieces: list[LabelCodes], lengths: list[int]) -> LabelCodes:
         merged[name] = (tuple(vocabulary), np.concatenate(columns) if len(columns) > 1 else columns[0])
     return merged
 
-
-def _no_contacts(count: int) -> np.ndarray:
-    contacts = np.empty(count, dtype=object)
-    contacts[:] = [()] * count
-    return contacts

@@ -29,7 +29,8 @@ from typing import Callable, NamedTuple, Sequence
 import numpy as np
 
 from .._errors import InvalidInputError
-from ._distances import Separation, _box_box, _box_point_local, _box_segment, _dot, _quiet, _segment_segment, _swept
+from ._distances import (_TINY, Separation, _box_box, _box_point_local, _box_segment, _clip_unit, _dot, _quiet,
+                         _segment_segment, _swept)
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 
 #: Pair evaluations per block (configurations × pairs of the widest group). Large enough that numpy's cost per
@@ -78,11 +79,12 @@ class _Group(NamedTuple):
     radius_b: np.ndarray
     swapped: np.ndarray  # (P_k,) bool
     bounds: Callable | None  # the kernel's cheap bounds (None: none, every pair is measured)
-    reach: np.ndarray  # (P_k, 1): half the round shapes' lengths, summed: what the bounds leave open
+    measured_rows: np.ndarray  # (P_k, m): the rows the distances and bounds read (see _evaluate)
+    reach: np.ndarray  # (P_k, 1): half the length of the round shape the bounds take as its middle
 
-    def inputs(self) -> tuple:
-        """The kernel's inputs: the rows (m, P_k) and the four sizes."""
-        return self.rows.T, self.half_size_a, self.half_size_b, self.radius_a, self.radius_b
+    def sizes(self) -> tuple:
+        """The kernel's four sizes."""
+        return self.half_size_a, self.half_size_b, self.radius_a, self.radius_b
 
 
 class CollisionCheck(NamedTuple):
@@ -289,9 +291,12 @@ class CollisionModel:
         of its clearance over these pairs, and a pair whose lower bound is at least max(U, margin) can be
         neither the clearance nor a close pair (a pair that attains U is measured, unless its bounds meet). Such
         a pair keeps its lower bound in ``result``.
+
+        The rows are read in :attr:`_Group.measured_rows` order (of two round shapes the longer first, for the
+        bounds); the witnesses read the pairs' own order (``rows``), whose distances agree to rounding.
         """
-        parts = [(group.start, group.stop, group.kernel, group.bounds, group.inputs(),
-                  group.reach) for group in self._groups]
+        parts = [(group.start, group.stop, group.kernel, group.bounds, group.sizes(), group.reach,
+                  group.measured_rows.T) for group in self._groups]
         count = columns.shape[2]
         block = max(1, min(count, _BLOCK_ELEMENTS // max(part[1] - part[0] for part in parts)))
         world = self._world_buffer(block)
@@ -301,20 +306,20 @@ class CollisionModel:
                 placed = world[:, :, : end - begin]
                 self._world_rows(columns[:, :, begin:end], placed)
                 # (3, m, P_k, B): each row a contiguous block
-                gathered = [np.take(placed, rows, axis=1) for _, _, _, _, (rows, *_), _ in parts]
+                gathered = [np.take(placed, rows, axis=1) for *_, rows in parts]
                 if margin is None:
-                    for (start, stop, kernel, _, (_, *sizes), _), rows in zip(parts, gathered):
+                    for (start, stop, kernel, _, sizes, _, _), rows in zip(parts, gathered):
                         result[begin:end, start:stop] = kernel(rows, *sizes, witness=False).T
                     continue
                 bounds = [None if bound is None else bound(rows, *sizes, reach)
-                          for (_, _, _, bound, (_, *sizes), reach), rows in zip(parts, gathered)]
+                          for (_, _, _, bound, sizes, reach, _), rows in zip(parts, gathered)]
                 upper = np.full(end - begin, np.inf)
                 for bound in bounds:
                     if bound is not None:
                         np.fmin(upper, bound[1].min(axis=0), out=upper)
                 # rounding: the bounds are as accurate as the coordinates; keep a pair they leave in doubt
                 cutoff = np.maximum(upper, margin) + _BOUND_SLACK * (1.0 + np.abs(placed).max())
-                for (start, stop, kernel, _, (_, *sizes), _), rows, bound in zip(parts, gathered, bounds):
+                for (start, stop, kernel, _, sizes, _, _), rows, bound in zip(parts, gathered, bounds):
                     result[begin:end, start:stop] = _measured(kernel, rows, sizes, bound, cutoff).T
 
 
@@ -389,13 +394,18 @@ _BOUND_SLACK = 1e-9
 
 
 def _round_round_bounds(rows, half_size_a, half_size_b, radius_a, radius_b, reach):
-    """Lower and upper bounds (P, B) of capsules' and spheres' distances from their middles: the balls of
-    radius r about the middles lie inside the shapes, the shapes inside the balls of radius r + half length."""
-    between = rows[:, 0] + rows[:, 1]
-    between -= rows[:, 2]
-    between -= rows[:, 3]  # twice the middles' difference
-    upper = np.sqrt(_dot(between, between))
-    upper *= 0.5
+    """Lower and upper bounds (P, B) of capsules' and spheres' distances from the distance of one's core (rows
+    0, 1: the longer segment) to the other's middle (rows 2, 3: the shorter one's ends): the other shape holds
+    the ball of radius r about its middle and lies inside the ball of radius r + half its length (``reach``)."""
+    segment = rows[:, 1] - rows[:, 0]
+    gap = rows[:, 2] + rows[:, 3]
+    gap *= 0.5
+    gap -= rows[:, 0]  # the middle, from the segment's start
+    along = _dot(gap, segment)
+    along /= np.maximum(_dot(segment, segment), _TINY)
+    _clip_unit(along)
+    gap -= along * segment
+    upper = np.sqrt(_dot(gap, gap))
     upper -= radius_a + radius_b
     return upper - reach, upper
 
@@ -541,7 +551,11 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
         pair = ShapePair(names[shapes[index].link], b, shapes[index].link, link_b, index, index_b,
                          f"{_KIND_NAMES[type(first)]}-{_KIND_NAMES[type(second)]}")
         rows = _kernel_rows(first, first_rows) + _kernel_rows(second, second_rows)
-        members[(_family(first), _family(second))].append((pair, rows, first, second, swapped))
+        # the bounds take the shorter round shape's middle: it comes second (the distance of two round shapes
+        # is symmetric, and radii enter as their sum)
+        shorter_first = _family(first) == "round" and _half_length(first) < _half_length(second)
+        measured_rows = rows[2:] + rows[:2] if shorter_first else rows
+        members[(_family(first), _family(second))].append((pair, rows, first, second, swapped, measured_rows))
 
     pairs: list[ShapePair] = []
     groups: list[_Group] = []
@@ -555,7 +569,8 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
         groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in members[family]]),
                              _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
                              np.array([member[4] for member in members[family]], dtype=bool),
-                             _BOUNDS.get(family), _reaches(firsts, seconds)))
+                             _BOUNDS.get(family), np.array([member[5] for member in members[family]]),
+                             np.array([[min(_half_length(a), _half_length(b))] for a, b in zip(firsts, seconds)])))
     body_pairs: dict[tuple[str, str], int] = {}
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)
@@ -582,11 +597,11 @@ def _family(shape: Shape) -> str:
     return "box" if isinstance(shape, Box) else "round"
 
 
-def _reaches(firsts: list[Shape], seconds: list[Shape]) -> np.ndarray:
-    """(P_k, 1): half the length of each pair's capsules, summed (0 for spheres and boxes)."""
-    def half_length(shape: Shape) -> float:
-        return 0.5 * float(np.linalg.norm(shape.end - shape.start)) if isinstance(shape, Capsule) else 0.0
-    return np.array([half_length(a) + half_length(b) for a, b in zip(firsts, seconds)])[:, None]
+def _half_length(shape: Shape) -> float:
+    """Half a capsule's length (0 for a sphere; a box is never a round shape's middle: +inf)."""
+    if isinstance(shape, Capsule):
+        return 0.5 * float(np.linalg.norm(shape.end - shape.start))
+    return 0.0 if isinstance(shape, Sphere) else np.inf
 
 
 def _half_sizes(shapes: list[Shape]) -> np.ndarray:

@@ -29,7 +29,7 @@ from typing import Callable, NamedTuple, Sequence
 import numpy as np
 
 from .._errors import InvalidInputError
-from ._distances import (_TINY, Separation, _box_box, _box_point_local, _box_segment, _clip_unit, _dot, _quiet,
+from ._distances import (Separation, _box_box, _box_point_local, _box_segment, _clip_unit, _dot, _quiet,
                          _segment_segment, _swept)
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 
@@ -80,7 +80,7 @@ class _Group(NamedTuple):
     swapped: np.ndarray  # (P_k,) bool
     bounds: Callable | None  # the kernel's cheap bounds (None: none, every pair is measured)
     measured_rows: np.ndarray  # (P_k, m): the rows the distances and bounds read (see _evaluate)
-    reach: np.ndarray  # (P_k, 1): half the length of the round shape the bounds take as its middle
+    bound_constants: tuple  # the bounds' sizes, single precision (see the bound functions)
 
     def sizes(self) -> tuple:
         """The kernel's four sizes."""
@@ -295,7 +295,7 @@ class CollisionModel:
         The rows are read in :attr:`_Group.measured_rows` order (of two round shapes the longer first, for the
         bounds); the witnesses read the pairs' own order (``rows``), whose distances agree to rounding.
         """
-        parts = [(group.start, group.stop, group.kernel, group.bounds, group.sizes(), group.reach,
+        parts = [(group.start, group.stop, group.kernel, group.bounds, group.sizes(), group.bound_constants,
                   group.measured_rows.T) for group in self._groups]
         count = columns.shape[2]
         block = max(1, min(count, _BLOCK_ELEMENTS // max(part[1] - part[0] for part in parts)))
@@ -305,22 +305,28 @@ class CollisionModel:
                 end = min(begin + block, count)
                 placed = world[:, :, : end - begin]
                 self._world_rows(columns[:, :, begin:end], placed)
-                # (3, m, P_k, B): each row a contiguous block
-                gathered = [np.take(placed, rows, axis=1) for *_, rows in parts]
                 if margin is None:
-                    for (start, stop, kernel, _, sizes, _, _), rows in zip(parts, gathered):
-                        result[begin:end, start:stop] = kernel(rows, *sizes, witness=False).T
+                    for start, stop, kernel, _, sizes, _, rows in parts:
+                        # (3, m, P_k, B): each row a contiguous block
+                        result[begin:end, start:stop] = kernel(np.take(placed, rows, axis=1), *sizes,
+                                                               witness=False).T
                     continue
-                bounds = [None if bound is None else bound(rows, *sizes, reach)
-                          for (_, _, _, bound, sizes, reach, _), rows in zip(parts, gathered)]
-                upper = np.full(end - begin, np.inf)
+                # single precision for the bounds, kept conservative by a slack far above its rounding (a few
+                # dozen ulps of the largest coordinate); coordinates it cannot hold are all measured
+                placed32 = placed.astype(np.float32)
+                largest = float(np.abs(placed32).max())
+                slack = _BOUND_SLACK * (1.0 + largest)
+                bounds = [None if bound is None or not largest < _BOUND_RANGE else
+                          bound(np.take(placed32, rows, axis=1), *constants)
+                          for _, _, _, bound, _, constants, rows in parts]
+                upper = np.full(end - begin, np.inf, dtype=np.float32)
                 for bound in bounds:
                     if bound is not None:
                         np.fmin(upper, bound[1].min(axis=0), out=upper)
-                # rounding: the bounds are as accurate as the coordinates; keep a pair they leave in doubt
-                cutoff = np.maximum(upper, margin) + _BOUND_SLACK * (1.0 + np.abs(placed).max())
-                for (start, stop, kernel, _, sizes, _, _), rows, bound in zip(parts, gathered, bounds):
-                    result[begin:end, start:stop] = _measured(kernel, rows, sizes, bound, cutoff).T
+                cutoff = np.maximum(upper + slack, margin) + slack
+                for (start, stop, kernel, _, sizes, _, rows), bound in zip(parts, bounds):
+                    result[begin:end, start:stop] = _measured(kernel, world, end - begin, rows, sizes, bound,
+                                                              cutoff, slack).T
 
 
     def _world_buffer(self, block: int) -> np.ndarray:
@@ -366,53 +372,62 @@ def _box_box_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witne
 _KERNELS = {("round", "round"): _round_round, ("box", "round"): _box_round, ("box", "box"): _box_box_kernel}
 
 
-def _measured(kernel, rows: np.ndarray, sizes: list[np.ndarray], bound, cutoff: np.ndarray) -> np.ndarray:
-    """(P_k, B): the kernel's distances where the pair's lower bound is below the configuration's ``cutoff``
-    (B,), its lower bound elsewhere."""
+def _measured(kernel, world: np.ndarray, count: int, rows: np.ndarray, sizes: tuple, bound,
+              cutoff: np.ndarray, slack: float) -> np.ndarray:
+    """(P_k, B): the kernel's distances where the pair's single-precision lower bound is below the
+    configuration's ``cutoff`` (B,), that bound less the ``slack`` elsewhere. ``world`` (3, K, block) holds the
+    block's reference rows in its first ``count`` columns; ``rows`` (m, P_k) are the pairs' rows."""
     if bound is None:
-        return kernel(rows, *sizes, witness=False)
+        return kernel(np.take(world[:, :, :count], rows, axis=1), *sizes, witness=False)
     lower = bound[0]
     pairs, configurations = np.nonzero(lower < cutoff)
     if pairs.size > _MEASURE_ALL * lower.size:  # the compaction would cost more than it saves
-        return kernel(rows, *sizes, witness=False)
+        return kernel(np.take(world[:, :, :count], rows, axis=1), *sizes, witness=False)
+    result = lower.astype(float)
+    result -= slack
     if pairs.size == 1:  # einsum sums a lone element in another order: measure it twice, for a batch's bits
         pairs, configurations = np.repeat(pairs, 2), np.repeat(configurations, 2)
-    # np.take keeps the layout the kernels see in a whole block (components first, contiguous), so that each
-    # distance has the same bits either way; indexing would lay the entries out first
-    entries = np.take(rows.reshape(rows.shape[0], rows.shape[1], -1), pairs * lower.shape[1] + configurations, axis=2)
-    lower[pairs, configurations] = kernel(entries, *(np.take(size[..., 0], pairs, axis=-1) for size in sizes),
-                                          witness=False)
-    return lower
+    # (3, m, n), gathered with np.take: the kernels then see the layout of a whole block (components first,
+    # contiguous), so that each distance has the same bits either way; indexing would lay the entries out first
+    entries = np.take(world.reshape(3, -1), rows[:, pairs] * world.shape[2] + configurations, axis=1)
+    result[pairs, configurations] = kernel(entries, *(np.take(size[..., 0], pairs, axis=-1) for size in sizes),
+                                           witness=False)
+    return result
 
 
 #: Above this share of pairs in doubt, a block measures them all.
 _MEASURE_ALL = 0.6
 
-#: Slack of the bounds' test, relative to the largest coordinate of a block (length unit): far above their
-#: rounding (a few ulps of the coordinates), far below any clearance a request states.
-_BOUND_SLACK = 1e-9
+#: Slack of the single-precision bounds, relative to the largest coordinate of a block (length unit): far above
+#: their rounding (a few dozen ulps of 6e-8), far below any clearance a request states.
+_BOUND_SLACK = 1e-5
+
+#: Coordinates at or past this (length unit) skip the bounds: their squares would leave single precision's range.
+_BOUND_RANGE = 1e15
 
 
-def _round_round_bounds(rows, half_size_a, half_size_b, radius_a, radius_b, reach):
+def _round_round_bounds(rows, radii, reach, inverse_square_length):
     """Lower and upper bounds (P, B) of capsules' and spheres' distances from the distance of one's core (rows
-    0, 1: the longer segment) to the other's middle (rows 2, 3: the shorter one's ends): the other shape holds
-    the ball of radius r about its middle and lies inside the ball of radius r + half its length (``reach``)."""
+    0, 1: the longer segment, 1 / its squared length given) to the other's middle (rows 2, 3: the shorter one's
+    ends): the other shape holds the ball of radius r about its middle and lies inside the ball of radius
+    r + half its length (``reach``); ``radii`` (P, 1) their sum."""
     segment = rows[:, 1] - rows[:, 0]
     gap = rows[:, 2] + rows[:, 3]
     gap *= 0.5
     gap -= rows[:, 0]  # the middle, from the segment's start
     along = _dot(gap, segment)
-    along /= np.maximum(_dot(segment, segment), _TINY)
+    along *= inverse_square_length
     _clip_unit(along)
     gap -= along * segment
     upper = np.sqrt(_dot(gap, gap))
-    upper -= radius_a + radius_b
+    upper -= radii
     return upper - reach, upper
 
 
-def _box_round_bounds(rows, half_size_a, half_size_b, radius_a, radius_b, reach):
+def _box_round_bounds(rows, half_size_a, radius_b, reach):
     """Lower and upper bounds (P, B) of a box's distance to a capsule or sphere from the box's signed distance
-    at the round shape's middle (the same balls as :func:`_round_round_bounds`)."""
+    at the round shape's middle (the same balls as :func:`_round_round_bounds`; the box's half sizes (3, P, 1),
+    the round shape's radius (P, 1))."""
     middle = rows[:, 4] + rows[:, 5]
     middle *= 0.5
     middle -= rows[:, 0]
@@ -570,7 +585,7 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
                              _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
                              np.array([member[4] for member in members[family]], dtype=bool),
                              _BOUNDS.get(family), np.array([member[5] for member in members[family]]),
-                             np.array([[min(_half_length(a), _half_length(b))] for a, b in zip(firsts, seconds)])))
+                             _bound_constants(family, firsts, seconds)))
     body_pairs: dict[tuple[str, str], int] = {}
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)
@@ -595,6 +610,19 @@ def _kernel_rows(shape: Shape, rows: list[int]) -> list[int]:
 
 def _family(shape: Shape) -> str:
     return "box" if isinstance(shape, Box) else "round"
+
+
+def _bound_constants(family: tuple[str, str], firsts: list[Shape], seconds: list[Shape]) -> tuple:
+    """The sizes the family's bounds take, single precision, (P_k, 1) each (a box's half sizes (3, P_k, 1))."""
+    reach = np.array([[min(_half_length(a), _half_length(b))] for a, b in zip(firsts, seconds)], dtype=np.float32)
+    if family == ("round", "round"):
+        radii = _radii(firsts) + _radii(seconds)
+        longer = [max(2.0 * _half_length(a), 2.0 * _half_length(b)) for a, b in zip(firsts, seconds)]
+        inverse = np.array([[1.0 / length ** 2 if length > 0.0 else 0.0] for length in longer])
+        return radii.astype(np.float32), reach, inverse.astype(np.float32)
+    if family == ("box", "round"):
+        return _half_sizes(firsts).astype(np.float32), _radii(seconds).astype(np.float32), reach
+    return ()
 
 
 def _half_length(shape: Shape) -> float:

@@ -366,3 +366,43 @@ def test_witnesses_of_entries_that_do_not_exist_raise_located_errors(configurati
 def test_docstring_examples():
     assert doctest.testmod(_model).failed == 0
 
+
+
+def scaled_shape(shape, factor: float):
+    if isinstance(shape, Capsule):
+        return Capsule(shape.start * factor, shape.end * factor, shape.radius * factor)
+    if isinstance(shape, Sphere):
+        return Sphere(shape.center * factor, shape.radius * factor)
+    return Box(shape.center * factor, shape.size * factor, shape.rotation)
+
+
+@pytest.mark.parametrize("factor", [1e-3, 1.0, 1e3, 1e6])
+def test_the_single_precision_bounds_keep_clearance_and_close_pairs_at_any_scale(factor):
+    """The check measures a pair only where its single-precision bounds leave it in doubt; in millimetres or
+    kilometres as in metres, its clearance is every pair's exact minimum, bit for bit, and its close pairs are
+    those the exact distances give."""
+    rng = np.random.default_rng(9)
+    model = collision_model([LinkShape(item.link, scaled_shape(item.shape, factor)) for item in arm_shapes()], 6,
+                            [Obstacle(o.name, scaled_shape(o.shape, factor)) for o in OBSTACLES])
+    frames = random_frames(rng, 400, 6)
+    frames[..., :3, 3] *= 0.3 * factor
+    margin = 0.05 * factor
+    check, distances = model.check(frames, margin), model.distances(frames)
+    np.testing.assert_array_equal(check.clearance, distances.min(axis=1))
+    assert (check.pair_distances <= distances + 1e-12 * factor).all()
+    assert (check.pair_distances != distances).mean() > 0.2
+    for s in range(0, 400, 7):
+        expected = sorted(((pair.a, pair.b), d) for pair, d in zip(model.pairs, distances[s]) if d < margin)
+        listed = sorted(((a, b), d) for a, b, d in check.close_pairs(model, s))
+        nearest: dict = {}
+        for key, d in expected:
+            nearest[key] = min(nearest.get(key, np.inf), d)
+        assert listed == sorted(nearest.items())
+
+
+def test_coordinates_past_single_precision_are_all_measured():
+    model = collision_model(arm_shapes(), 6, OBSTACLES)
+    frames = random_frames(np.random.default_rng(10), 50, 6)
+    frames[..., :3, 3] += 1e16  # the arm far away: every pair's distance in double precision
+    check = model.check(frames, 0.05)
+    np.testing.assert_array_equal(check.pair_distances, model.distances(frames))

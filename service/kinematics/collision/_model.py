@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 import numbers
 from dataclasses import dataclass
-from typing import Callable, NamedTuple, Sequence
+from typing import Callable, Iterator, NamedTuple, Sequence
 
 import numpy as np
 
@@ -202,9 +202,24 @@ class CollisionModel:
         shape (n + 1, 12, S), without their copy into 4 × 4 matrices (``single``: locate errors as for one
         configuration)."""
         margin_value = _finite_number(margin, ("margin",))
-        pair_distances = self._distances(frame_columns, margin_value)
+        count = frame_columns.shape[2]
+        pair_distances = np.empty((count, len(self.pairs)))
+        clearance = np.full(count, np.inf)
+        close: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
+        if count and self.pairs:
+            for begin, end in self._evaluated_blocks(frame_columns, pair_distances, margin_value):
+                # each block's clearance and close pairs while its distances are in cache
+                block = pair_distances[begin:end]
+                block.min(axis=1, out=clearance[begin:end])
+                rows, bodies, values = _close_pairs(block, clearance[begin:end], self.body_pair_of,
+                                                    len(self.body_pairs), margin_value)
+                close.append((rows + begin, bodies, values))
         self._check_finite(frame_columns, pair_distances, single)
-        return _close_pairs(pair_distances, self.body_pair_of, len(self.body_pairs), margin_value)
+        rows, bodies, values = (np.concatenate(parts) for parts in zip(*close)) if close else \
+            (np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp), np.zeros(0))
+        offsets = np.zeros(count + 1, dtype=np.intp)
+        np.cumsum(np.bincount(rows, minlength=count), out=offsets[1:])
+        return CollisionCheck(clearance, pair_distances, offsets, bodies, values)
 
     def witnesses(self, world_T_frames: np.ndarray, configurations: Sequence[int] | np.ndarray,
                   pairs: Sequence[int] | np.ndarray) -> Separation:
@@ -280,11 +295,14 @@ class CollisionModel:
         be the configuration's clearance or closer than the margin (see :meth:`_evaluate`)."""
         result = np.empty((columns.shape[2], len(self.pairs)))
         if columns.shape[2] and self.pairs:
-            self._evaluate(columns, result, margin)
+            for _ in self._evaluated_blocks(columns, result, margin):
+                pass
         return result
 
-    def _evaluate(self, columns: np.ndarray, result: np.ndarray, margin: float | None) -> None:
-        """Distances of the pairs into ``result`` (S, P), for the frame columns (L, 12, S).
+    def _evaluated_blocks(self, columns: np.ndarray, result: np.ndarray,
+                          margin: float | None) -> Iterator[tuple[int, int]]:
+        """Distances of the pairs into ``result`` (S, P), for the frame columns (L, 12, S), a block of
+        configurations [begin, end) at a time (yielded when it is filled).
 
         With a ``margin``, a pair is measured only where it can matter: each pair's cheap bounds (a shape's
         round core inside the ball about its middle, and around it) give every configuration an upper bound U
@@ -310,6 +328,7 @@ class CollisionModel:
                         # (3, m, P_k, B): each row a contiguous block
                         result[begin:end, start:stop] = kernel(np.take(placed, rows, axis=1), *sizes,
                                                                witness=False).T
+                    yield begin, end
                     continue
                 # single precision for the bounds, kept conservative by a slack far above its rounding (a few
                 # dozen ulps of the largest coordinate); coordinates it cannot hold are all measured
@@ -327,6 +346,7 @@ class CollisionModel:
                 for (start, stop, kernel, _, sizes, _, rows), bound in zip(parts, bounds):
                     result[begin:end, start:stop] = _measured(kernel, world, end - begin, rows, sizes, bound,
                                                               cutoff, slack).T
+                yield begin, end
 
 
     def _world_buffer(self, block: int) -> np.ndarray:
@@ -440,21 +460,19 @@ def _box_round_bounds(rows, half_size_a, radius_b, reach):
 # --- the close pairs ------------------------------------------------------------------------------------------
 
 
-def _close_pairs(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_count: int,
-                 margin: float) -> CollisionCheck:
-    count, pairs = pair_distances.shape
-    clearance = pair_distances.min(axis=1) if pairs else np.full(count, np.inf)
+def _close_pairs(pair_distances: np.ndarray, clearance: np.ndarray, body_pair_of: np.ndarray, body_count: int,
+                 margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The body pairs closer than ``margin`` of S configurations (their pair distances (S, P) and clearance
+    (S,)): configuration, body pair and distance of each, by configuration, nearest first."""
     close = np.flatnonzero(clearance < margin)  # the configurations that have a close pair
     body_distances = _body_distances(np.take(pair_distances, close, axis=0), body_pair_of, body_count)
     rows, bodies = np.nonzero(body_distances < margin)  # by configuration, then by body pair
     values = body_distances[rows, bodies]
     rows = close[rows]
     if rows.size and (rows[1:] == rows[:-1]).any():  # some configuration has several: nearest first
-        order = np.lexsort((bodies, values, rows))
+        order = np.lexsort((values, rows))  # stable: equal distances keep the body pairs' order
         rows, bodies, values = rows[order], bodies[order], values[order]
-    offsets = np.zeros(count + 1, dtype=np.intp)
-    np.cumsum(np.bincount(rows, minlength=count), out=offsets[1:])
-    return CollisionCheck(clearance, pair_distances, offsets, bodies, values)
+    return rows, bodies, values
 
 
 def _body_distances(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_count: int) -> np.ndarray:

@@ -10,9 +10,10 @@ table). Rows: ``link_frames`` for the configurations, the model's ``distances`` 
 single-pose path, where numpy's cost per call dominates) and of compiling the model. Last, what a request pays: the
 core's whole IK answer (``answer_ik``) for a batch of 10,000 targets from the PUMA's own FK, with its catalogue
 capsule model, without and with ``collisions`` (self-collision, a table and a post: the API example's cell), and
-their ratio (issue 25's goal: at most 2). Times are CPU seconds of this process
-(``time.process_time``), best of the repeats: on a shared machine that is less noisy than wall time, but still
-noisy; compare rows of one run.
+their ratio (issue 25's goal: at most 2); then the same batch as a whole request, sent through the service's ASGI
+application in process (routing, validation, the core, encoding; no network) in both answer forms. Times are CPU
+seconds of this process (``time.process_time``), best of the repeats: on a shared machine that is less noisy than
+wall time, but still noisy; compare rows of one run. The requests are timed in wall seconds (best of three).
 """
 
 from __future__ import annotations
@@ -23,6 +24,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+import orjson
 
 from service.kinematics import forward_kinematics, link_frames
 from service.kinematics.collision import Box, Capsule, CollisionRequest, LinkShape, Obstacle, collision_model
@@ -104,6 +106,11 @@ def main(argv: list[str] | None = None) -> int:
     for name, seconds in rows:
         print(f"| {name} | {seconds * 1e3:.3f} ms |")
     print(f"whole answer with collisions / without: {checked / plain:.2f}x (goal <= 2)")
+    print("| request (POST .../ik/batch, in process) | without collisions | with | ratio |")
+    print("| --- | --- | --- | --- |")
+    for form, (without, with_collisions) in whole_requests(targets).items():
+        print(f"| {targets} targets, {form} form | {without * 1e3:.0f} ms | {with_collisions * 1e3:.0f} ms | "
+              f"{with_collisions / without:.2f}x |")
     return 0
 
 
@@ -123,6 +130,30 @@ def whole_answers(count: int, repeats: int) -> tuple[float, float]:
     answer_ik(robot, targets, checked)  # compile the pairs once, as a server's first request does
     return (best_time(lambda: answer_ik(robot, targets, plain), repeats),
             best_time(lambda: answer_ik(robot, targets, checked), repeats))
+
+
+def whole_requests(count: int) -> dict[str, tuple[float, float]]:
+    """Wall seconds of a batch request of ``count`` PUMA targets (``{"matrices": ...}``) through the service's
+    application, per answer form, without and with the collision check of :func:`whole_answers`."""
+    from service.api.app import create_app
+    from service.config import Settings
+
+    from .request_profile import _asgi_seconds
+
+    robot = _puma()
+    q = np.random.default_rng(1).uniform(robot.lower, robot.upper, (count, robot.dof))
+    matrices = forward_kinematics(robot, q).reshape(count, 16).tolist()
+    cell = {"self": True, "margin": 0.005, "obstacles": [
+        {"name": "table", "box": {"center": [0.55, 0.0, -0.15], "size": [0.5, 1.0, 0.1]}},
+        {"name": "post", "capsule": {"from": [0.27, -0.2, -0.6], "to": [0.27, -0.2, 0.6], "radius": 0.06}}]}
+    app = create_app(Settings(_env_file=None, log_level="warning"))
+    times = {}
+    for form in ("arrays", "objects"):
+        bodies = [orjson.dumps({"targets": {"matrices": matrices}, "format": form, **extra})
+                  for extra in ({}, {"collisions": cell})]
+        times[form] = tuple(_asgi_seconds(app, "POST", "/v1/robots/puma560_standard/ik/batch", body, 1)
+                            for body in bodies)
+    return times
 
 
 if __name__ == "__main__":

@@ -60,6 +60,7 @@ def test_collision_benchmark_runs_with_tiny_sizes(capsys):
                 "check (margin 0.01), 200 configurations", "distances, 1 configuration (per call)",
                 "distances, 16 configurations (per call)", "collision_model (compiling the 12 pairs, per call)"):
         assert f"| {row} |" in out
+    assert "| 100 targets, arrays form |" in out and "| 100 targets, objects form |" in out
 
 
 def test_slide_classes_benchmark_runs_with_tiny_sizes(capsys):

@@ -33,11 +33,16 @@ from ._distances import (Separation, _box_box, _box_point_local, _box_segment, _
                          _segment_segment, _swept)
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 
-#: Pair evaluations per block (configurations × pairs of the widest group). Large enough that numpy's cost per
-#: call is small against the arithmetic (the bounds leave a third of the pairs to measure, in smaller arrays),
-#: small enough that a block's temporaries stay in cache (measured on 80,000 PUMA configurations and 34 pairs:
-#: 32768 and 65536 alike, 8192 a third slower).
-_BLOCK_ELEMENTS = 32768
+#: Pair evaluations per block (configurations × pairs of the widest group): large enough that numpy's cost per
+#: call is small against the arithmetic, small enough that a block's temporaries stay in cache. Measuring every
+#: pair: 4096 to 16384 alike, 1024 and 65536 slower. With the bounds, which leave an eighth to a third of the pairs
+#: to measure in smaller arrays, four times as many (80,000 PUMA configurations and 34 pairs: 32768 and 65536
+#: alike, 8192 a third slower).
+_BLOCK_ELEMENTS = 8192
+_BOUNDED_BLOCK_ELEMENTS = 32768
+
+#: Fewer pair evaluations than this are all measured: the bounds' numpy calls would cost more than they save.
+_BOUNDED_FROM = 4096
 
 #: The order in which pairs name the kinds of their shapes, and in which the kernels take them.
 _KIND_ORDER = (Box, Capsule, Sphere)
@@ -199,22 +204,23 @@ class CollisionModel:
     def check_frame_columns(self, frame_columns: np.ndarray, margin: float = 0.0, *,
                             single: bool = False) -> CollisionCheck:
         """:meth:`check` of link frames laid out as :func:`~service.kinematics.link_frame_columns` gives them,
-        shape (n + 1, 12, S), without their copy into 4 × 4 matrices (``single``: locate errors as for one
-        configuration)."""
+        shape (n + 1, 12, S) or (n + 1, 4, 3, S), without their copy into 4 × 4 matrices (``single``: locate
+        errors as for one configuration)."""
         margin_value = _finite_number(margin, ("margin",))
-        count = frame_columns.shape[2]
+        columns = frame_columns.reshape(self.link_count, 4, 3, -1)
+        count = columns.shape[3]
         pair_distances = np.empty((count, len(self.pairs)))
         clearance = np.full(count, np.inf)
         close: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         if count and self.pairs:
-            for begin, end in self._evaluated_blocks(frame_columns, pair_distances, margin_value):
+            for begin, end in self._evaluated_blocks(columns, pair_distances, margin_value):
                 # each block's clearance and close pairs while its distances are in cache
                 block = pair_distances[begin:end]
                 block.min(axis=1, out=clearance[begin:end])
                 rows, bodies, values = _close_pairs(block, clearance[begin:end], self.body_pair_of,
                                                     len(self.body_pairs), margin_value)
                 close.append((rows + begin, bodies, values))
-        self._check_finite(frame_columns, pair_distances, single)
+        self._check_finite(columns, pair_distances, single)
         rows, bodies, values = (np.concatenate(parts) for parts in zip(*close)) if close else \
             (np.zeros(0, dtype=np.intp), np.zeros(0, dtype=np.intp), np.zeros(0))
         offsets = np.zeros(count + 1, dtype=np.intp)
@@ -232,7 +238,7 @@ class CollisionModel:
         columns, _ = self._checked_frames(world_T_frames)
         configuration = np.asarray(configurations).reshape(-1)
         column = np.asarray(pairs).reshape(-1)
-        for values, name, size in ((configuration, "configurations", columns.shape[2]),
+        for values, name, size in ((configuration, "configurations", columns.shape[3]),
                                    (column, "pairs", len(self.pairs))):
             if values.size and not (np.issubdtype(values.dtype, np.integer) and 0 <= values.min()
                                     and values.max() < size):
@@ -246,7 +252,7 @@ class CollisionModel:
             if chosen.size == 0:
                 continue
             local = column[chosen] - group.start
-            world = self._world_rows(columns[:, :, configuration[chosen]])
+            world = self._world_rows(columns[..., configuration[chosen]])
             # entry k is pair local[k] in configuration k of this block: gather one (3, m) per entry
             rows = world[:, group.rows[local].T, np.arange(chosen.size)][:, :, None]
             with _quiet():
@@ -263,8 +269,8 @@ class CollisionModel:
     # --- internals --------------------------------------------------------------------------------------------
 
     def _checked_frames(self, world_T_frames) -> tuple[np.ndarray, bool]:
-        """Frames (S, n + 1, 4, 4) or (n + 1, 4, 4) checked, as frame columns (n + 1, 12, S), and whether one
-        configuration was given."""
+        """Frames (S, n + 1, 4, 4) or (n + 1, 4, 4) checked, seen as frame columns (n + 1, 4, 3, S) (a view: the
+        rotation's columns and the origin, each (3, S)), and whether one configuration was given."""
         try:
             frames = np.asarray(world_T_frames, dtype=float)
         except (TypeError, ValueError) as error:
@@ -276,8 +282,7 @@ class CollisionModel:
             raise InvalidInputError(
                 f"frames must have shape (S, {self.link_count}, 4, 4) or ({self.link_count}, 4, 4), "
                 f"got {np.shape(world_T_frames)}", location=("frames",))
-        columns = np.ascontiguousarray(frames[:, :, :3, :].transpose(1, 3, 2, 0))
-        return columns.reshape(self.link_count, 12, frames.shape[0]), single
+        return frames[:, :, :3, :].transpose(1, 3, 2, 0), single
 
     def _check_finite(self, columns: np.ndarray, result: np.ndarray, single: bool) -> None:
         if np.isfinite(result).all():
@@ -285,23 +290,23 @@ class CollisionModel:
         configuration = int(np.flatnonzero(~np.isfinite(result).all(axis=1))[0])
         where = () if single else (configuration,)
         for rows in self._link_rows:
-            if not np.isfinite(columns[rows.link, :, configuration]).all():
+            if not np.isfinite(columns[rows.link, ..., configuration]).all():
                 raise InvalidInputError(f"link frame {rows.link} is not finite",
                                         location=("frames", *where, rows.link))
         raise InvalidInputError("link frames too large: the distances overflow", location=("frames", *where))
 
     def _distances(self, columns: np.ndarray, margin: float | None = None) -> np.ndarray:
-        """Every pair's distance (S, P) for frame columns (L, 12, S); with a ``margin``, only where a pair can
-        be the configuration's clearance or closer than the margin (see :meth:`_evaluate`)."""
-        result = np.empty((columns.shape[2], len(self.pairs)))
-        if columns.shape[2] and self.pairs:
+        """Every pair's distance (S, P) for frame columns (L, 4, 3, S); with a ``margin``, only where a pair can
+        be the configuration's clearance or closer than the margin (see :meth:`_evaluated_blocks`)."""
+        result = np.empty((columns.shape[3], len(self.pairs)))
+        if columns.shape[3] and self.pairs:
             for _ in self._evaluated_blocks(columns, result, margin):
                 pass
         return result
 
     def _evaluated_blocks(self, columns: np.ndarray, result: np.ndarray,
                           margin: float | None) -> Iterator[tuple[int, int]]:
-        """Distances of the pairs into ``result`` (S, P), for the frame columns (L, 12, S), a block of
+        """Distances of the pairs into ``result`` (S, P), for the frame columns (L, 4, 3, S), a block of
         configurations [begin, end) at a time (yielded when it is filled).
 
         With a ``margin``, a pair is measured only where it can matter: each pair's cheap bounds (a shape's
@@ -315,14 +320,20 @@ class CollisionModel:
         """
         parts = [(group.start, group.stop, group.kernel, group.bounds, group.sizes(), group.bound_constants,
                   group.measured_rows.T) for group in self._groups]
-        count = columns.shape[2]
-        block = max(1, min(count, _BLOCK_ELEMENTS // max(part[1] - part[0] for part in parts)))
+        count = columns.shape[3]
+        if count * len(self.pairs) < _BOUNDED_FROM:
+            margin = None  # every pair measured: as exact, and fewer calls
+        elements = _BLOCK_ELEMENTS if margin is None else _BOUNDED_BLOCK_ELEMENTS
+        block = max(1, min(count, elements // max(part[1] - part[0] for part in parts)))
         world = self._world_buffer(block)
         with _quiet():
             for begin in range(0, count, block):
                 end = min(begin + block, count)
                 placed = world[:, :, : end - begin]
-                self._world_rows(columns[:, :, begin:end], placed)
+                frames = columns[..., begin:end]
+                if frames.strides[-1] != frames.itemsize:  # 4 × 4 frames seen as columns: the block's, in a
+                    frames = np.ascontiguousarray(frames)  # row each, so that einsum runs on unit strides
+                self._world_rows(frames, placed)
                 if margin is None:
                     for start, stop, kernel, _, sizes, _, rows in parts:
                         # (3, m, P_k, B): each row a contiguous block
@@ -357,14 +368,14 @@ class CollisionModel:
         return world
 
     def _world_rows(self, columns: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-        """World coordinates (3, K, B) of every reference row for the frame columns (L, 12, B) of B
+        """World coordinates (3, K, B) of every reference row for the frame columns (L, 4, 3, B) of B
         configurations: x_world = world_T_link · x_link, homogeneous (w = 1 for points, 0 for directions)."""
-        count = columns.shape[2]
+        count = columns.shape[3]
         if out is None:
             out = self._world_buffer(count)
         for link, first, end, local in self._link_rows:
             # x_world = x X + y Y + z Z + w P with the frame's columns X, Y, Z, P
-            out[:, first:end, :] = np.einsum("jcb,jk->ckb", columns[link].reshape(4, 3, count), local)
+            out[:, first:end, :] = np.einsum("jcb,jk->ckb", columns[link], local)
         return out
 
 

@@ -15,7 +15,8 @@ from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
+from .._rotations import wrap_angle
 from ._screws import rotate_about
 from ._structure import Geometry, idealised
 from .subproblems import subproblem_1, subproblem_2_chain
@@ -52,6 +53,13 @@ def wrist_codes(middle: np.ndarray) -> LabelCodes:
     return {"wrist": (("no_flip", "flip"), codes)}
 
 
+#: The volume of the wrist's unit axes (|det|) below which q_a is fixed only within a band: R_w carries the rounding
+#: of a dozen products (~1e-15), which moves q_a and q_c along their null motion by that over the volume, a tenth
+#: of DUPLICATE_TOLERANCE here (a PUMA with right angles 1e-5 off at q5 = 1e-9: the volume is 2e-11, and q4 came
+#: back 1.4e-6 off).
+ALIGNED_BELOW = 1e-8
+
+
 class SphericalWrist(Sealed):
     """Three revolute joints meeting at the wrist centre (Spong §4.2–4.4, done with subproblems).
 
@@ -63,7 +71,11 @@ class SphericalWrist(Sealed):
     own error: an arm whose relations hold within ``GEOMETRY_TOLERANCE`` but
     not exactly (a URDF's π/2 written to 11 digits) gives ``R_w`` with that
     error, and q_a, seen on the radius of ``R_w ω_c`` about ω_a, with that
-    error over the radius (see :attr:`free_below`).
+    error over the radius (see :attr:`free_below`). Where the two roots meet
+    (a wrist whose angles are not right ones, as CAD rounding leaves them,
+    folds its flip pair near the aligned pose), q_a is fixed only within a band
+    of rounding: it takes the reference value when that reaches ``R_w ω_c``
+    to rounding, and the fold is reported.
 
     Labels: see :func:`wrist_codes`.
     """
@@ -91,6 +103,21 @@ class SphericalWrist(Sealed):
             qb = np.where(free[..., None], qb_free[..., None], qb)
         valid = pair.valid[..., 0, :].copy()
         valid[..., 1] &= ~free
+        # where the two roots meet (the cones touch, or cross within rounding: a fold, where the flip pair is one),
+        # or the axes nearly align (their volume below ALIGNED_BELOW), the target fixes q_a only within a band:
+        # the root nearest the reference takes its value where that reaches R_w ω_c to rounding
+        met = pair.merged[..., 0] & ~free
+        aligned = (self._volume(qb) <= ALIGNED_BELOW) & pair.exact[..., 0, :]  # (..., 2); a miss's pair is coplanar
+        band = (met[..., None] | aligned) & valid & ~free[..., None]
+        if reference is not None and band.any():
+            held = reference[self.joints[0]]
+            qb_held = subproblem_1(b, c, rotate_about(a, -held, target_axis)).theta[..., 0]
+            miss = np.linalg.norm(rotate_about(a, held, rotate_about(b, qb_held, c)) - target_axis, axis=-1)
+            gap = np.where(band, np.abs(wrap_angle(qa - held)), np.inf)
+            nearest = np.arange(2) == np.argmin(gap, axis=-1)[..., None]
+            moved = band & nearest & (miss <= ROUNDING_TOLERANCE)[..., None]
+            qa = np.where(moved, held, qa)
+            qb = np.where(moved, qb_held[..., None], qb)
         # q_c: R(c, q_c) u = (R_a R_b)^T R_w u
         wanted = np.einsum("...ij,j->...i", R_w, self.normal)[..., None, :]  # (..., 1, 3)
         unwound = rotate_about(b, -qb, rotate_about(a, -qa, wanted))
@@ -105,7 +132,20 @@ class SphericalWrist(Sealed):
                     f"the first and last wrist axes are aligned: only q{self.joints[0] + 1} "
                     f"{'+' if relation == 'sum' else '−'} q{self.joints[2] + 1} is determined; "
                     f"q{self.joints[0] + 1} is set to the reference value (or 0)"))
+        singular.add(met, Singularity(
+            "wrist", self.joints, "boundary", f"the two wrist solutions meet (a fold of the wrist flip): "
+            f"q{self.joints[0] + 1} is fixed only within a band, and set to the reference value where it lies in "
+            f"it"))
+        singular.add(band.any(axis=-1) & ~met, Singularity(
+            "wrist", self.joints, "aligned", f"the wrist axes are nearly aligned: q{self.joints[0] + 1} is fixed "
+            f"only within a band, and set to the reference value where it lies in it"))
         return WristResult(joints, valid, singular)
+
+    def _volume(self, qb: np.ndarray) -> np.ndarray:
+        """|det| of the wrist's three unit axes at q_b (...,), which q_a turns together (so it does not count):
+        the wrist's part of the arm's Jacobian is singular where it vanishes."""
+        a, b, c = self.axes
+        return np.abs(np.cross(b, rotate_about(b, qb, np.broadcast_to(c, qb.shape + (3,)))) @ a)
 
     @cached_property
     def free_below(self) -> float:

@@ -211,7 +211,7 @@ class _SphericalWristOnePose:
         self.normal_home = scalar.vector_of(home_inverse[:3, :3] @ wrist.normal)
         # subproblem 2 about the wrist's first two axes, 1 about its last (the normal)
         self.wrist, self.wrist_axes = scalar.TwoTurns(a, b, wrist.free_below), (a, b)
-        self.wrist_last = axis_c
+        self.wrist_volume = wrist.volume_terms
         self.wrist_start = self.wrist.start(axis_c)
         self.last_turn = scalar.Turn(axis_c)
         self.last_normal = self.last_turn.coordinates(scalar.vector_of(wrist.normal))
@@ -240,8 +240,8 @@ class _SphericalWristOnePose:
             qa, qb = roots
             # the wrist's axes nearly aligned at a root (not at the least-squares pair of cones that miss, which
             # is coplanar): the array path holds q_a within its band (SphericalWrist)
-            if pairs[1] is not None and abs(scalar.dot(scalar.cross(b, scalar.rotate(b, qb, self.wrist_last)), a)) <= \
-                    scalar.MARGIN * ALIGNED_BELOW:
+            u, w = self.wrist_volume
+            if pairs[1] is not None and abs(u * math.cos(qb) + w * math.sin(qb)) <= scalar.MARGIN * ALIGNED_BELOW:
                 raise scalar.NotGeneric
             unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
             qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))

@@ -143,9 +143,16 @@ class SphericalWrist(Sealed):
 
     def _volume(self, qb: np.ndarray) -> np.ndarray:
         """|det| of the wrist's three unit axes at q_b (...,), which q_a turns together (so it does not count):
-        the wrist's part of the arm's Jacobian is singular where it vanishes."""
+        the wrist's part of the arm's Jacobian is singular where it vanishes. a·(b × R(b, q_b) c) is
+        u cos q_b + w sin q_b (:attr:`volume_terms`)."""
+        u, w = self.volume_terms
+        return np.abs(u * np.cos(qb) + w * np.sin(qb))
+
+    @cached_property
+    def volume_terms(self) -> tuple[float, float]:
+        """(u, w) = (a·(b × c), a·(b × (b × c))) of the wrist's axes: its volume at q_b is |u cos q_b + w sin q_b|."""
         a, b, c = self.axes
-        return np.abs(np.cross(b, rotate_about(b, qb, np.broadcast_to(c, qb.shape + (3,)))) @ a)
+        return float(a @ np.cross(b, c)), float(a @ np.cross(b, np.cross(b, c)))
 
     @cached_property
     def free_below(self) -> float:

@@ -657,11 +657,13 @@ class General6RPlan(Sealed):
         if len(rows):
             start = np.nan_to_num(joints[rows, slots])
             joints[rows, slots] = _newton(self.directions, self.points, self.revolute, A[rows], start)
-        joints[..., ~self.revolute] *= self.scale
         complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
         singular = SingularFlags(n)
-        if len(rows):
-            self._represent_singular_roots(joints, valid, rows, slots, A, reference, singular)
+        if len(rows):  # in normalised lengths, as Newton's steps work
+            normalised = None if reference is None else np.where(self.revolute, reference, np.divide(
+                reference, self.scale, dtype=float))
+            self._represent_singular_roots(joints, valid, rows, slots, A, normalised, singular)
+        joints[..., ~self.revolute] *= self.scale
         # out of reach by the bound: certainly no solution, however the eigenproblem was conditioned
         offset = targets[:, :3, 3] - self.points[0]
         beyond = np.einsum("ni,ni->n", offset, offset) > (self.reach * (1.0 + 1e-9)) ** 2
@@ -671,8 +673,8 @@ class General6RPlan(Sealed):
 
     def _represent_singular_roots(self, joints: np.ndarray, valid: np.ndarray, rows: np.ndarray, slots: np.ndarray,
                                   A: np.ndarray, reference: np.ndarray | None, singular: SingularFlags) -> None:
-        """Roots (``joints[rows, slots]`` of targets ``A``) where the Jacobian is singular (:func:`_singular_motion`):
-        the target fixes them along the null motion only to about DUPLICATE_TOLERANCE. The condition is reported,
+        """Roots (``joints[rows, slots]`` of targets ``A``, slides in normalised lengths, as ``reference``) where the
+        Jacobian is singular (:func:`_singular_motion`): the target fixes them along the null motion only to about DUPLICATE_TOLERANCE. The condition is reported,
         and the root is represented as the closed forms represent it: with the motion's leading joint at the
         reference value, where Newton's steps with that joint held reach the target; else the root itself.
 
@@ -696,8 +698,8 @@ class General6RPlan(Sealed):
         if not coaxial.all():
             family[~coaxial] = self._on_family(A[rows[~coaxial]], q[~coaxial], motion[~coaxial], leading[~coaxial])
         if reference is not None:
-            along = (wrap_angle(np.asarray(reference, dtype=float)[leading] - q[index, leading])
-                     / motion[index, leading])
+            along = self._difference(np.asarray(reference, dtype=float)[leading] - q[index, leading],
+                                     leading) / motion[index, leading]
             moved = self._along_family(A[rows], q, along[:, None] * motion, leading)
             reached = self._reached(A[rows], moved)
             # at a fold only the root nearest the reference moves (the other is a root of its own)
@@ -709,12 +711,16 @@ class General6RPlan(Sealed):
             members = np.flatnonzero((rows == row) & family)
             for position, k in enumerate(members.tolist()):
                 for other in members[:position].tolist():
-                    step = wrap_angle(joints[row, slots[k]] - joints[row, slots[other]])
+                    step = self._difference(joints[row, slots[k]] - joints[row, slots[other]], np.arange(6))
                     across = step - (step @ motion[other]) * motion[other]
                     if valid[row, slots[other]] and np.abs(across).max() <= SAME_FAMILY:
                         valid[row, slots[k]] = False
                         break
         self._report_singular(singular, rows, motion, coaxial, family, pair, leading)
+
+    def _difference(self, difference: np.ndarray, joints: np.ndarray) -> np.ndarray:
+        """Differences of joint values (...,) of ``joints`` (...,): revolute ones wrapped to (−π, π]."""
+        return np.where(self.revolute[joints], wrap_angle(difference), difference)
 
     def _on_family(self, A: np.ndarray, q: np.ndarray, motion: np.ndarray, held: np.ndarray) -> np.ndarray:
         """Which singular roots q (K, 6) lie on a family of solutions: a step of :data:`FAMILY_PROBE` along their
@@ -764,8 +770,9 @@ class General6RPlan(Sealed):
                 moving == np.isin(np.arange(6), joints)).all(axis=1)
             names = ", ".join(f"q{j + 1}" for j in joints)
             what = (f"a family of solutions passes here (a self-motion of {names})" if on_family else
-                    f"two solutions meet here (a fold; the Jacobian's null motion turns {names}), and the target "
-                    f"fixes them along that motion only to about {DUPLICATE_TOLERANCE:g} rad")
+                    f"the Jacobian is singular here (its null motion turns {names}: two solutions meet, or a family "
+                    f"nearly passes), and the target fixes the solution along that motion only to about "
+                    f"{DUPLICATE_TOLERANCE:g} rad")
             singular.add(_rows_mask(singular.count, rows[chosen]), Singularity(
                 "jacobian", joints, "free" if on_family else "boundary",
                 f"{what}; q{k + 1} is set to the reference value where that reaches the target"))

@@ -15,7 +15,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
+from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from .._rotations import wrap_angle
 from ._screws import rotate_about
 from ._structure import Geometry, idealised
@@ -53,11 +53,14 @@ def wrist_codes(middle: np.ndarray) -> LabelCodes:
     return {"wrist": (("no_flip", "flip"), codes)}
 
 
-#: The volume of the wrist's unit axes (|det|) below which q_a is fixed only within a band: R_w carries the rounding
-#: of a dozen products (~1e-15), which moves q_a and q_c along their null motion by that over the volume, a tenth
-#: of DUPLICATE_TOLERANCE here (a PUMA with right angles 1e-5 off at q5 = 1e-9: the volume is 2e-11, and q4 came
-#: back 1.4e-6 off).
+#: The volume of the wrist's unit axes (|det|) below which q_a is fixed only within a band: the error of R_w
+#: (rounding, and the positioning joints' own, ~1e-12 near a singularity) moves q_a and q_c along their null
+#: motion by about that over the volume (a PUMA with right angles 1e-5 off at q5 = 1e-9: volume 1e-9, q4 1.4e-6
+#: off; the catalogue's PUMA at q5 = 5e-9: q4 1.3e-3 off).
 ALIGNED_BELOW = 1e-8
+#: Where q_a is fixed only within a band, the reference's q_a represents the root when R(a, q_a) R(b, q_b) ω_c
+#: misses R_w ω_c by at most this (unit vectors): the FK check then accepts the solution it gives.
+BAND_MISS = 0.1 * ACCEPT_RESIDUAL
 
 
 class SphericalWrist(Sealed):
@@ -74,8 +77,9 @@ class SphericalWrist(Sealed):
     error over the radius (see :attr:`free_below`). Where the two roots meet
     (a wrist whose angles are not right ones, as CAD rounding leaves them,
     folds its flip pair near the aligned pose), q_a is fixed only within a band
-    of rounding: it takes the reference value when that reaches ``R_w ω_c``
-    to rounding, and the fold is reported.
+    (:data:`ALIGNED_BELOW`): it takes the reference value when that reaches
+    ``R_w ω_c`` within :data:`BAND_MISS`, and the fold (or the near
+    alignment) is reported.
 
     Labels: see :func:`wrist_codes`.
     """
@@ -105,7 +109,7 @@ class SphericalWrist(Sealed):
         valid[..., 1] &= ~free
         # where the two roots meet (the cones touch, or cross within rounding: a fold, where the flip pair is one),
         # or the axes nearly align (their volume below ALIGNED_BELOW), the target fixes q_a only within a band:
-        # the root nearest the reference takes its value where that reaches R_w ω_c to rounding
+        # the root nearest the reference takes its value where that reaches R_w ω_c within BAND_MISS
         met = pair.merged[..., 0] & ~free
         aligned = (self._volume(qb) <= ALIGNED_BELOW) & pair.exact[..., 0, :]  # (..., 2); a miss's pair is coplanar
         band = (met[..., None] | aligned) & valid & ~free[..., None]
@@ -115,7 +119,7 @@ class SphericalWrist(Sealed):
             miss = np.linalg.norm(rotate_about(a, held, rotate_about(b, qb_held, c)) - target_axis, axis=-1)
             gap = np.where(band, np.abs(wrap_angle(qa - held)), np.inf)
             nearest = np.arange(2) == np.argmin(gap, axis=-1)[..., None]
-            moved = band & nearest & (miss <= ROUNDING_TOLERANCE)[..., None]
+            moved = band & nearest & (miss <= BAND_MISS)[..., None]
             qa = np.where(moved, held, qa)
             qb = np.where(moved, qb_held[..., None], qb)
         # q_c: R(c, q_c) u = (R_a R_b)^T R_w u

@@ -128,6 +128,10 @@ FAMILY_STEP = 0.2
 #: The step (radians) along a singular root's null motion that tells a family (the target still reached, either
 #: way) from a fold (reached on one side at most).
 FAMILY_PROBE = 1e-3
+#: Where two roots at a fold came out as one, Newton's steps (at most SPLIT_NEWTON_STEPS) start this far (radians)
+#: either side of them along the null motion, beyond the band (1e-6…9e-6) in which the elimination places them.
+SPLIT_STEP = 1e-5
+SPLIT_NEWTON_STEPS = 30
 #: Joints whose share of a singular root's unit null motion is at least this are named in its report.
 SINGULAR_MOTION = 0.1
 
@@ -697,15 +701,19 @@ class General6RPlan(Sealed):
         family = coaxial.copy()
         if not coaxial.all():
             family[~coaxial] = self._on_family(A[rows[~coaxial]], q[~coaxial], motion[~coaxial], leading[~coaxial])
+        if not family.all():
+            self._split_fold_pairs(joints, rows, slots, A, motion, ~family)
+            q = joints[rows, slots]
         if reference is not None:
             along = self._difference(np.asarray(reference, dtype=float)[leading] - q[index, leading],
                                      leading) / motion[index, leading]
             moved = self._along_family(A[rows], q, along[:, None] * motion, leading)
             reached = self._reached(A[rows], moved)
             # at a fold only the root nearest the reference moves (the other is a root of its own)
+            distance = np.abs(self._difference(np.asarray(reference, dtype=float) - q, np.arange(6))).max(axis=1)
             for row in np.unique(rows[~family]).tolist():
                 members = np.flatnonzero((rows == row) & ~family)
-                reached[members[members != members[np.argmin(np.abs(along[members]))]]] = False
+                reached[members[members != members[np.argmin(distance[members])]]] = False
             joints[rows[reached], slots[reached]] = moved[reached]
         for row in np.unique(rows[family]).tolist():  # one representative per family: the first slot's
             members = np.flatnonzero((rows == row) & family)
@@ -717,6 +725,30 @@ class General6RPlan(Sealed):
                         valid[row, slots[k]] = False
                         break
         self._report_singular(singular, rows, motion, coaxial, family, pair, leading)
+
+    def _split_fold_pairs(self, joints: np.ndarray, rows: np.ndarray, slots: np.ndarray, A: np.ndarray,
+                          motion: np.ndarray, fold: np.ndarray) -> None:
+        """Two roots of one target at a fold (``fold`` (K,) of the singular roots ``joints[rows, slots]``) that came
+        out within DUPLICATE_TOLERANCE of each other: the elimination places them only to about that along the
+        null motion (``motion`` (K, 6)). Newton's steps from :data:`SPLIT_STEP` either side of their middle along
+        it find the two roots where they are apart; these replace the pair (in place) when both reach the target
+        and differ by more than DUPLICATE_TOLERANCE. Else the pair is one, a double root, and stays as it was."""
+        every = np.arange(6)
+        for row in np.unique(rows[fold]).tolist():
+            members = np.flatnonzero((rows == row) & fold).tolist()
+            for position, k in enumerate(members):
+                for other in members[:position]:
+                    first = joints[row, slots[other]]
+                    step = self._difference(joints[row, slots[k]] - first, every)
+                    if np.abs(step).max() > DUPLICATE_TOLERANCE:
+                        continue
+                    sides = np.array([[1.0], [-1.0]]) * SPLIT_STEP * motion[other]
+                    targets = A[[row, row]]
+                    split = _newton(self.directions, self.points, self.revolute, targets, first + 0.5 * step + sides,
+                                    steps=SPLIT_NEWTON_STEPS)
+                    apart = np.abs(self._difference(split[0] - split[1], every)).max() > DUPLICATE_TOLERANCE
+                    if apart and self._reached(targets, split).all():
+                        joints[row, slots[other]], joints[row, slots[k]] = split
 
     def _difference(self, difference: np.ndarray, joints: np.ndarray) -> np.ndarray:
         """Differences of joint values (...,) of ``joints`` (...,): revolute ones wrapped to (−π, π]."""

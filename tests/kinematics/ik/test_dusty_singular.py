@@ -178,3 +178,23 @@ def test_general_6r_where_two_solutions_meet(arm):
     for _ in range(6):
         structures = _check_promises(robot, singular_configuration(robot, rng), 0, held=False)
         assert "general_6r" in structures or "general" in structures, structures
+
+
+def test_general_6r_keeps_the_closed_form_where_two_solutions_meet():
+    """The Jaco 2's second configuration at det J = 0 of the test above (joint 1 moved by each δ): the elimination
+    gives the two meeting roots as one (1e-6…9e-6 off), so before, every answer went to the numeric search. Its
+    two roots are split by Newton's steps from either side along the null motion: the closed form answers,
+    complete, reports the fold, and with the generating configuration as the reference lists it (to Newton's
+    accuracy)."""
+    robot = kinova_j2n6s300()
+    rng = np.random.default_rng(7)
+    for _ in range(2):
+        q_singular = singular_configuration(robot, rng)
+    for delta in DELTAS:
+        q = q_singular.copy()
+        q[0] += delta
+        target = forward_kinematics(robot, q)
+        result = _answer(robot, target, None, None)
+        assert (result.method, result.complete) == ("analytic", True), (delta, result.detail)
+        assert [s.relation for s in result.singularities] == ["boundary"], (delta, result.singularities)
+        assert _nearest(robot, _answer(robot, target, q, None), q) <= 1e-12, delta

@@ -111,3 +111,12 @@ def test_three_parallel_benchmark_runs_with_tiny_sizes(capsys):
     out = capsys.readouterr().out
     assert "| 4∥5∥6 | IK, batch of 20 | core |" in out
     assert "core on 1∥2∥3: family three_parallel_at_base" in out
+
+
+def test_general_6r_singular_count_runs_with_tiny_sizes(capsys):
+    from benchmarks import general_6r_singular
+
+    assert general_6r_singular.main(["--quick"]) == 0
+    out = capsys.readouterr().out
+    assert "| ufactory_xarm6 | 10 |" in out
+    assert out.strip().splitlines()[-1].endswith("| 0 |")  # no broken promise

@@ -52,8 +52,8 @@ def _most_singular(robot, q: np.ndarray, joint: int, solved: slice) -> np.ndarra
 
 
 #: Every (arm, joint) case; the three that broke the promise (issue 22.6: the xArm 7's q2 = 0, the iiwa's
-#: stretched elbow, the Jaco 2's wrist at q5 = 1e-9) hold now. The one still open is
-#: test_raw_xarm7_elbow_keeps_its_promise below.
+#: stretched elbow, the Jaco 2's wrist at q5 = 1e-9) hold now, and so does test_raw_xarm7_elbow_keeps_its_promise
+#: below.
 CASES = [(robot_id, joint) for robot_id in ARMS for joint in range(6)]
 
 
@@ -95,13 +95,14 @@ def test_raw_urdf_arms_keep_their_promises_near_singularities(client, robot_id, 
 
 
 #: The raw xArm 7 (q7 held, general 6R) at its elbow, q4 = -0.4407 (σ_min/σ_max ~ 1e-17, null motion over q1, q2,
-#: q3, q5), found by a wider sweep than the one above (issue 22.6, open).
+#: q3, q5), found by a wider sweep than the one above (issue 22.6). Before: 4 roots listed, none within 1e-2…1.4 rad of
+#: the generating one, complete, no singularity (the eigenproblem's roots near the self-motion were ill-conditioned
+#: complex pairs, not flagged, and two real roots landed on the family 0.026 rad off). Now the self-motion is
+#: reported, and the answer is not complete where the eigenproblem cannot account for every root.
 XARM7_ELBOW = [-0.25603245193298774, 0.7034507153661882, 0.6334286339692494, -0.4407119403217023,
                -1.1552021001572843, 0.6870453512289281, 1.2822717858736796]
 
 
-@pytest.mark.xfail(strict=True, reason="open: the general 6R's eliminant loses the singular root (4 roots listed, "
-                                       "none within 1e-2..1.4 rad of the generating one), complete, no singularity")
 def test_raw_xarm7_elbow_keeps_its_promise(client):
     description = _description("ufactory_xarm7")
     robot = robot_from_description(TypeAdapter(RobotDescription).validate_python(description), max_joints=32)

@@ -281,7 +281,8 @@ class SingularityReport(ApiModel):
 
     kind: str = Field(description="wrist, shoulder, elbow, base, positioner, reach, coaxial (two consecutive "
                                   "joints on one line: only their sum or difference is fixed), assur_group, or "
-                                  "jacobian (trajectory rates)")
+                                  "jacobian (trajectory rates, or a general 6R solution where the Jacobian is "
+                                  "singular: a fold where two solutions meet, or a self-motion)")
     joints: list[int] = Field(description="0-based joint indices involved")
     relation: str = Field(description="sum, difference, signed_sum, free, stretched, folded, aligned, coincident, "
                                       "boundary")

@@ -22,7 +22,7 @@ from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Pos
 from ._screws import apply, chain_rotation, invert, rotation_about
 from .subproblems import subproblem_1
 from ._types import Candidates, LabelCodes, SingularFlags, Sealed
-from ._wrist import Roll, SphericalWrist, _perpendicular_unit
+from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, _perpendicular_unit
 
 
 class DecoupledPlan(Sealed):
@@ -212,6 +212,7 @@ class _SphericalWristOnePose:
         self.normal_home = scalar.vector_of(home_inverse[:3, :3] @ wrist.normal)
         # subproblem 2 about the wrist's first two axes, 1 about its last (the normal)
         self.wrist, self.wrist_axes = scalar.TwoTurns(a, b, wrist.free_below), (a, b)
+        self.wrist_volume = wrist.volume_terms
         self.wrist_start = self.wrist.start(axis_c)
         self.last_turn = scalar.Turn(axis_c)
         self.last_normal = self.last_turn.coordinates(scalar.vector_of(wrist.normal))
@@ -231,12 +232,18 @@ class _SphericalWristOnePose:
         the wrist, R_Gᵀ · R_target, applied to its last axis and normal."""
         wanted = scalar.mtv(R_G, normal)
         a, b = self.wrist_axes
-        for roots in self.wrist.angles(self.wrist_start, self.wrist.goal(scalar.mtv(R_G, axis_c))):
+        pairs = self.wrist.angles(self.wrist_start, self.wrist.goal(scalar.mtv(R_G, axis_c)))
+        for roots in pairs:
             if roots is None:
                 rows.append(None)
                 codes.append((None, None, None))
                 continue
             qa, qb = roots
+            # the wrist's axes nearly aligned at a root (not at the least-squares pair of cones that miss, which
+            # is coplanar): the array path holds q_a within its band (SphericalWrist)
+            u, w = self.wrist_volume
+            if pairs[1] is not None and abs(u * math.cos(qb) + w * math.sin(qb)) <= scalar.MARGIN * ALIGNED_BELOW:
+                raise scalar.NotGeneric
             unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
             qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))
             rows.append([*arm, qa, qb, qc])

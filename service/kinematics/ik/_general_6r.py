@@ -59,6 +59,12 @@ Completeness
     verified solution. Anything else is answered with ``complete: false``. A 6R arm's target farther from axis 1
     than the arm's reach bound is a certain ``unreachable`` (complete) whatever the conditioning (a slide has no
     such bound).
+Singular roots
+    Where the Jacobian at a verified root is singular to within :data:`FAMILY_CONDITION`, the target fixes the
+    root along the null motion only to about DUPLICATE_TOLERANCE: the singularity is reported (two coaxial
+    joints, a self-motion, or a fold where two roots meet), and the root is moved along that motion to the
+    reference's value of its leading joint where that still reaches the target, as the closed forms hold a free
+    joint (see :meth:`General6RPlan._represent_singular_roots`).
 
 Pieper-class arms (three consecutive axes through one point, or parallel) make Σ singular for every x in some
 arrangements (and give double eigenvalues, solutions that share q_a, in others); they are the closed-form
@@ -89,9 +95,12 @@ GENERAL_STRUCTURES = (GENERAL_6R, GENERAL_5R1P)
 AMBIGUITY_FACTOR = 100.0
 #: Roots y with |1 + y²| below this are the spurious ones at ±i.
 SPURIOUS_RADIUS = 1e-2
-#: Complex roots whose angle's imaginary part is below this get an error bound (the others are clearly complex:
-#: no double-precision eigenproblem is that far off without its matrices being flagged ill-conditioned).
-SUSPECT_IMAGINARY = 1e-2
+#: Complex roots whose angle's imaginary part is below this get an error bound. Near a family of solutions the
+#: eigenproblem is nearly singular while its matrices look well conditioned: with axes 1 and 3 of an arm 1e-6
+#: from coaxial at q2 = 0, the generating root came out as a pair at 0.54 rad from the real axis with a bound of
+#: 26 rad. Farther out, towards the spurious roots at ±i, the bound carried to the angle (over |1 + y²|) says
+#: nothing (a random pose's pair at 2.1 rad had a bound of 0.09, well conditioned in y).
+SUSPECT_IMAGINARY = 1.0
 #: Smallest reciprocal condition number of the leading matrix and of the right-hand coefficients accepted.
 CONDITION_FLOOR = 1e-9
 #: Newton steps on the FK at most, for every root whose error twist (normalised lengths, radians) is above
@@ -103,16 +112,28 @@ PLAN_ACCURACY = 1e-4
 #: An arrangement this accurate on the test configurations is taken without trying the others.
 GOOD_ENOUGH = 1e-10
 
-#: Two joints whose null motion (one turned by t, the other by ∓t) moves the tool by less than this ratio of the
-#: Jacobian's largest singular value are one family: the elimination's roots satisfy the loop to about
+#: A root where the Jacobian's null motion (two joints turned by ±t, or any joint motion) moves the tool by less
+#: than this ratio of its largest singular value is singular: the elimination's roots satisfy the loop to about
 #: ELIMINATION_RESIDUAL before Newton's steps, which pins them along that motion only to
-#: ELIMINATION_RESIDUAL / FAMILY_CONDITION = DUPLICATE_TOLERANCE; below it they land anywhere on the family (on a
-#: raw xArm 7 at q2 = 0, four roots 0.004-0.02 rad apart, each verified at ACCEPT_RESIDUAL).
+#: ELIMINATION_RESIDUAL / FAMILY_CONDITION = DUPLICATE_TOLERANCE; below it they land anywhere on a family (on a
+#: raw xArm 7 at q2 = 0, four roots 0.004-0.02 rad apart, each verified at ACCEPT_RESIDUAL), or anywhere in the
+#: band where two roots meet (on a Jaco 2 at det J = 0, 1e-6…9e-6 from the generating configuration).
 ELIMINATION_RESIDUAL = 1e-12
 FAMILY_CONDITION = ELIMINATION_RESIDUAL / DUPLICATE_TOLERANCE
 #: Two roots of such a family differ along its null motion; across it, by no more than this (radians): the
 #: xArm's four differed by 1.4e-5 in q2, where the Jacobian's σ_min is ~1e-8 of σ_max.
 SAME_FAMILY = 1e-4
+#: A family's representative is reached from a root in steps of at most this (radians) along its null motion.
+FAMILY_STEP = 0.2
+#: The step (radians) along a singular root's null motion that tells a family (the target still reached, either
+#: way) from a fold (reached on one side at most).
+FAMILY_PROBE = 1e-3
+#: Where two roots at a fold came out as one, Newton's steps (at most SPLIT_NEWTON_STEPS) start this far (radians)
+#: either side of them along the null motion, beyond the band (1e-6…9e-6) in which the elimination places them.
+SPLIT_STEP = 1e-5
+SPLIT_NEWTON_STEPS = 30
+#: Joints whose share of a singular root's unit null motion is at least this are named in its report.
+SINGULAR_MOTION = 0.1
 
 #: Trigonometric basis (1, cos, sin) sampled at 0, 2π/3, 4π/3: rows are samples.
 _GRID = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
@@ -536,28 +557,25 @@ def _chain_twists(directions: np.ndarray, points: np.ndarray, revolute: np.ndarr
     return R, p, twists
 
 
-def _coaxial_motion(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, q: np.ndarray
-                    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Where two joints' axes coincide at q (K, 6) (the xArm's joints 1 and 3 at q2 = 0), or nearly (the
-    smallest singular value of the twist Jacobian within :data:`FAMILY_CONDITION` of the largest): turning one by
-    t and the other by ∓t moves the tool by at most that ratio times t, so the target fixes only their sum or
-    difference to the acceptance tolerance.
+def _singular_motion(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, q: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Roots q (K, 6) where the twist Jacobian is singular to within :data:`FAMILY_CONDITION` (its smallest
+    singular value that small a ratio of its largest): the target fixes them along the null motion only to about
+    DUPLICATE_TOLERANCE. There two roots meet (a fold), or a family of solutions passes (two coaxial joints, as
+    the xArm's joints 1 and 3 at q2 = 0, or a self-motion over more joints, as a raw xArm 7's shoulder and joint
+    5 at its elbow angle q4 = -0.44 with q7 held).
 
-    Returns ``found`` (K,) bool, the pair (K, 2) int (lower joint first), and the null motion (K, 6): unit, ±1/√2
-    on the pair (+ on the first joint), 0 elsewhere. Other null motions (a fold, where roots meet) are not a
-    family and are not reported here: the elimination's own conditioning speaks for them.
-    """
+    Returns ``found`` (K,) bool, the unit null motion (K, 6) (largest entry positive) and ``coaxial`` (K,) bool:
+    the motion turns two joints only, one by t and the other by ∓t (±1/√2 on the pair)."""
     _, _, J = _chain_twists(directions, points, revolute, q)  # (K, joints, twist)
     u, sigma, _ = np.linalg.svd(J)
     null = u[..., -1]  # (K, 6): the joint motion of the smallest singular value
-    order = np.argsort(-np.abs(null), axis=-1)
-    pair = np.sort(order[:, :2], axis=-1)
-    top = np.take_along_axis(null, pair, axis=-1)
-    on_pair = np.abs(np.abs(top) - np.sqrt(0.5)).max(axis=-1) <= 1e-3
-    found = (sigma[:, -1] <= FAMILY_CONDITION * sigma[:, 0]) & on_pair
-    motion = np.zeros_like(null)
-    np.put_along_axis(motion, pair, np.sqrt(0.5) * np.sign(top) * np.sign(top[:, :1]), axis=-1)
-    return found, pair, motion
+    largest = np.take_along_axis(null, np.argmax(np.abs(null), axis=-1)[:, None], axis=-1)
+    null = null * np.sign(largest)
+    top = -np.sort(-np.abs(null), axis=-1)[:, :2]
+    coaxial = np.abs(top - np.sqrt(0.5)).max(axis=-1) <= 1e-3
+    found = sigma[:, -1] <= FAMILY_CONDITION * sigma[:, 0]
+    return found, null, coaxial
 
 
 class General6RPlan(Sealed):
@@ -643,11 +661,13 @@ class General6RPlan(Sealed):
         if len(rows):
             start = np.nan_to_num(joints[rows, slots])
             joints[rows, slots] = _newton(self.directions, self.points, self.revolute, A[rows], start)
-        joints[..., ~self.revolute] *= self.scale
         complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
         singular = SingularFlags(n)
-        if len(rows):
-            self._represent_coaxial_families(joints, valid, rows, slots, A, reference, singular)
+        if len(rows):  # in normalised lengths, as Newton's steps work
+            normalised = None if reference is None else np.where(self.revolute, reference, np.divide(
+                reference, self.scale, dtype=float))
+            self._represent_singular_roots(joints, valid, rows, slots, A, normalised, singular)
+        joints[..., ~self.revolute] *= self.scale
         # out of reach by the bound: certainly no solution, however the eigenproblem was conditioned
         offset = targets[:, :3, 3] - self.points[0]
         beyond = np.einsum("ni,ni->n", offset, offset) > (self.reach * (1.0 + 1e-9)) ** 2
@@ -655,54 +675,149 @@ class General6RPlan(Sealed):
         complete[beyond] = True
         return Candidates(joints, valid, singular, complete=complete, promise_needs_every_slot=True)
 
-    def _represent_coaxial_families(self, joints: np.ndarray, valid: np.ndarray, rows: np.ndarray,
-                                    slots: np.ndarray, A: np.ndarray, reference: np.ndarray | None,
-                                    singular: SingularFlags) -> None:
-        """Roots (``joints[rows, slots]`` of targets ``A``) where two axes coincide, or nearly
-        (:func:`_coaxial_motion`): the target fixes only the pair's sum or difference to the acceptance tolerance,
-        and the elimination's roots are arbitrary members of that family (four, 0.004-0.02 rad apart, on a raw
-        xArm 7 at q2 = 0). The condition is reported and the family has one representative, as the closed forms
-        give it: the member with the pair's first joint at the reference value, where Newton's steps with that
-        joint held reach the target (the family holds there); else the root itself. The other roots of the
-        family (differing along the null motion only) are no longer candidates (``valid`` (N, m), in place), so
-        that every valid slot still gives a distinct solution (the promise of :meth:`solve` needs it)."""
-        found, pair, motion = _coaxial_motion(self.directions, self.points, self.revolute, joints[rows, slots])
+    def _represent_singular_roots(self, joints: np.ndarray, valid: np.ndarray, rows: np.ndarray, slots: np.ndarray,
+                                  A: np.ndarray, reference: np.ndarray | None, singular: SingularFlags) -> None:
+        """Roots (``joints[rows, slots]`` of targets ``A``, slides in normalised lengths, as ``reference``) where the
+        Jacobian is singular (:func:`_singular_motion`): the target fixes them along the null motion only to about DUPLICATE_TOLERANCE. The condition is reported,
+        and the root is represented as the closed forms represent it: with the motion's leading joint at the
+        reference value, where Newton's steps with that joint held reach the target; else the root itself.
+
+        * On a family (two coaxial joints, or a self-motion over more: the target is reached a step along the
+          motion on both sides) the elimination's roots are arbitrary members (four, 0.004-0.02 rad apart, on a
+          raw xArm 7 at q2 = 0): the family has one representative, and its other roots (differing along the
+          motion only) are no longer candidates (``valid`` (N, m), in place), so that every valid slot still
+          gives a distinct solution (the promise of :meth:`solve` needs it).
+        * At a fold two roots meet and stay two slots (the verification merges them if they are one, and the
+          promise then falls); the one nearest the reference is moved to it."""
+        found, motion, coaxial = _singular_motion(self.directions, self.points, self.revolute, joints[rows, slots])
         if not found.any():
             return
-        rows, slots, pair, motion = rows[found], slots[found], pair[found], motion[found]
+        rows, slots, motion, coaxial = rows[found], slots[found], motion[found], coaxial[found]
         index = np.arange(len(rows))
-        first = pair[:, 0]
-        if reference is not None:
+        pair = np.sort(np.argsort(-np.abs(motion), axis=-1)[:, :2], axis=-1)
+        # the leading joint: a coaxial pair's first (as the report says), else the one the motion turns most
+        leading = np.where(coaxial, pair[:, 0], np.argmax(np.abs(motion), axis=-1))
+        q = joints[rows, slots]
+        family = coaxial.copy()
+        if not coaxial.all():
+            family[~coaxial] = self._on_family(A[rows[~coaxial]], q[~coaxial], motion[~coaxial], leading[~coaxial])
+        if not family.all():
+            self._split_fold_pairs(joints, rows, slots, A, motion, ~family)
             q = joints[rows, slots]
-            wanted = np.asarray(reference, dtype=float)[first]
-            along = wrap_angle(wanted - q[index, first]) / motion[index, first]
-            moved = _newton(self.directions, self.points, self.revolute, A[rows], q + along[:, None] * motion,
-                            held=first)
-            R, p, _ = _chain_twists(self.directions, self.points, self.revolute, moved)
-            reached = np.abs(_error_twist(R, p, A[rows, :3, :3], A[rows, :3, 3])).max(axis=1) <= 10 * NEWTON_TOLERANCE
+        if reference is not None:
+            along = self._difference(np.asarray(reference, dtype=float)[leading] - q[index, leading],
+                                     leading) / motion[index, leading]
+            moved = self._along_family(A[rows], q, along[:, None] * motion, leading)
+            reached = self._reached(A[rows], moved)
+            # at a fold only the root nearest the reference moves (the other is a root of its own)
+            distance = np.abs(self._difference(np.asarray(reference, dtype=float) - q, np.arange(6))).max(axis=1)
+            for row in np.unique(rows[~family]).tolist():
+                members = np.flatnonzero((rows == row) & ~family)
+                reached[members[members != members[np.argmin(distance[members])]]] = False
             joints[rows[reached], slots[reached]] = moved[reached]
-        for row in np.unique(rows).tolist():  # one representative per family: the first slot's
-            members = np.flatnonzero(rows == row)
+        for row in np.unique(rows[family]).tolist():  # one representative per family: the first slot's
+            members = np.flatnonzero((rows == row) & family)
             for position, k in enumerate(members.tolist()):
                 for other in members[:position].tolist():
-                    step = wrap_angle(joints[row, slots[k]] - joints[row, slots[other]])
+                    step = self._difference(joints[row, slots[k]] - joints[row, slots[other]], np.arange(6))
                     across = step - (step @ motion[other]) * motion[other]
                     if valid[row, slots[other]] and np.abs(across).max() <= SAME_FAMILY:
                         valid[row, slots[k]] = False
                         break
-        for i, j in {(int(a), int(b)) for a, b in pair}:
+        self._report_singular(singular, rows, motion, coaxial, family, pair, leading)
+
+    def _split_fold_pairs(self, joints: np.ndarray, rows: np.ndarray, slots: np.ndarray, A: np.ndarray,
+                          motion: np.ndarray, fold: np.ndarray) -> None:
+        """Two roots of one target at a fold (``fold`` (K,) of the singular roots ``joints[rows, slots]``) that came
+        out within DUPLICATE_TOLERANCE of each other: the elimination places them only to about that along the
+        null motion (``motion`` (K, 6)). Newton's steps from :data:`SPLIT_STEP` either side of their middle along
+        it find the two roots where they are apart; these replace the pair (in place) when both reach the target
+        and differ by more than DUPLICATE_TOLERANCE. Else the pair is one, a double root, and stays as it was."""
+        every = np.arange(6)
+        for row in np.unique(rows[fold]).tolist():
+            members = np.flatnonzero((rows == row) & fold).tolist()
+            for position, k in enumerate(members):
+                for other in members[:position]:
+                    first = joints[row, slots[other]]
+                    step = self._difference(joints[row, slots[k]] - first, every)
+                    if np.abs(step).max() > DUPLICATE_TOLERANCE:
+                        continue
+                    sides = np.array([[1.0], [-1.0]]) * SPLIT_STEP * motion[other]
+                    targets = A[[row, row]]
+                    split = _newton(self.directions, self.points, self.revolute, targets, first + 0.5 * step + sides,
+                                    steps=SPLIT_NEWTON_STEPS)
+                    apart = np.abs(self._difference(split[0] - split[1], every)).max() > DUPLICATE_TOLERANCE
+                    if apart and self._reached(targets, split).all():
+                        joints[row, slots[other]], joints[row, slots[k]] = split
+
+    def _difference(self, difference: np.ndarray, joints: np.ndarray) -> np.ndarray:
+        """Differences of joint values (...,) of ``joints`` (...,): revolute ones wrapped to (−π, π]."""
+        return np.where(self.revolute[joints], wrap_angle(difference), difference)
+
+    def _on_family(self, A: np.ndarray, q: np.ndarray, motion: np.ndarray, held: np.ndarray) -> np.ndarray:
+        """Which singular roots q (K, 6) lie on a family of solutions: a step of :data:`FAMILY_PROBE` along their
+        null motion (K, 6), either way, with joint ``held`` (K,) kept, still reaches the target. At a fold it does
+        on one side at most."""
+        reached = np.ones(len(q), dtype=bool)
+        for sign in (1.0, -1.0):
+            moved = _newton(self.directions, self.points, self.revolute, A, q + sign * FAMILY_PROBE * motion,
+                            held=held)
+            reached &= self._reached(A, moved)
+        return reached
+
+    def _reached(self, A: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """Whether joint vectors q (K, 6) reach their targets A (K, 4, 4) to Newton's tolerance (with margin)."""
+        R, p, _ = _chain_twists(self.directions, self.points, self.revolute, q)
+        return np.abs(_error_twist(R, p, A[:, :3, :3], A[:, :3, 3])).max(axis=1) <= 10 * NEWTON_TOLERANCE
+
+    def _along_family(self, A: np.ndarray, q: np.ndarray, change: np.ndarray, held: np.ndarray) -> np.ndarray:
+        """Roots q (K, 6) moved by ``change`` (K, 6) along their null motion, in steps of at most
+        :data:`FAMILY_STEP` radians, each followed by Newton's steps with joint ``held`` (K,) kept (a family's
+        path curves away from its tangent)."""
+        steps = max(1, int(np.ceil(np.abs(change).max(initial=0.0) / FAMILY_STEP)))
+        for _ in range(steps):
+            q = _newton(self.directions, self.points, self.revolute, A, q + change / steps, held=held)
+        return q
+
+    @staticmethod
+    def _report_singular(singular: SingularFlags, rows: np.ndarray, motion: np.ndarray, coaxial: np.ndarray,
+                         family: np.ndarray, pair: np.ndarray, leading: np.ndarray) -> None:
+        """The conditions of :meth:`_represent_singular_roots` per target: two coaxial joints (only their sum or
+        difference is fixed), a self-motion (relation ``free``) or a fold (``boundary``), with the joints the
+        null motion turns."""
+        for i, j in {(int(a), int(b)) for a, b in pair[coaxial]}:
             for relation, sign in (("sum", "+"), ("difference", "−")):
-                chosen = (first == i) & (pair[:, 1] == j) & ((motion[:, j] < 0) == (relation == "sum"))
+                chosen = coaxial & (pair[:, 0] == i) & (pair[:, 1] == j) & (
+                    (np.sign(motion[:, i]) != np.sign(motion[:, j])) == (relation == "sum"))
                 if chosen.any():
-                    mask = np.zeros(singular.count, dtype=bool)
-                    mask[rows[chosen]] = True
-                    singular.add(mask, Singularity(
+                    singular.add(_rows_mask(singular.count, rows[chosen]), Singularity(
                         "coaxial", (i, j), relation, f"joints {i + 1} and {j + 1} are coaxial here: only "
                         f"q{i + 1} {sign} q{j + 1} is determined; q{i + 1} is set to the reference value where "
                         f"the family reaches the target"))
+        moving = np.abs(motion) >= SINGULAR_MOTION
+        other = ~coaxial
+        for joints, k, on_family in {(tuple(np.flatnonzero(m).tolist()), int(k), bool(f))
+                                     for m, k, f in zip(moving[other], leading[other], family[other])}:
+            chosen = other & (leading == k) & (family == on_family) & (
+                moving == np.isin(np.arange(6), joints)).all(axis=1)
+            names = ", ".join(f"q{j + 1}" for j in joints)
+            what = (f"a family of solutions passes here (a self-motion of {names})" if on_family else
+                    f"the Jacobian is singular here (its null motion turns {names}: two solutions meet, or a family "
+                    f"nearly passes), and the target fixes the solution along that motion only to about "
+                    f"{DUPLICATE_TOLERANCE:g} rad")
+            singular.add(_rows_mask(singular.count, rows[chosen]), Singularity(
+                "jacobian", joints, "free" if on_family else "boundary",
+                f"{what}; q{k + 1} is set to the reference value where that reaches the target"))
 
     def label_codes(self, joints: np.ndarray) -> LabelCodes:
         return {}
+
+
+def _rows_mask(count: int, rows: np.ndarray) -> np.ndarray:
+    """A boolean mask (count,) true at ``rows``."""
+    mask = np.zeros(count, dtype=bool)
+    mask[rows] = True
+    return mask
 
 
 def is_pieper(geometry: Geometry) -> bool:

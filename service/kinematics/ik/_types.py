@@ -22,8 +22,10 @@ class Singularity:
     ``joints`` are 0-based joint indices. ``relation`` states what is still
     determined: ``"sum"`` or ``"difference"`` (only q_i ± q_j is fixed),
     ``"free"`` (the joint does not affect the target), ``"stretched"`` /
-    ``"folded"`` (an elbow at the edge of its range), ``"aligned"`` or
-    ``"coincident"`` (the RRR group's special cases).
+    ``"folded"`` (an elbow at the edge of its range), ``"boundary"`` (two
+    solutions meet: a fold), ``"aligned"`` or ``"coincident"`` (the RRR
+    group's special cases; ``"aligned"`` also a spherical wrist whose axes
+    nearly align, where q_a is fixed only within a band).
     """
 
     kind: str

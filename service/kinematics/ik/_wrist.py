@@ -15,7 +15,8 @@ from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .._rotations import wrap_angle
 from ._screws import rotate_about
 from ._structure import Geometry, idealised
 from .subproblems import subproblem_1, subproblem_2_chain
@@ -52,6 +53,16 @@ def wrist_codes(middle: np.ndarray) -> LabelCodes:
     return {"wrist": (("no_flip", "flip"), codes)}
 
 
+#: The volume of the wrist's unit axes (|det|) below which q_a is fixed only within a band: the error of R_w
+#: (rounding, and the positioning joints' own, ~1e-12 near a singularity) moves q_a and q_c along their null
+#: motion by about that over the volume (a PUMA with right angles 1e-5 off at q5 = 1e-9: volume 1e-9, q4 1.4e-6
+#: off; the catalogue's PUMA at q5 = 5e-9: q4 1.3e-3 off).
+ALIGNED_BELOW = 1e-8
+#: Where q_a is fixed only within a band, the reference's q_a represents the root when R(a, q_a) R(b, q_b) ω_c
+#: misses R_w ω_c by at most this (unit vectors): the FK check then accepts the solution it gives.
+BAND_MISS = 0.1 * ACCEPT_RESIDUAL
+
+
 class SphericalWrist(Sealed):
     """Three revolute joints meeting at the wrist centre (Spong §4.2–4.4, done with subproblems).
 
@@ -63,7 +74,12 @@ class SphericalWrist(Sealed):
     own error: an arm whose relations hold within ``GEOMETRY_TOLERANCE`` but
     not exactly (a URDF's π/2 written to 11 digits) gives ``R_w`` with that
     error, and q_a, seen on the radius of ``R_w ω_c`` about ω_a, with that
-    error over the radius (see :attr:`free_below`).
+    error over the radius (see :attr:`free_below`). Where the two roots meet
+    (a wrist whose angles are not right ones, as CAD rounding leaves them,
+    folds its flip pair near the aligned pose), q_a is fixed only within a band
+    (:data:`ALIGNED_BELOW`): it takes the reference value when that reaches
+    ``R_w ω_c`` within :data:`BAND_MISS`, and the fold (or the near
+    alignment) is reported.
 
     Labels: see :func:`wrist_codes`.
     """
@@ -91,6 +107,21 @@ class SphericalWrist(Sealed):
             qb = np.where(free[..., None], qb_free[..., None], qb)
         valid = pair.valid[..., 0, :].copy()
         valid[..., 1] &= ~free
+        # where the two roots meet (the cones touch, or cross within rounding: a fold, where the flip pair is one),
+        # or the axes nearly align (their volume below ALIGNED_BELOW), the target fixes q_a only within a band:
+        # the root nearest the reference takes its value where that reaches R_w ω_c within BAND_MISS
+        met = pair.merged[..., 0] & ~free
+        aligned = (self._volume(qb) <= ALIGNED_BELOW) & pair.exact[..., 0, :]  # (..., 2); a miss's pair is coplanar
+        band = (met[..., None] | aligned) & valid & ~free[..., None]
+        if reference is not None and band.any():
+            held = reference[self.joints[0]]
+            qb_held = subproblem_1(b, c, rotate_about(a, -held, target_axis)).theta[..., 0]
+            miss = np.linalg.norm(rotate_about(a, held, rotate_about(b, qb_held, c)) - target_axis, axis=-1)
+            gap = np.where(band, np.abs(wrap_angle(qa - held)), np.inf)
+            nearest = np.arange(2) == np.argmin(gap, axis=-1)[..., None]
+            moved = band & nearest & (miss <= BAND_MISS)[..., None]
+            qa = np.where(moved, held, qa)
+            qb = np.where(moved, qb_held[..., None], qb)
         # q_c: R(c, q_c) u = (R_a R_b)^T R_w u
         wanted = np.einsum("...ij,j->...i", R_w, self.normal)[..., None, :]  # (..., 1, 3)
         unwound = rotate_about(b, -qb, rotate_about(a, -qa, wanted))
@@ -105,7 +136,27 @@ class SphericalWrist(Sealed):
                     f"the first and last wrist axes are aligned: only q{self.joints[0] + 1} "
                     f"{'+' if relation == 'sum' else '−'} q{self.joints[2] + 1} is determined; "
                     f"q{self.joints[0] + 1} is set to the reference value (or 0)"))
+        singular.add(met, Singularity(
+            "wrist", self.joints, "boundary", f"the two wrist solutions meet (a fold of the wrist flip): "
+            f"q{self.joints[0] + 1} is fixed only within a band, and set to the reference value where it lies in "
+            f"it"))
+        singular.add(band.any(axis=-1) & ~met, Singularity(
+            "wrist", self.joints, "aligned", f"the wrist axes are nearly aligned: q{self.joints[0] + 1} is fixed "
+            f"only within a band, and set to the reference value where it lies in it"))
         return WristResult(joints, valid, singular)
+
+    def _volume(self, qb: np.ndarray) -> np.ndarray:
+        """|det| of the wrist's three unit axes at q_b (...,), which q_a turns together (so it does not count):
+        the wrist's part of the arm's Jacobian is singular where it vanishes. a·(b × R(b, q_b) c) is
+        u cos q_b + w sin q_b (:attr:`volume_terms`)."""
+        u, w = self.volume_terms
+        return np.abs(u * np.cos(qb) + w * np.sin(qb))
+
+    @cached_property
+    def volume_terms(self) -> tuple[float, float]:
+        """(u, w) = (a·(b × c), a·(b × (b × c))) of the wrist's axes: its volume at q_b is |u cos q_b + w sin q_b|."""
+        a, b, c = self.axes
+        return float(a @ np.cross(b, c)), float(a @ np.cross(b, np.cross(b, c)))
 
     @cached_property
     def free_below(self) -> float:

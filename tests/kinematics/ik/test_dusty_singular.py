@@ -22,6 +22,8 @@ from service.kinematics import Joint, Robot, ScrewJoint, forward_kinematics
 from service.kinematics.ik import joint_difference
 from service.kinematics.ik._answer import AnswerOptions, IKTargets, answer_ik
 from service.kinematics.ik._solve import result_of, unlimited
+from tests.arms import random_general_arm
+from tests.kinematics.ik.test_general_6r import kinova_j2n6s300, singular_configuration
 
 DELTAS = (0.0, 1e-12, 1e-9, 1e-6, 1e-3)
 HALF_PI_IN_A_URDF = 1.57079632679  # example-robot-data's iiwa and Jaco write it so
@@ -134,15 +136,13 @@ def test_puma_like_wrist_with_urdf_dust(seed):
     assert all(s == "intersecting_shoulder+spherical_wrist" for s in structures), structures
 
 
-PUMA_CAD_BROKEN = pytest.mark.xfail(strict=True, reason=(
-    "open: with right angles 1e-6 off, axes 4 and 6 align at q5 ~ 1e-6, not 0; at q5 = 1e-12 the two wrist roots "
-    "are < 1e-6 apart in subproblem 2's angles and merge (its DUPLICATE_TOLERANCE test), and the merged, polished "
-    "representative lies 4e-6 from the generating configuration with no singularity reported"))
-
-
-@PUMA_CAD_BROKEN  # at both dust levels
 @pytest.mark.parametrize("dust", [1e-6, 1e-5])
 def test_puma_like_wrist_with_cad_rounding(dust):
+    """Right angles 1e-6/1e-5 off: the wrist's flip pair folds at q5 = 0 (the axes span no volume there). Before:
+    at q5 = 1e-12 subproblem 2 merged the pair and its representative lay 4e-6 from the generating configuration;
+    at q5 = 1e-9 (dust 1e-5) the pair was two roots, one 1.4e-6 off (q4 seen through a volume of 2e-11), and no
+    singularity was reported. Now the wrist reports the fold (or the near alignment) and holds q4 at the
+    reference where that reaches the target."""
     rng = np.random.default_rng(int(dust * 1e7) + 1)
     robot = _puma_like(rng, dust)
     for _ in range(3):
@@ -151,11 +151,7 @@ def test_puma_like_wrist_with_cad_rounding(dust):
         _check_promises(robot, q, 4, held=False)
 
 
-GENERAL_LOST_ROOT = pytest.mark.xfail(strict=True, reason=(
-    "open: axes 1 and 3 1e-6 apart, q2 = 1e-12: the elimination returns 6 roots, none within 1.3 rad of the "
-    "generating configuration (the near-family root is lost, not flagged ambiguous), and claims complete"))
-COAXIAL_CASES = [pytest.param(seed, offset, marks=GENERAL_LOST_ROOT) if (seed, offset) == (0, 1e-6) else (seed, offset)
-                 for seed in range(4) for offset in (0.0, 1e-9, 1e-7, 1e-6, 1e-5)]
+COAXIAL_CASES = [(seed, offset) for seed in range(4) for offset in (0.0, 1e-9, 1e-7, 1e-6, 1e-5)]
 
 
 @pytest.mark.parametrize("seed, offset", COAXIAL_CASES)
@@ -168,3 +164,37 @@ def test_general_6r_with_nearly_coaxial_joints_1_and_3(seed, offset):
     q[1] = 0.0
     structures = _check_promises(robot, q, 1, held=False)
     assert "general_6r" in structures, structures
+
+
+@pytest.mark.parametrize("arm", ["kinova_j2n6s300", "random_general_arm"])
+def test_general_6r_where_two_solutions_meet(arm):
+    """det J = 0 on a general 6R arm (found by bisection along a random segment), the configuration's joint 1 then
+    moved by δ: two roots of the elimination meet there, and each is found only to about 1e-6 along the null
+    motion (before: complete, the listed root 1e-6…9e-6 from the generating configuration, no singularity; 57
+    of 525 such requests on five general arms)."""
+    robot = kinova_j2n6s300() if arm == "kinova_j2n6s300" else random_general_arm(np.random.default_rng(11),
+                                                                                  "standard")
+    rng = np.random.default_rng(7)
+    for _ in range(6):
+        structures = _check_promises(robot, singular_configuration(robot, rng), 0, held=False)
+        assert "general_6r" in structures or "general" in structures, structures
+
+
+def test_general_6r_keeps_the_closed_form_where_two_solutions_meet():
+    """The Jaco 2's second configuration at det J = 0 of the test above (joint 1 moved by each δ): the elimination
+    gives the two meeting roots as one (1e-6…9e-6 off), so before, every answer went to the numeric search. Its
+    two roots are split by Newton's steps from either side along the null motion: the closed form answers,
+    complete, reports the fold, and with the generating configuration as the reference lists it (to Newton's
+    accuracy)."""
+    robot = kinova_j2n6s300()
+    rng = np.random.default_rng(7)
+    for _ in range(2):
+        q_singular = singular_configuration(robot, rng)
+    for delta in DELTAS:
+        q = q_singular.copy()
+        q[0] += delta
+        target = forward_kinematics(robot, q)
+        result = _answer(robot, target, None, None)
+        assert (result.method, result.complete) == ("analytic", True), (delta, result.detail)
+        assert [s.relation for s in result.singularities] == ["boundary"], (delta, result.singularities)
+        assert _nearest(robot, _answer(robot, target, q, None), q) <= 1e-12, delta

@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from benchmarks import general_6r_singular
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import Joint, Robot, forward_kinematics, geometric_jacobian
@@ -395,16 +396,7 @@ def test_a_batch_larger_than_a_chunk_is_answered_in_one_piece():
 
 def singular_configuration(robot: Robot, rng: np.random.Generator) -> np.ndarray:
     """A configuration with det J = 0: bisection along the first random segment on which det J changes sign."""
-    while True:
-        start, end = rng.uniform(-np.pi, np.pi, (2, 6))
-        det = lambda t: np.linalg.det(geometric_jacobian(robot, start + t * (end - start)))
-        low, high = 0.0, 1.0
-        if np.sign(det(low)) != np.sign(det(high)):
-            break
-    for _ in range(60):
-        middle = 0.5 * (low + high)
-        low, high = (middle, high) if np.sign(det(middle)) == np.sign(det(low)) else (low, middle)
-    return start + low * (end - start)
+    return general_6r_singular.singular_configuration(robot, rng)[0]
 
 
 def test_the_api_reports_the_general_solvers_completeness_per_target(client):

@@ -35,11 +35,11 @@ from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 
 #: Pair evaluations per block (configurations × pairs of the widest group): large enough that numpy's cost per
 #: call is small against the arithmetic, small enough that a block's temporaries stay in cache. Measuring every
-#: pair: 4096 to 16384 alike, 1024 and 65536 slower. With the bounds, which leave an eighth to a third of the pairs
-#: to measure in smaller arrays, four times as many (80,000 PUMA configurations and 34 pairs: 32768 and 65536
-#: alike, 8192 a third slower).
+#: pair: 4096 to 16384 alike, 1024 and 65536 slower. With the single-precision bounds, which leave an eighth to a
+#: third of the pairs to measure in smaller arrays, sixteen times as many (80,000 PUMA configurations and 34 pairs:
+#: 98304 to 196608 alike, 32768 a tenth slower, 16384 a quarter).
 _BLOCK_ELEMENTS = 8192
-_BOUNDED_BLOCK_ELEMENTS = 32768
+_BOUNDED_BLOCK_ELEMENTS = 131072
 
 #: Fewer pair evaluations than this are all measured: the bounds' numpy calls would cost more than they save.
 _BOUNDED_FROM = 4096
@@ -355,8 +355,7 @@ class CollisionModel:
                         np.fmin(upper, bound[1].min(axis=0), out=upper)
                 cutoff = np.maximum(upper + slack, margin) + slack
                 for (start, stop, kernel, _, sizes, _, rows), bound in zip(parts, bounds):
-                    result[begin:end, start:stop] = _measured(kernel, world, end - begin, rows, sizes, bound,
-                                                              cutoff, slack).T
+                    _measure(result[begin:end, start:stop], kernel, world, rows, sizes, bound, cutoff, slack)
                 yield begin, end
 
 
@@ -403,27 +402,26 @@ def _box_box_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witne
 _KERNELS = {("round", "round"): _round_round, ("box", "round"): _box_round, ("box", "box"): _box_box_kernel}
 
 
-def _measured(kernel, world: np.ndarray, count: int, rows: np.ndarray, sizes: tuple, bound,
-              cutoff: np.ndarray, slack: float) -> np.ndarray:
-    """(P_k, B): the kernel's distances where the pair's single-precision lower bound is below the
+def _measure(out: np.ndarray, kernel, world: np.ndarray, rows: np.ndarray, sizes: tuple, bound,
+             cutoff: np.ndarray, slack: float) -> None:
+    """Into ``out`` (B, P_k): the kernel's distances where the pair's single-precision lower bound is below the
     configuration's ``cutoff`` (B,), that bound less the ``slack`` elsewhere. ``world`` (3, K, block) holds the
-    block's reference rows in its first ``count`` columns; ``rows`` (m, P_k) are the pairs' rows."""
-    if bound is None:
-        return kernel(np.take(world[:, :, :count], rows, axis=1), *sizes, witness=False)
-    lower = bound[0]
-    pairs, configurations = np.nonzero(lower < cutoff)
-    if pairs.size > _MEASURE_ALL * lower.size:  # the compaction would cost more than it saves
-        return kernel(np.take(world[:, :, :count], rows, axis=1), *sizes, witness=False)
-    result = lower.astype(float)
-    result -= slack
+    block's reference rows in its first B columns; ``rows`` (m, P_k) are the pairs' rows."""
+    count = out.shape[0]
+    if bound is not None:
+        lower = bound[0]
+        pairs, configurations = np.nonzero(lower < cutoff)
+    if bound is None or pairs.size > _MEASURE_ALL * lower.size:  # the compaction would cost more than it saves
+        out[...] = kernel(np.take(world[:, :, :count], rows, axis=1), *sizes, witness=False).T
+        return
+    np.subtract(lower.T, slack, out=out)
     if pairs.size == 1:  # einsum sums a lone element in another order: measure it twice, for a batch's bits
         pairs, configurations = np.repeat(pairs, 2), np.repeat(configurations, 2)
     # (3, m, n), gathered with np.take: the kernels then see the layout of a whole block (components first,
     # contiguous), so that each distance has the same bits either way; indexing would lay the entries out first
     entries = np.take(world.reshape(3, -1), rows[:, pairs] * world.shape[2] + configurations, axis=1)
-    result[pairs, configurations] = kernel(entries, *(np.take(size[..., 0], pairs, axis=-1) for size in sizes),
-                                           witness=False)
-    return result
+    out[configurations, pairs] = kernel(entries, *(np.take(size[..., 0], pairs, axis=-1) for size in sizes),
+                                        witness=False)
 
 
 #: Above this share of pairs in doubt, a block measures them all.

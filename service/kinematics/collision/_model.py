@@ -36,10 +36,12 @@ from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 #: Pair evaluations per block (configurations × pairs of the widest group): large enough that numpy's cost per
 #: call is small against the arithmetic, small enough that a block's temporaries stay in cache. Measuring every
 #: pair: 4096 to 16384 alike, 1024 and 65536 slower. With the single-precision bounds, which leave an eighth to a
-#: third of the pairs to measure in smaller arrays, sixteen times as many (80,000 PUMA configurations and 34 pairs:
-#: 98304 to 196608 alike, 32768 a tenth slower, 16384 a quarter).
+#: third of the pairs to measure in smaller arrays, up to sixteen times as many, in at most 4096 configurations
+#: (80,000 PUMA configurations and 34 pairs: 98304 to 196608 elements alike, 32768 a tenth slower, 16384 a quarter;
+#: with 12 pairs, blocks of 3,500 to 8,192 configurations alike, 18,724 half as slow again).
 _BLOCK_ELEMENTS = 8192
 _BOUNDED_BLOCK_ELEMENTS = 131072
+_BOUNDED_BLOCK_CONFIGURATIONS = 4096
 
 #: Fewer pair evaluations than this are all measured: the bounds' numpy calls would cost more than they save.
 _BOUNDED_FROM = 4096
@@ -323,8 +325,9 @@ class CollisionModel:
         count = columns.shape[3]
         if count * len(self.pairs) < _BOUNDED_FROM:
             margin = None  # every pair measured: as exact, and fewer calls
-        elements = _BLOCK_ELEMENTS if margin is None else _BOUNDED_BLOCK_ELEMENTS
-        block = max(1, min(count, elements // max(part[1] - part[0] for part in parts)))
+        widest = max(part[1] - part[0] for part in parts)
+        block = max(1, min(count, _BLOCK_ELEMENTS // widest if margin is None else
+                           min(_BOUNDED_BLOCK_ELEMENTS // widest, _BOUNDED_BLOCK_CONFIGURATIONS)))
         world = self._world_buffer(block)
         with _quiet():
             for begin in range(0, count, block):

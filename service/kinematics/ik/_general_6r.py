@@ -53,18 +53,24 @@ Back-substitution
     is kept.
 Completeness
     A target's answer is complete only when the algebra accounts for every solution: the right-hand
-    coefficients have full rank 8, the leading matrix is well conditioned, no eigenvalue is ambiguous (an
-    imaginary part within :data:`AMBIGUITY_FACTOR` times its first-order error bound: a root pair about to merge
-    or split), at most 16 roots are real, and (checked after verification) every real root gave one distinct
-    verified solution. Anything else is answered with ``complete: false``. A 6R arm's target farther from axis 1
-    than the arm's reach bound is a certain ``unreachable`` (complete) whatever the conditioning (a slide has no
+    coefficients have full rank 8, the leading matrix is well conditioned, at most 16 roots are real or
+    ambiguous, every ambiguous eigenvalue (an imaginary part within :data:`AMBIGUITY_FACTOR` times its first-order
+    error bound: a root pair about to merge or split) is accounted for, and (checked after verification) every
+    real root gave one distinct verified solution. Both halves of an ambiguous pair are back-substituted from
+    their common real part and split along the Jacobian's null motion there: they count when they verify as two
+    solutions, or as one double root where the Jacobian is singular (a fold: listed once, and reported).
+    Anything else is answered with ``complete: false``. A 6R arm's target farther from axis 1 than the arm's
+    reach bound is a certain ``unreachable`` (complete) whatever the conditioning (a slide has no
     such bound).
 Singular roots
     Where the Jacobian at a verified root is singular to within :data:`FAMILY_CONDITION`, the target fixes the
     root along the null motion only to about DUPLICATE_TOLERANCE: the singularity is reported (two coaxial
     joints, a self-motion, or a fold where two roots meet), and the root is moved along that motion to the
     reference's value of its leading joint where that still reaches the target, as the closed forms hold a free
-    joint (see :meth:`General6RPlan._represent_singular_roots`).
+    joint (see :meth:`General6RPlan._represent_singular_roots`). Two roots at a fold that Newton's steps left
+    within :data:`FOLD_PAIR` of each other are split again; where they meet within DUPLICATE_TOLERANCE they are
+    one double root, listed once (on five general arms at det J = 0, before this, 197 of 525 requests went to
+    the numeric search, and an exact double root was listed twice, 1e-6…5e-6 apart).
 
 Pieper-class arms (three consecutive axes through one point, or parallel) make Σ singular for every x in some
 arrangements (and give double eigenvalues, solutions that share q_a, in others); they are the closed-form
@@ -132,6 +138,17 @@ FAMILY_PROBE = 1e-3
 #: either side of them along the null motion, beyond the band (1e-6…9e-6) in which the elimination places them.
 SPLIT_STEP = 1e-5
 SPLIT_NEWTON_STEPS = 30
+#: Two roots at a fold closer than this (radians) are split again: Newton's steps stopped at NEWTON_TOLERANCE leave
+#: the two halves of a double root 1e-6…5e-6 apart (a Jaco 2 at det J = 0), both verified.
+FOLD_PAIR = 1e-4
+#: The split's Newton steps run until the error twist is below SPLIT_TOLERANCE (near rounding), not
+#: NEWTON_TOLERANCE, and by the pseudo-inverse (singular values down to SPLIT_RCOND of the largest), not with
+#: Newton's damping of 1e-14 on J Jᵀ: at a double root the residual grows with the square of the distance t along
+#: the null motion and σ_min of the Jacobian with t, so steps stopped at NEWTON_TOLERANCE, or damped once σ_min² is
+#: below 1e-14, leave the two sides 1e-6…5e-6 apart (a Jaco 2), both verified; run on, they meet within
+#: DUPLICATE_TOLERANCE.
+SPLIT_TOLERANCE = 1e-15
+SPLIT_RCOND = 1e-12
 #: Joints whose share of a singular root's unit null motion is at least this are named in its report.
 SINGULAR_MOTION = 0.1
 
@@ -304,15 +321,18 @@ class _Roots:
 
     ``joints`` (N, m, 6) in the robot's order and ``valid`` (N, m): the m slots hold each target's real roots
     (m is the largest count in the batch, at least 1). ``real_count`` (N,) counts them before the cut to 16;
-    ``ambiguous`` (N,) marks targets with a root neither clearly real nor clearly complex; ``conditioned``
+    ``ambiguous`` (N,) marks targets with a root neither clearly real nor clearly complex, ``near`` (N, m) the
+    slots that hold such roots (back-substituted from their real parts, and valid) and ``ambiguous_count`` (N,)
+    counts them before the cut; ``conditioned``
     (N,) that the right-hand coefficients and the leading matrix were well conditioned; ``shift`` (N,) the origin
     φ of the half-angle used for each target.
     """
 
-    def __init__(self, joints: np.ndarray, valid: np.ndarray, real_count: np.ndarray, ambiguous: np.ndarray,
-                 conditioned: np.ndarray, shift: np.ndarray) -> None:
+    def __init__(self, joints: np.ndarray, valid: np.ndarray, real_count: np.ndarray, near: np.ndarray,
+                 ambiguous_count: np.ndarray, conditioned: np.ndarray, shift: np.ndarray) -> None:
         self.joints, self.valid, self.real_count = joints, valid, real_count
-        self.ambiguous, self.conditioned, self.shift = ambiguous, conditioned, shift
+        self.ambiguous, self.near, self.ambiguous_count = ambiguous_count > 0, near, ambiguous_count
+        self.conditioned, self.shift = conditioned, shift
 
 
 def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
@@ -394,13 +414,13 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
         with np.errstate(divide="ignore", invalid="ignore"):
             bound = 2.0 * 24 * np.finfo(float).eps * size * condition / np.abs(1.0 + y[rows] ** 2)
             near[rows] = suspect[rows] & (imaginary[rows] <= AMBIGUITY_FACTOR * bound)
-    ambiguous = near.any(axis=1)
+    ambiguous_count = near.sum(axis=1)
     # back-substitute the real and the ambiguous roots only: m slots, nearest the real axis first
     real = real | near
     m = int(min(max(real.sum(axis=1).max(initial=0), 1), 16))
     order = np.argsort(imaginary, axis=1, kind="stable")[:, :m]
     take = (np.arange(n)[:, None], order)
-    valid = real[take]
+    valid, near = real[take], near[take]
     y, qa = y[take], shift[:, None] + angle.real[take]
     vectors = np.take_along_axis(vectors, order[:, None, :], axis=2)  # (N, 24, m)
     # monomials x_b^i x_c^j (i ≤ 3, j ≤ 2) of each root, from the block of the eigenvector that is not small
@@ -423,7 +443,7 @@ def _solve_arrangement(arr: _Arrangement, A: np.ndarray) -> _Roots:
     chain[..., 3] = _last_joint(arr, chain_A, chain)
     joints = np.empty_like(chain)
     joints[..., arr.order] = chain
-    return _Roots(joints, valid, real_count, ambiguous, rank_ok & lead_ok, shift)
+    return _Roots(joints, valid, real_count, near, ambiguous_count, rank_ok & lead_ok, shift)
 
 
 def _slide_interval(arr: _Arrangement, B: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -500,12 +520,13 @@ def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarr
 
 
 def _newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_targets: np.ndarray,
-            q: np.ndarray, steps: int = NEWTON_STEPS, held: np.ndarray | None = None) -> np.ndarray:
+            q: np.ndarray, steps: int = NEWTON_STEPS, held: np.ndarray | None = None,
+            tolerance: float = NEWTON_TOLERANCE, rcond: float | None = None) -> np.ndarray:
     """Newton's method on G_1 ⋯ G_6 = A for candidates q (K, 6) and targets A (K, 4, 4), normalised lengths
     (``revolute`` (6,) tells turns from slides); ``held`` (K,), a joint per candidate that keeps its value
     (Gauss–Newton on the other five).
 
-    Steps the candidates whose error twist is above :data:`NEWTON_TOLERANCE` (roots come from the eigenproblem
+    Steps the candidates whose error twist is above ``tolerance`` (roots come from the eigenproblem
     to about 1e-12, so one step, or none, usually suffices); singular candidates get a tiny damping instead of a
     failure.
     """
@@ -514,7 +535,7 @@ def _newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_
     for _ in range(steps + 1):
         R, p, twists = _chain_twists(directions, points, revolute, q)
         error = _error_twist(R, p, R_A, p_A)
-        active = np.abs(error).max(axis=1) > NEWTON_TOLERANCE
+        active = np.abs(error).max(axis=1) > tolerance
         if _ == steps or not active.any():
             break
         J = twists[active]
@@ -522,6 +543,9 @@ def _newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_
         if held is not None:
             J[np.arange(len(J)), held[active]] = 0.0
             fixed[np.arange(len(J)), held[active]] = 1.0
+        if rcond is not None:  # the pseudo-inverse: every singular value above rcond · σ_max counts in full
+            q[active] += np.einsum("kij,kj->ki", np.linalg.pinv(np.swapaxes(J, -1, -2), rcond=rcond), error[active])
+            continue
         JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6) + fixed[..., None] * np.eye(6)
         q[active] += np.linalg.solve(JJt, (J @ error[active][..., None]))[..., 0]
     return q
@@ -661,7 +685,10 @@ class General6RPlan(Sealed):
         if len(rows):
             start = np.nan_to_num(joints[rows, slots])
             joints[rows, slots] = _newton(self.directions, self.points, self.revolute, A[rows], start)
-        complete = roots.conditioned & ~roots.ambiguous & (roots.real_count <= 16)
+        resolved = self._split_near_pairs(joints, valid, roots.near, A)
+        complete = roots.conditioned & (~roots.ambiguous | resolved) & (
+            roots.real_count + roots.ambiguous_count <= 16)
+        rows, slots = np.nonzero(valid)
         singular = SingularFlags(n)
         if len(rows):  # in normalised lengths, as Newton's steps work
             normalised = None if reference is None else np.where(self.revolute, reference, np.divide(
@@ -702,17 +729,18 @@ class General6RPlan(Sealed):
         if not coaxial.all():
             family[~coaxial] = self._on_family(A[rows[~coaxial]], q[~coaxial], motion[~coaxial], leading[~coaxial])
         if not family.all():
-            self._split_fold_pairs(joints, rows, slots, A, motion, ~family)
+            self._split_fold_pairs(joints, valid, rows, slots, A, motion, ~family)
             q = joints[rows, slots]
         if reference is not None:
             along = self._difference(np.asarray(reference, dtype=float)[leading] - q[index, leading],
                                      leading) / motion[index, leading]
             moved = self._along_family(A[rows], q, along[:, None] * motion, leading)
-            reached = self._reached(A[rows], moved)
+            reached = self._reached(A[rows], moved) & valid[rows, slots]
             # at a fold only the root nearest the reference moves (the other is a root of its own)
             distance = np.abs(self._difference(np.asarray(reference, dtype=float) - q, np.arange(6))).max(axis=1)
-            for row in np.unique(rows[~family]).tolist():
-                members = np.flatnonzero((rows == row) & ~family)
+            fold = ~family & valid[rows, slots]
+            for row in np.unique(rows[fold]).tolist():
+                members = np.flatnonzero((rows == row) & fold)
                 reached[members[members != members[np.argmin(distance[members])]]] = False
             joints[rows[reached], slots[reached]] = moved[reached]
         for row in np.unique(rows[family]).tolist():  # one representative per family: the first slot's
@@ -726,29 +754,62 @@ class General6RPlan(Sealed):
                         break
         self._report_singular(singular, rows, motion, coaxial, family, pair, leading)
 
-    def _split_fold_pairs(self, joints: np.ndarray, rows: np.ndarray, slots: np.ndarray, A: np.ndarray,
-                          motion: np.ndarray, fold: np.ndarray) -> None:
-        """Two roots of one target at a fold (``fold`` (K,) of the singular roots ``joints[rows, slots]``) that came
-        out within DUPLICATE_TOLERANCE of each other: the elimination places them only to about that along the
-        null motion (``motion`` (K, 6)). Newton's steps from :data:`SPLIT_STEP` either side of their middle along
-        it find the two roots where they are apart; these replace the pair (in place) when both reach the target
-        and differ by more than DUPLICATE_TOLERANCE. Else the pair is one, a double root, and stays as it was."""
+    def _split_near_pairs(self, joints: np.ndarray, valid: np.ndarray, near: np.ndarray, A: np.ndarray
+                          ) -> np.ndarray:
+        """Roots neither clearly real nor clearly complex (``near`` (N, m) of ``joints`` (N, m, 6), targets A):
+        a conjugate pair about to become two real roots, or two real roots that rounding made complex. Both halves
+        were back-substituted from the same real part, so they came out as one point; :meth:`_split_fold_pairs`
+        splits them along the Jacobian's null motion there. Returns, per target (N,), whether every such root
+        was accounted for: two verified roots apart, or one double root (in place)."""
+        rows, slots = np.nonzero(near & valid)
+        unresolved = np.zeros(len(near), dtype=bool)
+        if len(rows):
+            _, motion, _ = _singular_motion(self.directions, self.points, self.revolute, joints[rows, slots])
+            done = self._split_fold_pairs(joints, valid, rows, slots, A, motion, np.ones(len(rows), dtype=bool))
+            unresolved[rows[~done]] = True
+        return ~unresolved
+
+    def _split_fold_pairs(self, joints: np.ndarray, valid: np.ndarray, rows: np.ndarray, slots: np.ndarray,
+                          A: np.ndarray, motion: np.ndarray, fold: np.ndarray) -> np.ndarray:
+        """Two roots of one target at a fold (``fold`` (K,) of the roots ``joints[rows, slots]``) that came out
+        within :data:`FOLD_PAIR` of each other: the elimination and Newton's steps place them only to about
+        DUPLICATE_TOLERANCE along the null motion (``motion`` (K, 6)). Newton's steps from :data:`SPLIT_STEP`
+        either side of their middle along it, run to :data:`SPLIT_TOLERANCE`, find the two roots where they are
+        apart, and replace the pair (in place) when both reach the target and differ by more than
+        DUPLICATE_TOLERANCE. Where both reach it within
+        DUPLICATE_TOLERANCE of each other the pair is one double root: its middle takes the first slot and the
+        second is no longer ``valid`` (N, m), provided the Jacobian is singular there (a simple root's two slots,
+        as a near-Pieper arm's two solutions that share q_a give, stay two). Returns which of the K roots were so
+        accounted for."""
         every = np.arange(6)
+        done = np.zeros(len(rows), dtype=bool)
         for row in np.unique(rows[fold]).tolist():
             members = np.flatnonzero((rows == row) & fold).tolist()
             for position, k in enumerate(members):
                 for other in members[:position]:
+                    if done[k] or done[other] or not (valid[row, slots[k]] and valid[row, slots[other]]):
+                        continue
                     first = joints[row, slots[other]]
                     step = self._difference(joints[row, slots[k]] - first, every)
-                    if np.abs(step).max() > DUPLICATE_TOLERANCE:
+                    if np.abs(step).max() > FOLD_PAIR:
                         continue
                     sides = np.array([[1.0], [-1.0]]) * SPLIT_STEP * motion[other]
                     targets = A[[row, row]]
                     split = _newton(self.directions, self.points, self.revolute, targets, first + 0.5 * step + sides,
-                                    steps=SPLIT_NEWTON_STEPS)
-                    apart = np.abs(self._difference(split[0] - split[1], every)).max() > DUPLICATE_TOLERANCE
-                    if apart and self._reached(targets, split).all():
+                                    steps=SPLIT_NEWTON_STEPS, tolerance=SPLIT_TOLERANCE, rcond=SPLIT_RCOND)
+                    if not self._reached(targets, split).all():
+                        continue
+                    gap = self._difference(split[0] - split[1], every)
+                    if np.abs(gap).max() > DUPLICATE_TOLERANCE:
                         joints[row, slots[other]], joints[row, slots[k]] = split
+                    else:  # one root, and a double one only where the Jacobian is singular: else a root is missing
+                        middle = split[1] + 0.5 * gap
+                        if not _singular_motion(self.directions, self.points, self.revolute, middle[None])[0][0]:
+                            continue
+                        joints[row, slots[other]] = middle
+                        valid[row, slots[k]] = False
+                    done[[other, k]] = True
+        return done
 
     def _difference(self, difference: np.ndarray, joints: np.ndarray) -> np.ndarray:
         """Differences of joint values (...,) of ``joints`` (...,): revolute ones wrapped to (−π, π]."""

@@ -9,6 +9,7 @@ columns, solvers and singularity reports listed once and referred to by index.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -106,17 +107,20 @@ def _clearances(table: SolutionTable) -> list[float | None]:
     return [None if math.isinf(value) else value for value in table.clearance.tolist()]
 
 
-def _contacts(table: SolutionTable) -> list[list[dict]]:
-    """Each row's pairs closer than the margin, as the wire names them (worded once, from the columns)."""
+def _contacts(table: SolutionTable) -> list[Sequence[dict]]:
+    """Each row's pairs closer than the margin, as the wire names them (worded once, from the columns); a row
+    without one gets the empty tuple (an empty array on the wire), shared."""
     contacts = table.contacts
     listed = contacts.pairs >= 0
-    names = contacts.names
-    entries = [{"a": names[pair][0], "b": names[pair][1], "distance": distance}
-               for pair, distance in zip(contacts.pairs[listed].tolist(), contacts.distances[listed].tolist())]
-    rows, start = [], 0
-    for count in listed.sum(axis=1).tolist():
-        rows.append(entries[start:start + count])
-        start += count
+    entries = [{"a": a, "b": b, "distance": distance} for (a, b), distance in
+               zip(map(contacts.names.__getitem__, contacts.pairs[listed].tolist()),
+                   contacts.distances[listed].tolist())]
+    counts = listed.sum(axis=1)
+    ends = np.cumsum(counts)
+    rows: list[Sequence[dict]] = [()] * len(counts)
+    close = np.flatnonzero(counts)
+    for row, start, end in zip(close.tolist(), (ends - counts)[close].tolist(), ends[close].tolist()):
+        rows[row] = entries[start:end]
     return rows
 
 

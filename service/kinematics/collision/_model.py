@@ -93,6 +93,13 @@ class _Group(NamedTuple):
         """The kernel's four sizes."""
         return self.half_size_a, self.half_size_b, self.radius_a, self.radius_b
 
+    def bounds_of(self, placed32: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """The lower and upper bounds (P_k, B) of the group's distances from the block's reference rows (3, K, B)
+        in single precision; None for a kernel without bounds."""
+        if self.bounds is None:
+            return None
+        return self.bounds(np.take(placed32, self.measured_rows.T, axis=1), *self.bound_constants)
+
 
 class CollisionCheck(NamedTuple):
     """The outcome of :meth:`CollisionModel.check` for S configurations, in columns.
@@ -117,16 +124,11 @@ class CollisionCheck(NamedTuple):
         return self.offsets[1:] > self.offsets[:-1]
 
     def close_pairs(self, model: "CollisionModel", configuration: int) -> list[tuple[str, str, float]]:
-        """Configuration ``configuration``'s close body pairs as (a, b, distance), nearest first."""
-        return list(self.close_pairs_of(model, [configuration])[0])
-
-    def close_pairs_of(self, model: "CollisionModel", configurations) -> list[tuple[tuple[str, str, float], ...]]:
-        """:meth:`close_pairs` of several configurations, each as a tuple (one pass over plain lists: a batch
-        may have tens of thousands of colliding configurations)."""
-        names = model.body_pairs
-        offsets = self.offsets.tolist()
-        entries = [(*names[pair], distance) for pair, distance in zip(self.body_pairs.tolist(), self.distances.tolist())]
-        return [tuple(entries[offsets[row]:offsets[row + 1]]) for row in configurations]
+        """Configuration ``configuration``'s close body pairs as (a, b, distance), nearest first (a batch's, as
+        columns: :class:`~._clearance.Contacts`)."""
+        listed = slice(self.offsets[configuration], self.offsets[configuration + 1])
+        return [(*model.body_pairs[pair], distance)
+                for pair, distance in zip(self.body_pairs[listed].tolist(), self.distances[listed].tolist())]
 
 
 class _LinkRows(NamedTuple):
@@ -320,47 +322,25 @@ class CollisionModel:
         The rows are read in :attr:`_Group.measured_rows` order (of two round shapes the longer first, for the
         bounds); the witnesses read the pairs' own order (``rows``), whose distances agree to rounding.
         """
-        parts = [(group.start, group.stop, group.kernel, group.bounds, group.sizes(), group.bound_constants,
-                  group.measured_rows.T) for group in self._groups]
         count = columns.shape[3]
         if count * len(self.pairs) < _BOUNDED_FROM:
             margin = None  # every pair measured: as exact, and fewer calls
-        widest = max(part[1] - part[0] for part in parts)
+        widest = max(group.stop - group.start for group in self._groups)
         block = max(1, min(count, _BLOCK_ELEMENTS // widest if margin is None else
                            min(_BOUNDED_BLOCK_ELEMENTS // widest, _BOUNDED_BLOCK_CONFIGURATIONS)))
         world = self._world_buffer(block)
         with _quiet():
             for begin in range(0, count, block):
                 end = min(begin + block, count)
-                placed = world[:, :, : end - begin]
                 frames = columns[..., begin:end]
                 if frames.strides[-1] != frames.itemsize:  # 4 × 4 frames seen as columns: the block's, in a
                     frames = np.ascontiguousarray(frames)  # row each, so that einsum runs on unit strides
-                self._world_rows(frames, placed)
-                if margin is None:
-                    for start, stop, kernel, _, sizes, _, rows in parts:
-                        # (3, m, P_k, B): each row a contiguous block
-                        result[begin:end, start:stop] = kernel(np.take(placed, rows, axis=1), *sizes,
-                                                               witness=False).T
-                    yield begin, end
-                    continue
-                # single precision for the bounds, kept conservative by a slack far above its rounding (a few
-                # dozen ulps of the largest coordinate); coordinates it cannot hold are all measured
-                placed32 = placed.astype(np.float32)
-                largest = float(np.abs(placed32).max())
-                slack = _BOUND_SLACK * (1.0 + largest)
-                bounds = [None if bound is None or not largest < _BOUND_RANGE else
-                          bound(np.take(placed32, rows, axis=1), *constants)
-                          for _, _, _, bound, _, constants, rows in parts]
-                upper = np.full(end - begin, np.inf, dtype=np.float32)
-                for bound in bounds:
-                    if bound is not None:
-                        np.fmin(upper, bound[1].min(axis=0), out=upper)
-                cutoff = np.maximum(upper + slack, margin) + slack
-                for (start, stop, kernel, _, sizes, _, rows), bound in zip(parts, bounds):
-                    _measure(result[begin:end, start:stop], kernel, world, rows, sizes, bound, cutoff, slack)
+                placed = self._world_rows(frames, world[:, :, : end - begin])
+                bounds, cutoff, slack = ([None] * len(self._groups), None, 0.0) if margin is None else \
+                    _bounds(self._groups, placed, margin)
+                for group, bound in zip(self._groups, bounds):
+                    _measure(result[begin:end, group.start:group.stop], group, world, bound, cutoff, slack)
                 yield begin, end
-
 
     def _world_buffer(self, block: int) -> np.ndarray:
         """(3, K, block): room for every reference row of a block of configurations, the obstacles' filled in."""
@@ -405,16 +385,33 @@ def _box_box_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witne
 _KERNELS = {("round", "round"): _round_round, ("box", "round"): _box_round, ("box", "box"): _box_box_kernel}
 
 
-def _measure(out: np.ndarray, kernel, world: np.ndarray, rows: np.ndarray, sizes: tuple, bound,
-             cutoff: np.ndarray, slack: float) -> None:
-    """Into ``out`` (B, P_k): the kernel's distances where the pair's single-precision lower bound is below the
-    configuration's ``cutoff`` (B,), that bound less the ``slack`` elsewhere. ``world`` (3, K, block) holds the
-    block's reference rows in its first B columns; ``rows`` (m, P_k) are the pairs' rows."""
-    count = out.shape[0]
+def _bounds(groups, placed: np.ndarray, margin: float) -> tuple[list, np.ndarray, float]:
+    """Each group's bounds for a block (:meth:`_Group.bounds_of`), every configuration's cutoff (B,) and the slack.
+
+    Single precision, kept conservative by a slack far above its rounding (a few dozen ulps of the largest
+    coordinate); coordinates it cannot hold have no bounds, so every pair is measured."""
+    placed32 = placed.astype(np.float32)
+    largest = float(np.abs(placed32).max())
+    slack = _BOUND_SLACK * (1.0 + largest)
+    bounds = [group.bounds_of(placed32) if largest < _BOUND_RANGE else None for group in groups]
+    upper = np.full(placed.shape[2], np.inf, dtype=np.float32)
+    for bound in bounds:
+        if bound is not None:
+            np.fmin(upper, bound[1].min(axis=0), out=upper)
+    return bounds, np.maximum(upper + slack, margin) + slack, slack
+
+
+def _measure(out: np.ndarray, group: _Group, world: np.ndarray, bound, cutoff: np.ndarray | None,
+             slack: float) -> None:
+    """Into ``out`` (B, P_k): the group's distances where the pair's single-precision lower bound is below the
+    configuration's ``cutoff`` (B,), that bound less the ``slack`` elsewhere; every one without a ``bound``.
+    ``world`` (3, K, block) holds the block's reference rows in its first B columns."""
+    count, kernel, rows, sizes = out.shape[0], group.kernel, group.measured_rows.T, group.sizes()
     if bound is not None:
         lower = bound[0]
         pairs, configurations = np.nonzero(lower < cutoff)
     if bound is None or pairs.size > _MEASURE_ALL * lower.size:  # the compaction would cost more than it saves
+        # (3, m, P_k, B): each row a contiguous block
         out[...] = kernel(np.take(world[:, :, :count], rows, axis=1), *sizes, witness=False).T
         return
     np.subtract(lower.T, slack, out=out)

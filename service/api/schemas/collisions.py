@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Union
+from typing import Annotated, ClassVar, Union
 
-from pydantic import Discriminator, Field, Tag
+from pydantic import Discriminator, Field, Tag, model_serializer
 
 from ...robots.schemas import BoxGeometry, CapsuleGeometry, LinkRef, SphereGeometry, shape_kind
 from .common import ApiModel, Flag, Number
@@ -79,10 +79,16 @@ COLLISIONS_FIELD = Field(None, description="with 'collisions' in the request: ea
                                            "null without")
 
 
-def without_unchecked(fields: dict, names: tuple[str, ...] = ("clearance", "collisions")) -> dict:
-    """An answer's serialised ``fields`` without the collision fields ``names`` when none of them has a value:
-    they appear only when the request asked for a collision check."""
-    if all(fields.get(name) is None for name in names):
-        for name in names:
-            fields.pop(name, None)
-    return fields
+class CheckedOnly(ApiModel):
+    """An answer part whose collision fields (``collision_fields``) appear only when the request asked for a
+    collision check: serialised without them when none has a value."""
+
+    collision_fields: ClassVar[tuple[str, ...]] = ("clearance", "collisions")
+
+    @model_serializer(mode="wrap")
+    def _checked_only(self, handler):
+        fields = handler(self)
+        if all(fields.get(name) is None for name in self.collision_fields):
+            for name in self.collision_fields:
+                fields.pop(name, None)
+        return fields

@@ -8,7 +8,7 @@ from typing import Annotated, Literal
 from pydantic import Discriminator, Field, Tag, model_serializer, model_validator
 
 from ...kinematics.ik import MAX_EQUIVALENTS, MAX_FREE_VALUES
-from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair, without_unchecked
+from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CheckedOnly, CollisionPair
 from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Flag, Number, RequestFrames,
                      RobotId)
 from .limits import JointLimitsOverride, LimitViolation
@@ -241,7 +241,7 @@ class Residual(ApiModel):
     orientation: float | None = Field(description="FK orientation error, radians; null for a position-only target")
 
 
-class IKSolution(ApiModel):
+class IKSolution(CheckedOnly):
     """One joint vector that reaches the target, verified by forward kinematics."""
 
     joints: list[float] = Field(description="joint values in table order, the request's angle unit")
@@ -258,10 +258,6 @@ class IKSolution(ApiModel):
     clearance: float | None = CLEARANCE_FIELD
     collisions: list[CollisionPair] | None = COLLISIONS_FIELD
 
-    @model_serializer(mode="wrap")
-    def _checked_only(self, handler):
-        """clearance and collisions appear only when the request asked for a collision check."""
-        return without_unchecked(handler(self))
 
 
 class SolverInfo(ApiModel):
@@ -343,7 +339,7 @@ class TargetColumns(ApiModel):
     rejected_count: list[int] = Field(description="rows of `rejected` for this target")
 
 
-class SolutionColumns(ApiModel):
+class SolutionColumns(CheckedOnly):
     """Solutions as columns, one row each, grouped by target in request order (`target` is non-decreasing).
 
     Rows of one target appear in the order the objects form lists them. Violations are not listed: a row with
@@ -368,10 +364,6 @@ class SolutionColumns(ApiModel):
     collisions: list[list[CollisionPair]] | None = Field(None, description="with collisions: each row's pairs "
                                                                            "closer than the margin")
 
-    @model_serializer(mode="wrap")
-    def _checked_only(self, handler):
-        """clearance and collisions appear only when the request asked for a collision check."""
-        return without_unchecked(handler(self))
 
 
 class IKBatchArraysResponse(ApiModel):

@@ -2,14 +2,14 @@
 
 from __future__ import annotations
 
-from typing import Annotated, Literal
+from typing import Annotated, ClassVar, Literal
 
-from pydantic import Field, model_serializer, model_validator
+from pydantic import Field, model_validator
 
 from ...kinematics import RATE_SINGULARITY_TOLERANCE
 from .common import (ANGLE_UNIT_FIELD, IN_PIECES, JOINT_NAMES_FIELD, AngleUnit, ApiModel, Number, RequestFrames, RobotId,
                      Vector3)
-from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CollisionPair, without_unchecked
+from .collisions import CLEARANCE_FIELD, COLLISIONS_FIELD, CollisionOptions, CheckedOnly, CollisionPair
 from .ik import Branch, FreeJointChoice, SingularityReport
 from .limits import LimitViolation
 from .poses import PoseTarget
@@ -112,13 +112,10 @@ class RateResidual(ApiModel):
                                                    "without accelerations")
 
 
-#: The fields a trajectory answer has only with a collision check.
-COLLISION_SAMPLE_FIELDS = ("clearance", "collisions", "collision_forced")
-COLLISION_SUMMARY_FIELDS = ("colliding_samples", "collision_branch_changes", "smallest_clearance")
-
-
-class TrajectorySampleResult(ApiModel):
+class TrajectorySampleResult(CheckedOnly):
     """The joint solution at one sample, on the branch being followed."""
+
+    collision_fields: ClassVar[tuple[str, ...]] = ("clearance", "collisions", "collision_forced")
 
     time: float = Field(description="the sample's time, seconds")
     status: Literal["ok", "unreachable", "not_found", "branch_unavailable", "no_collision_free_solution"] = Field(
@@ -155,10 +152,6 @@ class TrajectorySampleResult(ApiModel):
         None, description="with 'collisions': the branch's continuation collides, so (filter) the sample moved to "
                           "the nearest collision-free solution (branch_changed is then true); absent without")
 
-    @model_serializer(mode="wrap")
-    def _checked_only(self, handler):
-        """The collision fields appear only when the request asked for a collision check."""
-        return without_unchecked(handler(self), COLLISION_SAMPLE_FIELDS)
 
 
 class JointStep(ApiModel):
@@ -190,8 +183,11 @@ class ClearanceAt(ApiModel):
     sample: int | None = Field(description="index of that sample; null when none")
 
 
-class TrajectorySummary(ApiModel):
+class TrajectorySummary(CheckedOnly):
     """What a planner checks first: steps, nearness to singularities, limits, branch changes, misses."""
+
+    collision_fields: ClassVar[tuple[str, ...]] = ("colliding_samples", "collision_branch_changes",
+                                                   "smallest_clearance")
 
     largest_joint_step: JointStep = Field(description="per joint, the largest move between consecutive samples")
     smallest_distance_to_singularity: SingularityDistance = Field(
@@ -210,10 +206,6 @@ class TrajectorySummary(ApiModel):
         None, description="with 'collisions': the smallest clearance over the reached samples, and where; absent "
                           "without")
 
-    @model_serializer(mode="wrap")
-    def _checked_only(self, handler):
-        """The collision fields appear only when the request asked for a collision check."""
-        return without_unchecked(handler(self), COLLISION_SUMMARY_FIELDS)
 
 
 class TrajectorySolver(ApiModel):

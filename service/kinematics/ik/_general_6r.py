@@ -82,6 +82,9 @@ perturbed by 1e-5…1e-7: a solution missed on 1–2 targets in 300), and those 
 
 from __future__ import annotations
 
+import itertools
+from collections.abc import Iterator
+
 import numpy as np
 
 from .._rotations import wrap_angle
@@ -581,6 +584,13 @@ def _chain_twists(directions: np.ndarray, points: np.ndarray, revolute: np.ndarr
     return R, p, twists
 
 
+def _by_target(rows: np.ndarray, chosen: np.ndarray) -> Iterator[tuple[int, np.ndarray]]:
+    """The ``chosen`` (K,) roots grouped by target: (target, the indices of its chosen roots), ``rows`` (K,) being
+    each root's target."""
+    for row in np.unique(rows[chosen]).tolist():
+        yield row, np.flatnonzero((rows == row) & chosen)
+
+
 def _singular_motion(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, q: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Roots q (K, 6) where the twist Jacobian is singular to within :data:`FAMILY_CONDITION` (its smallest
@@ -738,20 +748,17 @@ class General6RPlan(Sealed):
             reached = self._reached(A[rows], moved) & valid[rows, slots]
             # at a fold only the root nearest the reference moves (the other is a root of its own)
             distance = np.abs(self._difference(np.asarray(reference, dtype=float) - q, np.arange(6))).max(axis=1)
-            fold = ~family & valid[rows, slots]
-            for row in np.unique(rows[fold]).tolist():
-                members = np.flatnonzero((rows == row) & fold)
+            for _, members in _by_target(rows, ~family & valid[rows, slots]):
                 reached[members[members != members[np.argmin(distance[members])]]] = False
             joints[rows[reached], slots[reached]] = moved[reached]
-        for row in np.unique(rows[family]).tolist():  # one representative per family: the first slot's
-            members = np.flatnonzero((rows == row) & family)
-            for position, k in enumerate(members.tolist()):
-                for other in members[:position].tolist():
-                    step = self._difference(joints[row, slots[k]] - joints[row, slots[other]], np.arange(6))
-                    across = step - (step @ motion[other]) * motion[other]
-                    if valid[row, slots[other]] and np.abs(across).max() <= SAME_FAMILY:
-                        valid[row, slots[k]] = False
-                        break
+        for row, members in _by_target(rows, family):  # one representative per family: the first slot's
+            for other, k in itertools.combinations(members.tolist(), 2):
+                if not (valid[row, slots[k]] and valid[row, slots[other]]):
+                    continue
+                step = self._difference(joints[row, slots[k]] - joints[row, slots[other]], np.arange(6))
+                across = step - (step @ motion[other]) * motion[other]
+                if np.abs(across).max() <= SAME_FAMILY:
+                    valid[row, slots[k]] = False
         self._report_singular(singular, rows, motion, coaxial, family, pair, leading)
 
     def _split_near_pairs(self, joints: np.ndarray, valid: np.ndarray, near: np.ndarray, A: np.ndarray
@@ -783,32 +790,30 @@ class General6RPlan(Sealed):
         accounted for."""
         every = np.arange(6)
         done = np.zeros(len(rows), dtype=bool)
-        for row in np.unique(rows[fold]).tolist():
-            members = np.flatnonzero((rows == row) & fold).tolist()
-            for position, k in enumerate(members):
-                for other in members[:position]:
-                    if done[k] or done[other] or not (valid[row, slots[k]] and valid[row, slots[other]]):
+        for row, members in _by_target(rows, fold):
+            for other, k in itertools.combinations(members.tolist(), 2):
+                if done[k] or done[other] or not (valid[row, slots[k]] and valid[row, slots[other]]):
+                    continue
+                first = joints[row, slots[other]]
+                step = self._difference(joints[row, slots[k]] - first, every)
+                if np.abs(step).max() > FOLD_PAIR:
+                    continue
+                sides = np.array([[1.0], [-1.0]]) * SPLIT_STEP * motion[other]
+                targets = A[[row, row]]
+                split = _newton(self.directions, self.points, self.revolute, targets, first + 0.5 * step + sides,
+                                steps=SPLIT_NEWTON_STEPS, tolerance=SPLIT_TOLERANCE, rcond=SPLIT_RCOND)
+                if not self._reached(targets, split).all():
+                    continue
+                gap = self._difference(split[0] - split[1], every)
+                if np.abs(gap).max() > DUPLICATE_TOLERANCE:
+                    joints[row, slots[other]], joints[row, slots[k]] = split
+                else:  # one root, and a double one only where the Jacobian is singular: else a root is missing
+                    middle = split[1] + 0.5 * gap
+                    if not _singular_motion(self.directions, self.points, self.revolute, middle[None])[0][0]:
                         continue
-                    first = joints[row, slots[other]]
-                    step = self._difference(joints[row, slots[k]] - first, every)
-                    if np.abs(step).max() > FOLD_PAIR:
-                        continue
-                    sides = np.array([[1.0], [-1.0]]) * SPLIT_STEP * motion[other]
-                    targets = A[[row, row]]
-                    split = _newton(self.directions, self.points, self.revolute, targets, first + 0.5 * step + sides,
-                                    steps=SPLIT_NEWTON_STEPS, tolerance=SPLIT_TOLERANCE, rcond=SPLIT_RCOND)
-                    if not self._reached(targets, split).all():
-                        continue
-                    gap = self._difference(split[0] - split[1], every)
-                    if np.abs(gap).max() > DUPLICATE_TOLERANCE:
-                        joints[row, slots[other]], joints[row, slots[k]] = split
-                    else:  # one root, and a double one only where the Jacobian is singular: else a root is missing
-                        middle = split[1] + 0.5 * gap
-                        if not _singular_motion(self.directions, self.points, self.revolute, middle[None])[0][0]:
-                            continue
-                        joints[row, slots[other]] = middle
-                        valid[row, slots[k]] = False
-                    done[[other, k]] = True
+                    joints[row, slots[other]] = middle
+                    valid[row, slots[k]] = False
+                done[[other, k]] = True
         return done
 
     def _difference(self, difference: np.ndarray, joints: np.ndarray) -> np.ndarray:

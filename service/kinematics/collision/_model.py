@@ -13,14 +13,16 @@ distance of every pair in every configuration, shape (S, P), with the sign conve
 How the work is laid out: every shape is reduced to a few reference rows (a capsule's two end points, a sphere's
 centre, a box's centre and its three axes), each a homogeneous point or direction fixed to a link or to the
 world. One matrix product per link maps that link's rows to the world for a block of configurations; the pairs
-then fall into three groups by the kernel that measures them (round–round for capsules and spheres, a sphere
-being a capsule of length 0; box–round; box–box), and each group gathers its rows and runs one vectorised kernel
-over the block. Configurations go through in blocks of a few thousand pair evaluations, so that the temporaries
+then fall into groups by the kernel that measures them: box–box, round–point, box–point, round–round and
+box–round (a point is a sphere or a capsule of length 0, a round shape any other capsule), the pairs of a base
+shape and an obstacle apart (they do not move). Each group gathers its rows and runs one vectorised kernel over
+the block. Configurations go through in blocks of a few thousand pair evaluations, so that the temporaries
 stay in cache.
 """
 
 from __future__ import annotations
 
+import itertools
 import math
 import numbers
 from dataclasses import dataclass
@@ -29,8 +31,8 @@ from typing import Callable, Iterator, NamedTuple, Sequence
 import numpy as np
 
 from .._errors import InvalidInputError
-from ._distances import (Separation, _box_box, _box_point_local, _box_segment, _clip_unit, _dot, _quiet,
-                         _segment_segment, _swept)
+from ._distances import (Separation, _box_box, _box_point, _box_point_local, _box_segment, _dot,
+                         _nearest_on_segment, _quiet, _segment_point, _segment_segment, _swept)
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 
 #: Pair evaluations per block (configurations × pairs of the widest group): large enough that numpy's cost per
@@ -73,8 +75,8 @@ class ShapePair:
 
 class _Group(NamedTuple):
     """The pairs one kernel measures: columns [start, stop) of the distances. Per pair, the reference rows the
-    kernel reads (those of its first shape, then its second), the sizes, and whether the kernel's first shape is
-    the pair's ``b``."""
+    kernel reads (those of its first shape, then its second: a box before a round shape, of two round shapes
+    the longer), the sizes, and whether the kernel's first shape is the pair's ``b``."""
 
     start: int
     stop: int
@@ -85,8 +87,8 @@ class _Group(NamedTuple):
     radius_a: np.ndarray  # (P_k, 1): a round shape's radius (0 for a box)
     radius_b: np.ndarray
     swapped: np.ndarray  # (P_k,) bool
+    fixed: bool  # base shapes and obstacles: the same in every configuration whose base frame is the same
     bounds: Callable | None  # the kernel's cheap bounds (None: none, every pair is measured)
-    measured_rows: np.ndarray  # (P_k, m): the rows the distances and bounds read (see _evaluate)
     bound_constants: tuple  # the bounds' sizes, single precision (see the bound functions)
 
     def sizes(self) -> tuple:
@@ -98,7 +100,7 @@ class _Group(NamedTuple):
         in single precision; None for a kernel without bounds."""
         if self.bounds is None:
             return None
-        return self.bounds(np.take(placed32, self.measured_rows.T, axis=1), *self.bound_constants)
+        return self.bounds(np.take(placed32, self.rows.T, axis=1), *self.bound_constants)
 
 
 class CollisionCheck(NamedTuple):
@@ -213,15 +215,15 @@ class CollisionModel:
         margin_value = _finite_number(margin, ("margin",))
         columns = frame_columns.reshape(self.link_count, 4, 3, -1)
         count = columns.shape[3]
-        pair_distances = np.empty((count, len(self.pairs)))
+        pair_distances = _pair_major(count, len(self.pairs))
         clearance = np.full(count, np.inf)
         close: list[tuple[np.ndarray, np.ndarray, np.ndarray]] = []
         if count and self.pairs:
             for begin, end in self._evaluated_blocks(columns, pair_distances, margin_value):
                 # each block's clearance and close pairs while its distances are in cache
-                block = pair_distances[begin:end]
-                block.min(axis=1, out=clearance[begin:end])
-                rows, bodies, values = _close_pairs(block, clearance[begin:end], self.body_pair_of,
+                by_pair = pair_distances[begin:end].T
+                by_pair.min(axis=0, out=clearance[begin:end])
+                rows, bodies, values = _close_pairs(by_pair, clearance[begin:end], self.body_pair_of,
                                                     len(self.body_pairs), margin_value)
                 close.append((rows + begin, bodies, values))
         self._check_finite(columns, pair_distances, single)
@@ -302,7 +304,7 @@ class CollisionModel:
     def _distances(self, columns: np.ndarray, margin: float | None = None) -> np.ndarray:
         """Every pair's distance (S, P) for frame columns (L, 4, 3, S); with a ``margin``, only where a pair can
         be the configuration's clearance or closer than the margin (see :meth:`_evaluated_blocks`)."""
-        result = np.empty((columns.shape[3], len(self.pairs)))
+        result = _pair_major(columns.shape[3], len(self.pairs))
         if columns.shape[3] and self.pairs:
             for _ in self._evaluated_blocks(columns, result, margin):
                 pass
@@ -313,14 +315,13 @@ class CollisionModel:
         """Distances of the pairs into ``result`` (S, P), for the frame columns (L, 4, 3, S), a block of
         configurations [begin, end) at a time (yielded when it is filled).
 
-        With a ``margin``, a pair is measured only where it can matter: each pair's cheap bounds (a shape's
-        round core inside the ball about its middle, and around it) give every configuration an upper bound U
-        of its clearance over these pairs, and a pair whose lower bound is at least max(U, margin) can be
+        The groups without bounds are measured first, in full: two boxes, and the pairs of a base shape and an
+        obstacle (once per block when the base frame is the same throughout, as it is for one robot). With a ``margin``, the
+        other pairs are then measured only where they can matter: their distances and each bounded pair's cheap
+        bounds (a shape's round core inside the ball about its middle, and around it) give every configuration
+        an upper bound U of its clearance, and a pair whose lower bound is at least max(U, margin) can be
         neither the clearance nor a close pair (a pair that attains U is measured, unless its bounds meet). Such
         a pair keeps its lower bound in ``result``.
-
-        The rows are read in :attr:`_Group.measured_rows` order (of two round shapes the longer first, for the
-        bounds); the witnesses read the pairs' own order (``rows``), whose distances agree to rounding.
         """
         count = columns.shape[3]
         if count * len(self.pairs) < _BOUNDED_FROM:
@@ -329,6 +330,9 @@ class CollisionModel:
         block = max(1, min(count, _BLOCK_ELEMENTS // widest if margin is None else
                            min(_BOUNDED_BLOCK_ELEMENTS // widest, _BOUNDED_BLOCK_CONFIGURATIONS)))
         world = self._world_buffer(block)
+        measured = [group for group in self._groups if group.bounds is None]
+        bounded = [group for group in self._groups if group.bounds is not None]
+        measured_columns = measured[-1].stop if measured else 0  # their columns come first
         with _quiet():
             for begin in range(0, count, block):
                 end = min(begin + block, count)
@@ -336,10 +340,15 @@ class CollisionModel:
                 if frames.strides[-1] != frames.itemsize:  # 4 × 4 frames seen as columns: the block's, in a
                     frames = np.ascontiguousarray(frames)  # row each, so that einsum runs on unit strides
                 placed = self._world_rows(frames, world[:, :, : end - begin])
-                bounds, cutoff, slack = ([None] * len(self._groups), None, 0.0) if margin is None else \
-                    _bounds(self._groups, placed, margin)
-                for group, bound in zip(self._groups, bounds):
-                    _measure(result[begin:end, group.start:group.stop], group, world, bound, cutoff, slack)
+                block_result = result[begin:end]
+                base_still = bool((frames[0] == frames[0][..., :1]).all())
+                for group in measured:
+                    _measure(block_result[:, group.start:group.stop], group, world, None, None, 0.0,
+                             once=group.fixed and base_still)
+                bounds, cutoff, slack = ([None] * len(bounded), None, 0.0) if margin is None else \
+                    _bounds(bounded, placed, margin, block_result[:, :measured_columns])
+                for group, bound in zip(bounded, bounds):
+                    _measure(block_result[:, group.start:group.stop], group, world, bound, cutoff, slack)
                 yield begin, end
 
     def _world_buffer(self, block: int) -> np.ndarray:
@@ -361,12 +370,24 @@ class CollisionModel:
         return out
 
 
+def _pair_major(count: int, pair_count: int) -> np.ndarray:
+    """Room for the distances (S, P) of S configurations, laid out pair by pair: the kernels fill a pair's
+    configurations, which are then contiguous."""
+    return np.empty((pair_count, count)).T
+
+
 # --- kernels: gathered rows (3, m, ...) and sizes -> distances, or cores with witnesses ------------------------
 
 
 def _round_round(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
-    """Capsules and spheres: rows p0, p1, q0, q1."""
+    """Two capsules: rows p0, p1 (the longer), q0, q1."""
     core = _segment_segment(rows, witness)
+    return _swept(core, radius_a, radius_b) if witness else core - (radius_a + radius_b)
+
+
+def _round_point(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
+    """A capsule or a sphere, and a sphere (or a capsule of length 0): rows p0, p1 (p0 twice for a sphere), q."""
+    core = _segment_point(rows, witness)
     return _swept(core, radius_a, radius_b) if witness else core - (radius_a + radius_b)
 
 
@@ -376,17 +397,26 @@ def _box_round(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
     return _swept(core, 0.0, radius_b) if witness else core - radius_b
 
 
+def _box_point_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
+    """A box and a sphere (or a capsule of length 0): rows centre, three axes, the sphere's centre."""
+    core = _box_point(rows[:, :4], half_size_a, rows[:, 4], witness)
+    return _swept(core, 0.0, radius_b) if witness else core - radius_b
+
+
 def _box_box_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
     """Two boxes: rows centre and three axes of each."""
     return _box_box(rows[:, :4], half_size_a, rows[:, 4:8], half_size_b, witness)
 
 
-#: The kernel of each pair of families, in the order of the columns. A sphere is a capsule of length 0.
-_KERNELS = {("round", "round"): _round_round, ("box", "round"): _box_round, ("box", "box"): _box_box_kernel}
+#: The kernel of each pair of families, in the order of the columns: first those measured in full (no bounds,
+#: :data:`_BOUNDS`).
+_KERNELS = {("box", "box"): _box_box_kernel, ("round", "point"): _round_point, ("box", "point"): _box_point_kernel,
+            ("round", "round"): _round_round, ("box", "round"): _box_round}
 
 
-def _bounds(groups, placed: np.ndarray, margin: float) -> tuple[list, np.ndarray, float]:
-    """Each group's bounds for a block (:meth:`_Group.bounds_of`), every configuration's cutoff (B,) and the slack.
+def _bounds(groups, placed: np.ndarray, margin: float, measured: np.ndarray) -> tuple[list, np.ndarray, float]:
+    """Each group's bounds for a block (:meth:`_Group.bounds_of`), every configuration's cutoff (B,) and the slack;
+    ``measured`` (B, E): the distances of the pairs already measured, which bound the clearance too.
 
     Single precision, kept conservative by a slack far above its rounding (a few dozen ulps of the largest
     coordinate); coordinates it cannot hold have no bounds, so every pair is measured."""
@@ -395,6 +425,8 @@ def _bounds(groups, placed: np.ndarray, margin: float) -> tuple[list, np.ndarray
     slack = _BOUND_SLACK * (1.0 + largest)
     bounds = [group.bounds_of(placed32) if largest < _BOUND_RANGE else None for group in groups]
     upper = np.full(placed.shape[2], np.inf, dtype=np.float32)
+    if measured.shape[1]:
+        upper[:] = np.fmin.reduce(measured, axis=1)
     for bound in bounds:
         if bound is not None:
             np.fmin(upper, bound[1].min(axis=0), out=upper)
@@ -402,17 +434,20 @@ def _bounds(groups, placed: np.ndarray, margin: float) -> tuple[list, np.ndarray
 
 
 def _measure(out: np.ndarray, group: _Group, world: np.ndarray, bound, cutoff: np.ndarray | None,
-             slack: float) -> None:
+             slack: float, *, once: bool = False) -> None:
     """Into ``out`` (B, P_k): the group's distances where the pair's single-precision lower bound is below the
-    configuration's ``cutoff`` (B,), that bound less the ``slack`` elsewhere; every one without a ``bound``.
-    ``world`` (3, K, block) holds the block's reference rows in its first B columns."""
-    count, kernel, rows, sizes = out.shape[0], group.kernel, group.measured_rows.T, group.sizes()
+    configuration's ``cutoff`` (B,), that bound less the ``slack`` elsewhere; every one without a ``bound``, and
+    ``once`` (the same rows in every configuration) those of the first. ``world`` (3, K, block) holds the block's
+    reference rows in its first B columns."""
+    count, kernel, rows, sizes = out.shape[0], group.kernel, group.rows.T, group.sizes()
     if bound is not None:
         lower = bound[0]
         pairs, configurations = np.nonzero(lower < cutoff)
     if bound is None or pairs.size > _MEASURE_ALL * lower.size:  # the compaction would cost more than it saves
-        # (3, m, P_k, B): each row a contiguous block
-        out[...] = kernel(np.take(world[:, :, :count], rows, axis=1), *sizes, witness=False).T
+        # (3, m, P_k, B): each row a contiguous block; once, the first configuration twice (as below)
+        placed = np.repeat(world[:, :, :1], 2, axis=2) if once else world[:, :, :count]
+        distances = kernel(np.take(placed, rows, axis=1), *sizes, witness=False)
+        out[...] = distances[:, :1].T if once else distances.T
         return
     np.subtract(lower.T, slack, out=out)
     if pairs.size == 1:  # einsum sums a lone element in another order: measure it twice, for a batch's bits
@@ -436,31 +471,45 @@ _BOUND_RANGE = 1e15
 
 
 def _round_round_bounds(rows, radii, reach, inverse_square_length):
-    """Lower and upper bounds (P, B) of capsules' and spheres' distances from the distance of one's core (rows
-    0, 1: the longer segment, 1 / its squared length given) to the other's middle (rows 2, 3: the shorter one's
-    ends): the other shape holds the ball of radius r about its middle and lies inside the ball of radius
-    r + half its length (``reach``); ``radii`` (P, 1) their sum."""
-    segment = rows[:, 1] - rows[:, 0]
-    gap = rows[:, 2] + rows[:, 3]
-    gap *= 0.5
-    gap -= rows[:, 0]  # the middle, from the segment's start
-    along = _dot(gap, segment)
-    along *= inverse_square_length
-    _clip_unit(along)
-    gap -= along * segment
+    """Lower and upper bounds (P, B) of two capsules' distance from the distance of one's core (rows 0, 1: the
+    longer segment, 1 / its squared length given) to the other's middle (rows 2, 3: the shorter one's ends):
+    the other shape holds the ball of radius r about its middle and lies inside the ball of radius r + half its
+    length (``reach``); ``radii`` (P, 1) their sum."""
+    middle = rows[:, 2] + rows[:, 3]
+    middle *= 0.5
+    return _round_middle_bounds(rows, middle, radii, reach, inverse_square_length)
+
+
+def _round_point_bounds(rows, radii, reach, inverse_square_length):
+    """:func:`_round_round_bounds` of a capsule or sphere (rows 0, 1) and a sphere (row 2, its centre: the
+    middle, ``reach`` 0), whose lower and upper bounds are the distance, in single precision."""
+    return _round_middle_bounds(rows, rows[:, 2], radii, reach, inverse_square_length)
+
+
+def _round_middle_bounds(rows, middle, radii, reach, inverse_square_length):
+    gap = middle - rows[:, 0]  # the middle, from the segment's start
+    _nearest_on_segment(gap, rows[:, 1] - rows[:, 0], inverse_square_length)
     upper = np.sqrt(_dot(gap, gap))
     upper -= radii
     return upper - reach, upper
 
 
 def _box_round_bounds(rows, half_size_a, radius_b, reach):
-    """Lower and upper bounds (P, B) of a box's distance to a capsule or sphere from the box's signed distance
-    at the round shape's middle (the same balls as :func:`_round_round_bounds`; the box's half sizes (3, P, 1),
-    the round shape's radius (P, 1))."""
+    """Lower and upper bounds (P, B) of a box's distance to a capsule from the box's signed distance at the
+    capsule's middle (the same balls as :func:`_round_round_bounds`; the box's half sizes (3, P, 1), the
+    capsule's radius (P, 1))."""
     middle = rows[:, 4] + rows[:, 5]
     middle *= 0.5
-    middle -= rows[:, 0]
-    local = np.einsum("ij...,i...->j...", rows[:, 1:4], middle)  # R^T (middle - centre)
+    return _box_middle_bounds(rows, middle, half_size_a, radius_b, reach)
+
+
+def _box_point_bounds(rows, half_size_a, radius_b, reach):
+    """:func:`_box_round_bounds` of a box and a sphere (row 4, its centre: the middle, ``reach`` 0)."""
+    return _box_middle_bounds(rows, rows[:, 4], half_size_a, radius_b, reach)
+
+
+def _box_middle_bounds(rows, middle, half_size_a, radius_b, reach):
+    local = np.einsum("ij...,i...->j...", rows[:, 1:4], middle - rows[:, 0])  # R^T (middle - centre)
     upper = _box_point_local(local, half_size_a)
     upper -= radius_b
     return upper - reach, upper
@@ -469,14 +518,15 @@ def _box_round_bounds(rows, half_size_a, radius_b, reach):
 # --- the close pairs ------------------------------------------------------------------------------------------
 
 
-def _close_pairs(pair_distances: np.ndarray, clearance: np.ndarray, body_pair_of: np.ndarray, body_count: int,
+def _close_pairs(by_pair: np.ndarray, clearance: np.ndarray, body_pair_of: np.ndarray, body_count: int,
                  margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The body pairs closer than ``margin`` of S configurations (their pair distances (S, P) and clearance
-    (S,)): configuration, body pair and distance of each, by configuration, nearest first."""
+    """The body pairs closer than ``margin`` of S configurations (their pair distances laid out pair by pair
+    (P, S), and their clearance (S,)): configuration, body pair and distance of each, by configuration, nearest
+    first."""
     close = np.flatnonzero(clearance < margin)  # the configurations that have a close pair
-    body_distances = _body_distances(np.take(pair_distances, close, axis=0), body_pair_of, body_count)
-    rows, bodies = np.nonzero(body_distances < margin)  # by configuration, then by body pair
-    values = body_distances[rows, bodies]
+    body_distances = _body_distances(np.take(by_pair, close, axis=1), body_pair_of, body_count)
+    rows, bodies = np.nonzero(body_distances.T < margin)  # by configuration, then by body pair
+    values = body_distances[bodies, rows]
     rows = close[rows]
     if rows.size and (rows[1:] == rows[:-1]).any():  # some configuration has several: nearest first
         order = np.lexsort((values, rows))  # stable: equal distances keep the body pairs' order
@@ -484,21 +534,22 @@ def _close_pairs(pair_distances: np.ndarray, clearance: np.ndarray, body_pair_of
     return rows, bodies, values
 
 
-def _body_distances(pair_distances: np.ndarray, body_pair_of: np.ndarray, body_count: int) -> np.ndarray:
-    """(S, B): each body pair's signed distance, the smallest over its shape pairs (the columns of
-    ``pair_distances`` (S, P) that ``body_pair_of`` maps to it)."""
+def _body_distances(by_pair: np.ndarray, body_pair_of: np.ndarray, body_count: int) -> np.ndarray:
+    """(B, S): each body pair's signed distance, the smallest over its shape pairs (the rows of ``by_pair``
+    (P, S) that ``body_pair_of`` maps to it)."""
     if body_count == len(body_pair_of) and (body_pair_of == np.arange(body_count)).all():
-        return pair_distances
-    first_column = np.unique(body_pair_of, return_index=True)[1]  # each body pair's first shape pair
-    body_distances = np.take(pair_distances, first_column, axis=1)
-    for column in np.flatnonzero(first_column[body_pair_of] != np.arange(len(body_pair_of))).tolist():
-        body = body_pair_of[column]
-        np.minimum(body_distances[:, body], pair_distances[:, column], out=body_distances[:, body])
+        return by_pair
+    first_row = np.unique(body_pair_of, return_index=True)[1]  # each body pair's first shape pair
+    body_distances = np.take(by_pair, first_row, axis=0)
+    for row in np.flatnonzero(first_row[body_pair_of] != np.arange(len(body_pair_of))).tolist():
+        body = body_pair_of[row]
+        np.minimum(body_distances[body], by_pair[row], out=body_distances[body])
     return body_distances
 
 
 #: The cheap bounds of each pair of families (two boxes have none: they are always measured).
-_BOUNDS = {("round", "round"): _round_round_bounds, ("box", "round"): _box_round_bounds}
+_BOUNDS = {("round", "point"): _round_point_bounds, ("box", "point"): _box_point_bounds,
+           ("round", "round"): _round_round_bounds, ("box", "round"): _box_round_bounds}
 
 
 # --- compilation ----------------------------------------------------------------------------------------------
@@ -587,32 +638,30 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
                                        shapes[other].shape, shape_rows[other]))
     members: dict[tuple[str, str], list] = {family: [] for family in _KERNELS}
     for index, shape_a, rows_a, b, link_b, index_b, shape_b, rows_b in candidates:
-        swapped = _KIND_ORDER.index(type(shape_a)) > _KIND_ORDER.index(type(shape_b))
+        named = sorted((shape_a, shape_b), key=lambda shape: _KIND_ORDER.index(type(shape)))
+        pair = ShapePair(names[shapes[index].link], b, shapes[index].link, link_b, index, index_b,
+                         f"{_KIND_NAMES[type(named[0])]}-{_KIND_NAMES[type(named[1])]}")
+        swapped = _kernel_order(shape_a) > _kernel_order(shape_b)
         first, second = (shape_b, shape_a) if swapped else (shape_a, shape_b)
         first_rows, second_rows = (rows_b, rows_a) if swapped else (rows_a, rows_b)
-        pair = ShapePair(names[shapes[index].link], b, shapes[index].link, link_b, index, index_b,
-                         f"{_KIND_NAMES[type(first)]}-{_KIND_NAMES[type(second)]}")
-        rows = _kernel_rows(first, first_rows) + _kernel_rows(second, second_rows)
-        # the bounds take the shorter round shape's middle: it comes second (the distance of two round shapes
-        # is symmetric, and radii enter as their sum)
-        shorter_first = _family(first) == "round" and _half_length(first) < _half_length(second)
-        measured_rows = rows[2:] + rows[:2] if shorter_first else rows
-        members[(_family(first), _family(second))].append((pair, rows, first, second, swapped, measured_rows))
+        family = ("box" if isinstance(first, Box) else "round",
+                  "box" if isinstance(second, Box) else "point" if _half_length(second) == 0.0 else "round")
+        rows = _kernel_rows(first, first_rows, False) + _kernel_rows(second, second_rows, family[1] == "point")
+        members[family].append((pair, rows, first, second, swapped))
 
     pairs: list[ShapePair] = []
     groups: list[_Group] = []
-    for family, kernel in _KERNELS.items():
-        if not members[family]:
+    for still, (family, kernel) in itertools.product((True, False), _KERNELS.items()):
+        group = [member for member in members[family] if (member[0].link_a == 0 and member[0].link_b is None) == still]
+        if not group:
             continue
         start = len(pairs)
-        pairs.extend(member[0] for member in members[family])
-        firsts = [member[2] for member in members[family]]
-        seconds = [member[3] for member in members[family]]
-        groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in members[family]]),
+        pairs.extend(member[0] for member in group)
+        firsts, seconds = [member[2] for member in group], [member[3] for member in group]
+        groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in group]),
                              _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
-                             np.array([member[4] for member in members[family]], dtype=bool),
-                             _BOUNDS.get(family), np.array([member[5] for member in members[family]]),
-                             _bound_constants(family, firsts, seconds)))
+                             np.array([member[4] for member in group], dtype=bool), still,
+                             None if still else _BOUNDS.get(family), _bound_constants(family, firsts, seconds)))
     body_pairs: dict[tuple[str, str], int] = {}
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)
@@ -630,24 +679,29 @@ def _local_rows(shape: Shape) -> list[list[float]]:
     return [[*shape.center.tolist(), 1.0], *([*axis, 0.0] for axis in shape.rotation.T.tolist())]
 
 
-def _kernel_rows(shape: Shape, rows: list[int]) -> list[int]:
-    """The rows a kernel reads for a shape: a round shape's two ends (a sphere's centre twice), a box's four."""
-    return [rows[0], rows[0]] if isinstance(shape, Sphere) else rows
+def _kernel_rows(shape: Shape, rows: list[int], point: bool) -> list[int]:
+    """The rows a kernel reads for a shape: a box's four; a round shape's two ends (a sphere's centre twice), or
+    its one point where the kernel takes a ``point`` (a sphere's centre, a capsule of length 0's start)."""
+    if isinstance(shape, Box):
+        return rows
+    return rows[:1] if point else [rows[0], rows[-1]]
 
 
-def _family(shape: Shape) -> str:
-    return "box" if isinstance(shape, Box) else "round"
+def _kernel_order(shape: Shape) -> tuple[int, float]:
+    """The order of a pair's shapes in its kernel: a box first, then of two round shapes the longer (the bounds
+    take the shorter one's middle, and a point comes second)."""
+    return (0, 0.0) if isinstance(shape, Box) else (1, -_half_length(shape))
 
 
 def _bound_constants(family: tuple[str, str], firsts: list[Shape], seconds: list[Shape]) -> tuple:
     """The sizes the family's bounds take, single precision, (P_k, 1) each (a box's half sizes (3, P_k, 1))."""
     reach = np.array([[min(_half_length(a), _half_length(b))] for a, b in zip(firsts, seconds)], dtype=np.float32)
-    if family == ("round", "round"):
+    if family[0] == "round":
         radii = _radii(firsts) + _radii(seconds)
         longer = [max(2.0 * _half_length(a), 2.0 * _half_length(b)) for a, b in zip(firsts, seconds)]
         inverse = np.array([[1.0 / length ** 2 if length > 0.0 else 0.0] for length in longer])
         return radii.astype(np.float32), reach, inverse.astype(np.float32)
-    if family == ("box", "round"):
+    if family[1] != "box":
         return _half_sizes(firsts).astype(np.float32), _radii(seconds).astype(np.float32), reach
     return ()
 

@@ -183,6 +183,54 @@ def test_a_real_arm_through_link_frames():
     np.testing.assert_allclose(model.distances(frames), reference_distances(model, frames), rtol=0, atol=1e-9)
 
 
+def point_and_base_model(robot):
+    """A PUMA model with a base capsule, a capsule of length 0 and a sphere (the kernels of a point), a capsule
+    and a box, and one obstacle of each kind."""
+    shapes = [LinkShape(0, Capsule([0, 0, -0.25], [0, 0, -0.7], 0.2)),
+              LinkShape(1, Capsule([0, 0, 0.05], [0, 0, 0.05], 0.075)),
+              LinkShape(2, Capsule([-0.4318, 0, 0], [-0.09, 0, 0], 0.12)),
+              LinkShape(4, Capsule([0, -0.34, 0], [0, -0.08, 0], 0.045)),
+              LinkShape(5, Sphere([0, 0, 0], 0.05)),
+              LinkShape(6, Box([0, 0, 0.05], [0.06, 0.06, 0.1]))]
+    obstacles = [Obstacle("table", Box([0.55, 0, -0.15], [0.5, 1.0, 0.1])),
+                 Obstacle("post", Capsule([0.27, -0.2, -0.6], [0.27, -0.2, 0.6], 0.06)),
+                 Obstacle("lamp", Sphere([0.3, 0.3, 0.4], 0.1))]
+    return collision_model(shapes, robot.dof + 1, obstacles, ignore=[(0, 2), (4, 6)])  # touching at home
+
+
+@pytest.mark.parametrize("base", ["still", "moving"])
+def test_points_and_base_shapes_through_link_frames(base):
+    """Spheres and capsules of length 0 take the point kernels; a base shape against an obstacle is measured
+    once per block when the base frame stays put, per configuration when it moves. Either way every distance
+    is the reference's, and the check's clearance and close pairs are the distances' own."""
+    robot = load_robot_file(ROBOTS / "puma560_standard.yaml", max_joints=16).robot
+    model = point_and_base_model(robot)
+    rng = np.random.default_rng(12)
+    frames = link_frames(robot, rng.uniform(-np.pi, np.pi, (600, robot.dof)))
+    if base == "moving":
+        frames[::3, 0] = [random_rigid(rng) for _ in range(len(frames[::3]))]
+        frames[::3, 0, :3, 3] *= 0.1
+    distances = model.distances(frames)
+    chosen = rng.choice(len(frames), 60, replace=False)
+    np.testing.assert_allclose(distances[chosen], reference_distances(model, frames[chosen]), rtol=0, atol=1e-9)
+    fixed = [k for k, pair in enumerate(model.pairs) if pair.link_a == 0 and pair.link_b is None]
+    assert len(fixed) == 3
+    assert (np.ptp(distances[:, fixed], axis=0) == 0).all() == (base == "still")
+    margin = 0.01
+    check = model.check(frames, margin)
+    np.testing.assert_array_equal(check.clearance, distances.min(axis=1))
+    assert (check.pair_distances != distances).any()  # the bounds left some pairs unmeasured
+    assert 0 < check.colliding.mean() < 1
+    for s in range(0, len(frames), 11):
+        nearest: dict = {}
+        for pair, d in zip(model.pairs, distances[s]):
+            if d < margin:
+                nearest[(pair.a, pair.b)] = min(nearest.get((pair.a, pair.b), np.inf), d)
+        listed = check.close_pairs(model, s)
+        assert sorted(((a, b), d) for a, b, d in listed) == sorted(nearest.items())
+        assert [d for _, _, d in listed] == sorted(d for _, _, d in listed)
+
+
 def test_single_configuration_zero_and_many():
     rng = np.random.default_rng(2)
     model = collision_model(arm_shapes(), 6, OBSTACLES)

@@ -104,7 +104,10 @@ def _rolls(table: SolutionTable, angle: float) -> list[float | None]:
 
 def _clearances(table: SolutionTable) -> list[float | None]:
     """Each row's clearance; null where no pair was checked (+inf)."""
-    return [None if math.isinf(value) else value for value in table.clearance.tolist()]
+    clearance = table.clearance
+    if not np.isinf(clearance).any():
+        return clearance.tolist()
+    return [None if math.isinf(value) else value for value in clearance.tolist()]
 
 
 def _contacts(table: SolutionTable) -> list[Sequence[dict]]:
@@ -172,7 +175,9 @@ def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer, angle: f
                "residual_position": table.position, "residual_orientation": orientation, "branch": branch,
                "free_values": free_values}
     if table.clearance is not None:
-        columns["clearance"], columns["collisions"] = _clearances(table), _contacts(table)
+        clearance = table.clearance  # as it stands when every row was checked (orjson writes the array)
+        columns["clearance"] = clearance if not np.isinf(clearance).any() else _clearances(table)
+        columns["collisions"] = _contacts(table)
     return columns
 
 

@@ -82,10 +82,10 @@ class _Group(NamedTuple):
     stop: int
     kernel: Callable
     rows: np.ndarray  # (P_k, m) row indices
-    half_size_a: np.ndarray  # (3, P_k, 1): a box's half sizes (zeros for a round shape)
-    half_size_b: np.ndarray
-    radius_a: np.ndarray  # (P_k, 1): a round shape's radius (0 for a box)
-    radius_b: np.ndarray
+    half_size_a: np.ndarray | None  # (3, P_k, 1): a box's half sizes (None for a round shape)
+    half_size_b: np.ndarray | None
+    radius_a: np.ndarray | None  # (P_k, 1): a round shape's radius (None for a box)
+    radius_b: np.ndarray | None
     swapped: np.ndarray  # (P_k,) bool
     fixed: bool  # base shapes and obstacles: the same in every configuration whose base frame is the same
     bounds: Callable | None  # the kernel's cheap bounds (None: none, every pair is measured)
@@ -262,7 +262,8 @@ class CollisionModel:
             # entry k is pair local[k] in configuration k of this block: gather one (3, m) per entry
             rows = world[:, group.rows[local].T, np.arange(chosen.size)][:, :, None]
             with _quiet():
-                core = group.kernel(rows, *(size[..., local, 0][..., None, :] for size in group[4:8]),
+                core = group.kernel(rows, *(None if size is None else size[..., local, 0][..., None, :]
+                                            for size in group.sizes()),
                                     witness=True)
             swapped = group.swapped[local][:, None]
             first, second, normal = (vector[:, 0].T for vector in core[1:])
@@ -455,7 +456,8 @@ def _measure(out: np.ndarray, group: _Group, world: np.ndarray, bound, cutoff: n
     # (3, m, n), gathered with np.take: the kernels then see the layout of a whole block (components first,
     # contiguous), so that each distance has the same bits either way; indexing would lay the entries out first
     entries = np.take(world.reshape(3, -1), rows[:, pairs] * world.shape[2] + configurations, axis=1)
-    out[configurations, pairs] = kernel(entries, *(np.take(size[..., 0], pairs, axis=-1) for size in sizes),
+    out[configurations, pairs] = kernel(entries, *(None if size is None else np.take(size[..., 0], pairs, axis=-1)
+                                                   for size in sizes),
                                         witness=False)
 
 
@@ -713,15 +715,18 @@ def _half_length(shape: Shape) -> float:
     return 0.0 if isinstance(shape, Sphere) else np.inf
 
 
-def _half_sizes(shapes: list[Shape]) -> np.ndarray:
-    """(3, P_k, 1): each box's half sizes, zeros for a round shape."""
-    return np.array([shape.half_size.tolist() if isinstance(shape, Box) else [0.0, 0.0, 0.0]
-                     for shape in shapes]).T[..., None]
+def _half_sizes(shapes: list[Shape]) -> np.ndarray | None:
+    """(3, P_k, 1): each box's half sizes, for shapes of one family; None for round shapes (no kernel reads it)."""
+    if not isinstance(shapes[0], Box):
+        return None
+    return np.array([shape.half_size.tolist() for shape in shapes]).T[..., None]
 
 
-def _radii(shapes: list[Shape]) -> np.ndarray:
-    """(P_k, 1): each round shape's radius, 0 for a box."""
-    return np.array([0.0 if isinstance(shape, Box) else shape.radius for shape in shapes])[:, None]
+def _radii(shapes: list[Shape]) -> np.ndarray | None:
+    """(P_k, 1): each round shape's radius, for shapes of one family; None for boxes (no kernel reads it)."""
+    if isinstance(shapes[0], Box):
+        return None
+    return np.array([shape.radius for shape in shapes])[:, None]
 
 
 # --- validation -----------------------------------------------------------------------------------------------

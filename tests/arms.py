@@ -1,13 +1,16 @@
-"""Arms the tests build: redundant and deficient arms from published parameters, seeded random arms of each IK
-family (with a random base and tool), and arms stated the way CAD exports and vendors state them (rounded DH values,
-rounded base and tool quaternions, the exact DH table of an arm given by its screws, whatever offsets that takes)."""
+"""Arms the tests build: redundant and deficient arms from published parameters, the catalogue arms' classes and
+the vendors' source URDFs, seeded random arms of each IK family (with a random base and tool), and arms stated the
+way CAD exports and vendors state them (rounded DH values, rounded base and tool quaternions, the exact DH table of
+an arm given by its screws, whatever offsets that takes)."""
 
 from __future__ import annotations
 
 import json
+from importlib.metadata import distribution
 from pathlib import Path
 
 import numpy as np
+import pytest
 from pydantic import TypeAdapter
 
 from service.kinematics import Joint, Robot, ScrewJoint
@@ -16,6 +19,75 @@ from service.robots.schemas import RobotDescription
 
 #: redundant and deficient arms from published parameters: name → inline description (DH table, limits)
 PUBLISHED_ARMS = json.loads((Path(__file__).parent / "data" / "redundant_and_deficient_arms.json").read_text())
+
+#: catalogue robot id → (target kind, generic number of solutions, solver structure): the catalogue arms with a
+#: finite generic solution set (tests/api/test_ik_recall.py holds each to its count)
+GENERIC_CATALOGUE_ARMS = {
+    "spong_ex3_1_planar_rr": ("position", 2, "planar_two_link"),
+    "spong_ex3_2_cylindrical_rpp": ("position", 2, "one_revolute_two_prismatic"),
+    "spong_ex3_3_spherical_wrist_rrr": ("pose", 2, "spherical_wrist"),
+    "spong_ex3_4_cylindrical_with_wrist": ("pose", 4, "one_revolute_two_prismatic+spherical_wrist"),
+    "spong_ex3_5_stanford": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "spong_ex3_6_scara_rrpr": ("pose", 2, "parallel_shoulder+roll"),
+    "spong_ex4_3_elbow_with_wrist": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "spong_sec4_3_elbow_shoulder_offset_with_wrist": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "spong_sec4_3_spherical_arm_rrp": ("position", 4, "intersecting_shoulder"),
+    "spong_sec4_3_spherical_arm_table3_4_frames": ("position", 4, "intersecting_shoulder"),
+    "ex004_1_prp": ("position", 2, "one_revolute_two_prismatic"),
+    "ex004_2_polar_rrp": ("position", 4, "intersecting_shoulder"),
+    "ex004_3_spherical_rrpr": ("pose", 2, "intersecting_shoulder+roll"),
+    "ex004_4_polar_offset_rrp": ("position", 4, "intersecting_shoulder"),
+    "assur001_scara_rrp": ("position", 2, "parallel_shoulder"),
+    "puma560_modified": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "puma560_khalil": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "puma560_standard": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "ur5": ("pose", 8, "three_parallel"),  # up to 8: see test_ik_recall's test_ur5_counts_are_the_real_solution_counts
+    "ur3e": ("pose", 8, "three_parallel"),
+    "ur5e": ("pose", 8, "three_parallel"),
+    "ur10e": ("pose", 8, "three_parallel"),
+    "ur16e": ("pose", 8, "three_parallel"),
+    # industrial arms with a spherical wrist (OPW arms and the Lite 6)
+    "kuka_kr6_r900_2": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "kuka_kr210_r2700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "fanuc_lrmate200id": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "abb_irb6700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "abb_irb120": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "ufactory_lite6": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    # URDF arms: the plan is read off their joint screws, as for DH tables
+    "kinova_jaco2": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "unitree_z1": ("pose", 8, "three_parallel"),
+}
+
+#: a 6R arm with skew axes (no two axes parallel or intersecting): no closed form, the general 6R solver. Its
+#: standard DH rows (a, alpha, d: each (6,), rad and m, theta offsets 0), and its inline description
+SKEW_6R_DH = dict(a=np.array([0.1, 0.5, 0.2, 0.05, 0.1, 0.03]), alpha=np.array([0.5, -0.9, 1.1, 0.7, -1.3, 0.4]),
+                  d=np.array([0.2, 0.1, -0.15, 0.3, 0.05, 0.1]))
+SKEW_6R_ROBOT = {"convention": "standard", "angle_unit": "rad",
+                 "joints": [{"a": float(a), "alpha": float(al), "d": float(d)}
+                            for a, al, d in zip(SKEW_6R_DH["a"], SKEW_6R_DH["alpha"], SKEW_6R_DH["d"])]}
+
+_EXAMPLE_ROBOT_DATA = "cmeel.prefix/share/example-robot-data/robots/"
+
+#: catalogue URDF arm id -> (distribution of the test extra, path of the vendor's source URDF inside it)
+URDF_SOURCES = {
+    "franka_panda": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "panda_description/urdf/panda.urdf"),
+    "kinova_jaco2": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "kinova_description/robots/kinova.urdf"),
+    "ufactory_xarm7": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "xarm_description/urdf/xarm7.urdf"),
+    "unitree_z1": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "z1_description/urdf/z1.urdf"),
+    "so101": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "so_arm_description/urdf/so101.urdf"),
+    "kuka_iiwa14": ("pybullet", "pybullet_data/kuka_iiwa/model.urdf"),
+}
+
+
+def source_urdf(robot_id: str) -> str:
+    """The text of a :data:`URDF_SOURCES` arm's source URDF, as its vendor wrote it."""
+    name, path = URDF_SOURCES[robot_id]
+    try:
+        file = Path(distribution(name).locate_file(path))
+    except Exception:  # noqa: BLE001 - a missing distribution
+        pytest.fail(f"{name} is not installed: it is in the test extra (pip install -e '.[test]')")
+    return file.read_text(encoding="utf-8")
+
 
 #: three-parallel case → (structure, 0-based standard-DH twists set to 0 or π (axes i+1 ∥ i+2), link lengths a_i
 #: set to 0 (axes i+1 and i+2 intersect), the middle parallel joint)

@@ -2,6 +2,7 @@
 
 ``closed_forms``: forward kinematics written out entry by entry (see it for which robots are covered).
 ``textbook_ik``: the textbook's inverse kinematics, every branch, with its names for the branches.
+``opw``: the OPW arms' forward kinematics from their seven parameters, and the catalogue OPW arms' sources.
 """
 
 from tests.oracles.closed_forms import CLOSED_FORMS, ORACLE_PARAMETERS

@@ -126,3 +126,18 @@ def sigma_ratio(robot, q: np.ndarray) -> float:
     """σ_min / σ_max of the FK-difference Jacobian at q."""
     values = np.linalg.svd(difference_jacobian(robot, q), compute_uv=False)
     return float(values[-1] / values[0])
+
+
+#: Sample times of the near-singular paths: 199 samples on [0, 1], sample 99 at the path's middle (t = 0.5).
+NEAR_SINGULAR_TIMES = np.linspace(0.0, 1.0, 199)
+
+#: A UR5e path (``near_singular_path``'s q0, v, δ) whose middle passes 3e-5 (σmin/σmax) from its shoulder
+#: singularity (the wrist point at radius d4 from axis 1, where the two q1 solutions meet). Before issue 22.11 the
+#: trajectory left it at sample 100 for the other q1 solution, with the same labels and branch_changed false, and
+#: ended 2.3 rad off.
+UR5E_PATH = ([-1.07, 1.812, -1.237, -0.292, -2.299, -0.609], [-0.593, -0.475, 0.501, -0.439, -0.03, 0.961], 1e-5)
+
+
+def twists_of(robot, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """[ṗ; ω] (N, 6) of the tool, world frame, by the FK-difference Jacobian; joints q and rates qd (N, n)."""
+    return np.einsum("kij,kj->ki", np.array([difference_jacobian(robot, row) for row in q]), qd)

@@ -146,6 +146,18 @@ def random_general_arm(rng: np.random.Generator, convention: str) -> Robot:
     return Robot(joints, convention=convention, world_T_base=base, flange_T_tool=tool)
 
 
+def kinova_j2n6s300() -> Robot:
+    """Kinova Jaco 2 6-DOF with its curved 60° wrist: Kinova's published standard DH table (no axes meet at
+    the wrist, so no closed-form family)."""
+    D1, D2, D3, D4, D5, D6, e2 = 0.2755, 0.41, 0.2073, 0.0741, 0.0741, 0.16, 0.0098
+    aa = np.pi / 6
+    ratio = np.sin(aa) / np.sin(2 * aa)
+    alpha = [np.pi / 2, np.pi, np.pi / 2, 2 * aa, 2 * aa, np.pi]
+    a = [0.0, D2, 0.0, 0.0, 0.0, 0.0]
+    d = [D1, 0.0, -e2, -(D3 + ratio * D4), -(ratio * D4 + ratio * D5), -(ratio * D5 + D6)]
+    return Robot([Joint(f"q{i + 1}", "revolute", a[i], alpha[i], d[i], 0.0) for i in range(6)], name="j2n6s300")
+
+
 def random_three_parallel_arm(case: str, convention: str, seed: int) -> Robot:
     """A random arm of a :data:`THREE_PARALLEL_CASES` class, with anti-parallel axes among the parallel ones, in
     standard DH restated in ``convention``, with a random base and tool."""

@@ -1,10 +1,15 @@
-"""Helpers shared by the IK tests: requests, random configurations, angles wrapped and matching solutions mod 2π."""
+"""Helpers shared by the IK tests: requests, random configurations, angles wrapped and matching solutions mod 2π,
+checks of every answer, an independent multi-start search, and singular configurations."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from service.kinematics.ik import joint_difference
+from benchmarks import general_6r_singular
+from service.kinematics import Robot, forward_kinematics, geometric_jacobian
+from service.kinematics.ik import joint_difference, solve_ik_arrays
+from service.kinematics.ik._general_6r import General6RPlan
+from service.kinematics.ik._verify import residuals
 
 #: Two joint vectors are the same solution when every joint agrees to this (rad, or length units).
 SAME = 1e-7
@@ -60,6 +65,11 @@ def find(robot, solutions: np.ndarray, q: np.ndarray, tolerance: float = SAME) -
     return index if distance[index] <= tolerance else None
 
 
+def found(robot, solutions: np.ndarray, q: np.ndarray, tolerance: float = SAME) -> bool:
+    """Whether q is among the solutions (revolute joints modulo 2π): :func:`find` found it."""
+    return find(robot, solutions, q, tolerance) is not None
+
+
 def same_set(robot, first: np.ndarray, second: np.ndarray, tolerance: float = SAME) -> bool:
     """Whether two lists of joint vectors hold the same solutions (mod 2π), each once."""
     if len(first) != len(second):
@@ -80,3 +90,67 @@ def fk_inline(client, robot: dict, q) -> np.ndarray:
     response = client.post("/v1/fk", json={"robot": robot, "joints": list(map(float, q))})
     assert response.status_code == 200, response.text
     return np.array(response.json()["pose"]["matrix"])
+
+
+def check_general_answers(robot: Robot, q: np.ndarray, plan: General6RPlan | None = None,
+                          structure: str = "general_6r"):
+    """Solve FK(q) for each row of q (N, 6) by the general solver; assert recall, no wrong solution, no
+    `unreachable`, an even count. Returns the arrays.
+
+    Without ``plan`` the router must choose the general solver (``structure``); with it, that plan is used (for a
+    real arm a closed-form family may one day claim)."""
+    targets = forward_kinematics(robot, q)
+    arrays = solve_ik_arrays(robot, targets, plan=plan)
+    assert arrays is not None and arrays.structure == structure
+    assert (arrays.count > 0).all(), "an FK pose was answered unreachable"
+    for row in range(len(q)):
+        solutions = arrays.joints[row, :arrays.count[row]]
+        assert found(robot, solutions, q[row]), f"pose {row}: generating vector missing"
+        position, orientation = residuals(robot, solutions, targets[row])
+        assert position.max() <= 1e-9 * robot.characteristic_length and orientation.max() <= 1e-9
+        assert arrays.count[row] % 2 == 0  # the real roots of a real polynomial of degree 16 come in pairs
+    return arrays
+
+
+def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.random.Generator,
+                         slide_range: tuple[float, float] = (-np.pi, np.pi)) -> np.ndarray:
+    """Every distinct solution a dense Levenberg–Marquardt search finds from ``starts`` random seeds (revolute
+    joints uniform in ±π, prismatic ones in ``slide_range``).
+
+    Knows nothing of the elimination: FK and the geometric Jacobian only, error in units of the robot's size.
+    """
+    scale = robot.characteristic_length
+    q = rng.uniform(-np.pi, np.pi, (starts, 6))
+    q[:, ~robot.is_revolute] = rng.uniform(*slide_range, (starts, int((~robot.is_revolute).sum())))
+    damping = np.full(starts, 1e-2)
+    def error_of(q):
+        T = forward_kinematics(robot, q)
+        position = (target[:3, 3] - T[:, :3, 3]) / scale
+        R = target[:3, :3] @ np.swapaxes(T[:, :3, :3], 1, 2)
+        rotation = 0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], 1)
+        return np.concatenate([position, rotation], axis=1)
+    error = error_of(q)
+    for _ in range(80):
+        J = geometric_jacobian(robot, q)
+        J[:, :3] /= scale
+        JtJ = np.swapaxes(J, 1, 2) @ J
+        step = np.linalg.solve(JtJ + damping[:, None, None] * np.eye(6),
+                               np.einsum("kji,kj->ki", J, error)[..., None])[..., 0]
+        trial = q + step
+        trial_error = error_of(trial)
+        better = (trial_error ** 2).sum(1) < (error ** 2).sum(1)
+        q[better], error[better] = trial[better], trial_error[better]
+        damping = np.where(better, damping / 10, damping * 10).clip(1e-12, 1e6)
+    converged = q[np.abs(error).max(axis=1) < 1e-11]
+    revolute = robot.is_revolute
+    converged[:, revolute] = wrapped(converged[:, revolute])
+    distinct: list[np.ndarray] = []
+    for candidate in converged:
+        if not any(np.abs(joint_difference(robot, candidate[None], other)).max() < 1e-6 for other in distinct):
+            distinct.append(candidate)
+    return np.array(distinct).reshape(-1, 6)
+
+
+def singular_configuration(robot: Robot, rng: np.random.Generator) -> np.ndarray:
+    """A configuration with det J = 0: bisection along the first random segment on which det J changes sign."""
+    return general_6r_singular.singular_configuration(robot, rng)[0]

@@ -9,6 +9,7 @@ from benchmarks import general_6r_singular
 from service.kinematics import Robot, forward_kinematics, geometric_jacobian
 from service.kinematics.ik import joint_difference, solve_ik_arrays
 from service.kinematics.ik._general_6r import General6RPlan
+from service.kinematics.ik._screws import move_point
 from service.kinematics.ik._verify import residuals
 
 #: Two joint vectors are the same solution when every joint agrees to this (rad, or length units).
@@ -154,3 +155,33 @@ def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.
 def singular_configuration(robot: Robot, rng: np.random.Generator) -> np.ndarray:
     """A configuration with det J = 0: bisection along the first random segment on which det J changes sign."""
     return general_6r_singular.singular_configuration(robot, rng)[0]
+
+
+def stretched_elbow(plan, q: np.ndarray) -> float:
+    """The value of joint 3 at which the wrist point (PUMA type) or the point on axis 4 (UR5 type) is farthest
+    from axis 2, for the other joints of q (n,), on the arm of ``plan`` (a closed-form plan of either type): the
+    stretched elbow, by golden-section search about a grid maximum."""
+    model = plan.model if hasattr(plan, "model") else plan.positioner.model
+    if plan.structure == "three_parallel":
+        point, anchor, axis = model.points[3], model.points[1], model.directions[1]
+    else:
+        point, anchor, axis = plan.point, plan.positioner.centre, None
+
+    def reach(value: float) -> float:
+        joints = q.copy()
+        joints[2] = value
+        offset = move_point(model.directions, model.points, model.is_revolute, joints[:3], point) - \
+            move_point(model.directions, model.points, model.is_revolute, joints[:1], anchor)
+        if axis is not None:  # in the plane normal to the parallel axes
+            turned = move_point(model.directions[:1], np.zeros((1, 3)), model.is_revolute[:1], joints[:1], axis)
+            offset = offset - (offset @ turned) * turned
+        return float(np.linalg.norm(offset))
+
+    grid = np.linspace(-np.pi, np.pi, 721)
+    best = grid[int(np.argmax([reach(v) for v in grid]))]
+    low, high = best - 2 * np.pi / 720, best + 2 * np.pi / 720
+    ratio = (np.sqrt(5) - 1) / 2
+    for _ in range(80):
+        a, b = high - ratio * (high - low), low + ratio * (high - low)
+        low, high = (a, high) if reach(a) < reach(b) else (low, b)
+    return (low + high) / 2

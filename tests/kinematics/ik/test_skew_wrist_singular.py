@@ -24,13 +24,7 @@ from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from tests.arms import random_ur_type_arm
-from tests.kinematics.ik.test_three_parallel_arcs import (
-    RESOLVED,
-    arc_holding,
-    arcs_of,
-    fk_miss,
-    reachable_sixth,
-)
+from tests.oracles.q6_arcs import RESOLVED, arc_holding, arcs_of, fk_miss, reachable_sixth
 
 WRIST_ANGLES = (0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-6, -1e-6, 1e-3, -1e-3)
 POSES_PER_ANGLE = 5

@@ -138,6 +138,52 @@ def restated_6r(a: np.ndarray, alpha: np.ndarray, d: np.ndarray, theta: np.ndarr
     return Robot(joints, convention=convention, world_T_base=world_T_base, flange_T_tool=tool)
 
 
+def stated_three_ways(rng: np.random.Generator, table: list[tuple[float, float, float, float]], kinds: str,
+                      limits: tuple[float, float] | None = None) -> list[Robot]:
+    """One arm in the standard, modified and Khalil conventions (same base, tool, FK): standard DH rows ``table``
+    (a, alpha, d, theta offset) of joints ``kinds`` ("R" or "P" each), some axes reversed at random (each with
+    probability 0.4), with a random base (translation in ±0.5) and tool (in ±0.2) drawn from ``rng``.
+    ``limits``: (lower, upper) of every prismatic joint; by default none."""
+    n = len(kinds)
+    rows = [list(row) for row in table]
+    base = random_rigid(rng, 0.5)
+    for joint in np.flatnonzero(rng.random(n) < 0.4):
+        base = _reverse_axis(rows, int(joint), base)
+    tool = random_rigid(rng, 0.2)
+    joint_kind = {"R": "revolute", "P": "prismatic"}
+    bounds = [limits if (k == "P" and limits) else (-np.inf, np.inf) for k in kinds]
+    standard = Robot([Joint(f"j{i + 1}", joint_kind[k], *row, *bound)
+                      for i, (row, k, bound) in enumerate(zip(rows, kinds, bounds))],
+                     convention="standard", world_T_base=base, flange_T_tool=tool)
+    # Craig: row i holds (a_{i−1}, alpha_{i−1}, d_i, theta_i); the last (a_n, alpha_n) moves into the tool
+    craig = [(0.0 if i == 0 else rows[i - 1][0], 0.0 if i == 0 else rows[i - 1][1], rows[i][2], rows[i][3])
+             for i in range(n)]
+    last = np.eye(4)
+    a, alpha = rows[-1][0], rows[-1][1]
+    last[:3, :3] = [[1, 0, 0], [0, np.cos(alpha), -np.sin(alpha)], [0, np.sin(alpha), np.cos(alpha)]]
+    last[0, 3] = a
+    modified_joints = [Joint(f"j{i + 1}", joint_kind[k], *row, *bound)
+                       for i, (row, k, bound) in enumerate(zip(craig, kinds, bounds))]
+    modified = Robot(modified_joints, convention="modified", world_T_base=base, flange_T_tool=last @ tool)
+    khalil = Robot(modified_joints, convention="khalil", world_T_base=base, flange_T_tool=last @ tool)
+    return [standard, modified, khalil]
+
+
+def _reverse_axis(rows: list[list[float]], joint: int, base: np.ndarray) -> np.ndarray:
+    """Flip joint ``joint``'s axis (standard DH, in place): frame joint−1 turns by π about its x axis.
+
+    Row ``joint − 1`` (or the base) gains π of twist; row ``joint`` measures θ and d along the flipped z
+    and loses π of twist. The arm is the same; its joint variable changes sign.
+    """
+    if joint == 0:
+        base = base @ np.diag([1.0, -1.0, -1.0, 1.0])
+    else:
+        rows[joint - 1][1] += np.pi
+    a, alpha, d, theta = rows[joint]
+    rows[joint] = [a, alpha - np.pi, -d, -theta]
+    return base
+
+
 def random_general_arm(rng: np.random.Generator, convention: str) -> Robot:
     """A random 6R arm with no decomposable geometry (DH entries uniform in ±1, in the given convention) with a
     random base (translation in ±1) and tool (translation in ±0.3)."""

@@ -138,6 +138,38 @@ def restated_6r(a: np.ndarray, alpha: np.ndarray, d: np.ndarray, theta: np.ndarr
     return Robot(joints, convention=convention, world_T_base=world_T_base, flange_T_tool=tool)
 
 
+class RandomDHRows:
+    """Random standard-DH row entries drawn from one generator, in the order they are asked for: link lengths
+    uniform in 0.1–0.5, twists of size 0.3–2.8 rad and either sign, joint offsets uniform in ±π."""
+
+    def __init__(self, rng: np.random.Generator):
+        self.rng = rng
+
+    def length(self) -> float:
+        return float(self.rng.uniform(0.1, 0.5))
+
+    def twist(self) -> float:
+        return float(self.rng.uniform(0.3, 2.8) * self.rng.choice([-1, 1]))
+
+    def offset(self) -> float:
+        return float(self.rng.uniform(-np.pi, np.pi))
+
+    def free(self) -> tuple[float, float, float, float]:
+        """A row (a, alpha, d, theta offset) with no special relation to its neighbours."""
+        return (self.length(), self.twist(), self.length(), self.offset())
+
+    def spherical_wrists(self) -> tuple[list[tuple], list[tuple]]:
+        """A spherical wrist's rows after a positioner (three rows: axes 4, 5, 6 meet) and a wrist's rows at the
+        base (two rows: axes 1, 2, 3 meet), drawn in that order. Wrist twists of equal size, as in every real
+        wrist (±90°): only then can the outer axes align."""
+        t = self.twist()
+        wrist = [(0.0, t, self.length(), self.offset()), (0.0, t * self.rng.choice([-1, 1]), 0.0, self.offset()),
+                 self.free()]
+        t = self.twist()
+        base_wrist = [(0.0, t, self.length(), self.offset()), (0.0, t * self.rng.choice([-1, 1]), 0.0, self.offset())]
+        return wrist, base_wrist
+
+
 def stated_three_ways(rng: np.random.Generator, table: list[tuple[float, float, float, float]], kinds: str,
                       limits: tuple[float, float] | None = None) -> list[Robot]:
     """One arm in the standard, modified and Khalil conventions (same base, tool, FK): standard DH rows ``table``

@@ -16,7 +16,7 @@ from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik.subproblems import subproblem_5_prismatic
-from tests.arms import stated_three_ways
+from tests.arms import RandomDHRows, stated_three_ways
 from tests.ik_helpers import (aligning_value, assert_every_solution, centred_configurations, positioner_determinant,
                               positioner_singular_configurations, wrapped)
 
@@ -26,25 +26,13 @@ POSES = 400  # per statement; three statements (conventions) per class: 1,200 po
 
 def _rows(kind: str, rng: np.random.Generator) -> tuple[list[tuple[float, float, float, float]], str]:
     """Standard DH rows (a, alpha, d, theta offset) of a random arm of the class, and its joint kinds."""
-    def length():
-        return float(rng.uniform(0.1, 0.5))
-
-    def twist():
-        return float(rng.uniform(0.3, 2.8) * rng.choice([-1, 1]))
-
-    def offset():
-        return float(rng.uniform(-np.pi, np.pi))
-
-    def free():
-        return (length(), twist(), length(), offset())
+    draw = RandomDHRows(rng)
+    length, twist, offset, free = draw.length, draw.twist, draw.offset, draw.free
 
     def right():  # a twist of ±90°: the next axis normal to this one
         return (length(), 90 * DEG * rng.choice([-1, 1]), length(), offset())
 
-    t = twist()
-    wrist = [(0.0, t, length(), offset()), (0.0, t * rng.choice([-1, 1]), 0.0, offset()), free()]
-    t = twist()
-    base_wrist = [(0.0, t, length(), offset()), (0.0, t * rng.choice([-1, 1]), 0.0, offset())]
+    wrist, base_wrist = draw.spherical_wrists()
     t = twist()
     positioners = {
         # skew axes 1 and 2, then an oblique slide

@@ -21,7 +21,7 @@ from service.kinematics import Joint, Robot, forward_kinematics, link_frames, sc
 from service.kinematics.ik import _numeric, joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik.subproblems import subproblem_1
-from tests.arms import stated_three_ways
+from tests.arms import RandomDHRows, stated_three_ways
 from tests.ik_helpers import (aligning_value, assert_every_solution, centred_configurations,
                               positioner_singular_configurations)
 
@@ -35,23 +35,9 @@ DATA = json.loads((Path(__file__).parents[2] / "data" / "opw_arms.json").read_te
 
 def _rows(kind: str, rng: np.random.Generator) -> tuple[list[tuple[float, float, float, float]], str]:
     """Standard DH rows (a, alpha, d, theta offset) of a random arm of the class, and its joint kinds."""
-    def length():
-        return float(rng.uniform(0.1, 0.5))
-
-    def twist():
-        return float(rng.uniform(0.3, 2.8) * rng.choice([-1, 1]))
-
-    def offset():
-        return float(rng.uniform(-np.pi, np.pi))
-
-    def free():
-        return (length(), twist(), length(), offset())
-
-    # wrist twists of equal size, as in every real wrist (±90°): only then can the outer axes align
-    t = twist()
-    wrist = [(0.0, t, length(), offset()), (0.0, t * rng.choice([-1, 1]), 0.0, offset()), free()]
-    t = twist()
-    base_wrist = [(0.0, t, length(), offset()), (0.0, t * rng.choice([-1, 1]), 0.0, offset())]
+    draw = RandomDHRows(rng)
+    length, twist, offset, free = draw.length, draw.twist, draw.offset, draw.free
+    wrist, base_wrist = draw.spherical_wrists()
     tables = {
         # axis 1, axis 2 offset from it, axes 2 ∥ 3 (alpha_2 = 0), then the wrist: KUKA/ABB/Fanuc type
         "offset_shoulder_parallel_elbow": ([free(), (length(), 0.0, length(), offset()), free()] + wrist, "RRRRRR"),

@@ -66,6 +66,17 @@ SKEW_6R_ROBOT = {"convention": "standard", "angle_unit": "rad",
                  "joints": [{"a": float(a), "alpha": float(al), "d": float(d)}
                             for a, al, d in zip(SKEW_6R_DH["a"], SKEW_6R_DH["alpha"], SKEW_6R_DH["d"])]}
 
+#: Four skew revolute joints and two slides: no closed-form family or general solver covers it, so the numeric
+#: search answers (every 6R arm, and every 6-joint arm with one slide, is solved by the general solver, and a 7R
+#: one by locking a joint). Modified DH, radians and metres, no limits.
+NUMERIC_ARM = {"convention": "modified", "joints": [
+    {"type": kind, "a": a, "alpha": alpha, "d": d}
+    for kind, a, alpha, d in zip(["revolute"] * 4 + ["prismatic"] * 2, [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
+                                 [0.5, -0.9, 1.1, 0.7, -1.3, 0.4], [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
+#: a skew 7R arm (standard DH, radians and metres): a redundant arm whose locked 6R arms go to the general solver
+SKEW_7R = {"convention": "standard", "joints": [
+    {"type": "revolute", "a": 0.1 * i, "alpha": 0.3 + 0.2 * i, "d": 0.05 * (i % 3)} for i in range(7)]}
+
 _EXAMPLE_ROBOT_DATA = "cmeel.prefix/share/example-robot-data/robots/"
 
 #: catalogue URDF arm id -> (distribution of the test extra, path of the vendor's source URDF inside it)

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.arms import SKEW_6R_DH, SKEW_6R_ROBOT
+from tests.arms import NUMERIC_ARM, SKEW_6R_DH, SKEW_6R_ROBOT, SKEW_7R
 from tests.conftest import assert_problem, catalogue_robot
 from tests.ik_helpers import angle_gap, find, joints_of, unlimited, wrapped
 from tests.oracles.closed_forms import CLOSED_FORMS
@@ -391,14 +391,6 @@ def _revolute(a, alpha, d, kind="revolute"):
     return {"type": kind, "a": a, "alpha": alpha, "d": d}
 
 
-NUMERIC_ARM = {"convention": "modified", "joints": [
-    _revolute(a, alpha, d, kind) for kind, a, alpha, d in zip(["revolute"] * 4 + ["prismatic"] * 2,
-                                                              [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
-                                                              [0.5, -0.9, 1.1, 0.7, -1.3, 0.4],
-                                                              [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
-
-
-SKEW_7R = {"convention": "standard", "joints": [_revolute(0.1 * i, 0.3 + 0.2 * i, 0.05 * (i % 3)) for i in range(7)]}
 SKEW_PRISMATIC = {"convention": "standard", "joints": [
     _revolute(0.1, 0.4, 0.2), _revolute(0.2, -0.7, 0.0, "prismatic"), _revolute(0.3, 1.0, 0.1),
     _revolute(0.05, 0.6, 0.0, "prismatic"), _revolute(0.1, -1.1, 0.2), _revolute(0.0, 0.3, 0.1)]}

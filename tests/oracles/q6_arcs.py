@@ -76,3 +76,15 @@ def arc_holding(arcs: list[np.ndarray], q6: float) -> int | None:
         if all((nearest + step) % GRID in members for step in range(-RESOLVED, RESOLVED + 1)):
             return label
     return None
+
+
+def resolved_wrist_configuration(robot: Robot, rng: np.random.Generator) -> tuple[np.ndarray, list[np.ndarray]]:
+    """A random configuration (6,) at the singular wrist (q5 = 0, the others uniform in ±π) whose arcs of q6 the
+    grid resolves (each at least 4 RESOLVED samples long, q6 clearly inside one), with those arcs: drawn again
+    until one is."""
+    while True:
+        q = rng.uniform(-np.pi, np.pi, 6)
+        q[4] = 0.0
+        arcs = arcs_of(reachable_sixth(robot, q))
+        if min(len(arc) for arc in arcs) >= 4 * RESOLVED and arc_holding(arcs, q[5]) is not None:
+            return q, arcs

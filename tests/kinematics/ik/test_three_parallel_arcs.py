@@ -24,7 +24,7 @@ from service.kinematics.ik import cached_plan
 from service.robots.catalogue import load_catalogue
 from tests.arms import random_ur_type_arm
 from tests.ik_helpers import wrapped
-from tests.oracles.q6_arcs import RESOLVED, arc_holding, arcs_of, fk_miss, q6_grid, reachable_sixth
+from tests.oracles.q6_arcs import arc_holding, fk_miss, q6_grid, resolved_wrist_configuration
 
 WRIST_OFFSETS = (0.0, 1e-12, -1e-12)
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
@@ -63,11 +63,7 @@ def _poses(robot: Robot, seed: int, count: int) -> list[tuple[np.ndarray, list[n
     rng = np.random.default_rng(seed)
     out = []
     while len(out) < count:
-        q = rng.uniform(-np.pi, np.pi, 6)
-        q[4] = 0.0
-        arcs = arcs_of(reachable_sixth(robot, q))
-        if min(len(arc) for arc in arcs) < 4 * RESOLVED or arc_holding(arcs, q[5]) is None:
-            continue
+        q, arcs = resolved_wrist_configuration(robot, rng)
         q[4] = WRIST_OFFSETS[len(out) % len(WRIST_OFFSETS)]
         out.append((q, arcs))
     return out

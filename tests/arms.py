@@ -16,6 +16,7 @@ from pydantic import TypeAdapter
 from service.kinematics import Joint, Robot, ScrewJoint
 from service.robots import robot_from_description
 from service.robots.schemas import RobotDescription
+from tests.oracles.rotations import axis_angle, rpy
 
 #: redundant and deficient arms from published parameters: name → inline description (DH table, limits)
 PUBLISHED_ARMS = json.loads((Path(__file__).parent / "data" / "redundant_and_deficient_arms.json").read_text())
@@ -455,7 +456,7 @@ def urdf_chain_screws(joints: list[dict]) -> tuple[np.ndarray, np.ndarray, np.nd
     for joint in joints:
         r, p, y = joint["rpy"]
         origin = np.eye(4)
-        origin[:3, :3] = _rot("z", y) @ _rot("y", p) @ _rot("x", r)
+        origin[:3, :3] = rpy(r, p, y)
         origin[:3, 3] = joint["xyz"]
         frame = frame @ origin
         directions.append(frame[:3, 2].copy())
@@ -463,20 +464,11 @@ def urdf_chain_screws(joints: list[dict]) -> tuple[np.ndarray, np.ndarray, np.nd
     return np.array(directions), np.array(points), frame
 
 
-def _rot(axis: str, angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return {"x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
-            "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
-            "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
-
-
 def screw_exponential(direction, point, revolute, q):
     """exp([S] q) for a unit screw, written independently of the core (Rodrigues)."""
     T = np.eye(4)
     if revolute:
-        k = np.array([[0, -direction[2], direction[1]], [direction[2], 0, -direction[0]],
-                      [-direction[1], direction[0], 0]])
-        R = np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * k @ k
+        R = axis_angle(direction, q)
         T[:3, :3] = R
         T[:3, 3] = (np.eye(3) - R) @ point
     else:

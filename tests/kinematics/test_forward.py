@@ -16,13 +16,13 @@ from service.kinematics import (
     screw_model,
 )
 from tests.arms import screw_exponential
+from tests.oracles.rotations import about
 
 
 def _rot(axis: str, angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
+    """The homogeneous rotation (4, 4) by ``angle`` about ``axis`` ("x", "y" or "z")."""
     T = np.eye(4)
-    i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]
-    T[i, i], T[i, j], T[j, i], T[j, j] = c, -s, s, c
+    T[:3, :3] = about(axis, angle)
     return T
 
 

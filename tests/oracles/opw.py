@@ -8,6 +8,8 @@ import math
 
 import numpy as np
 
+from tests.oracles.rotations import about
+
 #: robot id -> the source's OPW parameters (m), sign corrections and joint offsets (deg); sources in the YAML files.
 OPW_SOURCES = {
     "kuka_kr6_r900_2": (dict(a1=0.025, a2=-0.025, b=0.0, c1=0.400, c2=0.455, c3=0.420, c4=0.090),
@@ -23,18 +25,6 @@ OPW_SOURCES = {
 }
 
 
-def rot_z(t: float) -> np.ndarray:
-    """The rotation (3, 3) by t (rad) about z."""
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rot_y(t: float) -> np.ndarray:
-    """The rotation (3, 3) by t (rad) about y."""
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
 def opw_forward(p: dict, signs, offsets_deg, q: np.ndarray) -> np.ndarray:
     """Base_T_flange (4, 4) of an OPW arm at controller angles q (rad), after Brandstötter et al. 2014, eqs. for C and u."""
     t = np.asarray(signs) * q - np.radians(offsets_deg)
@@ -45,7 +35,7 @@ def opw_forward(p: dict, signs, offsets_deg, q: np.ndarray) -> np.ndarray:
     cz1 = p["c2"] * math.cos(t[1]) + k * math.cos(t[1] + t[2] + psi3)
     c = np.array([cx1 * math.cos(t[0]) - cy1 * math.sin(t[0]), cx1 * math.sin(t[0]) + cy1 * math.cos(t[0]),
                   cz1 + p["c1"]])
-    rotation = rot_z(t[0]) @ rot_y(t[1] + t[2]) @ rot_z(t[3]) @ rot_y(t[4]) @ rot_z(t[5])
+    rotation = about("z", t[0]) @ about("y", t[1] + t[2]) @ about("z", t[3]) @ about("y", t[4]) @ about("z", t[5])
     pose = np.eye(4)
     pose[:3, :3] = rotation
     pose[:3, 3] = c + p["c4"] * rotation[:, 2]

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from service.kinematics import forward_kinematics
+from tests.oracles.rotations import axis_angle
 
 
 def spiral(t):
@@ -19,13 +20,6 @@ def spiral(t):
     Dd = np.stack((10.0 * np.pi * c, 10.0 * np.pi * s, 10.0 * one), axis=-1)
     Ddd = np.stack((-5.0 * np.pi**2 * s, 5.0 * np.pi**2 * c, 0.0 * one), axis=-1)
     return D, Dd, Ddd
-
-
-def rotation(axis, angle: float) -> np.ndarray:
-    """R(k, θ) by Rodrigues' formula, k a unit vector."""
-    k = np.asarray(axis, dtype=float)
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * K @ K
 
 
 def wobble(t, world_T_start: np.ndarray, radius: float, k1, k2):
@@ -49,8 +43,8 @@ def wobble(t, world_T_start: np.ndarray, radius: float, k1, k2):
     poses = np.tile(np.eye(4), (len(t), 1, 1))
     omega, omegad = np.zeros((len(t), 3)), np.zeros((len(t), 3))
     for i in range(len(t)):
-        Ra = rotation(k1, a[i])
-        Rb = rotation(k2, b[i]) if k2.any() else np.eye(3)
+        Ra = axis_angle(k1, a[i])
+        Rb = axis_angle(k2, b[i]) if k2.any() else np.eye(3)
         poses[i, :3, :3] = Ra @ Rb @ world_T_start[:3, :3]
         poses[i, :3, 3] = p[i]
         second = Ra @ k2 * bd[i]

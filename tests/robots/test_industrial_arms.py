@@ -19,7 +19,8 @@ import pytest
 
 from service.kinematics.ik import joint_difference
 from tests.conftest import catalogue_robot
-from tests.oracles.opw import OPW_SOURCES, opw_forward, rot_y
+from tests.oracles.opw import OPW_SOURCES, opw_forward
+from tests.oracles.rotations import about, axis_angle
 
 DATA_DIR = Path(__file__).resolve().parents[1] / "data"
 N_RANDOM = 50
@@ -44,13 +45,6 @@ LRMATE_URDF_JOINTS = [
     ((0, 0, 0.330), (0, 0, 1)), ((0.050, 0, 0), (0, 1, 0)), ((0, 0, 0.330), (0, -1, 0)),
     ((0, 0, 0.035), (-1, 0, 0)), ((0.335, 0, 0), (0, -1, 0)), ((0.080, 0, 0), (-1, 0, 0)),
 ]
-
-
-def axis_angle(axis, angle: float) -> np.ndarray:
-    """Rodrigues rotation (3, 3) about a unit axis."""
-    k = np.asarray(axis, dtype=float)
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
 
 
 def urdf_forward(joints, tool_rotation: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -127,9 +121,9 @@ def test_opw_parameters_agree_with_the_golden_data(robot_id):
 
 
 @pytest.mark.parametrize("robot_id, joints, tool_rotation", [
-    ("kuka_kr210_r2700", KR210_URDF_JOINTS, rot_y(math.pi / 2)),
-    ("abb_irb6700", IRB6700_URDF_JOINTS, rot_y(math.pi / 2)),
-    ("fanuc_lrmate200id", LRMATE_URDF_JOINTS, rot_y(-math.pi / 2) @ np.diag([1.0, -1.0, -1.0])),  # Rz(0) Ry Rx(pi)
+    ("kuka_kr210_r2700", KR210_URDF_JOINTS, about("y", math.pi / 2)),
+    ("abb_irb6700", IRB6700_URDF_JOINTS, about("y", math.pi / 2)),
+    ("fanuc_lrmate200id", LRMATE_URDF_JOINTS, about("y", -math.pi / 2) @ np.diag([1.0, -1.0, -1.0])),  # Rz(0) Ry Rx(pi)
 ])
 def test_opw_parameters_are_those_of_the_urdf(robot_id, joints, tool_rotation):
     """The OPW data, signs and offsets used above reproduce the ROS-Industrial URDF the entry cites."""

@@ -18,17 +18,12 @@ import yaml
 from service.config import BUILTIN_ROBOTS_DIR
 from tests.arms import URDF_SOURCES, source_urdf
 from tests.conftest import assert_problem
+from tests.oracles.rotations import axis_angle, rpy
 
 
 def _numbers(element, attribute: str, default: str) -> np.ndarray:
     text = default if element is None else element.get(attribute, default)
     return np.array([float(v) for v in text.split()])
-
-
-def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    x, y, z = axis / np.linalg.norm(axis)
-    K = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
 
 
 def _source_chain(text: str, base: str, tip: str) -> list:
@@ -47,8 +42,7 @@ def _source_fk(chain: list, q: np.ndarray) -> np.ndarray:
         origin = joint.find("origin")
         roll, pitch, yaw = _numbers(origin, "rpy", "0 0 0")
         step = np.eye(4)
-        step[:3, :3] = _rotation(np.array([0, 0, 1.0]), yaw) @ _rotation(np.array([0, 1.0, 0]), pitch) \
-            @ _rotation(np.array([1.0, 0, 0]), roll)
+        step[:3, :3] = rpy(roll, pitch, yaw)
         step[:3, 3] = _numbers(origin, "xyz", "0 0 0")
         T = T @ step
         kind = joint.get("type")
@@ -59,7 +53,7 @@ def _source_fk(chain: list, q: np.ndarray) -> np.ndarray:
         if kind == "prismatic":
             motion[:3, 3] = axis / np.linalg.norm(axis) * q[i]
         else:
-            motion[:3, :3] = _rotation(axis, q[i])
+            motion[:3, :3] = axis_angle(axis / np.linalg.norm(axis), q[i])
         T = T @ motion
         i += 1
     return T

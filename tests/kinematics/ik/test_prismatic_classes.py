@@ -19,6 +19,7 @@ from service.kinematics.ik.subproblems import subproblem_5_prismatic
 from tests.arms import RandomDHRows, stated_three_ways
 from tests.ik_helpers import (aligning_value, assert_every_solution, centred_configurations, positioner_determinant,
                               positioner_singular_configurations, wrapped)
+from tests.oracles.rotations import axis_angle
 
 DEG = np.pi / 180
 POSES = 400  # per statement; three statements (conventions) per class: 1,200 poses
@@ -188,20 +189,17 @@ def test_subproblem_5_prismatic_agrees_with_a_dense_scan():
         phi, theta, s = rng.uniform(-np.pi, np.pi), rng.uniform(-np.pi, np.pi), rng.uniform(-0.5, 0.5)
         turns = bool(trial % 2)
 
-        def R(axis, t):
-            return np.cos(t) * np.eye(3) + np.sin(t) * np.cross(np.eye(3), axis) + (1 - np.cos(t)) * np.outer(axis, axis)
-
         if turns:
-            p2 = R(k2, phi) @ (p0 + R(k, theta) @ p1 + s * v)
+            p2 = axis_angle(k2, phi) @ (p0 + axis_angle(k, theta) @ p1 + s * v)
         else:
-            p2 = R(k2, phi) @ (p0 + R(k, theta) @ p1) - s * v
+            p2 = axis_angle(k2, phi) @ (p0 + axis_angle(k, theta) @ p1) - s * v
         sol = subproblem_5_prismatic(k2, k, p0, p1, p2, v, slide_turns=turns)
         found = np.stack([sol.phi, sol.theta, sol.s], axis=-1)[sol.valid & sol.exact]
         gaps = np.abs(np.stack([wrapped(found[:, 0] - phi), wrapped(found[:, 1] - theta), found[:, 2] - s], axis=-1))
         assert gaps.max(axis=1).min() < 1e-9
         for f in found:  # every candidate solves the vector equation
             lhs = p2 if turns else p2 + f[2] * v
-            rhs = R(k2, f[0]) @ (p0 + R(k, f[1]) @ p1 + (f[2] * v if turns else 0))
+            rhs = axis_angle(k2, f[0]) @ (p0 + axis_angle(k, f[1]) @ p1 + (f[2] * v if turns else 0))
             assert np.linalg.norm(lhs - rhs) < 1e-9
         if abs(k2 @ v) > 1e-6:  # the quartic: count its real roots by a dense scan
             grid = np.linspace(-np.pi, np.pi, 200001)

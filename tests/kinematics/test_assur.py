@@ -23,6 +23,7 @@ from service.kinematics._assur import (
     rrr_group,
 )
 from service.kinematics._tolerances import SINGULARITY_TOLERANCE
+from tests.ik_helpers import wrapped
 
 DATA = json.loads((Path(__file__).resolve().parents[1] / "data" / "assur_spiral_tables.json").read_text())
 L_OA = float(DATA["lengths_mm"]["l_OA"])
@@ -256,11 +257,8 @@ def test_angle_and_distance_functions_match_finite_differences_across_x_zero():
     def theta(tt):
         return np.arctan2(vec(tt)[1], vec(tt)[0])
 
-    def unwrap_diff(a, b):
-        return np.mod(a - b + np.pi, 2 * np.pi) - np.pi
-
-    fd1 = unwrap_diff(theta(t + h1), theta(t - h1)) / (2 * h1)
-    fd2 = (unwrap_diff(theta(t + h2), theta(t)) - unwrap_diff(theta(t), theta(t - h2))) / h2**2
+    fd1 = wrapped(theta(t + h1) - theta(t - h1)) / (2 * h1)
+    fd2 = (wrapped(theta(t + h2) - theta(t)) - wrapped(theta(t) - theta(t - h2))) / h2**2
     np.testing.assert_allclose(r.thetad, fd1, rtol=0, atol=1e-8)
     np.testing.assert_allclose(r.thetadd, fd2, rtol=0, atol=1e-5)
 

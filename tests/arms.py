@@ -228,10 +228,18 @@ def _reverse_axis(rows: list[list[float]], joint: int, base: np.ndarray) -> np.n
     return base
 
 
+def random_dh_robot(rng: np.random.Generator, convention: str, kinds: str) -> Robot:
+    """A random arm of joints ``kinds`` ("R" revolute or "P" prismatic each), every DH entry (a, alpha, d, theta)
+    uniform in ±1, in the given convention, with no base or tool."""
+    joints = [Joint(f"q{i + 1}", "revolute" if k == "R" else "prismatic", *rng.uniform(-1, 1, 4))
+              for i, k in enumerate(kinds)]
+    return Robot(joints, convention=convention)
+
+
 def random_general_arm(rng: np.random.Generator, convention: str) -> Robot:
     """A random 6R arm with no decomposable geometry (DH entries uniform in ±1, in the given convention) with a
     random base (translation in ±1) and tool (translation in ±0.3)."""
-    joints = [Joint(f"q{i + 1}", "revolute", *rng.uniform(-1, 1, 4)) for i in range(6)]
+    joints = random_dh_robot(rng, convention, "RRRRRR").joints
     base, tool = random_rigid(rng, 1.0), random_rigid(rng, 0.3)
     return Robot(joints, convention=convention, world_T_base=base, flange_T_tool=tool)
 

@@ -24,6 +24,7 @@ from service.kinematics._assur import (
 )
 from service.kinematics._tolerances import SINGULARITY_TOLERANCE
 from tests.ik_helpers import wrapped
+from tests.oracles.paths import spiral
 
 DATA = json.loads((Path(__file__).resolve().parents[1] / "data" / "assur_spiral_tables.json").read_text())
 L_OA = float(DATA["lengths_mm"]["l_OA"])
@@ -37,18 +38,6 @@ COLUMNS = DATA["columns"][1:]  # theta1 ... l3dd, attribute names of AssurScaraS
 # values below 1 (0.305078 ± 5e-7) and the printed zeros.
 TABLE_ATOL = 1e-6
 TABLE_RTOL = 5e-6
-
-
-def spiral(t):
-    """Tool path of the paper's example (eq. 16) and its exact derivatives, shape (N, 3) each."""
-    t = np.asarray(t, dtype=float)
-    w = np.pi / 2.0
-    s, c = np.sin(w * t), np.cos(w * t)
-    one = np.ones_like(t)
-    D = np.stack((100.0 + 20.0 * s, -20.0 * c, 50.0 + 10.0 * t), axis=-1)
-    Dd = np.stack((10.0 * np.pi * c, 10.0 * np.pi * s, 10.0 * one), axis=-1)
-    Ddd = np.stack((-5.0 * np.pi**2 * s, 5.0 * np.pi**2 * c, 0.0 * one), axis=-1)
-    return D, Dd, Ddd
 
 
 def solve_spiral(t, mode):

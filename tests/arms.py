@@ -16,7 +16,7 @@ from pydantic import TypeAdapter
 from service.kinematics import Joint, Robot, ScrewJoint
 from service.robots import robot_from_description
 from service.robots.schemas import RobotDescription
-from tests.oracles.rotations import axis_angle, rpy
+from tests.oracles.rotations import axis_angle, matrix_of_quaternion, rpy
 
 #: redundant and deficient arms from published parameters: name → inline description (DH table, limits)
 PUBLISHED_ARMS = json.loads((Path(__file__).parent / "data" / "redundant_and_deficient_arms.json").read_text())
@@ -381,9 +381,7 @@ def _rounded_transform(rng: np.random.Generator, transform: np.ndarray | None = 
     w, x, y, z = quaternion = np.round(quaternion, 6)
     w, x, y, z = quaternion / np.linalg.norm(quaternion)  # a reader normalises the written quaternion
     T = np.eye(4)
-    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    T[:3, :3] = matrix_of_quaternion(w, x, y, z)
     T[:3, 3] = np.round(translation, 4)
     return T
 

@@ -1,5 +1,5 @@
 """Rotations written out here, independently of the service's rotation code: Rodrigues' formula, the rotations
-about x, y and z, a URDF origin's fixed-axis roll, pitch and yaw, and random rotations."""
+about x, y and z, a URDF origin's fixed-axis roll, pitch and yaw, a unit quaternion's matrix, and random rotations."""
 
 from __future__ import annotations
 
@@ -24,6 +24,13 @@ def about(axis: str, angle: float) -> np.ndarray:
 def rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
     """A URDF origin's rotation (3, 3) from fixed-axis roll, pitch, yaw (rad): R = Rz(yaw) Ry(pitch) Rx(roll)."""
     return about("z", yaw) @ about("y", pitch) @ about("x", roll)
+
+
+def matrix_of_quaternion(w: float, x: float, y: float, z: float) -> np.ndarray:
+    """The rotation (3, 3) of the unit quaternion w + xi + yj + zk."""
+    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                     [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                     [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
 
 
 def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:

@@ -1,21 +1,105 @@
-"""Arms the tests build: redundant and deficient arms from published parameters, seeded random arms of each IK
-family (with a random base and tool), and arms stated the way CAD exports and vendors state them (rounded DH values,
-rounded base and tool quaternions, the exact DH table of an arm given by its screws, whatever offsets that takes)."""
+"""Arms the tests build: redundant and deficient arms from published parameters, the catalogue arms' classes and
+the vendors' source URDFs, seeded random arms of each IK family (with a random base and tool), and arms stated the
+way CAD exports and vendors state them (rounded DH values, rounded base and tool quaternions, the exact DH table of
+an arm given by its screws, whatever offsets that takes)."""
 
 from __future__ import annotations
 
 import json
+from importlib.metadata import distribution
 from pathlib import Path
 
 import numpy as np
+import pytest
 from pydantic import TypeAdapter
 
 from service.kinematics import Joint, Robot, ScrewJoint
 from service.robots import robot_from_description
 from service.robots.schemas import RobotDescription
+from tests.oracles.rotations import axis_angle, matrix_of_quaternion, rpy
 
 #: redundant and deficient arms from published parameters: name → inline description (DH table, limits)
 PUBLISHED_ARMS = json.loads((Path(__file__).parent / "data" / "redundant_and_deficient_arms.json").read_text())
+
+#: catalogue robot id → (target kind, generic number of solutions, solver structure): the catalogue arms with a
+#: finite generic solution set (tests/api/test_ik_recall.py holds each to its count)
+GENERIC_CATALOGUE_ARMS = {
+    "spong_ex3_1_planar_rr": ("position", 2, "planar_two_link"),
+    "spong_ex3_2_cylindrical_rpp": ("position", 2, "one_revolute_two_prismatic"),
+    "spong_ex3_3_spherical_wrist_rrr": ("pose", 2, "spherical_wrist"),
+    "spong_ex3_4_cylindrical_with_wrist": ("pose", 4, "one_revolute_two_prismatic+spherical_wrist"),
+    "spong_ex3_5_stanford": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "spong_ex3_6_scara_rrpr": ("pose", 2, "parallel_shoulder+roll"),
+    "spong_ex4_3_elbow_with_wrist": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "spong_sec4_3_elbow_shoulder_offset_with_wrist": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "spong_sec4_3_spherical_arm_rrp": ("position", 4, "intersecting_shoulder"),
+    "spong_sec4_3_spherical_arm_table3_4_frames": ("position", 4, "intersecting_shoulder"),
+    "ex004_1_prp": ("position", 2, "one_revolute_two_prismatic"),
+    "ex004_2_polar_rrp": ("position", 4, "intersecting_shoulder"),
+    "ex004_3_spherical_rrpr": ("pose", 2, "intersecting_shoulder+roll"),
+    "ex004_4_polar_offset_rrp": ("position", 4, "intersecting_shoulder"),
+    "assur001_scara_rrp": ("position", 2, "parallel_shoulder"),
+    "puma560_modified": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "puma560_khalil": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "puma560_standard": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "ur5": ("pose", 8, "three_parallel"),  # up to 8: see test_ik_recall's test_ur5_counts_are_the_real_solution_counts
+    "ur3e": ("pose", 8, "three_parallel"),
+    "ur5e": ("pose", 8, "three_parallel"),
+    "ur10e": ("pose", 8, "three_parallel"),
+    "ur16e": ("pose", 8, "three_parallel"),
+    # industrial arms with a spherical wrist (OPW arms and the Lite 6)
+    "kuka_kr6_r900_2": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "kuka_kr210_r2700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "fanuc_lrmate200id": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "abb_irb6700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
+    "abb_irb120": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "ufactory_lite6": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    # URDF arms: the plan is read off their joint screws, as for DH tables
+    "kinova_jaco2": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
+    "unitree_z1": ("pose", 8, "three_parallel"),
+}
+
+#: a 6R arm with skew axes (no two axes parallel or intersecting): no closed form, the general 6R solver. Its
+#: standard DH rows (a, alpha, d: each (6,), rad and m, theta offsets 0), and its inline description
+SKEW_6R_DH = dict(a=np.array([0.1, 0.5, 0.2, 0.05, 0.1, 0.03]), alpha=np.array([0.5, -0.9, 1.1, 0.7, -1.3, 0.4]),
+                  d=np.array([0.2, 0.1, -0.15, 0.3, 0.05, 0.1]))
+SKEW_6R_ROBOT = {"convention": "standard", "angle_unit": "rad",
+                 "joints": [{"a": float(a), "alpha": float(al), "d": float(d)}
+                            for a, al, d in zip(SKEW_6R_DH["a"], SKEW_6R_DH["alpha"], SKEW_6R_DH["d"])]}
+
+#: Four skew revolute joints and two slides: no closed-form family or general solver covers it, so the numeric
+#: search answers (every 6R arm, and every 6-joint arm with one slide, is solved by the general solver, and a 7R
+#: one by locking a joint). Modified DH, radians and metres, no limits.
+NUMERIC_ARM = {"convention": "modified", "joints": [
+    {"type": kind, "a": a, "alpha": alpha, "d": d}
+    for kind, a, alpha, d in zip(["revolute"] * 4 + ["prismatic"] * 2, [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
+                                 [0.5, -0.9, 1.1, 0.7, -1.3, 0.4], [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
+#: a skew 7R arm (standard DH, radians and metres): a redundant arm whose locked 6R arms go to the general solver
+SKEW_7R = {"convention": "standard", "joints": [
+    {"type": "revolute", "a": 0.1 * i, "alpha": 0.3 + 0.2 * i, "d": 0.05 * (i % 3)} for i in range(7)]}
+
+_EXAMPLE_ROBOT_DATA = "cmeel.prefix/share/example-robot-data/robots/"
+
+#: catalogue URDF arm id -> (distribution of the test extra, path of the vendor's source URDF inside it)
+URDF_SOURCES = {
+    "franka_panda": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "panda_description/urdf/panda.urdf"),
+    "kinova_jaco2": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "kinova_description/robots/kinova.urdf"),
+    "ufactory_xarm7": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "xarm_description/urdf/xarm7.urdf"),
+    "unitree_z1": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "z1_description/urdf/z1.urdf"),
+    "so101": ("example-robot-data", _EXAMPLE_ROBOT_DATA + "so_arm_description/urdf/so101.urdf"),
+    "kuka_iiwa14": ("pybullet", "pybullet_data/kuka_iiwa/model.urdf"),
+}
+
+
+def source_urdf(robot_id: str) -> str:
+    """The text of a :data:`URDF_SOURCES` arm's source URDF, as its vendor wrote it."""
+    name, path = URDF_SOURCES[robot_id]
+    try:
+        file = Path(distribution(name).locate_file(path))
+    except Exception:  # noqa: BLE001 - a missing distribution
+        pytest.fail(f"{name} is not installed: it is in the test extra (pip install -e '.[test]')")
+    return file.read_text(encoding="utf-8")
+
 
 #: three-parallel case → (structure, 0-based standard-DH twists set to 0 or π (axes i+1 ∥ i+2), link lengths a_i
 #: set to 0 (axes i+1 and i+2 intersect), the middle parallel joint)
@@ -66,12 +150,110 @@ def restated_6r(a: np.ndarray, alpha: np.ndarray, d: np.ndarray, theta: np.ndarr
     return Robot(joints, convention=convention, world_T_base=world_T_base, flange_T_tool=tool)
 
 
+class RandomDHRows:
+    """Random standard-DH row entries drawn from one generator, in the order they are asked for: link lengths
+    uniform in 0.1–0.5, twists of size 0.3–2.8 rad and either sign, joint offsets uniform in ±π."""
+
+    def __init__(self, rng: np.random.Generator):
+        self.rng = rng
+
+    def length(self) -> float:
+        return float(self.rng.uniform(0.1, 0.5))
+
+    def twist(self) -> float:
+        return float(self.rng.uniform(0.3, 2.8) * self.rng.choice([-1, 1]))
+
+    def offset(self) -> float:
+        return float(self.rng.uniform(-np.pi, np.pi))
+
+    def free(self) -> tuple[float, float, float, float]:
+        """A row (a, alpha, d, theta offset) with no special relation to its neighbours."""
+        return (self.length(), self.twist(), self.length(), self.offset())
+
+    def spherical_wrists(self) -> tuple[list[tuple], list[tuple]]:
+        """A spherical wrist's rows after a positioner (three rows: axes 4, 5, 6 meet) and a wrist's rows at the
+        base (two rows: axes 1, 2, 3 meet), drawn in that order. Wrist twists of equal size, as in every real
+        wrist (±90°): only then can the outer axes align."""
+        t = self.twist()
+        wrist = [(0.0, t, self.length(), self.offset()), (0.0, t * self.rng.choice([-1, 1]), 0.0, self.offset()),
+                 self.free()]
+        t = self.twist()
+        base_wrist = [(0.0, t, self.length(), self.offset()), (0.0, t * self.rng.choice([-1, 1]), 0.0, self.offset())]
+        return wrist, base_wrist
+
+
+def stated_three_ways(rng: np.random.Generator, table: list[tuple[float, float, float, float]], kinds: str,
+                      limits: tuple[float, float] | None = None) -> list[Robot]:
+    """One arm in the standard, modified and Khalil conventions (same base, tool, FK): standard DH rows ``table``
+    (a, alpha, d, theta offset) of joints ``kinds`` ("R" or "P" each), some axes reversed at random (each with
+    probability 0.4), with a random base (translation in ±0.5) and tool (in ±0.2) drawn from ``rng``.
+    ``limits``: (lower, upper) of every prismatic joint; by default none."""
+    n = len(kinds)
+    rows = [list(row) for row in table]
+    base = random_rigid(rng, 0.5)
+    for joint in np.flatnonzero(rng.random(n) < 0.4):
+        base = _reverse_axis(rows, int(joint), base)
+    tool = random_rigid(rng, 0.2)
+    joint_kind = {"R": "revolute", "P": "prismatic"}
+    bounds = [limits if (k == "P" and limits) else (-np.inf, np.inf) for k in kinds]
+    standard = Robot([Joint(f"j{i + 1}", joint_kind[k], *row, *bound)
+                      for i, (row, k, bound) in enumerate(zip(rows, kinds, bounds))],
+                     convention="standard", world_T_base=base, flange_T_tool=tool)
+    # Craig: row i holds (a_{i−1}, alpha_{i−1}, d_i, theta_i); the last (a_n, alpha_n) moves into the tool
+    craig = [(0.0 if i == 0 else rows[i - 1][0], 0.0 if i == 0 else rows[i - 1][1], rows[i][2], rows[i][3])
+             for i in range(n)]
+    last = np.eye(4)
+    a, alpha = rows[-1][0], rows[-1][1]
+    last[:3, :3] = [[1, 0, 0], [0, np.cos(alpha), -np.sin(alpha)], [0, np.sin(alpha), np.cos(alpha)]]
+    last[0, 3] = a
+    modified_joints = [Joint(f"j{i + 1}", joint_kind[k], *row, *bound)
+                       for i, (row, k, bound) in enumerate(zip(craig, kinds, bounds))]
+    modified = Robot(modified_joints, convention="modified", world_T_base=base, flange_T_tool=last @ tool)
+    khalil = Robot(modified_joints, convention="khalil", world_T_base=base, flange_T_tool=last @ tool)
+    return [standard, modified, khalil]
+
+
+def _reverse_axis(rows: list[list[float]], joint: int, base: np.ndarray) -> np.ndarray:
+    """Flip joint ``joint``'s axis (standard DH, in place): frame joint−1 turns by π about its x axis.
+
+    Row ``joint − 1`` (or the base) gains π of twist; row ``joint`` measures θ and d along the flipped z
+    and loses π of twist. The arm is the same; its joint variable changes sign.
+    """
+    if joint == 0:
+        base = base @ np.diag([1.0, -1.0, -1.0, 1.0])
+    else:
+        rows[joint - 1][1] += np.pi
+    a, alpha, d, theta = rows[joint]
+    rows[joint] = [a, alpha - np.pi, -d, -theta]
+    return base
+
+
+def random_dh_robot(rng: np.random.Generator, convention: str, kinds: str) -> Robot:
+    """A random arm of joints ``kinds`` ("R" revolute or "P" prismatic each), every DH entry (a, alpha, d, theta)
+    uniform in ±1, in the given convention, with no base or tool."""
+    joints = [Joint(f"q{i + 1}", "revolute" if k == "R" else "prismatic", *rng.uniform(-1, 1, 4))
+              for i, k in enumerate(kinds)]
+    return Robot(joints, convention=convention)
+
+
 def random_general_arm(rng: np.random.Generator, convention: str) -> Robot:
     """A random 6R arm with no decomposable geometry (DH entries uniform in ±1, in the given convention) with a
     random base (translation in ±1) and tool (translation in ±0.3)."""
-    joints = [Joint(f"q{i + 1}", "revolute", *rng.uniform(-1, 1, 4)) for i in range(6)]
+    joints = random_dh_robot(rng, convention, "RRRRRR").joints
     base, tool = random_rigid(rng, 1.0), random_rigid(rng, 0.3)
     return Robot(joints, convention=convention, world_T_base=base, flange_T_tool=tool)
+
+
+def kinova_j2n6s300() -> Robot:
+    """Kinova Jaco 2 6-DOF with its curved 60° wrist: Kinova's published standard DH table (no axes meet at
+    the wrist, so no closed-form family)."""
+    D1, D2, D3, D4, D5, D6, e2 = 0.2755, 0.41, 0.2073, 0.0741, 0.0741, 0.16, 0.0098
+    aa = np.pi / 6
+    ratio = np.sin(aa) / np.sin(2 * aa)
+    alpha = [np.pi / 2, np.pi, np.pi / 2, 2 * aa, 2 * aa, np.pi]
+    a = [0.0, D2, 0.0, 0.0, 0.0, 0.0]
+    d = [D1, 0.0, -e2, -(D3 + ratio * D4), -(ratio * D4 + ratio * D5), -(ratio * D5 + D6)]
+    return Robot([Joint(f"q{i + 1}", "revolute", a[i], alpha[i], d[i], 0.0) for i in range(6)], name="j2n6s300")
 
 
 def random_three_parallel_arm(case: str, convention: str, seed: int) -> Robot:
@@ -199,9 +381,7 @@ def _rounded_transform(rng: np.random.Generator, transform: np.ndarray | None = 
     w, x, y, z = quaternion = np.round(quaternion, 6)
     w, x, y, z = quaternion / np.linalg.norm(quaternion)  # a reader normalises the written quaternion
     T = np.eye(4)
-    T[:3, :3] = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                 [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                 [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    T[:3, :3] = matrix_of_quaternion(w, x, y, z)
     T[:3, 3] = np.round(translation, 4)
     return T
 
@@ -282,7 +462,7 @@ def urdf_chain_screws(joints: list[dict]) -> tuple[np.ndarray, np.ndarray, np.nd
     for joint in joints:
         r, p, y = joint["rpy"]
         origin = np.eye(4)
-        origin[:3, :3] = _rot("z", y) @ _rot("y", p) @ _rot("x", r)
+        origin[:3, :3] = rpy(r, p, y)
         origin[:3, 3] = joint["xyz"]
         frame = frame @ origin
         directions.append(frame[:3, 2].copy())
@@ -290,20 +470,11 @@ def urdf_chain_screws(joints: list[dict]) -> tuple[np.ndarray, np.ndarray, np.nd
     return np.array(directions), np.array(points), frame
 
 
-def _rot(axis: str, angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
-    return {"x": np.array([[1, 0, 0], [0, c, -s], [0, s, c]]),
-            "y": np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]]),
-            "z": np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])}[axis]
-
-
 def screw_exponential(direction, point, revolute, q):
     """exp([S] q) for a unit screw, written independently of the core (Rodrigues)."""
     T = np.eye(4)
     if revolute:
-        k = np.array([[0, -direction[2], direction[1]], [direction[2], 0, -direction[0]],
-                      [-direction[1], direction[0], 0]])
-        R = np.eye(3) + np.sin(q) * k + (1 - np.cos(q)) * k @ k
+        R = axis_angle(direction, q)
         T[:3, :3] = R
         T[:3, 3] = (np.eye(3) - R) @ point
     else:

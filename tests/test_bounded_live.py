@@ -15,25 +15,17 @@ from pathlib import Path
 import httpx
 import pytest
 
+from tests.arms import NUMERIC_ARM, SKEW_7R
 from tests.live import LiveServer
 
 pytestmark = pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs /proc")
 
 UR5_Q = [0.3, -1.0, 1.2, 0.4, 0.5, 0.6]
-# Four skew revolute joints and two slides: no closed-form family or general solver covers it, so the numeric
-# search answers (every 6R arm, and every 6-joint arm with one slide, is solved by the general solver, and a 7R
-# one by locking a joint).
-NUMERIC_ARM = {"convention": "modified", "joints": [
-    {"type": kind, "a": a, "alpha": alpha, "d": d}
-    for kind, a, alpha, d in zip(["revolute"] * 4 + ["prismatic"] * 2, [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
-                                 [0.5, -0.9, 1.1, 0.7, -1.3, 0.4], [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
 NUMERIC_TARGET = {"position": [0.3, 0.2, 0.5], "orientation": {"type": "rpy", "angles": [0.3, 0.2, 0.1]}}
 #: A request that keeps a worker busy for seconds (1.8 s here): a skew 7R arm with an inner joint free at 256
 #: values (the most an inner joint may take), each of which builds and solves its own general 6R plan (the
 #: numeric search of 2,000 starts on NUMERIC_ARM converges in ~0.2 s, too short to probe the server while it runs).
-SLOW_REQUEST = {"robot": {"convention": "standard", "joints": [
-    {"type": "revolute", "a": 0.1 * i, "alpha": 0.3 + 0.2 * i, "d": 0.05 * (i % 3)} for i in range(7)]},
-    "target": NUMERIC_TARGET, "free_joints": [{"joint": 3, "samples": 256}]}
+SLOW_REQUEST = {"robot": SKEW_7R, "target": NUMERIC_TARGET, "free_joints": [{"joint": 3, "samples": 256}]}
 
 
 def peak_rss_mb(pid: int) -> float:

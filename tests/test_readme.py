@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from tests.doc_pages import DOCS, README, ROOT, Block, blocks, pages, section, text
+from tests.ik_helpers import angle_gap
 
 
 def _quick_start_commands() -> list[str]:
@@ -307,7 +308,7 @@ def test_the_ur5_solution_counts_the_page_states(client):
         # v + 2kπ inside the inclusive [-2π, 2π]
         branches: list[np.ndarray] = []
         for joints in np.array([s["joints"] for s in answer["solutions"]]):
-            if not any(np.all(np.abs(np.angle(np.exp(1j * (joints - b)))) < 1e-6) for b in branches):
+            if not any(np.all(angle_gap(joints, b) < 1e-6) for b in branches):
                 branches.append(joints)
         branches = np.array(branches)
         fits = [sum(abs(v + 2 * k * np.pi) <= 2 * np.pi + 1e-9 for k in range(-2, 3)) for v in branches.ravel()]

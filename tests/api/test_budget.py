@@ -21,16 +21,10 @@ from service.api.gate import RequestGate
 from service.api.routers import health
 from service.config import Settings
 from service.kinematics import COUNT_CAP, Budget, BudgetExhausted, Limits
+from tests.arms import NUMERIC_ARM
 from tests.conftest import assert_problem
 
 UR5_Q = [0.3, -1.0, 1.2, 0.4, 0.5, 0.6]
-# Four skew revolute joints and two slides: no closed-form family or general solver covers it, so the numeric
-# search answers (every 6R arm, and every 6-joint arm with one slide, is solved by the general solver, and a 7R
-# one by locking a joint).
-NUMERIC_ARM = {"convention": "modified", "joints": [
-    {"type": kind, "a": a, "alpha": alpha, "d": d}
-    for kind, a, alpha, d in zip(["revolute"] * 4 + ["prismatic"] * 2, [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
-                                 [0.5, -0.9, 1.1, 0.7, -1.3, 0.4], [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
 
 
 def _ur5_target(client) -> dict:

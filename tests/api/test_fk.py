@@ -10,6 +10,7 @@ import pytest
 from service.api.schemas.fk import FKResponse
 from tests.conftest import DATA, assert_problem
 from tests.oracles.closed_forms import CLOSED_FORMS
+from tests.oracles.rotations import matrix_of_quaternion
 
 
 def _fk(client, robot_id, joints, **extra):
@@ -82,9 +83,7 @@ def test_pose_forms_agree(client):
     pose = _fk(client, "puma560_modified", [0.5, -0.7, 1.1, -0.4, 0.9, -1.3])["pose"]
     T = np.array(pose["matrix"])
     w, x, y, z = pose["quaternion_wxyz"]
-    R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                  [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                  [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    R = matrix_of_quaternion(w, x, y, z)
     assert w >= 0
     np.testing.assert_allclose(R, T[:3, :3], atol=1e-12)
     np.testing.assert_allclose(pose["position"], T[:3, 3])

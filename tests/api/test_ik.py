@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from tests.arms import NUMERIC_ARM, SKEW_6R_DH, SKEW_6R_ROBOT, SKEW_7R
 from tests.conftest import assert_problem, catalogue_robot
 from tests.ik_helpers import angle_gap, find, joints_of, unlimited, wrapped
 from tests.oracles.closed_forms import CLOSED_FORMS
@@ -331,13 +332,8 @@ def test_the_spherical_wrist_places_its_tool_point_with_two_solutions(client):
 # The numeric fallback
 # --------------------------------------------------------------------------
 
-#: a 6R arm with skew axes (no two axes parallel or intersecting): no closed form, the general 6R solver
-SKEW = dict(a=np.array([0.1, 0.5, 0.2, 0.05, 0.1, 0.03]), alpha=np.array([0.5, -0.9, 1.1, 0.7, -1.3, 0.4]),
-            d=np.array([0.2, 0.1, -0.15, 0.3, 0.05, 0.1]))
-SKEW_ROBOT = {"convention": "standard", "angle_unit": "rad",
-              "joints": [{"a": float(a), "alpha": float(al), "d": float(d)}
-                         for a, al, d in zip(SKEW["a"], SKEW["alpha"], SKEW["d"])]}
-SKEW_SCALE = float(np.abs(SKEW["a"]).sum() + np.abs(SKEW["d"]).sum())
+#: the skew 6R arm's size (sum of its |a| and |d|): the scale of its position tolerances
+SKEW_SCALE = float(np.abs(SKEW_6R_DH["a"]).sum() + np.abs(SKEW_6R_DH["d"]).sum())
 
 
 def _inline_ik(client, robot: dict, target: dict, **options):
@@ -349,14 +345,15 @@ def _inline_ik(client, robot: dict, target: dict, **options):
 @pytest.mark.parametrize("seed", range(5))
 def test_a_skew_6r_arm_gets_every_solution_from_the_general_solver(client, seed):
     q = np.random.default_rng(seed).uniform(-np.pi, np.pi, 6)
-    T = dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], q)
-    result = _inline_ik(client, SKEW_ROBOT, {"matrix": T.tolist()})
+    T = dh_fk(SKEW_6R_DH["a"], SKEW_6R_DH["alpha"], SKEW_6R_DH["d"], q)
+    result = _inline_ik(client, SKEW_6R_ROBOT, {"matrix": T.tolist()})
     assert result["status"] == "ok"
     assert result["solver"] == {"method": "analytic", "structure": "general_6r", "complete": True,
                                 "time_budget_exhausted": False}
     solutions = joints_of(result)
     for solution in result["solutions"]:  # every solution passes an FK check independent of the service
-        assert np.abs(dh_fk(SKEW["a"], SKEW["alpha"], SKEW["d"], solution["joints"]) - T).max() < 1e-9 * SKEW_SCALE
+        reached = dh_fk(SKEW_6R_DH["a"], SKEW_6R_DH["alpha"], SKEW_6R_DH["d"], solution["joints"])
+        assert np.abs(reached - T).max() < 1e-9 * SKEW_SCALE
         assert solution["residual"]["position"] <= 1e-9 * SKEW_SCALE
         assert solution["residual"]["orientation"] <= 1e-9
         assert solution["branch"] == {}
@@ -394,14 +391,6 @@ def _revolute(a, alpha, d, kind="revolute"):
     return {"type": kind, "a": a, "alpha": alpha, "d": d}
 
 
-NUMERIC_ARM = {"convention": "modified", "joints": [
-    _revolute(a, alpha, d, kind) for kind, a, alpha, d in zip(["revolute"] * 4 + ["prismatic"] * 2,
-                                                              [0.05, 0.3, 0.07, 0.25, 0.04, 0.06],
-                                                              [0.5, -0.9, 1.1, 0.7, -1.3, 0.4],
-                                                              [0.2, 0.1, -0.15, 0.3, 0.05, 0.1])]}
-
-
-SKEW_7R = {"convention": "standard", "joints": [_revolute(0.1 * i, 0.3 + 0.2 * i, 0.05 * (i % 3)) for i in range(7)]}
 SKEW_PRISMATIC = {"convention": "standard", "joints": [
     _revolute(0.1, 0.4, 0.2), _revolute(0.2, -0.7, 0.0, "prismatic"), _revolute(0.3, 1.0, 0.1),
     _revolute(0.05, 0.6, 0.0, "prismatic"), _revolute(0.1, -1.1, 0.2), _revolute(0.0, 0.3, 0.1)]}

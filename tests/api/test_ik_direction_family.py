@@ -19,7 +19,7 @@ import pytest
 
 from service.kinematics import forward_kinematics
 from tests.conftest import assert_problem, catalogue_robot
-from tests.ik_helpers import find, fk_matrix, joints_of
+from tests.ik_helpers import angle_gap, find, fk_matrix, joints_of
 
 SIX = ["puma560_standard", "ur5", "kuka_kr6_r900_2", "kinova_jaco2"]
 SEVEN = "franka_panda"
@@ -63,7 +63,7 @@ def _check_every_solution(robot, answer: dict, T: np.ndarray) -> None:
     assert np.abs(reached[:, :3, 2] - T[:3, 2]).max() <= 1e-9
     for solution, R in zip(answer["solutions"], reached[:, :3, :3]):
         roll = solution["free_values"]["roll"]
-        assert abs(np.angle(np.exp(1j * (roll - _roll(R))))) <= 1e-9
+        assert angle_gap(roll, _roll(R)) <= 1e-9
 
 
 @pytest.mark.parametrize("robot_id", SIX)
@@ -95,9 +95,8 @@ def test_with_the_generating_configuration_as_reference_it_is_the_nearest_member
         answer = response.json()
         assert answer["status"] == "ok" and answer["solver"]["complete"] is True
         first = np.array(answer["solutions"][0]["joints"])
-        assert np.abs(np.angle(np.exp(1j * (first - q)))).max() <= 1e-6, (first, q)
-        assert abs(np.angle(np.exp(1j * (answer["solutions"][0]["free_values"]["roll"] - _roll(T[:3, :3]))))) \
-            <= 1e-6
+        assert angle_gap(first, q).max() <= 1e-6, (first, q)
+        assert angle_gap(answer["solutions"][0]["free_values"]["roll"], _roll(T[:3, :3])) <= 1e-6
         _check_every_solution(robot, answer, T)
 
 

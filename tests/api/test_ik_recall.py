@@ -15,48 +15,13 @@ import numpy as np
 import pytest
 
 from service.kinematics.ik import joint_difference
+from tests.arms import GENERIC_CATALOGUE_ARMS
 from tests.conftest import catalogue_robot
 from tests.ik_helpers import random_configurations
-from tests.robots.test_industrial_arms import OPW_SOURCES, opw_forward
+from tests.oracles.opw import OPW_SOURCES, opw_forward
 
 SAMPLES = 1000
 
-#: robot id → (target kind, generic number of solutions, solver structure)
-GENERIC = {
-    "spong_ex3_1_planar_rr": ("position", 2, "planar_two_link"),
-    "spong_ex3_2_cylindrical_rpp": ("position", 2, "one_revolute_two_prismatic"),
-    "spong_ex3_3_spherical_wrist_rrr": ("pose", 2, "spherical_wrist"),
-    "spong_ex3_4_cylindrical_with_wrist": ("pose", 4, "one_revolute_two_prismatic+spherical_wrist"),
-    "spong_ex3_5_stanford": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    "spong_ex3_6_scara_rrpr": ("pose", 2, "parallel_shoulder+roll"),
-    "spong_ex4_3_elbow_with_wrist": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    "spong_sec4_3_elbow_shoulder_offset_with_wrist": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    "spong_sec4_3_spherical_arm_rrp": ("position", 4, "intersecting_shoulder"),
-    "spong_sec4_3_spherical_arm_table3_4_frames": ("position", 4, "intersecting_shoulder"),
-    "ex004_1_prp": ("position", 2, "one_revolute_two_prismatic"),
-    "ex004_2_polar_rrp": ("position", 4, "intersecting_shoulder"),
-    "ex004_3_spherical_rrpr": ("pose", 2, "intersecting_shoulder+roll"),
-    "ex004_4_polar_offset_rrp": ("position", 4, "intersecting_shoulder"),
-    "assur001_scara_rrp": ("position", 2, "parallel_shoulder"),
-    "puma560_modified": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    "puma560_khalil": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    "puma560_standard": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    "ur5": ("pose", 8, "three_parallel"),  # up to 8: see test_ur5_counts_are_the_real_solution_counts
-    "ur3e": ("pose", 8, "three_parallel"),
-    "ur5e": ("pose", 8, "three_parallel"),
-    "ur10e": ("pose", 8, "three_parallel"),
-    "ur16e": ("pose", 8, "three_parallel"),
-    # industrial arms with a spherical wrist (OPW arms and the Lite 6)
-    "kuka_kr6_r900_2": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
-    "kuka_kr210_r2700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
-    "fanuc_lrmate200id": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
-    "abb_irb6700": ("pose", 8, "offset_shoulder_parallel_elbow+spherical_wrist"),
-    "abb_irb120": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    "ufactory_lite6": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    # URDF arms: the plan is read off their joint screws, as for DH tables
-    "kinova_jaco2": ("pose", 8, "intersecting_shoulder+spherical_wrist"),
-    "unitree_z1": ("pose", 8, "three_parallel"),
-}
 #: The 7-joint catalogue arms: every solution at each value of a free joint (the service's default choice), each
 #: value's locked 6-joint arm solved by a family.
 REDUNDANT = {"franka_panda": "spherical_wrist+intersecting_shoulder with q7 free",
@@ -72,7 +37,7 @@ ELSEWHERE = {"so101", "ufactory_xarm6"}
 
 def test_every_catalogue_robot_has_an_analytic_class(client):
     assert {robot["id"] for robot in client.get("/v1/robots").json()["robots"]} == (
-        set(GENERIC) | set(REDUNDANT) | ELSEWHERE)
+        set(GENERIC_CATALOGUE_ARMS) | set(REDUNDANT) | ELSEWHERE)
 
 
 @pytest.mark.parametrize("robot_id", sorted(REDUNDANT))
@@ -101,11 +66,11 @@ def targets_for(client, robot_id: str, q: np.ndarray, kind: str) -> list[dict]:
     return [{"matrix": p["matrix"]} if kind == "pose" else {"position": p["position"]} for p in poses]
 
 
-@pytest.mark.parametrize("robot_id", sorted(GENERIC))
+@pytest.mark.parametrize("robot_id", sorted(GENERIC_CATALOGUE_ARMS))
 def test_generating_vector_is_among_the_solutions(client, robot_id):
-    kind, generic_count, structure = GENERIC[robot_id]
+    kind, generic_count, structure = GENERIC_CATALOGUE_ARMS[robot_id]
     robot = catalogue_robot(client, robot_id)
-    q = random_configurations(robot, SAMPLES, seed=sorted(GENERIC).index(robot_id))
+    q = random_configurations(robot, SAMPLES, seed=sorted(GENERIC_CATALOGUE_ARMS).index(robot_id))
     unlimited = [None] * robot.dof  # the mathematical solution set: no limits, so no 2π expansion either
     response = client.post(f"/v1/robots/{robot_id}/ik/batch",
                            json={"targets": targets_for(client, robot_id, q, kind), "limits": unlimited})

@@ -13,8 +13,6 @@ answer holds it.
 
 from __future__ import annotations
 
-from importlib.metadata import distribution
-
 import numpy as np
 import pytest
 import yaml
@@ -25,8 +23,8 @@ from service.kinematics import geometric_jacobian
 from service.robots.build import robot_from_description
 from service.robots.schemas import RobotDescription
 from pydantic import TypeAdapter
+from tests.arms import source_urdf
 from tests.ik_helpers import find
-from tests.robots.test_urdf import SOURCES
 
 DELTAS = (0.0, 1e-12, 1e-9, 1e-6, 1e-3)
 #: The arms whose raw URDFs the issue found false promises on (and their 6-joint siblings).
@@ -34,10 +32,9 @@ ARMS = ["ufactory_xarm7", "franka_panda", "kuka_iiwa14", "kinova_jaco2", "unitre
 
 
 def _description(robot_id: str) -> dict:
-    name, path = SOURCES[robot_id]
     sidecar = yaml.safe_load((BUILTIN_ROBOTS_DIR / f"{robot_id}.urdf.yaml").read_text(encoding="utf-8"))
-    urdf = distribution(name).locate_file(path).read_text(encoding="utf-8")
-    return {"format": "urdf", "urdf": urdf, "base_link": sidecar["base_link"], "tip_link": sidecar["tip_link"]}
+    return {"format": "urdf", "urdf": source_urdf(robot_id), "base_link": sidecar["base_link"],
+            "tip_link": sidecar["tip_link"]}
 
 
 def _most_singular(robot, q: np.ndarray, joint: int, solved: slice) -> np.ndarray:

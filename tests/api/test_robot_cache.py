@@ -14,8 +14,7 @@ from service.config import Settings
 from service.kinematics import Robot
 from service.kinematics._robot import FRAMED_ROBOTS_KEPT
 from service.kinematics.ik import cached_plan
-
-from .test_ik import SKEW_ROBOT  # a general 6R arm: its plan is the costliest to build
+from tests.arms import SKEW_6R_ROBOT  # a general 6R arm: its plan is the costliest to build
 
 
 def _lookups(client, outcome: str) -> float:
@@ -33,15 +32,15 @@ def _pose(client, robot: dict, joints: list[float]) -> list:
 def test_the_same_inline_description_is_built_once_and_answers_the_same():
     with TestClient(create_app(Settings(robot_cache_size=2))) as client:
         hits, misses = _lookups(client, "hit"), _lookups(client, "miss")
-        target = {"matrix": _pose(client, SKEW_ROBOT, [0.3, -0.2, 0.5, 0.1, 0.4, -0.6])}  # the one build
-        first = client.post("/v1/ik", json={"robot": SKEW_ROBOT, "target": target}).json()
-        second = client.post("/v1/ik", json={"robot": SKEW_ROBOT, "target": target}).json()
+        target = {"matrix": _pose(client, SKEW_6R_ROBOT, [0.3, -0.2, 0.5, 0.1, 0.4, -0.6])}  # the one build
+        first = client.post("/v1/ik", json={"robot": SKEW_6R_ROBOT, "target": target}).json()
+        second = client.post("/v1/ik", json={"robot": SKEW_6R_ROBOT, "target": target}).json()
         assert first == second and first["status"] == "ok"
         assert _lookups(client, "miss") - misses == 1 and _lookups(client, "hit") - hits == 2
         # the cached object carries the plan built by the first request
         cache: RobotCache = client.app.state.inline_robots
         (robot,) = [r for r in cache._entries.values() if r.dof == 6 and np.allclose(r.a, [j["a"] for j in
-                                                                                          SKEW_ROBOT["joints"]])]
+                                                                                          SKEW_6R_ROBOT["joints"]])]
         assert cached_plan(robot, constrain_orientation=True, reference=None) is \
             cached_plan(robot, constrain_orientation=True, reference=None)
 

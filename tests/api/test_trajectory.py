@@ -465,18 +465,17 @@ def test_free_joints_on_a_six_joint_arm_is_a_422_at_the_field(client):
 def test_a_ur5e_path_near_its_shoulder_singularity_stays_on_its_branch_through_http(client):
     """The issue's case through the route: poses and twists by FK of a joint path whose middle is 3e-5 (σmin/σmax)
     from the shoulder singularity; every sample on the generating joints, and the rates its q̇."""
-    from tests.kinematics.test_trajectory_near_singular import TIMES, UR5E_PATH, twists_of
-    from tests.oracles.paths import near_singular_path
+    from tests.oracles.paths import NEAR_SINGULAR_TIMES, UR5E_PATH, near_singular_path, twists_of
 
     robot = catalogue_robot(client, "ur5e")
-    q, qd, _ = near_singular_path(robot, *UR5E_PATH, TIMES)
-    answer = post(client, "ur5e", {"samples": pose_samples(TIMES, forward_kinematics(robot, q),
+    q, qd, _ = near_singular_path(robot, *UR5E_PATH, NEAR_SINGULAR_TIMES)
+    answer = post(client, "ur5e", {"samples": pose_samples(NEAR_SINGULAR_TIMES, forward_kinematics(robot, q),
                                                            twists_of(robot, q, qd)),
                                    "reference": q[0].tolist(), "damping": 1e-6})
     joints = np.array([s["joints"] for s in answer["samples"]])
     assert np.abs(joints - q).max() <= 1e-9
     assert all(s["status"] == "ok" for s in answer["samples"])
-    middle = [k for k in range(len(TIMES)) if abs(TIMES[k] - 0.5) < 0.1]
+    middle = [k for k in range(len(NEAR_SINGULAR_TIMES)) if abs(NEAR_SINGULAR_TIMES[k] - 0.5) < 0.1]
     assert not any(answer["samples"][k]["branch_changed"] for k in middle)
     velocities = np.array([s["velocities"] for s in answer["samples"]])
     assert np.abs(velocities - qd).max() < 1e-3 * np.abs(qd).max()

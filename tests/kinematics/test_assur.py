@@ -23,6 +23,8 @@ from service.kinematics._assur import (
     rrr_group,
 )
 from service.kinematics._tolerances import SINGULARITY_TOLERANCE
+from tests.ik_helpers import wrapped
+from tests.oracles.paths import spiral
 
 DATA = json.loads((Path(__file__).resolve().parents[1] / "data" / "assur_spiral_tables.json").read_text())
 L_OA = float(DATA["lengths_mm"]["l_OA"])
@@ -36,18 +38,6 @@ COLUMNS = DATA["columns"][1:]  # theta1 ... l3dd, attribute names of AssurScaraS
 # values below 1 (0.305078 ± 5e-7) and the printed zeros.
 TABLE_ATOL = 1e-6
 TABLE_RTOL = 5e-6
-
-
-def spiral(t):
-    """Tool path of the paper's example (eq. 16) and its exact derivatives, shape (N, 3) each."""
-    t = np.asarray(t, dtype=float)
-    w = np.pi / 2.0
-    s, c = np.sin(w * t), np.cos(w * t)
-    one = np.ones_like(t)
-    D = np.stack((100.0 + 20.0 * s, -20.0 * c, 50.0 + 10.0 * t), axis=-1)
-    Dd = np.stack((10.0 * np.pi * c, 10.0 * np.pi * s, 10.0 * one), axis=-1)
-    Ddd = np.stack((-5.0 * np.pi**2 * s, 5.0 * np.pi**2 * c, 0.0 * one), axis=-1)
-    return D, Dd, Ddd
 
 
 def solve_spiral(t, mode):
@@ -256,11 +246,8 @@ def test_angle_and_distance_functions_match_finite_differences_across_x_zero():
     def theta(tt):
         return np.arctan2(vec(tt)[1], vec(tt)[0])
 
-    def unwrap_diff(a, b):
-        return np.mod(a - b + np.pi, 2 * np.pi) - np.pi
-
-    fd1 = unwrap_diff(theta(t + h1), theta(t - h1)) / (2 * h1)
-    fd2 = (unwrap_diff(theta(t + h2), theta(t)) - unwrap_diff(theta(t), theta(t - h2))) / h2**2
+    fd1 = wrapped(theta(t + h1) - theta(t - h1)) / (2 * h1)
+    fd2 = (wrapped(theta(t + h2) - theta(t)) - wrapped(theta(t) - theta(t - h2))) / h2**2
     np.testing.assert_allclose(r.thetad, fd1, rtol=0, atol=1e-8)
     np.testing.assert_allclose(r.thetadd, fd2, rtol=0, atol=1e-5)
 

@@ -15,14 +15,14 @@ from service.kinematics import (
     link_transforms,
     screw_model,
 )
-from tests.arms import screw_exponential
+from tests.arms import random_dh_robot, screw_exponential
+from tests.oracles.rotations import about
 
 
 def _rot(axis: str, angle: float) -> np.ndarray:
-    c, s = np.cos(angle), np.sin(angle)
+    """The homogeneous rotation (4, 4) by ``angle`` about ``axis`` ("x", "y" or "z")."""
     T = np.eye(4)
-    i, j = {"x": (1, 2), "y": (2, 0), "z": (0, 1)}[axis]
-    T[i, i], T[i, j], T[j, i], T[j, j] = c, -s, s, c
+    T[:3, :3] = about(axis, angle)
     return T
 
 
@@ -30,14 +30,6 @@ def _trans(axis: str, distance: float) -> np.ndarray:
     T = np.eye(4)
     T["xyz".index(axis), 3] = distance
     return T
-
-
-def _random_robot(rng: np.random.Generator, convention: str, kinds: str) -> Robot:
-    joints = [
-        Joint(f"q{i + 1}", "revolute" if k == "R" else "prismatic", *rng.uniform(-1, 1, 2), *rng.uniform(-1, 1, 2))
-        for i, k in enumerate(kinds)
-    ]
-    return Robot(joints, convention=convention)
 
 
 @pytest.mark.parametrize("convention", ["standard", "modified", "khalil"])
@@ -76,7 +68,7 @@ def test_batch_equals_single_calls_and_base_and_tool_apply(convention):
     rng = np.random.default_rng(1)
     base = _rot("z", 0.3) @ _trans("x", 0.5) @ _rot("x", 1.1)
     tool = _trans("z", 0.2) @ _rot("y", -0.4)
-    plain = _random_robot(rng, convention, "RRPRRR")
+    plain = random_dh_robot(rng, convention, "RRPRRR")
     robot = Robot(plain.joints, convention=convention, world_T_base=base, flange_T_tool=tool)
     q = rng.uniform(-np.pi, np.pi, (20, 6))
     batch = forward_kinematics(robot, q)
@@ -88,7 +80,7 @@ def test_batch_equals_single_calls_and_base_and_tool_apply(convention):
 
 def test_link_frames_start_at_the_base_and_end_at_the_flange():
     rng = np.random.default_rng(2)
-    robot = Robot(_random_robot(rng, "standard", "RPR").joints, flange_T_tool=_trans("z", 0.3))
+    robot = Robot(random_dh_robot(rng, "standard", "RPR").joints, flange_T_tool=_trans("z", 0.3))
     q = rng.uniform(-1, 1, 3)
     frames = link_frames(robot, q)
     assert frames.shape == (4, 4, 4)
@@ -101,7 +93,7 @@ def test_every_link_frame_is_the_product_of_the_elementary_motions_before_it(con
     """link_frames runs the chain program; each frame is checked against the rows' elementary motions multiplied
     out here, in batches of several shapes, with a base and prismatic joints."""
     rng = np.random.default_rng(7)
-    plain = _random_robot(rng, convention, "RPRRPR")
+    plain = random_dh_robot(rng, convention, "RPRRPR")
     base = _rot("z", 0.4) @ _trans("x", 0.2) @ _rot("x", -0.3)
     robot = Robot(plain.joints, convention=convention, world_T_base=base)
     q = rng.uniform(-2, 2, (3, 5, 6))
@@ -124,7 +116,7 @@ def test_every_link_frame_is_the_product_of_the_elementary_motions_before_it(con
 @pytest.mark.parametrize("convention,kinds", [("standard", "RRPRRR"), ("modified", "PRRRPR"), ("khalil", "RRRRRR")])
 def test_product_of_exponentials_reproduces_dh_forward_kinematics(convention, kinds):
     rng = np.random.default_rng(3)
-    plain = _random_robot(rng, convention, kinds)
+    plain = random_dh_robot(rng, convention, kinds)
     robot = Robot(plain.joints, convention=convention, world_T_base=_rot("y", 0.7) @ _trans("z", 1.0),
                   flange_T_tool=_trans("x", 0.25))
     model = screw_model(robot)
@@ -139,7 +131,7 @@ def test_product_of_exponentials_reproduces_dh_forward_kinematics(convention, ki
 @pytest.mark.parametrize("convention", ["standard", "modified"])
 def test_jacobian_matches_finite_differences_of_fk(convention):
     rng = np.random.default_rng(4)
-    robot = Robot(_random_robot(rng, convention, "RRPRRP").joints, convention=convention,
+    robot = Robot(random_dh_robot(rng, convention, "RRPRRP").joints, convention=convention,
                   world_T_base=_rot("x", 0.4), flange_T_tool=_trans("y", 0.3))
     step = 1e-6
     for q in rng.uniform(-np.pi, np.pi, (10, robot.dof)):
@@ -201,7 +193,7 @@ def test_scalar_residuals_of_a_few_candidates_equal_the_array_ones(convention, m
 
     rng = np.random.default_rng(3)
     tool = _trans("z", 0.2) @ _rot("y", -0.4)
-    robot = Robot(_random_robot(rng, convention, "RRPRRR").joints, convention=convention,
+    robot = Robot(random_dh_robot(rng, convention, "RRPRRR").joints, convention=convention,
                   world_T_base=_rot("z", 0.3) @ _trans("x", 0.5), flange_T_tool=tool)
     q = rng.uniform(-np.pi, np.pi, (2, 8, 6))
     targets = forward_kinematics(robot, q[:, 0] + rng.normal(0, 1e-3, (2, 6)))

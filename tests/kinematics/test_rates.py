@@ -16,6 +16,7 @@ from service.config import Settings
 from service.kinematics import (Joint, Robot, _rates, forward_kinematics, geometric_jacobian, jacobian_derivative,
                                 joint_rates, task_space)
 from service.kinematics._rates import task_jacobian
+from tests.arms import random_dh_robot
 
 CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 ROBOT_IDS = sorted(entry.description.id for entry in CATALOGUE.entries())
@@ -27,8 +28,7 @@ def robot(robot_id: str) -> Robot:
 
 def random_robot(rng: np.random.Generator, convention: str, kinds: str) -> Robot:
     """A random arm with base and tool transforms, so every term of the screw form is exercised."""
-    joints = [Joint(f"q{i + 1}", "revolute" if k == "R" else "prismatic", *rng.uniform(-1, 1, 4))
-              for i, k in enumerate(kinds)]
+    joints = random_dh_robot(rng, convention, kinds).joints
     base, tool = np.eye(4), np.eye(4)
     base[:3, :3] = np.linalg.qr(rng.normal(size=(3, 3)))[0] * [1, 1, 1]
     if np.linalg.det(base[:3, :3]) < 0:

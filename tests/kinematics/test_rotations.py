@@ -36,28 +36,15 @@ from service.kinematics._rotations import (
     wrap_float,
 )
 from service.kinematics._tolerances import SINGULARITY_TOLERANCE
+from tests.oracles.rotations import axis_angle, random_rotations
 
 N = 1000
 PI = math.pi
 
 
-def random_rotations(rng: np.random.Generator, n: int) -> np.ndarray:
-    """(n, 3, 3) rotations from QR of Gaussian matrices (independent of the module)."""
-    Q, upper = np.linalg.qr(rng.standard_normal((n, 3, 3)))
-    Q = Q * np.sign(np.diagonal(upper, axis1=-2, axis2=-1))[:, None, :]
-    Q[np.linalg.det(Q) < 0, :, 0] *= -1.0
-    return Q
-
-
 def random_unit_vectors(rng: np.random.Generator, n: int) -> np.ndarray:
     v = rng.standard_normal((n, 3))
     return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-
-def rodrigues(axis: np.ndarray, angle: float) -> np.ndarray:
-    """Rotation by ``angle`` about the unit ``axis``, by Rodrigues' formula (independent of the module)."""
-    cross = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    return math.cos(angle) * np.eye(3) + math.sin(angle) * cross + (1.0 - math.cos(angle)) * np.outer(axis, axis)
 
 
 def quaternion_of(R: np.ndarray) -> np.ndarray:
@@ -153,7 +140,7 @@ def test_quaternion_round_trip_on_random_quaternions(rng):
 def test_matrix_from_quaternion_agrees_with_rodrigues(rng):
     for axis, angle in zip(random_unit_vectors(rng, 200), rng.uniform(0, 2 * PI, 200)):
         q = np.concatenate([[math.cos(angle / 2)], math.sin(angle / 2) * axis])
-        np.testing.assert_allclose(matrix_from_quaternion(q), rodrigues(axis, angle), atol=1e-14)
+        np.testing.assert_allclose(matrix_from_quaternion(q), axis_angle(axis, angle), atol=1e-14)
 
 
 def test_matrix_round_trip_through_quaternion(rng):
@@ -191,7 +178,7 @@ def test_half_turn_sign_tie_break(half_turn, expected):
 @pytest.mark.parametrize("angle", [PI - 1e-6, PI - 1e-9, PI - 1e-12, PI])
 def test_quaternion_of_near_half_turns_is_accurate(rng, angle):
     for axis in random_unit_vectors(rng, 100):
-        R = rodrigues(axis, angle)
+        R = axis_angle(axis, angle)
         assert np.trace(R) == pytest.approx(-1.0, abs=1e-11)
         expected = canonical(np.concatenate([[math.cos(angle / 2)], math.sin(angle / 2) * axis]))
         q = quaternion_of(R)

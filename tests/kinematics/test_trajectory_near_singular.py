@@ -19,16 +19,10 @@ from service.kinematics import TrajectoryOptions, follow_trajectory, forward_kin
 from service.kinematics.ik import joint_difference, solve_ik
 from service.robots.catalogue import load_catalogue
 from tests.conftest import DATA
-from tests.oracles.paths import difference_jacobian, near_singular_path, sigma_ratio
+from tests.oracles.paths import NEAR_SINGULAR_TIMES, UR5E_PATH, near_singular_path, sigma_ratio, twists_of
 from tests.arms import standard_dh_from_screws, urdf_chain_screws
 
 CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
-TIMES = np.linspace(0.0, 1.0, 199)  # sample 99 is the path's middle
-
-
-def twists_of(robot, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
-    """[ṗ; ω] (N, 6) of the tool, world frame, from the FK-difference Jacobian."""
-    return np.einsum("kij,kj->ki", np.array([difference_jacobian(robot, row) for row in q]), qd)
 
 
 def doosan():
@@ -36,31 +30,25 @@ def doosan():
     return standard_dh_from_screws(*urdf_chain_screws(joints))
 
 
-#: A UR5e path whose middle passes 3e-5 (σmin/σmax) from its shoulder singularity (the wrist point at radius d4
-#: from axis 1, where the two q1 solutions meet). Before issue 22.11 the trajectory left it at sample 100 for the
-#: other q1 solution, with the same labels and branch_changed false, and ended 2.3 rad off.
-UR5E_PATH = ([-1.07, 1.812, -1.237, -0.292, -2.299, -0.609], [-0.593, -0.475, 0.501, -0.439, -0.03, 0.961], 1e-5)
-
-
 @pytest.mark.parametrize("given", ["poses", "twists", "twists_and_accelerations"])
 def test_ur5e_stays_on_its_branch_past_a_near_singularity(given):
     robot = CATALOGUE.get("ur5e").robot
-    q, qd, qdd = near_singular_path(robot, *UR5E_PATH, TIMES)
+    q, qd, qdd = near_singular_path(robot, *UR5E_PATH, NEAR_SINGULAR_TIMES)
     assert 1e-6 < sigma_ratio(robot, q[99]) < 1e-4
     twists = twists_of(robot, q, qd) if given != "poses" else None
     accelerations = None
     if given == "twists_and_accelerations":  # p̈ and ω̇ by differences of the twist along the exact q(t)
         h = 1e-6
-        ahead, behind = near_singular_path(robot, *UR5E_PATH, TIMES + h), near_singular_path(robot, *UR5E_PATH,
-                                                                                             TIMES - h)
+        ahead = near_singular_path(robot, *UR5E_PATH, NEAR_SINGULAR_TIMES + h)
+        behind = near_singular_path(robot, *UR5E_PATH, NEAR_SINGULAR_TIMES - h)
         accelerations = (twists_of(robot, ahead[0], ahead[1]) - twists_of(robot, behind[0], behind[1])) / (2 * h)
-    result = follow_trajectory(robot, TIMES, forward_kinematics(robot, q), twists=twists, accelerations=accelerations,
-                               options=TrajectoryOptions(reference=q[0]))
+    result = follow_trajectory(robot, NEAR_SINGULAR_TIMES, forward_kinematics(robot, q), twists=twists,
+                               accelerations=accelerations, options=TrajectoryOptions(reference=q[0]))
     joints = np.array([s.joints for s in result.samples])
     assert np.abs(joints - q).max() <= 1e-9  # every sample on the generating path: no jump, no neighbour
     true_step = np.abs(np.diff(q, axis=0)).max(axis=0)
     assert (result.summary.largest_joint_step <= true_step + 1e-9).all()
-    middle = [k for k in range(len(TIMES)) if abs(TIMES[k] - 0.5) < 0.1]
+    middle = [k for k in range(len(NEAR_SINGULAR_TIMES)) if abs(NEAR_SINGULAR_TIMES[k] - 0.5) < 0.1]
     assert not any(result.samples[k].branch_changed for k in middle)
 
 
@@ -75,9 +63,10 @@ def test_near_singular_samples_are_polished_to_the_last_digits(robot_id, path):
     stops at leaves the joints off by residual / σmin; the trajectory polishes them with the core's Gauss–Newton
     (the generating joints are the truth)."""
     robot = CATALOGUE.get(robot_id).robot
-    q, _, _ = near_singular_path(robot, *path, TIMES)
+    q, _, _ = near_singular_path(robot, *path, NEAR_SINGULAR_TIMES)
     assert sigma_ratio(robot, q[99]) < 1e-4
-    result = follow_trajectory(robot, TIMES, forward_kinematics(robot, q), options=TrajectoryOptions(reference=q[0]))
+    result = follow_trajectory(robot, NEAR_SINGULAR_TIMES, forward_kinematics(robot, q),
+                               options=TrajectoryOptions(reference=q[0]))
     joints = np.array([s.joints for s in result.samples])
     errors = np.abs(joint_difference(robot, joints, q)).max(axis=1)
     assert errors[90:110].max() <= 1e-10
@@ -93,16 +82,16 @@ DOOSAN_PATH = ([2.901, 1.412, 0.259, -1.402, -2.132, 2.953], [0.032, -0.768, 0.2
 
 def test_doosan_held_labels_hold_where_the_true_path_carries_them():
     robot = doosan()
-    q, qd, _ = near_singular_path(robot, *DOOSAN_PATH, TIMES)
+    q, qd, _ = near_singular_path(robot, *DOOSAN_PATH, NEAR_SINGULAR_TIMES)
     assert sigma_ratio(robot, q[99]) < 1e-4
     poses = forward_kinematics(robot, q)
     first = solve_ik(robot, poses[0], reference=q[0]).solutions[0]
     assert np.abs(joint_difference(robot, first.joints, q[0])).max() < 1e-9
     held = dict(first.branch)
     assert set(held) == {"shoulder", "elbow", "wrist"}
-    result = follow_trajectory(robot, TIMES, poses, twists=twists_of(robot, q, qd),
+    result = follow_trajectory(robot, NEAR_SINGULAR_TIMES, poses, twists=twists_of(robot, q, qd),
                                options=TrajectoryOptions(branch=held))
-    assert [s.status for s in result.samples] == ["ok"] * len(TIMES)
+    assert [s.status for s in result.samples] == ["ok"] * len(NEAR_SINGULAR_TIMES)
     assert all(s.branch == held for s in result.samples)
     joints = np.array([s.joints for s in result.samples])
     assert np.abs(joint_difference(robot, joints, q)).max() <= 1e-9
@@ -114,7 +103,7 @@ def test_the_idealised_arms_labels_are_left_out_where_its_fold_and_the_true_arms
     answer), and the elbow label either as held or left out (the idealised arm's elbow fold is within its δ of
     the true arm's)."""
     robot = doosan()
-    q, _, _ = near_singular_path(robot, *DOOSAN_PATH, TIMES)
+    q, _, _ = near_singular_path(robot, *DOOSAN_PATH, NEAR_SINGULAR_TIMES)
     poses = forward_kinematics(robot, q)
     held = solve_ik(robot, poses[0], reference=q[0]).solutions[0].branch
     for k in range(90, 110):

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from service.kinematics import forward_kinematics
+from tests.oracles.rotations import axis_angle
 
 
 def spiral(t):
@@ -19,13 +20,6 @@ def spiral(t):
     Dd = np.stack((10.0 * np.pi * c, 10.0 * np.pi * s, 10.0 * one), axis=-1)
     Ddd = np.stack((-5.0 * np.pi**2 * s, 5.0 * np.pi**2 * c, 0.0 * one), axis=-1)
     return D, Dd, Ddd
-
-
-def rotation(axis, angle: float) -> np.ndarray:
-    """R(k, θ) by Rodrigues' formula, k a unit vector."""
-    k = np.asarray(axis, dtype=float)
-    K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    return np.eye(3) + np.sin(angle) * K + (1.0 - np.cos(angle)) * K @ K
 
 
 def wobble(t, world_T_start: np.ndarray, radius: float, k1, k2):
@@ -49,8 +43,8 @@ def wobble(t, world_T_start: np.ndarray, radius: float, k1, k2):
     poses = np.tile(np.eye(4), (len(t), 1, 1))
     omega, omegad = np.zeros((len(t), 3)), np.zeros((len(t), 3))
     for i in range(len(t)):
-        Ra = rotation(k1, a[i])
-        Rb = rotation(k2, b[i]) if k2.any() else np.eye(3)
+        Ra = axis_angle(k1, a[i])
+        Rb = axis_angle(k2, b[i]) if k2.any() else np.eye(3)
         poses[i, :3, :3] = Ra @ Rb @ world_T_start[:3, :3]
         poses[i, :3, 3] = p[i]
         second = Ra @ k2 * bd[i]
@@ -126,3 +120,18 @@ def sigma_ratio(robot, q: np.ndarray) -> float:
     """σ_min / σ_max of the FK-difference Jacobian at q."""
     values = np.linalg.svd(difference_jacobian(robot, q), compute_uv=False)
     return float(values[-1] / values[0])
+
+
+#: Sample times of the near-singular paths: 199 samples on [0, 1], sample 99 at the path's middle (t = 0.5).
+NEAR_SINGULAR_TIMES = np.linspace(0.0, 1.0, 199)
+
+#: A UR5e path (``near_singular_path``'s q0, v, δ) whose middle passes 3e-5 (σmin/σmax) from its shoulder
+#: singularity (the wrist point at radius d4 from axis 1, where the two q1 solutions meet). Before issue 22.11 the
+#: trajectory left it at sample 100 for the other q1 solution, with the same labels and branch_changed false, and
+#: ended 2.3 rad off.
+UR5E_PATH = ([-1.07, 1.812, -1.237, -0.292, -2.299, -0.609], [-0.593, -0.475, 0.501, -0.439, -0.03, 0.961], 1e-5)
+
+
+def twists_of(robot, q: np.ndarray, qd: np.ndarray) -> np.ndarray:
+    """[ṗ; ω] (N, 6) of the tool, world frame, by the FK-difference Jacobian; joints q and rates qd (N, n)."""
+    return np.einsum("kij,kj->ki", np.array([difference_jacobian(robot, row) for row in q]), qd)

@@ -15,6 +15,7 @@ import pytest
 
 from service.robots.export import METRES_PER_UNIT
 from tests.conftest import assert_problem
+from tests.ik_helpers import wrapped
 
 RNG_SEED = 13
 
@@ -51,7 +52,7 @@ def _same_solution_sets(a: list[dict], b: list[dict], revolute: np.ndarray, tol:
     A = np.array([s["joints"] for s in a])
     B = np.array([s["joints"] for s in b])
     delta = A[:, None, :] - B[None, :, :]
-    delta = np.where(revolute, (delta + np.pi) % (2 * np.pi) - np.pi, delta)
+    delta = np.where(revolute, wrapped(delta), delta)
     distance = np.abs(delta).max(axis=2)
     assert distance.min(axis=1).max() < tol and distance.min(axis=0).max() < tol, distance.min(axis=1).max()
 

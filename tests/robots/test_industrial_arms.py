@@ -19,24 +19,13 @@ import pytest
 
 from service.kinematics.ik import joint_difference
 from tests.conftest import catalogue_robot
+from tests.oracles.opw import OPW_SOURCES, opw_forward
+from tests.oracles.rotations import about, axis_angle
 
 DATA_DIR = Path(__file__).resolve().parents[1] / "data"
 N_RANDOM = 50
 ATOL = 1e-9
 
-#: robot id -> the source's OPW parameters (m), sign corrections and joint offsets (deg); sources in the YAML files.
-OPW_SOURCES = {
-    "kuka_kr6_r900_2": (dict(a1=0.025, a2=-0.025, b=0.0, c1=0.400, c2=0.455, c3=0.420, c4=0.090),
-                        (-1, 1, 1, -1, 1, -1), (0, -90, 0, 0, 0, 0)),
-    "kuka_kr210_r2700": (dict(a1=0.350, a2=0.041, b=0.0, c1=0.675, c2=1.150, c3=1.200, c4=0.215),
-                         (-1, 1, 1, -1, 1, -1), (0, -90, 0, 0, 0, 0)),
-    "abb_irb120": (dict(a1=0.0, a2=-0.070, b=0.0, c1=0.290, c2=0.270, c3=0.302, c4=0.072),
-                   (1, 1, 1, 1, 1, 1), (0, 0, -90, 0, 0, 0)),
-    "abb_irb6700": (dict(a1=0.320, a2=-0.200, b=0.0, c1=0.780, c2=1.125, c3=1.1425, c4=0.200),
-                    (1, 1, 1, 1, 1, 1), (0, 0, -90, 0, 0, 0)),
-    "fanuc_lrmate200id": (dict(a1=0.050, a2=-0.035, b=0.0, c1=0.330, c2=0.330, c3=0.335, c4=0.080),
-                          (1, 1, -1, -1, -1, -1), (0, 0, -90, 0, 0, 180)),
-}
 #: the same arms in tests/data/opw_arms.json (geometry only)
 OPW_DATA_IDS = {"kuka_kr6_r900_2": "kuka_kr6_r900_2", "abb_irb120": "abb_irb120",
                 "fanuc_lrmate200id": "fanuc_lrmate200id"}
@@ -56,40 +45,6 @@ LRMATE_URDF_JOINTS = [
     ((0, 0, 0.330), (0, 0, 1)), ((0.050, 0, 0), (0, 1, 0)), ((0, 0, 0.330), (0, -1, 0)),
     ((0, 0, 0.035), (-1, 0, 0)), ((0.335, 0, 0), (0, -1, 0)), ((0.080, 0, 0), (-1, 0, 0)),
 ]
-
-
-def rot_z(t: float) -> np.ndarray:
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rot_y(t: float) -> np.ndarray:
-    c, s = math.cos(t), math.sin(t)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def opw_forward(p: dict, signs, offsets_deg, q: np.ndarray) -> np.ndarray:
-    """Base_T_flange (4, 4) of an OPW arm at controller angles q (rad), after Brandstötter et al. 2014, eqs. for C and u."""
-    t = np.asarray(signs) * q - np.radians(offsets_deg)
-    psi3 = math.atan2(p["a2"], p["c3"])
-    k = math.hypot(p["a2"], p["c3"])
-    cx1 = p["c2"] * math.sin(t[1]) + k * math.sin(t[1] + t[2] + psi3) + p["a1"]
-    cy1 = p["b"]
-    cz1 = p["c2"] * math.cos(t[1]) + k * math.cos(t[1] + t[2] + psi3)
-    c = np.array([cx1 * math.cos(t[0]) - cy1 * math.sin(t[0]), cx1 * math.sin(t[0]) + cy1 * math.cos(t[0]),
-                  cz1 + p["c1"]])
-    rotation = rot_z(t[0]) @ rot_y(t[1] + t[2]) @ rot_z(t[3]) @ rot_y(t[4]) @ rot_z(t[5])
-    pose = np.eye(4)
-    pose[:3, :3] = rotation
-    pose[:3, 3] = c + p["c4"] * rotation[:, 2]
-    return pose
-
-
-def axis_angle(axis, angle: float) -> np.ndarray:
-    """Rodrigues rotation (3, 3) about a unit axis."""
-    k = np.asarray(axis, dtype=float)
-    kx = np.array([[0, -k[2], k[1]], [k[2], 0, -k[0]], [-k[1], k[0], 0]])
-    return np.eye(3) + math.sin(angle) * kx + (1 - math.cos(angle)) * kx @ kx
 
 
 def urdf_forward(joints, tool_rotation: np.ndarray, q: np.ndarray) -> np.ndarray:
@@ -166,9 +121,9 @@ def test_opw_parameters_agree_with_the_golden_data(robot_id):
 
 
 @pytest.mark.parametrize("robot_id, joints, tool_rotation", [
-    ("kuka_kr210_r2700", KR210_URDF_JOINTS, rot_y(math.pi / 2)),
-    ("abb_irb6700", IRB6700_URDF_JOINTS, rot_y(math.pi / 2)),
-    ("fanuc_lrmate200id", LRMATE_URDF_JOINTS, rot_y(-math.pi / 2) @ np.diag([1.0, -1.0, -1.0])),  # Rz(0) Ry Rx(pi)
+    ("kuka_kr210_r2700", KR210_URDF_JOINTS, about("y", math.pi / 2)),
+    ("abb_irb6700", IRB6700_URDF_JOINTS, about("y", math.pi / 2)),
+    ("fanuc_lrmate200id", LRMATE_URDF_JOINTS, about("y", -math.pi / 2) @ np.diag([1.0, -1.0, -1.0])),  # Rz(0) Ry Rx(pi)
 ])
 def test_opw_parameters_are_those_of_the_urdf(robot_id, joints, tool_rotation):
     """The OPW data, signs and offsets used above reproduce the ROS-Industrial URDF the entry cites."""

@@ -10,47 +10,20 @@ from __future__ import annotations
 
 import math
 import xml.etree.ElementTree as ET
-from importlib.metadata import distribution
-from pathlib import Path
 
 import numpy as np
 import pytest
 import yaml
 
 from service.config import BUILTIN_ROBOTS_DIR
+from tests.arms import URDF_SOURCES, source_urdf
 from tests.conftest import assert_problem
-
-_ERD = "cmeel.prefix/share/example-robot-data/robots/"
-
-#: catalogue id -> (distribution, path of the source URDF inside it)
-SOURCES = {
-    "franka_panda": ("example-robot-data", _ERD + "panda_description/urdf/panda.urdf"),
-    "kinova_jaco2": ("example-robot-data", _ERD + "kinova_description/robots/kinova.urdf"),
-    "ufactory_xarm7": ("example-robot-data", _ERD + "xarm_description/urdf/xarm7.urdf"),
-    "unitree_z1": ("example-robot-data", _ERD + "z1_description/urdf/z1.urdf"),
-    "so101": ("example-robot-data", _ERD + "so_arm_description/urdf/so101.urdf"),
-    "kuka_iiwa14": ("pybullet", "pybullet_data/kuka_iiwa/model.urdf"),
-}
-
-
-def _source_text(robot_id: str) -> str:
-    name, path = SOURCES[robot_id]
-    try:
-        file = Path(distribution(name).locate_file(path))
-    except Exception:  # noqa: BLE001 - a missing distribution
-        pytest.fail(f"{name} is not installed: it is in the test extra (pip install -e '.[test]')")
-    return file.read_text(encoding="utf-8")
+from tests.oracles.rotations import axis_angle, rpy
 
 
 def _numbers(element, attribute: str, default: str) -> np.ndarray:
     text = default if element is None else element.get(attribute, default)
     return np.array([float(v) for v in text.split()])
-
-
-def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
-    x, y, z = axis / np.linalg.norm(axis)
-    K = np.array([[0, -z, y], [z, 0, -x], [-y, x, 0]])
-    return np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K
 
 
 def _source_chain(text: str, base: str, tip: str) -> list:
@@ -69,8 +42,7 @@ def _source_fk(chain: list, q: np.ndarray) -> np.ndarray:
         origin = joint.find("origin")
         roll, pitch, yaw = _numbers(origin, "rpy", "0 0 0")
         step = np.eye(4)
-        step[:3, :3] = _rotation(np.array([0, 0, 1.0]), yaw) @ _rotation(np.array([0, 1.0, 0]), pitch) \
-            @ _rotation(np.array([1.0, 0, 0]), roll)
+        step[:3, :3] = rpy(roll, pitch, yaw)
         step[:3, 3] = _numbers(origin, "xyz", "0 0 0")
         T = T @ step
         kind = joint.get("type")
@@ -81,17 +53,17 @@ def _source_fk(chain: list, q: np.ndarray) -> np.ndarray:
         if kind == "prismatic":
             motion[:3, 3] = axis / np.linalg.norm(axis) * q[i]
         else:
-            motion[:3, :3] = _rotation(axis, q[i])
+            motion[:3, :3] = axis_angle(axis / np.linalg.norm(axis), q[i])
         T = T @ motion
         i += 1
     return T
 
 
-@pytest.mark.parametrize("robot_id", sorted(SOURCES))
+@pytest.mark.parametrize("robot_id", sorted(URDF_SOURCES))
 def test_catalogue_urdf_arms_match_their_source_files(client, robot_id):
     sidecar = yaml.safe_load((BUILTIN_ROBOTS_DIR / f"{robot_id}.urdf.yaml").read_text(encoding="utf-8"))
     assert sidecar["source"] and sidecar["licence"]
-    chain = _source_chain(_source_text(robot_id), sidecar["base_link"], sidecar["tip_link"])
+    chain = _source_chain(source_urdf(robot_id), sidecar["base_link"], sidecar["tip_link"])
     moving = [j for j in chain if j.get("type") != "fixed"]
     robot = client.get(f"/v1/robots/{robot_id}").json()
     summary = next(r for r in client.get("/v1/robots").json()["robots"] if r["id"] == robot_id)
@@ -127,7 +99,7 @@ def test_the_catalogue_has_the_arms_of_the_issue(client):
 
 def test_posting_a_real_urdf_returns_every_ik_solution(client):
     """The README's example: the Jaco2 URDF inline (meshes and all), a pose from its own FK, all 8+ solutions."""
-    text = _source_text("kinova_jaco2")
+    text = source_urdf("kinova_jaco2")
     robot = {"format": "urdf", "urdf": text, "base_link": "j2s6s200_link_base", "tip_link": "j2s6s200_end_effector"}
     q = [0.4, 2.6, 1.2, -0.7, 1.4, 0.2]
     fk = client.post("/v1/fk", json={"robot": robot, "joints": q}).json()

@@ -38,6 +38,7 @@ from service.kinematics.collision import (
 )
 from service.kinematics.collision import _distances
 from tests.oracles.collision import Bullet, kind_of, segment_distance_exact, signed_distance, signed_distances
+from tests.oracles.rotations import matrix_of_quaternion
 
 TOLERANCE = 1e-9
 KINDS = [("sphere", "sphere"), ("capsule", "sphere"), ("capsule", "capsule"), ("box", "sphere"),
@@ -58,10 +59,7 @@ def bullet():
 def random_rotation(rng: np.random.Generator) -> np.ndarray:
     """A uniformly random rotation (from a random unit quaternion)."""
     q = rng.normal(size=4)
-    w, x, y, z = q / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    return matrix_of_quaternion(*(q / np.linalg.norm(q)))
 
 
 class LightBox(NamedTuple):

@@ -16,18 +16,17 @@ from service.kinematics.collision import Box, Capsule, LinkShape, Obstacle, Sphe
 from service.kinematics.collision import _model
 from service.robots.catalogue import load_robot_file
 from tests.oracles.collision import signed_distance, signed_distances
+from tests.oracles.rotations import random_rotations
 
 ROBOTS = Path(__file__).resolve().parents[3] / "robots"
 
 
 def random_rigid(rng: np.random.Generator) -> np.ndarray:
-    """A random rigid transform, built from a QR decomposition (not from the service's rotations)."""
-    Q, R = np.linalg.qr(rng.normal(size=(3, 3)))
-    Q = Q * np.sign(np.diag(R))
-    if np.linalg.det(Q) < 0:
-        Q[:, 0] = -Q[:, 0]
+    """A random rigid transform (4, 4): a rotation from a QR decomposition (not from the service's rotations), then
+    a translation of standard normal coordinates."""
     T = np.eye(4)
-    T[:3, :3], T[:3, 3] = Q, rng.normal(size=3)
+    T[:3, :3] = random_rotations(rng, 1)[0]
+    T[:3, 3] = rng.normal(size=3)
     return T
 
 

@@ -19,12 +19,10 @@ import numpy as np
 import pytest
 
 from service.kinematics import Joint, Robot, ScrewJoint, forward_kinematics
-from service.kinematics.ik import joint_difference
+from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, joint_difference, result_of, unlimited
 from service.kinematics._tolerances import DUPLICATE_TOLERANCE
-from service.kinematics.ik._answer import AnswerOptions, IKTargets, answer_ik
-from service.kinematics.ik._solve import result_of, unlimited
-from tests.arms import random_general_arm
-from tests.kinematics.ik.test_general_6r import kinova_j2n6s300, multistart_solutions, singular_configuration
+from tests.arms import kinova_j2n6s300, random_general_arm
+from tests.ik_helpers import multistart_solutions, singular_configuration
 
 DELTAS = (0.0, 1e-12, 1e-9, 1e-6, 1e-3)
 HALF_PI_IN_A_URDF = 1.57079632679  # example-robot-data's iiwa and Jaco write it so

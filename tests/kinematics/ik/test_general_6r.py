@@ -1,8 +1,8 @@
 """The general 6R solver (ik/_general_6r.py): every solution of arms with no decomposable geometry.
 
 Independent references: the arm's own FK (poses from random joint vectors must come back, and every answer
-must reproduce its target); a dense multi-start Levenberg–Marquardt search written here, which knows nothing
-of the elimination, for the solution counts; Manocha and Canny's published example (IEEE Trans. Robot.
+must reproduce its target); a dense multi-start Levenberg–Marquardt search (tests/ik_helpers.py), which knows
+nothing of the elimination, for the solution counts; Manocha and Canny's published example (IEEE Trans. Robot.
 Autom. 10(5), 1994, Tables I and III), an arm with 16 real solutions; and Pieper's condition, evaluated here
 on the DH tables, for the routing.
 """
@@ -12,42 +12,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from benchmarks import general_6r_singular
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
-from service.kinematics import Joint, Robot, forward_kinematics, geometric_jacobian
+from service.kinematics import CONVENTIONS, Joint, Robot, forward_kinematics, geometric_jacobian
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_batch
 from service.kinematics.ik._general_6r import General6RPlan, _solve_arrangement, is_pieper
 from service.kinematics.ik import plan_for, solve_ik_arrays
 from service.kinematics.ik._plan import geometry_of
-from service.kinematics.ik._verify import residuals
-from tests.arms import random_general_arm, random_rotation
-from tests.ik_helpers import SAME, wrapped
-
-CONVENTIONS = ("standard", "modified", "khalil")
-
-
-def found(robot: Robot, solutions: np.ndarray, q: np.ndarray, tolerance: float = SAME) -> bool:
-    return len(solutions) > 0 and bool(
-        np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= tolerance)
-
-
-def check_answers(robot: Robot, q: np.ndarray, plan: General6RPlan | None = None, structure: str = "general_6r"):
-    """Solve FK(q) for each row of q; assert recall, no wrong solution, no `unreachable`. Returns the arrays.
-
-    Without ``plan`` the router must choose the general solver (``structure``); with it, that plan is used (for a
-    real arm a closed-form family may one day claim)."""
-    targets = forward_kinematics(robot, q)
-    arrays = solve_ik_arrays(robot, targets, plan=plan)
-    assert arrays is not None and arrays.structure == structure
-    assert (arrays.count > 0).all(), "an FK pose was answered unreachable"
-    for row in range(len(q)):
-        solutions = arrays.joints[row, :arrays.count[row]]
-        assert found(robot, solutions, q[row]), f"pose {row}: generating vector missing"
-        position, orientation = residuals(robot, solutions, targets[row])
-        assert position.max() <= 1e-9 * robot.characteristic_length and orientation.max() <= 1e-9
-        assert arrays.count[row] % 2 == 0  # the real roots of a real polynomial of degree 16 come in pairs
-    return arrays
+from tests.arms import kinova_j2n6s300, random_general_arm, random_rotation
+from tests.ik_helpers import check_general_answers, found, multistart_solutions, singular_configuration
 
 
 # ---------------------------------------------------------------------------
@@ -62,7 +35,7 @@ def test_every_generating_vector_comes_back_on_random_general_arms(convention):
     for _ in range(4):
         robot = random_general_arm(rng, convention)
         q = rng.uniform(-np.pi, np.pi, (90, 6))
-        arrays = check_answers(robot, q)
+        arrays = check_general_answers(robot, q)
         total += len(q)
         complete += int(arrays.complete.sum())
     assert total == 360  # 3 conventions × 4 arms × 90 poses = 1,080 poses in all
@@ -97,45 +70,6 @@ def test_the_same_arm_in_three_conventions_gets_the_same_solution_sets():
 # ---------------------------------------------------------------------------
 
 
-def multistart_solutions(robot: Robot, target: np.ndarray, starts: int, rng: np.random.Generator,
-                         slide_range: tuple[float, float] = (-np.pi, np.pi)) -> np.ndarray:
-    """Every distinct solution a dense Levenberg–Marquardt search finds from ``starts`` random seeds (revolute
-    joints uniform in ±π, prismatic ones in ``slide_range``).
-
-    Knows nothing of the elimination: FK and the geometric Jacobian only, error in units of the robot's size.
-    """
-    scale = robot.characteristic_length
-    q = rng.uniform(-np.pi, np.pi, (starts, 6))
-    q[:, ~robot.is_revolute] = rng.uniform(*slide_range, (starts, int((~robot.is_revolute).sum())))
-    damping = np.full(starts, 1e-2)
-    def error_of(q):
-        T = forward_kinematics(robot, q)
-        position = (target[:3, 3] - T[:, :3, 3]) / scale
-        R = target[:3, :3] @ np.swapaxes(T[:, :3, :3], 1, 2)
-        rotation = 0.5 * np.stack([R[:, 2, 1] - R[:, 1, 2], R[:, 0, 2] - R[:, 2, 0], R[:, 1, 0] - R[:, 0, 1]], 1)
-        return np.concatenate([position, rotation], axis=1)
-    error = error_of(q)
-    for _ in range(80):
-        J = geometric_jacobian(robot, q)
-        J[:, :3] /= scale
-        JtJ = np.swapaxes(J, 1, 2) @ J
-        step = np.linalg.solve(JtJ + damping[:, None, None] * np.eye(6),
-                               np.einsum("kji,kj->ki", J, error)[..., None])[..., 0]
-        trial = q + step
-        trial_error = error_of(trial)
-        better = (trial_error ** 2).sum(1) < (error ** 2).sum(1)
-        q[better], error[better] = trial[better], trial_error[better]
-        damping = np.where(better, damping / 10, damping * 10).clip(1e-12, 1e6)
-    converged = q[np.abs(error).max(axis=1) < 1e-11]
-    revolute = robot.is_revolute
-    converged[:, revolute] = wrapped(converged[:, revolute])
-    distinct: list[np.ndarray] = []
-    for candidate in converged:
-        if not any(np.abs(joint_difference(robot, candidate[None], other)).max() < 1e-6 for other in distinct):
-            distinct.append(candidate)
-    return np.array(distinct).reshape(-1, 6)
-
-
 def test_solution_counts_agree_with_a_dense_multistart_search():
     rng = np.random.default_rng(11)
     counts = []
@@ -152,22 +86,10 @@ def test_solution_counts_agree_with_a_dense_multistart_search():
     assert max(counts) > 2  # the comparison covered poses with several solutions (measured: 2 to 8)
 
 
-def kinova_j2n6s300() -> Robot:
-    """Kinova Jaco 2 6-DOF with its curved 60° wrist: Kinova's published standard DH table (no axes meet at
-    the wrist, so no closed-form family)."""
-    D1, D2, D3, D4, D5, D6, e2 = 0.2755, 0.41, 0.2073, 0.0741, 0.0741, 0.16, 0.0098
-    aa = np.pi / 6
-    ratio = np.sin(aa) / np.sin(2 * aa)
-    alpha = [np.pi / 2, np.pi, np.pi / 2, 2 * aa, 2 * aa, np.pi]
-    a = [0.0, D2, 0.0, 0.0, 0.0, 0.0]
-    d = [D1, 0.0, -e2, -(D3 + ratio * D4), -(ratio * D4 + ratio * D5), -(ratio * D5 + D6)]
-    return Robot([Joint(f"q{i + 1}", "revolute", a[i], alpha[i], d[i], 0.0) for i in range(6)], name="j2n6s300")
-
-
 def test_every_solution_of_a_kinova_jaco():
     robot = kinova_j2n6s300()
     q = np.random.default_rng(0).uniform(-np.pi, np.pi, (300, 6))
-    arrays = check_answers(robot, q, plan=General6RPlan(geometry_of(robot)))
+    arrays = check_general_answers(robot, q, plan=General6RPlan(geometry_of(robot)))
     assert arrays.complete.all()
     assert arrays.count.max() >= 10  # measured: 2 to 12 solutions per pose
 
@@ -234,7 +156,7 @@ def test_roots_at_pi_and_a_singular_leading_matrix():
         for joint in range(6):
             for k, offset in enumerate((0.0, 1e-12, 1e-9, -1e-6)):
                 q[4 * joint + k, joint] = np.pi + offset
-        check_answers(robot, q)
+        check_general_answers(robot, q)
         # the leading matrix was singular for the exact-π poses of joint a, and the shift moved it away
         a = plan.arrangement.order[0]
         targets = forward_kinematics(robot, q[4 * a:4 * a + 1])
@@ -397,11 +319,6 @@ def test_a_batch_larger_than_a_chunk_is_answered_in_one_piece():
     np.testing.assert_array_equal(whole.count, np.concatenate([p.count for p in pieces]))
     for row in range(len(q)):
         assert found(robot, whole.joints[row, :whole.count[row]], q[row])
-
-
-def singular_configuration(robot: Robot, rng: np.random.Generator) -> np.ndarray:
-    """A configuration with det J = 0: bisection along the first random segment on which det J changes sign."""
-    return general_6r_singular.singular_configuration(robot, rng)[0]
 
 
 def test_the_api_reports_the_general_solvers_completeness_per_target(client):

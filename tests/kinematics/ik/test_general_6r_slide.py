@@ -13,17 +13,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import Joint, Robot, forward_kinematics
-from service.kinematics._forward import joint_screws
-from service.kinematics.ik import solve_ik
-from service.kinematics.ik._answer import AnswerOptions, IKTargets, answer_ik
+from service.kinematics import CONVENTIONS, Joint, Robot, forward_kinematics, joint_screws
+from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, plan_for, solve_ik, unlimited
 from service.kinematics.ik._general_6r import GENERAL_5R1P, General6RPlan, _Arrangement
-from service.kinematics.ik._plan import geometry_of, plan_for
-from service.kinematics.ik._solve import unlimited
+from service.kinematics.ik._plan import geometry_of
 from service.kinematics.ik._verify import residuals
 from tests.arms import random_rotation
-from tests.kinematics.ik.test_general_6r import (CONVENTIONS, check_answers, found,
-                                                 multistart_solutions)
+from tests.ik_helpers import check_general_answers, found, multistart_solutions
 
 #: Geometry rounded as CAD exports round it (metres to the micrometre).
 CAD = 6
@@ -64,9 +60,9 @@ def configurations(rng: np.random.Generator, robot: Robot, count: int) -> np.nda
 
 
 def check_every_vector_returns(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """``check_answers`` of the 6R tests with the slide's structure: every generating vector back, no wrong
+    """``check_general_answers`` of the 6R tests with the slide's structure: every generating vector back, no wrong
     solution, no `unreachable`, an even count. Returns which answers are complete (N,)."""
-    return check_answers(robot, q, structure=GENERAL_5R1P).complete
+    return check_general_answers(robot, q, structure=GENERAL_5R1P).complete
 
 
 # ---------------------------------------------------------------------------
@@ -134,7 +130,7 @@ def test_the_slide_as_joint_a_with_its_interval_map(slide):
     plan.arrangement = _Arrangement(plan.directions, plan.points, plan.revolute, reverse, first)
     assert plan.arrangement.slide and plan.arrangement.order[0] == slide
     q = configurations(rng, robot, 40)
-    arrays = check_answers(robot, q, plan=plan, structure=GENERAL_5R1P)
+    arrays = check_general_answers(robot, q, plan=plan, structure=GENERAL_5R1P)
     assert arrays.complete.all()  # measured: all 160 complete
 
 

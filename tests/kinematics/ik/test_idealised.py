@@ -21,9 +21,8 @@ from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik_arrays, solve_ik_batch
 from service.kinematics.ik._plan import geometry_of
 from service.kinematics.ik._screws import rotate_about
-from tests.api.test_ik_recall import GENERIC
 from tests.conftest import DATA, catalogue_robot
-from tests.arms import rounded, standard_dh_from_screws, urdf_chain_screws
+from tests.arms import GENERIC_CATALOGUE_ARMS, rounded, standard_dh_from_screws, urdf_chain_screws
 from tests.ik_helpers import random_configurations, same_set
 
 POSES = 1000
@@ -85,11 +84,11 @@ def check_own_poses(robot: Robot, kind: str, structure: str | set[str], seed: in
     return answered
 
 
-@pytest.mark.parametrize("robot_id", sorted(GENERIC))
+@pytest.mark.parametrize("robot_id", sorted(GENERIC_CATALOGUE_ARMS))
 def test_rounded_catalogue_arms_keep_their_closed_form(client, robot_id):
     """π/2 written 1.5708, parallel axes 1e-5 off, lengths to 0.1 mm, base and tool from rounded quaternions."""
-    kind, _, structure = GENERIC[robot_id]
-    seed = sorted(GENERIC).index(robot_id)
+    kind, _, structure = GENERIC_CATALOGUE_ARMS[robot_id]
+    seed = sorted(GENERIC_CATALOGUE_ARMS).index(robot_id)
     robot = rounded(catalogue_robot(client, robot_id), seed)
     # a rounded offset-shoulder arm is also exactly of the general skew-axes class, whose closed form is complete too
     structures = {structure, "skew_axes+spherical_wrist"} if structure.startswith("offset_shoulder") else structure
@@ -290,7 +289,7 @@ def test_ur_stretched_elbow_at_wrist_singularity_is_never_called_unreachable(cli
     the near self-motion, not this one)."""
     robot = catalogue_robot(client, robot_id)
     if as_written == "rounded":
-        robot = rounded(robot, sorted(GENERIC).index(robot_id))
+        robot = rounded(robot, sorted(GENERIC_CATALOGUE_ARMS).index(robot_id))
     q = np.array([[1.4514319, -2.26133035, 0.0, -math.pi / 2, 0.0, 0.0],
                   [0.3, -1.0, 0.0, 0.7, 0.0, 0.0],
                   [-2.0, -0.4, 0.0, 2.5, 0.0, 0.0]])

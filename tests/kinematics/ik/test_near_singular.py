@@ -22,7 +22,7 @@ from service.kinematics.ik import joint_difference, solve_ik
 from service.kinematics.ik.subproblems import subproblem_2_chain
 from service.kinematics.ik._screws import rotate_about
 from tests.arms import random_family_arm
-from tests.ik_helpers import wrapped
+from tests.ik_helpers import stretched_elbow, wrapped
 
 EPSILONS = [1e-3, 1e-5, 1e-7, 3e-8, 1e-8, 5e-9, 3e-9, 2e-9, 1e-9, 1e-10, 1e-12, 0.0]
 #: robot id → (first wrist joint, middle wrist joint, last wrist joint)
@@ -283,8 +283,6 @@ def _turn_onto(k: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
 def _ur_type_singular_values(plan, q: np.ndarray, kind: str) -> tuple[int, float]:
     """The joint swept and its singular value for q's other joints: θ5 with axis 6 along the parallel axes (the
     wrist), θ3 with the elbow stretched, θ4 with θ2 + θ3 + θ4 turning axis 5 as near axis 1 as it goes."""
-    from tests.kinematics.ik.test_one_pose_families import _stretched_elbow
-
     g = plan.geometry
     w_p = g.direction(1)
     if kind == "wrist":
@@ -292,7 +290,7 @@ def _ur_type_singular_values(plan, q: np.ndarray, kind: str) -> tuple[int, float
         side = 1.0 if abs(six @ k - w_p @ k) <= abs(six @ k + w_p @ k) else -1.0
         return 4, _turn_onto(k, six, side * w_p)
     if kind == "elbow":
-        return 2, _stretched_elbow(None, plan, q)
+        return 2, stretched_elbow(plan, q)
     s2, s3, s4 = plan.signs
     total = _turn_onto(w_p, g.direction(4), g.direction(0))
     return 3, float(s4 * (total - s2 * q[1] - s3 * q[2]))

@@ -7,16 +7,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import Robot, forward_kinematics
+from service.kinematics import CONVENTIONS, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
-from service.kinematics.ik._screws import move_point
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from tests.arms import random_family_arm
+from tests.ik_helpers import stretched_elbow
 
 FAMILIES = ("intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist", "three_parallel")
-CONVENTIONS = ("standard", "modified", "khalil")
 
 
 def _array_path(monkeypatch, plan) -> None:
@@ -78,35 +77,6 @@ def test_random_arms_of_the_families_answer_alike_on_both_paths(family, conventi
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 
 
-def _stretched_elbow(robot: Robot, plan, q: np.ndarray) -> float:
-    """The value of joint 3 at which the wrist point (PUMA type) or the point on axis 4 (UR5 type) is farthest
-    from axis 2, for the other joints of q: the stretched elbow, by golden-section search about a grid maximum."""
-    model = plan.model if hasattr(plan, "model") else plan.positioner.model
-    if plan.structure == "three_parallel":
-        point, anchor, axis = model.points[3], model.points[1], model.directions[1]
-    else:
-        point, anchor, axis = plan.point, plan.positioner.centre, None
-
-    def reach(value: float) -> float:
-        joints = q.copy()
-        joints[2] = value
-        offset = move_point(model.directions, model.points, model.is_revolute, joints[:3], point) - \
-            move_point(model.directions, model.points, model.is_revolute, joints[:1], anchor)
-        if axis is not None:  # in the plane normal to the parallel axes
-            turned = move_point(model.directions[:1], np.zeros((1, 3)), model.is_revolute[:1], joints[:1], axis)
-            offset = offset - (offset @ turned) * turned
-        return float(np.linalg.norm(offset))
-
-    grid = np.linspace(-np.pi, np.pi, 721)
-    best = grid[int(np.argmax([reach(v) for v in grid]))]
-    low, high = best - 2 * np.pi / 720, best + 2 * np.pi / 720
-    ratio = (np.sqrt(5) - 1) / 2
-    for _ in range(80):
-        a, b = high - ratio * (high - low), low + ratio * (high - low)
-        low, high = (a, high) if reach(a) < reach(b) else (low, b)
-    return (low + high) / 2
-
-
 @pytest.mark.parametrize("robot_id", ["puma560_standard", "ur5"])
 @pytest.mark.parametrize("joint", ["wrist", "elbow"])
 def test_poses_approaching_the_wrist_and_elbow_singularities_answer_alike(robot_id, joint, monkeypatch):
@@ -118,7 +88,7 @@ def test_poses_approaching_the_wrist_and_elbow_singularities_answer_alike(robot_
     rng = np.random.default_rng(7)
     for trial in range(6):
         q = rng.uniform(-np.pi, np.pi, 6)
-        singular = 0.0 if joint == "wrist" else _stretched_elbow(robot, plan, q)
+        singular = 0.0 if joint == "wrist" else stretched_elbow(plan, q)
         index = 4 if joint == "wrist" else 2
         for epsilon in (1e-3, 1e-6, 1e-9, 1e-12, 0.0):
             q[index] = singular + epsilon * (1 if trial % 2 else -1)

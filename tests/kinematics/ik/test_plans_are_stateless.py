@@ -15,8 +15,7 @@ import numpy as np
 import pytest
 
 from service.kinematics import Joint, Robot, forward_kinematics
-from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, cached_plan
-from service.kinematics.ik._plan import plan_for
+from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, cached_plan, plan_for
 from service.kinematics.ik._positioning import POSITIONERS, Positioner
 from service.kinematics.ik._types import Sealed
 from tests.arms import PUBLISHED_ARMS, published_arm

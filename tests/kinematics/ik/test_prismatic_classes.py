@@ -16,14 +16,10 @@ from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik.subproblems import subproblem_5_prismatic
-from tests.arms import random_rigid
-from tests.ik_helpers import wrapped
-from tests.kinematics.ik.test_spherical_wrist_classes import (
-    _positioner_singular_configurations,
-    _reverse_axis,
-    assert_every_solution,
-    configurations,
-)
+from tests.arms import RandomDHRows, stated_three_ways
+from tests.ik_helpers import (aligning_value, assert_every_solution, centred_configurations, positioner_determinant,
+                              positioner_singular_configurations, wrapped)
+from tests.oracles.rotations import axis_angle
 
 DEG = np.pi / 180
 POSES = 400  # per statement; three statements (conventions) per class: 1,200 poses
@@ -31,25 +27,13 @@ POSES = 400  # per statement; three statements (conventions) per class: 1,200 po
 
 def _rows(kind: str, rng: np.random.Generator) -> tuple[list[tuple[float, float, float, float]], str]:
     """Standard DH rows (a, alpha, d, theta offset) of a random arm of the class, and its joint kinds."""
-    def length():
-        return float(rng.uniform(0.1, 0.5))
-
-    def twist():
-        return float(rng.uniform(0.3, 2.8) * rng.choice([-1, 1]))
-
-    def offset():
-        return float(rng.uniform(-np.pi, np.pi))
-
-    def free():
-        return (length(), twist(), length(), offset())
+    draw = RandomDHRows(rng)
+    length, twist, offset, free = draw.length, draw.twist, draw.offset, draw.free
 
     def right():  # a twist of ±90°: the next axis normal to this one
         return (length(), 90 * DEG * rng.choice([-1, 1]), length(), offset())
 
-    t = twist()
-    wrist = [(0.0, t, length(), offset()), (0.0, t * rng.choice([-1, 1]), 0.0, offset()), free()]
-    t = twist()
-    base_wrist = [(0.0, t, length(), offset()), (0.0, t * rng.choice([-1, 1]), 0.0, offset())]
+    wrist, base_wrist = draw.spherical_wrists()
     t = twist()
     positioners = {
         # skew axes 1 and 2, then an oblique slide
@@ -98,31 +82,10 @@ DECOUPLED = [kind for kind in sorted(CLASSES) if kind not in ("rr+wrist+slide", 
 
 
 def statements(kind: str, seed: int, limits: tuple[float, float] | None = None) -> list[Robot]:
-    """One random arm of the class in the standard, modified and Khalil conventions (same base, tool, FK)."""
+    """One random arm of the class in the standard, modified and Khalil conventions (same base, tool, FK);
+    ``limits``: (lower, upper) of every prismatic joint."""
     rng = np.random.default_rng(seed)
-    table, kinds = _rows(kind, rng)
-    n = len(kinds)
-    rows = [list(row) for row in table]
-    base = random_rigid(rng, 0.5)
-    for joint in np.flatnonzero(rng.random(n) < 0.4):
-        base = _reverse_axis(rows, int(joint), base)
-    tool = random_rigid(rng, 0.2)
-    joint_kind = {"R": "revolute", "P": "prismatic"}
-    bounds = [limits if (k == "P" and limits) else (-np.inf, np.inf) for k in kinds]
-    standard = Robot([Joint(f"j{i + 1}", joint_kind[k], *row, *bound)
-                      for i, (row, k, bound) in enumerate(zip(rows, kinds, bounds))],
-                     convention="standard", world_T_base=base, flange_T_tool=tool)
-    craig = [(0.0 if i == 0 else rows[i - 1][0], 0.0 if i == 0 else rows[i - 1][1], rows[i][2], rows[i][3])
-             for i in range(n)]
-    last = np.eye(4)
-    a, alpha = rows[-1][0], rows[-1][1]
-    last[:3, :3] = [[1, 0, 0], [0, np.cos(alpha), -np.sin(alpha)], [0, np.sin(alpha), np.cos(alpha)]]
-    last[0, 3] = a
-    modified_joints = [Joint(f"j{i + 1}", joint_kind[k], *row, *bound)
-                       for i, (row, k, bound) in enumerate(zip(craig, kinds, bounds))]
-    modified = Robot(modified_joints, convention="modified", world_T_base=base, flange_T_tool=last @ tool)
-    khalil = Robot(modified_joints, convention="khalil", world_T_base=base, flange_T_tool=last @ tool)
-    return [standard, modified, khalil]
+    return stated_three_ways(rng, *_rows(kind, rng), limits)
 
 
 def _assert_points(robot: Robot, q: np.ndarray, targets: np.ndarray, answer) -> None:
@@ -147,7 +110,7 @@ def test_random_arms_of_every_slide_class_in_every_convention(kind):
         plan = cached_plan(robot, constrain_orientation=pose, reference=None)
         assert plan is not None and plan.structure == structure
         assert plan.generic_count == generic
-        q = configurations(robot, POSES, seed=index)
+        q = centred_configurations(robot, POSES, seed=index)
         targets = forward_kinematics(robot, q)
         answer = solve_ik_arrays(robot, targets, constrain_orientation=pose)
         assert answer.count.max() <= generic
@@ -157,7 +120,7 @@ def test_random_arms_of_every_slide_class_in_every_convention(kind):
             _assert_points(robot, q, targets, answer)
         answers.append(answer)
     # the three statements are one arm: the same targets get the same solution sets
-    q = configurations(robots[0], POSES, seed=0)
+    q = centred_configurations(robots[0], POSES, seed=0)
     targets = forward_kinematics(robots[0], q)
     first = answers[0]
     for robot in robots[1:]:
@@ -180,7 +143,7 @@ def test_singular_poses_of_every_slide_class_report_a_singularity(kind):
     # along the second revolute joint (turning the first moves the whole arm rigidly; along a slide of ±1 the
     # Jacobian may not vanish)
     search = None if "base_wrist" in kind else int(np.flatnonzero(robot.is_revolute[:3])[1])
-    q = _positioner_singular_configurations(robot, plan, 20, seed=13, search=search, pool=6)
+    q = positioner_singular_configurations(robot, plan, 20, seed=13, search=search, pool=6)
     targets = forward_kinematics(robot, q)
     answer = solve_ik_arrays(robot, targets, constrain_orientation=pose)
     if pose:
@@ -199,7 +162,7 @@ def test_position_only_targets_of_slide_arms_hold_the_wrist(kind):
     """A position target of a 6-DOF slide arm holds joints 4–6 at the reference and places the tool point with
     the same family, complete; the generating vector is among the solutions."""
     robot = statements(kind, seed=list(CLASSES).index(kind))[2]
-    q = configurations(robot, 40, seed=23)
+    q = centred_configurations(robot, 40, seed=23)
     for q_true, target in zip(q, forward_kinematics(robot, q)):
         result = solve_ik(robot, target, constrain_orientation=False, reference=q_true)
         assert (result.method, result.complete, result.status) == ("analytic", True, "ok")
@@ -226,20 +189,17 @@ def test_subproblem_5_prismatic_agrees_with_a_dense_scan():
         phi, theta, s = rng.uniform(-np.pi, np.pi), rng.uniform(-np.pi, np.pi), rng.uniform(-0.5, 0.5)
         turns = bool(trial % 2)
 
-        def R(axis, t):
-            return np.cos(t) * np.eye(3) + np.sin(t) * np.cross(np.eye(3), axis) + (1 - np.cos(t)) * np.outer(axis, axis)
-
         if turns:
-            p2 = R(k2, phi) @ (p0 + R(k, theta) @ p1 + s * v)
+            p2 = axis_angle(k2, phi) @ (p0 + axis_angle(k, theta) @ p1 + s * v)
         else:
-            p2 = R(k2, phi) @ (p0 + R(k, theta) @ p1) - s * v
+            p2 = axis_angle(k2, phi) @ (p0 + axis_angle(k, theta) @ p1) - s * v
         sol = subproblem_5_prismatic(k2, k, p0, p1, p2, v, slide_turns=turns)
         found = np.stack([sol.phi, sol.theta, sol.s], axis=-1)[sol.valid & sol.exact]
         gaps = np.abs(np.stack([wrapped(found[:, 0] - phi), wrapped(found[:, 1] - theta), found[:, 2] - s], axis=-1))
         assert gaps.max(axis=1).min() < 1e-9
         for f in found:  # every candidate solves the vector equation
             lhs = p2 if turns else p2 + f[2] * v
-            rhs = R(k2, f[0]) @ (p0 + R(k, f[1]) @ p1 + (f[2] * v if turns else 0))
+            rhs = axis_angle(k2, f[0]) @ (p0 + axis_angle(k, f[1]) @ p1 + (f[2] * v if turns else 0))
             assert np.linalg.norm(lhs - rhs) < 1e-9
         if abs(k2 @ v) > 1e-6:  # the quartic: count its real roots by a dense scan
             grid = np.linspace(-np.pi, np.pi, 200001)
@@ -269,7 +229,7 @@ def test_slide_limits_filter_the_solutions_like_a_linear_axis(kind):
     pose = limited.dof == 6
     slide = int(np.flatnonzero(~limited.is_revolute)[0])
     rng = np.random.default_rng(31)
-    q = configurations(limited, 60, seed=29)
+    q = centred_configurations(limited, 60, seed=29)
     q[:, slide] = rng.uniform(-0.2, 0.4, len(q))
     q[-10:, slide] = rng.uniform(0.5, 0.9, 10)  # beyond travel
     limits = Limits.of(limited)
@@ -296,8 +256,6 @@ def test_slide_after_the_wrist_singular_poses_report_a_singularity():
     Jacobian [ω1 × (c − o1), ω2 × (c − o2), v6] at the current wrist centre c vanishes, found by bisection on
     q2) report the merged positioner roots; the wrist's aligned pose reports the wrist. Never unreachable or
     wrong; the generating vector found to 1e-5 (a double root)."""
-    from tests.kinematics.ik.test_spherical_wrist_classes import _aligning_value, _positioner_determinant
-
     kind = "rr+wrist+slide"
     robot = statements(kind, seed=list(CLASSES).index(kind))[0]
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
@@ -309,9 +267,9 @@ def test_slide_after_the_wrist_singular_poses_report_a_singularity():
         return (forward_kinematics(robot, unslid) @ home_inverse @ np.append(plan.centre, 1.0))[:, :3]
 
     def det(q):
-        return _positioner_determinant(robot, q, (0, 1, 5), centre)
+        return positioner_determinant(robot, q, (0, 1, 5), centre)
 
-    q = configurations(robot, 80, seed=13)
+    q = centred_configurations(robot, 80, seed=13)
     grid = np.linspace(-np.pi, np.pi, 721)
     trial = np.repeat(q[:, None], len(grid), axis=1)
     trial[..., 1] = grid
@@ -332,8 +290,8 @@ def test_slide_after_the_wrist_singular_poses_report_a_singularity():
     assert_every_solution(robot, q, targets, answer, tolerance=1e-5)
     for row in range(len(q)):
         assert any(s.kind == "positioner" for s in answer.singularities[row]), (row, answer.singularities[row])
-    aligned = configurations(robot, 20, seed=17)
-    aligned[:, 3] = _aligning_value(robot, aligned[0], (2, 3, 4))
+    aligned = centred_configurations(robot, 20, seed=17)
+    aligned[:, 3] = aligning_value(robot, aligned[0], (2, 3, 4))
     answer = solve_ik_arrays(robot, forward_kinematics(robot, aligned))
     assert (answer.count >= 1).all()
     for row in range(len(aligned)):
@@ -402,7 +360,7 @@ def test_slide_wrist_rr_pose_the_batch_answered_unreachable():
     exactness tolerance: unreachable in the batch of poses 220–229, found alone. Now found both ways."""
     kind = "slide+wrist+rr"
     robot = statements(kind, seed=list(CLASSES).index(kind))[1]
-    q = configurations(robot, POSES, seed=1)
+    q = centred_configurations(robot, POSES, seed=1)
     targets = forward_kinematics(robot, q)
     assert 1e-4 < abs(_slide_cosine(robot, q[224:225])[0]) < 1.2e-4
     for rows in (slice(220, 230), slice(224, 225)):
@@ -422,7 +380,7 @@ def test_slide_nearly_normal_to_the_far_revolute_axis(kind):
     levels = [sign * 10.0 ** -k for k in range(1, 13) for sign in (1, -1)] + [0.0]
     for seed in range(3):
         robot = statements(kind, seed=100 + seed)[seed]  # each convention once
-        start = configurations(robot, 12, seed=seed)
+        start = centred_configurations(robot, 12, seed=seed)
         q = np.concatenate([_with_slide_cosine(robot, start, level) for level in levels])
         assert np.abs(_slide_cosine(robot, q)).min() < 1e-15
         away = _smallest_singular_value(robot, q) > 1e-3

@@ -24,13 +24,7 @@ from service.kinematics import Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from tests.arms import random_ur_type_arm
-from tests.kinematics.ik.test_three_parallel_arcs import (
-    RESOLVED,
-    arc_holding,
-    arcs_of,
-    fk_miss,
-    reachable_sixth,
-)
+from tests.oracles.q6_arcs import arc_holding, fk_miss, resolved_wrist_configuration
 
 WRIST_ANGLES = (0.0, 1e-12, -1e-12, 1e-9, -1e-9, 1e-6, -1e-6, 1e-3, -1e-3)
 POSES_PER_ANGLE = 5
@@ -56,16 +50,10 @@ def _poses(robot: Robot, seed: int) -> list[tuple[np.ndarray, list[np.ndarray]]]
     rng = np.random.default_rng(seed)
     out = []
     for angle in WRIST_ANGLES:
-        found = 0
-        while found < POSES_PER_ANGLE:
-            q = rng.uniform(-np.pi, np.pi, 6)
-            q[4] = 0.0
-            arcs = arcs_of(reachable_sixth(robot, q))
-            if min(len(arc) for arc in arcs) < 4 * RESOLVED or arc_holding(arcs, q[5]) is None:
-                continue
+        for _ in range(POSES_PER_ANGLE):
+            q, arcs = resolved_wrist_configuration(robot, rng)
             q[4] = angle
             out.append((q, arcs))
-            found += 1
     return out
 
 

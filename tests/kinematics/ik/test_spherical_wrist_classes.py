@@ -17,11 +17,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.kinematics import Joint, Robot, forward_kinematics, joint_screws, link_frames, screw_model
+from service.kinematics import Joint, Robot, forward_kinematics, link_frames, screw_model
 from service.kinematics.ik import _numeric, joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik.subproblems import subproblem_1
-from tests.arms import random_rigid
+from tests.arms import RandomDHRows, stated_three_ways
+from tests.ik_helpers import (aligning_value, assert_every_solution, centred_configurations,
+                              positioner_singular_configurations)
 
 DEG = np.pi / 180
 POSES = 400  # per statement; three statements (conventions) per class
@@ -33,23 +35,9 @@ DATA = json.loads((Path(__file__).parents[2] / "data" / "opw_arms.json").read_te
 
 def _rows(kind: str, rng: np.random.Generator) -> tuple[list[tuple[float, float, float, float]], str]:
     """Standard DH rows (a, alpha, d, theta offset) of a random arm of the class, and its joint kinds."""
-    def length():
-        return float(rng.uniform(0.1, 0.5))
-
-    def twist():
-        return float(rng.uniform(0.3, 2.8) * rng.choice([-1, 1]))
-
-    def offset():
-        return float(rng.uniform(-np.pi, np.pi))
-
-    def free():
-        return (length(), twist(), length(), offset())
-
-    # wrist twists of equal size, as in every real wrist (±90°): only then can the outer axes align
-    t = twist()
-    wrist = [(0.0, t, length(), offset()), (0.0, t * rng.choice([-1, 1]), 0.0, offset()), free()]
-    t = twist()
-    base_wrist = [(0.0, t, length(), offset()), (0.0, t * rng.choice([-1, 1]), 0.0, offset())]
+    draw = RandomDHRows(rng)
+    length, twist, offset, free = draw.length, draw.twist, draw.offset, draw.free
+    wrist, base_wrist = draw.spherical_wrists()
     tables = {
         # axis 1, axis 2 offset from it, axes 2 ∥ 3 (alpha_2 = 0), then the wrist: KUKA/ABB/Fanuc type
         "offset_shoulder_parallel_elbow": ([free(), (length(), 0.0, length(), offset()), free()] + wrist, "RRRRRR"),
@@ -91,73 +79,10 @@ CLASSES = {
 }
 
 
-def _reverse_axis(rows: list[list[float]], joint: int, base: np.ndarray) -> np.ndarray:
-    """Flip joint ``joint``'s axis (standard DH, in place): frame joint−1 turns by π about its x axis.
-
-    Row ``joint − 1`` (or the base) gains π of twist; row ``joint`` measures θ and d along the flipped z
-    and loses π of twist. The arm is the same; its joint variable changes sign.
-    """
-    if joint == 0:
-        base = base @ np.diag([1.0, -1.0, -1.0, 1.0])
-    else:
-        rows[joint - 1][1] += np.pi
-    a, alpha, d, theta = rows[joint]
-    rows[joint] = [a, alpha - np.pi, -d, -theta]
-    return base
-
-
 def statements(kind: str, seed: int) -> list[Robot]:
     """One random arm of the class in the standard, modified and Khalil conventions (same base, tool, FK)."""
     rng = np.random.default_rng(seed)
-    table, kinds = _rows(kind, rng)
-    rows = [list(row) for row in table]
-    base = random_rigid(rng, 0.5)
-    for joint in np.flatnonzero(rng.random(6) < 0.4):
-        base = _reverse_axis(rows, int(joint), base)
-    tool = random_rigid(rng, 0.2)
-    joint_kind = {"R": "revolute", "P": "prismatic"}
-    standard = Robot([Joint(f"j{i + 1}", joint_kind[k], *row) for i, (row, k) in enumerate(zip(rows, kinds))],
-                     convention="standard", world_T_base=base, flange_T_tool=tool)
-    # Craig: row i holds (a_{i−1}, alpha_{i−1}, d_i, theta_i); the last (a_n, alpha_n) moves into the tool
-    craig = [(0.0 if i == 0 else rows[i - 1][0], 0.0 if i == 0 else rows[i - 1][1], rows[i][2], rows[i][3])
-             for i in range(6)]
-    last = np.eye(4)
-    a, alpha = rows[5][0], rows[5][1]
-    last[:3, :3] = [[1, 0, 0], [0, np.cos(alpha), -np.sin(alpha)], [0, np.sin(alpha), np.cos(alpha)]]
-    last[0, 3] = a
-    modified_joints = [Joint(f"j{i + 1}", joint_kind[k], *row) for i, (row, k) in enumerate(zip(craig, kinds))]
-    modified = Robot(modified_joints, convention="modified", world_T_base=base, flange_T_tool=last @ tool)
-    khalil = Robot(modified_joints, convention="khalil", world_T_base=base, flange_T_tool=last @ tool)
-    return [standard, modified, khalil]
-
-
-def configurations(robot: Robot, count: int, seed: int) -> np.ndarray:
-    rng = np.random.default_rng(seed)
-    q = rng.uniform(-np.pi, np.pi, (count, robot.dof))
-    q[:, ~robot.is_revolute] = rng.uniform(-0.5, 0.5, (count, int((~robot.is_revolute).sum())))
-    return q
-
-
-def assert_every_solution(robot: Robot, q: np.ndarray, targets: np.ndarray, answer,
-                          joints: list[int] | None = None, tolerance: float = 1e-7) -> None:
-    """Recall 100 %, 0 wrong solutions (checked by an FK computed here), nothing unreachable.
-
-    ``joints`` limits the recall comparison to those joints (near a singularity the others are determined
-    only to rounding divided by the distance from it).
-    """
-    assert (answer.count >= 1).all(), f"{(answer.count == 0).sum()} of the arm's own FK poses answered unreachable"
-    scale = robot.characteristic_length
-    rows, slots = np.nonzero(answer.valid)
-    reached = forward_kinematics(robot, answer.joints[rows, slots])
-    position = np.linalg.norm(reached[:, :3, 3] - targets[rows, :3, 3], axis=-1)
-    # ‖R₁ − R₂‖_F = 2√2 sin(θ/2): the rotation angle between them to first order, without arccos' loss near 0
-    angle = np.linalg.norm(reached[:, :3, :3] - targets[rows, :3, :3], axis=(-2, -1)) / np.sqrt(2)
-    wrong = (position > 1e-9 * scale) | (angle > 1e-9)
-    assert not wrong.any(), f"{wrong.sum()} wrong solutions"
-    joints = list(range(robot.dof)) if joints is None else joints
-    missed = [row for row in range(len(q)) if np.abs(joint_difference(
-        robot, answer.joints[row, :answer.count[row]], q[row]))[:, joints].max(axis=1).min() > tolerance]
-    assert not missed, f"generating vector missing for {len(missed)} of {len(q)} poses, e.g. {q[missed[0]]}"
+    return stated_three_ways(rng, *_rows(kind, rng))
 
 
 # --- random arms of every class --------------------------------------------------------------------------------
@@ -172,7 +97,7 @@ def test_random_arms_of_every_class_in_every_convention(kind):
         plan = cached_plan(robot, constrain_orientation=True, reference=None)
         assert plan is not None and plan.structure == structure
         assert plan.generic_count == generic
-        q = configurations(robot, POSES, seed=index)
+        q = centred_configurations(robot, POSES, seed=index)
         targets = forward_kinematics(robot, q)
         answer = solve_ik_arrays(robot, targets)
         assert answer.count.max() <= generic
@@ -199,8 +124,8 @@ def test_wrist_singular_poses_report_the_wrist_and_keep_a_solution(kind):
     middle = plan.inner.wrist.joints[1] if hasattr(plan, "inner") else plan.wrist.joints[1]
     middle = robot.dof - 1 - middle if hasattr(plan, "inner") else middle
     wrist = (3, 4, 5) if not hasattr(plan, "inner") else (0, 1, 2)
-    q = configurations(robot, 50, seed=7)
-    q[:, middle] = _aligning_value(robot, q[0], wrist)
+    q = centred_configurations(robot, 50, seed=7)
+    q[:, middle] = aligning_value(robot, q[0], wrist)
     targets = forward_kinematics(robot, q)
     answer = solve_ik_arrays(robot, targets)
     assert (answer.count >= 1).all()
@@ -221,37 +146,6 @@ def test_wrist_singular_poses_report_the_wrist_and_keep_a_solution(kind):
                               joints=None if exponent <= 4 else determined)
 
 
-def _aligning_value(robot: Robot, q: np.ndarray, wrist: tuple[int, int, int]) -> float:
-    """The middle wrist joint's value that aligns the outer wrist axes (the same for every q: a wrist property).
-
-    The signed ``(a × c)·b`` changes sign through the alignment as c turns about b; bisection finds it to
-    rounding, starting from the best of a grid.
-    """
-    a, b, c = wrist
-
-    def signed(values: np.ndarray) -> np.ndarray:
-        trial = np.repeat(q[None], len(values), axis=0)
-        trial[:, b] = values
-        axes = joint_screws(robot, trial).directions
-        return np.einsum("ni,ni->n", np.cross(axes[:, a], axes[:, c]), axes[:, b]), \
-            np.linalg.norm(np.cross(axes[:, a], axes[:, c]), axis=-1)
-
-    grid = np.linspace(-np.pi, np.pi, 3601)
-    value, size = signed(grid)
-    best = int(np.argmin(size))
-    low, high = grid[max(best - 1, 0)], grid[min(best + 1, len(grid) - 1)]
-    f_low = signed(np.array([low]))[0][0]
-    for _ in range(80):
-        mid = 0.5 * (low + high)
-        f_mid = signed(np.array([mid]))[0][0]
-        if np.sign(f_mid) == np.sign(f_low):
-            low, f_low = mid, f_mid
-        else:
-            high = mid
-    assert signed(np.array([low]))[1][0] < 1e-12
-    return 0.5 * (low + high)
-
-
 def _stretched_configurations(robot: Robot, plan, count: int, seed: int) -> np.ndarray:
     """Joint vectors with the positioner's third joint where the point is farthest from axis 2 (stretched)."""
     positioner = plan.positioner
@@ -263,7 +157,7 @@ def _stretched_configurations(robot: Robot, plan, count: int, seed: int) -> np.n
     # axis 3 (in the plane normal to them): subproblem 1's angle (an independent Rodrigues check follows)
     best = float(subproblem_1(g.direction(k), in_plane @ (positioner.point - g.point(k)),
                               in_plane @ (g.point(k) - g.point(j))).theta[0])
-    q = configurations(robot, count, seed)
+    q = centred_configurations(robot, count, seed)
     q[:, k] = best
     return q
 
@@ -291,69 +185,6 @@ def test_stretched_elbow_of_the_parallel_elbow_class_is_reported(kind):
     assert (answer.position[rows, slots] <= 1e-9 * robot.characteristic_length).all()
 
 
-def _positioner_determinant(robot: Robot, q: np.ndarray, joints: tuple[int, ...], centre) -> np.ndarray:
-    """det of the positioner's 3 × 3 Jacobian of the wrist centre at joint values q (M, n)."""
-    screws = joint_screws(robot, q)
-    point = centre(q)  # (M, 3)
-    columns = []
-    for j in joints:
-        if robot.is_revolute[j]:
-            columns.append(np.cross(screws.directions[:, j], point - screws.points[:, j]))
-        else:
-            columns.append(screws.directions[:, j])
-    return np.linalg.det(np.stack(columns, axis=-1))
-
-
-def _positioner_singular_configurations(robot: Robot, plan, count: int, seed: int, search: int | None = None,
-                                        pool: int = 2) -> np.ndarray:
-    """Random joint vectors moved, along one positioner joint (``search``; by default the third), onto a zero of
-    the positioner's Jacobian.
-
-    The 6 × 6 Jacobian about the wrist centre is block-triangular, so these are exactly the arm's singular
-    configurations other than the wrist's: a stretched or folded elbow, a shoulder at its boundary, two
-    positioner solutions merging.
-    """
-    if hasattr(plan, "inner"):  # wrist at the base: its centre is fixed in the world
-        n = robot.dof
-        joints = tuple(sorted(n - 1 - j for j in plan.inner.positioner.joints))
-        search = joints[0]  # the inverse chain's third positioner joint (its first one never matters)
-        fixed = plan.inner.point
-
-        def centre(q):
-            return np.broadcast_to(fixed, (len(q), 3))
-    else:
-        joints = plan.positioner.joints
-        search = joints[2] if search is None else search
-        home_inverse = np.linalg.inv(robot_home(robot))
-
-        def centre(q):
-            return (forward_kinematics(robot, q) @ home_inverse @ np.append(plan.point, 1.0))[:, :3]
-    grid = np.linspace(-np.pi, np.pi, 721) * (1.0 if robot.is_revolute[search] else 1 / np.pi)
-    q = configurations(robot, pool * count, seed)  # the first ``count`` whose Jacobian changes sign on the grid
-    trial = np.repeat(q[:, None], len(grid), axis=1)
-    trial[..., search] = grid
-    det = _positioner_determinant(robot, trial.reshape(-1, robot.dof), joints, centre).reshape(len(q), -1)
-    change = np.sign(det[:, :-1]) != np.sign(det[:, 1:])
-    rows = np.flatnonzero(change.any(axis=1))[:count]
-    first = change[rows].argmax(axis=1)
-    low, high, f_low = grid[first], grid[first + 1], det[rows, first]
-    q = q[rows]
-    for _ in range(60):  # bisection on every row at once
-        q[:, search] = 0.5 * (low + high)
-        f_mid = _positioner_determinant(robot, q, joints, centre)
-        same = np.sign(f_mid) == np.sign(f_low)
-        low, f_low, high = np.where(same, q[:, search], low), np.where(same, f_mid, f_low), \
-            np.where(same, high, q[:, search])
-    q[:, search] = 0.5 * (low + high)
-    found = q
-    assert len(found) == count
-    return found
-
-
-def robot_home(robot: Robot) -> np.ndarray:
-    return forward_kinematics(robot, np.zeros(robot.dof))
-
-
 @pytest.mark.parametrize("kind", sorted(CLASSES))
 def test_positioner_singular_poses_report_a_singularity(kind):
     """Stretched, folded and boundary poses of each class: flagged, never unreachable, never wrong.
@@ -362,7 +193,7 @@ def test_positioner_singular_poses_report_a_singularity(kind):
     """
     robot = statements(kind, seed=sorted(CLASSES).index(kind))[0]
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
-    q = _positioner_singular_configurations(robot, plan, 20, seed=13)
+    q = positioner_singular_configurations(robot, plan, 20, seed=13)
     targets = forward_kinematics(robot, q)
     answer = solve_ik_arrays(robot, targets)
     assert_every_solution(robot, q, targets, answer, tolerance=1e-5)
@@ -386,7 +217,7 @@ def test_published_industrial_arms_are_solved_in_closed_form(name):
     robot = published_arm(name)
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     assert plan is not None and plan.structure == DATA["arms"][name]["structure"]
-    q = configurations(robot, 1000, seed=5)
+    q = centred_configurations(robot, 1000, seed=5)
     targets = forward_kinematics(robot, q)
     answer = solve_ik_arrays(robot, targets)
     assert_every_solution(robot, q, targets, answer)
@@ -406,7 +237,7 @@ def test_published_arms_never_reach_the_numeric_fallback(name, monkeypatch):
 
     monkeypatch.setattr(_numeric, "search", refuse)
     monkeypatch.setattr("service.kinematics.ik._answer.search", refuse)
-    for q in configurations(robot, 20, seed=9):
+    for q in centred_configurations(robot, 20, seed=9):
         result = solve_ik(robot, forward_kinematics(robot, q))
         assert (result.method, result.complete, result.status) == ("analytic", True, "ok")
         assert result.structure == DATA["arms"][name]["structure"]
@@ -429,7 +260,7 @@ def test_kuka_front_and_back_labels_follow_the_shoulder_offset():
 def test_kuka_elbow_labels_are_the_side_of_the_shoulder_wrist_line():
     """Elbow up: axis 3 lies above the line from axis 2 to the wrist centre, in the arm's vertical plane."""
     robot = published_arm("kuka_kr6_r900_2")
-    q = configurations(robot, 200, seed=21)
+    q = centred_configurations(robot, 200, seed=21)
     answer = solve_ik_arrays(robot, forward_kinematics(robot, q))
     values, codes = answer.labels["elbow"]
     rows, slots = np.nonzero(answer.valid)
@@ -507,7 +338,7 @@ def test_kuka_stated_in_khalil_columns_through_the_api_is_solved_in_closed_form(
                        "theta": float(np.degrees(rows[i][3])), "r": float(rows[i][2])})
     robot = {"name": "KR 6 R900-2 (Khalil)", "convention": "khalil", "angle_unit": "deg", "length_unit": "m",
              "joints": joints}  # the last row has a_6 = alpha_6 = 0: no tool transform needed
-    for q in configurations(standard, 10, seed=17):
+    for q in centred_configurations(standard, 10, seed=17):
         target = forward_kinematics(standard, q)
         response = client.post("/v1/ik", json={"robot": robot, "target": {"matrix": target.tolist()}})
         assert response.status_code == 200, response.text
@@ -523,7 +354,7 @@ def test_position_only_targets_hold_the_wrist_and_place_the_tool_in_closed_form(
     """A position target holds joints 4–6 at the reference; joints 1–3 then place the tool point (its positioner
     family, complete); targets far out of reach are unreachable, with complete: true."""
     robot = statements(kind, seed=sorted(CLASSES).index(kind))[2]
-    q = configurations(robot, 40, seed=23)
+    q = centred_configurations(robot, 40, seed=23)
     targets = forward_kinematics(robot, q)
     for q_true, target in zip(q, targets):
         result = solve_ik(robot, target, constrain_orientation=False, reference=q_true)

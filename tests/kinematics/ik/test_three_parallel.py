@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from service.kinematics import Joint, Robot, forward_kinematics
+from service.kinematics import CONVENTIONS, Joint, Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik._plan import geometry_of
@@ -23,7 +23,6 @@ from tests.arms import THREE_PARALLEL_CASES as CASES, random_three_parallel_arm
 from tests.ik_helpers import SAME
 
 POSES = 1000
-CONVENTIONS = ("standard", "modified", "khalil")
 
 
 def _hits(robot: Robot, joints: np.ndarray, valid: np.ndarray, q: np.ndarray, tolerance: float) -> np.ndarray:

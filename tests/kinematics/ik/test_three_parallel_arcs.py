@@ -8,7 +8,8 @@ continuum of solutions. The answer must hold a solution on each (or say it is no
 The arcs are found here independently of the solver, by the arm's FK alone: with the target T held, turning joint 6
 from q6 to q6' moves everything before it by ``T · FK(q with q6')⁻¹``; the elbow reaches the moved point on axis 4
 when its distance from axis 2 (normal to the parallel axes) lies between the difference and the sum of the two
-planar link lengths. q6' is sampled on a fine grid of [−π, π) and the arcs are the grid's connected runs.
+planar link lengths. q6' is sampled on a fine grid of [−π, π) and the arcs are the grid's connected runs
+(tests/oracles/q6_arcs.py).
 """
 
 from __future__ import annotations
@@ -17,76 +18,16 @@ import numpy as np
 import pytest
 
 from service.config import Settings
-from service.kinematics import Robot, forward_kinematics, joint_screws
+from service.kinematics import Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.robots.catalogue import load_catalogue
 from tests.arms import random_ur_type_arm
 from tests.ik_helpers import wrapped
+from tests.oracles.q6_arcs import arc_holding, fk_miss, q6_grid, resolved_wrist_configuration
 
-GRID = 7200  # q6 samples on [−π, π): 0.05° apart
-#: an arc shorter than this many samples, or a q6 this close to an arc's end, is not resolved by the grid
-RESOLVED = 8
 WRIST_OFFSETS = (0.0, 1e-12, -1e-12)
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
-
-
-def _planar(v: np.ndarray, axis: np.ndarray) -> np.ndarray:
-    return v - (v @ axis)[..., None] * axis
-
-
-def reachable_sixth(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Which q6 of the grid (GRID,) the elbow reaches with, q1 and q5 held at q's, for the target FK(q)."""
-    screws = joint_screws(robot, q)
-    axis, points = screws.directions[1], screws.points
-    upper = np.linalg.norm(_planar(points[2] - points[1], axis))
-    fore = np.linalg.norm(_planar(points[3] - points[2], axis))
-    turned = np.repeat(q[None], GRID, axis=0)
-    turned[:, 5] = grid()
-    moved = screws.world_T_tool @ np.linalg.inv(forward_kinematics(robot, turned))  # (GRID, 4, 4)
-    point_on_4 = moved[:, :3, :3] @ points[3] + moved[:, :3, 3]
-    reach = np.linalg.norm(_planar(point_on_4 - points[1], axis), axis=-1)
-    return (abs(upper - fore) <= reach) & (reach <= upper + fore)
-
-
-def fk_miss(robot: Robot, solutions: np.ndarray, target: np.ndarray) -> np.ndarray:
-    """How far each of the solutions (M, n) misses the target (4, 4) by this test's FK, (M,): the position over the
-    arm's size, or the rotation matrix's largest entry, whichever is larger."""
-    reached = forward_kinematics(robot, solutions)
-    return np.maximum(np.abs(reached[:, :3, 3] - target[:3, 3]).max(axis=1) / robot.characteristic_length,
-                      np.abs(reached[:, :3, :3] - target[:3, :3]).max(axis=(1, 2)))
-
-
-def grid() -> np.ndarray:
-    return -np.pi + 2 * np.pi * np.arange(GRID) / GRID
-
-
-def arcs_of(reachable: np.ndarray) -> list[np.ndarray]:
-    """The connected runs of true samples on the circle, each as its sample indices in order."""
-    if reachable.all():
-        return [np.arange(GRID)]
-    start = int(np.argmin(reachable))  # a false sample: no run crosses it
-    order = np.roll(np.arange(GRID), -start)
-    runs, current = [], []
-    for index in order:
-        if reachable[index]:
-            current.append(index)
-        elif current:
-            runs.append(np.array(current))
-            current = []
-    if current:
-        runs.append(np.array(current))
-    return runs
-
-
-def arc_holding(arcs: list[np.ndarray], q6: float) -> int | None:
-    """The arc whose samples lie within RESOLVED samples of q6 on both sides (q6 clearly inside it), or None."""
-    nearest = int(np.rint((q6 + np.pi) / (2 * np.pi) * GRID)) % GRID
-    for label, arc in enumerate(arcs):
-        members = set(arc.tolist())
-        if all((nearest + step) % GRID in members for step in range(-RESOLVED, RESOLVED + 1)):
-            return label
-    return None
 
 
 def _check(robot: Robot, q: np.ndarray, arcs: list[np.ndarray], solutions: np.ndarray, complete: bool,
@@ -122,18 +63,14 @@ def _poses(robot: Robot, seed: int, count: int) -> list[tuple[np.ndarray, list[n
     rng = np.random.default_rng(seed)
     out = []
     while len(out) < count:
-        q = rng.uniform(-np.pi, np.pi, 6)
-        q[4] = 0.0
-        arcs = arcs_of(reachable_sixth(robot, q))
-        if min(len(arc) for arc in arcs) < 4 * RESOLVED or arc_holding(arcs, q[5]) is None:
-            continue
+        q, arcs = resolved_wrist_configuration(robot, rng)
         q[4] = WRIST_OFFSETS[len(out) % len(WRIST_OFFSETS)]
         out.append((q, arcs))
     return out
 
 
 def _nearest_to_zero(arcs: list[np.ndarray]) -> int:
-    distance = [np.abs(wrapped(grid()[arc])).min() for arc in arcs]
+    distance = [np.abs(wrapped(q6_grid()[arc])).min() for arc in arcs]
     return int(np.argmin(distance))
 
 
@@ -166,7 +103,7 @@ def test_each_arc_of_q6_the_elbow_reaches_with_has_a_solution(seed, convention):
         T = forward_kinematics(robot, q)
         elsewhere = q.copy()
         if other is not None:
-            elsewhere[5] = grid()[other[len(other) // 2]]
+            elsewhere[5] = q6_grid()[other[len(other) // 2]]
         answers = [("batch", batch.joints[row, :batch.count[row]], bool(batch.complete[row]), 0.0)]
         for name, reference in (("alone", None), ("reference", q), ("reference elsewhere", elsewhere)):
             result = solve_ik(robot, T, reference=reference)

@@ -52,12 +52,11 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
         return [[] for _ in free_of_target]
     joints = (table.joints / scale).tolist()
     position = table.position.tolist()
-    orientation = [None if missing else value
-                   for value, missing in zip(table.orientation.tolist(), np.isnan(table.orientation).tolist())]
+    orientation = [None if math.isnan(value) else value for value in table.orientation.tolist()]
     within = table.within_limits.tolist()
     branches = _branch_dicts(table)
-    lower = [None if np.isinf(value) else value for value in (answer.limits.lower / scale).tolist()]
-    upper = [None if np.isinf(value) else value for value in (answer.limits.upper / scale).tolist()]
+    lower = [None if math.isinf(value) else value for value in (answer.limits.lower / scale).tolist()]
+    upper = [None if math.isinf(value) else value for value in (answer.limits.upper / scale).tolist()]
     violations: dict[int, list[dict]] = {}
     for k, j in zip(*np.nonzero(outside)):
         violations.setdefault(int(k), []).append(
@@ -90,11 +89,12 @@ def _branch_dicts(table: SolutionTable) -> list[dict]:
         return [empty] * len(table.target)
     names = list(table.labels)
     codes = np.stack([table.labels[name][1] for name in names], axis=1).astype(np.int64) + 1  # (S, L), 0 = none
-    keys = codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)
-    distinct, first, row_of = np.unique(keys, return_index=True, return_inverse=True)
-    shared = [{name: table.labels[name][0][code - 1] for name, code in zip(names, codes[row].tolist()) if code}
-              for row in first.tolist()]
-    return [shared[i] for i in row_of.reshape(-1).tolist()]
+    keys = (codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)).tolist()
+    shared = {}
+    for key in dict.fromkeys(keys):  # the distinct branches, each worded from its first row
+        first = codes[keys.index(key)].tolist()
+        shared[key] = {name: table.labels[name][0][code - 1] for name, code in zip(names, first) if code}
+    return list(map(shared.__getitem__, keys))
 
 
 def _rolls(table: SolutionTable, angle: float) -> list[float | None]:

@@ -87,7 +87,7 @@ class _Group(NamedTuple):
     radius_a: np.ndarray | None  # (P_k, 1): a round shape's radius (None for a box)
     radius_b: np.ndarray | None
     swapped: np.ndarray  # (P_k,) bool
-    fixed: bool  # base shapes and obstacles: the same in every configuration whose base frame is the same
+    fixed: bool  # a base shape and an obstacle: the same in every configuration whose base frame is the same
     bounds: Callable | None  # the kernel's cheap bounds (None: none, every pair is measured)
     bound_constants: tuple  # the bounds' sizes, single precision (see the bound functions)
 
@@ -317,12 +317,12 @@ class CollisionModel:
         configurations [begin, end) at a time (yielded when it is filled).
 
         The groups without bounds are measured first, in full: two boxes, and the pairs of a base shape and an
-        obstacle (once per block when the base frame is the same throughout, as it is for one robot). With a ``margin``, the
-        other pairs are then measured only where they can matter: their distances and each bounded pair's cheap
-        bounds (a shape's round core inside the ball about its middle, and around it) give every configuration
-        an upper bound U of its clearance, and a pair whose lower bound is at least max(U, margin) can be
-        neither the clearance nor a close pair (a pair that attains U is measured, unless its bounds meet). Such
-        a pair keeps its lower bound in ``result``.
+        obstacle (once per block when the base frame is the same throughout, as it is for one robot). With a
+        ``margin``, the other pairs are then measured only where they can matter: their distances and each bounded
+        pair's cheap bounds (a shape's round core inside the ball about its middle, and around it) give every
+        configuration an upper bound U of its clearance, and a pair whose lower bound is at least max(U, margin)
+        can be neither the clearance nor a close pair (a pair that attains U is measured, unless its bounds meet).
+        Such a pair keeps its lower bound in ``result``.
         """
         count = columns.shape[3]
         if count * len(self.pairs) < _BOUNDED_FROM:
@@ -393,7 +393,7 @@ def _round_point(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness)
 
 
 def _box_round(rows, half_size_a, half_size_b, radius_a, radius_b, *, witness):
-    """A box and a capsule or sphere: rows centre, three axes, start, end."""
+    """A box and a capsule: rows centre, three axes, start, end."""
     core = _box_segment(rows[:, :4], half_size_a, rows[:, 4:6], witness)
     return _swept(core, 0.0, radius_b) if witness else core - radius_b
 

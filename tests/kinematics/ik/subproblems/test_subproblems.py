@@ -119,6 +119,18 @@ def assert_generic_two_roots(sol, gap, distinct):
     assert (distinct[~merged] > DUPLICATE_TOLERANCE).all()
 
 
+def assert_exact_two_root_instances(sol, known, reached, delta, scale, solve_row):
+    """Exact instances of a two-root subproblem, N_ROWS of them built from the angles ``known``: the record's
+    shapes, the generic two roots (:func:`assert_generic_two_roots`), every root's value ``reached`` (N_ROWS, 2)
+    equal to ``delta`` within RESIDUAL of ``scale`` (N_ROWS, 1), and every seventh row solved alone
+    (``solve_row``) as in the batch."""
+    assert_record_shapes(sol, (N_ROWS,), 2)
+    distinct = angle_gap(sol.theta[:, 0], sol.theta[:, 1])
+    assert_generic_two_roots(sol, gap_to_candidates(sol.theta, sol.valid, known), distinct)
+    assert not (np.abs(reached - delta[:, None]) > RESIDUAL * scale).any()  # NaN where no root
+    assert_rows_match(sol, solve_row, range(0, N_ROWS, 7))
+
+
 def test_rotation_convention_is_right_handed():
     np.testing.assert_allclose(rotate([0, 0, 1], np.pi / 2, [1, 0, 0]), [0, 1, 0], atol=1e-15)
     sol = subproblem_1([0, 0, 1], [1, 0, 0], [0, 1, 0])
@@ -422,13 +434,9 @@ def test_sp3_exact_instances(rng):
         theta = rng.uniform(-np.pi, np.pi, N_ROWS)
         delta = sp3_distance(k, theta, p, q)
         sol = subproblem_3(k, p, q, delta)
-        assert_record_shapes(sol, (N_ROWS,), 2)
-        distinct = angle_gap(sol.theta[:, 0], sol.theta[:, 1])
-        assert_generic_two_roots(sol, gap_to_candidates(sol.theta, sol.valid, theta), distinct)
         scale = (np.linalg.norm(p, axis=-1) + np.linalg.norm(q, axis=-1) + delta)[:, None]
-        reached = sp3_distance(k, sol.theta, p[:, None, :], q[:, None, :])
-        assert not (np.abs(reached - delta[:, None]) > RESIDUAL * scale).any()  # NaN where no root
-        assert_rows_match(sol, lambda i: subproblem_3(k, p[i], q[i], delta[i]), range(0, N_ROWS, 7))
+        assert_exact_two_root_instances(sol, theta, sp3_distance(k, sol.theta, p[:, None, :], q[:, None, :]), delta,
+                                        scale, lambda i: subproblem_3(k, p[i], q[i], delta[i]))
 
 
 def test_sp3_least_squares_beats_grid(rng):
@@ -501,13 +509,9 @@ def test_sp4_exact_instances(rng):
         theta = rng.uniform(-np.pi, np.pi, N_ROWS)
         delta = sp4_height(h, k, theta, p)
         sol = subproblem_4(h, k, p, delta)
-        assert_record_shapes(sol, (N_ROWS,), 2)
-        distinct = angle_gap(sol.theta[:, 0], sol.theta[:, 1])
-        assert_generic_two_roots(sol, gap_to_candidates(sol.theta, sol.valid, theta), distinct)
         scale = (np.linalg.norm(p, axis=-1) + np.abs(delta))[:, None]
-        reached = sp4_height(h, k, sol.theta, p[:, None, :])
-        assert not (np.abs(reached - delta[:, None]) > RESIDUAL * scale).any()  # NaN where no root
-        assert_rows_match(sol, lambda i: subproblem_4(h, k, p[i], delta[i]), range(0, N_ROWS, 7))
+        assert_exact_two_root_instances(sol, theta, sp4_height(h, k, sol.theta, p[:, None, :]), delta, scale,
+                                        lambda i: subproblem_4(h, k, p[i], delta[i]))
 
 
 def test_sp4_least_squares_beats_grid(rng):

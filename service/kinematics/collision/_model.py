@@ -14,15 +14,14 @@ How the work is laid out: every shape is reduced to a few reference rows (a caps
 centre, a box's centre and its three axes), each a homogeneous point or direction fixed to a link or to the
 world. One matrix product per link maps that link's rows to the world for a block of configurations; the pairs
 then fall into groups by the kernel that measures them: box–box, round–point, box–point, round–round and
-box–round (a point is a sphere or a capsule of length 0, a round shape any other capsule), the pairs of a base
-shape and an obstacle apart (they do not move). Each group gathers its rows and runs one vectorised kernel over
-the block. Configurations go through in blocks of a few thousand pair evaluations, so that the temporaries
+box–round (a point is a sphere or a capsule of length 0, a round shape any other capsule), each with the pairs of
+a base shape and an obstacle first (they do not move). Each group gathers its rows and runs one vectorised kernel
+over the block. Configurations go through in blocks of a few thousand pair evaluations, so that the temporaries
 stay in cache.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
 import numbers
 from dataclasses import dataclass
@@ -87,13 +86,25 @@ class _Group(NamedTuple):
     radius_a: np.ndarray | None  # (P_k, 1): a round shape's radius (None for a box)
     radius_b: np.ndarray | None
     swapped: np.ndarray  # (P_k,) bool
-    fixed: bool  # a base shape and an obstacle: the same in every configuration whose base frame is the same
     bounds: Callable | None  # the kernel's cheap bounds (None: none, every pair is measured)
-    bound_constants: tuple  # the bounds' sizes, single precision (see the bound functions)
+    bound_constants: tuple  # the bounds' sizes, single precision (see the bound functions), (..., P_k, 1) each
+    fixed: int  # the first pairs, of a base shape and an obstacle: the same wherever the base frame is
 
     def sizes(self) -> tuple:
         """The kernel's four sizes."""
         return self.half_size_a, self.half_size_b, self.radius_a, self.radius_b
+
+    def part(self, begin: int, end: int) -> "_Group":
+        """The group's pairs [begin, end) as a group of their own (columns start + begin … start + end)."""
+        def pairs_of(size):
+            return None if size is None else size[..., begin:end, :]
+
+        return self._replace(start=self.start + begin, stop=self.start + end, rows=self.rows[begin:end],
+                             half_size_a=pairs_of(self.half_size_a), half_size_b=pairs_of(self.half_size_b),
+                             radius_a=pairs_of(self.radius_a), radius_b=pairs_of(self.radius_b),
+                             swapped=self.swapped[begin:end],
+                             bound_constants=tuple(pairs_of(constant) for constant in self.bound_constants),
+                             fixed=min(self.fixed, end) - min(self.fixed, begin))
 
     def bounds_of(self, placed32: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
         """The lower and upper bounds (P_k, B) of the group's distances from the block's reference rows (3, K, B)
@@ -331,9 +342,14 @@ class CollisionModel:
         block = max(1, min(count, _BLOCK_ELEMENTS // widest if margin is None else
                            min(_BOUNDED_BLOCK_ELEMENTS // widest, _BOUNDED_BLOCK_CONFIGURATIONS)))
         world = self._world_buffer(block)
-        measured = [group for group in self._groups if group.bounds is None]
-        bounded = [group for group in self._groups if group.bounds is not None]
-        measured_columns = measured[-1].stop if measured else 0  # their columns come first
+        if margin is None:  # every pair measured in full: one kernel call per group
+            measured, bounded = list(self._groups), []
+        else:  # first a base shape's pairs with the obstacles, then the groups without bounds, then the others
+            measured = [group.part(0, group.fixed) for group in self._groups if group.fixed] + \
+                [group.part(group.fixed, len(group.rows)) for group in self._groups
+                 if group.bounds is None and group.fixed < len(group.rows)]
+            bounded = [group.part(group.fixed, len(group.rows)) for group in self._groups
+                       if group.bounds is not None and group.fixed < len(group.rows)]
         with _quiet():
             for begin in range(0, count, block):
                 end = min(begin + block, count)
@@ -342,14 +358,17 @@ class CollisionModel:
                     frames = np.ascontiguousarray(frames)  # row each, so that einsum runs on unit strides
                 placed = self._world_rows(frames, world[:, :, : end - begin])
                 block_result = result[begin:end]
-                base_still = bool((frames[0] == frames[0][..., :1]).all())
+                base_still = bool(bounded) and bool((frames[0] == frames[0][..., :1]).all())
                 for group in measured:
                     _measure(block_result[:, group.start:group.stop], group, world, None, None, 0.0,
-                             once=group.fixed and base_still)
-                bounds, cutoff, slack = ([None] * len(bounded), None, 0.0) if margin is None else \
-                    _bounds(bounded, placed, margin, block_result[:, :measured_columns])
-                for group, bound in zip(bounded, bounds):
-                    _measure(block_result[:, group.start:group.stop], group, world, bound, cutoff, slack)
+                             once=base_still and group.fixed == len(group.rows))
+                if bounded:
+                    clearance = np.full(end - begin, np.inf)  # so far: of the pairs measured
+                    for group in measured:
+                        np.fmin(clearance, block_result[:, group.start:group.stop].min(axis=1), out=clearance)
+                    bounds, cutoff, slack = _bounds(bounded, placed, margin, clearance)
+                    for group, bound in zip(bounded, bounds):
+                        _measure(block_result[:, group.start:group.stop], group, world, bound, cutoff, slack)
                 yield begin, end
 
     def _world_buffer(self, block: int) -> np.ndarray:
@@ -415,9 +434,9 @@ _KERNELS = {("box", "box"): _box_box_kernel, ("round", "point"): _round_point, (
             ("round", "round"): _round_round, ("box", "round"): _box_round}
 
 
-def _bounds(groups, placed: np.ndarray, margin: float, measured: np.ndarray) -> tuple[list, np.ndarray, float]:
+def _bounds(groups, placed: np.ndarray, margin: float, clearance: np.ndarray) -> tuple[list, np.ndarray, float]:
     """Each group's bounds for a block (:meth:`_Group.bounds_of`), every configuration's cutoff (B,) and the slack;
-    ``measured`` (B, E): the distances of the pairs already measured, which bound the clearance too.
+    ``clearance`` (B,): the smallest distance of the pairs already measured, which bounds the clearance too.
 
     Single precision, kept conservative by a slack far above its rounding (a few dozen ulps of the largest
     coordinate); coordinates it cannot hold have no bounds, so every pair is measured."""
@@ -425,9 +444,7 @@ def _bounds(groups, placed: np.ndarray, margin: float, measured: np.ndarray) -> 
     largest = float(np.abs(placed32).max())
     slack = _BOUND_SLACK * (1.0 + largest)
     bounds = [group.bounds_of(placed32) if largest < _BOUND_RANGE else None for group in groups]
-    upper = np.full(placed.shape[2], np.inf, dtype=np.float32)
-    if measured.shape[1]:
-        upper[:] = np.fmin.reduce(measured, axis=1)
+    upper = clearance.astype(np.float32)
     for bound in bounds:
         if bound is not None:
             np.fmin(upper, bound[1].min(axis=0), out=upper)
@@ -653,17 +670,18 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
 
     pairs: list[ShapePair] = []
     groups: list[_Group] = []
-    for still, (family, kernel) in itertools.product((True, False), _KERNELS.items()):
-        group = [member for member in members[family] if (member[0].link_a == 0 and member[0].link_b is None) == still]
-        if not group:
+    for family, kernel in _KERNELS.items():
+        if not members[family]:
             continue
+        still = [member[0].link_a == 0 and member[0].link_b is None for member in members[family]]
+        group = [member for member, _ in sorted(zip(members[family], still), key=lambda item: not item[1])]
         start = len(pairs)
         pairs.extend(member[0] for member in group)
         firsts, seconds = [member[2] for member in group], [member[3] for member in group]
         groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in group]),
                              _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
-                             np.array([member[4] for member in group], dtype=bool), still,
-                             None if still else _BOUNDS.get(family), _bound_constants(family, firsts, seconds)))
+                             np.array([member[4] for member in group], dtype=bool), _BOUNDS.get(family),
+                             _bound_constants(family, firsts, seconds), sum(still)))
     body_pairs: dict[tuple[str, str], int] = {}
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)

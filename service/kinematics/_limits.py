@@ -121,7 +121,7 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     q = np.asarray(q, dtype=float)
     tolerance = limits.tolerance(robot)
     lower, upper = limits.lower - tolerance, limits.upper + tolerance
-    both, continuous = limits.multi_valued(robot), limits.continuous(robot)
+    both = limits.multi_valued(robot)
     if both.any():  # every both-bounded column at once (whole rows: a column alone strides through them all)
         value, low_bound, high_bound = (q, lower, upper) if both.all() else (q[..., both], lower[both], upper[both])
         low = np.ceil((low_bound - value) / _TWO_PI)
@@ -133,6 +133,7 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     first, last = np.zeros_like(q), np.zeros_like(q)
     if both.any():
         first[..., both], last[..., both] = low, high
+    continuous = limits.continuous(robot)
     for j in np.flatnonzero(~both).tolist():  # one kind of joint per column
         value = q[..., j]
         if robot.is_revolute[j] and not continuous[j]:

@@ -236,7 +236,7 @@ class IKAnswer:
 
 @dataclass
 class _Part:
-    """Targets ``rows`` (k,) answered by one solver: their verified solutions (``verified``, k targets), the
+    """Targets ``rows`` (k,, ascending) answered by one solver: their verified solutions (``verified``, k targets), the
     solver, and per local row the words before the selection's notes (``details``) and after them
     (``remarks``). ``reported`` (k,) says where the solver's singular conditions are reported (default: the rows
     with a solution); ``unfinished`` (k,) where the numeric search's iteration cap stopped starts; ``sampled``
@@ -262,11 +262,13 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
     check_options(robot, options.ordering, options.reference, options.max_equivalents)
     timings: list[SolveTiming] = []
     parts: list[_Part] = []
-    if (kinds == DIRECTION).any():
+    per_kind = np.bincount(kinds, minlength=3) if len(kinds) else np.zeros(3, dtype=int)  # targets of each kind
+    if per_kind[DIRECTION]:
         parts += _directions(robot, targets, options, timings)
-    if (kinds == POSE).any():
-        parts += _poses(robot, matrices, np.flatnonzero(kinds == POSE), options, timings)
-    if (kinds == POSITION).any():
+    if per_kind[POSE]:
+        rows = np.arange(len(kinds)) if per_kind[POSE] == len(kinds) else np.flatnonzero(kinds == POSE)
+        parts += _poses(robot, matrices, rows, options, timings)
+    if per_kind[POSITION]:
         parts += _positions(robot, matrices, np.flatnonzero(kinds == POSITION), options, timings)
     return _assembled(robot, len(kinds), parts, limits, options, timings)
 
@@ -507,12 +509,12 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
     carry the plan's branch labels (``label_codes``), as the closed form's do: a target near a singularity,
     which the closed form hands over, keeps the labels a client holds along a path (issue 22.11)."""
     verified = closed.verified
-    broken = np.flatnonzero(~verified.complete)
-    promised = np.flatnonzero(verified.complete)
     for local in np.flatnonzero((verified.count == 0) & verified.complete).tolist():
         closed.details[local] = _unreachable_detail(robot, goal, local, verified)
-    if not len(broken):
+    if verified.complete.all():
         return [_timed(timings, closed, started)]
+    broken = np.flatnonzero(~verified.complete)
+    promised = np.flatnonzero(verified.complete)
     parts = [_timed(timings, _taken(closed, promised), started)] if len(promised) else []
     started = time.perf_counter()
     table = verified.table
@@ -674,21 +676,20 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
         if part.unfinished is not None:
             flags += part.unfinished
         lookup = np.zeros(4, dtype=int)
-        for code in np.unique(flags).tolist():
+        for code in np.flatnonzero(np.bincount(flags, minlength=4)).tolist():  # the codes met, ascending
             report = SolverReport(part.method, part.structure, code >= 2, code % 2 == 1, part.free_joints)
             if report not in reports:
                 reports.append(report)
             lookup[code] = reports.index(report)
         report_of[part.rows] = lookup[flags]
-        reported = verified.count > 0 if part.reported is None else part.reported
-        for local in np.flatnonzero(reported & verified.singularities.any()).tolist():  # the others meet none
-            met = verified.singularities[local]
-            if met:
-                singular_of[int(part.rows[local])] = met
+        if verified.singularities.entries:
+            reported = verified.count > 0 if part.reported is None else part.reported
+            for local in np.flatnonzero(reported & verified.singularities.any()).tolist():  # the others meet none
+                met = verified.singularities[local]
+                if met:
+                    singular_of[int(part.rows[local])] = met
         tables.append(verified.table.with_targets(part.rows[verified.table.target]))
-    table = SolutionTable.concat(tables, robot.dof)
-    if tables and len(table) and (np.diff(table.target) < 0).any():
-        table = table.take(np.argsort(table.target, kind="stable"))
+    table = SolutionTable.concat(tables, robot.dof)  # grouped by target: each part's rows ascend
     excluded = None
     if options.collisions is not None:  # a 2π-equivalent moves no link: each distinct solution is checked once
         options.budget.check("the collision check")
@@ -700,7 +701,9 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
                                reference=options.reference, ordering=options.ordering,
                                max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget)
     status = chosen.status.copy()
-    status[(status == "unreachable") & (~complete | sampled)] = "not_found"
+    unproven = ~complete | sampled
+    if unproven.any():
+        status[(status == "unreachable") & unproven] = "not_found"
     # solver reports numbered by first appearance in target order
     by_appearance = list(dict.fromkeys(report_of.tolist()))
     renumber = np.zeros(max(len(reports), 1), dtype=int)

@@ -9,6 +9,8 @@ from service.config import Settings
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import _verify, joint_difference, solve_ik, wrap_revolute
 from service.kinematics.ik import cached_plan
+from service.kinematics.ik._closed_form import _one_pose_candidates
+from service.kinematics.ik._goals import PoseGoal
 from service.kinematics.ik._verify import accepted, residual_arrays
 
 from tests.ik_helpers import random_configurations
@@ -129,3 +131,45 @@ def test_the_scan_of_many_slots_is_the_pairwise_scan(robot_id, monkeypatch):
         pairwise = _verify.first_of_each(robot, np.repeat(q, 3, axis=0), np.repeat(ok, 3, axis=0))
         monkeypatch.undo()
         assert (scanned[0] == pairwise[0]).all() and (pairwise[1:] == pairwise[0]).all()
+
+
+@pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)
+def test_the_float_check_of_one_pose_is_verify(robot_id):
+    """verify_one (the FK check, the duplicate scan and the labels of one pose's scalar slots, on floats) gives
+    the table, promise and nearest miss that verify gives for the same slots as candidates, bit for bit, with and
+    without a reference; where a valid slot's label is unclear (verify is then not given the scalar slots), it
+    gives the array path's rows and labels. The slots come wrapped, as verify would wrap them."""
+    robot = _CATALOGUE.get(robot_id).robot
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    references = [None, random_configurations(robot, 1, seed=14)[0]]
+    checked = unclear = 0
+    for i, T in enumerate(_poses(robot, 200, seed=15)):
+        one_pose = plan.solve_one(T)
+        if one_pose is None:
+            continue
+        valid = one_pose.valid[0]
+        assert (wrap_revolute(robot, one_pose.joints[0, valid]) == one_pose.joints[0, valid]).all()
+        goal, reference = PoseGoal(T[None]), references[i % 2]
+        fast = _verify.verify_one(robot, goal, one_pose, reference)
+        if fast is None:
+            continue
+        candidates = _one_pose_candidates(one_pose)
+        if candidates is None:  # a slot the FK check rejects has no clear label: against the array path
+            unclear += 1
+            slow = _verify.verify(robot, goal, plan.solve(T[None], reference), reference, plan.label_codes)
+            assert np.abs(joint_difference(robot, fast.table.joints, slow.table.joints)).max(initial=0) <= 1e-9
+        else:
+            checked += 1
+            slow = _verify.verify(robot, goal, candidates, reference)
+            np.testing.assert_array_equal(fast.table.joints, slow.table.joints)
+            np.testing.assert_array_equal(fast.table.position, slow.table.position)
+            np.testing.assert_array_equal(fast.table.orientation, slow.table.orientation)
+            np.testing.assert_array_equal(fast.nearest, slow.nearest)
+        np.testing.assert_array_equal(fast.table.target, slow.table.target)
+        np.testing.assert_array_equal(fast.table.within_limits, slow.table.within_limits)
+        np.testing.assert_array_equal(fast.complete, slow.complete)
+        assert list(fast.table.labels) == list(slow.table.labels)
+        for name, (values, codes) in fast.table.labels.items():
+            assert values == slow.table.labels[name][0]
+            np.testing.assert_array_equal(codes, slow.table.labels[name][1])
+    assert checked >= 150

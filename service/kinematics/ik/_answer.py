@@ -688,7 +688,8 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
                 met = verified.singularities[local]
                 if met:
                     singular_of[int(part.rows[local])] = met
-        tables.append(verified.table.with_targets(part.rows[verified.table.target]))
+        whole = len(parts) == 1 and len(part.rows) == n_targets  # rows 0 … N − 1: the part's own numbering
+        tables.append(verified.table if whole else verified.table.with_targets(part.rows[verified.table.target]))
     table = SolutionTable.concat(tables, robot.dof)  # grouped by target: each part's rows ascend
     excluded = None
     if options.collisions is not None:  # a 2π-equivalent moves no link: each distinct solution is checked once

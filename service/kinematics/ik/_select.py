@@ -331,7 +331,7 @@ def _each_once(table: SolutionTable, n_targets: int, turns: np.ndarray, max_equi
     available = rows_per_target.astype(np.int64, copy=False)
     notes = TargetNotes(np.flatnonzero(truncated), status, zeros, zeros, truncated, available, n_kept, available,
                         zeros, max_equivalents, False, None, n)
-    rejected = _listed(table.take(slice(0, 0)), np.zeros((0, n)), np.zeros(0, dtype=bool))
+    rejected = table.take(slice(0, 0))
     return Selection(status, truncated, np.zeros(n_targets, dtype=np.int64), available, notes, kept, rejected)
 
 

@@ -121,10 +121,9 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
         return ok.copy()
     tolerance = duplicate_tolerance(robot)
     revolute = robot.is_revolute
-    if n_targets == 1:  # one target: every pair of its slots at once, then the scan on Python booleans
+    if n_targets == 1:
         kept = ok.copy()
-        kept[0] = _scanned_pairs(_same(np.abs(joints[0, :, None] - joints[0, None]), tolerance, revolute).tolist(),
-                                 kept[0].tolist())
+        kept[0] = first_of_each_slot(robot, joints[0], kept[0].tolist())
         return kept
     if m > _PAIRWISE_SLOTS:
         return np.stack([_scanned(joints[row], ok[row], tolerance, revolute) for row in range(n_targets)]) \
@@ -141,6 +140,15 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
             kept[block, slot] &= ~np.any(same[:, offset:offset + slot] & kept[block, :slot], axis=1)
             offset += slot
     return kept
+
+
+def first_of_each_slot(robot: Robot, joints: np.ndarray, ok: list[bool]) -> list[bool]:
+    """:func:`first_of_each` of one target's slots ``joints`` (m, n), the ``ok`` ones and the result as lists (m,):
+    every pair of slots at once, then the scan on Python booleans."""
+    if len(ok) < 2:
+        return list(ok)
+    same = _same(np.abs(joints[:, None] - joints[None]), duplicate_tolerance(robot), robot.is_revolute)
+    return _scanned_pairs(same.tolist(), list(ok))
 
 
 def _same(gap: np.ndarray, tolerance: np.ndarray, revolute: np.ndarray) -> np.ndarray:
@@ -274,24 +282,30 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
         position, orientation = np.array(pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist())).T
     else:
         position = orientation = np.zeros(0)
-    size = error_size(robot, position, orientation, constrained)
-    if ((size > POLISH_FROM) & (size <= POLISH_RESIDUAL)).any() or np.isnan(size).any():
-        return None
+    sizes = error_size(robot, position, orientation, constrained).tolist()
+    for size in sizes:
+        if not (size <= POLISH_FROM or size > POLISH_RESIDUAL):  # verify would polish it (or a NaN error)
+            return None
     joints = np.array(rows, dtype=float).reshape(len(rows), robot.dof)
-    kept = np.flatnonzero(first_of_each(robot, joints[None], (size <= ACCEPT_RESIDUAL)[None])[0])
+    ok = [size <= ACCEPT_RESIDUAL for size in sizes]
+    kept = [row for row, keep in enumerate(first_of_each_slot(robot, joints, ok)) if keep]
     if reference is not None and len(kept) > 1:
-        kept = kept[np.argsort(distance_to_reference(robot, joints[kept], reference), kind="stable")]
-    order = kept.tolist()
-    codes = [one_pose.codes[slots[row]] for row in order]
-    if any(code is None for row in codes for code in row):
-        return None
-    count = len(order)
-    nearest = np.array([size.min() if len(size) else np.inf])
+        nearest_first = np.argsort(distance_to_reference(robot, joints[kept], reference), kind="stable")
+        kept = [kept[i] for i in nearest_first.tolist()]
+    codes = [one_pose.codes[slots[row]] for row in kept]
+    for row in codes:
+        if None in row:
+            return None
+    count = len(kept)
+    nearest = np.array([min(sizes, default=np.inf)])
     complete = promised(one_pose, np.array([count]), nearest, constrained)
-    labels = {name: (values, np.array([row[column] for row in codes], dtype=np.int8).reshape(count))
-              for column, (name, values) in enumerate(zip(one_pose.names, one_pose.values))}
-    table = SolutionTable(np.zeros(count, dtype=np.int64), joints[kept], np.ones(count, dtype=bool), position[kept],
-                          orientation[kept] if constrained else np.full(count, np.nan), labels)
+    columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)
+    labels = {name: (values, column) for name, values, column in zip(one_pose.names, one_pose.values, columns)}
+    if kept != list(range(len(rows))):  # else every row is kept, in slot order: no copy
+        kept = np.array(kept, dtype=np.intp)
+        joints, position, orientation = joints[kept], position[kept], orientation[kept]
+    table = SolutionTable(np.zeros(count, dtype=np.int64), joints, np.ones(count, dtype=bool), position,
+                          orientation if constrained else np.full(count, np.nan), labels)
     return Verified(table, complete, nearest, one_pose.singularities)
 
 

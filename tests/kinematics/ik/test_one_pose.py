@@ -13,6 +13,7 @@ from service.kinematics.ik._closed_form import _one_pose_candidates
 from service.kinematics.ik._goals import PoseGoal
 from service.kinematics.ik._verify import accepted, residual_arrays
 
+from tests.arms import random_family_arm
 from tests.ik_helpers import random_configurations
 
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
@@ -141,21 +142,44 @@ def test_the_float_check_of_one_pose_is_verify(robot_id):
     gives the array path's rows and labels. The slots come wrapped, as verify would wrap them."""
     robot = _CATALOGUE.get(robot_id).robot
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
-    references = [None, random_configurations(robot, 1, seed=14)[0]]
-    checked = unclear = 0
-    for i, T in enumerate(_poses(robot, 200, seed=15)):
+    exact, against_arrays = _float_check_against_verify(robot, plan, _poses(robot, 200, seed=15),
+                                                        [None, random_configurations(robot, 1, seed=14)[0]])
+    assert exact >= 150
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified", "khalil"])
+@pytest.mark.parametrize("family", ["intersecting_shoulder+spherical_wrist",
+                                    "offset_shoulder_parallel_elbow+spherical_wrist", "three_parallel"])
+def test_the_float_check_of_one_pose_is_verify_on_random_arms(family, convention):
+    """The same on random arms of the three families with random base and tool frames (on the UR type most poses
+    have a least-squares slot without a clear label, so most of its poses are compared with the array path)."""
+    exact = compared = 0
+    for seed in range(3):
+        robot = random_family_arm(family, convention, seed)
+        plan = cached_plan(robot, constrain_orientation=True, reference=None)
+        poses = forward_kinematics(robot, np.random.default_rng(seed).uniform(-np.pi, np.pi, (40, 6)))
+        counts = _float_check_against_verify(robot, plan, poses, [None, random_configurations(robot, 1, seed)[0]])
+        exact, compared = exact + counts[0], compared + sum(counts)
+    assert compared >= 0.75 * 3 * 40 and exact >= 10
+
+
+def _float_check_against_verify(robot, plan, poses: np.ndarray, references: list) -> tuple[int, int]:
+    """Assert verify_one against verify on each pose the scalar path answers (references taken in turn); returns
+    how many were compared bit for bit and how many against the array path."""
+    checked = against_arrays = 0
+    for i, T in enumerate(poses):
         one_pose = plan.solve_one(T)
         if one_pose is None:
             continue
         valid = one_pose.valid[0]
         assert (wrap_revolute(robot, one_pose.joints[0, valid]) == one_pose.joints[0, valid]).all()
-        goal, reference = PoseGoal(T[None]), references[i % 2]
+        goal, reference = PoseGoal(T[None]), references[i % len(references)]
         fast = _verify.verify_one(robot, goal, one_pose, reference)
         if fast is None:
             continue
         candidates = _one_pose_candidates(one_pose)
         if candidates is None:  # a slot the FK check rejects has no clear label: against the array path
-            unclear += 1
+            against_arrays += 1
             slow = _verify.verify(robot, goal, plan.solve(T[None], reference), reference, plan.label_codes)
             assert np.abs(joint_difference(robot, fast.table.joints, slow.table.joints)).max(initial=0) <= 1e-9
         else:
@@ -172,4 +196,4 @@ def test_the_float_check_of_one_pose_is_verify(robot_id):
         for name, (values, codes) in fast.table.labels.items():
             assert values == slow.table.labels[name][0]
             np.testing.assert_array_equal(codes, slow.table.labels[name][1])
-    assert checked >= 150
+    return checked, against_arrays

@@ -38,7 +38,7 @@ from ._general_6r import GENERAL_STRUCTURES
 from ._goals import DirectionGoal, PoseGoal
 from ._idealised import IdealisedPlan
 from ._numeric import NumericOptions, search
-from ._plan import geometry_of
+from ._plan import Plan, geometry_of
 from ._redundant import (FreeJoint, beyond_reach, family_for, free_joints_for, no_solution_detail, solve_family)
 from ._select import MAX_EQUIVALENTS, NOTE_WORDING, Ordering, Selection, check_options, select
 from ._table import SolutionTable
@@ -306,7 +306,7 @@ def _poses(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: Answer
         return [_timed(timings, _numeric(robot, goal, rows, options), started)]
     verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
     closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
-    return _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan), plan.label_codes)
+    return _with_fallback(robot, goal, closed, options, timings, started, plan)
 
 
 def answered_by_family(robot: Robot, options: AnswerOptions) -> bool:
@@ -338,7 +338,7 @@ def _positions(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: An
     verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
     closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
     held = [j for j in plan.free_joints if j >= 3] if robot.dof > 3 else []
-    parts = _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan), plan.label_codes)
+    parts = _with_fallback(robot, goal, closed, options, timings, started, plan)
     if not held:
         return parts
     closed = parts[0]
@@ -502,12 +502,12 @@ def _family(robot: Robot, goal: PoseGoal, rows: np.ndarray, free: list[FreeJoint
 
 
 def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerOptions, timings: list[SolveTiming],
-                   started: float, note: str, label_codes: Callable[[np.ndarray], LabelCodes] | None = None
-                   ) -> list[_Part]:
+                   started: float, plan: Plan) -> list[_Part]:
     """The closed form's part for the targets it promises, and the numeric search for the others, seeded with
-    the solutions the closed form verified there and reporting the conditions it met. The search's solutions
-    carry the plan's branch labels (``label_codes``), as the closed form's do: a target near a singularity,
-    which the closed form hands over, keeps the labels a client holds along a path (issue 22.11)."""
+    the solutions the closed form verified there and reporting the conditions it met (with the plan's note,
+    :func:`_fallback_note`). The search's solutions carry the plan's branch labels, as the closed form's do: a
+    target near a singularity, which the closed form hands over, keeps the labels a client holds along a path
+    (issue 22.11)."""
     verified = closed.verified
     for local in np.flatnonzero((verified.count == 0) & verified.complete).tolist():
         closed.details[local] = _unreachable_detail(robot, goal, local, verified)
@@ -523,9 +523,10 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
         start, stop = np.searchsorted(table.target, [local, local + 1])
         known[index, :stop - start] = table.joints[start:stop]
     fallback = _numeric(robot, goal.take(broken), closed.rows[broken], options, options.reference, known=known,
-                        label_codes=label_codes)
+                        label_codes=plan.label_codes)
     fallback.verified.singularities.extend(verified.singularities, rows=broken)
     fallback.reported = np.ones(len(broken), dtype=bool)
+    note = _fallback_note(plan)
     for local in range(len(broken)):
         fallback.details[local] = f"{note} {fallback.details.get(local, '')}".strip()
     parts.append(_timed(timings, fallback, started))
@@ -700,7 +701,8 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
         excluded = checked.colliding if options.collisions.filter else None
     chosen: Selection = select(robot, table, n_targets, limits, filter_limits=options.filter_limits,
                                reference=options.reference, ordering=options.ordering,
-                               max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget)
+                               max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget,
+                               options_checked=True)  # answer_ik checked them before it solved
     status = chosen.status.copy()
     unproven = ~complete | sampled
     if unproven.any():

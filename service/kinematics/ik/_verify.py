@@ -89,6 +89,12 @@ def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constr
     return error_size(robot, position, orientation, constrain_orientation) <= ACCEPT_RESIDUAL
 
 
+def polished(size):
+    """Whether candidates of these error sizes (:func:`error_size`: an array, or a float) get Gauss–Newton steps
+    before the check: near their target, not yet within it."""
+    return (size > POLISH_FROM) & (size <= POLISH_RESIDUAL)
+
+
 def duplicate_tolerance(robot: Robot) -> np.ndarray:
     """Per joint (n,), how close two solutions' values must be to count as one: ``DUPLICATE_TOLERANCE`` radians
     for a revolute joint, that times the arm's size for a prismatic one."""
@@ -121,13 +127,13 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
         return ok.copy()
     tolerance = duplicate_tolerance(robot)
     revolute = robot.is_revolute
+    if m > _PAIRWISE_SLOTS:
+        return np.stack([_scanned(joints[row], ok[row], tolerance, revolute) for row in range(n_targets)]) \
+            if n_targets else ok.copy()
     if n_targets == 1:
         kept = ok.copy()
         kept[0] = first_of_each_slot(robot, joints[0], kept[0].tolist())
         return kept
-    if m > _PAIRWISE_SLOTS:
-        return np.stack([_scanned(joints[row], ok[row], tolerance, revolute) for row in range(n_targets)]) \
-            if n_targets else ok.copy()
     earlier, later = _slot_pairs(m)
     chunk = max(1, _PAIR_ENTRIES // max(1, len(later) * n))
     kept = ok.copy()
@@ -143,8 +149,8 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
 
 
 def first_of_each_slot(robot: Robot, joints: np.ndarray, ok: list[bool]) -> list[bool]:
-    """:func:`first_of_each` of one target's slots ``joints`` (m, n), the ``ok`` ones and the result as lists (m,):
-    every pair of slots at once, then the scan on Python booleans."""
+    """:func:`first_of_each` of one target's few slots ``joints`` (m, n), m at most :data:`_PAIRWISE_SLOTS`, the
+    ``ok`` ones and the result as lists (m,): every pair of slots at once, then the scan on Python booleans."""
     if len(ok) < 2:
         return list(ok)
     same = _same(np.abs(joints[:, None] - joints[None]), duplicate_tolerance(robot), robot.is_revolute)
@@ -234,7 +240,7 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
     constrained = goal.constrain_orientation
     valid = candidates.valid
     size = error_size(robot, position, orientation, constrained)
-    near = valid & (size > POLISH_FROM) & (size <= POLISH_RESIDUAL)
+    near = valid & polished(size)
     if near.any():
         rows, slots = np.nonzero(near)
         refined = gauss_newton(robot, goal, joints[rows, slots], rows, steps=POLISH_STEPS, tolerance=POLISH_FROM,
@@ -279,12 +285,13 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     rows = [one_pose.rows[slot] for slot in slots]  # revolute joints wrapped already: verify's wrap leaves them
     constrained = goal.constrain_orientation
     if rows:
-        position, orientation = np.array(pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist())).T
+        residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist())
+        position, orientation = np.array(list(zip(*residuals)))  # each contiguous: the encoder writes them as they are
     else:
         position = orientation = np.zeros(0)
     sizes = error_size(robot, position, orientation, constrained).tolist()
     for size in sizes:
-        if not (size <= POLISH_FROM or size > POLISH_RESIDUAL):  # verify would polish it (or a NaN error)
+        if size != size or polished(size):  # a NaN error, or one verify would polish
             return None
     joints = np.array(rows, dtype=float).reshape(len(rows), robot.dof)
     ok = [size <= ACCEPT_RESIDUAL for size in sizes]

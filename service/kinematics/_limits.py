@@ -24,6 +24,7 @@ from typing import Sequence
 
 import numpy as np
 
+from ._cache import bounded_memo
 from ._errors import InvalidInputError
 from ._robot import Robot, check_limit_pair
 from ._tolerances import LIMIT_TOLERANCE
@@ -72,6 +73,23 @@ class Limits:
         """Which joints are revolute with both bounds finite: those expanded into their 2π-equivalents."""
         return robot.is_revolute & np.isfinite(self.lower) & np.isfinite(self.upper)
 
+    def widened(self, robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The bounds with their tolerance, ``lower − tolerance`` and ``upper + tolerance``, and
+        :meth:`multi_valued`: shape (n,) each, read-only. Kept on the robot for the last
+        :data:`_WIDENED_KEPT` limits asked by value (every answer applies its limits, mostly the same few)."""
+        def build() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            tolerance = self.tolerance(robot)
+            arrays = (self.lower - tolerance, self.upper + tolerance, self.multi_valued(robot))
+            for array in arrays:
+                array.flags.writeable = False
+            return arrays
+        key = (self.lower.dtype.str, self.lower.tobytes(), self.upper.dtype.str, self.upper.tobytes())
+        return bounded_memo(robot, "widened_limits", key, build, _WIDENED_KEPT)
+
+
+#: How many limits :meth:`Limits.widened` keeps per robot.
+_WIDENED_KEPT = 8
+
 
 @dataclass(frozen=True)
 class Violation:
@@ -119,9 +137,7 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     A joint limited to ±270° at 100° has turns [−1, 0]: −260° and 100°.
     """
     q = np.asarray(q, dtype=float)
-    tolerance = limits.tolerance(robot)
-    lower, upper = limits.lower - tolerance, limits.upper + tolerance
-    both, continuous = limits.multi_valued(robot), limits.continuous(robot)
+    lower, upper, both = limits.widened(robot)
     if both.any():  # every both-bounded column at once (whole rows: a column alone strides through them all)
         value, low_bound, high_bound = (q, lower, upper) if both.all() else (q[..., both], lower[both], upper[both])
         low = np.ceil((low_bound - value) / _TWO_PI)
@@ -133,6 +149,7 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     first, last = np.zeros_like(q), np.zeros_like(q)
     if both.any():
         first[..., both], last[..., both] = low, high
+    continuous = limits.continuous(robot)
     for j in np.flatnonzero(~both).tolist():  # one kind of joint per column
         value = q[..., j]
         if robot.is_revolute[j] and not continuous[j]:

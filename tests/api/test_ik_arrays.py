@@ -196,3 +196,18 @@ def _assert_same_answer(a, b, where: str = "") -> None:
             _assert_same_answer(x, y, f"{where}[{k}]")
     else:
         assert a == b, where
+
+
+@pytest.mark.parametrize("robot_id", ["puma560_standard", "ur5", "kuka_kr6_r900_2"])
+def test_arrays_form_of_one_target(client, robot_id):
+    """A batch of one pose is answered on the single-pose path (the float check of the scalar slots): its columns
+    encode as the batch's do, and hold the objects form's answer."""
+    targets = _targets(client, robot_id, 1, seed=3)[:1]
+    for options in ({}, {"limits": [{"lower": -np.pi, "upper": np.pi}] * 6, "filter_limits": False}):
+        objects = client.post(f"/v1/robots/{robot_id}/ik/batch", json={"targets": targets, **options})
+        arrays = client.post(f"/v1/robots/{robot_id}/ik/batch",
+                             json={"targets": targets, "format": "arrays", **options})
+        assert objects.status_code == arrays.status_code == 200, arrays.text
+        if options:  # ±π, flagged rather than filtered: at least the generating configuration is listed
+            assert objects.json()["results"][0]["solutions"]
+        _assert_same(arrays.json(), _columns_of_objects(objects.json()["results"]))

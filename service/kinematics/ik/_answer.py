@@ -38,7 +38,7 @@ from ._general_6r import GENERAL_STRUCTURES
 from ._goals import DirectionGoal, PoseGoal
 from ._idealised import IdealisedPlan
 from ._numeric import NumericOptions, search
-from ._plan import geometry_of
+from ._plan import Plan, geometry_of
 from ._redundant import (FreeJoint, beyond_reach, family_for, free_joints_for, no_solution_detail, solve_family)
 from ._select import MAX_EQUIVALENTS, NOTE_WORDING, Ordering, Selection, check_options, select
 from ._table import SolutionTable
@@ -236,7 +236,7 @@ class IKAnswer:
 
 @dataclass
 class _Part:
-    """Targets ``rows`` (k,) answered by one solver: their verified solutions (``verified``, k targets), the
+    """Targets ``rows`` (k,, ascending) answered by one solver: their verified solutions (``verified``, k targets), the
     solver, and per local row the words before the selection's notes (``details``) and after them
     (``remarks``). ``reported`` (k,) says where the solver's singular conditions are reported (default: the rows
     with a solution); ``unfinished`` (k,) where the numeric search's iteration cap stopped starts; ``sampled``
@@ -262,11 +262,13 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
     check_options(robot, options.ordering, options.reference, options.max_equivalents)
     timings: list[SolveTiming] = []
     parts: list[_Part] = []
-    if (kinds == DIRECTION).any():
+    per_kind = np.bincount(kinds, minlength=3) if len(kinds) else np.zeros(3, dtype=int)  # targets of each kind
+    if per_kind[DIRECTION]:
         parts += _directions(robot, targets, options, timings)
-    if (kinds == POSE).any():
-        parts += _poses(robot, matrices, np.flatnonzero(kinds == POSE), options, timings)
-    if (kinds == POSITION).any():
+    if per_kind[POSE]:
+        rows = np.arange(len(kinds)) if per_kind[POSE] == len(kinds) else np.flatnonzero(kinds == POSE)
+        parts += _poses(robot, matrices, rows, options, timings)
+    if per_kind[POSITION]:
         parts += _positions(robot, matrices, np.flatnonzero(kinds == POSITION), options, timings)
     return _assembled(robot, len(kinds), parts, limits, options, timings)
 
@@ -304,7 +306,7 @@ def _poses(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: Answer
         return [_timed(timings, _numeric(robot, goal, rows, options), started)]
     verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
     closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
-    return _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan), plan.label_codes)
+    return _with_fallback(robot, goal, closed, options, timings, started, plan)
 
 
 def answered_by_family(robot: Robot, options: AnswerOptions) -> bool:
@@ -336,7 +338,7 @@ def _positions(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: An
     verified = solve_closed_form(robot, plan, goal, options.reference, budget=options.budget)
     closed = _Part(rows, verified, "analytic", plan.structure, tuple(plan.free_joints))
     held = [j for j in plan.free_joints if j >= 3] if robot.dof > 3 else []
-    parts = _with_fallback(robot, goal, closed, options, timings, started, _fallback_note(plan), plan.label_codes)
+    parts = _with_fallback(robot, goal, closed, options, timings, started, plan)
     if not held:
         return parts
     closed = parts[0]
@@ -500,19 +502,19 @@ def _family(robot: Robot, goal: PoseGoal, rows: np.ndarray, free: list[FreeJoint
 
 
 def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerOptions, timings: list[SolveTiming],
-                   started: float, note: str, label_codes: Callable[[np.ndarray], LabelCodes] | None = None
-                   ) -> list[_Part]:
+                   started: float, plan: Plan) -> list[_Part]:
     """The closed form's part for the targets it promises, and the numeric search for the others, seeded with
-    the solutions the closed form verified there and reporting the conditions it met. The search's solutions
-    carry the plan's branch labels (``label_codes``), as the closed form's do: a target near a singularity,
-    which the closed form hands over, keeps the labels a client holds along a path (issue 22.11)."""
+    the solutions the closed form verified there and reporting the conditions it met (with the plan's note,
+    :func:`_fallback_note`). The search's solutions carry the plan's branch labels, as the closed form's do: a
+    target near a singularity, which the closed form hands over, keeps the labels a client holds along a path
+    (issue 22.11)."""
     verified = closed.verified
-    broken = np.flatnonzero(~verified.complete)
-    promised = np.flatnonzero(verified.complete)
     for local in np.flatnonzero((verified.count == 0) & verified.complete).tolist():
         closed.details[local] = _unreachable_detail(robot, goal, local, verified)
-    if not len(broken):
+    if verified.complete.all():
         return [_timed(timings, closed, started)]
+    broken = np.flatnonzero(~verified.complete)
+    promised = np.flatnonzero(verified.complete)
     parts = [_timed(timings, _taken(closed, promised), started)] if len(promised) else []
     started = time.perf_counter()
     table = verified.table
@@ -521,9 +523,10 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
         start, stop = np.searchsorted(table.target, [local, local + 1])
         known[index, :stop - start] = table.joints[start:stop]
     fallback = _numeric(robot, goal.take(broken), closed.rows[broken], options, options.reference, known=known,
-                        label_codes=label_codes)
+                        label_codes=plan.label_codes)
     fallback.verified.singularities.extend(verified.singularities, rows=broken)
     fallback.reported = np.ones(len(broken), dtype=bool)
+    note = _fallback_note(plan)
     for local in range(len(broken)):
         fallback.details[local] = f"{note} {fallback.details.get(local, '')}".strip()
     parts.append(_timed(timings, fallback, started))
@@ -674,21 +677,21 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
         if part.unfinished is not None:
             flags += part.unfinished
         lookup = np.zeros(4, dtype=int)
-        for code in np.unique(flags).tolist():
+        for code in np.flatnonzero(np.bincount(flags, minlength=4)).tolist():  # the codes met, ascending
             report = SolverReport(part.method, part.structure, code >= 2, code % 2 == 1, part.free_joints)
             if report not in reports:
                 reports.append(report)
             lookup[code] = reports.index(report)
         report_of[part.rows] = lookup[flags]
-        reported = verified.count > 0 if part.reported is None else part.reported
-        for local in np.flatnonzero(reported & verified.singularities.any()).tolist():  # the others meet none
-            met = verified.singularities[local]
-            if met:
-                singular_of[int(part.rows[local])] = met
-        tables.append(verified.table.with_targets(part.rows[verified.table.target]))
-    table = SolutionTable.concat(tables, robot.dof)
-    if tables and len(table) and (np.diff(table.target) < 0).any():
-        table = table.take(np.argsort(table.target, kind="stable"))
+        if verified.singularities.entries:
+            reported = verified.count > 0 if part.reported is None else part.reported
+            for local in np.flatnonzero(reported & verified.singularities.any()).tolist():  # the others meet none
+                met = verified.singularities[local]
+                if met:
+                    singular_of[int(part.rows[local])] = met
+        whole = len(parts) == 1 and len(part.rows) == n_targets  # rows 0 … N − 1: the part's own numbering
+        tables.append(verified.table if whole else verified.table.with_targets(part.rows[verified.table.target]))
+    table = SolutionTable.concat(tables, robot.dof)  # grouped by target: each part's rows ascend
     excluded = None
     if options.collisions is not None:  # a 2π-equivalent moves no link: each distinct solution is checked once
         options.budget.check("the collision check")
@@ -698,9 +701,12 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
         excluded = checked.colliding if options.collisions.filter else None
     chosen: Selection = select(robot, table, n_targets, limits, filter_limits=options.filter_limits,
                                reference=options.reference, ordering=options.ordering,
-                               max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget)
+                               max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget,
+                               options_checked=True)  # answer_ik checked them before it solved
     status = chosen.status.copy()
-    status[(status == "unreachable") & (~complete | sampled)] = "not_found"
+    unproven = ~complete | sampled
+    if unproven.any():
+        status[(status == "unreachable") & unproven] = "not_found"
     # solver reports numbered by first appearance in target order
     by_appearance = list(dict.fromkeys(report_of.tolist()))
     renumber = np.zeros(max(len(reports), 1), dtype=int)

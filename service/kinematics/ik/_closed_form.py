@@ -21,7 +21,7 @@ from ._goals import PoseGoal
 from ._plan import Plan, plan_for
 from ._table import SolutionTable
 from ._types import Candidates, SingularFlags
-from ._verify import Verified, verify
+from ._verify import Verified, verify, verify_one
 from ._types import Sealed
 
 #: Targets solved together: large enough that per-operation overhead is small, small enough that the
@@ -89,10 +89,14 @@ def solve_closed_form(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.nd
 
 def _solved(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.ndarray | None) -> Verified:
     """One chunk: the plan's candidates (its scalar path for one pose when it has one and the pose is clearly
-    generic), verified."""
+    generic, verified on floats where :func:`verify_one` can), verified."""
     candidates = None
     if len(goal) == 1 and hasattr(plan, "solve_one"):
-        candidates = _one_pose_candidates(plan.solve_one(goal.world_T_targets[0]))
+        one_pose = plan.solve_one(goal.world_T_targets[0])
+        verified = None if one_pose is None else verify_one(robot, goal, one_pose, reference)
+        if verified is not None:
+            return verified
+        candidates = _one_pose_candidates(one_pose)
     if candidates is None:
         candidates = plan.solve(goal.world_T_targets, reference)
     return verify(robot, goal, candidates, reference, plan.label_codes)

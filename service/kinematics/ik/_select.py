@@ -209,7 +209,7 @@ def effective_reference(robot: Robot, limits: Limits, reference: np.ndarray) -> 
 def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *, filter_limits: bool = True,
            reference: np.ndarray | None = None, ordering: Ordering = Ordering(),
            max_equivalents: int = MAX_EQUIVALENTS, excluded: np.ndarray | None = None,
-           budget: Budget = UNLIMITED) -> Selection:
+           budget: Budget = UNLIMITED, options_checked: bool = False) -> Selection:
     """Apply limits, expand 2π-equivalents, order and trim the verified solutions of N targets (``table``,
     grouped by target; see the module docstring).
 
@@ -231,8 +231,11 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
         are rejected at their closest equivalent, and the order and the caps apply to the others.
     budget : Budget
         Checked between chunks of the work.
+    options_checked : bool
+        The caller has run :func:`check_options` on these options (as ``answer_ik`` does before it solves).
     """
-    check_options(robot, ordering, reference, max_equivalents)
+    if not options_checked:
+        check_options(robot, ordering, reference, max_equivalents)
     if reference is not None:
         reference = effective_reference(robot, limits, reference)
     budget.check("selection")
@@ -280,7 +283,11 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     kept_rows = candidates[kept_rows]
     kept = _listed(table.take(kept_rows), kept_values, fits[kept_rows])
 
-    dropped_values = q[dropped] + _TWO_PI * closest_turns(robot, limits, q[dropped], first[dropped], last[dropped])
+    if filter_limits and excluded is None:  # the dropped rows are the misfits, their closest turns known
+        dropped_values = misfit_q + _TWO_PI * misfit_turns
+    else:
+        dropped_values = q[dropped] + _TWO_PI * closest_turns(robot, limits, q[dropped], first[dropped],
+                                                              last[dropped])
     if reference is not None and len(dropped):
         order = np.lexsort((travel(robot, limits, dropped_values, reference, ordering), target[dropped]))
         dropped, dropped_values = dropped[order], dropped_values[order]
@@ -293,7 +300,7 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     collided = np.zeros(n_targets, dtype=np.int64)  # rejected for a collision alone (within the limits, or flagged)
     if excluded is not None:
         collided = np.bincount(target[excluded & (fits | (not filter_limits))], minlength=n_targets)
-    status = np.full(n_targets, "ok", dtype=object)
+    status = _all_ok(n_targets)
     status[none_kept] = "no_solution_within_limits"
     status[none_kept & (collided > 0)] = "no_collision_free_solution"
     status[table.counts(n_targets) == 0] = "unreachable"
@@ -325,14 +332,22 @@ def _each_once(table: SolutionTable, n_targets: int, turns: np.ndarray, max_equi
         kept = _listed(table, values, np.ones(len(target), dtype=bool))
         n_kept = rows_per_target
     zeros = np.zeros(n_targets, dtype=np.int64)
-    status = np.full(n_targets, "ok", dtype=object)
+    status = _all_ok(n_targets)
     status[rows_per_target == 0] = "unreachable"
     truncated = rows_per_target > n_kept
     available = rows_per_target.astype(np.int64, copy=False)
     notes = TargetNotes(np.flatnonzero(truncated), status, zeros, zeros, truncated, available, n_kept, available,
                         zeros, max_equivalents, False, None, n)
-    rejected = _listed(table.take(np.zeros(0, dtype=np.int64)), np.zeros((0, n)), np.zeros(0, dtype=bool))
+    rejected = table.take(slice(0, 0))
     return Selection(status, truncated, np.zeros(n_targets, dtype=np.int64), available, notes, kept, rejected)
+
+
+def _all_ok(n_targets: int) -> np.ndarray:
+    """A status column (N,) of objects, every entry "ok" (``np.full`` of a str goes through a str array and a
+    cast: ten times slower on a batch)."""
+    status = np.empty(n_targets, dtype=object)
+    status.fill("ok")
+    return status
 
 
 def _listed(rows: SolutionTable, joints: np.ndarray, within: np.ndarray) -> SolutionTable:
@@ -370,6 +385,8 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     usable turns and their numbers; ``row_limit`` (S,) the most combinations a row may give.
     """
     n = q.shape[1]
+    if not len(target):  # no candidate row (none fits the limits)
+        return np.zeros(0, dtype=np.int64), np.zeros((0, n))
     weights = np.ones(n) if reference is None or ordering.weights is None else np.asarray(ordering.weights, float)
     ranks_cap = np.minimum(counts, row_limit[:, None]).astype(np.int64)
     if len(row_limit) and (row_limit == row_limit[0]).all():  # one limit: one target, or a reference

@@ -66,7 +66,7 @@ class SolutionTable:
         return len(self.target)
 
     def take(self, index: np.ndarray) -> "SolutionTable":
-        """The rows ``index`` (indices or a boolean mask), in that order."""
+        """The rows ``index`` (indices, a boolean mask or a slice), in that order."""
         return SolutionTable(self.target[index], self.joints[index], self.within_limits[index],
                              self.position[index], self.orientation[index],
                              {name: (values, codes[index]) for name, (values, codes) in self.labels.items()},

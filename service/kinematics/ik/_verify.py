@@ -16,11 +16,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._cache import memo
 from .._robot import Robot
 from .._rotations import wrap_angle
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
 from ._gauss_newton import gauss_newton
-from ._goals import Goal, PoseGoal
+from ._goals import Goal, PoseGoal, pose_residuals_of_rows
 from ._structure import arm_size
 from ._table import SolutionTable
 from ._types import Candidates, LabelCodes, SingularFlags
@@ -88,10 +89,23 @@ def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constr
     return error_size(robot, position, orientation, constrain_orientation) <= ACCEPT_RESIDUAL
 
 
+def polished(size):
+    """Whether candidates of these error sizes (:func:`error_size`: an array, or a float) get Gauss–Newton steps
+    before the check: near their target, not yet within it."""
+    return (size > POLISH_FROM) & (size <= POLISH_RESIDUAL)
+
+
 def duplicate_tolerance(robot: Robot) -> np.ndarray:
     """Per joint (n,), how close two solutions' values must be to count as one: ``DUPLICATE_TOLERANCE`` radians
     for a revolute joint, that times the arm's size for a prismatic one."""
-    return np.where(robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot))
+    return memo(robot, "ik_duplicate_tolerance", lambda: _read_only(
+        np.where(robot.is_revolute, DUPLICATE_TOLERANCE, DUPLICATE_TOLERANCE * arm_size(robot))))
+
+
+def _read_only(array: np.ndarray) -> np.ndarray:
+    """``array``, no longer writeable: a value kept on the robot and shared."""
+    array.flags.writeable = False
+    return array
 
 
 #: Most slots compared pairwise at once (N × m(m − 1)/2 pairs of n values): past it the targets go in chunks, and
@@ -116,21 +130,16 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
     if m > _PAIRWISE_SLOTS:
         return np.stack([_scanned(joints[row], ok[row], tolerance, revolute) for row in range(n_targets)]) \
             if n_targets else ok.copy()
+    if n_targets == 1:
+        kept = ok.copy()
+        kept[0] = first_of_each_slot(robot, joints[0], kept[0].tolist())
+        return kept
     earlier, later = _slot_pairs(m)
     chunk = max(1, _PAIR_ENTRIES // max(1, len(later) * n))
     kept = ok.copy()
     for start in range(0, n_targets, chunk):
         block = slice(start, start + chunk)
-        gap = np.abs(joints[block, later, :] - joints[block, earlier, :])  # (b, pairs, n)
-        # wrapped values: a revolute difference d lies in (−2π, 2π), and |wrap(d)| = min(|d|, 2π − |d|)
-        if revolute.all():
-            np.minimum(gap, 2 * np.pi - gap, out=gap)
-        elif revolute.any():
-            gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
-        same = (gap <= tolerance).all(axis=-1)
-        if n_targets == 1:  # one target: the same scan on Python booleans (m − 1 steps of a few pairs each)
-            kept[0] = _scanned_pairs(same[0].tolist(), kept[0].tolist())
-            return kept
+        same = _same(np.abs(joints[block, later, :] - joints[block, earlier, :]), tolerance, revolute)  # (b, pairs)
         # the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
         offset = 0
         for slot in range(1, m):
@@ -139,14 +148,37 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
     return kept
 
 
-def _scanned_pairs(same: list[bool], kept: list[bool]) -> list[bool]:
-    """The scan of :func:`first_of_each` for one target: ``same`` lists its slot pairs in :func:`_slot_pairs`
-    order, ``kept`` (m,) the ok slots; a slot is dropped when it equals a slot kept before it."""
-    offset = 0
-    for slot in range(1, len(kept)):
-        if kept[slot] and any(s and k for s, k in zip(same[offset:offset + slot], kept)):
-            kept[slot] = False
-        offset += slot
+def first_of_each_slot(robot: Robot, joints: np.ndarray, ok: list[bool]) -> list[bool]:
+    """:func:`first_of_each` of one target's few slots ``joints`` (m, n), m at most :data:`_PAIRWISE_SLOTS`, the
+    ``ok`` ones and the result as lists (m,): every pair of slots at once, then the scan on Python booleans."""
+    if len(ok) < 2:
+        return list(ok)
+    same = _same(np.abs(joints[:, None] - joints[None]), duplicate_tolerance(robot), robot.is_revolute)
+    return _scanned_pairs(same.tolist(), list(ok))
+
+
+def _same(gap: np.ndarray, tolerance: np.ndarray, revolute: np.ndarray) -> np.ndarray:
+    """Which pairs of joint vectors are one solution, from their gaps |a − b| (..., n) (overwritten): every joint
+    within ``tolerance`` (n,), revolute ones modulo 2π. Shape (...)."""
+    # wrapped values: a revolute difference d lies in (−2π, 2π), and |wrap(d)| = min(|d|, 2π − |d|)
+    if revolute.all():
+        np.minimum(gap, 2 * np.pi - gap, out=gap)
+    elif revolute.any():
+        gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
+    return (gap <= tolerance).all(axis=-1)
+
+
+def _scanned_pairs(same: list[list[bool]], kept: list[bool]) -> list[bool]:
+    """The scan of :func:`first_of_each` for one target: ``same`` (m × m) says which slots are one solution,
+    ``kept`` (m,) the ok slots; a slot is dropped when it equals a slot kept before it."""
+    distinct: list[int] = []
+    for slot, keep in enumerate(kept):
+        if keep:
+            row = same[slot]
+            if any(row[earlier] for earlier in distinct):
+                kept[slot] = False
+            else:
+                distinct.append(slot)
     return kept
 
 
@@ -163,9 +195,7 @@ def _scanned(joints: np.ndarray, ok: np.ndarray, tolerance: np.ndarray, revolute
     kept = np.zeros(len(ok), dtype=bool)
     distinct = np.zeros((0, joints.shape[1]))
     for slot in np.flatnonzero(ok).tolist():
-        gap = np.abs(distinct - joints[slot])
-        gap = np.where(revolute, np.minimum(gap, 2 * np.pi - gap), gap)
-        if not (gap <= tolerance).all(axis=1).any():
+        if not _same(np.abs(distinct - joints[slot]), tolerance, revolute).any():
             kept[slot] = True
             distinct = np.vstack([distinct, joints[slot]])
     return kept
@@ -186,10 +216,10 @@ class Verified:
     nearest: np.ndarray
     singularities: SingularFlags
 
-    @property
+    @functools.cached_property
     def count(self) -> np.ndarray:
-        """Solutions per target, shape (N,)."""
-        return self.table.counts(len(self.complete))
+        """Solutions per target, shape (N,), read-only (counted once: the answer reads it several times)."""
+        return _read_only(self.table.counts(len(self.complete)))
 
 
 def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarray | None = None,
@@ -210,7 +240,7 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
     constrained = goal.constrain_orientation
     valid = candidates.valid
     size = error_size(robot, position, orientation, constrained)
-    near = valid & (size > POLISH_FROM) & (size <= POLISH_RESIDUAL)
+    near = valid & polished(size)
     if near.any():
         rows, slots = np.nonzero(near)
         refined = gauss_newton(robot, goal, joints[rows, slots], rows, steps=POLISH_STEPS, tolerance=POLISH_FROM,
@@ -241,6 +271,49 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
                           {name: (values, codes[rows, slots].astype(np.int8, copy=False))
                            for name, (values, codes) in labels.items()})
     return Verified(table, complete, nearest, candidates.singularities)
+
+
+def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | None = None) -> Verified | None:
+    """:func:`verify` of one target's candidates from a family's scalar path (a :class:`~._scalar.OnePose`: slots
+    as lists of floats, None where empty, each with its label codes), on floats and a few small arrays: the same
+    table, promise and nearest miss. Only the valid slots are checked, and only the rows kept need a clear label
+    (a least-squares slot the FK check rejects may sit where a label flips).
+
+    None where :func:`verify` would polish a candidate, a candidate's error is NaN, or a kept row's label is not
+    clear: then :func:`verify` of the candidates (or the array path) decides."""
+    slots = [slot for slot, q in enumerate(one_pose.rows) if q is not None]
+    rows = [one_pose.rows[slot] for slot in slots]  # revolute joints wrapped already: verify's wrap leaves them
+    constrained = goal.constrain_orientation
+    if rows:
+        residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist())
+        position, orientation = np.array(list(zip(*residuals)))  # each contiguous: the encoder writes them as they are
+    else:
+        position = orientation = np.zeros(0)
+    sizes = error_size(robot, position, orientation, constrained).tolist()
+    for size in sizes:
+        if size != size or polished(size):  # a NaN error, or one verify would polish
+            return None
+    joints = np.array(rows, dtype=float).reshape(len(rows), robot.dof)
+    ok = [size <= ACCEPT_RESIDUAL for size in sizes]
+    kept = [row for row, keep in enumerate(first_of_each_slot(robot, joints, ok)) if keep]
+    if reference is not None and len(kept) > 1:
+        nearest_first = np.argsort(distance_to_reference(robot, joints[kept], reference), kind="stable")
+        kept = [kept[i] for i in nearest_first.tolist()]
+    codes = [one_pose.codes[slots[row]] for row in kept]
+    for row in codes:
+        if None in row:
+            return None
+    count = len(kept)
+    nearest = np.array([min(sizes, default=np.inf)])
+    complete = promised(one_pose, np.array([count]), nearest, constrained)
+    columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)
+    labels = {name: (values, column) for name, values, column in zip(one_pose.names, one_pose.values, columns)}
+    if kept != list(range(len(rows))):  # else every row is kept, in slot order: no copy
+        kept = np.array(kept, dtype=np.intp)
+        joints, position, orientation = joints[kept], position[kept], orientation[kept]
+    table = SolutionTable(np.zeros(count, dtype=np.int64), joints, np.ones(count, dtype=bool), position,
+                          orientation if constrained else np.full(count, np.nan), labels)
+    return Verified(table, complete, nearest, one_pose.singularities)
 
 
 def _residuals_at(robot: Robot, goal: Goal, q: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -9,8 +9,11 @@ from service.config import Settings
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import _verify, joint_difference, solve_ik, wrap_revolute
 from service.kinematics.ik import cached_plan
+from service.kinematics.ik._closed_form import _one_pose_candidates
+from service.kinematics.ik._goals import PoseGoal
 from service.kinematics.ik._verify import accepted, residual_arrays
 
+from tests.arms import random_family_arm
 from tests.ik_helpers import random_configurations
 
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
@@ -129,3 +132,68 @@ def test_the_scan_of_many_slots_is_the_pairwise_scan(robot_id, monkeypatch):
         pairwise = _verify.first_of_each(robot, np.repeat(q, 3, axis=0), np.repeat(ok, 3, axis=0))
         monkeypatch.undo()
         assert (scanned[0] == pairwise[0]).all() and (pairwise[1:] == pairwise[0]).all()
+
+
+@pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)
+def test_the_float_check_of_one_pose_is_verify(robot_id):
+    """verify_one (the FK check, the duplicate scan and the labels of one pose's scalar slots, on floats) gives
+    the table, promise and nearest miss that verify gives for the same slots as candidates, bit for bit, with and
+    without a reference; where a valid slot's label is unclear (verify is then not given the scalar slots), it
+    gives the array path's rows and labels. The slots come wrapped, as verify would wrap them."""
+    robot = _CATALOGUE.get(robot_id).robot
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    exact, against_arrays = _float_check_against_verify(robot, plan, _poses(robot, 200, seed=15),
+                                                        [None, random_configurations(robot, 1, seed=14)[0]])
+    assert exact >= 150
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified", "khalil"])
+@pytest.mark.parametrize("family", ["intersecting_shoulder+spherical_wrist",
+                                    "offset_shoulder_parallel_elbow+spherical_wrist", "three_parallel"])
+def test_the_float_check_of_one_pose_is_verify_on_random_arms(family, convention):
+    """The same on random arms of the three families with random base and tool frames (on the UR type most poses
+    have a least-squares slot without a clear label, so most of its poses are compared with the array path)."""
+    exact = compared = 0
+    for seed in range(3):
+        robot = random_family_arm(family, convention, seed)
+        plan = cached_plan(robot, constrain_orientation=True, reference=None)
+        poses = forward_kinematics(robot, np.random.default_rng(seed).uniform(-np.pi, np.pi, (40, 6)))
+        counts = _float_check_against_verify(robot, plan, poses, [None, random_configurations(robot, 1, seed)[0]])
+        exact, compared = exact + counts[0], compared + sum(counts)
+    assert compared >= 0.75 * 3 * 40 and exact >= 10
+
+
+def _float_check_against_verify(robot, plan, poses: np.ndarray, references: list) -> tuple[int, int]:
+    """Assert verify_one against verify on each pose the scalar path answers (references taken in turn); returns
+    how many were compared bit for bit and how many against the array path."""
+    checked = against_arrays = 0
+    for i, T in enumerate(poses):
+        one_pose = plan.solve_one(T)
+        if one_pose is None:
+            continue
+        valid = one_pose.valid[0]
+        assert (wrap_revolute(robot, one_pose.joints[0, valid]) == one_pose.joints[0, valid]).all()
+        goal, reference = PoseGoal(T[None]), references[i % len(references)]
+        fast = _verify.verify_one(robot, goal, one_pose, reference)
+        if fast is None:
+            continue
+        candidates = _one_pose_candidates(one_pose)
+        if candidates is None:  # a slot the FK check rejects has no clear label: against the array path
+            against_arrays += 1
+            slow = _verify.verify(robot, goal, plan.solve(T[None], reference), reference, plan.label_codes)
+            assert np.abs(joint_difference(robot, fast.table.joints, slow.table.joints)).max(initial=0) <= 1e-9
+        else:
+            checked += 1
+            slow = _verify.verify(robot, goal, candidates, reference)
+            np.testing.assert_array_equal(fast.table.joints, slow.table.joints)
+            np.testing.assert_array_equal(fast.table.position, slow.table.position)
+            np.testing.assert_array_equal(fast.table.orientation, slow.table.orientation)
+            np.testing.assert_array_equal(fast.nearest, slow.nearest)
+        np.testing.assert_array_equal(fast.table.target, slow.table.target)
+        np.testing.assert_array_equal(fast.table.within_limits, slow.table.within_limits)
+        np.testing.assert_array_equal(fast.complete, slow.complete)
+        assert list(fast.table.labels) == list(slow.table.labels)
+        for name, (values, codes) in fast.table.labels.items():
+            assert values == slow.table.labels[name][0]
+            np.testing.assert_array_equal(codes, slow.table.labels[name][1])
+    return checked, against_arrays

@@ -211,8 +211,8 @@ def _segment_segment(ends: np.ndarray, witness: bool):
 
 def _nearest_on_segment(offset: np.ndarray, segment: np.ndarray, inverse_square_length) -> np.ndarray:
     """The parameter s* = clamp((offset · segment) / (segment · segment)) of the point of a segment P(s) = p0 + s
-    segment nearest a point q, given ``offset`` = q - p0 (3, ...) and 1 / (segment · segment) (0 for a segment of
-    length 0, whose s* is then 0); ``offset`` becomes the gap q - P(s*) in place."""
+    segment nearest a point q, given ``offset`` = q - p0 (3, ...) and 1 / (segment · segment) (any finite number
+    for a segment of length 0, whose s* is then 0); ``offset`` becomes the gap q - P(s*) in place."""
     along = _dot(offset, segment)
     along *= inverse_square_length
     _clip_unit(along)

@@ -181,6 +181,7 @@ class CollisionModel:
     _link_rows: tuple[_LinkRows, ...]
     _world_rows_fixed: np.ndarray  # (3, K_obstacles): the obstacles' rows, already in the world
     _groups: tuple[_Group, ...]
+    _body_merge: _BodyMerge
 
     # --- evaluation -------------------------------------------------------------------------------------------
 
@@ -234,8 +235,7 @@ class CollisionModel:
                 # each block's clearance and close pairs while its distances are in cache
                 by_pair = pair_distances[begin:end].T
                 by_pair.min(axis=0, out=clearance[begin:end])
-                rows, bodies, values = _close_pairs(by_pair, clearance[begin:end], self.body_pair_of,
-                                                    len(self.body_pairs), margin_value)
+                rows, bodies, values = _close_pairs(by_pair, clearance[begin:end], self._body_merge, margin_value)
                 close.append((rows + begin, bodies, values))
         self._check_finite(columns, pair_distances, single)
         rows, bodies, values = (np.concatenate(parts) for parts in zip(*close)) if close else \
@@ -537,13 +537,40 @@ def _box_middle_bounds(rows, middle, half_size_a, radius_b, reach):
 # --- the close pairs ------------------------------------------------------------------------------------------
 
 
-def _close_pairs(by_pair: np.ndarray, clearance: np.ndarray, body_pair_of: np.ndarray, body_count: int,
+class _BodyMerge(NamedTuple):
+    """How the shape pairs' distances become the body pairs': each body pair's first shape pair (B,), and the
+    later shape pairs of a body pair as (shape pair, body pair); None for ``first`` when every body pair has one
+    shape pair, in order."""
+
+    first: np.ndarray | None
+    later: tuple[tuple[int, int], ...]
+
+    @classmethod
+    def of(cls, body_pair_of: np.ndarray) -> "_BodyMerge":
+        first = np.unique(body_pair_of, return_index=True)[1]
+        if len(first) == len(body_pair_of):  # body pairs are numbered by their first shape pair: the identity
+            return cls(None, ())
+        later = np.flatnonzero(first[body_pair_of] != np.arange(len(body_pair_of)))
+        return cls(first, tuple(zip(later.tolist(), body_pair_of[later].tolist())))
+
+    def distances(self, by_pair: np.ndarray) -> np.ndarray:
+        """(B, S): each body pair's signed distance, the smallest over its shape pairs' rows of ``by_pair``
+        (P, S)."""
+        if self.first is None:
+            return by_pair
+        body_distances = np.take(by_pair, self.first, axis=0)
+        for row, body in self.later:
+            np.minimum(body_distances[body], by_pair[row], out=body_distances[body])
+        return body_distances
+
+
+def _close_pairs(by_pair: np.ndarray, clearance: np.ndarray, merge: _BodyMerge,
                  margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The body pairs closer than ``margin`` of S configurations (their pair distances laid out pair by pair
     (P, S), and their clearance (S,)): configuration, body pair and distance of each, by configuration, nearest
     first."""
     close = np.flatnonzero(clearance < margin)  # the configurations that have a close pair
-    body_distances = _body_distances(np.take(by_pair, close, axis=1), body_pair_of, body_count)
+    body_distances = merge.distances(np.take(by_pair, close, axis=1))
     rows, bodies = np.nonzero(body_distances.T < margin)  # by configuration, then by body pair
     values = body_distances[bodies, rows]
     rows = close[rows]
@@ -551,19 +578,6 @@ def _close_pairs(by_pair: np.ndarray, clearance: np.ndarray, body_pair_of: np.nd
         order = np.lexsort((values, rows))  # stable: equal distances keep the body pairs' order
         rows, bodies, values = rows[order], bodies[order], values[order]
     return rows, bodies, values
-
-
-def _body_distances(by_pair: np.ndarray, body_pair_of: np.ndarray, body_count: int) -> np.ndarray:
-    """(B, S): each body pair's signed distance, the smallest over its shape pairs (the rows of ``by_pair``
-    (P, S) that ``body_pair_of`` maps to it)."""
-    if body_count == len(body_pair_of) and (body_pair_of == np.arange(body_count)).all():
-        return by_pair
-    first_row = np.unique(body_pair_of, return_index=True)[1]  # each body pair's first shape pair
-    body_distances = np.take(by_pair, first_row, axis=0)
-    for row in np.flatnonzero(first_row[body_pair_of] != np.arange(len(body_pair_of))).tolist():
-        body = body_pair_of[row]
-        np.minimum(body_distances[body], by_pair[row], out=body_distances[body])
-    return body_distances
 
 
 #: The cheap bounds of each pair of families (two boxes have none: they are always measured).
@@ -686,7 +700,8 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)
     return CollisionModel(count, tuple(shapes), tuple(obstacle_list), tuple(pairs), tuple(body_pairs),
-                          body_pair_of, tuple(link_rows), np.array(fixed).T.reshape(3, -1), tuple(groups))
+                          body_pair_of, tuple(link_rows), np.array(fixed).T.reshape(3, -1), tuple(groups),
+                          _BodyMerge.of(body_pair_of))
 
 
 def _local_rows(shape: Shape) -> list[list[float]]:

@@ -21,7 +21,12 @@ What the stages do not account for is the framework (Starlette's and FastAPI's l
 ASGI layer. Beside each request: a bare FastAPI application with one POST route taking the same body (parsed and
 validated by FastAPI as it does by default, answering a constant), and the same bare application with the service's
 ASGI layer (:class:`~service.api.gate.RequestGate`) added, so that layer's own cost shows. Best of three rounds per
-row; read the shares, the absolute times move with the machine's load.
+row; read the shares, the absolute times move with the machine's load. Below them, the same single requests handed to
+a work loop, and with their arguments found by FastAPI's general dependency solver (as before the small-first routes
+found a plain request's arguments themselves).
+
+Stages timed alone run hot (the same few functions in a loop); inside a request they run among the framework's code,
+slower, and the rest row counts that difference too: for a single IK it over-states the framework.
 """
 
 from __future__ import annotations
@@ -233,6 +238,22 @@ def _profile_ik(app, robot_id: str, robot, T, count: int, *, batch: bool) -> Pro
                                                     body, count))
 
 
+def _through_fastapi_solver(settings: Settings, robot_id: str, q, T, count: int) -> tuple[float, float]:
+    """Seconds of a single FK and a single IK whole request when FastAPI's general dependency solver finds their
+    arguments, as it did for every request before the small-first routes found a plain request's arguments
+    themselves (:class:`~service.api.routing._PlainArguments`)."""
+    plain_arguments = routing._PlainArguments.of
+    routing._PlainArguments.of = classmethod(lambda cls, route: None)  # type: ignore[method-assign]
+    try:  # the routes' handlers are built with the application (when its first request is matched)
+        app = create_app(settings)
+        fk = _asgi_seconds(app, "POST", f"/v1/robots/{robot_id}/fk", orjson.dumps({"joints": q.tolist()}), count)
+        ik = _asgi_seconds(app, "POST", f"/v1/robots/{robot_id}/ik", orjson.dumps({"target": {"matrix": T.tolist()}}),
+                           count)
+    finally:
+        routing._PlainArguments.of = plain_arguments  # type: ignore[method-assign]
+    return fk, ik
+
+
 def _collector_passes() -> tuple[float, float]:
     """Seconds of one full collector pass with what start-up built (the application, its catalogue) tracked, and
     with it frozen as the application's lifespan freezes it (best of three each)."""
@@ -329,6 +350,7 @@ def main(argv: list[str] | None = None) -> int:
                                   orjson.dumps({"target": {"matrix": T[0].tolist()}}), count)
     finally:
         routing.SMALL_BODY_BYTES = small_body_bytes
+    fk_solved, ik_solved = _through_fastapi_solver(settings, args.robot, q[0], T[0], count)
     tracked_pass, frozen_pass = _collector_passes()
 
     print(f"machine: {machine()}")
@@ -343,6 +365,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"| bare FastAPI: GET | {bare_get * 1e6:,.1f} |")
     print(f"| POST fk, whole request, handed to a work loop | {fk_handed * 1e6:,.1f} |")
     print(f"| POST ik, whole request, handed to a work loop | {ik_handed * 1e6:,.1f} |")
+    print(f"| POST fk, whole request, arguments found by FastAPI's dependency solver | {fk_solved * 1e6:,.1f} |")
+    print(f"| POST ik, whole request, arguments found by FastAPI's dependency solver | {ik_solved * 1e6:,.1f} |")
     print(f"\n- whole request / bare FastAPI POST of the same body: FK {fk.whole / fk.bare_post:.1f}, IK "
           f"{ik.whole / ik.bare_post:.1f}, batch {ik_batch.whole / ik_batch.bare_post:.2f}")
     print(f"- the service's ASGI layer on a bare POST: FK body +{(fk.gated_post - fk.bare_post) * 1e6:,.1f} µs, "
@@ -353,6 +377,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"- batch per target: whole request {ik_batch.whole / args.batch * 1e6:,.2f} µs, core answer "
           f"{ik_batch.stages['core answer (answer_ik)'] / args.batch * 1e6:,.2f} µs")
     print(f"- handed to a work loop / where it arrives: FK {fk_handed / fk.whole:.2f}, IK {ik_handed / ik.whole:.2f}")
+    print(f"- FastAPI's dependency solver / the plain arguments: FK {fk_solved / fk.whole:.2f}, "
+          f"IK {ik_solved / ik.whole:.2f}")
     print(f"- one full garbage-collector pass in this process: {tracked_pass * 1e3:,.1f} ms with the start-up "
           f"objects tracked, {frozen_pass * 1e3:,.1f} ms with them frozen (the lifespan's _tune_collector)")
     return 0

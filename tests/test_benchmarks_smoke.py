@@ -42,6 +42,8 @@ def test_request_profile_runs_with_tiny_sizes(capsys):
     assert "|     of which the solve alone (solve_ik) |" in out
     assert out.count("| bare FastAPI: POST of this body, validated |") == 3
     assert "| bare FastAPI + the service's ASGI layer (RequestGate): POST of this body |" in out
+    for request in ("fk", "ik"):
+        assert f"| POST {request}, whole request, arguments found by FastAPI's dependency solver |" in out
 
 
 def test_wrist_classes_benchmark_runs_with_tiny_sizes(capsys):

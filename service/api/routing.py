@@ -284,8 +284,18 @@ class _PlainArguments:
     @classmethod
     def of(cls, route: APIRoute) -> "_PlainArguments | None":
         """``route``: the route as included in the application (FastAPI's effective route, with the application's
-        dependencies and dependency overrides), see :func:`_as_included`."""
+        dependencies and dependency overrides), see :func:`_as_included`. None too for a FastAPI whose internals
+        are not those read here (the attributes of its ``Dependant`` and fields): its own handler answers then."""
+        try:
+            return cls._of(route)
+        except (AttributeError, TypeError):
+            return None
+
+    @classmethod
+    def _of(cls, route: APIRoute) -> "_PlainArguments | None":
         dependant = route.dependant
+        if not callable(getattr(dependant.body_params[0] if dependant.body_params else None, "validate", None)):
+            return None
         if not (_plain(dependant) and len(dependant.body_params) == 1 and not route._embed_body_fields
                 and not isinstance(dependant.body_params[0].field_info, params.Form) and not dependant.path_params
                 and not dependant.header_params and not dependant.cookie_params
@@ -311,7 +321,10 @@ class _PlainArguments:
             parsed = orjson.loads(body)
         except orjson.JSONDecodeError:
             return None
-        model, errors = self._body.validate(parsed, {}, loc=("body",))
+        try:  # FastAPI's field API (fastapi._compat): a different one means its handler answers
+            model, errors = self._body.validate(parsed, {}, loc=("body",))
+        except (AttributeError, TypeError):
+            return None
         if errors:
             return None
         path_params = scope.get("path_params", {})
@@ -321,7 +334,10 @@ class _PlainArguments:
             for field_name, alias, field in fields:
                 if alias not in path_params:
                     return None
-                arguments[field_name], errors = field.validate(path_params[alias], {}, loc=("path", alias))
+                try:
+                    arguments[field_name], errors = field.validate(path_params[alias], {}, loc=("path", alias))
+                except (AttributeError, TypeError):
+                    return None
                 if errors:
                     return None
             dependency_arguments.append((name, call, request_name, arguments))

@@ -4,6 +4,9 @@ each request below is answered byte for byte (status, headers, body) as FastAPI'
 
 from __future__ import annotations
 
+import asyncio
+from types import SimpleNamespace
+
 import fastapi.routing
 import numpy as np
 import pytest
@@ -165,3 +168,36 @@ def test_dependency_overrides_are_honoured():
         response = client.post("/v1/robots/anything/fk", json={"joints": PUMA_Q})
     assert response.status_code == 200, response.text
     assert response.json()["robot_id"] == "overridden-anything"
+
+
+
+def test_a_fastapi_of_other_internals_leaves_every_request_to_its_handler(monkeypatch, solver_calls):
+    """The plain arguments read FastAPI's private route and field API; where it is not what they read (another
+    FastAPI), the route takes FastAPI's handler: the answer is FastAPI's, never an error of the shortcut."""
+    assert routing._PlainArguments.of(SimpleNamespace(dependant=SimpleNamespace(body_params=[]))) is None
+
+    def other_internals(cls, route):
+        raise AttributeError("'APIRoute' object has no attribute '_embed_body_fields'")
+
+    monkeypatch.setattr(routing._PlainArguments, "_of", classmethod(other_internals))
+    with _client() as client:
+        answer = client.post("/v1/robots/puma560_standard/fk", json={"joints": PUMA_Q})
+    assert answer.status_code == 200 and solver_calls == ["/v1/robots/puma560_standard/fk"]
+
+
+def test_a_field_validate_of_another_signature_leaves_the_request_to_fastapi():
+    """Per request too: a body field whose validate takes other arguments gives None (FastAPI's handler answers),
+    before anything ran."""
+    from service.api.routers import fk
+
+    route = next(route for route in fk.router.routes if route.path.endswith("/robots/{robot_id}/fk"))
+    plain = routing._PlainArguments.of(route)
+    assert plain is not None
+    plain._body = SimpleNamespace(name="body", validate=lambda value: value)
+    scope = {"type": "http", "method": "POST", "path": "/v1/robots/puma560_standard/fk", "query_string": b"",
+             "headers": [(b"content-type", b"application/json")], "path_params": {"robot_id": "puma560_standard"}}
+
+    async def receive():
+        return {"type": "http.request", "body": b"", "more_body": False}
+
+    assert asyncio.run(plain.answer(scope, receive, b'{"joints": [0, 0, 0, 0, 0, 0]}', False)) is None

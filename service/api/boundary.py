@@ -26,6 +26,7 @@ from ..kinematics import (
     check_transform,
     check_transforms,
     check_unit_quaternion,
+    frame_quaternions,
     matrix_from_quaternion,
     quaternions_from_matrices,
 )
@@ -238,9 +239,9 @@ def free_joints_to_core(robot: Robot, choices: Sequence | None, unit: AngleUnit
 
 
 def poses_from_matrices(matrices: np.ndarray) -> list[dict]:
-    """Wire poses for a stack of transforms, shape (N, 4, 4)."""
+    """Wire poses for a stack of transforms the core computed (FK), shape (N, 4, 4)."""
     matrices = np.asarray(matrices, dtype=float)
-    quaternions = quaternions_from_matrices(matrices[:, :3, :3]).tolist()
+    quaternions = frame_quaternions(matrices[:, :3, :3]).tolist()
     return [
         {"matrix": T, "position": [T[0][3], T[1][3], T[2][3]], "quaternion_wxyz": quaternion}
         for T, quaternion in zip(matrices.tolist(), quaternions)

@@ -49,6 +49,7 @@ __all__ = [
     "matrix_from_quaternion",
     "matrix_from_rpy",
     "quaternions_from_matrices",
+    "frame_quaternions",
     "rot_x",
     "rot_y",
     "rot_z",
@@ -429,6 +430,42 @@ def _quaternions_from_matrices(R: np.ndarray) -> np.ndarray:
     q = row / (2.0 * np.sqrt(row[rows, k]))[:, None]
     q /= np.linalg.norm(q, axis=-1, keepdims=True)  # inputs are orthonormal only within a tolerance
     return _canonical_sign(q).reshape(*R.shape[:-2], 4)
+
+
+def _quaternion_of_rotation(r: list[float]) -> list[float]:
+    """:func:`_quaternions_from_matrices` of one rotation given as its nine entries row by row, on floats: the
+    same K, the same choice of its largest diagonal entry, the same normalisation and sign."""
+    r00, r01, r02, r10, r11, r12, r20, r21, r22 = r
+    trace = r00 + r11 + r22
+    diagonal = (1.0 + trace, 1.0 + r00 - r11 - r22, 1.0 - r00 + r11 - r22, 1.0 - r00 - r11 + r22)
+    zx, xy_, xz_ = r21 - r12, r02 - r20, r10 - r01
+    xy, xz, yz = r01 + r10, r02 + r20, r12 + r21
+    K = ((diagonal[0], zx, xy_, xz_), (zx, diagonal[1], xy, xz), (xy_, xy, diagonal[2], yz),
+         (xz_, xz, yz, diagonal[3]))
+    k = diagonal.index(max(diagonal))
+    scale = 2.0 * math.sqrt(K[k][k])
+    q = [value / scale for value in K[k]]
+    length = math.sqrt(sum(value * value for value in q))
+    q = [value / length for value in q]
+    first_nonzero = next((value for value in q[1:] if value != 0.0), 0.0)
+    if q[0] < 0.0 or (q[0] == 0.0 and first_nonzero < 0.0):
+        q = [-value for value in q]
+    q[0] = abs(q[0])  # turn a -0.0 into 0.0
+    return q
+
+
+def frame_quaternions(R: ArrayLike) -> np.ndarray:
+    """:func:`quaternions_from_matrices` of rotations the core computed (FK poses, link frames), shape (N, 3, 3),
+    without its input checks, which hold by construction; one rotation is converted on floats, where numpy's cost
+    per call would be most of the time.
+
+    >>> frame_quaternions(rot_z([np.pi / 2])).round(6).tolist()
+    [[0.707107, 0.0, 0.0, 0.707107]]
+    """
+    R = np.asarray(R, dtype=float)
+    if R.shape[0] == 1:
+        return np.array([_quaternion_of_rotation(R.reshape(9).tolist())])
+    return _quaternions_from_matrices(R)
 
 
 def matrix_from_quaternion(wxyz: ArrayLike) -> np.ndarray:

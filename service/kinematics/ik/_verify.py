@@ -38,7 +38,9 @@ FRAGILE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum",
 
 
 def wrap_revolute(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Revolute joint values wrapped to (−π, π]; prismatic values unchanged. Shape (..., n)."""
+    """Revolute joint values wrapped to (−π, π]; prismatic values unchanged. Shape (..., n), a new array."""
+    if robot.is_revolute.all():  # the usual arm: no pass to keep prismatic values
+        return wrap_angle(q)
     return np.where(robot.is_revolute, wrap_angle(q), q)
 
 

@@ -72,19 +72,29 @@ def solve_closed_form(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.nd
     if n_targets <= CHUNK:
         budget.check("the analytic solve")
         return _solved(robot, plan, goal, reference)
-    starts = list(range(0, n_targets, CHUNK))
+    edges = chunk_edges(n_targets, threads or os.cpu_count() or 1)
 
-    def solve(start: int) -> Verified:
+    def solve(start: int, stop: int) -> Verified:
         budget.check("the analytic solve")
-        return _solved(robot, plan, goal.take(np.arange(start, min(start + CHUNK, n_targets))), reference)
+        return _solved(robot, plan, goal.take(np.arange(start, stop)), reference)
 
-    workers = min(threads or os.cpu_count() or 1, len(starts))
+    workers = min(threads or os.cpu_count() or 1, len(edges) - 1)
     if workers > 1:
         with ThreadPoolExecutor(workers) as pool:
-            parts = list(pool.map(solve, starts))
+            parts = list(pool.map(solve, edges[:-1], edges[1:]))
     else:
-        parts = [solve(start) for start in starts]
+        parts = [solve(start, stop) for start, stop in zip(edges[:-1], edges[1:])]
     return joined(parts, robot.dof)
+
+
+def chunk_edges(n_targets: int, threads: int) -> list[int]:
+    """Where the chunks of N targets start, and N: at most :data:`CHUNK` targets each, as many chunks as a multiple
+    of the threads that can work on them, all of one size (within one target), so that each thread has as much
+    to do (10,000 on 2 threads: 4 of 2,500, not 4,096 + 4,096 on one and 1,808 on the other)."""
+    chunks = -(-n_targets // CHUNK)
+    workers = max(1, min(threads, chunks))
+    chunks = -(-chunks // workers) * workers
+    return [index * n_targets // chunks for index in range(chunks + 1)]
 
 
 def _solved(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.ndarray | None) -> Verified:

@@ -141,7 +141,9 @@ def _tabled_turns(caps: np.ndarray, owner: np.ndarray, ranks: np.ndarray, cheape
     rank = np.arange(len(entry)) - table_start.ravel()[entry]
     table = [a.ravel()[entry] for a in (cheapest, direction, ahead, behind)]
     table = table[0] + _rank_offsets(rank, *table[1:])
-    return table[table_start[owner] + ranks]
+    at = np.take(table_start, owner, axis=0)  # np.take: a plain gather, faster than indexing with arrays
+    at += ranks
+    return np.take(table, at)
 
 
 def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, reference: np.ndarray | None,
@@ -191,9 +193,15 @@ def _rank_offsets(ranks: np.ndarray, direction: np.ndarray, ahead: np.ndarray, b
 def _rank_tuples(ranks_cap: np.ndarray, row_limit: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Every rank tuple r of each row with r_j < ranks_cap[row, j] and ∏(r_j + 1) ≤ row_limit[row].
 
-    Returns (row (C,), ranks (C, n)), rows ascending and each row's tuples in lexicographic order. A few rows
-    of few tuples each (one target's) are looked up row by row (:func:`_row_rank_tuples`).
+    Returns (row (C,), ranks (C, n)), rows ascending and each row's tuples in lexicographic order. Rows all
+    alike, or a few rows (one target's), of few tuples each are looked up (:func:`_row_rank_tuples`): once for
+    all, or row by row.
     """
+    if len(ranks_cap) > 1 and (ranks_cap == ranks_cap[0]).all() and (row_limit == row_limit[0]).all():
+        caps = ranks_cap[0].tolist()  # every row alike (a batch of one arm's solutions): one row's tuples, repeated
+        if math.prod(caps) * len(caps) <= _FEW_RANKS:
+            ranks = _row_rank_tuples(tuple(caps), int(row_limit[0]))
+            return np.repeat(np.arange(len(ranks_cap)), len(ranks)), np.tile(ranks, (len(ranks_cap), 1))
     if len(ranks_cap) <= _FEW_ROWS:
         caps, limits = ranks_cap.tolist(), row_limit.tolist()
         if all(math.prod(row) * len(row) <= _FEW_RANKS for row in caps):

@@ -38,7 +38,7 @@ capped at :data:`.._budget.COUNT_CAP`.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
@@ -281,7 +281,7 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
                                       reference, ordering, budget)
     kept_rows = candidates[kept_rows]
-    kept = _listed(table.take(kept_rows), kept_values, fits[kept_rows])
+    kept = table.take(kept_rows, joints=kept_values, within_limits=fits[kept_rows])
 
     if filter_limits and excluded is None:  # the dropped rows are the misfits, their closest turns known
         dropped_values = misfit_q + _TWO_PI * misfit_turns
@@ -291,7 +291,7 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     if reference is not None and len(dropped):
         order = np.lexsort((travel(robot, limits, dropped_values, reference, ordering), target[dropped]))
         dropped, dropped_values = dropped[order], dropped_values[order]
-    rejected = _listed(table.take(dropped), dropped_values, fits[dropped])
+    rejected = table.take(dropped, joints=dropped_values, within_limits=fits[dropped])
 
     n_kept = kept.counts(n_targets)
     n_rejected = rejected.counts(n_targets)
@@ -326,10 +326,10 @@ def _each_once(table: SolutionTable, n_targets: int, turns: np.ndarray, max_equi
     values = table.joints + _TWO_PI * turns
     if len(target) and rows_per_target.max() > max_equivalents:  # the cap: each target's first rows
         keep = position_in_group(target) < max_equivalents
-        kept = _listed(table.take(keep), values[keep], np.ones(int(keep.sum()), dtype=bool))
+        kept = table.take(keep, joints=values[keep], within_limits=np.ones(int(keep.sum()), dtype=bool))
         n_kept = np.minimum(rows_per_target, max_equivalents)
     else:
-        kept = _listed(table, values, np.ones(len(target), dtype=bool))
+        kept = replace(table, joints=values, within_limits=np.ones(len(target), dtype=bool))
         n_kept = rows_per_target
     zeros = np.zeros(n_targets, dtype=np.int64)
     status = _all_ok(n_targets)
@@ -348,12 +348,6 @@ def _all_ok(n_targets: int) -> np.ndarray:
     status = np.empty(n_targets, dtype=object)
     status.fill("ok")
     return status
-
-
-def _listed(rows: SolutionTable, joints: np.ndarray, within: np.ndarray) -> SolutionTable:
-    """``rows`` at the equivalents ``joints`` (K, n) listed, flagged ``within`` the limits (K,)."""
-    return SolutionTable(rows.target, joints, within, rows.position, rows.orientation, rows.labels, rows.clearance,
-                         rows.contacts, rows.roll)
 
 
 def _within_move(robot: Robot, limits: Limits, q: np.ndarray, first: np.ndarray, last: np.ndarray,
@@ -398,13 +392,19 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     bound = np.minimum(capped_products(ranks_cap), down_sets).astype(float)
     # chunks of whole rows: a row's combinations are at most MAX_COMBINATIONS_PER_SOLUTION, but one target's rows
     # (16 solutions, or 32 samples of a free joint times 8) may hold millions, so a target may span chunks
-    chunk = (np.cumsum(bound) - bound) // _CHUNK_ROWS
+    before = np.cumsum(bound) - bound
+    chunk = before // _CHUNK_ROWS
     if not len(target):
         edges = np.zeros(1, int)
     elif chunk[-1] == 0:  # one chunk
         edges = np.array([0, len(target)])
     else:
-        edges = np.flatnonzero(np.concatenate(([True], chunk[1:] != chunk[:-1], [True])))
+        edges = _target_edges(target, before, bound,
+                              np.flatnonzero(np.concatenate(([True], chunk[1:] != chunk[:-1], [True]))))
+    spanning = bool((target[edges[1:-1]] == target[edges[1:-1] - 1]).any())
+    if not spanning:  # each chunk's kept rows go straight to their place: per target, at most the limit or them all
+        most = int(np.minimum(np.bincount(target, weights=bound), limit).sum())
+        rows_out, values_out, filled = np.empty(most, dtype=np.int64), np.empty((most, n)), 0
     kept_rows, kept_values, kept_keys = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))], [np.zeros(0)]
     for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
         budget.check("selection")
@@ -414,13 +414,13 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
         # the combinations are put in answer order and cut by an index into them (C,), so the joint values
         # (C, n) are gathered once, at the end
         if reference is None:
-            cost = np.sum(np.abs(turns), axis=1)
-            pick = np.lexsort((cost, owner))  # each row's combinations cheapest first, ties by rank tuple
+            cost = _turn_sums(turns)
+            pick = _grouped_order(owner, cost)  # each row's combinations cheapest first, ties by rank tuple
             key = position_in_group(owner[pick])  # the row's stream position: the targets take turns between rows
             early = key < row_limit[owner[pick]]
             pick, key = pick[early], key[early]
-            picked = owner[pick]
-            order = np.lexsort((picked, key, target[picked]))
+            # rows ascend here and give one combination per stream position: ties of (target, key) are in row order
+            order = _grouped_order(target[owner[pick]], key)
             pick, key = pick[order], key[order]
             values = None
         else:
@@ -431,20 +431,68 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
             key = cost[pick]
         first_few = position_in_group(target[owner[pick]]) < limit
         pick, key = pick[first_few], key[first_few]
-        kept_rows.append(owner[pick])
-        kept_values.append(q[owner[pick]] + _TWO_PI * turns[pick] if values is None else values[pick])
-        kept_keys.append(key)
-    if len(kept_rows) == 2:  # one chunk: no copy
-        return kept_rows[1], kept_values[1]
+        picked = owner[pick]
+        if spanning:
+            kept_rows.append(picked)
+            kept_values.append(q[picked] + _TWO_PI * turns[pick] if values is None else values[pick])
+            kept_keys.append(key)
+            continue
+        block = slice(filled, filled + len(pick))
+        rows_out[block] = picked
+        if values is None:  # q + 2πk, as 2πk + q (the same sum); np.take: a plain gather, faster than indexing
+            np.multiply(np.take(turns, pick, axis=0), _TWO_PI, out=values_out[block])
+            values_out[block] += np.take(q, picked, axis=0)
+        else:
+            values_out[block] = values[pick]
+        filled = block.stop
+    if not spanning:
+        if filled < most // 2:  # far fewer than the most: not kept in the larger arrays
+            return rows_out[:filled].copy(), values_out[:filled].copy()
+        return rows_out[:filled], values_out[:filled]
+    # a target over several chunks: its kept combinations from each, ordered again as one chunk orders them
+    # (each chunk's come in row order, so the stable sorts break ties as one chunk would)
     rows, values, keys = np.concatenate(kept_rows), np.concatenate(kept_values), np.concatenate(kept_keys)
-    if (target[edges[1:-1]] == target[edges[1:-1] - 1]).any():
-        # a target over several chunks: its kept combinations from each, ordered again as one chunk orders them
-        # (each chunk's come in row order, so the stable sorts break ties as one chunk would)
-        order = np.lexsort((rows, keys, target[rows])) if reference is None else np.lexsort((keys, target[rows]))
-        rows, values = rows[order], values[order]
-        first_few = position_in_group(target[rows]) < limit
-        rows, values = rows[first_few], values[first_few]
-    return rows, values
+    order = np.lexsort((rows, keys, target[rows])) if reference is None else np.lexsort((keys, target[rows]))
+    rows, values = rows[order], values[order]
+    first_few = position_in_group(target[rows]) < limit
+    return rows[first_few], values[first_few]
+
+
+def _target_edges(target: np.ndarray, before: np.ndarray, bound: np.ndarray, edges: np.ndarray) -> np.ndarray:
+    """The chunk edges (E,) of :func:`_nearest`, each inside a target of at most :data:`_CHUNK_ROWS` / 8
+    combinations moved back to that target's first row: such a target is then ranked in one chunk, and the
+    chunks' kept combinations need no ordering again (a chunk grows by at most an eighth). ``before`` and
+    ``bound`` (S,) are the combinations before each row and of each row."""
+    inner = edges[1:-1]
+    split = target[inner] == target[inner - 1]
+    if not split.any():
+        return edges
+    start = np.searchsorted(target, target[inner], side="left")
+    stop = np.searchsorted(target, target[inner], side="right")
+    size = before[stop - 1] + bound[stop - 1] - before[start]
+    moved = np.where(split & (size <= _CHUNK_ROWS // 8), start, inner)
+    return np.unique(np.concatenate(([0], moved, [len(target)])))
+
+
+def _turn_sums(turns: np.ndarray) -> np.ndarray:
+    """Σ_j |k_j| per combination of whole turns (C, n), shape (C,): by ``einsum`` (one pass, four times
+    ``sum(axis=1)``'s speed on short rows) where every partial sum is a whole number below 2**53, so exact in any
+    order of summation; by ``sum`` elsewhere."""
+    size = np.abs(turns)
+    if size.max(initial=0.0) * turns.shape[1] < 2.0 ** 53:
+        return np.einsum("ij->i", size)
+    return size.sum(axis=1)
+
+
+def _grouped_order(groups: np.ndarray, within: np.ndarray) -> np.ndarray:
+    """``np.lexsort((within, groups))`` for keys that are whole numbers ≥ 0 (ints, or floats holding them): one
+    stable sort of one integer key, groups × (largest within + 1) + within, where that stays below 2**62; the
+    lexsort elsewhere. Shape (K,) each."""
+    if len(groups):
+        span = int(within.max()) + 1
+        if (int(groups.max()) + 1) * span < 1 << 62:
+            return np.argsort(groups.astype(np.int64) * span + within.astype(np.int64), kind="stable")
+    return np.lexsort((within, groups))
 
 
 class TargetNotes(Mapping):

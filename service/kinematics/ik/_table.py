@@ -65,9 +65,13 @@ class SolutionTable:
     def __len__(self) -> int:
         return len(self.target)
 
-    def take(self, index: np.ndarray) -> "SolutionTable":
-        """The rows ``index`` (indices, a boolean mask or a slice), in that order."""
-        return SolutionTable(self.target[index], self.joints[index], self.within_limits[index],
+    def take(self, index: np.ndarray, *, joints: np.ndarray | None = None,
+             within_limits: np.ndarray | None = None) -> "SolutionTable":
+        """The rows ``index`` (indices, a boolean mask or a slice), in that order; with ``joints`` (K, n) and
+        ``within_limits`` (K,), listed at those values and flags instead of their own (a selection's
+        2π-equivalents: the rows' own are then not gathered)."""
+        return SolutionTable(self.target[index], self.joints[index] if joints is None else joints,
+                             self.within_limits[index] if within_limits is None else within_limits,
                              self.position[index], self.orientation[index],
                              {name: (values, codes[index]) for name, (values, codes) in self.labels.items()},
                              None if self.clearance is None else self.clearance[index],

@@ -38,7 +38,9 @@ FRAGILE_RELATIONS = frozenset({"free", "sum", "difference", "signed_sum",
 
 
 def wrap_revolute(robot: Robot, q: np.ndarray) -> np.ndarray:
-    """Revolute joint values wrapped to (−π, π]; prismatic values unchanged. Shape (..., n)."""
+    """Revolute joint values wrapped to (−π, π]; prismatic values unchanged. Shape (..., n), a new array."""
+    if robot.is_revolute.all():  # the usual arm: no pass to keep prismatic values
+        return wrap_angle(q)
     return np.where(robot.is_revolute, wrap_angle(q), q)
 
 
@@ -139,7 +141,9 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
     kept = ok.copy()
     for start in range(0, n_targets, chunk):
         block = slice(start, start + chunk)
-        same = _same(np.abs(joints[block, later, :] - joints[block, earlier, :]), tolerance, revolute)  # (b, pairs)
+        same = _same_pairs(joints[block], earlier, later, tolerance, revolute)  # (b, pairs)
+        if not same.any():  # no two slots one solution: every ok slot is a first occurrence
+            continue
         # the sequential scan over slots, on booleans only: the pairs of slot s are those with later == s
         offset = 0
         for slot in range(1, m):
@@ -155,6 +159,20 @@ def first_of_each_slot(robot: Robot, joints: np.ndarray, ok: list[bool]) -> list
         return list(ok)
     same = _same(np.abs(joints[:, None] - joints[None]), duplicate_tolerance(robot), robot.is_revolute)
     return _scanned_pairs(same.tolist(), list(ok))
+
+
+def _same_pairs(joints: np.ndarray, earlier: np.ndarray, later: np.ndarray, tolerance: np.ndarray,
+                revolute: np.ndarray) -> np.ndarray:
+    """Which pairs of slots (``earlier``, ``later``, (P,) each) of each target's ``joints`` (b, m, n) are one
+    solution, shape (b, P): screened on the last joint alone (distinct solutions mostly differ there), then
+    :func:`_same` on every joint of the pairs that pass, so that only those gaps are gathered whole."""
+    last = joints[:, :, -1]
+    close = _same(np.abs(last[:, later] - last[:, earlier])[..., None], tolerance[-1:], revolute[-1:])
+    rows, pairs = np.nonzero(close)
+    if len(rows):
+        close[rows, pairs] = _same(np.abs(joints[rows, later[pairs]] - joints[rows, earlier[pairs]]), tolerance,
+                                   revolute)
+    return close
 
 
 def _same(gap: np.ndarray, tolerance: np.ndarray, revolute: np.ndarray) -> np.ndarray:

@@ -210,6 +210,57 @@ def test_a_batch_answers_the_same_in_small_chunks(monkeypatch):
         np.testing.assert_array_equal(small.solutions.joints, whole.solutions.joints)
 
 
+def test_chunk_edges_move_to_target_starts_and_the_answer_stays(monkeypatch):
+    """Chunks of 4,096 combinations over UR5 targets of up to 512 (8 solutions × 64 equivalents): each edge moves to
+    its target's first row, so no target spans chunks, and the rows, their order, joints (bit for bit), flags and
+    labels are those of one chunk, with and without a reference and with a cap that trims."""
+    from service.kinematics.ik import _select
+    robot = CATALOGUE.get("ur5").robot
+    q = np.random.default_rng(4).uniform(-np.pi, np.pi, (60, 6))
+    arrays = solve_ik_arrays(robot, forward_kinematics(robot, q))
+    edges_made = []
+    target_edges = _select._target_edges
+
+    def recorded(target, *rest):
+        edges = target_edges(target, *rest)
+        edges_made.append((target, edges))
+        return edges
+
+    for options in ({}, {"max_equivalents": 100}, {"reference": q[0], "max_equivalents": 300}):
+        whole = select_arrays(robot, arrays, Limits.of(robot), **options)
+        monkeypatch.setattr(_select, "_CHUNK_ROWS", 4096)
+        monkeypatch.setattr(_select, "_target_edges", recorded)
+        small = select_arrays(robot, arrays, Limits.of(robot), **options)
+        monkeypatch.undo()
+        for kind in ("solutions", "rejected"):
+            mine, one = getattr(small, kind), getattr(whole, kind)
+            np.testing.assert_array_equal(mine.target, one.target)
+            assert mine.joints.tobytes() == one.joints.tobytes()
+            np.testing.assert_array_equal(mine.within_limits, one.within_limits)
+            assert {k: (v, c.tolist()) for k, (v, c) in mine.labels.items()} == {
+                k: (v, c.tolist()) for k, (v, c) in one.labels.items()}
+    assert edges_made
+    for target, edges in edges_made:
+        assert len(edges) > 3  # several chunks
+        inner = edges[1:-1]
+        assert (target[inner] != target[inner - 1]).all()  # each one at a target's first row
+
+
+def test_rows_all_alike_take_one_rows_rank_tuples_repeated():
+    """Rows of equal caps and limits get one row's tuples, repeated: the same as enumerating every row."""
+    from service.kinematics.ik import _equivalents
+    rng = np.random.default_rng(2)
+    for _ in range(30):
+        rows, n = int(rng.integers(2, 80)), int(rng.integers(1, 7))
+        caps = np.repeat(rng.integers(0, 4, (1, n)), rows, axis=0)
+        limit = np.full(rows, int(rng.integers(0, 40)))
+        owner, ranks = _equivalents._rank_tuples(caps, limit)
+        expected_owner, expected_ranks = _equivalents._enumerated_rank_tuples(caps, limit)
+        np.testing.assert_array_equal(owner, expected_owner)
+        np.testing.assert_array_equal(ranks, expected_ranks)
+        assert ranks.shape == (len(owner), n)
+
+
 CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 
 

@@ -1,0 +1,50 @@
+"""A batch larger than a chunk is split into chunks of one size, as many as a multiple of the threads, and its
+answer does not depend on the split: the same table, bit for bit, on 1, 2 or 3 threads."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from service.config import Settings
+from service.kinematics import forward_kinematics
+from service.kinematics.ik import _closed_form
+from service.kinematics.ik._closed_form import cached_plan, chunk_edges, solve_closed_form
+from service.kinematics.ik._goals import PoseGoal
+from service.robots.catalogue import load_catalogue
+
+CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+
+
+@pytest.mark.parametrize("n_targets, threads", [(10_000, 2), (10_000, 1), (10_000, 4), (4_097, 2), (8_192, 2),
+                                                (123_457, 3), (40_000, 16)])
+def test_chunks_are_even_and_a_multiple_of_the_threads(n_targets, threads):
+    edges = chunk_edges(n_targets, threads)
+    sizes = np.diff(edges)
+    assert edges[0] == 0 and edges[-1] == n_targets
+    assert sizes.max() <= _closed_form.CHUNK and sizes.max() - sizes.min() <= 1
+    fewest = -(-n_targets // _closed_form.CHUNK)
+    assert len(sizes) >= fewest
+    assert len(sizes) % min(threads, fewest) == 0  # each thread gets as many chunks
+
+
+def test_ten_thousand_poses_on_two_threads_are_four_chunks_of_2500():
+    assert chunk_edges(10_000, 2) == [0, 2_500, 5_000, 7_500, 10_000]
+
+
+@pytest.mark.parametrize("robot_id", ["puma560_standard", "ur5", "kuka_kr6_r900_2"])
+def test_the_answer_does_not_depend_on_the_split(robot_id, monkeypatch):
+    robot = CATALOGUE.get(robot_id).robot
+    q = np.random.default_rng(21).uniform(-np.pi, np.pi, (1_000, robot.dof))
+    goal = PoseGoal(forward_kinematics(robot, q))
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    whole = solve_closed_form(robot, plan, goal, None)  # one chunk
+    monkeypatch.setattr(_closed_form, "CHUNK", 96)
+    for threads in (1, 2, 3):
+        split = solve_closed_form(robot, plan, goal, None, threads=threads)
+        for name in ("target", "joints", "within_limits", "position", "orientation"):
+            assert getattr(split.table, name).tobytes() == getattr(whole.table, name).tobytes(), (threads, name)
+        assert {k: (v, c.tobytes()) for k, (v, c) in split.table.labels.items()} == {
+            k: (v, c.tobytes()) for k, (v, c) in whole.table.labels.items()}
+        np.testing.assert_array_equal(split.complete, whole.complete)
+        np.testing.assert_array_equal(split.nearest, whole.nearest)

@@ -57,6 +57,10 @@ class DerivedStore:
                 store.popitem(last=False)
         return value
 
+    def holds(self, namespace: str, key: Hashable) -> bool:
+        """Whether a bounded namespace keeps ``key`` now (asking would build nothing; the order is left as it is)."""
+        return key in self._values.get(("bounded", namespace), ())
+
     def namespace_size(self, namespace: str) -> int:
         """How many keys a bounded namespace holds now."""
         return len(self._values.get(("bounded", namespace), ()))
@@ -70,6 +74,11 @@ def memo(robot: Any, key: Hashable, build: Callable[[], T]) -> T:
 def is_memoised(robot: Any, key: Hashable) -> bool:
     """Whether :func:`memo` has kept ``key`` for ``robot`` (asking would build nothing)."""
     return key in robot.derived
+
+
+def is_bounded_memoised(robot: Any, namespace: str, key: Hashable) -> bool:
+    """Whether :func:`bounded_memo` keeps ``key`` of ``namespace`` for ``robot`` now."""
+    return robot.derived.holds(namespace, key)
 
 
 def bounded_memo(robot: Any, namespace: str, key: Hashable, build: Callable[[], T], capacity: int) -> T:

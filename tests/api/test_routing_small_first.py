@@ -173,3 +173,32 @@ def test_while_a_request_computes_on_a_work_loop_small_ones_take_their_turn(clie
         routing.CORE_TURNS.give_back()
     assert client.post("/v1/robots/puma560_standard/ik", json=body).status_code == 200
     assert where == ["work", "here"]
+
+
+CELL = {"self": True, "margin": 0.005, "obstacles": [
+    {"name": "table", "box": {"center": [0.55, 0.0, -0.15], "size": [0.5, 1.0, 0.1]}},
+    {"name": "post", "capsule": {"from": [0.27, -0.2, -0.6], "to": [0.27, -0.2, 0.6], "radius": 0.06}}]}
+
+
+def test_a_single_ik_with_collisions_is_small_once_its_model_is_kept(fresh, where, monkeypatch):
+    """The first request compiles its collision model on a work loop; the same cell again finds it kept, and a
+    single pose's check is small; a cell of many obstacles (more pair distances than a small check) is not. Each
+    is answered byte for byte as on a work loop."""
+    target = _puma_target(fresh)
+    fresh.post("/v1/robots/puma560_standard/ik", json={"target": {"matrix": target}})  # the plan is built
+    where.clear()
+    body = {"target": {"matrix": target}, "collisions": CELL}
+    first, second = (fresh.post("/v1/robots/puma560_standard/ik", json=body) for _ in range(2))
+    assert first.status_code == second.status_code == 200 and first.content == second.content
+    assert where == ["work", "here"]
+    assert first.json()["rejected"] and all(s["collisions"] for s in first.json()["rejected"])
+    crowded = {**CELL, "obstacles": [{"name": f"post {k}", "sphere": {"center": [1.0 + k, 0, 0], "radius": 0.1}}
+                                     for k in range(40)]}
+    for _ in range(2):
+        assert fresh.post("/v1/robots/puma560_standard/ik",
+                          json={"target": {"matrix": target}, "collisions": crowded}).status_code == 200
+    assert where[2:] == ["work", "work"]  # kept, but 8 solutions × (28 + 320) pairs is not a small check
+    small = fresh.post("/v1/robots/puma560_standard/ik", json=body)
+    monkeypatch.setattr(routing, "SMALL_BODY_BYTES", -1)  # every request on a work loop
+    handed = fresh.post("/v1/robots/puma560_standard/ik", json=body)
+    assert where[-2:] == ["here", "work"] and small.content == handed.content

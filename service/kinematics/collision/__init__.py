@@ -16,7 +16,8 @@ from ._distances import (
     separation,
     sphere_sphere,
 )
-from ._clearance import Clearances, CollisionRequest, Contacts, at_collisions, clearances, colliding, frame_index, link_names, model_for
+from ._clearance import (Clearances, CollisionRequest, Contacts, at_collisions, clearances, colliding, frame_index,
+                         link_names, model_for, model_is_kept)
 from ._model import CollisionCheck, CollisionModel, ShapePair, collision_model
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere, restated, scaled
 
@@ -46,6 +47,7 @@ __all__ = [
     "frame_index",
     "link_names",
     "model_for",
+    "model_is_kept",
     "restated",
     "scaled",
     "separation",

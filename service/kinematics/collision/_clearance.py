@@ -14,7 +14,7 @@ from typing import Iterator
 
 import numpy as np
 
-from .._cache import bounded_memo, memo
+from .._cache import bounded_memo, is_bounded_memoised, is_memoised, memo
 from .._errors import InvalidInputError
 from .._forward import link_frame_columns, link_frames
 from ._model import CollisionCheck, CollisionModel, collision_model
@@ -102,15 +102,28 @@ def model_for(robot, request: CollisionRequest) -> CollisionModel:
     if not robot.collision:
         raise InvalidInputError("this robot carries no collision shapes: describe them in its 'collision' field "
                                 "(capsules, spheres, boxes fixed to its links) to check collisions")
-    # the request's pairs first, so that an error about one names its place in the request
-    ignore = request.ignore
-    if request.self_collision:
-        ignore = tuple(dict.fromkeys((*ignore, *touching_at_home(robot))))
+    ignore = _ignored(robot, request)
 
     def build() -> CollisionModel:
         return _compiled(robot, request.obstacles, self_collision=request.self_collision, ignore=ignore)
 
     return bounded_memo(robot, "collision_model", (request.key(), ignore), build, MODELS_KEPT)
+
+
+def model_is_kept(robot, request: CollisionRequest) -> bool:
+    """Whether :func:`model_for` would answer without compiling anything (the robot's pairs touching at home and
+    the request's model both kept)."""
+    if not robot.collision or (request.self_collision and not is_memoised(robot, _TOUCHING_AT_HOME)):
+        return False
+    return is_bounded_memoised(robot, "collision_model", (request.key(), _ignored(robot, request)))
+
+
+def _ignored(robot, request: CollisionRequest) -> tuple:
+    """The link pairs the request's model leaves out: the request's own first (so that an error about one names
+    its place in the request), then, with self-collision, those touching at home."""
+    if not request.self_collision:
+        return request.ignore
+    return tuple(dict.fromkeys((*request.ignore, *touching_at_home(robot))))
 
 
 def touching_at_home(robot) -> tuple[tuple[int, int], ...]:
@@ -128,7 +141,10 @@ def touching_at_home(robot) -> tuple[tuple[int, int], ...]:
         return tuple(sorted({(pair.link_a, pair.link_b) for pair, distance in zip(model.pairs, distances.tolist())
                              if distance < 0.0}))
 
-    return memo(robot, "collision_touching_at_home", build)
+    return memo(robot, _TOUCHING_AT_HOME, build)
+
+
+_TOUCHING_AT_HOME = "collision_touching_at_home"
 
 
 def _compiled(robot, obstacles, *, self_collision: bool, ignore) -> CollisionModel:

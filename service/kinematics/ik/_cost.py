@@ -14,7 +14,7 @@ import numpy as np
 
 from .._limits import Limits
 from .._robot import Robot
-from ..collision import at_collisions, model_for
+from ..collision import at_collisions, model_for, model_is_kept
 from ._answer import (DIRECTION, POSE, POSITION, AnswerOptions, IKTargets, _at_free_joints,
                       direction_free_joints, direction_groups, answered_by_family)
 from ._closed_form import cached_plan, plan_is_kept
@@ -27,6 +27,11 @@ from ._redundant import family_for, free_joints_for, grid_size
 #: The most rows a single-target answer may hold for its work to count as small (:attr:`Cost.small`): a
 #: closed-form solve, a selection and an encoding of a few milliseconds at most.
 SMALL_ROWS = 64
+
+#: The most pair distances (distinct solutions × shape pairs) a collision check may measure for its work to count
+#: as small: a few hundred microseconds, every pair measured at once (a single PUMA pose with its catalogue
+#: capsules, a table and a post: 8 × 44 at most).
+SMALL_PAIR_CHECKS = 2048
 
 
 @dataclass(frozen=True)
@@ -166,13 +171,14 @@ def collision_pair_bound(robot: Robot, request) -> int:
 
 
 def is_small(robot: Robot, targets: IKTargets, options: AnswerOptions) -> bool:
-    """:attr:`Cost.small`, decided without building anything (a plan not yet kept makes the work not small):
-    the closed form of a kept plan, no search, no family, an answer of at most :data:`SMALL_ROWS` rows."""
+    """:attr:`Cost.small`, decided without building anything (a plan or a collision model not yet kept makes the
+    work not small): the closed form of a kept plan, no search, no family, an answer of at most
+    :data:`SMALL_ROWS` rows, and a collision check of at most :data:`SMALL_PAIR_CHECKS` pair distances."""
     kinds = np.asarray(targets.kinds)
     if robot.dof > 6 or options.free_joints is not None or (kinds == DIRECTION).any():
         return False
-    if options.collisions is not None:  # compiling the pairs may take milliseconds
-        return False
+    if options.collisions is not None and not model_is_kept(robot, options.collisions):
+        return False  # compiling the pairs may take milliseconds
     if robot.dof > 3 and (kinds == POSITION).any():  # a held joint may leave a point to the search
         return False
     most = 0
@@ -187,4 +193,5 @@ def is_small(robot: Robot, targets: IKTargets, options: AnswerOptions) -> bool:
     kept = options.max_equivalents if options.ordering.max_solutions is None else min(
         options.max_equivalents, options.ordering.max_solutions)
     rows, _ = worst_answer_per_target(most, equivalents_per_solution(robot, limits), kept)
-    return len(kinds) * rows <= SMALL_ROWS
+    checks = 0 if options.collisions is None else len(kinds) * most * collision_pair_bound(robot, options.collisions)
+    return len(kinds) * rows <= SMALL_ROWS and checks <= SMALL_PAIR_CHECKS

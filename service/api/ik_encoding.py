@@ -63,12 +63,13 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
             {"joint": int(j), "value": joints[k][j], "lower": lower[j], "upper": upper[j]})
     targets = table.target.tolist()
     per_target: list[list[dict]] = [[] for _ in free_of_target]
+    any_free = any(free_of_target)
     for k, target in enumerate(targets):
         per_target[target].append({
             "joints": joints[k], "branch": branches[k],
             "within_limits": within[k], "violations": violations.get(k, []),
             "residual": {"position": position[k], "orientation": orientation[k]},
-            "free_values": {str(j): joints[k][j] for j in free_of_target[target]}})
+            "free_values": {str(j): joints[k][j] for j in free_of_target[target]} if any_free else {}})
     if table.roll is not None:
         for solution, roll in zip((s for rows in per_target for s in rows), _rolls(table, angle)):
             if roll is not None:

@@ -103,12 +103,16 @@ def _rolls(table: SolutionTable, angle: float) -> list[float | None]:
     return [None if math.isnan(value) else value for value in (table.roll / angle).tolist()]
 
 
-def _clearances(table: SolutionTable) -> list[float | None]:
+def _clearances(table: SolutionTable) -> np.ndarray | list[float | None]:
     """Each row's clearance; null where no pair was checked (+inf)."""
-    clearance = table.clearance
-    if not np.isinf(clearance).any():
-        return clearance.tolist()
-    return [None if math.isinf(value) else value for value in clearance.tolist()]
+    return _nulled(table.clearance, np.isinf(table.clearance))
+
+
+def _nulled(values: np.ndarray, missing: np.ndarray) -> np.ndarray | list:
+    """A column (S,) as it stands (orjson writes the array), or as a list with None where ``missing`` (S,)."""
+    if not missing.any():
+        return values
+    return [None if gap else value for value, gap in zip(values.tolist(), missing.tolist())]
 
 
 def _contacts(table: SolutionTable) -> list[Sequence[dict]]:
@@ -159,9 +163,7 @@ def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer, angle: f
     target has no such free joint; ``"roll"``: each row's roll about the tool axis (``angle``: radians per unit),
     or None."""
     joints = table.joints / scale
-    orientation = table.orientation
-    if np.isnan(orientation).any():
-        orientation = [None if np.isnan(value) else value for value in orientation.tolist()]
+    orientation = _nulled(table.orientation, np.isnan(table.orientation))
     branch = {name: np.array([*values, None], dtype=object)[codes].tolist()
               for name, (values, codes) in table.labels.items()}
     free_values = {}
@@ -176,9 +178,7 @@ def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer, angle: f
                "residual_position": table.position, "residual_orientation": orientation, "branch": branch,
                "free_values": free_values}
     if table.clearance is not None:
-        clearance = table.clearance  # as it stands when every row was checked (orjson writes the array)
-        columns["clearance"] = clearance if not np.isinf(clearance).any() else _clearances(table)
-        columns["collisions"] = _contacts(table)
+        columns["clearance"], columns["collisions"] = _clearances(table), _contacts(table)
     return columns
 
 

@@ -294,9 +294,9 @@ class _PlainArguments:
     @classmethod
     def _of(cls, route: APIRoute) -> "_PlainArguments | None":
         dependant = route.dependant
-        if not callable(getattr(dependant.body_params[0] if dependant.body_params else None, "validate", None)):
+        if len(dependant.body_params) != 1 or not callable(dependant.body_params[0].validate):
             return None
-        if not (_plain(dependant) and len(dependant.body_params) == 1 and not route._embed_body_fields
+        if not (_plain(dependant) and not route._embed_body_fields
                 and not isinstance(dependant.body_params[0].field_info, params.Form) and not dependant.path_params
                 and not dependant.header_params and not dependant.cookie_params
                 and inspect.iscoroutinefunction(dependant.call)
@@ -383,7 +383,9 @@ def _is_json(scope: dict) -> bool:
 
 
 class FastJSONRoute(APIRoute):
-    """:class:`APIRoute` with orjson body parsing, handled on a work loop (see the module docstring)."""
+    """:class:`APIRoute` with orjson body parsing: small-first routes start where the request arrives and find a
+    plain request's arguments themselves (:class:`_PlainArguments`), other work runs on a work loop (see the
+    module docstring)."""
 
     def __init__(self, path: str, endpoint: Callable[..., Any], **kwargs: Any) -> None:
         self.small_first = getattr(endpoint, "small_first", False)  # before APIRoute builds its handler

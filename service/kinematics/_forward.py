@@ -76,9 +76,9 @@ _FRAMES_BLOCK = 4096
 def _matrix_frames(robot: Robot, q: np.ndarray) -> np.ndarray:
     """:func:`link_frames` of a DH robot as products of its 4 × 4 link transforms, shape (..., n + 1, 4, 4).
 
-    The joint screws (:func:`joint_screws`, and so the IK plans' geometry and the Jacobian) are read from these
-    products; they differ from the column operations of :func:`link_frames` in the last bits only, and the IK
-    plans' near-singular behaviour is held by tests on these bits.
+    The joint screws (:func:`joint_screws`, and so the IK plans' screw model and the Jacobian) are read from these
+    products; they differ from the column operations of :func:`link_frames` (which give the plans' link x
+    directions) in the last bits only, and the IK plans' near-singular behaviour is held by tests on these bits.
     """
     theta = robot.theta + np.where(robot.is_revolute, q, 0.0)
     d = robot.d + np.where(robot.is_revolute, 0.0, q)

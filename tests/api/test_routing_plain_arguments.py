@@ -5,6 +5,7 @@ each request below is answered byte for byte (status, headers, body) as FastAPI'
 from __future__ import annotations
 
 import asyncio
+import json
 from types import SimpleNamespace
 
 import fastapi.routing
@@ -107,7 +108,7 @@ def test_plain_requests_skip_the_solver_and_get_the_same_answers(monkeypatch, so
     pose = next(content for path, _, _, content in fast if path == "/v1/robots/puma560_standard/fk")
     with _client() as client:
         robot = client.app.state.catalogue.get("puma560_standard").robot
-    np.testing.assert_allclose(np.array(__import__("json").loads(pose)["pose"]["matrix"]),
+    np.testing.assert_allclose(np.array(json.loads(pose)["pose"]["matrix"]),
                                forward_kinematics(robot, np.array(PUMA_Q)), atol=1e-12)
 
 
@@ -168,7 +169,6 @@ def test_dependency_overrides_are_honoured():
         response = client.post("/v1/robots/anything/fk", json={"joints": PUMA_Q})
     assert response.status_code == 200, response.text
     assert response.json()["robot_id"] == "overridden-anything"
-
 
 
 def test_a_fastapi_of_other_internals_leaves_every_request_to_its_handler(monkeypatch, solver_calls):

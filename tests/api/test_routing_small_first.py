@@ -197,7 +197,7 @@ def test_a_single_ik_with_collisions_is_small_once_its_model_is_kept(fresh, wher
     for _ in range(2):
         assert fresh.post("/v1/robots/puma560_standard/ik",
                           json={"target": {"matrix": target}, "collisions": crowded}).status_code == 200
-    assert where[2:] == ["work", "work"]  # kept, but 8 solutions × (28 + 320) pairs is not a small check
+    assert where[2:] == ["work", "work"]  # kept, but 8 solutions × (320 + the self pairs) is not a small check
     small = fresh.post("/v1/robots/puma560_standard/ik", json=body)
     monkeypatch.setattr(routing, "SMALL_BODY_BYTES", -1)  # every request on a work loop
     handed = fresh.post("/v1/robots/puma560_standard/ik", json=body)

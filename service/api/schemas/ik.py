@@ -259,7 +259,6 @@ class IKSolution(CheckedOnly):
     collisions: list[CollisionPair] | None = COLLISIONS_FIELD
 
 
-
 class SolverInfo(ApiModel):
     """Which solver answered, and what it guarantees."""
 
@@ -363,7 +362,6 @@ class SolutionColumns(CheckedOnly):
                                                                    "the objects form")
     collisions: list[list[CollisionPair]] | None = Field(None, description="with collisions: each row's pairs "
                                                                            "closer than the margin")
-
 
 
 class IKBatchArraysResponse(ApiModel):

@@ -153,7 +153,6 @@ class TrajectorySampleResult(CheckedOnly):
                           "the nearest collision-free solution (branch_changed is then true); absent without")
 
 
-
 class JointStep(ApiModel):
     """The largest move of each joint between consecutive reached samples, and where it happens."""
 
@@ -205,7 +204,6 @@ class TrajectorySummary(CheckedOnly):
     smallest_clearance: ClearanceAt | None = Field(
         None, description="with 'collisions': the smallest clearance over the reached samples, and where; absent "
                           "without")
-
 
 
 class TrajectorySolver(ApiModel):

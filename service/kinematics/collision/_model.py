@@ -106,11 +106,9 @@ class _Group(NamedTuple):
                              bound_constants=tuple(pairs_of(constant) for constant in self.bound_constants),
                              fixed=min(self.fixed, end) - min(self.fixed, begin))
 
-    def bounds_of(self, placed32: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    def bounds_of(self, placed32: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The lower and upper bounds (P_k, B) of the group's distances from the block's reference rows (3, K, B)
-        in single precision; None for a kernel without bounds."""
-        if self.bounds is None:
-            return None
+        in single precision (a group with ``bounds``)."""
         return self.bounds(np.take(placed32, self.rows.T, axis=1), *self.bound_constants)
 
 
@@ -313,12 +311,11 @@ class CollisionModel:
                                         location=("frames", *where, rows.link))
         raise InvalidInputError("link frames too large: the distances overflow", location=("frames", *where))
 
-    def _distances(self, columns: np.ndarray, margin: float | None = None) -> np.ndarray:
-        """Every pair's distance (S, P) for frame columns (L, 4, 3, S); with a ``margin``, only where a pair can
-        be the configuration's clearance or closer than the margin (see :meth:`_evaluated_blocks`)."""
+    def _distances(self, columns: np.ndarray) -> np.ndarray:
+        """Every pair's distance (S, P) for frame columns (L, 4, 3, S), each measured."""
         result = _pair_major(columns.shape[3], len(self.pairs))
         if columns.shape[3] and self.pairs:
-            for _ in self._evaluated_blocks(columns, result, margin):
+            for _ in self._evaluated_blocks(columns, result, None):
                 pass
         return result
 
@@ -350,8 +347,8 @@ class CollisionModel:
                  if group.bounds is None and group.fixed < len(group.rows)]
             bounded = [group.part(group.fixed, len(group.rows)) for group in self._groups
                        if group.bounds is not None and group.fixed < len(group.rows)]
-        with _quiet():
-            for begin in range(0, count, block):
+        for begin in range(0, count, block):
+            with _quiet():  # per block: the caller's code between blocks keeps its own floating-point state
                 end = min(begin + block, count)
                 frames = columns[..., begin:end]
                 if frames.strides[-1] != frames.itemsize:  # 4 × 4 frames seen as columns: the block's, in a
@@ -369,7 +366,7 @@ class CollisionModel:
                     bounds, cutoff, slack = _bounds(bounded, placed, margin, clearance)
                     for group, bound in zip(bounded, bounds):
                         _measure(block_result[:, group.start:group.stop], group, world, bound, cutoff, slack)
-                yield begin, end
+            yield begin, end
 
     def _world_buffer(self, block: int) -> np.ndarray:
         """(3, K, block): room for every reference row of a block of configurations, the obstacles' filled in."""
@@ -669,18 +666,20 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
                 if link_a != link_b and (link_a, link_b) not in skipped:
                     candidates.append((index, shapes[index].shape, shape_rows[index], names[link_b], link_b, other,
                                        shapes[other].shape, shape_rows[other]))
+    half = {id(shape): _half_length(shape) for shape in (*(item.shape for item in shapes),
+                                                         *(obstacle.shape for obstacle in obstacle_list))}
     members: dict[tuple[str, str], list] = {family: [] for family in _KERNELS}
     for index, shape_a, rows_a, b, link_b, index_b, shape_b, rows_b in candidates:
         named = sorted((shape_a, shape_b), key=lambda shape: _KIND_ORDER.index(type(shape)))
         pair = ShapePair(names[shapes[index].link], b, shapes[index].link, link_b, index, index_b,
                          f"{_KIND_NAMES[type(named[0])]}-{_KIND_NAMES[type(named[1])]}")
-        swapped = _kernel_order(shape_a) > _kernel_order(shape_b)
+        swapped = _kernel_order(shape_a, half[id(shape_a)]) > _kernel_order(shape_b, half[id(shape_b)])
         first, second = (shape_b, shape_a) if swapped else (shape_a, shape_b)
         first_rows, second_rows = (rows_b, rows_a) if swapped else (rows_a, rows_b)
         family = ("box" if isinstance(first, Box) else "round",
-                  "box" if isinstance(second, Box) else "point" if _half_length(second) == 0.0 else "round")
+                  "box" if isinstance(second, Box) else "point" if half[id(second)] == 0.0 else "round")
         rows = _kernel_rows(first, first_rows, False) + _kernel_rows(second, second_rows, family[1] == "point")
-        members[family].append((pair, rows, first, second, swapped))
+        members[family].append((pair, rows, first, second, swapped, half[id(first)], half[id(second)]))
 
     pairs: list[ShapePair] = []
     groups: list[_Group] = []
@@ -695,7 +694,8 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
         groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in group]),
                              _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
                              np.array([member[4] for member in group], dtype=bool), _BOUNDS.get(family),
-                             _bound_constants(family, firsts, seconds), sum(still)))
+                             _bound_constants(family, firsts, seconds, [member[5] for member in group],
+                                              [member[6] for member in group]), sum(still)))
     body_pairs: dict[tuple[str, str], int] = {}
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)
@@ -722,23 +722,26 @@ def _kernel_rows(shape: Shape, rows: list[int], point: bool) -> list[int]:
     return rows[:1] if point else [rows[0], rows[-1]]
 
 
-def _kernel_order(shape: Shape) -> tuple[int, float]:
+def _kernel_order(shape: Shape, half_length: float) -> tuple[int, float]:
     """The order of a pair's shapes in its kernel: a box first, then of two round shapes the longer (the bounds
-    take the shorter one's middle, and a point comes second)."""
-    return (0, 0.0) if isinstance(shape, Box) else (1, -_half_length(shape))
+    take the shorter one's middle, and a point comes second); ``half_length``: the shape's
+    (:func:`_half_length`)."""
+    return (0, 0.0) if isinstance(shape, Box) else (1, -half_length)
 
 
-def _bound_constants(family: tuple[str, str], firsts: list[Shape], seconds: list[Shape]) -> tuple:
-    """The sizes the family's bounds take, single precision, (P_k, 1) each (a box's half sizes (3, P_k, 1))."""
-    reach = np.array([[min(_half_length(a), _half_length(b))] for a, b in zip(firsts, seconds)], dtype=np.float32)
+def _bound_constants(family: tuple[str, str], firsts: list[Shape], seconds: list[Shape], first_halves: list[float],
+                     second_halves: list[float]) -> tuple:
+    """The sizes the family's bounds take, single precision, (P_k, 1) each (a box's half sizes (3, P_k, 1));
+    ``first_halves`` and ``second_halves``: the shapes' half lengths (:func:`_half_length`)."""
+    if family == ("box", "box"):
+        return ()
+    reach = np.array([[min(a, b)] for a, b in zip(first_halves, second_halves)], dtype=np.float32)
     if family[0] == "round":
         radii = _radii(firsts) + _radii(seconds)
-        longer = [max(2.0 * _half_length(a), 2.0 * _half_length(b)) for a, b in zip(firsts, seconds)]
+        longer = [max(2.0 * a, 2.0 * b) for a, b in zip(first_halves, second_halves)]
         inverse = np.array([[1.0 / length ** 2 if length > 0.0 else 0.0] for length in longer])
         return radii.astype(np.float32), reach, inverse.astype(np.float32)
-    if family[1] != "box":
-        return _half_sizes(firsts).astype(np.float32), _radii(seconds).astype(np.float32), reach
-    return ()
+    return _half_sizes(firsts).astype(np.float32), _radii(seconds).astype(np.float32), reach
 
 
 def _half_length(shape: Shape) -> float:

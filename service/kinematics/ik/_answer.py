@@ -691,7 +691,7 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
                     singular_of[int(part.rows[local])] = met
         whole = len(parts) == 1 and len(part.rows) == n_targets  # rows 0 … N − 1: the part's own numbering
         tables.append(verified.table if whole else verified.table.with_targets(part.rows[verified.table.target]))
-    table = SolutionTable.concat(tables, robot.dof)  # grouped by target: each part's rows ascend
+    table = SolutionTable.concat(tables, robot.dof)  # grouped by target (concat regroups interleaved parts)
     excluded = None
     if options.collisions is not None:  # a 2π-equivalent moves no link: each distinct solution is checked once
         options.budget.check("the collision check")
@@ -701,8 +701,7 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
         excluded = checked.colliding if options.collisions.filter else None
     chosen: Selection = select(robot, table, n_targets, limits, filter_limits=options.filter_limits,
                                reference=options.reference, ordering=options.ordering,
-                               max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget,
-                               options_checked=True)  # answer_ik checked them before it solved
+                               max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget)
     status = chosen.status.copy()
     unproven = ~complete | sampled
     if unproven.any():

@@ -72,13 +72,14 @@ def solve_closed_form(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.nd
     if n_targets <= CHUNK:
         budget.check("the analytic solve")
         return _solved(robot, plan, goal, reference)
-    edges = chunk_edges(n_targets, threads or os.cpu_count() or 1)
+    threads = threads or os.cpu_count() or 1
+    edges = chunk_edges(n_targets, threads)
 
     def solve(start: int, stop: int) -> Verified:
         budget.check("the analytic solve")
         return _solved(robot, plan, goal.take(np.arange(start, stop)), reference)
 
-    workers = min(threads or os.cpu_count() or 1, len(edges) - 1)
+    workers = min(threads, len(edges) - 1)
     if workers > 1:
         with ThreadPoolExecutor(workers) as pool:
             parts = list(pool.map(solve, edges[:-1], edges[1:]))

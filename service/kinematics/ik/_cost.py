@@ -30,7 +30,7 @@ SMALL_ROWS = 64
 
 #: The most pair distances (distinct solutions × shape pairs) a collision check may measure for its work to count
 #: as small: a few hundred microseconds, every pair measured at once (a single PUMA pose with its catalogue
-#: capsules, a table and a post: 8 × 44 at most).
+#: capsules, a table and a post: 8 × 34).
 SMALL_PAIR_CHECKS = 2048
 
 
@@ -193,5 +193,5 @@ def is_small(robot: Robot, targets: IKTargets, options: AnswerOptions) -> bool:
     kept = options.max_equivalents if options.ordering.max_solutions is None else min(
         options.max_equivalents, options.ordering.max_solutions)
     rows, _ = worst_answer_per_target(most, equivalents_per_solution(robot, limits), kept)
-    checks = 0 if options.collisions is None else len(kinds) * most * collision_pair_bound(robot, options.collisions)
+    checks = 0 if options.collisions is None else len(kinds) * most * len(model_for(robot, options.collisions).pairs)
     return len(kinds) * rows <= SMALL_ROWS and checks <= SMALL_PAIR_CHECKS

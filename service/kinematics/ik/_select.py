@@ -209,7 +209,7 @@ def effective_reference(robot: Robot, limits: Limits, reference: np.ndarray) -> 
 def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *, filter_limits: bool = True,
            reference: np.ndarray | None = None, ordering: Ordering = Ordering(),
            max_equivalents: int = MAX_EQUIVALENTS, excluded: np.ndarray | None = None,
-           budget: Budget = UNLIMITED, options_checked: bool = False) -> Selection:
+           budget: Budget = UNLIMITED) -> Selection:
     """Apply limits, expand 2π-equivalents, order and trim the verified solutions of N targets (``table``,
     grouped by target; see the module docstring).
 
@@ -231,11 +231,8 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
         are rejected at their closest equivalent, and the order and the caps apply to the others.
     budget : Budget
         Checked between chunks of the work.
-    options_checked : bool
-        The caller has run :func:`check_options` on these options (as ``answer_ik`` does before it solves).
     """
-    if not options_checked:
-        check_options(robot, ordering, reference, max_equivalents)
+    check_options(robot, ordering, reference, max_equivalents)
     if reference is not None:
         reference = effective_reference(robot, limits, reference)
     budget.check("selection")
@@ -394,9 +391,7 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     # (16 solutions, or 32 samples of a free joint times 8) may hold millions, so a target may span chunks
     before = np.cumsum(bound) - bound
     chunk = before // _CHUNK_ROWS
-    if not len(target):
-        edges = np.zeros(1, int)
-    elif chunk[-1] == 0:  # one chunk
+    if chunk[-1] == 0:  # one chunk
         edges = np.array([0, len(target)])
     else:
         edges = _target_edges(target, before, bound,
@@ -405,7 +400,7 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     if not spanning:  # each chunk's kept rows go straight to their place: per target, at most the limit or them all
         most = int(np.minimum(np.bincount(target, weights=bound), limit).sum())
         rows_out, values_out, filled = np.empty(most, dtype=np.int64), np.empty((most, n)), 0
-    kept_rows, kept_values, kept_keys = [np.zeros(0, dtype=np.int64)], [np.zeros((0, n))], [np.zeros(0)]
+    kept_rows, kept_values, kept_keys = [], [], []  # of each chunk, where a target spans chunks
     for start, stop in zip(edges[:-1].tolist(), edges[1:].tolist()):
         budget.check("selection")
         owner, turns = combination_turns(q[start:stop], first[start:stop], last[start:stop], ranks_cap[start:stop],

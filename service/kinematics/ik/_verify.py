@@ -187,7 +187,7 @@ def _same(gap: np.ndarray, tolerance: np.ndarray, revolute: np.ndarray) -> np.nd
 
 
 def _scanned_pairs(same: list[list[bool]], kept: list[bool]) -> list[bool]:
-    """The scan of :func:`first_of_each` for one target: ``same`` (m × m) says which slots are one solution,
+    """The scan of :func:`first_of_each_slot` (one target): ``same`` (m × m) says which slots are one solution,
     ``kept`` (m,) the ok slots; a slot is dropped when it equals a slot kept before it."""
     distinct: list[int] = []
     for slot, keep in enumerate(kept):

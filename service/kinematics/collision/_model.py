@@ -30,8 +30,8 @@ from typing import Callable, Iterator, NamedTuple, Sequence
 import numpy as np
 
 from .._errors import InvalidInputError
-from ._distances import (Separation, _box_box, _box_point, _box_point_local, _box_segment, _dot,
-                         _nearest_on_segment, _quiet, _segment_point, _segment_segment, _swept)
+from ._bounds import FAMILY_BOUNDS, block_bounds
+from ._distances import Separation, _box_box, _box_point, _box_segment, _quiet, _segment_point, _segment_segment, _swept
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 
 #: Pair evaluations per block (configurations × pairs of the widest group): large enough that numpy's cost per
@@ -363,7 +363,7 @@ class CollisionModel:
                     clearance = np.full(end - begin, np.inf)  # so far: of the pairs measured
                     for group in measured:
                         np.fmin(clearance, block_result[:, group.start:group.stop].min(axis=1), out=clearance)
-                    bounds, cutoff, slack = _bounds(bounded, placed, margin, clearance)
+                    bounds, cutoff, slack = block_bounds(bounded, placed, margin, clearance)
                     for group, bound in zip(bounded, bounds):
                         _measure(block_result[:, group.start:group.stop], group, world, bound, cutoff, slack)
             yield begin, end
@@ -426,26 +426,9 @@ def _box_box_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witne
 
 
 #: The kernel of each pair of families, in the order of the columns: first those measured in full (no bounds,
-#: :data:`_BOUNDS`).
+#: :data:`._bounds.FAMILY_BOUNDS`).
 _KERNELS = {("box", "box"): _box_box_kernel, ("round", "point"): _round_point, ("box", "point"): _box_point_kernel,
             ("round", "round"): _round_round, ("box", "round"): _box_round}
-
-
-def _bounds(groups, placed: np.ndarray, margin: float, clearance: np.ndarray) -> tuple[list, np.ndarray, float]:
-    """Each group's bounds for a block (:meth:`_Group.bounds_of`), every configuration's cutoff (B,) and the slack;
-    ``clearance`` (B,): the smallest distance of the pairs already measured, which bounds the clearance too.
-
-    Single precision, kept conservative by a slack far above its rounding (a few dozen ulps of the largest
-    coordinate); coordinates it cannot hold have no bounds, so every pair is measured."""
-    placed32 = placed.astype(np.float32)
-    largest = float(np.abs(placed32).max())
-    slack = _BOUND_SLACK * (1.0 + largest)
-    bounds = [group.bounds_of(placed32) if largest < _BOUND_RANGE else None for group in groups]
-    upper = clearance.astype(np.float32)
-    for bound in bounds:
-        if bound is not None:
-            np.fmin(upper, bound[1].min(axis=0), out=upper)
-    return bounds, np.maximum(upper + slack, margin) + slack, slack
 
 
 def _measure(out: np.ndarray, group: _Group, world: np.ndarray, bound, cutoff: np.ndarray | None,
@@ -477,59 +460,6 @@ def _measure(out: np.ndarray, group: _Group, world: np.ndarray, bound, cutoff: n
 
 #: Above this share of pairs in doubt, a block measures them all.
 _MEASURE_ALL = 0.6
-
-#: Slack of the single-precision bounds, relative to the largest coordinate of a block (length unit): far above
-#: their rounding (a few dozen ulps of 6e-8), far below any clearance a request states.
-_BOUND_SLACK = 1e-5
-
-#: Coordinates at or past this (length unit) skip the bounds: their squares would leave single precision's range.
-_BOUND_RANGE = 1e15
-
-
-def _round_round_bounds(rows, radii, reach, inverse_square_length):
-    """Lower and upper bounds (P, B) of two capsules' distance from the distance of one's core (rows 0, 1: the
-    longer segment, 1 / its squared length given) to the other's middle (rows 2, 3: the shorter one's ends):
-    the other shape holds the ball of radius r about its middle and lies inside the ball of radius r + half its
-    length (``reach``); ``radii`` (P, 1) their sum."""
-    middle = rows[:, 2] + rows[:, 3]
-    middle *= 0.5
-    return _round_middle_bounds(rows, middle, radii, reach, inverse_square_length)
-
-
-def _round_point_bounds(rows, radii, reach, inverse_square_length):
-    """:func:`_round_round_bounds` of a capsule or sphere (rows 0, 1) and a sphere (row 2, its centre: the
-    middle, ``reach`` 0), whose lower and upper bounds are the distance, in single precision."""
-    return _round_middle_bounds(rows, rows[:, 2], radii, reach, inverse_square_length)
-
-
-def _round_middle_bounds(rows, middle, radii, reach, inverse_square_length):
-    gap = middle - rows[:, 0]  # the middle, from the segment's start
-    _nearest_on_segment(gap, rows[:, 1] - rows[:, 0], inverse_square_length)
-    upper = np.sqrt(_dot(gap, gap))
-    upper -= radii
-    return upper - reach, upper
-
-
-def _box_round_bounds(rows, half_size_a, radius_b, reach):
-    """Lower and upper bounds (P, B) of a box's distance to a capsule from the box's signed distance at the
-    capsule's middle (the same balls as :func:`_round_round_bounds`; the box's half sizes (3, P, 1), the
-    capsule's radius (P, 1))."""
-    middle = rows[:, 4] + rows[:, 5]
-    middle *= 0.5
-    return _box_middle_bounds(rows, middle, half_size_a, radius_b, reach)
-
-
-def _box_point_bounds(rows, half_size_a, radius_b, reach):
-    """:func:`_box_round_bounds` of a box and a sphere (row 4, its centre: the middle, ``reach`` 0)."""
-    return _box_middle_bounds(rows, rows[:, 4], half_size_a, radius_b, reach)
-
-
-def _box_middle_bounds(rows, middle, half_size_a, radius_b, reach):
-    local = np.einsum("ij...,i...->j...", rows[:, 1:4], middle - rows[:, 0])  # R^T (middle - centre)
-    upper = _box_point_local(local, half_size_a)
-    upper -= radius_b
-    return upper - reach, upper
-
 
 # --- the close pairs ------------------------------------------------------------------------------------------
 
@@ -575,11 +505,6 @@ def _close_pairs(by_pair: np.ndarray, clearance: np.ndarray, merge: _BodyMerge,
         order = np.lexsort((values, rows))  # stable: equal distances keep the body pairs' order
         rows, bodies, values = rows[order], bodies[order], values[order]
     return rows, bodies, values
-
-
-#: The cheap bounds of each pair of families (two boxes have none: they are always measured).
-_BOUNDS = {("round", "point"): _round_point_bounds, ("box", "point"): _box_point_bounds,
-           ("round", "round"): _round_round_bounds, ("box", "round"): _box_round_bounds}
 
 
 # --- compilation ----------------------------------------------------------------------------------------------
@@ -693,7 +618,7 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
         firsts, seconds = [member[2] for member in group], [member[3] for member in group]
         groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in group]),
                              _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
-                             np.array([member[4] for member in group], dtype=bool), _BOUNDS.get(family),
+                             np.array([member[4] for member in group], dtype=bool), FAMILY_BOUNDS.get(family),
                              _bound_constants(family, firsts, seconds, [member[5] for member in group],
                                               [member[6] for member in group]), sum(still)))
     body_pairs: dict[tuple[str, str], int] = {}

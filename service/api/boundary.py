@@ -36,12 +36,12 @@ from ..kinematics.collision import CollisionRequest, Obstacle, clearances, frame
 from ..robots.build import bounds as _bounds
 from ..robots.geometry import shape_from_wire
 from ..robots.orientations import rotation_from_orientation
+from ..units import radians_per
 from .schemas.collisions import CollisionOptions
 from .schemas.common import AngleUnit
 from .schemas.ik import MatrixRows, Ordering as OrderingOptions
 from .schemas.poses import DirectionOrientation, PoseTarget
 
-_DEGREE = math.pi / 180.0
 
 
 @contextmanager
@@ -66,7 +66,7 @@ def wire_worded(error: KinematicsError) -> KinematicsError:
 
 def _unit_scale(robot: Robot, unit: AngleUnit) -> np.ndarray:
     """Per-joint factor from the request's unit to the core's (radians, lengths)."""
-    return np.where(robot.is_revolute, _DEGREE if unit == "deg" else 1.0, 1.0)
+    return np.where(robot.is_revolute, radians_per(unit), 1.0)
 
 
 def joints_to_core(robot: Robot, values: Sequence[float] | Sequence[Sequence[float]], unit: AngleUnit,
@@ -111,7 +111,7 @@ def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool
     if orientation is None:
         return T, False
     with located("orientation"):
-        T[:3, :3] = rotation_from_orientation(orientation, _DEGREE if unit == "deg" else 1.0)
+        T[:3, :3] = rotation_from_orientation(orientation, radians_per(unit))
     return T, True
 
 
@@ -147,7 +147,7 @@ def target_direction(target: PoseTarget, unit: AngleUnit
         vectors.append(vector / np.linalg.norm(vector))
     rolls = None
     if orientation.roll_values is not None:
-        rolls = np.asarray(orientation.roll_values, dtype=float) * (_DEGREE if unit == "deg" else 1.0)
+        rolls = np.asarray(orientation.roll_values, dtype=float) * radians_per(unit)
     elif orientation.roll_samples is not None:
         rolls = roll_samples(orientation.roll_samples)
     return np.asarray(target.position, dtype=float), vectors[0], vectors[1], rolls
@@ -353,7 +353,7 @@ def collisions_to_core(robot: Robot, options: CollisionOptions | None, unit: Ang
     located at ``("body", "collisions", …)``."""
     if options is None:
         return None
-    radians_per_unit = _DEGREE if unit == "deg" else 1.0
+    radians_per_unit = radians_per(unit)
     obstacles = []
     for index, entry in enumerate(options.obstacles):
         with located("body", "collisions", "obstacles", index):

@@ -15,7 +15,8 @@ import numpy as np
 
 from ..kinematics import Budget, Robot
 from ..kinematics.ik import IKAnswer, SolutionTable
-from .boundary import _DEGREE, WIRE_NOTES, _unit_scale
+from ..units import radians_per
+from .boundary import WIRE_NOTES, _unit_scale
 
 
 def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget: Budget) -> list[dict]:
@@ -26,7 +27,7 @@ def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
                 "time_budget_exhausted": s.time_budget_exhausted} for s in answer.solvers]
     reports = [_report(report) for report in answer.singularity_reports]
     free_of_target = [list(answer.solvers[index].free_joints) for index in answer.solver.tolist()]
-    angle = _DEGREE if unit == "deg" else 1.0
+    angle = radians_per(unit)
     kept = _solution_dicts(answer.solutions, answer.solution_violations, answer, scale, free_of_target, angle)
     rejected = _solution_dicts(answer.rejected, answer.rejected_violations, answer, scale, free_of_target, angle)
     status, truncated, detail = answer.status.tolist(), answer.truncated.tolist(), answer.detail_list(WIRE_NOTES)
@@ -153,8 +154,8 @@ def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
                     "trimmed": answer.trimmed, "available": answer.available,
                     "solution_count": np.bincount(answer.solutions.target, minlength=n_targets),
                     "rejected_count": np.bincount(answer.rejected.target, minlength=n_targets)},
-        "solutions": _columns(answer.solutions, scale, answer, _DEGREE if unit == "deg" else 1.0),
-        "rejected": _columns(answer.rejected, scale, answer, _DEGREE if unit == "deg" else 1.0),
+        "solutions": _columns(answer.solutions, scale, answer, radians_per(unit)),
+        "rejected": _columns(answer.rejected, scale, answer, radians_per(unit)),
     }
 
 

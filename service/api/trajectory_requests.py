@@ -11,6 +11,7 @@ from fastapi import Request
 
 from ..kinematics import Budget, InvalidInputError, Robot, TrajectoryOptions, TrajectoryResult
 from ..kinematics.ik import AnswerOptions, IKOptions, IKTargets, estimate
+from ..units import radians_per
 from .boundary import (collisions_to_core, free_joints_to_core, joints_from_core, joints_to_core, located,
                        target_matrix, violation_to_wire)
 from .budget import budget_of, check_collision_cost
@@ -61,7 +62,7 @@ def trajectory_in_core(request: Request, ref: RobotRef, body: TrajectoryRequest)
         if flag != constrained[0]:
             raise InvalidInputError("every sample's pose must be the same kind: all with an orientation, or all "
                                     "position-only", location=("body", "samples", k, "pose"))
-    angle = math.pi / 180.0 if unit == "deg" else 1.0
+    angle = radians_per(unit)
     reference = None
     if body.reference is not None:
         with located("body", "reference"):
@@ -92,7 +93,7 @@ def _vector(robot: Robot, values: np.ndarray | None, unit: str, scale: np.ndarra
 def trajectory_to_wire(asked: AskedTrajectory, result: TrajectoryResult, body: TrajectoryRequest) -> dict:
     """The answer as TrajectoryResponse's fields, built field by field (a test validates it against the model)."""
     robot, unit, budget = asked.ref.robot, body.angle_unit, asked.budget
-    paper_scale = np.array([math.pi / 180.0, math.pi / 180.0, 1.0]) if unit == "deg" else np.ones(3)
+    paper_scale = np.array([radians_per(unit), radians_per(unit), 1.0])
     samples = []
     for k, s in enumerate(result.samples):
         if k % 256 == 0:

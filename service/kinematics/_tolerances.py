@@ -62,8 +62,3 @@ SINGULARITY_TOLERANCE = 1e-7
 #: below this (see :mod:`._rates`): the joint rates would be more than about a
 #: thousand times the task rate, in units of the robot's size.
 RATE_SINGULARITY_TOLERANCE = 1e-3
-
-
-def is_near_zero(value: np.ndarray | float, tolerance: float = GEOMETRY_TOLERANCE) -> np.ndarray | bool:
-    """Whether ``|value| <= tolerance``, elementwise."""
-    return np.abs(value) <= tolerance

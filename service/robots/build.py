@@ -14,11 +14,11 @@ import numpy as np
 
 from ..kinematics import InvalidInputError, Joint, LimitOrderError, Robot, ScrewJoint, craig_row_from_khalil
 from ..kinematics.collision import LinkShape, restated
+from ..units import radians_per
 from .geometry import base_T_frames_at_zero, link_shapes, wire_from_shape
 from .schemas import MAX_NOTES_CHARS, AnyRobotDescription, KhalilRobot, ScrewsRobot, URDFRobot
 from .urdf import URDFChain, parse_urdf
 
-_DEGREE = math.pi / 180.0
 
 
 def robot_from_description(description: AnyRobotDescription, *, max_joints: int) -> Robot:
@@ -29,7 +29,7 @@ def robot_from_description(description: AnyRobotDescription, *, max_joints: int)
     if isinstance(description, URDFRobot):
         return _robot_from_urdf(description, base, tool, max_joints)
     _check_joint_count(len(description.joints), max_joints)
-    angle = _DEGREE if description.angle_unit == "deg" else 1.0
+    angle = radians_per(description.angle_unit)
     try:
         return _robot_from_rows(description, angle, base, tool, name,
                                 link_shapes(description.collision or (), angle))

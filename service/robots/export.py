@@ -32,7 +32,6 @@ from .schemas import (
     AnyRobotDescription,
     DHJoint,
     DHRobot,
-    KhalilJoint,
     KhalilRobot,
     ScrewJointDescription,
     ScrewsRobot,

@@ -13,7 +13,7 @@ from __future__ import annotations
 from enum import Enum
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import BeforeValidator, Discriminator, Field, RootModel, Strict, Tag, model_validator
+from pydantic import BeforeValidator, Discriminator, Field, RootModel, Strict, Tag
 from pydantic_core import PydanticCustomError
 
 from ._fields import AngleUnit, ApiModel, Matrix4, Number, RobotId, Vector3

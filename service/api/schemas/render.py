@@ -7,7 +7,7 @@ from enum import Enum
 from pydantic import Field
 
 from .collisions import CollisionOptions
-from .common import ANGLE_UNIT_FIELD, AngleUnit, ApiModel, Number, RequestFrames
+from .common import ANGLE_UNIT_FIELD, AngleUnit, Number, RequestFrames
 from ...robots.schemas import RobotDescription
 
 #: Most configurations one picture draws (each is a panel of its own).

@@ -33,10 +33,11 @@ import math
 import numpy as np
 
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from ._screws import axis_frame
 from ._types import LabelCodes, SingularFlags
 from .subproblems._paden_kahan import _distance_equation, _subproblem_2_chain_clear
 from .subproblems._roots import _harmonic_clear
-from .subproblems._vectors import _rotate_onto_clear, axis_frame
+from .subproblems._vectors import _rotate_onto_clear
 
 #: How far (as a multiple of each tolerance) a quantity must be from the array solver's threshold for the
 #: scalar path to decide the pose; closer than that, the array path decides.
@@ -193,7 +194,7 @@ def rotate(k: Vector, theta: float, v: Vector) -> Vector:
 # --- the subproblems, generic case only ------------------------------------------------------------------
 
 def plane_axes(k: Vector) -> tuple[Vector, Vector]:
-    """e1, e2 of :func:`.subproblems._vectors.axis_frame` (k completes the right-handed frame); built once per plan."""
+    """e1, e2 of :func:`._screws.axis_frame` (k completes the right-handed frame); built once per plan."""
     frame = axis_frame(np.asarray(k, dtype=float))
     return tuple(frame[:, 0].tolist()), tuple(frame[:, 1].tolist())
 

@@ -1,6 +1,9 @@
-"""Rigid motions of single joints, vectorised: the exponentials of the screw model."""
+"""Rigid motions of single joints, vectorised: the exponentials of the screw model, and the frame about an axis
+that they and the subproblems turn points in (the one home of Rodrigues' formula in the solvers)."""
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -16,7 +19,7 @@ def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
     theta = np.asarray(theta, dtype=float)
     v = np.asarray(v, dtype=float)
     shape = v.shape if v.shape[:-1] == theta.shape else np.broadcast_shapes(v.shape, theta.shape + (3,))
-    frame = _frame_about(k)  # columns e1, e2, k
+    frame = axis_frame(k)  # columns e1, e2, k
     if v.shape != shape:
         v = np.broadcast_to(v, shape)
     if theta.shape != shape[:-1]:
@@ -33,21 +36,40 @@ def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
     return (frame @ turned).T.reshape(shape)
 
 
-def _frame_about(k: np.ndarray) -> np.ndarray:
-    """A right-handed orthonormal frame [e1, e2, k] (columns) around the unit vector k, memoised by value."""
-    key = tuple(np.asarray(k, dtype=float).tolist())
+def axis_frame(k: np.ndarray) -> np.ndarray:
+    """The right-handed orthonormal frame ``[e1, e2, k]`` (as columns, (3, 3)) around the unit axis ``k`` (3,),
+    read-only, remembered by value in a bounded cache (the joint axes are a few constants).
+
+    ``p @ axis_frame(k)`` gives the coordinates ``(x, y, z)`` of ``p``, where ``z = k·p`` is the height along
+    the axis. A rotation about ``k`` turns ``(x, y)`` like a plane rotation: ``R(k, θ) p`` has
+    ``(x cos θ − y sin θ, x sin θ + y cos θ, z)``.
+    """
+    key = tuple(k.tolist()) if isinstance(k, np.ndarray) else tuple(float(value) for value in k)
     frame = _FRAMES.get(key)
     if frame is None:
-        k = np.asarray(key)
-        trial = np.eye(3)[np.argmin(np.abs(k))]
-        e1 = np.cross(k, trial)
-        e1 /= np.linalg.norm(e1)
-        frame = _FRAMES[key] = np.stack([e1, np.cross(k, e1), k], axis=1)
+        frame = _built_frame(*key)
         frame.setflags(write=False)
+        if len(_FRAMES) < _FRAMES_KEPT:
+            _FRAMES[key] = frame
     return frame
 
 
 _FRAMES: dict[tuple[float, ...], np.ndarray] = {}
+_FRAMES_KEPT = 4096  # bounded: a caller sweeping over many axes keeps no more than this
+
+
+def _built_frame(kx: float, ky: float, kz: float) -> np.ndarray:
+    """:func:`axis_frame` of (kx, ky, kz): e1 = k × (the coordinate axis least aligned with k), normalised."""
+    if abs(kx) <= abs(ky) and abs(kx) <= abs(kz):
+        e1 = (0.0, kz, -ky)
+    elif abs(ky) <= abs(kz):
+        e1 = (-kz, 0.0, kx)
+    else:
+        e1 = (ky, -kx, 0.0)
+    n = math.sqrt(e1[0] ** 2 + e1[1] ** 2 + e1[2] ** 2)
+    ax, ay, az = e1[0] / n, e1[1] / n, e1[2] / n
+    e2 = (ky * az - kz * ay, kz * ax - kx * az, kx * ay - ky * ax)  # k × e1
+    return np.array([[ax, e2[0], kx], [ay, e2[1], ky], [az, e2[2], kz]])
 
 
 def rotation_about(k: np.ndarray, theta: np.ndarray) -> np.ndarray:

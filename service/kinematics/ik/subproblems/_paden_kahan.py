@@ -15,9 +15,10 @@ from numpy.typing import ArrayLike
 from ..._errors import InvalidInputError
 from ..._rotations import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE
+from .._screws import axis_frame
 from ._records import _GAP_ROUNDING, _MERGE_SIN_SQUARED, _NEAR_TANGENT_GAP, AnglePairSolutions, AngleSolutions
 from ._roots import _harmonic
-from ._vectors import _coords, _cross3, _distances, _hypot, _norm, _pair, _points, _rotate_onto, _unit, axis_frame
+from ._vectors import _coords, _cross3, _distances, _hypot, _norm, _pair, _points, _rotate_onto, _unit
 
 
 def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike, free_below: ArrayLike | None = None) -> AngleSolutions:

@@ -13,6 +13,7 @@ from numpy.typing import ArrayLike
 
 from ..._rotations import wrap_angle
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .._screws import axis_frame, rotate_about
 from ._records import _MERGE_RESIDUAL, DisplacementSolutions, TurnSlideSolutions
 from ._roots import _harmonic, _trig_quartic_roots, _vanishes
 from ._vectors import (
@@ -24,10 +25,8 @@ from ._vectors import (
     _pair,
     _points,
     _rotate_onto,
-    _rotate_points,
     _rotation_parts,
     _unit,
-    axis_frame,
 )
 
 
@@ -384,13 +383,13 @@ def subproblem_5_prismatic(k2: ArrayLike, k: ArrayLike, p0: ArrayLike, p1: Array
                 valid[..., later] &= ~same
         theta = np.where(valid, theta, np.nan)
         s = np.where(valid, s, np.nan)
-        L = centre[..., None, :] + _rotate_points(k, np.nan_to_num(theta), p1[..., None, :]) - fixed[..., None, :]
+        L = centre[..., None, :] + rotate_about(k, np.nan_to_num(theta), p1[..., None, :]) - fixed[..., None, :]
         slide = s[..., None] * v[..., None, :]
         turned, onto = (L + slide, np.broadcast_to(p2[..., None, :], L.shape)) if slide_turns \
             else (L, p2[..., None, :] + slide)
         phi, _, phi_free = _rotate_onto(axis_frame(k2), np.nan_to_num(turned), np.nan_to_num(onto),
                                         np.ones(shape)[..., None])
-        miss = _norm(onto - _rotate_points(k2, phi, turned))
+        miss = _norm(onto - rotate_about(k2, phi, turned))
     nan = np.nan
     return TurnSlideSolutions(
         phi=np.where(valid, phi, nan), theta=np.where(valid, theta, nan), s=np.where(valid, s * S[..., None], nan),

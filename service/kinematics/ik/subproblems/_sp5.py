@@ -12,9 +12,10 @@ from numpy.typing import ArrayLike
 
 from ..._rotations import wrap_angle
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .._screws import axis_frame, rotate_about
 from ._records import AngleTripleSolutions
 from ._roots import _trig_quartic_roots, _vanishes
-from ._vectors import _dot, _norm, _points, _rotate_onto, _rotate_points, _rotation_parts, _unit, axis_frame
+from ._vectors import _dot, _norm, _points, _rotate_onto, _rotation_parts, _unit
 
 
 def _inverse_2x2(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -138,10 +139,10 @@ def subproblem_5(k1: ArrayLike, k2: ArrayLike, k3: ArrayLike, p0: ArrayLike, p1:
         theta_s = np.arctan2(u_s[..., 1], u_s[..., 0])
     theta1 = wrap_angle(np.where(by_theta1[..., None], theta_t, theta_s))
     theta3 = wrap_angle(np.where(by_theta1[..., None], theta_s, theta_t))
-    L = p0[..., None, :] + _rotate_points(k1, theta1, p1[..., None, :])
-    M = p2[..., None, :] + _rotate_points(k3, theta3, p3[..., None, :])
+    L = p0[..., None, :] + rotate_about(k1, theta1, p1[..., None, :])
+    M = p2[..., None, :] + rotate_about(k3, theta3, p3[..., None, :])
     theta2, _, _ = _rotate_onto(axis_frame(k2), np.nan_to_num(M), np.nan_to_num(L), S[..., None])
-    miss = _norm(L - _rotate_points(k2, theta2, M))
+    miss = _norm(L - rotate_about(k2, theta2, M))
     # the same root twice (a tangent root): keep the first
     merged = double & separable & ~free  # a tangent root of the harmonic equation, already reported once
     for later in range(1, 4):

@@ -12,9 +12,10 @@ from numpy.typing import ArrayLike
 
 from ..._rotations import wrap_angle
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .._screws import axis_frame
 from ._records import AngleQuadSolutions
 from ._roots import _harmonic, _trig_quartic_roots
-from ._vectors import _coords, _dot, _hypot, _norm, _points, _unit, axis_frame
+from ._vectors import _coords, _dot, _hypot, _norm, _points, _unit
 
 
 _NEWTON_STEPS = 2  # on the pair of equations, after the quartic's roots

@@ -2,11 +2,11 @@
 
 * Input checks at the subproblems' boundary: constant unit axes (``_unit``, remembered by value in a bounded
   cache), batches of points (``_points``) and distances (``_distances``).
-* Axis frames: ``axis_frame(k)``, the right-handed frame ``[e1, e2, k]`` around an axis (bounded cache), and the
-  coordinates of points in it.
+* Coordinates of points in an axis frame (:func:`.._screws.axis_frame`, the right-handed frame ``[e1, e2, k]``
+  around an axis).
 * Vector helpers: row-wise dot products and norms, the cross product of two 3-vectors, two-slot candidates,
-  Rodrigues' rotation of points, and the subproblem 1 core ``_rotate_onto`` that subproblems 1, 2, 5 and the
-  turn-slide subproblem 5 all end with.
+  the parts of a point that a rotation keeps and turns, and the subproblem 1 core ``_rotate_onto`` that
+  subproblems 1, 2, 5 and the turn-slide subproblem 5 all end with.
 """
 
 from __future__ import annotations
@@ -69,43 +69,6 @@ def _distances(d: ArrayLike, name: str) -> np.ndarray:
     return d
 
 
-def axis_frame(k: np.ndarray) -> np.ndarray:
-    """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``, remembered by value
-    (read-only) as :func:`_unit` remembers the axes."""
-    key = tuple(k.tolist())
-    frame = _FRAMES.get(key)
-    if frame is None:
-        frame = _build_frame(k)
-        if len(_FRAMES) < _UNITS_KEPT:
-            frame.setflags(write=False)
-            _FRAMES[key] = frame
-    return frame
-
-
-_FRAMES: dict[tuple, np.ndarray] = {}
-
-
-def _build_frame(k: np.ndarray) -> np.ndarray:
-    """Right-handed orthonormal frame ``[e1, e2, k]`` (as columns) around the unit axis ``k``.
-
-    ``p @ axis_frame(k)`` gives the coordinates ``(x, y, z)`` of ``p``, where ``z = k.p``
-    is the height along the axis. A rotation about ``k`` turns ``(x, y)`` like a
-    plane rotation: ``R(k, theta) p`` has ``(x cos - y sin, x sin + y cos, z)``.
-    """
-    kx, ky, kz = k.tolist()
-    # e1 = k x (the coordinate axis least aligned with k), normalised.
-    if abs(kx) <= abs(ky) and abs(kx) <= abs(kz):
-        e1 = (0.0, kz, -ky)
-    elif abs(ky) <= abs(kz):
-        e1 = (-kz, 0.0, kx)
-    else:
-        e1 = (ky, -kx, 0.0)
-    n = math.sqrt(e1[0] ** 2 + e1[1] ** 2 + e1[2] ** 2)
-    ax, ay, az = e1[0] / n, e1[1] / n, e1[2] / n
-    e2 = (ky * az - kz * ay, kz * ax - kx * az, kx * ay - ky * ax)  # k x e1
-    return np.array([[ax, e2[0], kx], [ay, e2[1], ky], [az, e2[2], kz]])
-
-
 def _coords(p: np.ndarray, frame: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     c = p @ frame
     return c[..., 0], c[..., 1], c[..., 2]
@@ -140,13 +103,6 @@ def _rotation_parts(k: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarra
     """``R(k, theta) p = fixed + cos(theta) perp + sin(theta) cross`` for points ``p`` (..., 3)."""
     fixed = (p @ k)[..., None] * k
     return fixed, p - fixed, np.cross(k, p)
-
-
-def _rotate_points(k: np.ndarray, theta: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """``R(k, theta) p`` (Rodrigues), broadcasting ``theta`` (...) against points ``p`` (..., 3)."""
-    fixed, perp, cross = _rotation_parts(k, p)
-    c, s = np.cos(theta)[..., None], np.sin(theta)[..., None]
-    return fixed + c * perp + s * cross
 
 
 def _pair(shape: tuple[int, ...], first: ArrayLike, second: ArrayLike, dtype: type) -> np.ndarray:

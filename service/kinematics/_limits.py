@@ -103,8 +103,8 @@ class Violation:
 
 def within(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray:
     """Whether each row of q (shape (..., n)) is inside every bound, tolerance included."""
-    tolerance = limits.tolerance(robot)
-    return np.all((q >= limits.lower - tolerance) & (q <= limits.upper + tolerance), axis=-1)
+    lower, upper, _ = limits.widened(robot)
+    return np.all((q >= lower) & (q <= upper), axis=-1)
 
 
 def violations(robot: Robot, limits: Limits, q: np.ndarray) -> list[Violation]:
@@ -115,8 +115,8 @@ def violations(robot: Robot, limits: Limits, q: np.ndarray) -> list[Violation]:
     A PUMA 560 wrist (q5 in [−100°, 100°]) at 120° gives one violation,
     ``Violation(4, 2.094…, −1.745…, 1.745…)``.
     """
-    tolerance = limits.tolerance(robot)
-    outside = (q < limits.lower - tolerance) | (q > limits.upper + tolerance)
+    lower, upper, _ = limits.widened(robot)
+    outside = (q < lower) | (q > upper)
     return [Violation(int(i), float(q[i]), float(limits.lower[i]), float(limits.upper[i]))
             for i in np.flatnonzero(outside)]
 

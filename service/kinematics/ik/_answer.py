@@ -742,7 +742,7 @@ def _violations(robot: Robot, limits: Limits, table: SolutionTable) -> np.ndarra
     """Which joints (S, n) of each row outside the limits break them (tolerance included); False elsewhere."""
     if table.within_limits.all():  # the usual kept table: nothing to compare
         return np.zeros(table.joints.shape, dtype=bool)
-    tolerance = limits.tolerance(robot)
-    outside = (table.joints < limits.lower - tolerance) | (table.joints > limits.upper + tolerance)
+    lower, upper, _ = limits.widened(robot)
+    outside = (table.joints < lower) | (table.joints > upper)
     return outside & ~table.within_limits[:, None]
 

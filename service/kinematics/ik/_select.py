@@ -193,16 +193,16 @@ def effective_reference(robot: Robot, limits: Limits, reference: np.ndarray) -> 
     >>> effective_reference(arm, Limits.of(arm), np.array([4.0])).round(4).tolist()
     [-2.2832]
     """
-    tolerance = limits.tolerance(robot)
-    outside = limits.multi_valued(robot) & ((reference < limits.lower - tolerance)
-                                            | (reference > limits.upper + tolerance))
+    lower, upper, multi_valued = limits.widened(robot)
+    outside = multi_valued & ((reference < lower) | (reference > upper))
     if not outside.any():
         return reference
+    tolerance = limits.tolerance(robot)
     with np.errstate(invalid="ignore"):  # whole turns towards the nearer bound, the fewest that cross it
         turns = np.where(reference > limits.upper, -np.ceil((reference - limits.upper - tolerance) / _TWO_PI),
-                         np.ceil((limits.lower - tolerance - reference) / _TWO_PI))
+                         np.ceil((lower - reference) / _TWO_PI))
     moved = reference + _TWO_PI * np.where(outside, turns, 0.0)
-    fits = (moved >= limits.lower - tolerance) & (moved <= limits.upper + tolerance)
+    fits = (moved >= lower) & (moved <= upper)
     return np.where(outside & fits, moved, reference)
 
 

@@ -89,7 +89,7 @@ import numpy as np
 
 from .._rotations import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE
-from ._screws import chain_motion, invert, joint_motion
+from ._screws import chain_motion, cross, frame_about, invert, joint_motion, rotation_about
 from ._structure import Geometry
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 
@@ -171,41 +171,11 @@ _SLIDE_GRID = np.array([-1.0, 0.0, 1.0])
 _POWERS = np.stack([np.ones(3), _SLIDE_GRID, _SLIDE_GRID ** 2], axis=1)
 
 
-def _cross_matrix(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """[k]× and [k]×² for a unit axis k, memoised by value (an arm has a few axes)."""
-    key = tuple(k.tolist())
-    pair = _CROSS.get(key)
-    if pair is None:
-        K = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-        pair = (K, K @ K)
-        if len(_CROSS) < 4096:
-            _CROSS[key] = pair
-    return pair
-
-
-_CROSS: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray]] = {}
-_EYE3 = np.eye(3)
-
-
-def _rodrigues(k: np.ndarray | tuple[np.ndarray, np.ndarray], q: np.ndarray) -> np.ndarray:
-    """R(k, q) for q of shape (...,): (..., 3, 3). ``k`` is the unit axis or its pair ([k]×, [k]×²)."""
-    K, KK = k if isinstance(k, tuple) else _cross_matrix(k)
-    q = np.asarray(q, dtype=float)[..., None, None]
-    return _EYE3 + np.sin(q) * K + (1.0 - np.cos(q)) * KK
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a × b along the last axis (np.cross without its axis bookkeeping)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
-
-
 def _fourteen(p: np.ndarray, l: np.ndarray) -> np.ndarray:
     """Raghavan and Roth's 14 quantities of a point p and unit direction l (..., 3): (..., 14)."""
     pp = np.einsum("...i,...i->...", p, p)[..., None]
     pl = np.einsum("...i,...i->...", p, l)[..., None]
-    return np.concatenate([p, l, pp, pl, _cross(p, l), l * pp - 2.0 * p * pl], axis=-1)
+    return np.concatenate([p, l, pp, pl, cross(p, l), l * pp - 2.0 * p * pl], axis=-1)
 
 
 class _Arrangement:
@@ -222,7 +192,6 @@ class _Arrangement:
             directions, points, revolute = -directions[::-1], points[::-1], revolute[::-1]
         self.reverse, self.first = reverse, first
         self.directions, self.points, self.revolute = directions, points, revolute
-        self.cross = [_cross_matrix(k) for k in directions]
         a, d = first, first + 3
         # the target's side: joints (e, f) and where they stand around A
         self.rhs = {2: (0, 1), 1: (0, 5), 0: (5, 4)}[first]
@@ -233,7 +202,7 @@ class _Arrangement:
         # a slide's leading matrix at d → ∞ (φ = 0) is singular by construction: its shifts start at the next
         self.shifts = _SHIFTS[1:] if self.slide else _SHIFTS
         # basis(q_b) ⊗ basis(q_c) times (1 + x²) per revolute joint → the powers x_b^i x_c^j (9, 9)
-        self.powers = np.kron(_HALF if self.kinds[1] else _EYE3, _HALF if self.kinds[2] else _EYE3)
+        self.powers = np.kron(_HALF if self.kinds[1] else np.eye(3), _HALF if self.kinds[2] else np.eye(3))
         self.line_point, self.line_direction = points[d], directions[d]
         # the point o on axis a nearest the other axes' points (any point of the axis keeps the structure)
         k = directions[a]
@@ -506,20 +475,19 @@ def _last_joint(arr: _Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarr
         q[..., joint] = chain[..., slot]
     q *= arr.revolute  # a slide turns nothing
     d = a + 3
-    R_before = _rodrigues(arr.cross[0], q[..., 0])
+    R_before = rotation_about(arr.directions[0], q[..., 0])
     for j in range(1, d):
-        R_before = R_before @ _rodrigues(arr.cross[j], q[..., j])
+        R_before = R_before @ rotation_about(arr.directions[j], q[..., j])
     R_d = np.swapaxes(R_before, -1, -2) @ A[:, None, :3, :3]
     if d < 5:
-        R_after = _rodrigues(arr.cross[5], q[..., 5])
+        R_after = rotation_about(arr.directions[5], q[..., 5])
         for j in range(4, d, -1):
-            R_after = _rodrigues(arr.cross[j], q[..., j]) @ R_after
+            R_after = rotation_about(arr.directions[j], q[..., j]) @ R_after
         R_d = R_d @ np.swapaxes(R_after, -1, -2)
-    k = arr.directions[d]
-    u = _cross(k, np.eye(3)[np.argmin(np.abs(k))])
-    u /= np.linalg.norm(u)
-    turned = R_d @ u
-    return np.arctan2(turned @ _cross(k, u), turned @ u)
+    # the angle about axis d from R_d's turn of the frame's first unit vector
+    first, second, _ = frame_about(arr.directions[d]).T.copy()
+    turned = R_d @ first
+    return np.arctan2(turned @ second, turned @ first)
 
 
 def _newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_targets: np.ndarray,
@@ -559,15 +527,14 @@ def _error_twist(R: np.ndarray, p: np.ndarray, R_A: np.ndarray, p_A: np.ndarray)
     R_err = R_A @ np.swapaxes(R, -1, -2)
     omega = 0.5 * np.stack([R_err[:, 2, 1] - R_err[:, 1, 2], R_err[:, 0, 2] - R_err[:, 2, 0],
                             R_err[:, 1, 0] - R_err[:, 0, 1]], axis=-1)
-    return np.concatenate([omega, p_A - p - _cross(omega, p)], axis=-1)
+    return np.concatenate([omega, p_A - p - cross(omega, p)], axis=-1)
 
 
 def _chain_twists(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, q: np.ndarray
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """G_1 ⋯ G_6 at q (K, 6) as its rotation (K, 3, 3) and translation (K, 3), and the spatial joint twists
     (K, 6, 6) at q, (ω, v): (ω, p × ω) of a turn through p, (0, k) of a slide along k; normalised lengths."""
-    cross = [_cross_matrix(k) for k in directions]
-    R = np.broadcast_to(_EYE3, q.shape[:-1] + (3, 3))
+    R = np.broadcast_to(np.eye(3), q.shape[:-1] + (3, 3))
     p = np.zeros(q.shape[:-1] + (3,))
     twists = np.zeros(q.shape + (6,))
     for j in range(6):
@@ -577,8 +544,8 @@ def _chain_twists(directions: np.ndarray, points: np.ndarray, revolute: np.ndarr
             p = p + axis * q[:, j, None]
             continue
         twists[:, j, :3] = axis
-        twists[:, j, 3:] = _cross(R @ points[j] + p, axis)
-        turn = _rodrigues(cross[j], q[:, j])
+        twists[:, j, 3:] = cross(R @ points[j] + p, axis)
+        turn = rotation_about(directions[j], q[:, j])
         p = p + (R @ (points[j] - turn @ points[j])[..., None])[..., 0]
         R = R @ turn
     return R, p, twists

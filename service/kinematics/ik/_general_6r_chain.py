@@ -39,6 +39,11 @@ def newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_t
     Steps the candidates whose error twist is above ``tolerance`` (roots come from the eigenproblem
     to about 1e-12, so one step, or none, usually suffices); singular candidates get a tiny damping instead of a
     failure.
+
+    Not :func:`._gauss_newton.gauss_newton`: that loop runs on a Robot's FK and a goal's pose error, holds one
+    joint set for the whole batch and only damps, where this one runs on the normalised chain against A, holds a
+    joint per candidate, and needs the pseudo-inverse (``rcond``) to split a double root (damped steps leave its
+    halves ~3e-6 apart: three general-6R tests fail).
     """
     q = q.copy()
     R_A, p_A = A_targets[:, :3, :3], A_targets[:, :3, 3]

@@ -16,7 +16,8 @@ from service.robots.catalogue import load_catalogue
 from service.config import Settings
 from service.kinematics import CONVENTIONS, Joint, Robot, forward_kinematics, geometric_jacobian
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_batch
-from service.kinematics.ik._general_6r import General6RPlan, _solve_arrangement, is_pieper
+from service.kinematics.ik._general_6r import General6RPlan, is_pieper
+from service.kinematics.ik._general_6r_elimination import solve_arrangement
 from service.kinematics.ik import plan_for, solve_ik_arrays
 from service.kinematics.ik._plan import geometry_of
 from tests.arms import kinova_j2n6s300, random_general_arm, random_rotation
@@ -161,7 +162,7 @@ def test_roots_at_pi_and_a_singular_leading_matrix():
         a = plan.arrangement.order[0]
         targets = forward_kinematics(robot, q[4 * a:4 * a + 1])
         targets[:, :3, 3] /= plan.scale
-        roots = _solve_arrangement(plan.arrangement, targets @ plan.home_inverse)
+        roots = solve_arrangement(plan.arrangement, targets @ plan.home_inverse)
         assert roots.shift[0] != 0.0 and roots.conditioned[0]
 
 

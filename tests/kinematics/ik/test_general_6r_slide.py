@@ -1,6 +1,6 @@
-"""The general solver on 6-joint arms with one slide (ik/_general_6r.py, "One slide"): every solution of a
-prismatic joint plus five revolute joints of general geometry, such as a mobile manipulator's torso lift under a
-5R arm.
+"""The general solver on 6-joint arms with one slide (ik/_general_6r.py, its algebra in
+ik/_general_6r_elimination.py, "One slide"): every solution of a prismatic joint plus five revolute joints of
+general geometry, such as a mobile manipulator's torso lift under a 5R arm.
 
 Independent references: the arm's own FK (poses from random joint vectors must come back, and every answer must
 reproduce its target); the dense multi-start Levenberg–Marquardt search of ``test_general_6r`` (FK and the
@@ -15,7 +15,8 @@ import pytest
 
 from service.kinematics import CONVENTIONS, Joint, Robot, forward_kinematics, joint_screws
 from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, plan_for, solve_ik, unlimited
-from service.kinematics.ik._general_6r import GENERAL_5R1P, General6RPlan, _Arrangement
+from service.kinematics.ik._general_6r import GENERAL_5R1P, General6RPlan
+from service.kinematics.ik._general_6r_elimination import Arrangement
 from service.kinematics.ik._plan import geometry_of
 from service.kinematics.ik._verify import residuals
 from tests.arms import random_rotation
@@ -127,7 +128,7 @@ def test_the_slide_as_joint_a_with_its_interval_map(slide):
     plan = General6RPlan(geometry_of(robot))
     reverse = slide > 2
     first = 5 - slide if reverse else slide
-    plan.arrangement = _Arrangement(plan.directions, plan.points, plan.revolute, reverse, first)
+    plan.arrangement = Arrangement(plan.directions, plan.points, plan.revolute, reverse, first)
     assert plan.arrangement.slide and plan.arrangement.order[0] == slide
     q = configurations(rng, robot, 40)
     arrays = check_general_answers(robot, q, plan=plan, structure=GENERAL_5R1P)

@@ -8,5 +8,12 @@ RADIANS_PER_DEGREE = math.pi / 180.0
 
 
 def radians_per(unit: str) -> float:
-    """Radians in one ``unit``: ``"deg"`` or ``"rad"``."""
-    return RADIANS_PER_DEGREE if unit == "deg" else 1.0
+    """Radians in one ``unit``: ``"deg"`` or ``"rad"`` (anything else raises ValueError: the schemas let only
+    these two through)."""
+    try:
+        return _RADIANS_PER[unit]
+    except KeyError:
+        raise ValueError(f"unknown angle unit {unit!r}: 'deg' or 'rad'") from None
+
+
+_RADIANS_PER = {"deg": RADIANS_PER_DEGREE, "rad": 1.0}

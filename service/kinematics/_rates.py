@@ -64,7 +64,7 @@ from typing import Literal
 import numpy as np
 
 from ._errors import InvalidInputError
-from ._forward import geometric_jacobian, joint_screws, screw_model
+from ._forward import cross, geometric_jacobian, joint_screws, screw_model
 from ._robot import Robot
 from ._tolerances import GEOMETRY_TOLERANCE, RATE_SINGULARITY_TOLERANCE
 
@@ -105,15 +105,15 @@ def jacobian_derivative(robot: Robot, q: np.ndarray, qd: np.ndarray) -> np.ndarr
     revolute = robot.is_revolute[:, None]  # (n, 1)
     # Each joint's twist in spatial form (angular w_j, linear at the world origin s_j), times q̇_j.
     w = np.where(revolute, directions, 0.0) * qd[..., None]
-    s = np.where(revolute, np.cross(points, directions), directions) * qd[..., None]
+    s = np.where(revolute, cross(points, directions), directions) * qd[..., None]
     # Exclusive cumulative sums: the twist of the link that carries axis i (joints j < i).
     W = np.cumsum(w, axis=-2) - w
     S = np.cumsum(s, axis=-2) - s
-    point_velocity = S + np.cross(W, points)  # ṗ_i
-    tool_velocity = np.sum(s, axis=-2)[..., None, :] + np.cross(np.sum(w, axis=-2)[..., None, :], p)  # ṗ
-    axis_rate = np.cross(W, directions)  # ω̇_i (or the slide direction's rate)
+    point_velocity = S + cross(W, points)  # ṗ_i
+    tool_velocity = np.sum(s, axis=-2)[..., None, :] + cross(np.sum(w, axis=-2)[..., None, :], p)  # ṗ
+    axis_rate = cross(W, directions)  # ω̇_i (or the slide direction's rate)
     linear = np.where(revolute,
-                      np.cross(axis_rate, p - points) + np.cross(directions, tool_velocity - point_velocity),
+                      cross(axis_rate, p - points) + cross(directions, tool_velocity - point_velocity),
                       axis_rate)
     angular = np.where(revolute, axis_rate, 0.0)
     return np.concatenate([np.swapaxes(linear, -1, -2), np.swapaxes(angular, -1, -2)], axis=-2)

@@ -26,6 +26,7 @@ import numpy as np
 
 from ..kinematics import Robot, ScrewJoint, rpy_from_matrix, screw_model
 from ..kinematics.collision import Capsule, Sphere, restated, scaled
+from ..units import radians_per
 from .build import robot_from_description
 from .geometry import base_T_frames_at_zero, restated_between, wire_from_shape
 from .schemas import (
@@ -104,7 +105,7 @@ def screws_description(description: AnyRobotDescription, robot: Robot) -> Screws
     model = screw_model(_bare(robot))
     angle_unit = getattr(description, "angle_unit", "rad")
     length_unit = getattr(description, "length_unit", "m")
-    scale = 180.0 / math.pi if angle_unit == "deg" else 1.0
+    scale = 1.0 / radians_per(angle_unit)  # description units per radian
     joints = [ScrewJointDescription(name=name, type="revolute" if revolute else "prismatic",
                                     axis=_clean(direction), point=_clean(point),
                                     limits=_limits(lower, upper, scale if revolute else 1.0))

@@ -14,6 +14,13 @@ import numpy as np
 
 from ._distances import _box_point_local, _dot, _nearest_on_segment
 
+#: Slack of the single-precision bounds, relative to the largest coordinate of a block (length unit): far above
+#: their rounding (a few dozen ulps of 6e-8), far below any clearance a request states.
+BOUND_SLACK = 1e-5
+
+#: Coordinates at or past this (length unit) skip the bounds: their squares would leave single precision's range.
+BOUND_RANGE = 1e15
+
 
 def block_bounds(groups, placed: np.ndarray, margin: float, clearance: np.ndarray) -> tuple[list, np.ndarray, float]:
     """Each group's bounds for a block (``bounds_of`` of the model's pair groups), every configuration's cutoff (B,) and the slack;
@@ -30,14 +37,6 @@ def block_bounds(groups, placed: np.ndarray, margin: float, clearance: np.ndarra
         if bound is not None:
             np.fmin(upper, bound[1].min(axis=0), out=upper)
     return bounds, np.maximum(upper + slack, margin) + slack, slack
-
-
-#: Slack of the single-precision bounds, relative to the largest coordinate of a block (length unit): far above
-#: their rounding (a few dozen ulps of 6e-8), far below any clearance a request states.
-BOUND_SLACK = 1e-5
-
-#: Coordinates at or past this (length unit) skip the bounds: their squares would leave single precision's range.
-BOUND_RANGE = 1e15
 
 
 def _round_round_bounds(rows, radii, reach, inverse_square_length):
@@ -88,3 +87,18 @@ def _box_middle_bounds(rows, middle, half_size_a, radius_b, reach):
 #: The cheap bounds of each pair of families (two boxes have none: they are always measured).
 FAMILY_BOUNDS = {("round", "point"): _round_point_bounds, ("box", "point"): _box_point_bounds,
                  ("round", "round"): _round_round_bounds, ("box", "round"): _box_round_bounds}
+
+
+def bound_constants(family: tuple[str, str], first_half_sizes: np.ndarray | None, first_radii: np.ndarray | None,
+                    second_radii: np.ndarray | None, first_halves: list[float], second_halves: list[float]) -> tuple:
+    """The sizes a family's bounds take, in the order its bound function takes them, single precision, (P, 1)
+    each (a box's half sizes (3, P, 1)): from the pairs' first shapes' half sizes (boxes) or radii, the second
+    shapes' radii, and the shapes' half lengths (0 for a sphere)."""
+    if family == ("box", "box"):
+        return ()
+    reach = np.array([[min(a, b)] for a, b in zip(first_halves, second_halves)], dtype=np.float32)
+    if family[0] == "round":
+        longer = [max(2.0 * a, 2.0 * b) for a, b in zip(first_halves, second_halves)]
+        inverse = np.array([[1.0 / length ** 2 if length > 0.0 else 0.0] for length in longer])
+        return (first_radii + second_radii).astype(np.float32), reach, inverse.astype(np.float32)
+    return first_half_sizes.astype(np.float32), second_radii.astype(np.float32), reach

@@ -30,7 +30,7 @@ from typing import Callable, Iterator, NamedTuple, Sequence
 import numpy as np
 
 from .._errors import InvalidInputError
-from ._bounds import FAMILY_BOUNDS, block_bounds
+from ._bounds import FAMILY_BOUNDS, block_bounds, bound_constants
 from ._distances import Separation, _box_box, _box_point, _box_segment, _quiet, _segment_point, _segment_segment, _swept
 from ._shapes import Box, Capsule, LinkShape, Obstacle, Shape, Sphere
 
@@ -616,11 +616,11 @@ def collision_model(link_shapes: Sequence[LinkShape], link_count: int, obstacles
         start = len(pairs)
         pairs.extend(member[0] for member in group)
         firsts, seconds = [member[2] for member in group], [member[3] for member in group]
-        groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in group]),
-                             _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds),
+        sizes = _half_sizes(firsts), _half_sizes(seconds), _radii(firsts), _radii(seconds)
+        groups.append(_Group(start, len(pairs), kernel, np.array([member[1] for member in group]), *sizes,
                              np.array([member[4] for member in group], dtype=bool), FAMILY_BOUNDS.get(family),
-                             _bound_constants(family, firsts, seconds, [member[5] for member in group],
-                                              [member[6] for member in group]), sum(still)))
+                             bound_constants(family, sizes[0], sizes[2], sizes[3], [member[5] for member in group],
+                                             [member[6] for member in group]), sum(still)))
     body_pairs: dict[tuple[str, str], int] = {}
     body_pair_of = np.array([body_pairs.setdefault((pair.a, pair.b), len(body_pairs)) for pair in pairs],
                             dtype=np.intp)
@@ -652,21 +652,6 @@ def _kernel_order(shape: Shape, half_length: float) -> tuple[int, float]:
     take the shorter one's middle, and a point comes second); ``half_length``: the shape's
     (:func:`_half_length`)."""
     return (0, 0.0) if isinstance(shape, Box) else (1, -half_length)
-
-
-def _bound_constants(family: tuple[str, str], firsts: list[Shape], seconds: list[Shape], first_halves: list[float],
-                     second_halves: list[float]) -> tuple:
-    """The sizes the family's bounds take, single precision, (P_k, 1) each (a box's half sizes (3, P_k, 1));
-    ``first_halves`` and ``second_halves``: the shapes' half lengths (:func:`_half_length`)."""
-    if family == ("box", "box"):
-        return ()
-    reach = np.array([[min(a, b)] for a, b in zip(first_halves, second_halves)], dtype=np.float32)
-    if family[0] == "round":
-        radii = _radii(firsts) + _radii(seconds)
-        longer = [max(2.0 * a, 2.0 * b) for a, b in zip(first_halves, second_halves)]
-        inverse = np.array([[1.0 / length ** 2 if length > 0.0 else 0.0] for length in longer])
-        return radii.astype(np.float32), reach, inverse.astype(np.float32)
-    return _half_sizes(firsts).astype(np.float32), _radii(seconds).astype(np.float32), reach
 
 
 def _half_length(shape: Shape) -> float:

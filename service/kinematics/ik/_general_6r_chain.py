@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._forward import cross
 from .._tolerances import DUPLICATE_TOLERANCE
-from ._screws import cross, rotation_about
+from ._screws import rotation_about
 
 #: Newton steps on the FK at most, for every root whose error twist (normalised lengths, radians) is above
 #: NEWTON_TOLERANCE; the shared verification then accepts at 1e-9.

@@ -57,7 +57,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._screws import axis_frame, chain_motion, cross, invert, joint_motion, rotation_about
+from .._forward import cross
+from ._screws import axis_frame, chain_motion, chain_rotation, invert, joint_motion
 
 #: A complex root whose angle's imaginary part is within this many times its error bound of the real axis
 #: (a pair about to become two real roots, or two real roots split by rounding) is ambiguous.
@@ -391,17 +392,13 @@ def _last_joint(arr: Arrangement, A: np.ndarray, chain: np.ndarray) -> np.ndarra
     a = arr.first
     for slot, joint in enumerate((a, a + 1, a + 2, a + 3, *arr.rhs)):
         q[..., joint] = chain[..., slot]
-    q *= arr.revolute  # a slide turns nothing
     d = a + 3
-    R_before = rotation_about(arr.directions[0], q[..., 0])
-    for j in range(1, d):
-        R_before = R_before @ rotation_about(arr.directions[j], q[..., j])
-    R_d = np.swapaxes(R_before, -1, -2) @ A[:, None, :3, :3]
+    before = slice(0, d)
+    R_d = np.swapaxes(chain_rotation(arr.directions[before], arr.revolute[before], q[..., before]), -1, -2) \
+        @ A[:, None, :3, :3]
     if d < 5:
-        R_after = rotation_about(arr.directions[5], q[..., 5])
-        for j in range(4, d, -1):
-            R_after = rotation_about(arr.directions[j], q[..., j]) @ R_after
-        R_d = R_d @ np.swapaxes(R_after, -1, -2)
+        after = slice(d + 1, 6)
+        R_d = R_d @ np.swapaxes(chain_rotation(arr.directions[after], arr.revolute[after], q[..., after]), -1, -2)
     # the angle about axis d from R_d's turn of the frame's first unit vector
     first, second, _ = axis_frame(arr.directions[d]).T.copy()
     turned = R_d @ first

@@ -1,5 +1,6 @@
-"""Rigid motions of single joints, vectorised: the exponentials of the screw model, and the frame about an axis
-that they and the subproblems turn points in (the one home of Rodrigues' formula in the solvers)."""
+"""Rigid motions of single joints, vectorised: the exponentials of the screw model (Rodrigues' formula for one
+axis, applied to points or built as matrices), and the frame about an axis that they and the subproblems turn
+points in. Float twins for the one-pose paths are in :mod:`._scalar`."""
 
 from __future__ import annotations
 
@@ -70,14 +71,6 @@ def _built_frame(kx: float, ky: float, kz: float) -> np.ndarray:
     ax, ay, az = e1[0] / n, e1[1] / n, e1[2] / n
     e2 = (ky * az - kz * ay, kz * ax - kx * az, kx * ay - ky * ax)  # k × e1
     return np.array([[ax, e2[0], kx], [ay, e2[1], ky], [az, e2[2], kz]])
-
-
-def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """a × b along the last axis, shapes (..., 3) broadcast together: np.cross's values without its axis
-    bookkeeping (a third of its time on small batches, and the general solver's Newton steps call it often)."""
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
 def rotation_about(k: np.ndarray, theta: np.ndarray) -> np.ndarray:

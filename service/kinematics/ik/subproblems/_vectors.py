@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._errors import InvalidInputError
+from ..._forward import cross
 from ..._rotations import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
 
@@ -102,7 +103,7 @@ def _norm(a: np.ndarray) -> np.ndarray:
 def _rotation_parts(k: np.ndarray, p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``R(k, theta) p = fixed + cos(theta) perp + sin(theta) cross`` for points ``p`` (..., 3)."""
     fixed = (p @ k)[..., None] * k
-    return fixed, p - fixed, np.cross(k, p)
+    return fixed, p - fixed, cross(k, p)
 
 
 def _pair(shape: tuple[int, ...], first: ArrayLike, second: ArrayLike, dtype: type) -> np.ndarray:

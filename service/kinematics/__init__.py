@@ -28,7 +28,7 @@ from ._limits import (
     within,
 )
 from ._rates import JointRates, TaskSpace, jacobian_derivative, joint_rates, task_space
-from ._robot import JOINT_KINDS, Joint, JointKind, Robot, ScrewJoint, check_joint_values
+from ._robot import JOINT_KINDS, Joint, JointKind, Robot, ScrewJoint, check_joint_values, rotation_with_z
 from ._rotations import (
     check_rotation,
     check_transform,
@@ -94,6 +94,7 @@ __all__ = [
     "matrix_from_quaternion",
     "matrix_from_rpy",
     "quaternions_from_matrices",
+    "rotation_with_z",
     "rpy_from_matrix",
     "screw_model",
     "task_space",

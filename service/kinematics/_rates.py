@@ -65,7 +65,7 @@ import numpy as np
 
 from ._errors import InvalidInputError
 from ._forward import cross, geometric_jacobian, joint_screws, screw_model
-from ._robot import Robot
+from ._robot import Robot, rotation_with_z
 from ._tolerances import GEOMETRY_TOLERANCE, RATE_SINGULARITY_TOLERANCE
 
 __all__ = ["JointRates", "TaskSpace", "jacobian_derivative", "joint_rates", "rate_residuals", "task_jacobian",
@@ -166,14 +166,6 @@ def _row_name(kind: str, direction: np.ndarray) -> str:
     return f"{kind}·[{', '.join(f'{c:.6g}' for c in direction)}]"
 
 
-def _plane_basis(u: np.ndarray) -> np.ndarray:
-    """Two orthonormal vectors normal to u, the first the projection of the world axis least aligned with u."""
-    trial = np.eye(3)[int(np.argmin(np.abs(u)))]
-    e1 = trial - (trial @ u) * u
-    e1 /= np.linalg.norm(e1)
-    return np.stack([e1, np.cross(u, e1)])
-
-
 def task_space(robot: Robot, *, constrain_orientation: bool, free_joints: tuple[int, ...] | list[int] = ()
                ) -> TaskSpace:
     """The twist rows ``robot`` controls for a target of this kind (the rule in the module docstring).
@@ -206,7 +198,7 @@ def task_space(robot: Robot, *, constrain_orientation: bool, free_joints: tuple[
     linear = identity
     linear_names = [f"v{a}" for a in _AXES]
     if u is not None and all(abs(model.directions[i] @ u) <= GEOMETRY_TOLERANCE * 10 for i in prismatic):
-        plane = _plane_basis(u)
+        plane = rotation_with_z(u)[:, :2].T  # two orthonormal vectors normal to u
         if abs(abs(u[2]) - 1.0) <= GEOMETRY_TOLERANCE * 10:
             plane = identity[:2]
         linear, linear_names = plane, [_row_name("v", e) for e in plane]

@@ -322,14 +322,18 @@ def _joint_frame(joint: ScrewJoint, index: int) -> np.ndarray:
                                 f"its length is {norm:.9g}",
                                 location=(*where, "axis"))
     _check_limits(joint, where)
-    z = axis / norm
-    # x: the base axis least aligned with z, made orthogonal to it (deterministic, well conditioned)
+    frame = np.eye(4)
+    frame[:3, :3], frame[:3, 3] = rotation_with_z(axis / norm), point
+    return frame
+
+
+def rotation_with_z(z: np.ndarray) -> np.ndarray:
+    """A rotation (3, 3) whose z column is the unit vector ``z`` (3,): x is the base axis least aligned with z
+    made orthogonal to it (deterministic, well conditioned), y = z × x."""
     helper = np.eye(3)[int(np.argmin(np.abs(z)))]
     x = helper - (helper @ z) * z
     x /= np.linalg.norm(x)
-    frame = np.eye(4)
-    frame[:3, 0], frame[:3, 1], frame[:3, 2], frame[:3, 3] = x, np.cross(z, x), z, point
-    return frame
+    return np.column_stack([x, np.cross(z, x), z])
 
 
 def _inverse(T: np.ndarray) -> np.ndarray:

@@ -24,7 +24,7 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
-from ..kinematics import Robot, ScrewJoint, rpy_from_matrix, screw_model
+from ..kinematics import Robot, ScrewJoint, rotation_with_z, rpy_from_matrix, screw_model
 from ..kinematics.collision import Capsule, Sphere, restated, scaled
 from ..units import radians_per
 from .build import robot_from_description
@@ -206,7 +206,7 @@ def _collision_element(shape) -> list[str]:
         length = float(np.linalg.norm(axis))
         T[:3, 3] = 0.5 * (shape.start + shape.end)
         if length > 0.0:
-            T[:3, :3] = _rotation_onto_z(axis / length)
+            T[:3, :3] = rotation_with_z(axis / length)
         geometry = f'<cylinder radius="{shape.radius!r}" length="{length!r}"/>'
     elif isinstance(shape, Sphere):
         T[:3, 3] = shape.center
@@ -215,14 +215,6 @@ def _collision_element(shape) -> list[str]:
         T[:3, :3], T[:3, 3] = shape.rotation, shape.center
         geometry = f'<box size="{" ".join(repr(float(v)) for v in shape.size)}"/>'
     return ["    <collision>", "  " + _origin(T, 1.0), f"      <geometry>{geometry}</geometry>", "    </collision>"]
-
-
-def _rotation_onto_z(direction: np.ndarray) -> np.ndarray:
-    """A rotation whose z column is the unit vector ``direction`` (x, y completing it deterministically)."""
-    helper = np.eye(3)[int(np.argmin(np.abs(direction)))]
-    x = helper - (helper @ direction) * direction
-    x /= np.linalg.norm(x)
-    return np.column_stack([x, np.cross(direction, x), direction])
 
 
 def _origin(T: np.ndarray, metres: float) -> str:

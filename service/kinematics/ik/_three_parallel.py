@@ -38,7 +38,7 @@ from . import _scalar as scalar
 from .._rotations import wrap_angle, wrap_any_float
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
-from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
+from ._screws import JointTrig, apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
@@ -200,16 +200,17 @@ class _AxesTwoToFourParallel(Sealed):
         in the plane normal to the parallel axes (so the points the description puts on them do not matter).
         Wrist: the sign of sin q5 (:func:`wrist_codes`)."""
         g, m = self.geometry, self.model
+        trig = JointTrig(joints)  # each joint's cos and sin, shared by the turns below
         def moved(upto: int, x: np.ndarray) -> np.ndarray:
-            return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x)
+            return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x, trig)
 
-        forward = rotate_about(g.direction(0), joints[:, 0], self.forward)
+        forward = rotate_about(g.direction(0), joints[:, 0], self.forward, trig[0])
         wrist_point = moved(3, g.point(3))
         shoulder = np.einsum("mi,mi->m", wrist_point - g.point(0), forward)
         shoulder_point = moved(1, g.point(1))
         elbow_point = moved(2, g.point(2)) - shoulder_point
         reach = wrist_point - shoulder_point
-        normal = rotate_about(g.direction(0), joints[:, 0], self.omega_p)  # the parallel axes, after joint 1
+        normal = rotate_about(g.direction(0), joints[:, 0], self.omega_p, trig[0])  # the parallel axes, after joint 1
         elbow_point = elbow_point - np.einsum("mi,mi->m", elbow_point, normal)[:, None] * normal
         reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
         line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)

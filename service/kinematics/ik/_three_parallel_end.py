@@ -26,7 +26,7 @@ import numpy as np
 
 from .._rotations import wrap_angle
 from ._positioning import side_codes
-from ._screws import apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
+from ._screws import JointTrig, apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_3, subproblem_6
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
@@ -160,11 +160,13 @@ def parallel_elbow_codes(geometry: Geometry, joints: np.ndarray, first: int) -> 
     measured in the plane normal to the parallel axes (−1 where it is on the line, or where that plane holds no
     up: the parallel axes vertical)."""
     m = geometry.model
+    trig = JointTrig(joints)  # each joint's cos and sin, shared by the turns below
     def moved(upto: int, x: np.ndarray) -> np.ndarray:
-        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x)
+        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x, trig)
 
     start, middle, end = (moved(first + j, geometry.point(first + j)) for j in range(3))
-    normal = chain_rotation(m.directions[:first], m.is_revolute[:first], joints[:, :first]) @ geometry.direction(first)
+    normal = chain_rotation(m.directions[:first], m.is_revolute[:first], joints[:, :first], trig) \
+        @ geometry.direction(first)
     def planar(x: np.ndarray) -> np.ndarray:
         return x - np.einsum("mi,mi->m", x, normal)[:, None] * normal
 

@@ -15,7 +15,7 @@ from fnmatch import fnmatchcase
 import numpy as np
 
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
-from .._screws import chain_motion, move_point
+from .._screws import JointTrig, chain_motion, move_point
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity, Sealed
 
@@ -136,10 +136,11 @@ class Positioner(Sealed):
         """The same labels as arrays: name → (values, codes (M,), −1 where the label is left out)."""
         return {}
 
-    def _moved(self, q: np.ndarray, upto: int, x: np.ndarray) -> np.ndarray:
-        """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) applied to the point x (3,), for joint values (..., n)."""
+    def _moved(self, q: np.ndarray, upto: int, x: np.ndarray, trig: JointTrig | None = None) -> np.ndarray:
+        """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) applied to the point x (3,), for joint values (..., n) (``trig``
+        their cos and sin, when shared)."""
         m = self.model
-        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], q[..., :upto], x)
+        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], q[..., :upto], x, trig)
 
     def _motion(self, q: np.ndarray, upto: int) -> np.ndarray:
         """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) for joint values (..., n)."""

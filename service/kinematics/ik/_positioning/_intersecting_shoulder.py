@@ -9,7 +9,7 @@ import numpy as np
 
 from ..._rotations import wrap_angle
 from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE
-from .._screws import chain_rotation, rotate_about
+from .._screws import JointTrig, chain_rotation, rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
 from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3
@@ -217,8 +217,9 @@ class IntersectingShoulder(Positioner):
         """
         g, (i, j, k) = self.geometry, self.joints
         forward_home, in_plane, up = self.label_constants
-        forward = rotate_about(g.direction(i), joints[:, i], forward_home)
-        point = self._moved(joints, k + 1, self.point)
+        trig = JointTrig(joints)  # each joint's cos and sin, shared by the turns below
+        forward = rotate_about(g.direction(i), joints[:, i], forward_home, trig[i])
+        point = self._moved(joints, k + 1, self.point, trig)
         reach = point - self.centre
         axis = g.direction(i)
         sideways = reach - np.outer(reach @ axis, axis)
@@ -228,10 +229,10 @@ class IntersectingShoulder(Positioner):
         # (the point as near axis 1 as the offset allows) left and right meet: no shoulder label
         codes: LabelCodes = {"shoulder": (("left", "right"), side_codes(along, np.linalg.norm(reach, axis=-1)))}
         if g.model.is_revolute[k] and not self.free_joints:
-            elbow = self._moved(joints, k, g.point(k)) - self.centre
+            elbow = self._moved(joints, k, g.point(k), trig) - self.centre
             if in_plane:  # work in the arm's plane, normal to axis 2
                 m = self.model
-                normal = np.einsum("mij,j->mi", chain_rotation(m.directions[:j], m.is_revolute[:j], joints[:, :j]),
+                normal = np.einsum("mij,j->mi", chain_rotation(m.directions[:j], m.is_revolute[:j], joints[:, :j], trig),
                                    g.direction(j))
                 elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
                 reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal

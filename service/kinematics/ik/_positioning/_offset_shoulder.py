@@ -9,7 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE
-from .._screws import rotate_about
+from .._screws import JointTrig, rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
 from ..subproblems import (
@@ -160,15 +160,16 @@ class OffsetShoulderParallelElbow(Positioner):
         if not (g.model.is_revolute[i] and g.model.is_revolute[k]) or self.forward is None:
             return {}
         axis = g.direction(i)
-        point = self._moved(joints, k + 1, self.point)
+        trig = JointTrig(joints)  # each joint's cos and sin, shared by the turns below
+        point = self._moved(joints, k + 1, self.point, trig)
         reach = point - g.point(i)
         reach = reach - np.outer(reach @ axis, axis)
-        forward = rotate_about(axis, joints[:, i], self.forward)
+        forward = rotate_about(axis, joints[:, i], self.forward, trig[i])
         codes: LabelCodes = {"shoulder": (("left", "right"), side_codes(np.einsum("mi,mi->m", reach, forward),
                                                                        np.linalg.norm(point - g.point(i), axis=-1)))}
-        shoulder = self._moved(joints, i + 1, self.shoulder)
-        normal = rotate_about(axis, joints[:, i], g.direction(j))
-        elbow = self._moved(joints, k, g.point(k)) - shoulder
+        shoulder = self._moved(joints, i + 1, self.shoulder, trig)
+        normal = rotate_about(axis, joints[:, i], g.direction(j), trig[i])
+        elbow = self._moved(joints, k, g.point(k), trig) - shoulder
         line = point - shoulder
         elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
         line = line - np.einsum("mi,mi->m", line, normal)[:, None] * normal

@@ -89,6 +89,7 @@ import numpy as np
 
 from .._rotations import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE
+from .._forward import JointTrig
 from ._screws import chain_motion, invert, joint_motion
 from ._structure import Geometry
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
@@ -875,7 +876,7 @@ class General6RPlan(Sealed):
                 "jacobian", joints, "free" if on_family else "boundary",
                 f"{what}; q{k + 1} is set to the reference value where that reaches the target"))
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         return {}
 
 

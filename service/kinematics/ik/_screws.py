@@ -4,21 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-
-class JointTrig:
-    """cos and sin of each joint column of q (..., n), each computed once, when first asked for: steps that turn
-    the same joints several times (a family's branch labels) share them. ``trig[i]`` is (cos q_i, sin q_i)."""
-
-    def __init__(self, q: np.ndarray) -> None:
-        self.q = np.asarray(q, dtype=float)
-        self._pairs: dict[int, tuple[np.ndarray, np.ndarray]] = {}
-
-    def __getitem__(self, joint: int) -> tuple[np.ndarray, np.ndarray]:
-        pair = self._pairs.get(joint)
-        if pair is None:
-            angle = self.q[..., joint]
-            pair = self._pairs[joint] = (np.cos(angle), np.sin(angle))
-        return pair
+from .._forward import JointTrig
 
 
 def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray,

@@ -15,7 +15,8 @@ from fnmatch import fnmatchcase
 import numpy as np
 
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
-from .._screws import JointTrig, chain_motion, move_point
+from ..._forward import JointTrig
+from .._screws import chain_motion, move_point
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity, Sealed
 
@@ -132,8 +133,9 @@ class Positioner(Sealed):
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         raise NotImplementedError
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        """The same labels as arrays: name → (values, codes (M,), −1 where the label is left out)."""
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
+        """The same labels as arrays: name → (values, codes (M,), −1 where the label is left out); ``trig`` the
+        joints' cos and sin, when the caller shares them."""
         return {}
 
     def _moved(self, q: np.ndarray, upto: int, x: np.ndarray, trig: JointTrig | None = None) -> np.ndarray:

@@ -9,7 +9,8 @@ import numpy as np
 
 from ..._rotations import wrap_angle
 from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE
-from .._screws import JointTrig, chain_rotation, rotate_about
+from ..._forward import JointTrig
+from .._screws import chain_rotation, rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
 from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3
@@ -207,7 +208,7 @@ class IntersectingShoulder(Positioner):
         g, (i, j, k) = self.geometry, self.joints
         return self._forward_direction(), bool(g.parallel(j, k)), g.upward(g.direction(i))
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """Shoulder left/right: the sign of the reach along link 1's forward direction (see
         :meth:`_forward_direction`); none when the point is on axis 1. Elbow up/down (revolute joint 3,
         unless it is free): the side of the shoulder–point line the elbow lies on, along the robot's up
@@ -217,7 +218,7 @@ class IntersectingShoulder(Positioner):
         """
         g, (i, j, k) = self.geometry, self.joints
         forward_home, in_plane, up = self.label_constants
-        trig = JointTrig(joints)  # each joint's cos and sin, shared by the turns below
+        trig = JointTrig(joints) if trig is None else trig  # each joint's cos and sin, shared by the turns below
         forward = rotate_about(g.direction(i), joints[:, i], forward_home, trig[i])
         point = self._moved(joints, k + 1, self.point, trig)
         reach = point - self.centre

@@ -9,7 +9,8 @@ from functools import cached_property
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE
-from .._screws import JointTrig, rotate_about
+from ..._forward import JointTrig
+from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
 from ..subproblems import (
@@ -155,12 +156,12 @@ class OffsetShoulderParallelElbow(Positioner):
         return (np.linalg.norm((at - g.point(j)) @ in_plane, axis=-1)
                 < np.linalg.norm((opposite - g.point(j)) @ in_plane, axis=-1))
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         g, (i, j, k) = self.geometry, self.joints
         if not (g.model.is_revolute[i] and g.model.is_revolute[k]) or self.forward is None:
             return {}
         axis = g.direction(i)
-        trig = JointTrig(joints)  # each joint's cos and sin, shared by the turns below
+        trig = JointTrig(joints) if trig is None else trig  # each joint's cos and sin, shared by the turns below
         point = self._moved(joints, k + 1, self.point, trig)
         reach = point - g.point(i)
         reach = reach - np.outer(reach @ axis, axis)

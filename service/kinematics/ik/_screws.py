@@ -61,8 +61,12 @@ def rotation_about(k: np.ndarray, theta: np.ndarray, cos_sin: tuple[np.ndarray, 
     theta = np.asarray(theta, dtype=float)
     K, KK = _cross_matrices(k)
     cos, sin = (np.cos(theta), np.sin(theta)) if cos_sin is None else cos_sin
-    sin, cos = sin[..., None, None], cos[..., None, None]
-    return _EYE3 + sin * K + (1.0 - cos) * KK
+    # I + sin θ K + (1 − cos θ) K², entry by entry as rows (9, M) of one long loop each (a (M, 3, 3) broadcast
+    # runs nine values at a time), then laid out (M, 3, 3)
+    entries = K.reshape(9, 1) * sin.reshape(-1)
+    entries += _EYE3.reshape(9, 1)
+    entries += KK.reshape(9, 1) * (1.0 - cos.reshape(-1))
+    return entries.T.copy().reshape(theta.shape + (3, 3))
 
 
 def _cross_matrices(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -10,7 +10,7 @@ import numpy as np
 from ..._rotations import wrap_angle
 from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE
 from ..._forward import JointTrig
-from .._screws import chain_rotation, rotate_about
+from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
 from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3
@@ -231,10 +231,8 @@ class IntersectingShoulder(Positioner):
         codes: LabelCodes = {"shoulder": (("left", "right"), side_codes(along, np.linalg.norm(reach, axis=-1)))}
         if g.model.is_revolute[k] and not self.free_joints:
             elbow = self._moved(joints, k, g.point(k), trig) - self.centre
-            if in_plane:  # work in the arm's plane, normal to axis 2
-                m = self.model
-                normal = np.einsum("mij,j->mi", chain_rotation(m.directions[:j], m.is_revolute[:j], joints[:, :j], trig),
-                                   g.direction(j))
+            if in_plane:  # work in the arm's plane, normal to axis 2 (turned by joint 1, the one before it)
+                normal = rotate_about(axis, joints[:, i], g.direction(j), trig[i])
                 elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
                 reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
             line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)

@@ -140,7 +140,7 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     lower, upper, both = limits.widened(robot)
     if both.any():  # every both-bounded column at once (whole rows: a column alone strides through them all)
         value, low_bound, high_bound = (q, lower, upper) if both.all() else (q[..., both], lower[both], upper[both])
-        if both.all() and _one_turn_each(value, low_bound, high_bound):
+        if both.all() and value.size >= _CHECKED_FROM and _one_turn_each(value, low_bound, high_bound):
             return np.zeros_like(q), np.zeros_like(q)
         # in place, a few (..., n) arrays in all: a batch's table has tens of thousands of rows
         low = np.subtract(low_bound, value)
@@ -177,6 +177,9 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
 
 #: How far inside the values :func:`_one_turn_each` takes are from where a turn's quotient may round to a whole one.
 _INTERIOR_MARGIN = 1e-6
+#: The fewest values :func:`turn_ranges` checks with :func:`_one_turn_each` first: below, its few calls cost more
+#: than the quotients (one target's rows).
+_CHECKED_FROM = 1024
 
 
 def _one_turn_each(q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:

@@ -259,13 +259,37 @@ def _program(start: tuple[float, ...], operations: list[tuple[int, int, object]]
     return ChainProgram(start, tuple(operations), joint_steps, tuple(frame_ends))
 
 
-def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+class JointTrig:
+    """cos and sin of each joint column of q (..., n), each computed once, when first asked for: the FK check and
+    a family's branch labels turn the same joints, the labels several times. ``trig[i]`` is (cos q_i, sin q_i)."""
+
+    def __init__(self, q: np.ndarray) -> None:
+        self.q = np.asarray(q, dtype=float)
+        self._pairs: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def __getitem__(self, joint: int) -> tuple[np.ndarray, np.ndarray]:
+        pair = self._pairs.get(joint)
+        if pair is None:
+            angle = self.q[..., joint]
+            pair = self._pairs[joint] = (np.cos(angle), np.sin(angle))
+        return pair
+
+    def renew(self, rows: np.ndarray) -> None:
+        """Recompute the pairs kept so far at ``rows`` of q (M, n), whose values the caller has changed."""
+        for joint, (cos, sin) in self._pairs.items():
+            angle = self.q[rows, joint]
+            cos[rows], sin[rows] = np.cos(angle), np.sin(angle)
+
+
+def tool_columns(robot: Robot, q: np.ndarray, trig: JointTrig | None = None
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """``world_T_tool`` for a batch of joint vectors, as its four columns (:class:`ChainProgram`, each operation
     a few elementwise operations over the whole batch).
 
     Parameters
     ----------
     q : ndarray, shape (N, n)
+    trig : the cos and sin of q's columns, when shared with the caller's other steps
 
     Returns
     -------
@@ -273,14 +297,14 @@ def tool_columns(robot: Robot, q: np.ndarray) -> tuple[np.ndarray, np.ndarray, n
         The rotation's columns and the position of the tool, in the world frame.
     """
     program = chain_program(robot)
-    *_, tool = _run(program, np.asarray(q, dtype=float).T, ())
+    *_, tool = _run(program, np.asarray(q, dtype=float).T, (), trig)
     return tool
 
 
-def _run(program: ChainProgram, qt: np.ndarray, frame_ends: tuple[int, ...]) -> list:
+def _run(program: ChainProgram, qt: np.ndarray, frame_ends: tuple[int, ...], trig: JointTrig | None = None) -> list:
     """Run ``program`` on joint values ``qt`` (n, N): the frame (x, y, z, p columns, each (3, N)) after each count
     of operations in ``frame_ends``, then the last one. The arrays are never written in place, so a frame handed
-    out stays as it was."""
+    out stays as it was. ``trig`` (of qt's transpose) gives the cos and sin of the joints turned with no offset."""
     count = qt.shape[1]
     start = np.array(program.start).reshape(4, 3, 1)
     x, y, z, p = (np.repeat(column, count, axis=1) for column in start)
@@ -292,8 +316,11 @@ def _run(program: ChainProgram, qt: np.ndarray, frame_ends: tuple[int, ...]) -> 
             frames.append((x, y, z, p))
             end = next(ends, -1)
         if kind == _TURN:
-            angle = qt[joint] + value if value != 0.0 else qt[joint]
-            c, s = np.cos(angle), np.sin(angle)
+            if value == 0.0 and trig is not None:
+                c, s = trig[joint]
+            else:
+                angle = qt[joint] + value if value != 0.0 else qt[joint]
+                c, s = np.cos(angle), np.sin(angle)
             x, y = x * c + y * s, y * c - x * s
         elif kind == _SLIDE:
             p = p + z * (qt[joint] + value)

@@ -140,10 +140,21 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     lower, upper, both = limits.widened(robot)
     if both.any():  # every both-bounded column at once (whole rows: a column alone strides through them all)
         value, low_bound, high_bound = (q, lower, upper) if both.all() else (q[..., both], lower[both], upper[both])
-        low = np.ceil((low_bound - value) / _TWO_PI)
-        high = np.floor((high_bound - value) / _TWO_PI)
-        low += value + _TWO_PI * low < low_bound
-        high -= value + _TWO_PI * high > high_bound
+        if both.all() and value.size >= _CHECKED_FROM and _one_turn_each(value, low_bound, high_bound):
+            return np.zeros_like(q), np.zeros_like(q)
+        # in place, a few (..., n) arrays in all: a batch's table has tens of thousands of rows
+        low = np.subtract(low_bound, value)
+        low /= _TWO_PI
+        np.ceil(low, out=low)
+        high = np.subtract(high_bound, value)
+        high /= _TWO_PI
+        np.floor(high, out=high)
+        end = np.multiply(low, _TWO_PI)  # the end values q + 2kπ, checked against the bounds
+        end += value
+        low += end < low_bound
+        np.multiply(high, _TWO_PI, out=end)
+        end += value
+        high -= end > high_bound
         if both.all():
             return low, high
     first, last = np.zeros_like(q), np.zeros_like(q)
@@ -162,6 +173,22 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
         else:
             last[..., j] = np.where((value >= lower[j]) & (value <= upper[j]), 0.0, -1.0)
     return first, last
+
+
+#: How far inside the values :func:`_one_turn_each` takes are from where a turn's quotient may round to a whole one.
+_INTERIOR_MARGIN = 1e-6
+#: The fewest values :func:`turn_ranges` checks with :func:`_one_turn_each` first: below, its few calls cost more
+#: than the quotients (one target's rows).
+_CHECKED_FROM = 1024
+
+
+def _one_turn_each(q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
+    """Whether every value of q (..., n) lies inside its bounds (n,) and so far from the bounds moved by a whole
+    turn either way that :func:`turn_ranges` would give it the turns [0, 0] alone (as +0.0): three comparisons
+    instead of the quotients, for the usual batch under limits of about one turn."""
+    inside_low = np.maximum(lower, upper - _TWO_PI + _INTERIOR_MARGIN)
+    inside_high = np.minimum(upper, lower + _TWO_PI - _INTERIOR_MARGIN)
+    return bool(np.all(inside_low < inside_high)) and bool(((q > inside_low) & (q < inside_high)).all())
 
 
 def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray,

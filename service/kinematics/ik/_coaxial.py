@@ -20,6 +20,7 @@ import re
 
 import numpy as np
 
+from .._forward import JointTrig
 from .._rotations import wrap_angle
 from ._structure import Geometry
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
@@ -127,7 +128,7 @@ class CoaxialPlan(Sealed):
 
         return re.sub(r"(\bq|\bjoints? |\baxis |\baxes |\band )(\d+)", one_based, detail)
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """The inner plan's labels of joint vectors (M, n)."""
         return self.inner.label_codes(self._reduced(joints))
 

@@ -19,6 +19,7 @@ from .._rotations import wrap_float
 from .._tolerances import GEOMETRY_TOLERANCE
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
+from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, rotation_about
 from .subproblems import subproblem_1
 from ._types import Candidates, LabelCodes, SingularFlags, Sealed
@@ -157,12 +158,12 @@ class DecoupledPlan(Sealed):
             joints[rows, :, i] = np.where(held, joints[rows, :, i], q[..., i])
             joints[rows, :, j] = np.where(held, joints[rows, :, j], q[..., j])
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """Branch labels of full joint vectors (M, n) as arrays: the positioner's, then the wrist's."""
         codes: LabelCodes = {}
         for part in (self.positioner, self.wrist):
             if part is not None:
-                codes.update(part.label_codes(joints))
+                codes.update(part.label_codes(joints, trig))
         return codes
 
     def solve_one(self, world_T_target: np.ndarray) -> scalar.OnePose | None:

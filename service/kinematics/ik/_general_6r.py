@@ -47,6 +47,7 @@ from collections.abc import Iterator
 
 import numpy as np
 
+from .._forward import JointTrig
 from .._rotations import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE
 from ._general_6r_chain import NEWTON_TOLERANCE, chain_twists, error_twist, newton, singular_motion
@@ -366,7 +367,7 @@ class General6RPlan(Sealed):
                 "jacobian", joints, "free" if on_family else "boundary",
                 f"{what}; q{k + 1} is set to the reference value where that reaches the target"))
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         return {}
 
 

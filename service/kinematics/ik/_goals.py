@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._forward import forward_kinematics, geometric_jacobian, tool_columns, tool_columns_scalar_rows
+from .._forward import JointTrig, forward_kinematics, geometric_jacobian, tool_columns, tool_columns_scalar_rows
 from .._robot import Robot
 from ._structure import arm_size
 
@@ -60,9 +60,11 @@ class PoseGoal:
     def take(self, rows: np.ndarray) -> "PoseGoal":
         return PoseGoal(self.world_T_targets[rows], self.constrain_orientation)
 
-    def residuals(self, robot: Robot, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def residuals(self, robot: Robot, joints: np.ndarray, trig: JointTrig | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
         """Position (length units) and orientation (radians) errors of m candidates per target, joints (N, m, n):
-        shape (N, m) each. The orientation is computed for position targets too (the answer reports NaN)."""
+        shape (N, m) each. The orientation is computed for position targets too (the answer reports NaN).
+        ``trig``: the cos and sin of the joints as rows (N·m, n), when the caller shares them."""
         n_targets, m, n = joints.shape
         if n_targets * m <= SCALAR_CANDIDATES:
             position, orientation = np.empty((n_targets, m)), np.empty((n_targets, m))
@@ -70,7 +72,7 @@ class PoseGoal:
                                                            self.world_T_targets[:, :3, :].tolist())):
                 position[row], orientation[row] = zip(*pose_residuals_of_rows(robot, candidates, target))
             return position, orientation
-        x, y, z, p = (c.reshape(3, n_targets, m) for c in tool_columns(robot, joints.reshape(-1, n)))
+        x, y, z, p = (c.reshape(3, n_targets, m) for c in tool_columns(robot, joints.reshape(-1, n), trig))
         target = np.moveaxis(self.world_T_targets[:, :3, :], 0, -1)[..., None]  # (3, 4, N, 1)
         tx, ty, tz, tp = target[:, 0], target[:, 1], target[:, 2], target[:, 3]
         delta = p - tp
@@ -130,8 +132,10 @@ class DirectionGoal:
     def take(self, rows: np.ndarray) -> "DirectionGoal":
         return DirectionGoal(self.positions[rows], self.directions[rows], self.tool_axis)
 
-    def residuals(self, robot: Robot, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Position error (length units) and the angle between tool axis and direction (rad), shape (N, m)."""
+    def residuals(self, robot: Robot, joints: np.ndarray, trig: JointTrig | None = None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """Position error (length units) and the angle between tool axis and direction (rad), shape (N, m).
+        ``trig`` is not used: the FK here builds whole matrices."""
         T = forward_kinematics(robot, joints.reshape(-1, robot.dof)).reshape(joints.shape[:-1] + (4, 4))
         position = np.linalg.norm(T[..., :3, 3] - self.positions[:, None], axis=-1)
         pointing = T[..., :3, :3] @ self.tool_axis

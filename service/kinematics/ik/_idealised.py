@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._forward import ScrewModel, geometric_jacobian
+from .._forward import JointTrig, ScrewModel, geometric_jacobian
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL
 from ._screws import chain_motion
@@ -227,7 +227,7 @@ class IdealisedPlan(Sealed):
         size = position / self.size
         return np.maximum(size, orientation) if self.constrain_orientation else size
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """The idealised family's labels of joint vectors (M, n) of the true arm, except where they are not the
         true arm's: a label changes where the idealised arm's branches meet, which is up to a few δ from where
         the true arm's do. So near a singularity of the true arm (σ_min within :data:`SINGULAR_MARGIN` δ), a

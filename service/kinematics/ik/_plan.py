@@ -13,7 +13,7 @@ from typing import Protocol
 import numpy as np
 
 from .._cache import memo
-from .._forward import link_frames, screw_model
+from .._forward import JointTrig, link_frames, screw_model
 from .._robot import Robot
 from ._coaxial import CoaxialPlan, coaxial_pair, without_joint
 from ._decoupled import DecoupledPlan
@@ -41,7 +41,7 @@ class Plan(Protocol):
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates: ...
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes: ...
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes: ...
 
 
 def geometry_of(robot: Robot) -> Geometry:
@@ -153,7 +153,7 @@ def _reversed_three_parallel_plan(geometry: Geometry, reverse: Geometry, n: int)
         plan = family.match(reverse)
         if plan is not None:  # the elbow label of the parallel axes as the chain is described
             return ReversedPlan(plan, geometry.model.home, n, structure=structure,
-                                label_codes=lambda joints: {"elbow": parallel_elbow_codes(geometry, joints, first)})
+                                label_codes=lambda joints, trig=None: {"elbow": parallel_elbow_codes(geometry, joints, first, trig)})
     return None
 
 

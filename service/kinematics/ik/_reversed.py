@@ -15,7 +15,7 @@ from typing import Callable
 
 import numpy as np
 
-from .._forward import ScrewModel
+from .._forward import JointTrig, ScrewModel
 from ._decoupled import DecoupledPlan
 from ._screws import invert
 from ._structure import Geometry
@@ -75,8 +75,8 @@ class ReversedPlan(Sealed):
         detail = re.sub(r"(\bq|\bjoints? |\baxis )(\d+)", one_based, detail)
         return Singularity(flag.kind, tuple(sorted(n - 1 - j for j in flag.joints)), flag.relation, detail)
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """The inverse chain's labels (its wrist flip and its positioner's branches) of joint vectors (M, n)."""
         if self.own_label_codes is not None:
-            return self.own_label_codes(joints)
+            return self.own_label_codes(joints, trig)
         return self.inner.label_codes(joints[:, ::-1])

@@ -8,11 +8,15 @@ import math
 
 import numpy as np
 
+from .._forward import JointTrig
 
-def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
+
+def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray,
+                 cos_sin: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """R(k, θ)·v by Rodrigues' formula.
 
-    k : (3,) unit axis; theta : (...,); v : (..., 3), broadcast together.
+    k : (3,) unit axis; theta : (...,); v : (..., 3), broadcast together; ``cos_sin`` (cos θ, sin θ), theta's
+    shape, when the caller has them already.
     In a frame (e1, e2, k) around the axis the turn is a plane rotation of the
     (e1, e2) coordinates, so the work is two small matrix products and four
     elementwise products (cheaper than the cross-product form).
@@ -23,12 +27,13 @@ def rotate_about(k: np.ndarray, theta: np.ndarray, v: np.ndarray) -> np.ndarray:
     frame = axis_frame(k)  # columns e1, e2, k
     if v.shape != shape:
         v = np.broadcast_to(v, shape)
+    if cos_sin is None:
+        cos_sin = np.cos(theta), np.sin(theta)
     if theta.shape != shape[:-1]:
-        theta = np.broadcast_to(theta, shape[:-1])
+        cos_sin = tuple(np.broadcast_to(part, shape[:-1]) for part in cos_sin)
     # (3, 3) @ (3, M) products run as one BLAS call; (M, 3) @ (3, 3) would not
     local = frame.T @ v.reshape(-1, 3).T  # (3, M): coordinates along e1, e2, k
-    theta = theta.reshape(-1)
-    cos, sin = np.cos(theta), np.sin(theta)
+    cos, sin = (part.reshape(-1) for part in cos_sin)
     a, b = local[0], local[1]
     turned = np.empty_like(local)
     np.subtract(a * cos, b * sin, out=turned[0])
@@ -73,12 +78,18 @@ def _built_frame(kx: float, ky: float, kz: float) -> np.ndarray:
     return np.array([[ax, e2[0], kx], [ay, e2[1], ky], [az, e2[2], kz]])
 
 
-def rotation_about(k: np.ndarray, theta: np.ndarray) -> np.ndarray:
-    """R(k, θ) as matrices, shape (..., 3, 3)."""
+def rotation_about(k: np.ndarray, theta: np.ndarray, cos_sin: tuple[np.ndarray, np.ndarray] | None = None
+                   ) -> np.ndarray:
+    """R(k, θ) as matrices, shape (..., 3, 3); ``cos_sin`` (cos θ, sin θ) when the caller has them already."""
     theta = np.asarray(theta, dtype=float)
     K, KK = _cross_matrices(k)
-    sin, cos = np.sin(theta)[..., None, None], np.cos(theta)[..., None, None]
-    return _EYE3 + sin * K + (1.0 - cos) * KK
+    cos, sin = (np.cos(theta), np.sin(theta)) if cos_sin is None else cos_sin
+    # I + sin θ K + (1 − cos θ) K², entry by entry as rows (9, M) of one long loop each (a (M, 3, 3) broadcast
+    # runs nine values at a time), then laid out (M, 3, 3)
+    entries = K.reshape(9, 1) * sin.reshape(-1)
+    entries += _EYE3.reshape(9, 1)
+    entries += KK.reshape(9, 1) * (1.0 - cos.reshape(-1))
+    return entries.T.copy().reshape(theta.shape + (3, 3))
 
 
 def _cross_matrices(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -129,26 +140,28 @@ def chain_motion(directions: np.ndarray, points: np.ndarray, revolute: np.ndarra
 
 
 def move_point(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, q: np.ndarray,
-               x: np.ndarray) -> np.ndarray:
+               x: np.ndarray, trig: JointTrig | None = None) -> np.ndarray:
     """:func:`chain_motion` applied to the point x (3,): shape (..., 3), turning the point joint by joint
-    from the last to the first (vector operations only, no 4×4 products)."""
+    from the last to the first (vector operations only, no 4×4 products). ``trig``: q's cos and sin, when shared."""
     q = np.asarray(q, dtype=float)
     x = np.broadcast_to(np.asarray(x, dtype=float), q.shape[:-1] + (3,))
     for i in reversed(range(q.shape[-1])):
         if revolute[i]:
-            x = points[i] + rotate_about(directions[i], q[..., i], x - points[i])
+            x = points[i] + rotate_about(directions[i], q[..., i], x - points[i], None if trig is None else trig[i])
         else:
             x = x + directions[i] * q[..., i, None]
     return x
 
 
-def chain_rotation(directions: np.ndarray, revolute: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """The rotation part of :func:`chain_motion`, shape (..., 3, 3): prismatic joints do not turn."""
+def chain_rotation(directions: np.ndarray, revolute: np.ndarray, q: np.ndarray, trig: JointTrig | None = None
+                   ) -> np.ndarray:
+    """The rotation part of :func:`chain_motion`, shape (..., 3, 3): prismatic joints do not turn. ``trig``: q's
+    cos and sin, when shared."""
     q = np.asarray(q, dtype=float)
     R = None
     for i in range(q.shape[-1]):
         if revolute[i]:
-            turn = rotation_about(directions[i], q[..., i])
+            turn = rotation_about(directions[i], q[..., i], None if trig is None else trig[i])
             R = turn if R is None else R @ turn
     return np.broadcast_to(np.eye(3), q.shape[:-1] + (3, 3)) if R is None else R
 

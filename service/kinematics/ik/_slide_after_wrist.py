@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert
 from ._structure import Geometry
 from .subproblems import subproblem_5_prismatic
@@ -78,5 +79,5 @@ class SlideAfterSphericalWrist:
             singular.add((mask.reshape(n_targets, 4) & arm_ok).any(axis=1), flag)
         return Candidates(joints.reshape(n_targets, -1, 6), valid.reshape(n_targets, -1), singular)
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        return self.wrist.label_codes(joints)
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
+        return self.wrist.label_codes(joints, trig)

@@ -38,6 +38,7 @@ from . import _scalar as scalar
 from .._rotations import wrap_angle, wrap_any_float
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
+from .._forward import JointTrig
 from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
@@ -194,22 +195,23 @@ class _AxesTwoToFourParallel(Sealed):
         other = np.where(rising(q6) == rising(candidates[..., 0]), candidates[..., 1], candidates[..., 0])
         return q6, np.where(two_arcs, wrap_angle(other), np.nan)
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """Shoulder left/right: the sign of the reach to axis 4 along link 1's forward direction. Elbow up/down:
         the side of the line from axis 2 to axis 4 that axis 3 lies on, along the robot's up direction, measured
         in the plane normal to the parallel axes (so the points the description puts on them do not matter).
-        Wrist: the sign of sin q5 (:func:`wrist_codes`)."""
+        Wrist: the sign of sin q5 (:func:`wrist_codes`). ``trig``: the joints' cos and sin, when shared."""
         g, m = self.geometry, self.model
+        trig = JointTrig(joints) if trig is None else trig  # each joint's cos and sin, shared by the turns below
         def moved(upto: int, x: np.ndarray) -> np.ndarray:
-            return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x)
+            return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x, trig)
 
-        forward = rotate_about(g.direction(0), joints[:, 0], self.forward)
+        forward = rotate_about(g.direction(0), joints[:, 0], self.forward, trig[0])
         wrist_point = moved(3, g.point(3))
         shoulder = np.einsum("mi,mi->m", wrist_point - g.point(0), forward)
         shoulder_point = moved(1, g.point(1))
         elbow_point = moved(2, g.point(2)) - shoulder_point
         reach = wrist_point - shoulder_point
-        normal = rotate_about(g.direction(0), joints[:, 0], self.omega_p)  # the parallel axes, after joint 1
+        normal = rotate_about(g.direction(0), joints[:, 0], self.omega_p, trig[0])  # the parallel axes, after joint 1
         elbow_point = elbow_point - np.einsum("mi,mi->m", elbow_point, normal)[:, None] * normal
         reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
         line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)
@@ -217,7 +219,7 @@ class _AxesTwoToFourParallel(Sealed):
         side = rejection @ g.upward(g.direction(0))
         return {"shoulder": (("left", "right"), side_codes(shoulder, np.linalg.norm(wrist_point - g.point(0), axis=-1))),
                 "elbow": (("up", "down"), side_codes(side, np.linalg.norm(elbow_point, axis=-1))),
-                **wrist_codes(joints[:, 4])}
+                **wrist_codes(trig[4][1])}
 
 
 class ThreeParallelPlan(_AxesTwoToFourParallel):

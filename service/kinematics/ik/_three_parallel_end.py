@@ -26,6 +26,7 @@ import numpy as np
 
 from .._rotations import wrap_angle
 from ._positioning import side_codes
+from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_3, subproblem_6
@@ -150,21 +151,24 @@ class ThreeParallelAtEndPlan(Sealed):
         near = np.argmin(np.abs(wrap_angle(np.nan_to_num(roots.theta, nan=1e9) - target)), axis=-1)
         return np.take_along_axis(roots.theta, near[..., None], -1)[..., 0]
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        return {"elbow": parallel_elbow_codes(self.geometry, joints, 3)}
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
+        return {"elbow": parallel_elbow_codes(self.geometry, joints, 3, trig)}
 
 
-def parallel_elbow_codes(geometry: Geometry, joints: np.ndarray, first: int) -> tuple[tuple[str, str], np.ndarray]:
+def parallel_elbow_codes(geometry: Geometry, joints: np.ndarray, first: int, trig: JointTrig | None = None
+                         ) -> tuple[tuple[str, str], np.ndarray]:
     """Elbow up/down of the planar chain of parallel axes first, first + 1, first + 2, for joints (M, n): the side
     of the line from the first axis to the third that the middle axis lies on, along the robot's up direction,
     measured in the plane normal to the parallel axes (−1 where it is on the line, or where that plane holds no
     up: the parallel axes vertical)."""
     m = geometry.model
+    trig = JointTrig(joints) if trig is None else trig  # each joint's cos and sin, shared by the turns below
     def moved(upto: int, x: np.ndarray) -> np.ndarray:
-        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x)
+        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], joints[:, :upto], x, trig)
 
     start, middle, end = (moved(first + j, geometry.point(first + j)) for j in range(3))
-    normal = chain_rotation(m.directions[:first], m.is_revolute[:first], joints[:, :first]) @ geometry.direction(first)
+    normal = chain_rotation(m.directions[:first], m.is_revolute[:first], joints[:, :first], trig) \
+        @ geometry.direction(first)
     def planar(x: np.ndarray) -> np.ndarray:
         return x - np.einsum("mi,mi->m", x, normal)[:, None] * normal
 

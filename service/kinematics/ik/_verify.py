@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._cache import memo
+from .._forward import JointTrig
 from .._robot import Robot
 from .._rotations import wrap_angle
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
@@ -241,20 +242,23 @@ class Verified:
 
 
 def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarray | None = None,
-           label_codes: Callable[[np.ndarray], LabelCodes] | None = None,
+           label_codes: Callable[[np.ndarray, JointTrig], LabelCodes] | None = None,
            held: np.ndarray | None = None) -> Verified:
     """The verified, distinct solutions among ``candidates`` (N, m, n) for the goal's N targets: each target's
     in slot order, or nearest the ``reference`` (n,) first (wrap-aware, the largest joint move; ties in slot
     order).
 
-    Labels are the candidates' own; ``label_codes`` labels joint vectors (M, n) for a solver that gives none.
+    Labels are the candidates' own; ``label_codes`` labels joint vectors (M, n) for a solver that gives none,
+    with the cos and sin of their joints that the FK check computed (a :class:`JointTrig`).
     The joints ``held`` ((n,) bool: a redundant arm's free joints at the values asked) keep their values exactly
     when a candidate is polished.
     """
     n_targets, m, n = candidates.joints.shape
     raw = candidates.joints
-    joints = wrap_revolute(robot, raw if np.isfinite(raw).all() else np.nan_to_num(raw))
-    position, orientation = goal.residuals(robot, joints)
+    joints = np.ascontiguousarray(wrap_revolute(robot, raw if np.isfinite(raw).all() else np.nan_to_num(raw)))
+    rows_of_joints = joints.reshape(-1, n)  # a view: the polish below writes through it
+    trig = JointTrig(rows_of_joints)  # computed by the FK check, shared with the labels
+    position, orientation = goal.residuals(robot, joints, trig)
     constrained = goal.constrain_orientation
     valid = candidates.valid
     size = error_size(robot, position, orientation, constrained)
@@ -264,6 +268,7 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
         refined = gauss_newton(robot, goal, joints[rows, slots], rows, steps=POLISH_STEPS, tolerance=POLISH_FROM,
                                moving=None if held is None else ~held)
         joints[rows, slots] = wrap_revolute(robot, refined.joints)
+        trig.renew(rows * m + slots)
         p, o = _residuals_at(robot, goal, joints[rows, slots], rows)
         position[rows, slots], orientation[rows, slots] = p, o
         size[rows, slots] = error_size(robot, p, o, constrained)
@@ -275,7 +280,7 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
         complete &= count == valid.sum(axis=1)
     labels = candidates.labels if candidates.labels is not None else (
         {} if label_codes is None else {name: (values, codes.reshape(n_targets, m))
-                                        for name, (values, codes) in label_codes(joints.reshape(-1, n)).items()})
+                                        for name, (values, codes) in label_codes(rows_of_joints, trig).items()})
     if reference is None:
         rows, slots = np.nonzero(kept)
     else:

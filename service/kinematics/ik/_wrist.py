@@ -17,6 +17,7 @@ import numpy as np
 
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from .._rotations import wrap_angle
+from .._forward import JointTrig
 from ._screws import rotate_about
 from ._structure import Geometry, idealised
 from .subproblems import subproblem_1, subproblem_2_chain
@@ -38,8 +39,8 @@ def _perpendicular_unit(axis: np.ndarray) -> np.ndarray:
     return u / np.linalg.norm(u)
 
 
-def wrist_codes(middle: np.ndarray) -> LabelCodes:
-    """Wrist label codes from the middle wrist joint's angles (M,): 0 ``no_flip`` when its sine is positive, else
+def wrist_codes(sine: np.ndarray) -> LabelCodes:
+    """Wrist label codes from the sines of the middle wrist joint's angles (M,): 0 ``no_flip`` when positive, else
     1 ``flip``.
 
     The flip is (q_a + π, −q_b, q_c + π) (textbook §2.3, §3.2). When the sine is
@@ -47,7 +48,6 @@ def wrist_codes(middle: np.ndarray) -> LabelCodes:
     the outer axes are aligned, the two branches are one family and no wrist
     label applies (−1).
     """
-    sine = np.sin(middle)
     codes = np.where(sine > 0, 0, 1).astype(np.int8)
     codes[np.abs(sine) <= 10 * GEOMETRY_TOLERANCE] = -1
     return {"wrist": (("no_flip", "flip"), codes)}
@@ -168,8 +168,9 @@ class SphericalWrist(Sealed):
         deviation = idealised(self.geometry, 10 * GEOMETRY_TOLERANCE).deviation
         return max(GEOMETRY_TOLERANCE, deviation / DUPLICATE_TOLERANCE)
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        return wrist_codes(joints[:, self.joints[1]])
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
+        middle = self.joints[1]
+        return wrist_codes(np.sin(joints[:, middle]) if trig is None else trig[middle][1])
 
 
 class Roll:
@@ -189,7 +190,7 @@ class Roll:
         q = subproblem_1(self.axis, self.normal, wanted).theta  # (..., 1)
         return WristResult(q[..., None], np.ones(q.shape, dtype=bool), SingularFlags(len(R_w)))
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         return {}
 
 
@@ -220,5 +221,5 @@ class TwoAxisWrist(Sealed):
         qb = subproblem_1(b, self.normal, rotate_about(a, -qa, wanted)).theta[..., 0]
         return WristResult(np.stack([qa, qb], axis=-1), first.exact.copy(), SingularFlags(len(R_w)))
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         return {}

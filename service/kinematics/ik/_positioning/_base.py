@@ -15,6 +15,7 @@ from fnmatch import fnmatchcase
 import numpy as np
 
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from ..._forward import JointTrig
 from .._screws import chain_motion, move_point
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity, Sealed
@@ -132,14 +133,16 @@ class Positioner(Sealed):
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         raise NotImplementedError
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
-        """The same labels as arrays: name → (values, codes (M,), −1 where the label is left out)."""
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
+        """The same labels as arrays: name → (values, codes (M,), −1 where the label is left out); ``trig`` the
+        joints' cos and sin, when the caller shares them."""
         return {}
 
-    def _moved(self, q: np.ndarray, upto: int, x: np.ndarray) -> np.ndarray:
-        """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) applied to the point x (3,), for joint values (..., n)."""
+    def _moved(self, q: np.ndarray, upto: int, x: np.ndarray, trig: JointTrig | None = None) -> np.ndarray:
+        """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) applied to the point x (3,), for joint values (..., n) (``trig``
+        their cos and sin, when shared)."""
         m = self.model
-        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], q[..., :upto], x)
+        return move_point(m.directions[:upto], m.points[:upto], m.is_revolute[:upto], q[..., :upto], x, trig)
 
     def _motion(self, q: np.ndarray, upto: int) -> np.ndarray:
         """exp([S_1] q_1) ⋯ exp([S_upto] q_upto) for joint values (..., n)."""

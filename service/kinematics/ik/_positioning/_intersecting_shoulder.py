@@ -9,7 +9,8 @@ import numpy as np
 
 from ..._rotations import wrap_angle
 from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE
-from .._screws import chain_rotation, rotate_about
+from ..._forward import JointTrig
+from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
 from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3
@@ -207,7 +208,7 @@ class IntersectingShoulder(Positioner):
         g, (i, j, k) = self.geometry, self.joints
         return self._forward_direction(), bool(g.parallel(j, k)), g.upward(g.direction(i))
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """Shoulder left/right: the sign of the reach along link 1's forward direction (see
         :meth:`_forward_direction`); none when the point is on axis 1. Elbow up/down (revolute joint 3,
         unless it is free): the side of the shoulder–point line the elbow lies on, along the robot's up
@@ -217,8 +218,9 @@ class IntersectingShoulder(Positioner):
         """
         g, (i, j, k) = self.geometry, self.joints
         forward_home, in_plane, up = self.label_constants
-        forward = rotate_about(g.direction(i), joints[:, i], forward_home)
-        point = self._moved(joints, k + 1, self.point)
+        trig = JointTrig(joints) if trig is None else trig  # each joint's cos and sin, shared by the turns below
+        forward = rotate_about(g.direction(i), joints[:, i], forward_home, trig[i])
+        point = self._moved(joints, k + 1, self.point, trig)
         reach = point - self.centre
         axis = g.direction(i)
         sideways = reach - np.outer(reach @ axis, axis)
@@ -228,11 +230,9 @@ class IntersectingShoulder(Positioner):
         # (the point as near axis 1 as the offset allows) left and right meet: no shoulder label
         codes: LabelCodes = {"shoulder": (("left", "right"), side_codes(along, np.linalg.norm(reach, axis=-1)))}
         if g.model.is_revolute[k] and not self.free_joints:
-            elbow = self._moved(joints, k, g.point(k)) - self.centre
-            if in_plane:  # work in the arm's plane, normal to axis 2
-                m = self.model
-                normal = np.einsum("mij,j->mi", chain_rotation(m.directions[:j], m.is_revolute[:j], joints[:, :j]),
-                                   g.direction(j))
+            elbow = self._moved(joints, k, g.point(k), trig) - self.centre
+            if in_plane:  # work in the arm's plane, normal to axis 2 (turned by joint 1, the one before it)
+                normal = rotate_about(axis, joints[:, i], g.direction(j), trig[i])
                 elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
                 reach = reach - np.einsum("mi,mi->m", reach, normal)[:, None] * normal
             line = reach / np.maximum(np.linalg.norm(reach, axis=-1, keepdims=True), 1e-300)

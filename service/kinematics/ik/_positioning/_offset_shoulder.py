@@ -9,6 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE
+from ..._forward import JointTrig
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -155,20 +156,21 @@ class OffsetShoulderParallelElbow(Positioner):
         return (np.linalg.norm((at - g.point(j)) @ in_plane, axis=-1)
                 < np.linalg.norm((opposite - g.point(j)) @ in_plane, axis=-1))
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         g, (i, j, k) = self.geometry, self.joints
         if not (g.model.is_revolute[i] and g.model.is_revolute[k]) or self.forward is None:
             return {}
         axis = g.direction(i)
-        point = self._moved(joints, k + 1, self.point)
+        trig = JointTrig(joints) if trig is None else trig  # each joint's cos and sin, shared by the turns below
+        point = self._moved(joints, k + 1, self.point, trig)
         reach = point - g.point(i)
         reach = reach - np.outer(reach @ axis, axis)
-        forward = rotate_about(axis, joints[:, i], self.forward)
+        forward = rotate_about(axis, joints[:, i], self.forward, trig[i])
         codes: LabelCodes = {"shoulder": (("left", "right"), side_codes(np.einsum("mi,mi->m", reach, forward),
                                                                        np.linalg.norm(point - g.point(i), axis=-1)))}
-        shoulder = self._moved(joints, i + 1, self.shoulder)
-        normal = rotate_about(axis, joints[:, i], g.direction(j))
-        elbow = self._moved(joints, k, g.point(k)) - shoulder
+        shoulder = self._moved(joints, i + 1, self.shoulder, trig)
+        normal = rotate_about(axis, joints[:, i], g.direction(j), trig[i])
+        elbow = self._moved(joints, k, g.point(k), trig) - shoulder
         line = point - shoulder
         elbow = elbow - np.einsum("mi,mi->m", elbow, normal)[:, None] * normal
         line = line - np.einsum("mi,mi->m", line, normal)[:, None] * normal

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE
+from ..._forward import JointTrig
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -95,11 +96,11 @@ class PlanarTwoLink(Positioner):
                                                  "the point is on the first axis; joint 1 is free"), singular)
         return PositionerResult(joints, valid, singular)
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         g, (i, j) = self.geometry, self.joints
         up = g.upward(g.direction(i))
-        elbow = self._moved(joints, i + 1, g.point(j)) - g.point(i)
-        point = self._moved(joints, j + 1, self.point) - g.point(i)
+        elbow = self._moved(joints, i + 1, g.point(j), trig) - g.point(i)
+        point = self._moved(joints, j + 1, self.point, trig) - g.point(i)
         side = np.einsum("mi,i->m", np.cross(point, elbow), up)
         return {"elbow": (("up", "down"), side_codes(side, np.linalg.norm(point, axis=-1) * np.linalg.norm(elbow, axis=-1)))}
 

@@ -8,6 +8,7 @@ import numpy as np
 
 from ..._rotations import wrap_angle
 from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, ROUNDING_TOLERANCE
+from ..._forward import JointTrig
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -66,11 +67,11 @@ class ParallelShoulder(Positioner):
                                                            "the two assembly modes meet"), singular)
         return PositionerResult(joints, valid, singular)
 
-    def label_codes(self, joints: np.ndarray) -> LabelCodes:
+    def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         g, (i, j, k) = self.geometry, self.joints
         up = g.upward(g.direction(i))
-        elbow = self._moved(joints, i + 1, g.point(j)) - g.point(i)
-        point = self._moved(joints, k + 1, self.point) - g.point(i)
+        elbow = self._moved(joints, i + 1, g.point(j), trig) - g.point(i)
+        point = self._moved(joints, k + 1, self.point, trig) - g.point(i)
         side = np.einsum("mi,i->m", np.cross(point, elbow), up)
         size = np.linalg.norm(point, axis=-1) * np.linalg.norm(elbow, axis=-1)
         return {"assembly_mode": ((1, 2), side_codes(side, size))}

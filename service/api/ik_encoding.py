@@ -55,7 +55,7 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
     position = table.position.tolist()
     orientation = [None if math.isnan(value) else value for value in table.orientation.tolist()]
     within = table.within_limits.tolist()
-    branches = _branch_dicts(table)
+    branches = table.branches()
     lower = [None if math.isinf(value) else value for value in (answer.limits.lower / scale).tolist()]
     upper = [None if math.isinf(value) else value for value in (answer.limits.upper / scale).tolist()]
     violations: dict[int, list[dict]] = {}
@@ -80,23 +80,6 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
                                                  _contacts(table)):
             solution["clearance"], solution["collisions"] = clearance, contacts
     return per_target
-
-
-def _branch_dicts(table: SolutionTable) -> list[dict]:
-    """Each row's branch labels as a dict (a label left out where its code is −1). Rows with the same codes share
-    one dict: an answer has a handful of distinct branches among thousands of rows, and the dicts are only
-    encoded."""
-    if not table.labels:
-        empty: dict = {}
-        return [empty] * len(table.target)
-    names = list(table.labels)
-    codes = np.stack([table.labels[name][1] for name in names], axis=1).astype(np.int64) + 1  # (S, L), 0 = none
-    keys = (codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)).tolist()
-    shared = {}
-    for key in dict.fromkeys(keys):  # the distinct branches, each worded from its first row
-        first = codes[keys.index(key)].tolist()
-        shared[key] = {name: table.labels[name][0][code - 1] for name, code in zip(names, first) if code}
-    return list(map(shared.__getitem__, keys))
 
 
 def _rolls(table: SolutionTable, angle: float) -> list[float | None]:

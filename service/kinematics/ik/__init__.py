@@ -23,7 +23,8 @@ from ._plan import plan_for
 from ._redundant import (MAX_FREE_VALUES, FamilyVerified, FreeJoint, NotRedundantError, beyond_reach,
                          free_joints_for, no_solution_detail, solve_free_joint_family)
 from ._select import MAX_EQUIVALENTS, NOTE_WORDING, Ordering, Selection, check_ordering, joint_travel, select, travel
-from ._solve import IKArrays, result_of, solve_direction, solve_ik, solve_ik_arrays, solve_ik_batch, unlimited
+from ._solve import (IKArrays, result_of, results_of, solve_direction, solve_ik, solve_ik_arrays, solve_ik_batch,
+                     unlimited)
 from ._table import SolutionTable
 from ._types import IKResult, Singularity, Solution
 from ._verify import distance_to_reference, joint_difference, wrap_revolute
@@ -78,6 +79,7 @@ __all__ = [
     "plan_for",
     "plan_is_kept",
     "result_of",
+    "results_of",
     "roll_samples",
     "select",
     "solve_ik",

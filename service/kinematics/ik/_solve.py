@@ -12,14 +12,15 @@ reference, the solutions come nearest first (wrap-aware, the largest single join
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from .._budget import UNLIMITED, Budget
 from .._limits import Limits
 from .._robot import Robot
-from ._answer import DIRECTION, AnswerOptions, IKAnswer, IKOptions, IKTargets, answer_ik
+from ._answer import (DIRECTION, AnswerOptions, IKAnswer, IKOptions, IKTargets, SolverReport, answer_ik,
+                      answered_by_family)
 from ._closed_form import cached_plan, solve_closed_form
 from ._goals import PoseGoal
 from ._plan import Plan
@@ -51,8 +52,31 @@ def solve_ik(robot: Robot, world_T_target: np.ndarray, *, constrain_orientation:
         Every distinct solution that FK verifies, with branch labels, residuals and the singularities met.
     """
     target = np.asarray(world_T_target, dtype=float)
+    if constrain_orientation and reference is None:
+        closed = _closed_form_result(robot, target, options or IKOptions())
+        if closed is not None:
+            return closed
     return solve_ik_batch(robot, target[None], constrain_orientation=constrain_orientation, reference=reference,
                           options=options)[0]
+
+
+def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) -> IKResult | None:
+    """:func:`solve_ik` of a pose without a reference where the closed form answers it alone: it covers the
+    arm, promises every solution and found some. The answer's selection would then list each solution once, as
+    it stands (no limits, no order to impose), and no words: the same record without building the answer. None
+    elsewhere (a redundant arm's family, the numeric search's fallback, an unreachable pose's detail)."""
+    if answered_by_family(robot, AnswerOptions()):
+        return None
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    if plan is None:
+        return None
+    verified = solve_closed_form(robot, plan, PoseGoal(target[None]), None, budget=options.budget)
+    if not (verified.complete[0] and verified.count[0]):
+        return None
+    table = verified.table
+    listed = replace(table, joints=table.joints + 0.0)  # as the selection lists them, q + 2π·0 (−0.0 is 0.0)
+    report = SolverReport("analytic", plan.structure, True, False, tuple(plan.free_joints))
+    return _result(_solutions(listed), "ok", report, verified.singularities[0], None)
 
 
 def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,
@@ -62,22 +86,43 @@ def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orien
     targets = IKTargets.poses(np.asarray(world_T_targets, dtype=float), constrain_orientation=constrain_orientation)
     answer = answer_ik(robot, targets, AnswerOptions(reference=reference, limits=unlimited(robot),
                                                      filter_limits=False, search=options, budget=options.budget))
-    return [result_of(answer, row) for row in range(len(answer))]
+    return results_of(answer)
+
+
+def results_of(answer: IKAnswer) -> list[IKResult]:
+    """Every target of an answer as an :class:`IKResult` record (its kept solutions, in answer order), in one
+    pass over the answer's tables."""
+    solutions = _solutions(answer.solutions)
+    start, stop = answer.solutions.bounds(len(answer))
+    reports = answer.singularity_reports
+    return [_result(solutions[first:end], status, answer.solvers[solver],
+                    [reports[i] for i in answer.singularities[row]], detail)
+            for row, (first, end, status, solver, detail) in enumerate(zip(
+                start.tolist(), stop.tolist(), answer.status.tolist(), answer.solver.tolist(), answer.detail_list()))]
 
 
 def result_of(answer: IKAnswer, row: int) -> IKResult:
-    """Target ``row`` of an answer as an :class:`IKResult` record (its kept solutions, in answer order)."""
-    view = answer.target(row)
-    table = view.solutions
-    labels = [(name, values, codes.tolist()) for name, (values, codes) in table.labels.items()]
-    orientation = table.orientation.tolist()
-    solutions = [Solution(table.joints[k], {name: values[codes[k]] for name, values, codes in labels if codes[k] >= 0},
-                          float(table.position[k]), orientation[k]) for k in range(len(table))]
-    status = "ok" if solutions else ("not_found" if view.status == "not_found" else "unreachable")
-    return IKResult(status=status, solutions=solutions, method=view.solver.method, structure=view.solver.structure,
-                    complete=view.solver.complete, singularities=list(view.singularities),
-                    free_joints=list(view.solver.free_joints), detail=view.detail or "",
-                    search_exhausted_budget=view.solver.time_budget_exhausted)
+    """Target ``row`` of an answer as an :class:`IKResult` record (:func:`results_of` of that target alone)."""
+    first, end = np.searchsorted(answer.solutions.target, [row, row + 1])
+    return _result(_solutions(answer.solutions.take(slice(first, end))), str(answer.status[row]),
+                   answer.solvers[int(answer.solver[row])],
+                   [answer.singularity_reports[i] for i in answer.singularities[row]], answer.detail[row])
+
+
+def _solutions(table: SolutionTable) -> list[Solution]:
+    """Every row of a table as a :class:`Solution`, in table order (joints as row views of the table)."""
+    return [Solution(q, branch, position, orientation) for q, branch, position, orientation in
+            zip(table.joints, table.branches(), table.position.tolist(), table.orientation.tolist())]
+
+
+def _result(solutions: list[Solution], status: str, solver: SolverReport, singularities: list, detail: str | None
+            ) -> IKResult:
+    """One target's record: its solutions, the answer's status (``ok`` when it has solutions, ``not_found``
+    or ``unreachable`` otherwise), its solver, the conditions met and the words."""
+    return IKResult(status="ok" if solutions else ("not_found" if status == "not_found" else "unreachable"),
+                    solutions=solutions, method=solver.method, structure=solver.structure, complete=solver.complete,
+                    singularities=singularities, free_joints=list(solver.free_joints), detail=detail or "",
+                    search_exhausted_budget=solver.time_budget_exhausted)
 
 
 @dataclass(frozen=True)

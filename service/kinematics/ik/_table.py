@@ -116,6 +116,22 @@ class SolutionTable:
             table = table.take(np.argsort(table.target, kind="stable"))
         return table
 
+    def branches(self) -> list[dict]:
+        """Each row's branch labels as a dict, name → label (a name left out where the row's code is −1). Rows
+        with the same codes share one dict (read-only by convention): an answer has a handful of distinct
+        branches among thousands of rows."""
+        if not self.labels or not len(self.target):
+            empty: dict = {}
+            return [empty] * len(self.target)
+        names = list(self.labels)
+        codes = np.stack([self.labels[name][1] for name in names], axis=1).astype(np.int64) + 1  # (S, L), 0 = none
+        keys = (codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)).tolist()
+        shared = {}
+        for key in dict.fromkeys(keys):  # the distinct branches, each worded from its first row
+            first = codes[keys.index(key)].tolist()
+            shared[key] = {name: self.labels[name][0][code - 1] for name, code in zip(names, first) if code}
+        return list(map(shared.__getitem__, keys))
+
     def bounds(self, n_targets: int) -> tuple[np.ndarray, np.ndarray]:
         """Each target's rows as [start, stop), shape (N,) each."""
         edges = np.searchsorted(self.target, np.arange(n_targets + 1))

@@ -1,0 +1,97 @@
+"""The library's records (ik/_solve.py): ``solve_ik`` of one pose, which answers from the closed form alone where
+it promises every solution, against the record of the whole answer (``answer_ik`` with no limits, then
+``results_of``), field by field, on every catalogue arm and on random arms of the closed-form families."""
+
+import numpy as np
+import pytest
+
+from service.config import Settings
+from service.kinematics import forward_kinematics
+from service.kinematics.ik import (AnswerOptions, IKResult, IKTargets, answer_ik, result_of, results_of, solve_ik,
+                                   solve_ik_batch, unlimited)
+from service.robots.catalogue import load_catalogue
+from tests.arms import random_family_arm, random_three_parallel_arm
+from tests.ik_helpers import random_configurations
+
+_CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+CATALOGUE_IDS = sorted(entry.description.id for entry in _CATALOGUE.entries())
+
+
+def _poses(robot, count: int, seed: int) -> np.ndarray:
+    """Reachable poses, poses at configurations snapped to 0 and ±π/2 (singular ones among them), and poses
+    moved out of reach."""
+    rng = np.random.default_rng(seed)
+    q = random_configurations(robot, count, seed)
+    snapped = q[: count // 3].copy()
+    snap = rng.random(snapped.shape) < 0.4
+    snapped[snap] = rng.choice([0.0, np.pi / 2, -np.pi / 2], snap.sum())
+    T = forward_kinematics(robot, np.concatenate([q, snapped]))
+    far = T[: count // 6].copy()
+    far[:, :3, 3] *= 3.0
+    return np.concatenate([T, far])
+
+
+def _answered(robot, T: np.ndarray) -> IKResult:
+    """The record of the whole answer for one pose: answer_ik with no limits and no filter, as solve_ik_batch."""
+    answer = answer_ik(robot, IKTargets.poses(T[None]), AnswerOptions(limits=unlimited(robot), filter_limits=False))
+    return results_of(answer)[0]
+
+
+def _assert_same(record: IKResult, expected: IKResult) -> None:
+    assert (record.status, record.method, record.structure, record.complete, record.free_joints, record.detail,
+            record.search_exhausted_budget) == (expected.status, expected.method, expected.structure,
+                                                expected.complete, expected.free_joints, expected.detail,
+                                                expected.search_exhausted_budget)
+    assert record.singularities == expected.singularities
+    assert len(record.solutions) == len(expected.solutions)
+    for mine, theirs in zip(record.solutions, expected.solutions):
+        assert np.array_equal(mine.joints, theirs.joints)
+        assert (mine.branch, mine.position_residual, mine.orientation_residual) == \
+            (theirs.branch, theirs.position_residual, theirs.orientation_residual)
+
+
+def _check(robot, poses: np.ndarray) -> int:
+    """Compare every pose; return how many took the closed form's own record (status ok, analytic, complete)."""
+    own = 0
+    for T in poses:
+        record = solve_ik(robot, T)
+        _assert_same(record, _answered(robot, T))
+        own += record.status == "ok" and record.method == "analytic" and record.complete
+    return own
+
+
+@pytest.mark.parametrize("robot_id", CATALOGUE_IDS)
+def test_solve_ik_is_the_answers_record_on_the_catalogue(robot_id):
+    robot = _CATALOGUE.get(robot_id).robot
+    poses = _poses(robot, 24, seed=len(robot_id))
+    own = _check(robot, poses)
+    if robot.dof <= 6 and robot_id.startswith(("puma", "ur5", "kuka_kr6")):
+        assert own >= len(poses) // 2  # the shortcut is taken on these arms: the comparison is not vacuous
+
+
+@pytest.mark.parametrize("family", ["intersecting_shoulder+spherical_wrist",
+                                    "offset_shoulder_parallel_elbow+spherical_wrist", "three_parallel"])
+@pytest.mark.parametrize("convention", ["standard", "modified", "khalil"])
+def test_solve_ik_is_the_answers_record_on_random_arms(family, convention):
+    for seed in range(3):
+        robot = random_family_arm(family, convention, seed, wrist_singular=seed == 2)
+        assert _check(robot, _poses(robot, 12, seed)) > 0
+
+
+@pytest.mark.parametrize("case", ["skew_wrist_234", "at_end_456_with_1_2_intersecting", "at_base_123_with_5_6_intersecting"])
+def test_solve_ik_is_the_answers_record_on_other_three_parallel_arms(case):
+    robot = random_three_parallel_arm(case, "standard", 7)
+    _check(robot, _poses(robot, 12, 3))
+
+
+def test_records_of_a_batch_are_each_targets_record():
+    robot = _CATALOGUE.get("puma560_standard").robot
+    poses = _poses(robot, 30, 11)
+    answer = answer_ik(robot, IKTargets.poses(poses), AnswerOptions(limits=unlimited(robot), filter_limits=False))
+    every = results_of(answer)
+    assert len(every) == len(poses)
+    for row, record in enumerate(every):
+        _assert_same(record, result_of(answer, row))
+    for record, batch_record in zip(every, solve_ik_batch(robot, poses)):
+        _assert_same(record, batch_record)
+    assert {record.status for record in every} == {"ok", "unreachable"}

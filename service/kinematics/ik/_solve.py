@@ -12,7 +12,7 @@ reference, the solutions come nearest first (wrap-aware, the largest single join
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -74,9 +74,9 @@ def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) ->
     if not (verified.complete[0] and verified.count[0]):
         return None
     table = verified.table
-    listed = replace(table, joints=table.joints + 0.0)  # as the selection lists them, q + 2π·0 (−0.0 is 0.0)
     report = SolverReport("analytic", plan.structure, True, False, tuple(plan.free_joints))
-    return _result(_solutions(listed), "ok", report, verified.singularities[0], None)
+    # the joints as the selection lists them, q + 2π·0 (a −0.0 becomes 0.0)
+    return _result(_solutions(table, table.joints + 0.0), "ok", report, verified.singularities[0], None)
 
 
 def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,
@@ -109,10 +109,12 @@ def result_of(answer: IKAnswer, row: int) -> IKResult:
                    [answer.singularity_reports[i] for i in answer.singularities[row]], answer.detail[row])
 
 
-def _solutions(table: SolutionTable) -> list[Solution]:
-    """Every row of a table as a :class:`Solution`, in table order (joints as row views of the table)."""
+def _solutions(table: SolutionTable, joints: np.ndarray | None = None) -> list[Solution]:
+    """Every row of a table as a :class:`Solution`, in table order, its joints a row view of the table's (or of
+    ``joints`` (S, n), the same rows' values as listed)."""
     return [Solution(q, branch, position, orientation) for q, branch, position, orientation in
-            zip(table.joints, table.branches(), table.position.tolist(), table.orientation.tolist())]
+            zip(table.joints if joints is None else joints, table.branches(), table.position.tolist(),
+                table.orientation.tolist())]
 
 
 def _result(solutions: list[Solution], status: str, solver: SolverReport, singularities: list, detail: str | None

@@ -18,6 +18,10 @@ from ..collision import Contacts
 from ._types import LabelCodes
 
 
+#: Up to this many rows, :meth:`SolutionTable.branches` keys the rows by their codes in Python.
+_FEW_ROWS = 64
+
+
 @dataclass(frozen=True)
 class SolutionTable:
     """Solutions of many targets, one row each, grouped by target in output order.
@@ -124,12 +128,16 @@ class SolutionTable:
             empty: dict = {}
             return [empty] * len(self.target)
         names = list(self.labels)
-        codes = np.stack([self.labels[name][1] for name in names], axis=1).astype(np.int64) + 1  # (S, L), 0 = none
-        keys = (codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)).tolist()
-        shared = {}
-        for key in dict.fromkeys(keys):  # the distinct branches, each worded from its first row
-            first = codes[keys.index(key)].tolist()
-            shared[key] = {name: self.labels[name][0][code - 1] for name, code in zip(names, first) if code}
+        columns = [self.labels[name][1] for name in names]
+        if len(self.target) <= _FEW_ROWS:  # each row's codes as its key (numpy's fixed cost would dominate)
+            keys = list(zip(*(column.tolist() for column in columns)))
+            codes_of = dict(zip(keys, keys))
+        else:  # each row's codes as one integer, the distinct ones worded from their first rows
+            codes = np.stack(columns, axis=1).astype(np.int64) + 1  # (S, L), 0 = none
+            keys = (codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)).tolist()
+            codes_of = {key: (codes[keys.index(key)] - 1).tolist() for key in dict.fromkeys(keys)}
+        shared = {key: {name: self.labels[name][0][code] for name, code in zip(names, row) if code >= 0}
+                  for key, row in codes_of.items()}
         return list(map(shared.__getitem__, keys))
 
     def bounds(self, n_targets: int) -> tuple[np.ndarray, np.ndarray]:

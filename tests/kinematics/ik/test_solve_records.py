@@ -95,3 +95,19 @@ def test_records_of_a_batch_are_each_targets_record():
     for record, batch_record in zip(every, solve_ik_batch(robot, poses)):
         _assert_same(record, batch_record)
     assert {record.status for record in every} == {"ok", "unreachable"}
+
+
+@pytest.mark.parametrize("rows", [1, 7, 64, 65, 500])
+def test_branches_word_each_rows_labels_on_both_sides_of_the_few_rows_path(rows):
+    """SolutionTable.branches keys a few rows by their code tuples and many by one integer: either way each row's
+    dict names exactly its labels whose code is not −1."""
+    from service.kinematics.ik._table import SolutionTable
+    rng = np.random.default_rng(rows)
+    labels = {name: (values, rng.integers(-1, len(values), rows).astype(np.int8))
+              for name, values in (("shoulder", ("left", "right")), ("elbow", ("up", "down")),
+                                   ("assembly_mode", (1, 2, 3)))}
+    table = SolutionTable(np.zeros(rows, dtype=np.int64), np.zeros((rows, 6)), np.ones(rows, dtype=bool),
+                          np.zeros(rows), np.zeros(rows), labels)
+    expected = [{name: values[codes[k]] for name, (values, codes) in labels.items() if codes[k] >= 0}
+                for k in range(rows)]
+    assert table.branches() == expected

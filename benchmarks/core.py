@@ -176,7 +176,7 @@ def bench_robot(report: Report, label: str, robot: Robot, args: argparse.Namespa
             fk_single[name] = (lambda f: lambda: [f(q) for q in q_single])(lib.fk_single)
         if lib.fk_batch is not None:
             fk_batch[name] = (lambda f: lambda: f(q_batch))(lib.fk_batch)
-    for task, tasks, count in ((f"FK, single configuration", fk_single, len(q_single)),
+    for task, tasks, count in (("FK, single configuration", fk_single, len(q_single)),
                                (f"FK, batch of {args.batch:,}", fk_batch, len(q_batch))):
         for name, seconds in best_of(tasks, args.repeats).items():
             report.rows.append(Row(label, task, name, seconds / count))

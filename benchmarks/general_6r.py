@@ -215,7 +215,7 @@ def main(argv: list[str] | None = None) -> int:
     print()
     for note in notes:
         print(f"- {note}")
-    print(f"- goal: general 6R median ≤ 1 ms per pose single (this run: see the core rows)")
+    print("- goal: general 6R median ≤ 1 ms per pose single (this run: see the core rows)")
     return 0
 
 

@@ -149,7 +149,7 @@ def _roll_family_rows(rng: np.random.Generator, poses: int) -> None:
             times, answers = _timed(call, poses)
             recall = (np.mean([_recovered(a.joints[0, :1], q[i]) for i, a in enumerate(answers)])
                       if with_reference else float("nan"))
-            print(_row(label, f"position + direction, 36 rolls" + (", the generating vector as reference"
+            print(_row(label, "position + direction, 36 rolls" + (", the generating vector as reference"
                                                                    if with_reference else ""),
                        times, float(np.mean([a.count[0] for a in answers])), float(recall)))
 

@@ -35,6 +35,20 @@ def random_configurations(robot, count: int, seed: int) -> np.ndarray:
     return q
 
 
+def mixed_poses(robot, count: int, seed: int) -> np.ndarray:
+    """Random reachable poses, poses at singular configurations (joints snapped to 0 or ±π/2) and poses
+    moved out of reach."""
+    rng = np.random.default_rng(seed)
+    q = random_configurations(robot, count, seed)
+    snapped = q[: count // 4].copy()
+    snap = rng.random(snapped.shape) < 0.3
+    snapped[snap] = rng.choice([0.0, np.pi / 2, -np.pi / 2, np.pi], snap.sum())
+    T = forward_kinematics(robot, np.concatenate([q, snapped]))
+    far = T[: count // 10].copy()
+    far[:, :3, 3] *= rng.uniform(1.5, 3.0, (len(far), 1))
+    return np.concatenate([T, far])
+
+
 def unlimited(robot) -> list[None]:
     """A ``limits`` override with no limits at all: the mathematical solution set, no 2π expansion."""
     return [None] * robot.dof

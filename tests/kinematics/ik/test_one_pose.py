@@ -14,7 +14,7 @@ from service.kinematics.ik._goals import PoseGoal
 from service.kinematics.ik._verify import accepted, residual_arrays
 
 from tests.arms import random_family_arm
-from tests.ik_helpers import random_configurations
+from tests.ik_helpers import mixed_poses, random_configurations
 
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 _PLANS = {entry.description.id: (entry.robot, cached_plan(entry.robot, constrain_orientation=True, reference=None))
@@ -22,20 +22,6 @@ _PLANS = {entry.description.id: (entry.robot, cached_plan(entry.robot, constrain
 # Robots without an analytic plan (the 7-joint arms: numeric fallback) have no scalar path either.
 ONE_POSE_ROBOTS = sorted(robot_id for robot_id, (robot, plan) in _PLANS.items() if hasattr(plan, "solve_one")
                          and plan.solve_one(forward_kinematics(robot, np.full(robot.dof, 0.3))) is not None)
-
-
-def _poses(robot, count: int, seed: int) -> np.ndarray:
-    """Random reachable poses, poses at singular configurations (joints snapped to 0 or ±π/2) and poses
-    moved out of reach."""
-    rng = np.random.default_rng(seed)
-    q = random_configurations(robot, count, seed)
-    snapped = q[: count // 4].copy()
-    snap = rng.random(snapped.shape) < 0.3
-    snapped[snap] = rng.choice([0.0, np.pi / 2, -np.pi / 2, np.pi], snap.sum())
-    T = forward_kinematics(robot, np.concatenate([q, snapped]))
-    far = T[: count // 10].copy()
-    far[:, :3, 3] *= rng.uniform(1.5, 3.0, (len(far), 1))
-    return np.concatenate([T, far])
 
 
 def test_the_hot_families_are_covered():
@@ -53,7 +39,7 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
     robot = _CATALOGUE.get(robot_id).robot
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     answered = labelled = 0
-    for T in _poses(robot, 400, seed=11):
+    for T in mixed_poses(robot, 400, seed=11):
         one_pose = plan.solve_one(T)
         if one_pose is None:
             continue
@@ -87,7 +73,7 @@ def test_single_pose_answers_do_not_depend_on_the_path(robot_id, monkeypatch):
     nearest first with one (two solutions at the same distance, e.g. sharing the joint that moves most, may
     swap: the paths' last bits differ)."""
     robot = _CATALOGUE.get(robot_id).robot
-    poses = _poses(robot, 200, seed=12)
+    poses = mixed_poses(robot, 200, seed=12)
     references = [None, random_configurations(robot, 1, seed=13)[0]]
     one_pose = [solve_ik(robot, T, reference=references[i % 2]) for i, T in enumerate(poses)]
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
@@ -142,7 +128,7 @@ def test_the_float_check_of_one_pose_is_verify(robot_id):
     gives the array path's rows and labels. The slots come wrapped, as verify would wrap them."""
     robot = _CATALOGUE.get(robot_id).robot
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
-    exact, against_arrays = _float_check_against_verify(robot, plan, _poses(robot, 200, seed=15),
+    exact, against_arrays = _float_check_against_verify(robot, plan, mixed_poses(robot, 200, seed=15),
                                                         [None, random_configurations(robot, 1, seed=14)[0]])
     assert exact >= 150
 

@@ -6,29 +6,14 @@ import numpy as np
 import pytest
 
 from service.config import Settings
-from service.kinematics import forward_kinematics
 from service.kinematics.ik import (AnswerOptions, IKResult, IKTargets, answer_ik, result_of, results_of, solve_ik,
                                    solve_ik_batch, unlimited)
 from service.robots.catalogue import load_catalogue
 from tests.arms import random_family_arm, random_three_parallel_arm
-from tests.ik_helpers import random_configurations
+from tests.ik_helpers import mixed_poses
 
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 CATALOGUE_IDS = sorted(entry.description.id for entry in _CATALOGUE.entries())
-
-
-def _poses(robot, count: int, seed: int) -> np.ndarray:
-    """Reachable poses, poses at configurations snapped to 0 and ±π/2 (singular ones among them), and poses
-    moved out of reach."""
-    rng = np.random.default_rng(seed)
-    q = random_configurations(robot, count, seed)
-    snapped = q[: count // 3].copy()
-    snap = rng.random(snapped.shape) < 0.4
-    snapped[snap] = rng.choice([0.0, np.pi / 2, -np.pi / 2], snap.sum())
-    T = forward_kinematics(robot, np.concatenate([q, snapped]))
-    far = T[: count // 6].copy()
-    far[:, :3, 3] *= 3.0
-    return np.concatenate([T, far])
 
 
 def _answered(robot, T: np.ndarray) -> IKResult:
@@ -63,7 +48,7 @@ def _check(robot, poses: np.ndarray) -> int:
 @pytest.mark.parametrize("robot_id", CATALOGUE_IDS)
 def test_solve_ik_is_the_answers_record_on_the_catalogue(robot_id):
     robot = _CATALOGUE.get(robot_id).robot
-    poses = _poses(robot, 24, seed=len(robot_id))
+    poses = mixed_poses(robot, 24, seed=len(robot_id))
     own = _check(robot, poses)
     if robot.dof <= 6 and robot_id.startswith(("puma", "ur5", "kuka_kr6")):
         assert own >= len(poses) // 2  # the shortcut is taken on these arms: the comparison is not vacuous
@@ -75,18 +60,18 @@ def test_solve_ik_is_the_answers_record_on_the_catalogue(robot_id):
 def test_solve_ik_is_the_answers_record_on_random_arms(family, convention):
     for seed in range(3):
         robot = random_family_arm(family, convention, seed, wrist_singular=seed == 2)
-        assert _check(robot, _poses(robot, 12, seed)) > 0
+        assert _check(robot, mixed_poses(robot, 12, seed)) > 0
 
 
 @pytest.mark.parametrize("case", ["skew_wrist_234", "at_end_456_with_1_2_intersecting", "at_base_123_with_5_6_intersecting"])
 def test_solve_ik_is_the_answers_record_on_other_three_parallel_arms(case):
     robot = random_three_parallel_arm(case, "standard", 7)
-    _check(robot, _poses(robot, 12, 3))
+    _check(robot, mixed_poses(robot, 12, 3))
 
 
 def test_records_of_a_batch_are_each_targets_record():
     robot = _CATALOGUE.get("puma560_standard").robot
-    poses = _poses(robot, 30, 11)
+    poses = mixed_poses(robot, 30, 11)
     answer = answer_ik(robot, IKTargets.poses(poses), AnswerOptions(limits=unlimited(robot), filter_limits=False))
     every = results_of(answer)
     assert len(every) == len(poses)

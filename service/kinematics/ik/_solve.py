@@ -71,9 +71,9 @@ def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) ->
     if plan is None:
         return None
     verified = solve_closed_form(robot, plan, PoseGoal(target[None]), None, budget=options.budget)
-    if not (verified.complete[0] and verified.count[0]):
-        return None
     table = verified.table
+    if not (verified.complete[0] and len(table)):  # one target: its rows are the table's
+        return None
     report = SolverReport("analytic", plan.structure, True, False, tuple(plan.free_joints))
     # the joints as the selection lists them, q + 2π·0 (a −0.0 becomes 0.0)
     return _result(_solutions(table, table.joints + 0.0), "ok", report, verified.singularities[0], None)

@@ -362,10 +362,13 @@ def promised(candidates: Candidates, count: np.ndarray, nearest: np.ndarray, con
 
     Those rows go to the fallback."""
     complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
-    narrow = (count == 0) & (nearest <= POLISH_RESIDUAL)
+    empty = count == 0
+    if not empty.any():  # both exceptions are about rows without a solution
+        return complete
+    narrow = empty & (nearest <= POLISH_RESIDUAL)
     for mask, flag in candidates.singularities.entries:
         if flag.relation in FRAGILE_RELATIONS:
             complete &= ~(mask & narrow)
         if constrain_orientation and flag.relation == "free":
-            complete &= ~(mask & (count == 0) & candidates.valid.any(axis=1))
+            complete &= ~(mask & empty & candidates.valid.any(axis=1))
     return complete

@@ -76,7 +76,8 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
             if roll is not None:
                 solution["free_values"]["roll"] = roll
     if table.clearance is not None:
-        for solution, clearance, contacts in zip((s for rows in per_target for s in rows), _clearances(table),
+        clearance_values = [None if math.isinf(value) else value for value in table.clearance.tolist()]
+        for solution, clearance, contacts in zip((s for rows in per_target for s in rows), clearance_values,
                                                  _contacts(table)):
             solution["clearance"], solution["collisions"] = clearance, contacts
     return per_target
@@ -88,7 +89,7 @@ def _rolls(table: SolutionTable, angle: float) -> list[float | None]:
 
 
 def _clearances(table: SolutionTable) -> np.ndarray | list[float | None]:
-    """Each row's clearance; null where no pair was checked (+inf)."""
+    """The clearance column of the arrays form; null where no pair was checked (+inf)."""
     return _nulled(table.clearance, np.isinf(table.clearance))
 
 

@@ -261,7 +261,8 @@ def _program(start: tuple[float, ...], operations: list[tuple[int, int, object]]
 
 class JointTrig:
     """cos and sin of each joint column of q (..., n), each computed once, when first asked for: the FK check and
-    a family's branch labels turn the same joints, the labels several times. ``trig[i]`` is (cos q_i, sin q_i)."""
+    a family's branch labels turn the same joints, the labels several times. ``trig[i]`` is (cos q_i, sin q_i).
+    A float array ``q`` is kept as it is (not copied): :meth:`renew` re-reads the rows the caller changed in it."""
 
     def __init__(self, q: np.ndarray) -> None:
         self.q = np.asarray(q, dtype=float)

@@ -188,7 +188,7 @@ def _one_turn_each(q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
     instead of the quotients, for the usual batch under limits of about one turn."""
     inside_low = np.maximum(lower, upper - _TWO_PI + _INTERIOR_MARGIN)
     inside_high = np.minimum(upper, lower + _TWO_PI - _INTERIOR_MARGIN)
-    return bool(np.all(inside_low < inside_high)) and bool(((q > inside_low) & (q < inside_high)).all())
+    return bool(((q > inside_low) & (q < inside_high)).all())  # an empty interval fails every value
 
 
 def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray,

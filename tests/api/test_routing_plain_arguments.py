@@ -28,7 +28,7 @@ def _client(monkeypatch: pytest.MonkeyPatch | None = None) -> TestClient:
     (FastAPI's handler answers everything, as before they existed)."""
     if monkeypatch is not None:
         monkeypatch.setattr(routing._PlainArguments, "of", classmethod(lambda cls, route: None))
-    return TestClient(create_app(Settings(log_level="warning")))
+    return TestClient(create_app(Settings(_env_file=None, log_level="warning")))
 
 
 @pytest.fixture()

@@ -15,7 +15,7 @@ centre, a box's centre and its three axes), each a homogeneous point or directio
 world. One matrix product per link maps that link's rows to the world for a block of configurations; the pairs
 then fall into groups by the kernel that measures them: box–box, round–point, box–point, round–round and
 box–round (a point is a sphere or a capsule of length 0, a round shape any other capsule), each with the pairs of
-a base shape and an obstacle first (they do not move). Each group gathers its rows and runs one vectorised kernel
+a base shape and an obstacle first (they do not move while the base frame stays put). Each group gathers its rows and runs one vectorised kernel
 over the block. Configurations go through in blocks of a few thousand pair evaluations, so that the temporaries
 stay in cache.
 """
@@ -88,7 +88,7 @@ class _Group(NamedTuple):
     swapped: np.ndarray  # (P_k,) bool
     bounds: Callable | None  # the kernel's cheap bounds (None: none, every pair is measured)
     bound_constants: tuple  # the bounds' sizes, single precision (see the bound functions), (..., P_k, 1) each
-    fixed: int  # the first pairs, of a base shape and an obstacle: the same wherever the base frame is
+    fixed: int  # the first pairs, a base shape's with the obstacles: the same wherever the base frame is the same
 
     def sizes(self) -> tuple:
         """The kernel's four sizes."""
@@ -347,6 +347,7 @@ class CollisionModel:
                  if group.bounds is None and group.fixed < len(group.rows)]
             bounded = [group.part(group.fixed, len(group.rows)) for group in self._groups
                        if group.bounds is not None and group.fixed < len(group.rows)]
+        fixed_only = any(group.fixed == len(group.rows) for group in measured)  # groups measured once if still
         for begin in range(0, count, block):
             with _quiet():  # per block: the caller's code between blocks keeps its own floating-point state
                 end = min(begin + block, count)
@@ -355,7 +356,7 @@ class CollisionModel:
                     frames = np.ascontiguousarray(frames)  # row each, so that einsum runs on unit strides
                 placed = self._world_rows(frames, world[:, :, : end - begin])
                 block_result = result[begin:end]
-                base_still = bool(bounded) and bool((frames[0] == frames[0][..., :1]).all())
+                base_still = fixed_only and bool((frames[0] == frames[0][..., :1]).all())
                 for group in measured:
                     _measure(block_result[:, group.start:group.stop], group, world, None, None, 0.0,
                              once=base_still and group.fixed == len(group.rows))
@@ -425,8 +426,8 @@ def _box_box_kernel(rows, half_size_a, half_size_b, radius_a, radius_b, *, witne
     return _box_box(rows[:, :4], half_size_a, rows[:, 4:8], half_size_b, witness)
 
 
-#: The kernel of each pair of families, in the order of the columns: first those measured in full (no bounds,
-#: :data:`._bounds.FAMILY_BOUNDS`).
+#: The kernel of each pair of families, in the order of the columns: box–box first (it has no bounds in
+#: :data:`._bounds.FAMILY_BOUNDS`, so it is always measured in full).
 _KERNELS = {("box", "box"): _box_box_kernel, ("round", "point"): _round_point, ("box", "point"): _box_point_kernel,
             ("round", "round"): _round_round, ("box", "round"): _box_round}
 

@@ -236,7 +236,7 @@ class IdealisedPlan(Sealed):
         that stays on one branch of the true arm would see it flip (issue 22.11, a Doosan M1013 written with
         1.571 for π/2)."""
         joints = np.asarray(joints, dtype=float)
-        codes = self.inner.label_codes(joints)
+        codes = self.inner.label_codes(joints, trig)
         if not codes or not len(joints):
             return codes
         near = np.flatnonzero(self._smallest_singular_value(joints) <= SINGULAR_MARGIN * self.deviation)

@@ -103,16 +103,14 @@ def results_of(answer: IKAnswer) -> list[IKResult]:
 
 def result_of(answer: IKAnswer, row: int) -> IKResult:
     """Target ``row`` of an answer as an :class:`IKResult` record (:func:`results_of` of that target alone)."""
-    first, end = np.searchsorted(answer.solutions.target, [row, row + 1])
-    return _result(_solutions(answer.solutions.take(slice(first, end))), str(answer.status[row]),
-                   answer.solvers[int(answer.solver[row])],
-                   [answer.singularity_reports[i] for i in answer.singularities[row]], answer.detail[row])
+    view = answer.target(row)
+    return _result(_solutions(view.solutions), view.status, view.solver, view.singularities, view.detail)
 
 
 def _solutions(table: SolutionTable, joints: np.ndarray | None = None) -> list[Solution]:
     """Every row of a table as a :class:`Solution`, in table order, its joints a row view of the table's (or of
-    ``joints`` (S, n), the same rows' values as listed)."""
-    return [Solution(q, branch, position, orientation) for q, branch, position, orientation in
+    ``joints`` (S, n), the same rows' values as listed) and its branch a dict of its own (the table shares them)."""
+    return [Solution(q, dict(branch), position, orientation) for q, branch, position, orientation in
             zip(table.joints if joints is None else joints, table.branches(), table.position.tolist(),
                 table.orientation.tolist())]
 

@@ -18,8 +18,9 @@ from ..collision import Contacts
 from ._types import LabelCodes
 
 
-#: Up to this many rows, :meth:`SolutionTable.branches` keys the rows by their codes in Python.
-_FEW_ROWS = 64
+#: Up to this many rows, :meth:`SolutionTable.branches` keys the rows by their codes in Python (the two ways
+#: cost about the same at 300 rows).
+_FEW_ROWS = 256
 
 
 @dataclass(frozen=True)
@@ -134,8 +135,10 @@ class SolutionTable:
             codes_of = dict(zip(keys, keys))
         else:  # each row's codes as one integer, the distinct ones worded from their first rows
             codes = np.stack(columns, axis=1).astype(np.int64) + 1  # (S, L), 0 = none
-            keys = (codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)).tolist()
-            codes_of = {key: (codes[keys.index(key)] - 1).tolist() for key in dict.fromkeys(keys)}
+            key_column = codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)
+            distinct, first = np.unique(key_column, return_index=True)
+            keys = key_column.tolist()
+            codes_of = dict(zip(distinct.tolist(), (codes[first] - 1).tolist()))
         shared = {key: {name: self.labels[name][0][code] for name, code in zip(names, row) if code >= 0}
                   for key, row in codes_of.items()}
         return list(map(shared.__getitem__, keys))

@@ -218,6 +218,8 @@ def test_points_and_base_shapes_through_link_frames(base):
     margin = 0.01
     check = model.check(frames, margin)
     np.testing.assert_array_equal(check.clearance, distances.min(axis=1))
+    # the base's pairs with the obstacles are measured in full, once per block while the base stays put
+    np.testing.assert_array_equal(check.pair_distances[:, fixed], distances[:, fixed])
     assert (check.pair_distances != distances).any()  # the bounds left some pairs unmeasured
     assert 0 < check.colliding.mean() < 1
     for s in range(0, len(frames), 11):

@@ -4,9 +4,8 @@ from __future__ import annotations
 
 import gc
 import logging
-import threading
-from contextlib import asynccontextmanager, contextmanager
-from typing import AsyncIterator, Iterator
+from contextlib import asynccontextmanager
+from typing import AsyncIterator
 
 from typing import Any
 
@@ -71,36 +70,6 @@ def _tune_collector() -> None:
     gc.set_threshold(*COLLECTOR_THRESHOLDS)
 
 
-class _CollectorTuning:
-    """:func:`_tune_collector` for the applications running in this process: done when the first starts, undone
-    when the last stops. Undone earlier, an application started and stopped inside another's lifespan (tests)
-    would unfreeze the other's start-up objects and restore the default thresholds under it."""
-
-    def __init__(self) -> None:
-        self._lock = threading.Lock()
-        self._running = 0
-        self._thresholds = gc.get_threshold()
-
-    @contextmanager
-    def tuned(self) -> Iterator[None]:
-        with self._lock:
-            if self._running == 0:
-                self._thresholds = gc.get_threshold()
-            _tune_collector()  # this application's start-up objects frozen too
-            self._running += 1
-        try:
-            yield
-        finally:
-            with self._lock:
-                self._running -= 1
-                if self._running == 0:  # an application started again must not pile frozen objects up
-                    gc.unfreeze()
-                    gc.set_threshold(*self._thresholds)
-
-
-_COLLECTOR = _CollectorTuning()
-
-
 def _operation_id(route: APIRoute) -> str:
     """Stable operationIds: the one written on the route, never a generated one."""
     return route.operation_id or route.name
@@ -120,9 +89,12 @@ def create_app(settings: Settings | None = None) -> FastAPI:
                                              max_file_bytes=settings.max_robot_file_bytes)
         logger.info("catalogue loaded: %d robots from %s", len(app.state.catalogue),
                     ", ".join(str(d) for d in directories))
-        with _COLLECTOR.tuned():
-            yield
-            app.state.shutting_down = True  # /readyz: 503 from here on (the catalogue is dropped below)
+        thresholds = gc.get_threshold()
+        _tune_collector()
+        yield
+        app.state.shutting_down = True  # /readyz: 503 from here on (the catalogue is dropped below)
+        gc.unfreeze()  # an application started again in this process (tests) must not pile frozen objects up
+        gc.set_threshold(*thresholds)
         app.state.catalogue = None
 
     app = FastAPI(

@@ -65,7 +65,7 @@ def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) ->
     arm, promises every solution and found some. The answer's selection would then list each solution once, as
     it stands (no limits, no order to impose), and no words: the same record without building the answer. None
     elsewhere (a redundant arm's family, the numeric search's fallback, an unreachable pose's detail)."""
-    if answered_by_family(robot, AnswerOptions()):
+    if answered_by_family(robot, _DEFAULT_ANSWER):
         return None
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     if plan is None:
@@ -77,6 +77,10 @@ def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) ->
     report = SolverReport("analytic", plan.structure, True, False, tuple(plan.free_joints))
     # the joints as the selection lists them, q + 2π·0 (a −0.0 becomes 0.0)
     return _result(_solutions(table, table.joints + 0.0), "ok", report, verified.singularities[0], None)
+
+
+#: The answer's options where the caller gives none (frozen, so shared).
+_DEFAULT_ANSWER = AnswerOptions()
 
 
 def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,

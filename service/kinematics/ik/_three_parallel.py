@@ -39,7 +39,7 @@ from .._rotations import wrap_angle, wrap_any_float
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
 from .._forward import JointTrig
-from ._screws import apply, invert, joint_motion, move_point, rotate_about, rotation_about
+from ._screws import apply, invert, joint_motion, move_point, rotate_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
@@ -79,39 +79,39 @@ class _AxesTwoToFourParallel(Sealed):
 
     def _complete(self, A: np.ndarray, q1: np.ndarray, q5: np.ndarray, valid15: np.ndarray,
                   singular: SingularFlags, reference: np.ndarray | None) -> Candidates:
-        """Steps 3–5 from candidate pairs (q1, q5) of shape (N, m): 2m joint vectors per target."""
+        """Steps 3–5 from candidate pairs (q1, q5) of shape (N, m): 2m joint vectors per target.
+
+        Every product of the joints' motions is applied to the few vectors it acts on, as turns about the axes
+        (:func:`rotate_about`, (N, m, 3) each), not built as (N, m, 4, 4) matrices: R_1ᵀ R_A v is
+        R(ω_1, −q_1) (R_A v), and G_5⁻¹ x is R(ω_5, −q_5) (x − p_5) + p_5."""
         g, w_p = self.geometry, self.omega_p
         n, m = q1.shape
-        R1 = joint_motion(g.direction(0), g.point(0), True, q1)  # (N, m, 4, 4)
-        R_rest = np.swapaxes(R1[..., :3, :3], -1, -2) @ A[:, None, :3, :3]  # (N, m, 3, 3)
-        # 3. q6
+        R_A, t_A = A[:, None, :3, :3], A[:, None, :3, 3]  # (N, 1, 3, 3), (N, 1, 3)
+        # 3. q6: R(ω_6, −q_6) R(ω_5, −q_5) ω_p = R_Aᵀ R_1 ω_p
         p = rotate_about(g.direction(4), -q5, w_p)  # (N, m, 3)
-        q = np.einsum("...ji,j->...i", R_rest, w_p)
+        q = np.einsum("...ji,...j->...i", R_A, rotate_about(g.direction(0), q1, w_p))
         sixth = subproblem_1(g.direction(5), p, q)
         q6 = -sixth.theta[..., 0]
         free_six = sixth.degenerate
-        G5 = joint_motion(g.direction(4), g.point(4), True, q5)
         unrepresented = np.zeros(n, dtype=bool)
         if free_six.any():
             q6 = np.where(free_six, 0.0 if reference is None else reference[5], q6)
-            q6, other_arc = self._reachable_sixth(A, R1, G5, q6, free_six)
+            q6, other_arc = self._reachable_sixth(A, q1, q5, q6, free_six)
             if np.isfinite(other_arc).any():
                 q1, q5, q6, valid15, free_six, unrepresented = _second_arc_slots(
                     q1, q5, q6, valid15, free_six, other_arc)
-                R1 = joint_motion(g.direction(0), g.point(0), True, q1)
-                R_rest = np.swapaxes(R1[..., :3, :3], -1, -2) @ A[:, None, :3, :3]
-                G5 = joint_motion(g.direction(4), g.point(4), True, q5)
-        # 4. R_234 about ω_p: the signed sum
-        G6 = joint_motion(g.direction(5), g.point(5), True, q6)
-        R5, R6 = G5[..., :3, :3], G6[..., :3, :3]
-        R234 = R_rest @ np.swapaxes(R6, -1, -2) @ np.swapaxes(R5, -1, -2)
-        angle_sum = subproblem_1(w_p, self.normal_p, R234 @ self.normal_p).theta[..., 0]  # (N, m)
-        # 5. point on axis 4 through joints 2 and 3
-        # G_1 G_2 G_3 p_4 = A G_6⁻¹ G_5⁻¹ p_4 (G_4 leaves p_4 where it is)
-        y = apply(invert(G5), g.point(3))
-        y = apply(invert(G6), y)
-        p4_world = apply(A[:, None], y)
-        z = apply(invert(R1), p4_world)  # (N, m, 3)
+        # 4. R_234 = R_1ᵀ R_A R_6ᵀ R_5ᵀ about ω_p: the signed sum, from where it turns the normal n_p; and
+        # 5. the point on axis 4 through joints 2 and 3: G_1 G_2 G_3 p_4 = A G_6⁻¹ G_5⁻¹ p_4 (G_4 leaves p_4 where
+        # it is). Both undo joint 5, then joint 6, then the target, then joint 1.
+        undone_5 = rotate_about(g.direction(4), -q5[..., None], np.stack([self.normal_p, g.point(3) - g.point(4)]))
+        undone_5[..., 1, :] += g.point(4) - g.point(5)
+        undone_6 = rotate_about(g.direction(5), -q6[..., None], undone_5)  # (N, m, 2, 3)
+        undone_6[..., 1, :] += g.point(5)
+        in_world = np.einsum("...ij,...kj->...ki", R_A, undone_6)
+        in_world[..., 1, :] += t_A - g.point(0)
+        undone_1 = rotate_about(g.direction(0), -q1[..., None], in_world)
+        angle_sum = subproblem_1(w_p, self.normal_p, undone_1[..., 0, :]).theta[..., 0]  # (N, m)
+        z = undone_1[..., 1, :] + g.point(0)  # (N, m, 3)
         elbow = subproblem_3(g.direction(2), g.point(3) - g.point(2), g.point(1) - g.point(2),
                              np.linalg.norm(z - g.point(1), axis=-1))
         q3 = elbow.theta  # (N, m, 2)
@@ -153,7 +153,7 @@ class _AxesTwoToFourParallel(Sealed):
         return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), singular,
                           complete=~unpromised if unpromised.any() else None)
 
-    def _reachable_sixth(self, A: np.ndarray, R1: np.ndarray, G5: np.ndarray, q6: np.ndarray,
+    def _reachable_sixth(self, A: np.ndarray, q1: np.ndarray, q5: np.ndarray, q6: np.ndarray,
                          free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """q6 where axis 6 lies along the parallel axes (``free``, (N, m)): the orientation leaves it free, the
         position does not. Turning about axis 6 carries the point on axis 4 round axis 6 (the two are apart), so
@@ -168,6 +168,8 @@ class _AxesTwoToFourParallel(Sealed):
         values lie one on each arc. Returns q6 (N, m) and a value on the other arc than q6's (N, m), NaN where
         the reachable values are one arc (or none)."""
         g = self.geometry
+        R1 = joint_motion(g.direction(0), g.point(0), True, q1)  # (N, m, 4, 4): a rare path
+        G5 = joint_motion(g.direction(4), g.point(4), True, q5)
         # the distance step 5 asks of the elbow is |R(ω_6, −q6) u − w|, u and w from a point on axis 6
         u = apply(invert(G5), g.point(3)) - g.point(5)  # (N, m, 3)
         w = apply(invert(A)[:, None], apply(R1, g.point(1))) - g.point(5)
@@ -251,12 +253,11 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
         q1 = -shoulder.theta  # (N, 2)
         if reference is not None:  # the centre on axis 1: any q1 puts it there, so q1 takes the reference value
             q1 = np.where(shoulder.degenerate[..., None], reference[0], q1)
-        R1 = rotation_about(g.direction(0), q1)  # (N, 2, 3, 3)
-        R_rest = np.swapaxes(R1, -1, -2) @ A[:, None, :3, :3]  # (N, 2, 3, 3)
-        # 2. wrist: two roots for q5. R_rest ω_6 = R_234 R(ω_5, q5) ω_6 with R_234 a turn about ω_p: subproblem 2
-        # on the whole vector, not subproblem 4 on its height ω_p·R_rest ω_6, which near the wrist singularity
+        # 2. wrist: two roots for q5. R_1ᵀ R_A ω_6 = R_234 R(ω_5, q5) ω_6 with R_234 a turn about ω_p: subproblem 2
+        # on the whole vector, not subproblem 4 on its height ω_p·R_1ᵀ R_A ω_6, which near the wrist singularity
         # (height cos q5) holds q5 only to second order and merged ±q5 below 5e-7 into q5 = 0.
-        wrist = subproblem_2(w_p, g.direction(4), R_rest @ g.direction(5), g.direction(5))
+        sixth_in_arm = rotate_about(g.direction(0), -q1, (A[:, :3, :3] @ g.direction(5))[:, None, :])  # (N, 2, 3)
+        wrist = subproblem_2(w_p, g.direction(4), sixth_in_arm, g.direction(5))
         _flag_rows(shoulder.degenerate, Singularity("shoulder", (0,), "free",
                                                     "the wrist point is on the first axis; joint 1 is free, set to the reference value (or 0)"), singular)
         _flag_rows(shoulder.merged, Singularity("shoulder", (0,), "boundary",

@@ -20,10 +20,10 @@ from .._tolerances import GEOMETRY_TOLERANCE
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
 from .._forward import JointTrig
-from ._screws import apply, chain_rotation, invert, rotation_about
+from ._screws import apply, chain_rotation, invert, rotation_about, unturned
 from .subproblems import subproblem_1
 from ._types import Candidates, LabelCodes, SingularFlags, Sealed
-from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, _perpendicular_unit
+from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, _perpendicular_unit, seen_by
 
 
 class DecoupledPlan(Sealed):
@@ -81,13 +81,12 @@ class DecoupledPlan(Sealed):
             arm_joints = joints[..., :k]
         if self.wrist is None:
             return Candidates(joints, arm_valid, singular)
-        # the wrist's rotation: H = G⁻¹ · world_T_target · home⁻¹, of which only the rotation is needed
+        # the wrist's rotation R_H = R_Gᵀ · R_target (G the positioning joints' motion), applied to the vectors
+        # the wrist reads: R_target's images turned back through the positioning joints
+        seen = seen_by(self.wrist, R_target)[:, None]  # (N, 1, j, 3)
         if self.positioner is not None:
-            R_G = chain_rotation(model.directions[:k], model.is_revolute[:k], np.nan_to_num(arm_joints))
-            R_H = np.swapaxes(R_G, -1, -2) @ R_target[:, None]
-        else:
-            R_H = R_target[:, None]
-        wrist = self.wrist.solve(R_H.reshape(-1, 3, 3), reference)
+            seen = unturned(model.directions[:k], model.is_revolute[:k], np.nan_to_num(arm_joints), seen)
+        wrist = self.wrist.solve(seen.reshape((-1,) + seen.shape[-2:]), reference)
         m_wrist = wrist.joints.shape[1]
         wrist_joints = wrist.joints.reshape(n_targets, m_arm, m_wrist, -1)
         wrist_valid = wrist.valid.reshape(n_targets, m_arm, m_wrist)

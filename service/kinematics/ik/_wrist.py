@@ -6,6 +6,9 @@ joints' motion already removed), these solve
 ``R(ω_a, q_a) R(ω_b, q_b) = R_w`` (two axes meeting: an arm with one joint fewer than six, such as
 one with two coaxial joints) or ``R(ω, q) = R_w`` (a final roll). Axes are the home axes of the screw
 model.
+
+A wrist reads ``R_w`` only through the few home vectors it turns (:attr:`reads`, (k, 3)): its ``solve`` takes
+``R_w`` applied to them (:func:`seen_by`), which the caller can compute without building ``R_w``.
 """
 
 from __future__ import annotations
@@ -22,6 +25,12 @@ from ._screws import rotate_about
 from ._structure import Geometry, idealised
 from .subproblems import subproblem_1, subproblem_2_chain
 from ._types import LabelCodes, SingularFlags, Singularity, Sealed
+
+
+def seen_by(wrist, R_w: np.ndarray) -> np.ndarray:
+    """``R_w`` (..., 3, 3) applied to each of the wrist's :attr:`reads` vectors: what its ``solve`` takes,
+    shape (..., k, 3)."""
+    return np.einsum("...ij,kj->...ki", R_w, wrist.reads)
 
 
 @dataclass
@@ -92,10 +101,12 @@ class SphericalWrist(Sealed):
         self.joints = joints
         self.axes = [geometry.direction(j) for j in joints]
         self.normal = _perpendicular_unit(self.axes[2])
+        self.reads = np.stack([self.axes[2], self.normal])  # ω_c and its normal
 
-    def solve(self, R_w: np.ndarray, reference: np.ndarray | None) -> WristResult:
+    def solve(self, seen: np.ndarray, reference: np.ndarray | None) -> WristResult:
+        """The wrist's joints for ``seen`` (N, 2, 3): R_w ω_c and R_w times ω_c's normal (:func:`seen_by`)."""
         a, b, c = self.axes
-        target_axis = R_w @ c  # (..., 3)
+        target_axis = seen[..., 0, :]  # (..., 3)
         pair = subproblem_2_chain(a, b, c, target_axis[..., None, :])
         qa, qb = pair.theta1[..., 0, :], pair.theta2[..., 0, :]  # (..., 2)
         free = pair.degenerate[..., 0] | (np.linalg.norm(np.cross(a, target_axis), axis=-1) <= self.free_below)
@@ -123,11 +134,11 @@ class SphericalWrist(Sealed):
             qa = np.where(moved, held, qa)
             qb = np.where(moved, qb_held[..., None], qb)
         # q_c: R(c, q_c) u = (R_a R_b)^T R_w u
-        wanted = np.einsum("...ij,j->...i", R_w, self.normal)[..., None, :]  # (..., 1, 3)
+        wanted = seen[..., 1:, :]  # (..., 1, 3)
         unwound = rotate_about(b, -qb, rotate_about(a, -qa, wanted))
         qc = subproblem_1(c, self.normal, unwound).theta[..., 0]
         joints = np.stack([qa, qb, qc], axis=-1)
-        singular = SingularFlags(len(R_w))
+        singular = SingularFlags(len(seen))
         if free.any():
             aligned = rotate_about(b, qb[..., 0], c) @ a
             for relation, mask in (("sum", free & (aligned > 0)), ("difference", free & ~(aligned > 0))):
@@ -184,11 +195,12 @@ class Roll:
         self.joints = (joint,)
         self.axis = geometry.direction(joint)
         self.normal = _perpendicular_unit(self.axis)
+        self.reads = self.normal[None]
 
-    def solve(self, R_w: np.ndarray, reference: np.ndarray | None) -> WristResult:
-        wanted = np.einsum("...ij,j->...i", R_w, self.normal)
-        q = subproblem_1(self.axis, self.normal, wanted).theta  # (..., 1)
-        return WristResult(q[..., None], np.ones(q.shape, dtype=bool), SingularFlags(len(R_w)))
+    def solve(self, seen: np.ndarray, reference: np.ndarray | None) -> WristResult:
+        """The roll for ``seen`` (N, 1, 3): R_w times a normal of the axis (:func:`seen_by`)."""
+        q = subproblem_1(self.axis, self.normal, seen[..., 0, :]).theta  # (..., 1)
+        return WristResult(q[..., None], np.ones(q.shape, dtype=bool), SingularFlags(len(seen)))
 
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         return {}
@@ -212,14 +224,16 @@ class TwoAxisWrist(Sealed):
         self.joints = joints
         self.axes = [geometry.direction(j) for j in joints]
         self.normal = _perpendicular_unit(self.axes[1])
+        self.reads = np.stack([self.axes[1], self.normal])  # ω_b and its normal
 
-    def solve(self, R_w: np.ndarray, reference: np.ndarray | None) -> WristResult:
+    def solve(self, seen: np.ndarray, reference: np.ndarray | None) -> WristResult:
+        """The two joints for ``seen`` (N, 2, 3): R_w ω_b and R_w times ω_b's normal (:func:`seen_by`)."""
         a, b = self.axes
-        first = subproblem_1(a, b, np.einsum("...ij,j->...i", R_w, b))  # theta (..., 1)
+        first = subproblem_1(a, b, seen[..., 0, :])  # theta (..., 1)
         qa = first.theta
-        wanted = np.einsum("...ij,j->...i", R_w, self.normal)[..., None, :]  # (..., 1, 3)
+        wanted = seen[..., 1:, :]  # (..., 1, 3)
         qb = subproblem_1(b, self.normal, rotate_about(a, -qa, wanted)).theta[..., 0]
-        return WristResult(np.stack([qa, qb], axis=-1), first.exact.copy(), SingularFlags(len(R_w)))
+        return WristResult(np.stack([qa, qb], axis=-1), first.exact.copy(), SingularFlags(len(seen)))
 
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         return {}

@@ -275,6 +275,12 @@ class JointTrig:
             pair = self._pairs[joint] = (np.cos(angle), np.sin(angle))
         return pair
 
+    def take(self, rows: np.ndarray) -> "JointTrig":
+        """The rows ``rows`` of q (M, n) with the pairs computed so far: a new object, q and pairs copied."""
+        taken = JointTrig(self.q[rows])
+        taken._pairs = {joint: (cos[rows], sin[rows]) for joint, (cos, sin) in self._pairs.items()}
+        return taken
+
     def renew(self, rows: np.ndarray) -> None:
         """Recompute the pairs kept so far at ``rows`` of q (M, n), whose values the caller has changed."""
         for joint, (cos, sin) in self._pairs.items():

@@ -158,11 +158,25 @@ class DecoupledPlan(Sealed):
             joints[rows, :, j] = np.where(held, joints[rows, :, j], q[..., j])
 
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
-        """Branch labels of full joint vectors (M, n) as arrays: the positioner's, then the wrist's."""
+        """Branch labels of full joint vectors (M, n) as arrays: the positioner's, then the wrist's.
+
+        The positioner's labels read its own joints alone, and the wrist's slots of one arm branch share them (the
+        rows come in runs, as :meth:`solve` lays them out): each run is labelled once, from its first row."""
         codes: LabelCodes = {}
-        for part in (self.positioner, self.wrist):
-            if part is not None:
-                codes.update(part.label_codes(joints, trig))
+        if self.positioner is not None:
+            arm = joints[:, list(self.positioner.joints)]
+            first = np.ones(len(joints), dtype=bool)
+            first[1:] = (arm[1:] != arm[:-1]).any(axis=1)  # a NaN differs from itself: its row is labelled alone
+            if first.all():
+                codes.update(self.positioner.label_codes(joints, trig))
+            else:
+                rows = np.flatnonzero(first)
+                run_of = np.cumsum(first) - 1
+                for name, (values, run_codes) in self.positioner.label_codes(
+                        joints[rows], None if trig is None else trig.take(rows)).items():
+                    codes[name] = (values, run_codes[run_of])
+        if self.wrist is not None:
+            codes.update(self.wrist.label_codes(joints, trig))
         return codes
 
     def solve_one(self, world_T_target: np.ndarray) -> scalar.OnePose | None:

@@ -15,6 +15,10 @@ from typing import Any, Callable, Hashable, TypeVar
 
 T = TypeVar("T")
 
+#: Most values a module-level cache keyed by an axis keeps (unit axes, axis frames, cross matrices): a robot's
+#: joint axes are a few constants, and a caller sweeping over many axes keeps no more than this.
+AXES_KEPT = 4096
+
 
 class DerivedStore:
     """Values derived from one robot, built on first use. Two threads asking for the same missing key may both

@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+from .._cache import AXES_KEPT
 from .._forward import JointTrig
 
 
@@ -55,13 +56,12 @@ def axis_frame(k: np.ndarray) -> np.ndarray:
     if frame is None:
         frame = _built_frame(*key)
         frame.setflags(write=False)
-        if len(_FRAMES) < _FRAMES_KEPT:
+        if len(_FRAMES) < AXES_KEPT:
             _FRAMES[key] = frame
     return frame
 
 
 _FRAMES: dict[tuple[float, ...], np.ndarray] = {}
-_FRAMES_KEPT = 4096  # bounded: a caller sweeping over many axes keeps no more than this
 
 
 def _built_frame(kx: float, ky: float, kz: float) -> np.ndarray:
@@ -101,7 +101,7 @@ def _cross_matrices(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pair = (K, K @ K)
         for matrix in pair:
             matrix.setflags(write=False)
-        if len(_CROSS) < 4096:
+        if len(_CROSS) < AXES_KEPT:
             _CROSS[key] = pair
     return pair
 

@@ -16,6 +16,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._cache import AXES_KEPT
 from ..._errors import InvalidInputError
 from ..._forward import cross
 from ..._rotations import wrap_angle, wrap_float
@@ -36,14 +37,13 @@ def _unit(k: ArrayLike, name: str) -> np.ndarray:
     if known is not None:
         return known
     unit = _checked_unit(k, name)
-    if key is not None and len(_UNITS) < _UNITS_KEPT:
+    if key is not None and len(_UNITS) < AXES_KEPT:
         unit.setflags(write=False)
         _UNITS[key] = unit
     return unit
 
 
 _UNITS: dict[tuple, np.ndarray] = {}
-_UNITS_KEPT = 4096  # bounded: a caller sweeping over many axes keeps no more than this
 
 
 def _checked_unit(k: ArrayLike, name: str) -> np.ndarray:

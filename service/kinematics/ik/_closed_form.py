@@ -25,7 +25,8 @@ from ._verify import Verified, verify, verify_one
 from ._types import Sealed
 
 #: Targets solved together: large enough that per-operation overhead is small, small enough that the
-#: (chunk × m × n) temporaries stay in cache and memory is bounded whatever the batch size.
+#: (chunk × m × n) temporaries stay in cache and memory is bounded whatever the batch size. A family whose
+#: temporaries per target are a few dozen numbers solves more at once (its ``targets_per_chunk``).
 CHUNK = 4096
 
 
@@ -69,11 +70,12 @@ def solve_closed_form(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.nd
     """Every verified solution of the goal's N targets by the plan, vectorised over the targets (see the module
     docstring). ``reference`` (n,) sets the joints a target leaves free."""
     n_targets = len(goal)
-    if n_targets <= CHUNK:
+    chunk = getattr(plan, "targets_per_chunk", CHUNK)
+    if n_targets <= chunk:
         budget.check("the analytic solve")
         return _solved(robot, plan, goal, reference)
     threads = threads or os.cpu_count() or 1
-    edges = chunk_edges(n_targets, threads)
+    edges = chunk_edges(n_targets, threads, chunk)
 
     def solve(start: int, stop: int) -> Verified:
         budget.check("the analytic solve")
@@ -88,11 +90,11 @@ def solve_closed_form(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.nd
     return joined(parts, robot.dof)
 
 
-def chunk_edges(n_targets: int, threads: int) -> list[int]:
-    """Where the chunks of N targets start, and N: at most :data:`CHUNK` targets each, as many chunks as a multiple
+def chunk_edges(n_targets: int, threads: int, chunk: int = CHUNK) -> list[int]:
+    """Where the chunks of N targets start, and N: at most ``chunk`` targets each, as many chunks as a multiple
     of the threads that can work on them, all of one size (within one target), so that each thread has as much
     to do (10,000 on 2 threads: 4 of 2,500, not 4,096 + 4,096 on one and 1,808 on the other)."""
-    chunks = -(-n_targets // CHUNK)
+    chunks = -(-n_targets // chunk)
     workers = max(1, min(threads, chunks))
     chunks = -(-chunks // workers) * workers
     return [index * n_targets // chunks for index in range(chunks + 1)]

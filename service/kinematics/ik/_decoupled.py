@@ -22,7 +22,7 @@ from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Pos
 from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, rotation_about, unturned
 from .subproblems import subproblem_1
-from ._types import Candidates, LabelCodes, SingularFlags, Sealed
+from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Sealed
 from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, _perpendicular_unit, seen_by
 
 
@@ -30,6 +30,7 @@ class DecoupledPlan(Sealed):
     """A positioner over joints 0…k−1 and an optional wrist over joints k…n−1."""
 
     method = "analytic"
+    targets_per_chunk = LEAN_CHUNK
 
     def __init__(self, positioner: Positioner | None, wrist: SphericalWrist | Roll | None, point: np.ndarray,
                  home: np.ndarray | None, dof: int, fixed: dict[int, float] | None = None) -> None:

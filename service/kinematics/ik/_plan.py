@@ -33,7 +33,8 @@ from ._wrist import Roll, SphericalWrist, TwoAxisWrist
 class Plan(Protocol):
     """A family's solver for one robot. A family with a scalar path for one pose also has
     ``solve_one(world_T_target) -> OnePose | None`` (:mod:`._scalar`: the candidates with their labels); None
-    sends the pose to ``solve`` and ``label_codes``."""
+    sends the pose to ``solve`` and ``label_codes``. A family may set ``targets_per_chunk``, the most targets a
+    batch solves at once (default :data:`~._closed_form.CHUNK`)."""
 
     structure: str
     generic_count: int

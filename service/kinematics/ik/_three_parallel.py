@@ -42,7 +42,7 @@ from .._forward import JointTrig
 from ._screws import apply, invert, joint_motion, move_point, rotate_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
-from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
+from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 from ._wrist import _perpendicular_unit, wrist_codes
 
 
@@ -52,6 +52,7 @@ class _AxesTwoToFourParallel(Sealed):
 
     method = "analytic"
     generic_count = 8
+    targets_per_chunk = LEAN_CHUNK
     free_joints: list[int] = []
     centre: np.ndarray
 

@@ -40,6 +40,7 @@ def test_the_answer_does_not_depend_on_the_split(robot_id, monkeypatch):
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     whole = solve_closed_form(robot, plan, goal, None)  # one chunk
     monkeypatch.setattr(_closed_form, "CHUNK", 96)
+    monkeypatch.setattr(type(plan), "targets_per_chunk", 96, raising=False)  # these families' own chunk
     for threads in (1, 2, 3):
         split = solve_closed_form(robot, plan, goal, None, threads=threads)
         for name in ("target", "joints", "within_limits", "position", "orientation"):
@@ -48,3 +49,20 @@ def test_the_answer_does_not_depend_on_the_split(robot_id, monkeypatch):
             k: (v, c.tobytes()) for k, (v, c) in whole.table.labels.items()}
         np.testing.assert_array_equal(split.complete, whole.complete)
         np.testing.assert_array_equal(split.nearest, whole.nearest)
+
+
+@pytest.mark.parametrize("robot_id, chunk", [("puma560_standard", 8_192), ("ur5", 8_192), ("kuka_kr6_r900_2", 8_192)])
+def test_a_family_solves_its_own_chunk_of_targets(robot_id, chunk, monkeypatch):
+    """The lean families (a few dozen numbers per target) solve twice the default at once; a batch is cut into
+    chunks of at most the plan's size."""
+    robot = CATALOGUE.get(robot_id).robot
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    assert plan.targets_per_chunk == chunk == 2 * _closed_form.CHUNK
+    sizes = []
+    solved = _closed_form._solved
+    monkeypatch.setattr(_closed_form, "_solved", lambda robot, plan, goal, reference: (
+        sizes.append(len(goal)), solved(robot, plan, goal, reference))[1])
+    monkeypatch.setattr(type(plan), "targets_per_chunk", 300)
+    q = np.random.default_rng(5).uniform(-np.pi, np.pi, (1_000, robot.dof))
+    answer = solve_closed_form(robot, plan, PoseGoal(forward_kinematics(robot, q)), None, threads=2)
+    assert sorted(sizes) == [250] * 4 and len(answer.complete) == 1_000

@@ -52,7 +52,6 @@ class _AxesTwoToFourParallel(Sealed):
 
     method = "analytic"
     generic_count = 8
-    targets_per_chunk = LEAN_CHUNK
     free_joints: list[int] = []
     centre: np.ndarray
 
@@ -83,7 +82,7 @@ class _AxesTwoToFourParallel(Sealed):
         """Steps 3–5 from candidate pairs (q1, q5) of shape (N, m): 2m joint vectors per target.
 
         Every product of the joints' motions is applied to the few vectors it acts on, as turns about the axes
-        (:func:`rotate_about`, (N, m, 3) each), not built as (N, m, 4, 4) matrices: R_1ᵀ R_A v is
+        (:func:`rotate_about`, (N, m, 3), or (N, m, 2, 3) for two at once), not built as (N, m, 4, 4) matrices: R_1ᵀ R_A v is
         R(ω_1, −q_1) (R_A v), and G_5⁻¹ x is R(ω_5, −q_5) (x − p_5) + p_5."""
         g, w_p = self.geometry, self.omega_p
         n, m = q1.shape
@@ -229,6 +228,7 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
     """The UR5-type family: axes 2 ∥ 3 ∥ 4, axes 5 and 6 intersecting."""
 
     structure = "three_parallel"
+    targets_per_chunk = LEAN_CHUNK
 
     @classmethod
     def match(cls, geometry: Geometry) -> "ThreeParallelPlan | None":

@@ -155,10 +155,12 @@ class IKResult:
     search_exhausted_budget: bool = False
 
 
-#: The ``targets_per_chunk`` of the lean families (the decoupled ones and those with axes 2–4 parallel, a few dozen
-#: numbers of temporaries per target): twice :data:`~._closed_form.CHUNK`. On 10,000 and 50,000 targets it answered
-#: 10–15 % faster per pose for about 10 % more peak memory; the general 6R, whose elimination matrices are large,
-#: ran slower and used 75 % more memory at that size, so it keeps the default.
+#: The ``targets_per_chunk`` of the lean families (a decoupled plan, and the UR type with axes 2–4 parallel and
+#: axes 5 and 6 meeting: a few dozen numbers of temporaries per target), twice :data:`~._closed_form.CHUNK`. On
+#: 10,000 and 50,000 targets it answered 10–15 % faster per pose for about 10 % more peak memory; the general 6R,
+#: whose elimination matrices are large, ran slower and used 75 % more memory at that size, so it keeps the
+#: default, as do the plans not measured (the skew-wrist UR type) and those that wrap another (idealised, reversed,
+#: coaxial).
 LEAN_CHUNK = 8192
 
 

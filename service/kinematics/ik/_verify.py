@@ -154,13 +154,13 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
 
 
 def first_of_each_slot(robot: Robot, joints: np.ndarray, ok: list[bool]) -> list[bool]:
-    """:func:`first_of_each` of one target's few slots ``joints`` (m, n, finite), m at most
-    :data:`_PAIRWISE_SLOTS`, the ``ok`` ones and the result as lists (m,): every pair of slots at once, then the
-    scan on Python booleans where two slots are one solution."""
+    """:func:`first_of_each` of one target's few slots ``joints`` (m, n), m at most :data:`_PAIRWISE_SLOTS`, the
+    ``ok`` ones and the result as lists (m,): every pair of slots at once, then the scan on Python booleans where
+    two slots are one solution."""
     if len(ok) < 2:
         return list(ok)
     same = _same(np.abs(joints[:, None] - joints[None]), duplicate_tolerance(robot), robot.is_revolute)
-    if np.count_nonzero(same) == len(ok):  # finite slots, each one solution with itself alone: nothing to drop
+    if not np.tril(same, -1).any():  # no two slots one solution: nothing to drop
         return list(ok)
     return _scanned_pairs(same.tolist(), list(ok))
 
@@ -331,9 +331,7 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
             return None
     count = len(kept)
     nearest = np.array([min(sizes, default=np.inf)])
-    # with solutions the family's word stands (both of promised's exceptions are about rows without one)
-    complete = np.ones(1, dtype=bool) if count and one_pose.complete is None else promised(
-        one_pose, np.array([count]), nearest, constrained)
+    complete = promised(one_pose, np.array([count]), nearest, constrained)
     columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)
     labels = {name: (values, column) for name, values, column in zip(one_pose.names, one_pose.values, columns)}
     if kept != list(range(len(rows))):  # else every row is kept, in slot order: no copy

@@ -51,18 +51,29 @@ def test_the_answer_does_not_depend_on_the_split(robot_id, monkeypatch):
         np.testing.assert_array_equal(split.nearest, whole.nearest)
 
 
-@pytest.mark.parametrize("robot_id, chunk", [("puma560_standard", 8_192), ("ur5", 8_192), ("kuka_kr6_r900_2", 8_192)])
+@pytest.mark.parametrize("robot_id, chunk", [("puma560_standard", 8_192), ("ur5", 8_192), ("kuka_kr6_r900_2", 8_192),
+                                             ("ufactory_xarm6", _closed_form.CHUNK)])
 def test_a_family_solves_its_own_chunk_of_targets(robot_id, chunk, monkeypatch):
-    """The lean families (a few dozen numbers per target) solve twice the default at once; a batch is cut into
-    chunks of at most the plan's size."""
+    """The lean families (a few dozen numbers per target) solve twice the default at once, the general 6R the
+    default; a batch is cut into chunks of at most the plan's size, on as many threads as the default would
+    keep busy."""
     robot = CATALOGUE.get(robot_id).robot
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
-    assert plan.targets_per_chunk == chunk == 2 * _closed_form.CHUNK
+    assert getattr(plan, "targets_per_chunk", _closed_form.CHUNK) == chunk
     sizes = []
     solved = _closed_form._solved
     monkeypatch.setattr(_closed_form, "_solved", lambda robot, plan, goal, reference: (
         sizes.append(len(goal)), solved(robot, plan, goal, reference))[1])
-    monkeypatch.setattr(type(plan), "targets_per_chunk", 300)
+    monkeypatch.setattr(_closed_form, "CHUNK", 96)
+    monkeypatch.setattr(type(plan), "targets_per_chunk", 300, raising=False)
     q = np.random.default_rng(5).uniform(-np.pi, np.pi, (1_000, robot.dof))
     answer = solve_closed_form(robot, plan, PoseGoal(forward_kinematics(robot, q)), None, threads=2)
     assert sorted(sizes) == [250] * 4 and len(answer.complete) == 1_000
+
+
+def test_a_larger_chunk_keeps_the_threads_busy():
+    """A lean family's larger chunk makes fewer chunks, never fewer threads than the default chunk would use."""
+    chunk = 2 * _closed_form.CHUNK
+    assert chunk_edges(10_000, 2, chunk) == [0, 5_000, 10_000]
+    assert len(chunk_edges(6_000, 2, chunk)) - 1 == 2  # one call of 6,000 would leave a core idle
+    assert len(chunk_edges(50_000, 16, chunk)) - 1 == len(chunk_edges(50_000, 16)) - 1 == 13

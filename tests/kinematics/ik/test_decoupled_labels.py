@@ -1,22 +1,27 @@
 """A decoupled plan labels each run of rows that share the positioning joints once (the wrist's slots of one arm
 branch): its labels must equal the positioner's and the wrist's labellers run on every row alone, whatever the
-rows' order, on random arms of both decoupled families in every convention and on the catalogue's."""
+rows' order, with or without the cos and sin the FK check shares (a JointTrig, taken for the runs), on random arms
+of both decoupled families in every convention and on catalogue arms of both."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
+from service.config import Settings
 from service.kinematics import CONVENTIONS, forward_kinematics
+from service.kinematics._forward import JointTrig
 from service.kinematics.ik import cached_plan
+from service.robots.catalogue import load_catalogue
 from tests.arms import random_family_arm
 from tests.ik_helpers import random_configurations
 
 FAMILIES = ("intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist")
+CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
 
 
 def _row_by_row(plan, rows: np.ndarray) -> dict:
-    """The positioner's and the wrist's labels of each row on its own (no runs)."""
+    """The positioner's and the wrist's labels of each row on its own (no runs, no shared trig)."""
     codes = {}
     for part in (plan.positioner, plan.wrist):
         for row in rows:
@@ -32,19 +37,36 @@ def _assert_same(got: dict, expected: dict) -> None:
         np.testing.assert_array_equal(got[name][1], codes)
 
 
+def _assert_runs_labelled_alone(robot, plan, rng) -> None:
+    targets = forward_kinematics(robot, random_configurations(robot, 6, seed=3))
+    candidates = plan.solve(targets, None)
+    rows = np.nan_to_num(candidates.joints.reshape(-1, robot.dof))
+    k = len(plan.positioner.joints)
+    assert (rows[1::2, :k] == rows[::2, :k]).all()  # the runs the shortcut relies on are there
+    rows[5, 1] += 1e-9  # a polished row leaves its run
+    rows[7, 0] = np.nan
+    for order in (np.arange(len(rows)), rng.permutation(len(rows))):
+        expected = _row_by_row(plan, rows[order])
+        _assert_same(plan.label_codes(rows[order]), expected)
+        trig = JointTrig(rows[order])
+        for joint in range(robot.dof):  # as after the FK check: every pair computed
+            trig[joint]
+        _assert_same(plan.label_codes(rows[order], trig), expected)
+
+
 @pytest.mark.parametrize("family", FAMILIES)
 @pytest.mark.parametrize("convention", CONVENTIONS)
 def test_runs_are_labelled_as_each_row_alone(family, convention):
     seed = 100 * FAMILIES.index(family) + CONVENTIONS.index(convention)
-    rng = np.random.default_rng(seed)
     robot = random_family_arm(family, convention, seed)
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     assert plan.structure == family
-    targets = forward_kinematics(robot, random_configurations(robot, 6, seed=3))
-    candidates = plan.solve(targets, None)
-    rows = np.nan_to_num(candidates.joints.reshape(-1, robot.dof))
-    assert (rows[1::2, :3] == rows[::2, :3]).all()  # the runs the shortcut relies on are there
-    rows[5, 1] += 1e-9  # a polished row leaves its run
-    rows[7, 0] = np.nan
-    for order in (np.arange(len(rows)), rng.permutation(len(rows))):
-        _assert_same(plan.label_codes(rows[order]), _row_by_row(plan, rows[order]))
+    _assert_runs_labelled_alone(robot, plan, np.random.default_rng(seed))
+
+
+@pytest.mark.parametrize("robot_id", ["puma560_khalil", "kuka_kr6_r900_2", "abb_irb120"])
+def test_runs_are_labelled_as_each_row_alone_on_catalogue_arms(robot_id):
+    robot = CATALOGUE.get(robot_id).robot
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    assert plan.structure in FAMILIES
+    _assert_runs_labelled_alone(robot, plan, np.random.default_rng(1))

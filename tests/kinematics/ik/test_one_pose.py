@@ -120,6 +120,24 @@ def test_the_scan_of_many_slots_is_the_pairwise_scan(robot_id, monkeypatch):
         assert (scanned[0] == pairwise[0]).all() and (pairwise[1:] == pairwise[0]).all()
 
 
+def test_the_scan_of_one_target_is_the_scan_of_many():
+    """first_of_each_slot (one target's slots, the one-pose path) keeps the slots first_of_each keeps for a batch
+    (several targets, screened pairwise), whatever the values: duplicates beside rows that are not finite, whose
+    gaps compare false, must still be dropped."""
+    robot = _CATALOGUE.get("puma560_khalil").robot
+    a = np.array([0.3, -1.2, 0.4, 2.0, -0.5, 1.0])
+    cases = [np.array([a, a, np.full(6, np.nan), np.full(6, np.nan)]),
+             np.array([a, np.full(6, np.inf), a + 1e-12, a + 2 * np.pi * robot.is_revolute]),
+             np.array([a, a + 0.1, a + 0.2, a + 0.3])]
+    for joints in cases:
+        ok = [True] * len(joints)
+        with np.errstate(invalid="ignore"):  # inf − inf
+            expected = _verify.first_of_each(robot, np.repeat(joints[None], 2, axis=0),
+                                             np.ones((2, len(joints)), bool))
+            assert _verify.first_of_each_slot(robot, joints, ok) == expected[0].tolist() == expected[1].tolist()
+    assert _verify.first_of_each_slot(robot, cases[0], [True] * 4) == [True, False, True, True]
+
+
 @pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)
 def test_the_float_check_of_one_pose_is_verify(robot_id):
     """verify_one (the FK check, the duplicate scan and the labels of one pose's scalar slots, on floats) gives

@@ -166,19 +166,6 @@ def chain_rotation(directions: np.ndarray, revolute: np.ndarray, q: np.ndarray, 
     return np.broadcast_to(np.eye(3), q.shape[:-1] + (3, 3)) if R is None else R
 
 
-def unturned(directions: np.ndarray, revolute: np.ndarray, q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """:func:`chain_rotation` transposed, applied to vectors: R(q)ᵀ v for joint values q (..., k) and vectors
-    v (..., j, 3) broadcast against them (j vectors per joint vector), turned back joint by joint from the
-    first (vector operations only, no 3×3 products). Returns shape (..., j, 3): a read-only broadcast view of v
-    where no joint turns it (no revolute joint among them), else a new array."""
-    q = np.asarray(q, dtype=float)
-    for i in range(q.shape[-1]):
-        if revolute[i]:
-            v = rotate_about(directions[i], -q[..., i, None], v)
-    shape = np.broadcast_shapes(np.shape(v), q.shape[:-1] + np.shape(v)[-2:])
-    return v if np.shape(v) == shape else np.broadcast_to(v, shape)
-
-
 def apply(T: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Transform points: T (..., 4, 4) applied to x (..., 3)."""
     return np.einsum("...ij,...j->...i", T[..., :3, :3], x) + T[..., :3, 3]

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._forward import JointTrig
-from ._screws import apply, invert, unturned
+from ._screws import apply, chain_rotation, invert
 from ._structure import Geometry
 from .subproblems import subproblem_5_prismatic
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity
@@ -59,8 +59,9 @@ class SlideAfterSphericalWrist:
         if sol.phi_free.any():  # the wrist centre on axis 1
             q1 = np.where(sol.phi_free, 0.0 if reference is None else reference[0], q1)
         arm = np.stack([q1, sol.theta], axis=-1)  # (N, 4, 2)
-        seen = unturned(self.model.directions[:2], self.model.is_revolute[:2], np.nan_to_num(arm),
-                        seen_by(self.wrist, Q)[:, None])  # (N, 4, j, 3): R_armᵀ Q applied to the wrist's vectors
+        # (N, 4, j, 3): R_armᵀ Q applied to the wrist's vectors, as rows times R_arm
+        seen = seen_by(self.wrist, Q)[:, None] @ chain_rotation(self.model.directions[:2],
+                                                                self.model.is_revolute[:2], np.nan_to_num(arm))
         wrist = self.wrist.solve(seen.reshape((-1,) + seen.shape[-2:]), reference)
         m_wrist = wrist.joints.shape[1]
         joints = np.zeros((n_targets, 4, m_wrist, 6))

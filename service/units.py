@@ -4,8 +4,6 @@ from __future__ import annotations
 
 import math
 
-RADIANS_PER_DEGREE = math.pi / 180.0
-
 
 def radians_per(unit: str) -> float:
     """Radians in one ``unit``: ``"deg"`` or ``"rad"`` (anything else raises ValueError: the schemas let only
@@ -16,4 +14,4 @@ def radians_per(unit: str) -> float:
         raise ValueError(f"unknown angle unit {unit!r}: 'deg' or 'rad'") from None
 
 
-_RADIANS_PER = {"deg": RADIANS_PER_DEGREE, "rad": 1.0}
+_RADIANS_PER = {"deg": math.pi / 180.0, "rad": 1.0}

@@ -36,9 +36,9 @@ def random_configurations(robot, count: int, seed: int) -> np.ndarray:
 
 
 def mixed_poses(robot, count: int, seed: int) -> np.ndarray:
-    """Random reachable poses, poses at singular configurations (joints snapped to 0 or ±π/2) and poses
+    """Random reachable poses, poses at singular configurations (joints snapped to 0, ±π/2 or π) and poses
     moved out of reach."""
-    rng = np.random.default_rng(seed)
+    rng = np.random.default_rng([seed, 1])  # not random_configurations' stream: which joints snap is its own draw
     q = random_configurations(robot, count, seed)
     snapped = q[: count // 4].copy()
     snap = rng.random(snapped.shape) < 0.3

@@ -43,7 +43,6 @@ from .schemas.ik import MatrixRows, Ordering as OrderingOptions
 from .schemas.poses import DirectionOrientation, PoseTarget
 
 
-
 @contextmanager
 def located(*prefix: str | int) -> Iterator[None]:
     """Prefix the location of any core error raised inside the block, worded for the wire where the core's words

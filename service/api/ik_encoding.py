@@ -121,7 +121,7 @@ def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
     """The arrays form: per-target columns, the two solution tables as columns (numpy arrays, encoded as
     they stand)."""
     budget.check("encoding")
-    scale = _unit_scale(robot, unit)
+    scale, angle = _unit_scale(robot, unit), radians_per(unit)
     solvers = [{"method": s.method, "structure": s.structure, "complete": s.complete,
                 "time_budget_exhausted": s.time_budget_exhausted, "free_joints": list(s.free_joints)}
                for s in answer.solvers]
@@ -138,8 +138,8 @@ def ik_columns(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget:
                     "trimmed": answer.trimmed, "available": answer.available,
                     "solution_count": np.bincount(answer.solutions.target, minlength=n_targets),
                     "rejected_count": np.bincount(answer.rejected.target, minlength=n_targets)},
-        "solutions": _columns(answer.solutions, scale, answer, radians_per(unit)),
-        "rejected": _columns(answer.rejected, scale, answer, radians_per(unit)),
+        "solutions": _columns(answer.solutions, scale, answer, angle),
+        "rejected": _columns(answer.rejected, scale, answer, angle),
     }
 
 

@@ -9,11 +9,11 @@ from dataclasses import dataclass
 import numpy as np
 from fastapi import Request
 
-from ..kinematics import Budget, InvalidInputError, Robot, TrajectoryOptions, TrajectoryResult
+from ..kinematics import Budget, InvalidInputError, TrajectoryOptions, TrajectoryResult
 from ..kinematics.ik import AnswerOptions, IKOptions, IKTargets, estimate
 from ..units import radians_per
 from .boundary import (collisions_to_core, free_joints_to_core, joints_from_core, joints_to_core, located,
-                       target_matrix, violation_to_wire)
+                       target_matrix, violation_to_wire, _unit_scale)
 from .budget import budget_of, check_collision_cost
 from .deps import RobotRef, check_batch_size, settings_of, with_request_frames
 from .schemas.trajectory import TrajectoryRequest
@@ -84,16 +84,18 @@ def trajectory_in_core(request: Request, ref: RobotRef, body: TrajectoryRequest)
                            np.array([_cartesian(s.acceleration, angle) for s in body.samples]), options, budget)
 
 
-def _vector(robot: Robot, values: np.ndarray | None, unit: str, scale: np.ndarray | None = None) -> list | None:
+def _vector(values: np.ndarray | None, scale: np.ndarray) -> list | None:
+    """Joint values (n,) from the core's units to the request's (``scale``, :func:`~.boundary._unit_scale`), or
+    None where there are none."""
     if values is None or np.isnan(values).any():
         return None
-    return (joints_from_core(robot, values, unit) if scale is None else values / scale).tolist()
+    return (values / scale).tolist()
 
 
 def trajectory_to_wire(asked: AskedTrajectory, result: TrajectoryResult, body: TrajectoryRequest) -> dict:
     """The answer as TrajectoryResponse's fields, built field by field (a test validates it against the model)."""
     robot, unit, budget = asked.ref.robot, body.angle_unit, asked.budget
-    paper_scale = np.array([radians_per(unit), radians_per(unit), 1.0])
+    scale = _unit_scale(robot, unit)  # the paper's joints too: only an RRP arm has them
     samples = []
     for k, s in enumerate(result.samples):
         if k % 256 == 0:
@@ -101,9 +103,9 @@ def trajectory_to_wire(asked: AskedTrajectory, result: TrajectoryResult, body: T
         sample = {
             "time": s.time,
             "status": s.status,
-            "joints": _vector(robot, s.joints, unit),
-            "velocities": _vector(robot, s.velocities, unit),
-            "accelerations": _vector(robot, s.accelerations, unit),
+            "joints": _vector(s.joints, scale),
+            "velocities": _vector(s.velocities, scale),
+            "accelerations": _vector(s.accelerations, scale),
             "branch": s.branch,
             "branch_changed": s.branch_changed,
             "singularities": [{"kind": x.kind, "joints": list(x.joints), "relation": x.relation, "detail": x.detail}
@@ -115,9 +117,9 @@ def trajectory_to_wire(asked: AskedTrajectory, result: TrajectoryResult, body: T
             "residual": None if not s.reached else {"velocity": s.velocity_residual,
                                                     "acceleration": s.acceleration_residual},
             "paper": None if s.paper is None else {
-                "joints": _vector(robot, s.paper.joints, unit, paper_scale),
-                "velocities": _vector(robot, s.paper.velocities, unit, paper_scale),
-                "accelerations": _vector(robot, s.paper.accelerations, unit, paper_scale),
+                "joints": _vector(s.paper.joints, scale),
+                "velocities": _vector(s.paper.velocities, scale),
+                "accelerations": _vector(s.paper.accelerations, scale),
                 "case": s.paper.case},
         }
         if asked.options.collisions is not None:

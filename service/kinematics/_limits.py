@@ -138,27 +138,27 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     """
     q = np.asarray(q, dtype=float)
     lower, upper, both = limits.widened(robot)
+    low = high = None  # the both-bounded columns' turns, None where every one is 0
     if both.any():  # every both-bounded column at once (whole rows: a column alone strides through them all)
         value, low_bound, high_bound = (q, lower, upper) if both.all() else (q[..., both], lower[both], upper[both])
-        if both.all() and value.size >= _CHECKED_FROM and _one_turn_each(value, low_bound, high_bound):
-            return np.zeros_like(q), np.zeros_like(q)
-        # in place, a few (..., n) arrays in all: a batch's table has tens of thousands of rows
-        low = np.subtract(low_bound, value)
-        low /= _TWO_PI
-        np.ceil(low, out=low)
-        high = np.subtract(high_bound, value)
-        high /= _TWO_PI
-        np.floor(high, out=high)
-        end = np.multiply(low, _TWO_PI)  # the end values q + 2kπ, checked against the bounds
-        end += value
-        low += end < low_bound
-        np.multiply(high, _TWO_PI, out=end)
-        end += value
-        high -= end > high_bound
-        if both.all():
-            return low, high
+        if not (value.size >= _CHECKED_FROM and _one_turn_each(value, low_bound, high_bound)):
+            # in place, a few (..., n) arrays in all: a batch's table has tens of thousands of rows
+            low = np.subtract(low_bound, value)
+            low /= _TWO_PI
+            np.ceil(low, out=low)
+            high = np.subtract(high_bound, value)
+            high /= _TWO_PI
+            np.floor(high, out=high)
+            end = np.multiply(low, _TWO_PI)  # the end values q + 2kπ, checked against the bounds
+            end += value
+            low += end < low_bound
+            np.multiply(high, _TWO_PI, out=end)
+            end += value
+            high -= end > high_bound
+            if both.all():
+                return low, high
     first, last = np.zeros_like(q), np.zeros_like(q)
-    if both.any():
+    if low is not None:
         first[..., both], last[..., both] = low, high
     continuous = limits.continuous(robot)
     for j in np.flatnonzero(~both).tolist():  # one kind of joint per column

@@ -198,9 +198,8 @@ def task_space(robot: Robot, *, constrain_orientation: bool, free_joints: tuple[
     linear = identity
     linear_names = [f"v{a}" for a in _AXES]
     if u is not None and all(abs(model.directions[i] @ u) <= GEOMETRY_TOLERANCE * 10 for i in prismatic):
-        plane = rotation_with_z(u)[:, :2].T  # two orthonormal vectors normal to u
-        if abs(abs(u[2]) - 1.0) <= GEOMETRY_TOLERANCE * 10:
-            plane = identity[:2]
+        # two orthonormal vectors normal to u: x and y when u is the z axis
+        plane = identity[:2] if abs(abs(u[2]) - 1.0) <= GEOMETRY_TOLERANCE * 10 else rotation_with_z(u)[:, :2].T
         linear, linear_names = plane, [_row_name("v", e) for e in plane]
     rows = [np.concatenate([e, np.zeros(3)]) for e in linear]
     names = list(linear_names)

@@ -20,7 +20,6 @@ from .schemas import MAX_NOTES_CHARS, AnyRobotDescription, KhalilRobot, ScrewsRo
 from .urdf import URDFChain, parse_urdf
 
 
-
 def robot_from_description(description: AnyRobotDescription, *, max_joints: int) -> Robot:
     """Build the core robot of any description form, converting angles to radians once."""
     base = None if description.base is None else np.asarray(description.base, dtype=float)

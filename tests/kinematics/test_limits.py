@@ -47,6 +47,32 @@ def test_turn_ranges_per_kind_of_joint():
     assert last[4] < first[4]  # 120° has no equivalent in ±100°
 
 
+@pytest.mark.parametrize("robot", [
+    arm(*[("revolute", -170 * DEG, 170 * DEG)] * 6),  # every joint bounded within a turn
+    arm(("revolute", -170 * DEG, 170 * DEG), ("revolute", -math.inf, math.inf), ("revolute", -120 * DEG, 120 * DEG),
+        ("prismatic", 0.1, 1.0), ("revolute", -100 * DEG, 100 * DEG)),  # some bounded, the others not
+    MIXED], ids=["bounded", "partly bounded", "mixed"])
+def test_the_one_turn_shortcut_gives_the_quotients_turns(robot, monkeypatch):
+    """A large batch whose bounded values all sit well inside limits of about one turn takes every such turn as
+    0 without the quotients: the same (first, last), bit for bit (+0.0), as the quotients, for batches that take
+    the shortcut and batches one value near a bound keeps from it."""
+    from service.kinematics import _limits
+
+    rng = np.random.default_rng(4)
+    limits = Limits.of(robot)
+    inside = np.clip(rng.uniform(-1.5, 1.5, (2_000, robot.dof)), np.maximum(robot.lower, -1.5) + 0.01,
+                     np.minimum(robot.upper, 1.5) - 0.01)
+    near_bound = inside.copy()
+    near_bound[7, 0] = robot.upper[0] - 1e-9
+    for q in (inside, near_bound):
+        shortcut = turn_ranges(robot, limits, q)
+        monkeypatch.setattr(_limits, "_CHECKED_FROM", math.inf)
+        quotients = turn_ranges(robot, limits, q)
+        monkeypatch.undo()
+        for a, b in zip(shortcut, quotients):
+            assert a.tobytes() == b.tobytes()
+
+
 def test_turn_ranges_count_huge_limits_without_generating_them():
     wide = arm(("revolute", -1e6, 1e6))
     first, last = turn_ranges(wide, Limits.of(wide), np.array([0.5]))

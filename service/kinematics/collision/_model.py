@@ -347,7 +347,8 @@ class CollisionModel:
                  if group.bounds is None and group.fixed < len(group.rows)]
             bounded = [group.part(group.fixed, len(group.rows)) for group in self._groups
                        if group.bounds is not None and group.fixed < len(group.rows)]
-        fixed_only = any(group.fixed == len(group.rows) for group in measured)  # groups measured once if still
+        # some group is only a base shape's pairs with obstacles: measured once per block while the base stays put
+        whole_fixed_groups = any(group.fixed == len(group.rows) for group in measured)
         for begin in range(0, count, block):
             with _quiet():  # per block: the caller's code between blocks keeps its own floating-point state
                 end = min(begin + block, count)
@@ -356,7 +357,7 @@ class CollisionModel:
                     frames = np.ascontiguousarray(frames)  # row each, so that einsum runs on unit strides
                 placed = self._world_rows(frames, world[:, :, : end - begin])
                 block_result = result[begin:end]
-                base_still = fixed_only and bool((frames[0] == frames[0][..., :1]).all())
+                base_still = whole_fixed_groups and bool((frames[0] == frames[0][..., :1]).all())
                 for group in measured:
                     _measure(block_result[:, group.start:group.stop], group, world, None, None, 0.0,
                              once=base_still and group.fixed == len(group.rows))

@@ -27,6 +27,7 @@ import numpy as np
 
 from .._budget import UNLIMITED, Budget
 from .._errors import InvalidInputError, KinematicsError
+from .._forward import JointTrig
 from .._limits import Limits
 from .._robot import Robot
 from ..collision import CollisionRequest, at_collisions, clearances
@@ -311,8 +312,14 @@ def _poses(robot: Robot, matrices: np.ndarray, rows: np.ndarray, options: Answer
 
 def answered_by_family(robot: Robot, options: AnswerOptions) -> bool:
     """Whether full poses are answered as a family over free joints: those the request names, or a redundant
-    arm's (n > 6) unless its one degree of redundancy is a coaxial pair's split (:func:`coaxial_redundancy`)."""
-    return options.free_joints is not None or (robot.dof > 6 and not coaxial_redundancy(robot))
+    arm's (:func:`redundant_family`)."""
+    return options.free_joints is not None or redundant_family(robot)
+
+
+def redundant_family(robot: Robot) -> bool:
+    """Whether the arm's full poses are a family over free joints whatever the request: a redundant arm (n > 6)
+    unless its one degree of redundancy is a coaxial pair's split (:func:`coaxial_redundancy`)."""
+    return robot.dof > 6 and not coaxial_redundancy(robot)
 
 
 def coaxial_redundancy(robot: Robot) -> bool:
@@ -510,7 +517,7 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
     (issue 22.11)."""
     verified = closed.verified
     for local in np.flatnonzero((verified.count == 0) & verified.complete).tolist():
-        closed.details[local] = _unreachable_detail(robot, goal, local, verified)
+        closed.details[local] = unreachable_detail(robot, goal, local, verified)
     if verified.complete.all():
         return [_timed(timings, closed, started)]
     broken = np.flatnonzero(~verified.complete)
@@ -550,7 +557,7 @@ def _fallback_note(plan) -> str:
 def _numeric(robot: Robot, goal: PoseGoal, rows: np.ndarray, options: AnswerOptions,
              reference: np.ndarray | None = None, *, known: np.ndarray | None = None,
              free: list[FreeJoint] | None = None,
-             label_codes: Callable[[np.ndarray], LabelCodes] | None = None) -> _Part:
+             label_codes: Callable[[np.ndarray, JointTrig], LabelCodes] | None = None) -> _Part:
     """The numeric search's part for the goal's targets (their indices ``rows``), seeded with ``known``
     solutions; with ``free``, once per combination of the free joints' values, those joints held. ``label_codes``
     labels the solutions (a closed-form plan's, where the search completes its answer); None leaves them
@@ -624,7 +631,7 @@ def _taken(part: _Part, local: np.ndarray) -> _Part:
                  None if part.unfinished is None else part.unfinished[local])
 
 
-def _unreachable_detail(robot: Robot, goal: PoseGoal, local: int, verified: Verified) -> str:
+def unreachable_detail(robot: Robot, goal: PoseGoal, local: int, verified: Verified) -> str:
     """Why a target the closed form proves unreachable has no solution: beyond the reach sphere, or (for a pose)
     whether the position alone is reachable."""
     position = goal.world_T_targets[local, :3, 3]

@@ -26,9 +26,9 @@ from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Sealed
 from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, _perpendicular_unit, seen_by
 
 
-#: Rows from which :meth:`DecoupledPlan.label_codes` finds the runs: below, finding them costs more than labelling
-#: every row (measured on the PUMA, the KUKA KR6 and the Stanford arm: even at about 1,000 rows, 10–12 % saved at
-#: 4,096).
+#: Rows from which :meth:`DecoupledPlan.label_codes` labels one row per run: below, finding the runs costs more
+#: than it saves (on the PUMA, the KUKA KR6 and the Stanford arm the two break even at about 1,000 rows; at 4,096
+#: the runs save 10–12 %).
 _RUNS_FROM = 1024
 
 
@@ -171,12 +171,11 @@ class DecoupledPlan(Sealed):
         rows come in runs, as :meth:`solve` lays them out): from :data:`_RUNS_FROM` rows, each run is labelled
         once, from its first row."""
         codes: LabelCodes = {}
-        if self.positioner is not None and len(joints) < _RUNS_FROM:
-            codes.update(self.positioner.label_codes(joints, trig))
-        elif self.positioner is not None:
-            arm = joints[:, list(self.positioner.joints)]
-            first = np.ones(len(joints), dtype=bool)
-            first[1:] = (arm[1:] != arm[:-1]).any(axis=1)  # a NaN differs from itself: its row is labelled alone
+        if self.positioner is not None:
+            first = np.ones(len(joints), dtype=bool)  # each row that starts a run
+            if len(joints) >= _RUNS_FROM:
+                arm = joints[:, list(self.positioner.joints)]
+                first[1:] = (arm[1:] != arm[:-1]).any(axis=1)  # a NaN differs from itself: its row is labelled alone
             if first.all():
                 codes.update(self.positioner.label_codes(joints, trig))
             else:

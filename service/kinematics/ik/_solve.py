@@ -20,7 +20,7 @@ from .._budget import UNLIMITED, Budget
 from .._limits import Limits
 from .._robot import Robot
 from ._answer import (DIRECTION, AnswerOptions, IKAnswer, IKOptions, IKTargets, SolverReport, answer_ik,
-                      answered_by_family)
+                      redundant_family, unreachable_detail)
 from ._closed_form import cached_plan, solve_closed_form
 from ._goals import PoseGoal
 from ._plan import Plan
@@ -61,26 +61,26 @@ def solve_ik(robot: Robot, world_T_target: np.ndarray, *, constrain_orientation:
 
 
 def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) -> IKResult | None:
-    """:func:`solve_ik` of a pose without a reference where the closed form answers it alone: it covers the
-    arm, promises every solution and found some. The answer's selection would then list each solution once, as
-    it stands (no limits, no order to impose), and no words: the same record without building the answer. None
-    elsewhere (a redundant arm's family, the numeric search's fallback, an unreachable pose's detail)."""
-    if answered_by_family(robot, _DEFAULT_ANSWER):
+    """:func:`solve_ik` of a pose without a reference where the closed form answers it alone: it covers the arm
+    and promises every solution. The answer's selection would then list each solution once, as it stands (no
+    limits, no order to impose), and word only an unreachable pose: the same record without building the answer.
+    None elsewhere (a redundant arm's family, a target the numeric search completes)."""
+    if redundant_family(robot):
         return None
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     if plan is None:
         return None
-    verified = solve_closed_form(robot, plan, PoseGoal(target[None]), None, budget=options.budget)
-    table = verified.table
-    if not (verified.complete[0] and len(table)):  # one target: its rows are the table's
+    goal = PoseGoal(target[None])
+    verified = solve_closed_form(robot, plan, goal, None, budget=options.budget)
+    if not verified.complete[0]:
         return None
     report = SolverReport("analytic", plan.structure, True, False, tuple(plan.free_joints))
+    table = verified.table  # one target: its rows are the table's
+    if not len(table):
+        detail = unreachable_detail(robot, goal, 0, verified)
+        return _result([], "unreachable", report, verified.singularities[0], detail)
     # the joints as the selection lists them, q + 2π·0 (a −0.0 becomes 0.0)
     return _result(_solutions(table, table.joints + 0.0), "ok", report, verified.singularities[0], None)
-
-
-#: The answer's options where the caller gives none (frozen, so shared).
-_DEFAULT_ANSWER = AnswerOptions()
 
 
 def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,

@@ -77,3 +77,17 @@ def test_a_larger_chunk_keeps_the_threads_busy():
     assert chunk_edges(10_000, 2, chunk) == [0, 5_000, 10_000]
     assert len(chunk_edges(6_000, 2, chunk)) - 1 == 2  # one call of 6,000 would leave a core idle
     assert len(chunk_edges(50_000, 16, chunk)) - 1 == len(chunk_edges(50_000, 16)) - 1 == 13
+
+
+def test_a_batch_of_several_chunks_runs_them_on_threads(monkeypatch):
+    """The chunks of a batch go to a pool of as many threads as chunks can keep busy (two here)."""
+    robot = CATALOGUE.get("puma560_standard").robot
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    pools = []
+    pool = _closed_form.ThreadPoolExecutor
+    monkeypatch.setattr(_closed_form, "ThreadPoolExecutor", lambda workers: (pools.append(workers), pool(workers))[1])
+    monkeypatch.setattr(_closed_form, "CHUNK", 96)
+    monkeypatch.setattr(type(plan), "targets_per_chunk", 300)
+    q = np.random.default_rng(6).uniform(-np.pi, np.pi, (1_000, robot.dof))
+    solve_closed_form(robot, plan, PoseGoal(forward_kinematics(robot, q)), None, threads=2)
+    assert pools == [2]

@@ -155,13 +155,17 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
 
 def first_of_each_slot(robot: Robot, joints: np.ndarray, ok: list[bool]) -> list[bool]:
     """:func:`first_of_each` of one target's few slots ``joints`` (m, n), m at most :data:`_PAIRWISE_SLOTS`, the
-    ``ok`` ones and the result as lists (m,): every pair of slots at once, then the scan on Python booleans where
-    two slots are one solution."""
-    if len(ok) < 2:
+    ``ok`` ones and the result as lists (m,): every pair at once (:func:`_same_pairs`), then the scan on Python
+    booleans where two slots are one solution."""
+    m = len(ok)
+    if m < 2:
         return list(ok)
-    same = _same(np.abs(joints[:, None] - joints[None]), duplicate_tolerance(robot), robot.is_revolute)
-    if not np.tril(same, -1).any():  # no two slots one solution: nothing to drop
+    earlier, later = _slot_pairs(m)
+    pairs = _same_pairs(joints[None], earlier, later, duplicate_tolerance(robot), robot.is_revolute)[0]
+    if not pairs.any():  # no two slots one solution: nothing to drop
         return list(ok)
+    same = np.zeros((m, m), dtype=bool)
+    same[later, earlier] = pairs  # the scan reads a slot's row at the slots before it
     return _scanned_pairs(same.tolist(), list(ok))
 
 
@@ -310,25 +314,21 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     slots = [slot for slot, q in enumerate(one_pose.rows) if q is not None]
     rows = [one_pose.rows[slot] for slot in slots]  # revolute joints wrapped already: verify's wrap leaves them
     constrained = goal.constrain_orientation
-    if rows:
-        residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist())
-        position, orientation = np.array(list(zip(*residuals)))  # each contiguous: the encoder writes them as they are
-    else:
-        position = orientation = np.zeros(0)
+    residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist()) if rows else ()
+    # (2, k), each row contiguous: the encoder writes them as they are
+    position, orientation = np.array(list(zip(*residuals)) or ((), ()), dtype=float)
     sizes = error_size(robot, position, orientation, constrained).tolist()
-    for size in sizes:
-        if size != size or polished(size):  # a NaN error, or one verify would polish
-            return None
+    if any(size != size or polished(size) for size in sizes):  # a NaN error, or one verify would polish
+        return None
     joints = np.array(rows, dtype=float).reshape(len(rows), robot.dof)
-    ok = [size <= ACCEPT_RESIDUAL for size in sizes]
-    kept = [row for row, keep in enumerate(first_of_each_slot(robot, joints, ok)) if keep]
+    kept = [row for row, keep in enumerate(first_of_each_slot(robot, joints, [size <= ACCEPT_RESIDUAL
+                                                                              for size in sizes])) if keep]
     if reference is not None and len(kept) > 1:
         nearest_first = np.argsort(distance_to_reference(robot, joints[kept], reference), kind="stable")
         kept = [kept[i] for i in nearest_first.tolist()]
     codes = [one_pose.codes[slots[row]] for row in kept]
-    for row in codes:
-        if None in row:
-            return None
+    if any(None in row for row in codes):
+        return None
     count = len(kept)
     nearest = np.array([min(sizes, default=np.inf)])
     complete = promised(one_pose, np.array([count]), nearest, constrained)
@@ -365,9 +365,9 @@ def promised(candidates: Candidates, count: np.ndarray, nearest: np.ndarray, con
 
     Those rows go to the fallback."""
     complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
-    empty = count == 0
-    if not empty.any():  # both exceptions are about rows without a solution
+    if count.all():  # both exceptions are about rows without a solution
         return complete
+    empty = count == 0
     narrow = empty & (nearest <= POLISH_RESIDUAL)
     for mask, flag in candidates.singularities.entries:
         if flag.relation in FRAGILE_RELATIONS:

@@ -20,10 +20,10 @@ from .._tolerances import GEOMETRY_TOLERANCE
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
 from .._forward import JointTrig
-from ._screws import apply, chain_rotation, invert, rotation_about
+from ._screws import apply, chain_rotation, invert, perpendicular_unit, rotation_about
 from .subproblems import subproblem_1
 from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Sealed
-from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, _perpendicular_unit, seen_by
+from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, seen_by
 
 
 #: Rows from which :meth:`DecoupledPlan.label_codes` labels one row per run: below, finding the runs costs more
@@ -157,7 +157,7 @@ class DecoupledPlan(Sealed):
                     held |= first.degenerate
                     q[..., i] = first.theta[..., 0]
                     M = np.swapaxes(rotation_about(model.directions[i], q[..., i]) @ C, -1, -2) @ M
-                u = _perpendicular_unit(axis)
+                u = perpendicular_unit(axis)
                 last = subproblem_1(axis, np.broadcast_to(u, q.shape[:-1] + (3,)), M @ u)
             held |= last.degenerate
             q[..., j] = last.theta[..., 0]

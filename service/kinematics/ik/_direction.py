@@ -55,10 +55,10 @@ from ._goals import DirectionGoal
 from ._plan import Plan, geometry_of, plan_for_geometry
 from ._redundant import (MAX_FREE_VALUES, FreeJoint, FreeJointFamily, default_free_joints, family_for,
                          free_joints_for, free_value_grid, gathered, grid_size, one_target)
+from ._screws import perpendicular_unit
 from ._structure import Geometry, arm_size
 from ._types import Candidates, SingularFlags, Singularity
 from ._verify import Verified, distance_to_reference, joint_difference, verify
-from ._wrist import _perpendicular_unit
 
 #: The virtual joint's value (rad) within which a 6-joint solution is one of the 5-joint arm (the roll case).
 VIRTUAL_AT_ZERO = 1e-6
@@ -129,7 +129,7 @@ def direction_plan(robot: Robot, tool_axis: np.ndarray) -> DirectionPlan | None:
             plan = plan_for_geometry(_with_virtual_roll(geometry, axis_world), constrain_orientation=True,
                                      reference=None)
             return None if plan is None else DirectionPlan(plan, a, None, f"virtual_roll+{plan.structure}")
-        first = _perpendicular_unit(a)
+        first = perpendicular_unit(a)
         for axis in (first, np.cross(a, first)):
             plan = plan_for_geometry(_with_virtual_roll(geometry, R_home @ axis), constrain_orientation=True,
                                      reference=None)
@@ -148,7 +148,7 @@ def rotations_to(tool_axis: np.ndarray, world_directions: np.ndarray) -> np.ndar
     axis = np.cross(a, d)
     sine, cosine = np.linalg.norm(axis, axis=-1), d @ a
     opposite = sine < 1e-12
-    axis = np.where(opposite[:, None], _perpendicular_unit(a), axis / np.where(opposite, 1.0, sine)[:, None])
+    axis = np.where(opposite[:, None], perpendicular_unit(a), axis / np.where(opposite, 1.0, sine)[:, None])
     angle = np.arctan2(sine, cosine)
     angle = np.where(opposite & (cosine < 0), np.pi, angle)
     return about_axes(axis, angle)
@@ -237,7 +237,7 @@ def rolls_of(tool_axis: np.ndarray, direction: np.ndarray, world_R_tool: np.ndar
     0.5
     """
     a = _unit(np.asarray(tool_axis, dtype=float))
-    u = _perpendicular_unit(a)
+    u = perpendicular_unit(a)
     R_t = rotations_to(a, np.asarray(direction, dtype=float)[None])[0]
     turned = (world_R_tool @ u) @ R_t  # rows: (R_t^T R u)^T, (K, 3)
     return np.arctan2(turned @ np.cross(a, u), turned @ u)

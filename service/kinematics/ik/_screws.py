@@ -64,6 +64,12 @@ def axis_frame(k: np.ndarray) -> np.ndarray:
 _FRAMES: dict[tuple[float, ...], np.ndarray] = {}
 
 
+def perpendicular_unit(k: np.ndarray) -> np.ndarray:
+    """A unit vector perpendicular to the unit axis ``k`` (3,): e1 of :func:`axis_frame` (k × the coordinate axis
+    least aligned with k, normalised), read-only."""
+    return axis_frame(k)[:, 0]
+
+
 def _built_frame(kx: float, ky: float, kz: float) -> np.ndarray:
     """:func:`axis_frame` of (kx, ky, kz): e1 = k × (the coordinate axis least aligned with k), normalised."""
     if abs(kx) <= abs(ky) and abs(kx) <= abs(kz):

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._cache import memo
-from .._forward import ScrewModel, screw_model
+from .._forward import ScrewModel, cross, screw_model
 from .._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
 
 
@@ -64,7 +64,7 @@ class Geometry:
 
     def parallel(self, i: int, j: int) -> bool:
         """Whether the axes (or sliding directions) of joints i and j are parallel or anti-parallel."""
-        return bool(np.linalg.norm(np.cross(self.direction(i), self.direction(j))) <= GEOMETRY_TOLERANCE * 10)
+        return bool(np.linalg.norm(cross(self.direction(i), self.direction(j))) <= GEOMETRY_TOLERANCE * 10)
 
     def intersection(self, i: int, j: int) -> np.ndarray | None:
         """The point where two non-parallel revolute axes meet, or None if they are skew or parallel."""
@@ -89,7 +89,7 @@ class Geometry:
     def on_axis(self, i: int, point: np.ndarray) -> bool:
         """Whether ``point`` lies on the axis of revolute joint i."""
         offset = point - self.point(i)
-        return bool(np.linalg.norm(np.cross(self.direction(i), offset)) <= GEOMETRY_TOLERANCE * 10 * self.length_scale)
+        return bool(np.linalg.norm(cross(self.direction(i), offset)) <= GEOMETRY_TOLERANCE * 10 * self.length_scale)
 
 
 def _closest_common_point(points: list[np.ndarray], directions: list[np.ndarray], scale: float) -> np.ndarray | None:
@@ -104,7 +104,7 @@ def _closest_common_point(points: list[np.ndarray], directions: list[np.ndarray]
         return None
     x = np.linalg.solve(A, b)
     for p, k in zip(points, directions):
-        if np.linalg.norm(np.cross(k, x - p)) > GEOMETRY_TOLERANCE * 10 * scale:
+        if np.linalg.norm(cross(k, x - p)) > GEOMETRY_TOLERANCE * 10 * scale:
             return None
     return x
 
@@ -162,12 +162,12 @@ def _common_normal_foot(p: np.ndarray, k: np.ndarray, p_other: np.ndarray, k_oth
                         least_sine: float = _FOOT_SINE) -> np.ndarray | None:
     """The point of line (p, k) nearest to line (p_other, k_other); None when the sine of their angle is below
     ``least_sine`` (the foot runs away as 1/sine)."""
-    normal = np.cross(k, k_other)
+    normal = cross(k, k_other)
     sine = float(np.linalg.norm(normal))
     if sine <= least_sine:
         return None
     # p + t k − (p_other + s k_other) ⟂ k and k_other: t = ((p_other − p) × k_other)·n / |n|², n = k × k_other
-    t = float(np.cross(p_other - p, k_other) @ normal) / sine ** 2
+    t = float(cross(p_other - p, k_other) @ normal) / sine ** 2
     return p + t * k
 
 
@@ -205,7 +205,7 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
     group_of = list(range(n))
     for j in range(n):
         for i in range(j):
-            if group_of[i] == i and np.linalg.norm(np.cross(directions[i], directions[j])) <= tolerance:
+            if group_of[i] == i and np.linalg.norm(cross(directions[i], directions[j])) <= tolerance:
                 group_of[j] = i
                 break
     leaders = [i for i in range(n) if group_of[i] == i]
@@ -230,7 +230,7 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
         fixed = [g for g in members if g in assigned]
         if not set(members) <= revolute or len(fixed) == len(members) or (fixed and len(members) > 2):
             continue
-        if all(np.linalg.norm(np.cross(directions[members[0]], directions[g])) <= 10 * GEOMETRY_TOLERANCE
+        if all(np.linalg.norm(cross(directions[members[0]], directions[g])) <= 10 * GEOMETRY_TOLERANCE
                for g in members[1:]):
             continue  # all parallel: no common point
         centre = _least_squares_point(points[members], directions[members])
@@ -245,7 +245,7 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
                 points[g] = centre
         assigned.update(members)
     # how far each line moved: its angle, and its displacement at the canonical point
-    angle = np.linalg.norm(np.cross(model.directions, directions), axis=1)
+    angle = np.linalg.norm(cross(model.directions, directions), axis=1)
     shift = np.array([_line_distance(model.points[i], points[i], directions[i]) for i in range(n)]) / scale
     shift[~model.is_revolute] = 0.0
     deviation = float((angle + shift).max()) if n else 0.0
@@ -261,4 +261,4 @@ def _least_squares_point(points: np.ndarray, directions: np.ndarray) -> np.ndarr
 
 
 def _line_distance(x: np.ndarray, p: np.ndarray, k: np.ndarray) -> float:
-    return float(np.linalg.norm(np.cross(k, x - p)))
+    return float(np.linalg.norm(cross(k, x - p)))

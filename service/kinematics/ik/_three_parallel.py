@@ -38,12 +38,12 @@ from . import _scalar as scalar
 from .._rotations import wrap_angle, wrap_any_float
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
-from .._forward import JointTrig
-from ._screws import apply, invert, joint_motion, move_point, rotate_about
+from .._forward import JointTrig, cross
+from ._screws import apply, invert, joint_motion, move_point, perpendicular_unit, rotate_about
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
 from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Singularity, Sealed
-from ._wrist import _perpendicular_unit, wrist_codes
+from ._wrist import wrist_codes
 
 
 class _AxesTwoToFourParallel(Sealed):
@@ -62,8 +62,8 @@ class _AxesTwoToFourParallel(Sealed):
         self.home_inverse = invert(self.model.home)
         self.omega_p = geometry.direction(1)
         self.signs = np.array([np.sign(geometry.direction(j) @ self.omega_p) for j in (1, 2, 3)])
-        self.normal_p = _perpendicular_unit(self.omega_p)
-        forward = _unit(np.cross(geometry.direction(0), self.omega_p))
+        self.normal_p = perpendicular_unit(self.omega_p)
+        forward = _unit(cross(geometry.direction(0), self.omega_p))
         reach = geometry.point(3) - geometry.point(0)
         self.forward = forward if forward @ reach >= 0 else -forward
 

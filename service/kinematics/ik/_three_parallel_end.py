@@ -27,12 +27,12 @@ import numpy as np
 from .._rotations import wrap_angle
 from ._positioning import side_codes
 from .._forward import JointTrig
-from ._screws import apply, chain_rotation, invert, joint_motion, move_point, rotate_about, rotation_about
+from ._screws import (apply, chain_rotation, invert, joint_motion, move_point, perpendicular_unit, rotate_about,
+                      rotation_about)
 from ._structure import Geometry
 from .subproblems import subproblem_1, subproblem_3, subproblem_6
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 from ._three_parallel import _split_double_root
-from ._wrist import _perpendicular_unit
 
 
 class ThreeParallelAtEndPlan(Sealed):
@@ -57,7 +57,7 @@ class ThreeParallelAtEndPlan(Sealed):
         self.home_inverse = invert(self.model.home)
         self.omega = geometry.direction(3)
         self.signs = np.array([np.sign(geometry.direction(j) @ self.omega) for j in (3, 4, 5)])
-        self.normal = _perpendicular_unit(self.omega)
+        self.normal = perpendicular_unit(self.omega)
         # the range of ||R(ω_5, q) (p_6 − p_5) − (p_4 − p_5)|| over q: the reach of the pair 4, 5 from axis 4
         along = geometry.direction(4)
         a, b = geometry.point(5) - geometry.point(4), geometry.point(3) - geometry.point(4)

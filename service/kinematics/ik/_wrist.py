@@ -20,8 +20,8 @@ import numpy as np
 
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from .._rotations import wrap_angle
-from .._forward import JointTrig
-from ._screws import rotate_about
+from .._forward import JointTrig, cross
+from ._screws import perpendicular_unit, rotate_about
 from ._structure import Geometry, idealised
 from .subproblems import subproblem_1, subproblem_2_chain
 from ._types import LabelCodes, SingularFlags, Singularity, Sealed
@@ -40,12 +40,6 @@ class WristResult:
     joints: np.ndarray
     valid: np.ndarray
     singularities: SingularFlags
-
-
-def _perpendicular_unit(axis: np.ndarray) -> np.ndarray:
-    trial = np.eye(3)[np.argmin(np.abs(axis))]
-    u = np.cross(axis, trial)
-    return u / np.linalg.norm(u)
 
 
 def wrist_codes(sine: np.ndarray) -> LabelCodes:
@@ -100,7 +94,7 @@ class SphericalWrist(Sealed):
         self.geometry = geometry
         self.joints = joints
         self.axes = [geometry.direction(j) for j in joints]
-        self.normal = _perpendicular_unit(self.axes[2])
+        self.normal = perpendicular_unit(self.axes[2])
         self.reads = np.stack([self.axes[2], self.normal])  # ω_c and its normal
 
     def solve(self, seen: np.ndarray, reference: np.ndarray | None) -> WristResult:
@@ -167,7 +161,7 @@ class SphericalWrist(Sealed):
     def volume_terms(self) -> tuple[float, float]:
         """(u, w) = (a·(b × c), a·(b × (b × c))) of the wrist's axes: its volume at q_b is |u cos q_b + w sin q_b|."""
         a, b, c = self.axes
-        return float(a @ np.cross(b, c)), float(a @ np.cross(b, np.cross(b, c)))
+        return float(a @ cross(b, c)), float(a @ cross(b, cross(b, c)))
 
     @cached_property
     def free_below(self) -> float:
@@ -194,7 +188,7 @@ class Roll:
         self.geometry = geometry
         self.joints = (joint,)
         self.axis = geometry.direction(joint)
-        self.normal = _perpendicular_unit(self.axis)
+        self.normal = perpendicular_unit(self.axis)
         self.reads = self.normal[None]
 
     def solve(self, seen: np.ndarray, reference: np.ndarray | None) -> WristResult:
@@ -223,7 +217,7 @@ class TwoAxisWrist(Sealed):
         self.geometry = geometry
         self.joints = joints
         self.axes = [geometry.direction(j) for j in joints]
-        self.normal = _perpendicular_unit(self.axes[1])
+        self.normal = perpendicular_unit(self.axes[1])
         self.reads = np.stack([self.axes[1], self.normal])  # ω_b and its normal
 
     def solve(self, seen: np.ndarray, reference: np.ndarray | None) -> WristResult:

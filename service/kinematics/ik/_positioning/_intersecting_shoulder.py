@@ -9,7 +9,7 @@ import numpy as np
 
 from ..._rotations import wrap_angle
 from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE
-from ..._forward import JointTrig
+from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -191,14 +191,14 @@ class IntersectingShoulder(Positioner):
         axis = g.direction(i)
         offset = self._offset()
         if offset is not None:
-            forward = _unit(np.cross(offset, g.upward(axis)))
+            forward = _unit(cross(offset, g.upward(axis)))
             if forward is not None:
                 return forward
         if g.link_x is not None:
             forward = _unit(g.link_x[i] - (g.link_x[i] @ axis) * axis)
             if forward is not None:
                 return forward
-        normal = _unit(np.cross(axis, g.direction(j)))
+        normal = _unit(cross(axis, g.direction(j)))
         return normal if normal is not None else self.point - self.centre
 
     @cached_property

@@ -8,7 +8,6 @@ columns, solvers and singularity reports listed once and referred to by index.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -53,11 +52,10 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
         return [[] for _ in free_of_target]
     joints = (table.joints / scale).tolist()
     position = table.position.tolist()
-    orientation = [None if math.isnan(value) else value for value in table.orientation.tolist()]
+    orientation = _listed(table.orientation, np.isnan)
     within = table.within_limits.tolist()
     branches = table.branches()
-    lower = [None if math.isinf(value) else value for value in (answer.limits.lower / scale).tolist()]
-    upper = [None if math.isinf(value) else value for value in (answer.limits.upper / scale).tolist()]
+    lower, upper = _listed(answer.limits.lower / scale, np.isinf), _listed(answer.limits.upper / scale, np.isinf)
     violations: dict[int, list[dict]] = {}
     for k, j in zip(*np.nonzero(outside)):
         violations.setdefault(int(k), []).append(
@@ -76,8 +74,8 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
             if roll is not None:
                 solution["free_values"]["roll"] = roll
     if table.clearance is not None:
-        clearance_values = [None if math.isinf(value) else value for value in table.clearance.tolist()]
-        for solution, clearance, contacts in zip((s for rows in per_target for s in rows), clearance_values,
+        for solution, clearance, contacts in zip((s for rows in per_target for s in rows),
+                                                 _listed(table.clearance, np.isinf),
                                                  _contacts(table)):
             solution["clearance"], solution["collisions"] = clearance, contacts
     return per_target
@@ -85,19 +83,17 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
 
 def _rolls(table: SolutionTable, angle: float) -> list[float | None]:
     """Each row's roll about the tool axis in the request's angle unit; None where the row has none."""
-    return [None if math.isnan(value) else value for value in (table.roll / angle).tolist()]
+    return _listed(table.roll / angle, np.isnan)
 
 
-def _clearances(table: SolutionTable) -> np.ndarray | list[float | None]:
-    """The clearance column of the arrays form; null where no pair was checked (+inf)."""
-    return _nulled(table.clearance, np.isinf(table.clearance))
+def _listed(values: np.ndarray, missing: np.ufunc) -> list[float | None]:
+    """A column (S,) as a list, None where ``missing`` (``np.isnan`` or ``np.isinf``) holds."""
+    return [None if gap else value for value, gap in zip(values.tolist(), missing(values).tolist())]
 
 
-def _nulled(values: np.ndarray, missing: np.ndarray) -> np.ndarray | list:
-    """A column (S,) as it stands (orjson writes the array), or as a list with None where ``missing`` (S,)."""
-    if not missing.any():
-        return values
-    return [None if gap else value for value, gap in zip(values.tolist(), missing.tolist())]
+def _nulled(values: np.ndarray, missing: np.ufunc) -> np.ndarray | list[float | None]:
+    """A column (S,) as it stands (orjson writes the array) when no value is ``missing``, else :func:`_listed`."""
+    return _listed(values, missing) if missing(values).any() else values
 
 
 def _contacts(table: SolutionTable) -> list[Sequence[dict]]:
@@ -148,7 +144,7 @@ def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer, angle: f
     target has no such free joint; ``"roll"``: each row's roll about the tool axis (``angle``: radians per unit),
     or None."""
     joints = table.joints / scale
-    orientation = _nulled(table.orientation, np.isnan(table.orientation))
+    orientation = _nulled(table.orientation, np.isnan)
     branch = {name: np.array([*values, None], dtype=object)[codes].tolist()
               for name, (values, codes) in table.labels.items()}
     free_values = {}
@@ -163,7 +159,8 @@ def _columns(table: SolutionTable, scale: np.ndarray, answer: IKAnswer, angle: f
                "residual_position": table.position, "residual_orientation": orientation, "branch": branch,
                "free_values": free_values}
     if table.clearance is not None:
-        columns["clearance"], columns["collisions"] = _clearances(table), _contacts(table)
+        # null where no pair was checked (+inf)
+        columns["clearance"], columns["collisions"] = _nulled(table.clearance, np.isinf), _contacts(table)
     return columns
 
 

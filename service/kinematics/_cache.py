@@ -20,6 +20,22 @@ T = TypeVar("T")
 AXES_KEPT = 4096
 
 
+class AxisCache(dict):
+    """A module-level cache keyed by a constant vector's values (a joint axis): read with ``get``, filled through
+    :meth:`keep`, which stops keeping once ``capacity`` keys are held (the first ones, a robot's axes, stay; a
+    caller sweeping over many axes has the rest computed each time)."""
+
+    def __init__(self, capacity: int = AXES_KEPT) -> None:
+        super().__init__()
+        self.capacity = capacity
+
+    def keep(self, key: Hashable, value: T) -> T:
+        """``value``, kept under ``key`` while fewer than ``capacity`` keys are."""
+        if len(self) < self.capacity:
+            self[key] = value
+        return value
+
+
 class DerivedStore:
     """Values derived from one robot, built on first use. Two threads asking for the same missing key may both
     build it; one of the two equal values is kept."""

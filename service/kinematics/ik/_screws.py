@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from .._cache import AXES_KEPT
+from .._cache import AxisCache
 from .._forward import JointTrig
 
 
@@ -56,12 +56,11 @@ def axis_frame(k: np.ndarray) -> np.ndarray:
     if frame is None:
         frame = _built_frame(*key)
         frame.setflags(write=False)
-        if len(_FRAMES) < AXES_KEPT:
-            _FRAMES[key] = frame
+        _FRAMES.keep(key, frame)
     return frame
 
 
-_FRAMES: dict[tuple[float, ...], np.ndarray] = {}
+_FRAMES = AxisCache()
 
 
 def perpendicular_unit(k: np.ndarray) -> np.ndarray:
@@ -107,12 +106,11 @@ def _cross_matrices(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         pair = (K, K @ K)
         for matrix in pair:
             matrix.setflags(write=False)
-        if len(_CROSS) < AXES_KEPT:
-            _CROSS[key] = pair
+        _CROSS.keep(key, pair)
     return pair
 
 
-_CROSS: dict[tuple[float, ...], tuple[np.ndarray, np.ndarray]] = {}
+_CROSS = AxisCache()
 _EYE3 = np.eye(3)
 _EYE3.setflags(write=False)
 

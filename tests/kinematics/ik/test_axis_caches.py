@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from service.kinematics._cache import AxisCache
 from service.kinematics.ik import _screws
 from service.kinematics.ik.subproblems import _vectors
 
@@ -12,8 +13,7 @@ from service.kinematics.ik.subproblems import _vectors
 def test_a_sweep_over_many_axes_keeps_at_most_the_bound(monkeypatch):
     kept = 8
     for module, cache in ((_screws, "_FRAMES"), (_screws, "_CROSS"), (_vectors, "_UNITS")):
-        monkeypatch.setattr(module, "AXES_KEPT", kept)
-        monkeypatch.setattr(module, cache, {})
+        monkeypatch.setattr(module, cache, AxisCache(kept))
     rng = np.random.default_rng(7)
     axes = rng.normal(size=(3 * kept, 3))
     axes /= np.linalg.norm(axes, axis=1, keepdims=True)

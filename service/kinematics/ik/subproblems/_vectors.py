@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._cache import AXES_KEPT
+from ..._cache import AxisCache
 from ..._errors import InvalidInputError
 from ..._forward import cross
 from ..._rotations import wrap_angle, wrap_float
@@ -37,13 +37,13 @@ def _unit(k: ArrayLike, name: str) -> np.ndarray:
     if known is not None:
         return known
     unit = _checked_unit(k, name)
-    if key is not None and len(_UNITS) < AXES_KEPT:
+    if key is not None:
         unit.setflags(write=False)
-        _UNITS[key] = unit
+        _UNITS.keep(key, unit)
     return unit
 
 
-_UNITS: dict[tuple, np.ndarray] = {}
+_UNITS = AxisCache()
 
 
 def _checked_unit(k: ArrayLike, name: str) -> np.ndarray:

@@ -155,17 +155,16 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
 
 def first_of_each_slot(robot: Robot, joints: np.ndarray, ok: list[bool]) -> list[bool]:
     """:func:`first_of_each` of one target's few slots ``joints`` (m, n), m at most :data:`_PAIRWISE_SLOTS`, the
-    ``ok`` ones and the result as lists (m,): every pair at once (:func:`_same_pairs`), then the scan on Python
-    booleans where two slots are one solution."""
+    ``ok`` ones and the result as lists (m,): every pair of slots at once, then the scan on Python booleans where
+    two slots are one solution. (Unlike :func:`_same_pairs`, no screen on the last joint first: the UR type's
+    slots share their last joint in pairs.)"""
     m = len(ok)
     if m < 2:
         return list(ok)
+    same = _same(np.abs(joints[:, None] - joints[None]), duplicate_tolerance(robot), robot.is_revolute)
     earlier, later = _slot_pairs(m)
-    pairs = _same_pairs(joints[None], earlier, later, duplicate_tolerance(robot), robot.is_revolute)[0]
-    if not pairs.any():  # no two slots one solution: nothing to drop
+    if not same[later, earlier].any():  # no two slots one solution: nothing to drop
         return list(ok)
-    same = np.zeros((m, m), dtype=bool)
-    same[later, earlier] = pairs  # the scan reads a slot's row at the slots before it
     return _scanned_pairs(same.tolist(), list(ok))
 
 

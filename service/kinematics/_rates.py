@@ -193,7 +193,7 @@ def task_space(robot: Robot, *, constrain_orientation: bool, free_joints: tuple[
     u = None
     if revolute:
         first = model.directions[revolute[0]]
-        if all(np.linalg.norm(np.cross(first, model.directions[i])) <= GEOMETRY_TOLERANCE * 10 for i in revolute):
+        if all(np.linalg.norm(cross(first, model.directions[i])) <= GEOMETRY_TOLERANCE * 10 for i in revolute):
             u = -first if first[2] < -1e-12 else first
     linear = identity
     linear_names = [f"v{a}" for a in _AXES]

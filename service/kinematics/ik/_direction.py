@@ -46,7 +46,7 @@ import numpy as np
 from .._budget import UNLIMITED, Budget
 from .._cache import bounded_memo
 from .._errors import InvalidInputError
-from .._forward import forward_kinematics
+from .._forward import cross, forward_kinematics
 from .._robot import Robot
 from .._rotations import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
@@ -123,14 +123,14 @@ def direction_plan(robot: Robot, tool_axis: np.ndarray) -> DirectionPlan | None:
         axis_world = R_home @ a
         last = robot.dof - 1
         along_last = (bool(model.is_revolute[last])
-                      and np.linalg.norm(np.cross(model.directions[last], axis_world)) <= GEOMETRY_TOLERANCE * 10
+                      and np.linalg.norm(cross(model.directions[last], axis_world)) <= GEOMETRY_TOLERANCE * 10
                       and geometry.on_axis(last, origin))
         if not along_last:
             plan = plan_for_geometry(_with_virtual_roll(geometry, axis_world), constrain_orientation=True,
                                      reference=None)
             return None if plan is None else DirectionPlan(plan, a, None, f"virtual_roll+{plan.structure}")
         first = perpendicular_unit(a)
-        for axis in (first, np.cross(a, first)):
+        for axis in (first, cross(a, first)):
             plan = plan_for_geometry(_with_virtual_roll(geometry, R_home @ axis), constrain_orientation=True,
                                      reference=None)
             if plan is not None:
@@ -145,7 +145,7 @@ def rotations_to(tool_axis: np.ndarray, world_directions: np.ndarray) -> np.ndar
     the shortest turn, or a half turn about an axis perpendicular to it when the two are opposite."""
     a = _unit(np.asarray(tool_axis, dtype=float))
     d = world_directions / np.linalg.norm(world_directions, axis=-1, keepdims=True)
-    axis = np.cross(a, d)
+    axis = cross(a, d)
     sine, cosine = np.linalg.norm(axis, axis=-1), d @ a
     opposite = sine < 1e-12
     axis = np.where(opposite[:, None], perpendicular_unit(a), axis / np.where(opposite, 1.0, sine)[:, None])
@@ -240,7 +240,7 @@ def rolls_of(tool_axis: np.ndarray, direction: np.ndarray, world_R_tool: np.ndar
     u = perpendicular_unit(a)
     R_t = rotations_to(a, np.asarray(direction, dtype=float)[None])[0]
     turned = (world_R_tool @ u) @ R_t  # rows: (R_t^T R u)^T, (K, 3)
-    return np.arctan2(turned @ np.cross(a, u), turned @ u)
+    return np.arctan2(turned @ cross(a, u), turned @ u)
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._forward import JointTrig, forward_kinematics, geometric_jacobian, tool_columns, tool_columns_scalar_rows
+from .._forward import JointTrig, cross, forward_kinematics, geometric_jacobian, tool_columns, tool_columns_scalar_rows
 from .._robot import Robot
 from ._structure import arm_size
 
@@ -139,7 +139,7 @@ class DirectionGoal:
         T = forward_kinematics(robot, joints.reshape(-1, robot.dof)).reshape(joints.shape[:-1] + (4, 4))
         position = np.linalg.norm(T[..., :3, 3] - self.positions[:, None], axis=-1)
         pointing = T[..., :3, :3] @ self.tool_axis
-        angle = np.arctan2(np.linalg.norm(np.cross(pointing, self.directions[:, None]), axis=-1),
+        angle = np.arctan2(np.linalg.norm(cross(pointing, self.directions[:, None]), axis=-1),
                            np.einsum("nmi,ni->nm", pointing, self.directions))
         return position, angle
 

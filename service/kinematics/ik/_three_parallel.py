@@ -191,7 +191,7 @@ class _AxesTwoToFourParallel(Sealed):
 
         def rising(sixth: np.ndarray) -> np.ndarray:
             """Whether the distance grows with q6 there: the sign of its derivative, ω_6 · (R(ω_6, −q6) u × w)."""
-            return np.cross(rotate_about(g.direction(5), -sixth, u), w) @ g.direction(5) > 0
+            return cross(rotate_about(g.direction(5), -sixth, u), w) @ g.direction(5) > 0
 
         # the two middle values mirror each other about the distance's extremes: one on each arc
         other = np.where(rising(q6) == rising(candidates[..., 0]), candidates[..., 1], candidates[..., 0])
@@ -393,10 +393,10 @@ class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
         arm = rotate_about(axis_1, -q1, (apply(A, self.centre) - g.point(0))[:, None, :])
         offset = rotate_about(axis_5, q5, self.centre - g.point(4))
         position = arm @ w_p - offset @ w_p - w_p @ (g.point(4) - g.point(0))
-        slope_1, slope_5 = -np.cross(axis_1, arm) @ w_p, -np.cross(axis_5, offset) @ w_p
+        slope_1, slope_5 = -cross(axis_1, arm) @ w_p, -cross(axis_5, offset) @ w_p
         normal = self._normal_part
-        return _nearer_root_on_line(normal(wanted), normal(-np.cross(axis_1, wanted)), normal(turned),
-                                    normal(np.cross(axis_5, turned)), position, slope_1, slope_5)
+        return _nearer_root_on_line(normal(wanted), normal(-cross(axis_1, wanted)), normal(turned),
+                                    normal(cross(axis_5, turned)), position, slope_1, slope_5)
 
     def _normal_part(self, v: np.ndarray) -> np.ndarray:
         """The part of vectors (..., 3) normal to the parallel axes."""

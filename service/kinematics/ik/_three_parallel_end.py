@@ -26,7 +26,7 @@ import numpy as np
 
 from .._rotations import wrap_angle
 from ._positioning import side_codes
-from .._forward import JointTrig
+from .._forward import JointTrig, cross
 from ._screws import (apply, chain_rotation, invert, joint_motion, move_point, perpendicular_unit, rotate_about,
                       rotation_about)
 from ._structure import Geometry
@@ -69,7 +69,7 @@ class ThreeParallelAtEndPlan(Sealed):
         def planar(x: np.ndarray) -> np.ndarray:
             return x - (x @ w) * w
         beyond, before = planar(geometry.point(5) - geometry.point(4)), planar(geometry.point(4) - geometry.point(3))
-        self.stretched5 = (float(np.arctan2(np.cross(beyond, before) @ geometry.direction(4), beyond @ before))
+        self.stretched5 = (float(np.arctan2(cross(beyond, before) @ geometry.direction(4), beyond @ before))
                            if np.linalg.norm(beyond) * np.linalg.norm(before) > 0 else 0.0)
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
@@ -142,7 +142,7 @@ class ThreeParallelAtEndPlan(Sealed):
         y = apply(y, p4)  # (N, 4, 3): G_2 G_3 p_4
         # the distance that joint 1 sweeps, [near, far], meets the reach of the pair 4, 5 (the pose is reached)
         tip = np.broadcast_to((apply(A, g.point(5)) - p1)[:, None], y.shape)
-        radial = np.linalg.norm(np.cross(h1, tip), axis=-1), np.linalg.norm(np.cross(h1, y - p1), axis=-1)
+        radial = np.linalg.norm(cross(h1, tip), axis=-1), np.linalg.norm(cross(h1, y - p1), axis=-1)
         rise = (tip - (y - p1)) @ h1
         near, far = np.hypot(radial[0] - radial[1], rise), np.hypot(radial[0] + radial[1], rise)
         low, high = np.maximum(near, self.reach[0]), np.minimum(far, self.reach[1])

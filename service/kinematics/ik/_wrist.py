@@ -103,7 +103,7 @@ class SphericalWrist(Sealed):
         target_axis = seen[..., 0, :]  # (..., 3)
         pair = subproblem_2_chain(a, b, c, target_axis[..., None, :])
         qa, qb = pair.theta1[..., 0, :], pair.theta2[..., 0, :]  # (..., 2)
-        free = pair.degenerate[..., 0] | (np.linalg.norm(np.cross(a, target_axis), axis=-1) <= self.free_below)
+        free = pair.degenerate[..., 0] | (np.linalg.norm(cross(a, target_axis), axis=-1) <= self.free_below)
         if free.any():
             start = 0.0 if reference is None else reference[self.joints[0]]
             back = rotate_about(a, -start, target_axis)

@@ -87,7 +87,7 @@ class IntersectingShoulder(Positioner):
         # subproblem 2 is degenerate when the target is on axis 1 (joint 1 free), or when the point is on axis 2
         # (joint 2 free: an elbow that lines the point up with it, as the stretched elbow of a 7R arm does)
         reach_scale = np.maximum(reach[:, None], np.linalg.norm(w3 - c, axis=-1))  # (N, 2)
-        on_axis_1 = (np.linalg.norm(np.cross(g.direction(i), targets - c), axis=-1)[:, None]
+        on_axis_1 = (np.linalg.norm(cross(g.direction(i), targets - c), axis=-1)[:, None]
                      <= GEOMETRY_TOLERANCE * reach_scale)
         free_shoulder = pair.degenerate & on_axis_1  # (N, 2)
         free_second = (pair.degenerate | self._near_axis_2_at_fold(third, w3 - c, reach_scale)) & ~on_axis_1
@@ -149,7 +149,7 @@ class IntersectingShoulder(Positioner):
             return np.zeros(point.shape[:2], dtype=bool)
         half = 0.5 * np.abs(wrap_angle(third.theta[:, 0] - third.theta[:, 1]))
         at_fold = third.merged | (np.nan_to_num(half, nan=0.0) <= FOLD_TOLERANCE)  # (N,)
-        radius = np.linalg.norm(np.cross(g.direction(j), point), axis=-1)
+        radius = np.linalg.norm(cross(g.direction(j), point), axis=-1)
         return at_fold[:, None] & (radius <= FOLD_TOLERANCE * scale)
 
     def _stretched(self, q3: np.ndarray, w: np.ndarray, c: np.ndarray) -> np.ndarray:

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE
-from ..._forward import JointTrig
+from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -101,7 +101,7 @@ class PlanarTwoLink(Positioner):
         up = g.upward(g.direction(i))
         elbow = self._moved(joints, i + 1, g.point(j), trig) - g.point(i)
         point = self._moved(joints, j + 1, self.point, trig) - g.point(i)
-        side = np.einsum("mi,i->m", np.cross(point, elbow), up)
+        side = np.einsum("mi,i->m", cross(point, elbow), up)
         return {"elbow": (("up", "down"), side_codes(side, np.linalg.norm(point, axis=-1) * np.linalg.norm(elbow, axis=-1)))}
 
 
@@ -128,7 +128,7 @@ class IntersectingPair(Positioner):
         start = {i: 0.0 if reference is None else float(reference[i]), j: 0.0 if reference is None
                  else float(reference[j])}
         # the chain form's theta1 is free with the target on axis 1, theta2 with the point on axis 2
-        on_axis_1 = np.linalg.norm(np.cross(g.direction(i), targets - c), axis=-1) <= GEOMETRY_TOLERANCE * g.length_scale
+        on_axis_1 = np.linalg.norm(cross(g.direction(i), targets - c), axis=-1) <= GEOMETRY_TOLERANCE * g.length_scale
         on_axis_2 = pair.degenerate & ~on_axis_1
         both = on_axis_1 & (np.linalg.norm(self.point - c) <= GEOMETRY_TOLERANCE * g.length_scale)
         if pair.degenerate.any():

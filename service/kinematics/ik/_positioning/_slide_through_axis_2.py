@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..._forward import cross
 from ..._rotations import wrap_angle
 from ..._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
 from .._screws import rotate_about
@@ -50,14 +51,14 @@ class SlideThroughAxis2:
             return None
         k1, k2, v = geometry.direction(i), geometry.direction(j), geometry.direction(k)
         offset = point - centre
-        crossing_miss = abs(float(offset @ np.cross(k2, v)))
+        crossing_miss = abs(float(offset @ cross(k2, v)))
         if abs(float(v @ k2)) > GEOMETRY_TOLERANCE or crossing_miss > GEOMETRY_TOLERANCE * geometry.length_scale:
             return None
         cos_alpha = float(k1 @ k2)
         n1 = k1 - cos_alpha * k2
         sin_alpha = float(np.linalg.norm(n1))
         n1 = n1 / sin_alpha
-        n2 = np.cross(k2, n1)
+        n2 = cross(k2, n1)
         return cls(float(offset @ k2), -float(offset @ v), n1, n2, float(np.arctan2(v @ n2, v @ n1)), cos_alpha,
                    sin_alpha)
 

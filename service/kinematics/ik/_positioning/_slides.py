@@ -8,7 +8,7 @@ import numpy as np
 
 from ..._rotations import wrap_angle
 from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, ROUNDING_TOLERANCE
-from ..._forward import JointTrig
+from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -72,7 +72,7 @@ class ParallelShoulder(Positioner):
         up = g.upward(g.direction(i))
         elbow = self._moved(joints, i + 1, g.point(j), trig) - g.point(i)
         point = self._moved(joints, k + 1, self.point, trig) - g.point(i)
-        side = np.einsum("mi,i->m", np.cross(point, elbow), up)
+        side = np.einsum("mi,i->m", cross(point, elbow), up)
         size = np.linalg.norm(point, axis=-1) * np.linalg.norm(elbow, axis=-1)
         return {"assembly_mode": ((1, 2), side_codes(side, size))}
 
@@ -238,7 +238,7 @@ class SkewAxesWithSlide(Positioner):
         normal = along <= GEOMETRY_TOLERANCE
         if normal and geometry.parallel(eliminated, circle):
             return None  # planar: the height along the parallel axes never changes
-        turn = float(np.linalg.norm(np.cross(geometry.direction(eliminated), geometry.direction(circle))))
+        turn = float(np.linalg.norm(cross(geometry.direction(eliminated), geometry.direction(circle))))
         if GEOMETRY_TOLERANCE < along <= RECOGNITION_TOLERANCE \
                 or 10 * GEOMETRY_TOLERANCE < turn <= RECOGNITION_TOLERANCE:
             return None  # nearly special (a rounded SCARA): the idealised family answers, refined on this arm

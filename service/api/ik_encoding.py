@@ -88,12 +88,18 @@ def _rolls(table: SolutionTable, angle: float) -> list[float | None]:
 
 def _listed(values: np.ndarray, missing: np.ufunc) -> list[float | None]:
     """A column (S,) as a list, None where ``missing`` (``np.isnan`` or ``np.isinf``) holds."""
-    return [None if gap else value for value, gap in zip(values.tolist(), missing(values).tolist())]
+    return _with_none(values, missing(values))
 
 
 def _nulled(values: np.ndarray, missing: np.ufunc) -> np.ndarray | list[float | None]:
     """A column (S,) as it stands (orjson writes the array) when no value is ``missing``, else :func:`_listed`."""
-    return _listed(values, missing) if missing(values).any() else values
+    gaps = missing(values)
+    return _with_none(values, gaps) if gaps.any() else values
+
+
+def _with_none(values: np.ndarray, gaps: np.ndarray) -> list[float | None]:
+    """``values`` (S,) as a list, None where ``gaps`` (S,) is true."""
+    return [None if gap else value for value, gap in zip(values.tolist(), gaps.tolist())]
 
 
 def _contacts(table: SolutionTable) -> list[Sequence[dict]]:

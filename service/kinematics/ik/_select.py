@@ -239,9 +239,13 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     n = robot.dof
     target, q = table.target, table.joints
     first, last = turn_ranges(robot, limits, q)
-    if reference is None and excluded is None and (first == last).all():
-        return _each_once(table, n_targets, first, max_equivalents, n)
+    unordered = reference is None and excluded is None
+    if unordered and (first == last).all():  # every row fits at one equivalent (one flat comparison: a batch's)
+        return _each_once(robot, limits, table, n_targets, first, last, np.ones(len(q), dtype=bool), filter_limits,
+                          max_equivalents)
     fits = np.all(last >= first, axis=1)
+    if unordered and (np.all(first == last, axis=1) | ~fits).all():  # and the others at none
+        return _each_once(robot, limits, table, n_targets, first, last, fits, filter_limits, max_equivalents)
     keepable = fits if filter_limits else np.ones(len(q), dtype=bool)
     if excluded is not None:
         keepable = keepable & ~excluded
@@ -290,53 +294,73 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
         dropped, dropped_values = dropped[order], dropped_values[order]
     rejected = table.take(dropped, joints=dropped_values, within_limits=fits[dropped])
 
-    n_kept = kept.counts(n_targets)
-    n_rejected = rejected.counts(n_targets)
-    outside = np.bincount(kept.target[~kept.within_limits], minlength=n_targets)
-    none_kept = (np.bincount(c_target, minlength=n_targets) == 0) & (n_rejected > 0)
     collided = np.zeros(n_targets, dtype=np.int64)  # rejected for a collision alone (within the limits, or flagged)
     if excluded is not None:
         collided = np.bincount(target[excluded & (fits | (not filter_limits))], minlength=n_targets)
-    status = _all_ok(n_targets)
-    status[none_kept] = "no_solution_within_limits"
-    status[none_kept & (collided > 0)] = "no_collision_free_solution"
-    status[table.counts(n_targets) == 0] = "unreachable"
-    no_fit = status == "no_solution_within_limits"
     capped = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
+    return _outcome(table.counts(n_targets), kept, kept.counts(n_targets), rejected,
+                    np.bincount(c_target, minlength=n_targets), available, with_all_moves, collided, capped,
+                    max_equivalents, reference is not None, limit if lowered else None, n)
+
+
+def _outcome(rows: np.ndarray, kept: SolutionTable, n_kept: np.ndarray, rejected: SolutionTable,
+             candidates: np.ndarray, available: np.ndarray, with_all_moves: np.ndarray, collided: np.ndarray,
+             capped: bool, max_equivalents: int, has_reference: bool, lowered_to: int | None, n: int) -> Selection:
+    """The selection of :func:`select` from its kept and rejected tables, with each target's status, counts and
+    notes. Per target, shape (N,) each: ``rows`` the verified solutions, ``n_kept`` the kept rows,
+    ``candidates`` the rows that may be kept (they fit, or the limits flag them, and no collision excludes them),
+    ``available`` and ``with_all_moves`` their combinations after and before ``max_joint_move``, ``collided`` the
+    rows rejected for a collision alone; ``capped`` says ``max_solutions`` set the number kept, and
+    ``lowered_to`` the limit :func:`enumerable_limit` imposed, if any.
+    """
+    n_targets = len(rows)
+    n_rejected = rejected.counts(n_targets)
+    outside = np.bincount(kept.target[~kept.within_limits], minlength=n_targets)
+    none_kept = (candidates == 0) & (n_rejected > 0)  # a target with no row at all rejects none either
+    no_fit = none_kept & (collided == 0)
+    reached = rows > 0
+    status = _all_ok(n_targets)
+    status[no_fit] = "no_solution_within_limits"
+    status[none_kept & (collided > 0)] = "no_collision_free_solution"
+    status[~reached] = "unreachable"
     truncated = (available > n_kept) & (not capped)
     trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
-    noted = (no_fit | (outside > 0) | truncated | ((status == "ok") & (n_kept == 0) & (with_all_moves > 0))
+    noted = (no_fit | (outside > 0) | truncated | (reached & ~none_kept & (n_kept == 0) & (with_all_moves > 0))
              | (collided > 0))
     notes = TargetNotes(np.flatnonzero(noted), status, n_rejected, outside, truncated, available, n_kept,
-                        with_all_moves, collided, max_equivalents, reference is not None, limit if lowered else None,
-                        n)
+                        with_all_moves, collided, max_equivalents, has_reference, lowered_to, n)
     return Selection(status, truncated, trimmed, available, notes, kept, rejected)
 
 
-def _each_once(table: SolutionTable, n_targets: int, turns: np.ndarray, max_equivalents: int, n: int) -> Selection:
-    """:func:`select` where every row fits the limits at exactly one 2π-equivalent (limits within a whole turn,
-    or none: each solution once) and nothing orders or excludes rows: each target's first ``max_equivalents``
-    rows in table order, at that equivalent, and the per-target counts the general path gives for them (each
-    row one combination, no rejected row), in a few array operations."""
-    target = table.target
-    rows_per_target = table.counts(n_targets)
-    values = table.joints + _TWO_PI * turns
-    if len(target) and rows_per_target.max() > max_equivalents:  # the cap: each target's first rows
-        keep = position_in_group(target) < max_equivalents
-        kept = table.take(keep, joints=values[keep], within_limits=np.ones(int(keep.sum()), dtype=bool))
-        n_kept = np.minimum(rows_per_target, max_equivalents)
+def _each_once(robot: Robot, limits: Limits, table: SolutionTable, n_targets: int, first: np.ndarray,
+               last: np.ndarray, fits: np.ndarray, filter_limits: bool, max_equivalents: int) -> Selection:
+    """:func:`select` where every row that fits the limits does so at exactly one 2π-equivalent (limits within a
+    whole turn, or none; ``first``, ``last`` (S, n) its turn ranges, ``fits`` (S,)) and nothing orders or
+    excludes rows: each target's first ``max_equivalents`` rows that may be kept, in table order, and the others
+    rejected at their closest equivalent, in table order, with the counts the general path gives for them (each
+    row one combination), in a few array operations."""
+    target, q = table.target, table.joints
+    turns = first
+    misfits = np.flatnonzero(~fits)
+    if len(misfits):  # each at its closest equivalent: rejected, or kept and flagged
+        turns = first.copy()
+        turns[misfits] = closest_turns(robot, limits, q[misfits], first[misfits], last[misfits])
+    values = q + _TWO_PI * turns
+    dropped = misfits if filter_limits else misfits[:0]
+    rows = table.counts(n_targets)
+    candidates = rows if not len(dropped) else np.bincount(np.delete(target, dropped), minlength=n_targets)
+    if not len(misfits) and candidates.max(initial=0) <= max_equivalents:  # every row kept as it stands
+        kept, n_kept = replace(table, joints=values, within_limits=fits), rows
     else:
-        kept = replace(table, joints=values, within_limits=np.ones(len(target), dtype=bool))
-        n_kept = rows_per_target
-    zeros = np.zeros(n_targets, dtype=np.int64)
-    status = _all_ok(n_targets)
-    status[rows_per_target == 0] = "unreachable"
-    truncated = rows_per_target > n_kept
-    available = rows_per_target.astype(np.int64, copy=False)
-    notes = TargetNotes(np.flatnonzero(truncated), status, zeros, zeros, truncated, available, n_kept, available,
-                        zeros, max_equivalents, False, None, n)
-    rejected = table.take(slice(0, 0))
-    return Selection(status, truncated, np.zeros(n_targets, dtype=np.int64), available, notes, kept, rejected)
+        keep = np.delete(np.arange(len(target)), dropped)
+        if candidates.max(initial=0) > max_equivalents:  # the cap: each target's first rows
+            keep = keep[position_in_group(target[keep]) < max_equivalents]
+        kept = table.take(keep, joints=values[keep], within_limits=fits[keep])
+        n_kept = kept.counts(n_targets)
+    rejected = table.take(dropped, joints=values[dropped], within_limits=fits[dropped])
+    nothing = np.zeros(n_targets, dtype=np.int64)
+    return _outcome(rows, kept, n_kept, rejected, candidates, candidates, candidates, nothing, False,
+                    max_equivalents, False, None, robot.dof)
 
 
 def _all_ok(n_targets: int) -> np.ndarray:

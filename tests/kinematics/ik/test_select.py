@@ -14,7 +14,7 @@ import pytest
 
 from service.kinematics import COUNT_CAP, LIMIT_TOLERANCE, Joint, Limits, Robot, forward_kinematics
 from service.kinematics.ik import IKResult, Ordering, Solution, solve_ik_arrays
-from tests.selection import select, select_arrays
+from tests.selection import select, select_arrays, select_table, table_of_arrays
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
 
@@ -289,6 +289,50 @@ def test_one_target_select_is_the_row_of_select_arrays(robot_id):
                 np.testing.assert_array_equal(table.joints[mine],
                                               np.array([e.solution.joints for e in entries]).reshape(-1, robot.dof))
                 assert table.within_limits[mine].tolist() == [e.within_limits for e in entries]
+
+
+@pytest.mark.parametrize("robot_id", ["puma560_standard", "kuka_kr6_r900_2", "ur5"])
+def test_rows_kept_once_each_are_the_general_paths(robot_id, monkeypatch):
+    """Limits under a whole turn (each solution has one equivalent within them, or none) and no reference: the
+    selection keeps the rows in table order without ranking any (``_each_once``). A batch's answer, with
+    solutions rejected, flagged, capped and targets out of reach, is the general path's (forced by an exclusion
+    mask that excludes nothing) in every field, bit for bit."""
+    from service.kinematics.ik import _select
+    robot = CATALOGUE.get(robot_id).robot
+    rng = np.random.default_rng(11)
+    q = rng.uniform(-np.pi, np.pi, (30, robot.dof))
+    targets = forward_kinematics(robot, q)
+    targets[::7, :3, 3] += 10.0  # out of reach
+    table = table_of_arrays(solve_ik_arrays(robot, targets))
+    taken = []
+    each_once = _select._each_once
+    monkeypatch.setattr(_select, "_each_once", lambda *args: taken.append(True) or each_once(*args))
+    met = {"rejected": 0, "flagged": 0, "truncated": 0, "unreachable": 0}
+    for trial in range(12):
+        lower = rng.uniform(-np.pi, 0.5, robot.dof)
+        upper = lower + rng.uniform(0.5, TWO_PI - 0.01, robot.dof)
+        open_joint = rng.random(robot.dof) < 0.2
+        limits = Limits(np.where(open_joint, -INF, lower), np.where(open_joint, INF, upper))
+        options = {"filter_limits": bool(trial % 2), "max_equivalents": [1, 3, 1024][trial % 3]}
+        lean = select_table(robot, table, len(targets), limits, **options)
+        general = select_table(robot, table, len(targets), limits, excluded=np.zeros(len(table), dtype=bool),
+                               **options)
+        context = (trial, options)
+        for name in ("status", "truncated", "trimmed", "available"):
+            np.testing.assert_array_equal(getattr(lean, name), getattr(general, name), err_msg=str(context))
+        assert dict(lean.notes) == dict(general.notes), context
+        for kind in ("solutions", "rejected"):
+            mine, theirs = getattr(lean, kind), getattr(general, kind)
+            for column in ("target", "joints", "within_limits", "position", "orientation"):
+                assert getattr(mine, column).tobytes() == getattr(theirs, column).tobytes(), (context, kind, column)
+            assert {k: (v, c.tolist()) for k, (v, c) in mine.labels.items()} == {
+                k: (v, c.tolist()) for k, (v, c) in theirs.labels.items()}, (context, kind)
+        met["rejected"] += len(lean.rejected)
+        met["flagged"] += int(np.sum(~lean.solutions.within_limits))
+        met["truncated"] += int(lean.truncated.sum())
+        met["unreachable"] += int(np.sum(lean.status == "unreachable"))
+    assert len(taken) == 12  # every lean call took the rows-once path
+    assert min(met.values()) > 0, met  # and the cases meet each kind of row and target
 
 
 def test_huge_limits_are_answered_bounded_with_exact_counts():

@@ -1,8 +1,10 @@
 """One target's answer (the few-rows forms of the selection) is the general array path's, field by field.
 
 For one target the selection looks rank tuples up row by row, works out each combination's turns directly and
-skips the bookkeeping of many targets (:mod:`service.kinematics.ik._equivalents`). The general path is forced by
-answering the same target inside a batch of other targets, with those forms switched off: the two answers must
+skips the bookkeeping of many targets (:mod:`service.kinematics.ik._equivalents`); where each solution has at most
+one equivalent within the limits and nothing orders the rows, it keeps them in table order without ranking any
+(``_select._each_once``). The general path is forced by answering the same target inside a batch of other
+targets, with those forms switched off and an exclusion mask that excludes nothing: the two answers must
 agree bit for bit, over random catalogue arms, limits (±2π and wider, narrow, one-sided, exactly at a
 solution's joints), references (some exactly between two equivalents) and options.
 """
@@ -15,7 +17,7 @@ import pytest
 from service.config import Settings
 from service.kinematics import Limits, forward_kinematics
 from service.kinematics.ik import AnswerOptions, IKTargets, Ordering, SolutionTable, answer_ik, select, solve_ik_arrays
-from service.kinematics.ik import _equivalents
+from service.kinematics.ik import _equivalents, _select
 from tests.selection import table_of_arrays
 from service.robots.catalogue import load_catalogue
 
@@ -99,14 +101,14 @@ def _select_both(robot, target, options, rng, monkeypatch):
     with monkeypatch.context() as forced:  # the general forms only: every row enumerated and tabled at once
         forced.setattr(_equivalents, "_FEW_ROWS", -1)
         forced.setattr(_equivalents, "_FEW_RANKS", -1)
-        general = select(robot, batch, 7, options.limits, **arguments)
+        general = select(robot, batch, 7, options.limits, excluded=np.zeros(len(batch), dtype=bool), **arguments)
     return mine, general
 
 
 @pytest.fixture
 def calls(monkeypatch):
     """Counts of the selection's few-rows and general forms, as the cases call them."""
-    counted = {"few rows": 0, "general": 0}
+    counted = {"few rows": 0, "general": 0, "each once": 0}
 
     def counting(function, key):
         def wrapper(*args, **kwargs):
@@ -116,6 +118,7 @@ def calls(monkeypatch):
 
     monkeypatch.setattr(_equivalents, "_row_rank_tuples", counting(_equivalents._row_rank_tuples, "few rows"))
     monkeypatch.setattr(_equivalents, "_tabled_turns", counting(_equivalents._tabled_turns, "general"))
+    monkeypatch.setattr(_select, "_each_once", counting(_select._each_once, "each once"))
     return counted
 
 
@@ -135,8 +138,9 @@ def test_one_target_selects_as_the_general_path(monkeypatch, calls):
         assert _rows(answer.rejected, 0) == _rows(mine.rejected, 0), case
         assert (answer.status[0], answer.available[0], answer.trimmed[0]) == (
             mine.status[0], mine.available[0], mine.trimmed[0])
-    # the cases exercise the few-rows forms and the general one, and rank many equivalents
-    assert ranked > 50 and calls["general"] > 50 and kept_many > 100, (ranked, calls, kept_many)
+    # the cases exercise the few-rows forms, the rows kept once each and the general one, and rank many equivalents
+    assert ranked > 50 and calls["general"] > 50 and calls["each once"] > 30 and kept_many > 100, (
+        ranked, calls, kept_many)
 
 
 def test_joint_exactly_at_its_limits_and_reference_between_equivalents(monkeypatch):

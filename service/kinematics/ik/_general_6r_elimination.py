@@ -299,8 +299,7 @@ def solve_arrangement(arr: Arrangement, A: np.ndarray) -> Roots:
     near = np.zeros_like(real)
     rows = np.flatnonzero(suspect.any(axis=1))
     if len(rows):  # the bound needs the left eigenvectors: only for targets with a complex root near the axis
-        left_vectors = np.linalg.inv(vectors[rows])
-        condition = np.linalg.norm(left_vectors, axis=2) * np.linalg.norm(vectors[rows], axis=1)
+        condition = _eigenvalue_conditions(vectors[rows])
         size = np.linalg.norm(companions[rows], axis=(1, 2))[:, None]
         with np.errstate(divide="ignore", invalid="ignore"):
             bound = 2.0 * 24 * np.finfo(float).eps * size * condition / np.abs(1.0 + y[rows] ** 2)
@@ -360,6 +359,24 @@ def _slide_to_angle(E: np.ndarray, centre: np.ndarray, half_width: np.ndarray) -
     Q1 = w * (E[:, 1] + 2.0 * c * E[:, 2])
     Q2 = w ** 2 * E[:, 2]
     return 0.5 * np.stack([Q0 + Q2, Q0 - Q2, Q1], axis=1)
+
+
+def _eigenvalue_conditions(vectors: np.ndarray) -> np.ndarray:
+    """Each eigenvalue's condition number ‖l_i‖ ‖v_i‖, shape (R, k), from the right eigenvectors (R, k, k) as
+    columns, the left ones being the rows of their inverse. Where a target's eigenvectors are dependent (a
+    defective eigenvalue, as a degenerate arm gives: every link 1e-12 long), no eigenvalue of it has a finite
+    bound: its conditions are inf, so each complex root near the axis counts as ambiguous."""
+    right = np.linalg.norm(vectors, axis=1)
+    try:
+        return np.linalg.norm(np.linalg.inv(vectors), axis=2) * right
+    except np.linalg.LinAlgError:  # one singular matrix fails the whole stack: target by target
+        conditions = np.full(right.shape, np.inf)
+        for row, matrix in enumerate(vectors):
+            try:
+                conditions[row] = np.linalg.norm(np.linalg.inv(matrix), axis=1) * right[row]
+            except np.linalg.LinAlgError:
+                pass
+        return conditions
 
 
 def _monomial_value(m: np.ndarray, revolute: bool) -> np.ndarray:

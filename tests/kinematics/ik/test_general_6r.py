@@ -301,6 +301,38 @@ def test_targets_beyond_the_reach_bound_are_unreachable_and_complete(distance):
     assert result.solutions == []
 
 
+def test_a_target_whose_eigenvectors_are_dependent_gets_unbounded_conditions():
+    """The error bound of a complex root near the axis needs the left eigenvectors, the rows of V⁻¹. A target
+    whose eigenvectors are dependent (a defective eigenvalue) has none: its eigenvalues' conditions are inf
+    (each such root then counts as ambiguous), and the targets beside it keep their own."""
+    from service.kinematics.ik._general_6r_elimination import _eigenvalue_conditions
+
+    well = np.array([[2.0, 1.0], [0.0, 1.0]])  # columns (2, 0) and (1, 1): V⁻¹ rows (0.5, −0.5) and (0, 1)
+    dependent = np.array([[1.0, 1.0], [0.0, 0.0]])
+    conditions = _eigenvalue_conditions(np.stack([well, dependent, well]))
+    expected = np.array([np.hypot(0.5, 0.5) * 2.0, 1.0 * np.sqrt(2.0)])
+    np.testing.assert_allclose(conditions[[0, 2]], [expected, expected], rtol=1e-15)
+    assert np.isinf(conditions[1]).all()
+
+
+@pytest.mark.parametrize("size", [1e-12, 1e-9])
+def test_an_arm_of_tiny_links_answers_a_direction_target_out_of_reach(client, size):
+    """Every link 1e-12 long, each twist 90°: a direction target 0.24 away gave a 500 (the elimination's
+    eigenvectors were exactly dependent and V⁻¹ failed). It is out of reach, and said so; a target the arm
+    reaches, at its own scale, is answered with solutions the service verified."""
+    robot = {"convention": "standard",
+             "joints": [{"type": "revolute", "a": size, "d": size, "alpha": np.pi / 2}] * 6}
+    far = {"position": [0.1, 0.1, 0.2], "orientation": {"type": "direction", "world_direction": [0, 0, 1]}}
+    response = client.post("/v1/ik", json={"robot": robot, "target": far})
+    assert response.status_code == 200, response.text
+    assert response.json()["status"] == "unreachable"
+    near = {"position": [0.1 * size, 0.1 * size, 0.2 * size],
+            "orientation": {"type": "direction", "world_direction": [0, 0, 1]}}
+    response = client.post("/v1/ik", json={"robot": robot, "target": near})
+    assert response.status_code == 200, response.text
+    assert response.json()["status"] == "ok" and response.json()["solutions"]
+
+
 def test_a_batch_larger_than_a_chunk_is_answered_in_one_piece():
     """The solver gives each chunk of targets only the slots it needs; chunks of different widths are merged."""
     from service.kinematics.ik import _closed_form

@@ -11,6 +11,7 @@ import numpy as np
 
 from .._forward import geometric_jacobian
 from .._limits import Limits
+from .._linear import solve_each
 from .._rates import TaskSpace, joint_rates, task_jacobian
 from .._robot import Robot
 from ..ik import IKOptions, IKResult, distance_to_reference, joint_difference
@@ -147,10 +148,7 @@ def _listed_rates(robot: Robot, results: list[IKResult], tracking: Tracking | No
         b = np.nan_to_num(row_scale * twists) @ task.basis.T  # (M, m)
         with np.errstate(all="ignore"):
             if task.solve == "exact":
-                try:
-                    y = np.linalg.solve(Js, b[..., None])[..., 0]
-                except np.linalg.LinAlgError:  # an exactly singular one: the pseudo-inverse for all
-                    y = np.einsum("nkm,nm->nk", np.linalg.pinv(Js), b)
+                y = solve_each(Js, b[..., None])[..., 0]
             else:
                 y = np.einsum("nkm,nm->nk", np.linalg.pinv(Js), b)
         velocities = np.zeros((len(q), robot.dof))

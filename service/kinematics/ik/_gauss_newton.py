@@ -27,6 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._budget import UNLIMITED, Budget
+from .._linear import solve_each
 from .._robot import Robot
 from ._goals import Goal
 
@@ -71,7 +72,7 @@ def gauss_newton(robot: Robot, goal: Goal, q: np.ndarray, rows: np.ndarray, *, s
         mu = damping[index] * np.maximum(1.0, np.trace(JJt, axis1=-2, axis2=-1)) if adaptive else damping[index]
         JJt[:, np.arange(JJt.shape[1]), np.arange(JJt.shape[1])] += mu[:, None]
         with np.errstate(all="ignore"):
-            solved = np.linalg.solve(JJt, error[index][..., None])[..., 0]
+            solved = solve_each(JJt, error[index][..., None])[..., 0]
             trial = q[index]
             trial[:, columns] += np.einsum("kji,kj->ki", J, solved)
             trial_error = goal.error(robot, trial, rows[index])

@@ -73,6 +73,9 @@ GOOD_ENOUGH = 1e-10
 SAME_FAMILY = 1e-4
 #: A family's representative is reached from a root in steps of at most this (radians) along its null motion.
 FAMILY_STEP = 0.2
+#: The most such steps: a turn needs fewer (its way is at most π / |its share of the unit motion| ≤ π√6, 39
+#: steps); only a slide's way, in normalised lengths, can be longer, and it is taken in longer steps.
+MAX_FAMILY_STEPS = 64
 #: The step (radians) along a singular root's null motion that tells a family (the target still reached, either
 #: way) from a fold (reached on one side at most).
 FAMILY_PROBE = 1e-3
@@ -331,8 +334,12 @@ class General6RPlan(Sealed):
     def _along_family(self, A: np.ndarray, q: np.ndarray, change: np.ndarray, held: np.ndarray) -> np.ndarray:
         """Roots q (K, 6) moved by ``change`` (K, 6) along their null motion, in steps of at most
         :data:`FAMILY_STEP` radians, each followed by Newton's steps with joint ``held`` (K,) kept (a family's
-        path curves away from its tangent)."""
-        steps = max(1, int(np.ceil(np.abs(change).max(initial=0.0) / FAMILY_STEP)))
+        path curves away from its tangent), and at most :data:`MAX_FAMILY_STEPS` of them: a longer way (a slide's
+        reference far along the motion, as an arm of 1e-11 links with a slide metres out asks) is taken in longer
+        steps, and where they miss the target the caller keeps the root. A change that is not finite moves
+        nothing."""
+        change = np.where(np.isfinite(change).all(axis=1, keepdims=True), change, 0.0)
+        steps = min(max(1, int(np.ceil(np.abs(change).max(initial=0.0) / FAMILY_STEP))), MAX_FAMILY_STEPS)
         for _ in range(steps):
             q = newton(self.directions, self.points, self.revolute, A, q + change / steps, held=held)
         return q

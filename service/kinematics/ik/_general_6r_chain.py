@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._forward import cross
+from .._linear import solve_each
 from .._tolerances import DUPLICATE_TOLERANCE
 from ._screws import rotation_about
 
@@ -63,7 +64,7 @@ def newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_t
             q[active] += np.einsum("kij,kj->ki", np.linalg.pinv(np.swapaxes(J, -1, -2), rcond=rcond), error[active])
             continue
         JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6) + fixed[..., None] * np.eye(6)
-        q[active] += np.linalg.solve(JJt, (J @ error[active][..., None]))[..., 0]
+        q[active] += solve_each(JJt, J @ error[active][..., None])[..., 0]
     return q
 
 

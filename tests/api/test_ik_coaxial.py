@@ -127,3 +127,23 @@ def test_a_free_joint_named_on_that_arm_leaves_the_pair_held(client):
         assert solution["free_values"]["6"] == solution["joints"][6]
         np.testing.assert_allclose(fk_inline(client, UR5_WITH_A_COAXIAL_BASE, solution["joints"]), target,
                                    atol=1e-9)
+
+
+@pytest.mark.parametrize("rows", [
+    # a planar 3R arm whose joints 1 and 2 are one line, carrying a 3R wrist (no closed form covers the arm
+    # without joint 2: it went to the three-parallel family, which listed one member of the family, unflagged)
+    [{"type": "revolute"}, {"type": "revolute", "a": 0.3}, {"type": "revolute", "alpha": np.pi / 2},
+     {"type": "revolute", "alpha": np.pi / 2}, {"type": "revolute", "a": 0.3}, {"type": "revolute"}],
+])
+def test_a_coaxial_pair_no_closed_form_covers_is_still_stated(client, rows):
+    """Two coaxial joints fix only their sum, whatever covers the rest of the arm: when no closed form covers
+    the arm without the pair's second joint, the numeric search answers, and the pair's relation is stated and
+    its second joint listed free, held at the reference value."""
+    robot = {"convention": "standard", "joints": rows}
+    q = [0.5, 0.3, 0.5, 0.5, 0.5, 0.5]
+    pose = client.post("/v1/fk", json={"robot": robot, "joints": q}).json()["pose"]
+    answer = client.post("/v1/ik", json={"robot": robot, "target": pose, "reference": q}).json()
+    assert answer["status"] == "ok", answer["detail"]
+    assert answer["free_joints"] == [1]
+    assert [(s["kind"], s["joints"], s["relation"]) for s in answer["singularities"]] == [("coaxial", [0, 1], "sum")]
+    assert (np.abs((joints_of(answer) - q + np.pi) % (2 * np.pi) - np.pi).max(axis=1) <= 1e-6).any()

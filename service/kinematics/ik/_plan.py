@@ -66,8 +66,9 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
     to the general 6R solver, last, because a rounded Pieper arm is nearly degenerate for its elimination.
     """
     geometry = geometry_of(robot)
-    plan = _coaxial_plan(geometry, constrain_orientation, reference) or \
-        _family_plan(geometry, constrain_orientation, reference)
+    if coaxial_pair(geometry) is not None:  # only the pair's sum is fixed: no plan of the whole arm says so
+        return _coaxial_plan(geometry, constrain_orientation, reference)
+    plan = _family_plan(geometry, constrain_orientation, reference)
     if plan is not None:
         return plan
     ideal = idealised(geometry)
@@ -82,8 +83,9 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
 def plan_for_geometry(geometry: Geometry, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     """:func:`plan_for` on a screw model directly, exact recognition only (the idealised retry needs the robot):
     also for arms that exist only as models, such as a redundant arm with joints locked (see ``_redundant``)."""
-    plan = _coaxial_plan(geometry, constrain_orientation, reference) or \
-        _family_plan(geometry, constrain_orientation, reference)
+    if coaxial_pair(geometry) is not None:
+        return _coaxial_plan(geometry, constrain_orientation, reference)
+    plan = _family_plan(geometry, constrain_orientation, reference)
     if plan is None and constrain_orientation:
         plan = General6RPlan.match(geometry)
     return plan
@@ -186,6 +188,8 @@ def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
         positioner = find_positioner(geometry, tuple(range(k)), point) if k else None
         if k and positioner is None:
             continue
+        if positioner is not None and positioner.free_joints and not isinstance(wrist, SphericalWrist):
+            continue  # a joint the position leaves free turns the tool: only a spherical wrist takes that up
         return DecoupledPlan(positioner, wrist, point, model.home, n)
     return None
 

@@ -202,6 +202,8 @@ class OffsetShoulderIntersectingElbow(Positioner):
             return None
         if geometry.model.is_revolute[joints[0]] and geometry.on_axis(joints[0], centre):
             return None  # all three axes through one point: it cannot place a point
+        if geometry.on_axis(joints[2], point):
+            return None  # joint 3 never moves the point: two joints cannot place it
         return cls(geometry, joints, point, centre)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:

@@ -33,7 +33,7 @@ class OneRevolute(Positioner):
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         """Joint values (N, 1, 1) carrying the point to targets (N, 3), valid (N, 1) where on the circle."""
         g, (i,) = self.geometry, self.joints
-        turn = subproblem_1(g.direction(i), self.point - g.point(i), targets - g.point(i))
+        turn = subproblem_1(g.direction(i), self.point - g.point(i), targets - g.point(i), scale=g.length_scale)
         free = turn.degenerate  # (N,): the point (or the target) on the axis
         q = np.where(free[:, None], 0.0 if reference is None else reference[i], turn.theta)
         singular = SingularFlags(len(targets))

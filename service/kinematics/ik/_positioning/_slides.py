@@ -107,6 +107,8 @@ class OneRevoluteTwoPrismatic(Positioner):
         axial = np.array([omega @ geometry.direction(s) for s in slides])
         if np.abs(axial).max() <= GEOMETRY_TOLERANCE:
             return None  # no slide along the axis: the height equation does not fix them
+        if geometry.parallel(*slides):
+            return None  # parallel slides move the point along one line: only their sum is fixed
         return cls(geometry, joints, point, revolute=revolute, slides=slides)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
@@ -136,7 +138,7 @@ class OneRevoluteTwoPrismatic(Positioner):
         world = targets[:, None, :] - p - slides @ V_pre.T
         # an azimuth seen on a radius is known to the target's rounding / radius: free only within rounding
         band = ROUNDING_TOLERANCE * (g.length_scale + np.linalg.norm(targets, axis=-1))[:, None]
-        turn = subproblem_1(omega, body, world, free_below=band)
+        turn = subproblem_1(omega, body, world, free_below=band, scale=g.length_scale)
         theta = turn.theta[..., 0]
         free = turn.degenerate
         if reference is not None:

@@ -21,7 +21,8 @@ from ._roots import _harmonic
 from ._vectors import _coords, _cross3, _distances, _hypot, _norm, _pair, _points, _rotate_onto, _unit
 
 
-def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike, free_below: ArrayLike | None = None) -> AngleSolutions:
+def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike, free_below: ArrayLike | None = None,
+                 scale: float | None = None) -> AngleSolutions:
     """Paden-Kahan 1: solve ``R(k, theta) p = q``; else minimise ``||R(k, theta) p - q||``.
 
     An exact solution needs ``||p_perp|| = ||q_perp||`` and ``k.p = k.q``. The
@@ -39,6 +40,10 @@ def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike, free_below: ArrayLike
         The radius from the axis at or below which a point counts as on it (``degenerate``); by default
         ``GEOMETRY_TOLERANCE * L``. A caller that knows the target's rounding passes it: a point further
         out still fixes the angle, to rounding / radius.
+    scale : float, optional
+        The length ``L`` the tolerances are relative to; by default ``max(||p||, ||q||)``. A positioner passes
+        its arm's size: a point at the axis's origin and a target there (both ~0, one of them rounding dust) are
+        then judged against the arm, not against the dust.
 
     Returns
     -------
@@ -64,7 +69,8 @@ def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike, free_below: ArrayLike
     p = _points(p, "p")
     q = _points(q, "q")
     free_below = None if free_below is None else np.asarray(free_below, dtype=float)
-    theta, exact, degenerate = _rotate_onto(axis_frame(k), p, q, free_below=free_below)  # all of the batch shape
+    theta, exact, degenerate = _rotate_onto(axis_frame(k), p, q, None if scale is None else np.float64(scale),
+                                            free_below=free_below)  # all of the batch shape
     return AngleSolutions(
         theta=theta[..., None],
         valid=np.ones(theta.shape + (1,), dtype=bool),

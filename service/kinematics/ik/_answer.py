@@ -241,8 +241,8 @@ class _Part:
     solver, and per local row the words before the selection's notes (``details``) and after them
     (``remarks``). ``reported`` (k,) says where the solver's singular conditions are reported (default: the rows
     with a solution); ``unfinished`` (k,) where the numeric search's iteration cap stopped starts; ``sampled``
-    (k,) where the solver answered complete at sampled values of a continuous freedom (the roll), so an empty
-    answer proves nothing: ``not_found`` rather than ``unreachable``."""
+    (k,) where the solver answered complete at sampled values of a continuous freedom (the roll, a redundant
+    arm's free joints), so an empty answer proves nothing: ``not_found`` rather than ``unreachable``."""
 
     rows: np.ndarray
     verified: Verified
@@ -499,9 +499,14 @@ def _family(robot: Robot, goal: PoseGoal, rows: np.ndarray, free: list[FreeJoint
         return [_timed(timings, part, started)]
     with _at_free_joints():
         answer = solve_family(robot, family, goal, free, options.reference, budget=options.budget)
-    part = _Part(rows, answer.verified, "analytic", family.structure, family.free_joints)
+    # solved completely at each free value, which proves nothing for the values between: an empty answer is
+    # not_found, unless the position is beyond the arm's reach
+    part = _Part(rows, answer.verified, "analytic", family.structure, family.free_joints,
+                 sampled=np.ones(len(rows), dtype=bool))
     for local in np.flatnonzero(answer.verified.count == 0).tolist():
-        part.details[local] = no_solution_detail(robot, free, goal.world_T_targets[local, :3, 3])
+        position = goal.world_T_targets[local, :3, 3]
+        part.details[local] = no_solution_detail(robot, free, position)
+        part.sampled[local] = not bool(beyond_reach(robot, position))
     for local in np.flatnonzero(answer.missing > 0).tolist():
         part.remarks[local] = (f"At {answer.missing[local]} of the free values the locked arm falls outside the "
                                f"closed-form family, so no solution is listed there.")

@@ -195,3 +195,31 @@ def test_free_joint_errors_are_located_in_the_request_and_worded_in_the_core_ter
     with pytest.raises(InvalidInputError) as caught:  # answer_ik puts them at its option
         answer_ik(robot, target, AnswerOptions(free_joints=[(9, [0.0], None)]))
     assert caught.value.location == ("free_joints", 0, "joint")
+
+
+@pytest.mark.parametrize("robot_id, q", [
+    ("kinova_gen3", [2.646482, 1.330195, 0.504285, 0.001, 1.997572, -1.487952, 0.836111]),
+    ("kuka_iiwa14", [0.605373, -0.781728, 1.685082, 0.001, 0.558733, 0.550195, -2.776092]),
+    ("kuka_iiwa14", [-0.406115, -1.118501, 0.767787, 0.024351, 0.436138, -1.823231, 1.213270]),
+])
+def test_an_empty_family_near_a_stretched_elbow_is_not_said_unreachable(robot_id, q):
+    """A redundant arm's family is solved completely at each sampled value of its free joint, which proves
+    nothing for the values between: a pose from the arm's own FK that no sampled value reaches (an elbow a
+    thousandth of a radian from straight, where each locked arm's two elbow roots nearly meet) is `not_found`,
+    not `unreachable` (a hostile probe found it said unreachable, with complete true). A pose beyond the reach
+    sphere stays a proof."""
+    from service.config import Settings
+    from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik
+    from service.robots.catalogue import load_catalogue
+
+    robot = load_catalogue([Settings().builtin_robots_dir], max_joints=32).get(robot_id).robot
+    q = np.array(q)
+    target = forward_kinematics(robot, q)
+    far = target.copy()
+    far[:3, 3] *= 100.0
+    for reference in (None, q):
+        answer = answer_ik(robot, IKTargets.poses(np.stack([target, far])), AnswerOptions(reference=reference))
+        assert answer.status[0] != "unreachable", answer.detail_list()[0]
+        if answer.status[0] == "ok":
+            assert_fk_verified(robot, answer.solutions.joints[answer.solutions.target == 0], target)
+        assert answer.status[1] == "unreachable" and "outside the workspace" in answer.detail_list()[1]

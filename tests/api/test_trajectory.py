@@ -479,3 +479,23 @@ def test_a_ur5e_path_near_its_shoulder_singularity_stays_on_its_branch_through_h
     assert not any(answer["samples"][k]["branch_changed"] for k in middle)
     velocities = np.array([s["velocities"] for s in answer["samples"]])
     assert np.abs(velocities - qd).max() < 1e-3 * np.abs(qd).max()
+
+
+@pytest.mark.parametrize("robot_id, q0, q1", [
+    ("franka_panda", [1.3259, 1.9502, 0.8228, 1.3389, -0.4329, 1.0029, -0.4614],
+     [1.7557, 2.2237, 0.7022, 1.6231, -0.8663, 1.4279, -0.2683]),
+    ("kuka_iiwa14", [0.3, 0.8, -0.4, -1.2, 0.6, 0.9, 0.2], [0.6, 1.0, -0.2, -1.0, 0.4, 1.2, 0.5]),
+])
+def test_a_redundant_arm_on_a_smooth_path_keeps_its_branch_unchanged(client, robot_id, q0, q1):
+    """A redundant arm's answer lists members of a family over its free joint, several near the previous
+    sample's joints: choosing among members of one branch (the same labels) is not a change of branch. A probe
+    found every sample after the first marked branch_changed with its labels unchanged."""
+    Q = np.linspace(q0, q1, 60)[:6].tolist()
+    poses = client.post(f"/v1/robots/{robot_id}/fk/batch", json={"joints": Q}).json()["poses"]
+    answer = client.post(f"/v1/robots/{robot_id}/ik/trajectory",
+                         json={"samples": [{"time": 0.1 * k, "pose": pose} for k, pose in enumerate(poses)],
+                               "reference": Q[0]}).json()
+    samples = answer["samples"]
+    assert [s["status"] for s in samples] == ["ok"] * 6
+    assert all(s["branch"] == samples[0]["branch"] for s in samples)
+    assert not any(s["branch_changed"] for s in samples) and answer["summary"]["branch_changes"] == []

@@ -171,6 +171,8 @@ def _follow(robot: Robot, times: np.ndarray, targets: np.ndarray, results: list[
         if previous is not None and distances is not None:
             nearest = float(distances.min())
             apart = _distance(robot, joints[pool], joints[choice], weights) > SAME_SOLUTION
+            if result.free_joints:  # members of a family over free joints: only another branch makes it unsure
+                apart &= np.array([branches[i] != branches[choice] for i in pool], dtype=bool)
             others = distances[apart].tolist()
             # another solution about as near the prediction: which one continues the branch is not known
             unsure = any(d <= AMBIGUITY_FACTOR * nearest and d > SAME_SOLUTION for d in others)

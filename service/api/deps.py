@@ -113,4 +113,6 @@ def check_batch_size(request: Request, rows: int, field: str) -> None:
     limit = settings_of(request).max_batch
     if rows > limit:
         raise ProblemError(413, "batch-too-large", "Batch too large",
-                           f"{field} has {rows} rows; this service accepts at most {limit} (KIN_MAX_BATCH).")
+                           f"{field} has {rows} rows; this service accepts at most {limit} (KIN_MAX_BATCH).",
+                           errors=[{"loc": ["body", field], "msg": f"at most {limit} rows (KIN_MAX_BATCH)",
+                                    "type": "too_long"}])

@@ -37,9 +37,25 @@ def svg_response(text: str) -> Response:
 
 
 def wants_svg(request: Request) -> bool:
-    """Whether the client asked for the picture: ``Accept: image/svg+xml`` before any JSON type."""
-    accept = request.headers.get("accept", "")
-    return SVG_MEDIA_TYPE in accept and "json" not in accept.split(SVG_MEDIA_TYPE, 1)[0]
+    """Whether the client prefers the picture: ``Accept`` weighs ``image/svg+xml`` above JSON (``application/json``,
+    ``application/*`` or ``*/*``) by its quality values (RFC 9110 §12.5.1, q = 1 by default), the one listed first
+    at equal weights. No ``Accept``, or one that does not name SVG, gets JSON."""
+    svg = json = (0.0, 0)  # (weight, −position): the best range of each
+    for position, part in enumerate(request.headers.get("accept", "").split(",")):
+        media, *parameters = (piece.strip().lower() for piece in part.split(";"))
+        weight = 1.0
+        for parameter in parameters:
+            name, _, value = parameter.partition("=")
+            if name.strip() == "q":
+                try:
+                    weight = min(max(float(value), 0.0), 1.0)
+                except ValueError:
+                    weight = 0.0
+        if media == SVG_MEDIA_TYPE:
+            svg = max(svg, (weight, -position))
+        elif media in ("application/json", "application/*", "*/*"):
+            json = max(json, (weight, -position))
+    return svg[0] > 0.0 and svg > json
 
 
 def render_request_svg(ref: RobotRef, body: RenderRequest) -> str:

@@ -294,7 +294,9 @@ def test_a_chunked_body_under_the_maximum_is_served(small_limits_client):
     ("/v1/limits", {"joints": [[0.0, 0.0]] * 4, "robot": PLANAR}),
 ])
 def test_a_batch_over_the_maximum_is_413(small_limits_client, path, body):
-    assert_problem(small_limits_client.post(path, json=body), 413, match="at most 3")
+    problem = assert_problem(small_limits_client.post(path, json=body), 413, match="at most 3")
+    field = "targets" if "targets" in body else "joints"  # the field at fault, located as a 422's are
+    assert [error["loc"] for error in problem["errors"]] == [["body", field]]
     body_at_limit = {key: value[:3] if isinstance(value, list) else value for key, value in body.items()}
     assert small_limits_client.post(path, json=body_at_limit).status_code == 200
 

@@ -133,6 +133,26 @@ def test_ik_answers_with_the_picture_of_every_distinct_solution(client):
     assert first[1] == " · ".join(f"{k} {v}" for k, v in labels.items())
 
 
+@pytest.mark.parametrize("accept, picture", [
+    ("image/svg+xml", True),
+    ("image/svg+xml, application/json", True),  # equal weights: the one listed first
+    ("application/json, image/svg+xml", False),
+    ("image/svg+xml;q=0.1, application/json", False),  # a probe got the picture here
+    ("application/json;q=0.5, image/svg+xml", True),
+    ("image/svg+xml;q=0.9, */*;q=0.8", True),
+    ("*/*", False),
+    ("image/svg+xml;q=0", False),
+    ("image/svg+xml;q=oops, application/json", False),
+    ("text/html, image/webp", False),
+])
+def test_the_ik_picture_follows_the_accept_weights(client, accept, picture):
+    robot = catalogue_robot(client, "puma560_standard")
+    body = {"target": {"matrix": forward_kinematics(robot, np.radians(README_Q_DEG)).tolist()}}
+    response = client.post("/v1/robots/puma560_standard/ik", json=body, headers={"Accept": accept})
+    assert response.status_code == 200
+    assert response.headers["content-type"] == ("image/svg+xml" if picture else "application/json")
+
+
 def test_ik_render_query_and_json_by_default(client):
     robot = catalogue_robot(client, "puma560_standard")
     matrix = forward_kinematics(robot, np.radians(README_Q_DEG)).tolist()

@@ -21,7 +21,7 @@ from ._closed_form import cached_plan, plan_is_kept
 from ._direction import direction_plan, refined_rows, roll_family, roll_rows
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, combinations_to_rank, enumerable_limit,
                            equivalents_per_solution, worst_answer_per_target)
-from ._free_search import REFINED_MINIMA
+from ._free_search import EXTRA_VALUES_WITH_REFERENCE
 from ._redundant import family_for, free_joints_for, grid_size
 
 #: The most rows a single-target answer may hold for its work to count as small (:attr:`Cost.small`): a
@@ -122,7 +122,7 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
             family = None if free is None else family_for(robot, tuple(sorted(f.joint for f in free)))
             values = 1 if free is None else grid_size([len(f.values) for f in free])
             if family is not None and family.available:
-                refined = REFINED_MINIMA if options.reference is not None and len(free) == 1 else 0
+                refined = EXTRA_VALUES_WITH_REFERENCE if options.reference is not None and len(free) == 1 else 0
                 most = max(most, (values + refined) * family.generic_count)
                 free_values = max(free_values, values + refined)
             else:  # the numeric search, at each combination of the values asked (or once over every joint)

@@ -26,6 +26,13 @@ from ._verify import Verified, distance_to_reference, wrap_revolute
 
 #: Local minima of the distance to the reference refined per target, nearest first.
 REFINED_MINIMA = 4
+#: The free values solved beyond the grid when a reference is given: the refined minima and, where they found
+#: nothing near it, the reference's own value (:func:`solve_at_reference`).
+EXTRA_VALUES_WITH_REFERENCE = REFINED_MINIMA + 1
+#: How near a solution found already must be to the reference for its own value not to be solved, and how near
+#: to one found already a solution at that value is the same (radians or length units, the largest joint move):
+#: above the refinement's last bracket (~3e-8 rad), below any step between two members a client tells apart.
+SAME_AS_FOUND = 1e-6
 #: Values tried across each bracket per refinement round; the next bracket spans two of their spacings (8× narrower).
 REFINE_POINTS = 17
 #: Refinement rounds per minimum: a 2π / 32 bracket (0.4 rad) to ~3e-8 rad.
@@ -60,6 +67,25 @@ def refine_nearest(robot: Robot, family: FreeJointFamily, target: np.ndarray, va
     periodic = bool(robot.is_revolute[joint]) and _evenly_over_a_turn(values)
     return refine_over(robot, values, grid, reference, minima_kept, rounds, solve, track, periodic,
                        lambda chosen: _wrapped(robot, joint, chosen))
+
+
+def solve_at_reference(robot: Robot, family: FreeJointFamily, target: np.ndarray, found: list[Verified],
+                       reference: np.ndarray) -> Verified | None:
+    """The complete solutions at the reference's own value of the one free joint, where the grid and the
+    refinement (``found``) have none within :data:`SAME_AS_FOUND` of the reference: a branch that reaches the
+    target only between two grid values (an elbow a few hundredths of a radian from straight gives one that
+    narrow) has no sample to refine from, and a reference on it is then found where it is. Rows within
+    SAME_AS_FOUND of one found already are left out; None where nothing is solved."""
+    found_joints = np.concatenate([part.table.joints for part in found])
+    if len(found_joints) and distance_to_reference(robot, found_joints, reference).min() <= SAME_AS_FOUND:
+        return None
+    joint = family.free[0]
+    solved = solve_at(robot, family, target, np.asarray(reference, dtype=float)[[joint]][None], reference)
+    new = [len(found_joints) == 0 or distance_to_reference(robot, found_joints, row).min() > SAME_AS_FOUND
+           for row in solved.table.joints]
+    if all(new):
+        return solved
+    return Verified(solved.table.take(np.flatnonzero(new)), solved.complete, solved.nearest, solved.singularities)
 
 
 def _evenly_over_a_turn(values: np.ndarray) -> bool:

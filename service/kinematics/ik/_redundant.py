@@ -401,7 +401,7 @@ def solve_family(robot: Robot, family: FreeJointFamily, goal: PoseGoal, free: li
     and, with a reference and one free joint, at the values where a branch comes nearest it between samples
     (:func:`~._free_search.refine_nearest`, ``minima`` minima refined by ``rounds`` rounds). ``budget`` is checked
     before each target and within its solves."""
-    from ._free_search import REFINE_ROUNDS, REFINED_MINIMA, refine_nearest
+    from ._free_search import REFINE_ROUNDS, REFINED_MINIMA, refine_nearest, solve_at_reference
 
     values = free_value_grid(free, family)
     targets, refined = [], []
@@ -415,6 +415,9 @@ def solve_family(robot: Robot, family: FreeJointFamily, goal: PoseGoal, free: li
                                    REFINE_ROUNDS if rounds is None else rounds)
             if extra is not None:
                 parts.append(extra)
+            at_reference = solve_at_reference(robot, family, target, parts, reference)
+            if at_reference is not None:
+                parts.append(at_reference)
         refined.append(sum(len(part.complete) for part in parts[1:]))
         targets.append(one_target(robot, parts, index, reference))
     missing = 0 if family.ends_only else sum(family.locked_plan(row) is None for row in values)
@@ -477,7 +480,7 @@ def free_joint_solutions(robot: Robot, requested: Requested | None, refined: boo
     as for :func:`free_joints_for`): the locked arm's generic count at each free value, and at the values the
     continuous search adds when ``refined`` (a reference is given). None when no family covers the arm: the
     numeric search answers."""
-    from ._free_search import REFINED_MINIMA
+    from ._free_search import EXTRA_VALUES_WITH_REFERENCE
 
     free = free_joints_for(robot, requested)
     if free is None:
@@ -486,7 +489,7 @@ def free_joint_solutions(robot: Robot, requested: Requested | None, refined: boo
     if not family.available:
         return None
     values = grid_size([len(f.values) for f in free])
-    return (values + (REFINED_MINIMA if refined and len(free) == 1 else 0)) * family.generic_count
+    return (values + (EXTRA_VALUES_WITH_REFERENCE if refined and len(free) == 1 else 0)) * family.generic_count
 
 
 def beyond_reach(robot: Robot, positions: np.ndarray) -> np.ndarray:

@@ -223,3 +223,25 @@ def test_an_empty_family_near_a_stretched_elbow_is_not_said_unreachable(robot_id
         if answer.status[0] == "ok":
             assert_fk_verified(robot, answer.solutions.joints[answer.solutions.target == 0], target)
         assert answer.status[1] == "unreachable" and "outside the workspace" in answer.detail_list()[1]
+
+
+@pytest.mark.parametrize("robot_id, q", [
+    ("kuka_iiwa14", [-1.403817, 1.960958, 2.9, 0.1, 1.639384, -2.0, 1.556454]),
+    ("kuka_iiwa14", [0.605373, -0.781728, 1.685082, 0.001, 0.558733, 0.550195, -2.776092]),
+    ("kinova_gen3", [2.646482, 1.330195, 0.504285, 0.001, 1.997572, -1.487952, 0.836111]),
+])
+def test_a_reference_that_solves_the_pose_comes_first_even_between_grid_values(robot_id, q):
+    """With a reference the family is searched near it (the nearest first over the whole family). Near a
+    stretched elbow a branch reaches the pose only between two grid values of the free joint, so neither the
+    grid nor the refinement of its minima has a sample on it: the reference's own free value is solved then,
+    and a reference that is itself a solution comes first (a probe found it 3.09 rad away, or not at all)."""
+    from service.config import Settings
+    from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik
+    from service.robots.catalogue import load_catalogue
+
+    robot = load_catalogue([Settings().builtin_robots_dir], max_joints=32).get(robot_id).robot
+    q = np.array(q)
+    answer = answer_ik(robot, IKTargets.poses(forward_kinematics(robot, q)[None]),
+                       AnswerOptions(reference=q, filter_limits=False))
+    assert answer.status[0] == "ok"
+    assert distance_to_reference(robot, answer.solutions.joints[0], q) <= 1e-6

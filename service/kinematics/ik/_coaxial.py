@@ -85,7 +85,7 @@ class CoaxialPlan(Sealed):
         self.sign = 1.0 if self.relation == "sum" else -1.0
         self.dof = dof
         i, j = self.first + 1, self.second + 1
-        self.structure = f"{inner.structure} with q{j} free (coaxial with q{i})"
+        self.structure = f"{self._renumbered(inner.structure)} with q{j} free (coaxial with q{i})"
         self.generic_count = inner.generic_count
         self.report = coaxial_report(pair)
 

@@ -105,3 +105,19 @@ def test_five_joint_arm_poses_by_a_two_axis_wrist():
         assert np.abs(reached[:, :3, 3] - target[:3, 3]).max() <= 1e-9 * robot.characteristic_length
         assert np.abs(reached[:, :3, :3] - target[:3, :3]).max() <= 1e-9
         assert np.abs(joint_difference(robot, solutions, q)).max(axis=1).min() <= 1e-7
+
+
+def test_nested_coaxial_pairs_name_the_arms_own_joints():
+    """Three joints on one line: two pairs, one inside the other's reduced arm. The structure and the reports
+    name the arm's joints (a probe saw "with q2 free (coaxial with q1)" repeated, in each reduced arm's numbers)."""
+    from service.kinematics import Joint, Robot
+
+    robot = Robot([Joint("q1", "revolute", 0.0, 0.0, 0.1, 0.0), Joint("q2", "revolute", 0.0, 0.0, 0.1, 0.0),
+                   Joint("q3", "revolute", 0.5, 0.0, 0.1, 0.0)], name="three on one line")
+    q = np.array([0.3, 0.2, 0.1])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok"
+    assert result.structure.endswith("with q3 free (coaxial with q1) with q2 free (coaxial with q1)")
+    assert result.free_joints == [1, 2]
+    assert sorted((s.kind, s.joints, s.relation) for s in result.singularities) == [
+        ("coaxial", (0, 1), "sum"), ("coaxial", (0, 2), "sum")]

@@ -504,9 +504,9 @@ def _family(robot: Robot, goal: PoseGoal, rows: np.ndarray, free: list[FreeJoint
     part = _Part(rows, answer.verified, "analytic", family.structure, family.free_joints,
                  sampled=np.ones(len(rows), dtype=bool))
     for local in np.flatnonzero(answer.verified.count == 0).tolist():
-        position = goal.world_T_targets[local, :3, 3]
-        part.details[local] = no_solution_detail(robot, free, position)
-        part.sampled[local] = not bool(beyond_reach(robot, position))
+        beyond = bool(beyond_reach(robot, goal.world_T_targets[local, :3, 3]))
+        part.details[local] = no_solution_detail(free, beyond)
+        part.sampled[local] = not beyond
     for local in np.flatnonzero(answer.missing > 0).tolist():
         part.remarks[local] = (f"At {answer.missing[local]} of the free values the locked arm falls outside the "
                                f"closed-form family, so no solution is listed there.")

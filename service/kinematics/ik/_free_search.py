@@ -75,7 +75,8 @@ def solve_at_reference(robot: Robot, family: FreeJointFamily, target: np.ndarray
     refinement (``found``) have none within :data:`SAME_AS_FOUND` of the reference: a branch that reaches the
     target only between two grid values (an elbow a few hundredths of a radian from straight gives one that
     narrow) has no sample to refine from, and a reference on it is then found where it is. Rows within
-    SAME_AS_FOUND of one found already are left out; None where nothing is solved."""
+    SAME_AS_FOUND of one found already are left out; None where a solution found already is that near the
+    reference (nothing is solved then)."""
     found_joints = np.concatenate([part.table.joints for part in found])
     if len(found_joints) and distance_to_reference(robot, found_joints, reference).min() <= SAME_AS_FOUND:
         return None

@@ -66,8 +66,9 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
     to the general 6R solver, last, because a rounded Pieper arm is nearly degenerate for its elimination.
     """
     geometry = geometry_of(robot)
-    if coaxial_pair(geometry) is not None:  # only the pair's sum is fixed: no plan of the whole arm says so
-        return _coaxial_plan(geometry, constrain_orientation, reference)
+    pair = coaxial_pair(geometry)
+    if pair is not None:  # only the pair's sum is fixed: no plan of the whole arm says so
+        return _coaxial_plan(geometry, pair, constrain_orientation, reference)
     plan = _family_plan(geometry, constrain_orientation, reference)
     if plan is not None:
         return plan
@@ -83,21 +84,19 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
 def plan_for_geometry(geometry: Geometry, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     """:func:`plan_for` on a screw model directly, exact recognition only (the idealised retry needs the robot):
     also for arms that exist only as models, such as a redundant arm with joints locked (see ``_redundant``)."""
-    if coaxial_pair(geometry) is not None:
-        return _coaxial_plan(geometry, constrain_orientation, reference)
+    pair = coaxial_pair(geometry)
+    if pair is not None:
+        return _coaxial_plan(geometry, pair, constrain_orientation, reference)
     plan = _family_plan(geometry, constrain_orientation, reference)
     if plan is None and constrain_orientation:
         plan = General6RPlan.match(geometry)
     return plan
 
 
-def _coaxial_plan(geometry: Geometry, constrain_orientation: bool, reference: np.ndarray | None
-                  ) -> CoaxialPlan | None:
-    """Two consecutive coaxial revolute joints: the plan of the arm without the second (see :mod:`._coaxial`),
-    or None when there are none or no family covers that arm."""
-    pair = coaxial_pair(geometry)
-    if pair is None:
-        return None
+def _coaxial_plan(geometry: Geometry, pair: tuple[int, int, str], constrain_orientation: bool,
+                  reference: np.ndarray | None) -> CoaxialPlan | None:
+    """Two consecutive coaxial revolute joints (``pair``, :func:`coaxial_pair`): the plan of the arm without the
+    second (see :mod:`._coaxial`), or None when no family covers that arm."""
     first, second, relation = pair
     if reference is not None:  # the locked arm's: joint i carries q_i ± q_j
         full = np.asarray(reference, dtype=float)

@@ -386,7 +386,7 @@ def free_value_grid(free: list[FreeJoint], family: FreeJointFamily) -> np.ndarra
 class FamilyVerified:
     """The family's answer for N targets: ``verified`` (N targets, each target's solutions over every free value),
     the grid ``values`` (S, f), and per target (N,) how many free values had no locked plan (``missing``) and how
-    many the continuous search added (``refined``)."""
+    many the continuous search and the reference's own value added (``refined``)."""
 
     verified: Verified
     values: np.ndarray
@@ -504,10 +504,10 @@ def beyond_reach(robot: Robot, positions: np.ndarray) -> np.ndarray:
     return distance > reach * (1.0 + 1e-9) + 1e-12
 
 
-def no_solution_detail(robot: Robot, free: list[FreeJoint], position: np.ndarray | None = None) -> str:
+def no_solution_detail(free: list[FreeJoint], beyond: bool) -> str:
     """What an empty answer of the family means: none at the values solved, which proves nothing for others,
-    unless the position lies beyond the arm's reach."""
-    if position is not None and bool(beyond_reach(robot, position)):
+    unless the position lies ``beyond`` the arm's reach (:func:`beyond_reach`)."""
+    if beyond:
         return "The target position is outside the workspace (farther from the base than the arm can reach)."
     names = ", ".join(f"q{f.joint + 1}" for f in free)
     count = math.prod(len(f.values) for f in free)

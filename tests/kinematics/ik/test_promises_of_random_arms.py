@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from service.kinematics import Joint, Robot, forward_kinematics
-from service.kinematics.ik import solve_ik
+from service.kinematics.ik import distance_to_reference, solve_ik
 
 H = np.pi / 2
 
@@ -37,8 +37,7 @@ def _random_arm(rng: np.random.Generator, n: int) -> Robot:
 
 
 def _distance(robot: Robot, a: np.ndarray, b: np.ndarray) -> float:
-    difference = np.abs(a - b)
-    return float(np.where(robot.is_revolute, np.abs((a - b + np.pi) % (2 * np.pi) - np.pi), difference).max())
+    return float(distance_to_reference(robot, a, b))
 
 
 @pytest.mark.parametrize("seed", [1, 2])

@@ -25,7 +25,6 @@ from ..kinematics import (
     check_joint_values,
     check_transform,
     check_transforms,
-    check_unit_quaternion,
     frame_quaternions,
     matrix_from_quaternion,
     quaternions_from_matrices,
@@ -105,7 +104,7 @@ def target_matrix(target: PoseTarget, unit: AngleUnit) -> tuple[np.ndarray, bool
     orientation = target.orientation
     if orientation is None and target.quaternion_wxyz is not None:
         with located("quaternion_wxyz"):
-            T[:3, :3] = matrix_from_quaternion(check_unit_quaternion(np.asarray(target.quaternion_wxyz, dtype=float)))
+            T[:3, :3] = matrix_from_quaternion(target.quaternion_wxyz)  # checked there
         return T, True
     if orientation is None:
         return T, False

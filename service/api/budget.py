@@ -16,6 +16,7 @@
 from __future__ import annotations
 
 import logging
+from collections.abc import Callable
 
 import numpy as np
 from fastapi import Request
@@ -94,21 +95,22 @@ def check_turns(settings: Settings, robot: Robot, limits: Limits, location: tupl
                                     "type": "value_error"}])
 
 
-def check_answer_size(settings: Settings, robot: Robot, *, rows: int, form: str, what: str) -> None:
+def check_answer_size(settings: Settings, robot: Robot, *, rows: int, form: str, what: Callable[[], str]) -> None:
     """413 when an answer of ``rows`` solutions would exceed KIN_MAX_SOLUTIONS_PER_RESPONSE or the estimated
-    response bytes KIN_MAX_RESPONSE_BYTES; says which cap, by how much, and what lowers it."""
+    response bytes KIN_MAX_RESPONSE_BYTES; says which cap, by how much, and what lowers it (``what()`` words
+    where the rows come from, only for a refusal)."""
     cap = settings.max_solutions_per_response
     remedy = ("Lower max_equivalents or max_solutions (each caps the solutions per target), send fewer targets, "
               "or narrow multi-turn limits.")
     if rows > cap:
         raise ProblemError(413, "answer-too-large", "Answer too large",
-                           f"The answer could hold {rows:,} solutions ({what}), "
+                           f"The answer could hold {rows:,} solutions ({what()}), "
                            f"{rows - cap:,} more than KIN_MAX_SOLUTIONS_PER_RESPONSE = {cap:,}. {remedy}")
     size = rows * (_SOLUTION_OVERHEAD_BYTES[form] + _BYTES_PER_NUMBER * robot.dof)
     if size > settings.max_response_bytes:
         raise ProblemError(413, "answer-too-large", "Answer too large",
-                           f"The answer could take about {size:,} bytes ({what}), {size - settings.max_response_bytes:,} "
-                           f"more than KIN_MAX_RESPONSE_BYTES = {settings.max_response_bytes:,}. {remedy}")
+                           f"The answer could take about {size:,} bytes ({what()}), "
+                           f"{size - settings.max_response_bytes:,} more than KIN_MAX_RESPONSE_BYTES = {settings.max_response_bytes:,}. {remedy}")
 
 
 #: Most shapes one picture draws (panels × (obstacles + link shapes)): each is SVG text written in Python.
@@ -164,8 +166,10 @@ def check_ik_cost(settings: Settings, robot: Robot, limits: Limits, cost: Cost, 
             f"solution would rank {cost.ranked:,} combinations of this {robot.dof}-joint arm's turns "
             f"per solution, more than the {MAX_COMBINATIONS_PER_SOLUTION:,} one answer may. Ask for "
             f"at most {most:,} (max_equivalents or max_solutions), or narrow multi-turn limits.")
-    check_answer_size(settings, robot, rows=cost.rows, form=form,
-                      what=f"{cost.targets:,} targets × up to {cost.rows_per_target:,} each: "
-                           f"{cost.solutions_per_target} solutions × {cost.equivalents:,} 2π-equivalents with at most "
-                           f"{cost.kept:,} kept" + (f", when {cost.rejected_per_target} of them are rejected"
-                                                   if cost.rejected_per_target else ""))
+
+    def what() -> str:
+        rejected = f", when {cost.rejected_per_target} of them are rejected" if cost.rejected_per_target else ""
+        return (f"{cost.targets:,} targets × up to {cost.rows_per_target:,} each: {cost.solutions_per_target} "
+                f"solutions × {cost.equivalents:,} 2π-equivalents with at most {cost.kept:,} kept{rejected}")
+
+    check_answer_size(settings, robot, rows=cost.rows, form=form, what=what)

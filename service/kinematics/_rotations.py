@@ -379,19 +379,21 @@ def rot_z(angle: ArrayLike) -> np.ndarray:
 
 def _matrices_from_quaternions(q: np.ndarray) -> np.ndarray:
     """(..., 4) quaternions, not necessarily of unit norm, to (..., 3, 3) rotations."""
+    if q.ndim == 1:  # one quaternion: its entries on floats (as arrays of shape () they cost ~1 µs an operation)
+        w, x, y, z = q.tolist()
+        return np.array(_rotation_entries(w, x, y, z, 2.0 / (w * w + x * x + y * y + z * z)))
     w, x, y, z = np.moveaxis(q, -1, 0)
-    s = 2.0 / np.sum(q * q, axis=-1)
     R = np.empty(q.shape[:-1] + (3, 3))
-    R[..., 0, 0] = 1.0 - s * (y * y + z * z)
-    R[..., 0, 1] = s * (x * y - w * z)
-    R[..., 0, 2] = s * (x * z + w * y)
-    R[..., 1, 0] = s * (x * y + w * z)
-    R[..., 1, 1] = 1.0 - s * (x * x + z * z)
-    R[..., 1, 2] = s * (y * z - w * x)
-    R[..., 2, 0] = s * (x * z - w * y)
-    R[..., 2, 1] = s * (y * z + w * x)
-    R[..., 2, 2] = 1.0 - s * (x * x + y * y)
+    for i, row in enumerate(_rotation_entries(w, x, y, z, 2.0 / np.sum(q * q, axis=-1))):
+        R[..., i, 0], R[..., i, 1], R[..., i, 2] = row
     return R
+
+
+def _rotation_entries(w, x, y, z, s):
+    """The rotation matrix of the quaternion (w, x, y, z) with s = 2 / |q|², row by row: floats or arrays."""
+    return ((1.0 - s * (y * y + z * z), s * (x * y - w * z), s * (x * z + w * y)),
+            (s * (x * y + w * z), 1.0 - s * (x * x + z * z), s * (y * z - w * x)),
+            (s * (x * z - w * y), s * (y * z + w * x), 1.0 - s * (x * x + y * y)))
 
 
 def _canonical_sign(q: np.ndarray) -> np.ndarray:
@@ -783,8 +785,7 @@ _PI, _THREE_PI = math.pi, 3.0 * math.pi
 
 
 def wrap_float(theta: float) -> float:
-    """:func:`wrap_angle` of one float in (−3π, 3π] (a sum of two wrapped angles), bit for bit, without numpy's
-    per-call cost: the one-pose paths wrap each angle they compute."""
+    """:func:`wrap_angle` of one float in (−3π, 3π] (a sum of two wrapped angles), bit for bit, on floats."""
     if theta > _PI:
         return theta - _TWO_PI
     if theta <= -_PI:

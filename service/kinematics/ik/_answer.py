@@ -73,6 +73,12 @@ class IKTargets:
     rolls: Sequence[np.ndarray | None] | None = None
     indexed: bool = False
 
+    @property
+    def per_kind(self) -> list[int]:
+        """How many targets are of each kind, indexed by the kind (:data:`POSITION`, :data:`POSE`,
+        :data:`DIRECTION`)."""
+        return np.bincount(np.asarray(self.kinds), minlength=3).tolist() if len(self.kinds) else [0, 0, 0]
+
     def at(self, row: int, *field: str) -> tuple:
         """Where an error about target ``row`` is located in the request: ``("target", *field)`` for a single
         target, ``("targets", row, *field)`` for a batch's (``indexed``)."""
@@ -263,7 +269,7 @@ def answer_ik(robot: Robot, targets: IKTargets, options: AnswerOptions = AnswerO
     check_options(robot, options.ordering, options.reference, options.max_equivalents)
     timings: list[SolveTiming] = []
     parts: list[_Part] = []
-    per_kind = np.bincount(kinds, minlength=3) if len(kinds) else np.zeros(3, dtype=int)  # targets of each kind
+    per_kind = targets.per_kind
     if per_kind[DIRECTION]:
         parts += _directions(robot, targets, options, timings)
     if per_kind[POSE]:

@@ -93,7 +93,9 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
     most, numeric_targets, numeric_per_target, free_values = 0, 0, starts, 1
     if small is None:
         small = is_small(robot, targets, options)  # before anything is built
-    for kind in np.unique(kinds).tolist():
+    for kind, of_kind in enumerate(targets.per_kind):
+        if not of_kind:
+            continue
         rows = kinds == kind
         if kind == DIRECTION and robot.dof >= 6:  # the family over the free roll: rolls × free values × solutions
             groups = direction_groups(targets, np.flatnonzero(rows))
@@ -126,13 +128,13 @@ def estimate(robot: Robot, targets: IKTargets, options: AnswerOptions, *, kept_a
                 most = max(most, (values + refined) * family.generic_count)
                 free_values = max(free_values, values + refined)
             else:  # the numeric search, at each combination of the values asked (or once over every joint)
-                numeric_targets += int(rows.sum())
+                numeric_targets += of_kind
                 numeric_per_target = max(numeric_per_target, starts * (values if options.free_joints else 1))
                 most = max(most, numeric_per_target)
             continue
         plan = cached_plan(robot, constrain_orientation=constrained, reference=options.reference)
         if plan is None:
-            numeric_targets += int(rows.sum())
+            numeric_targets += of_kind
             most = max(most, starts)
         else:
             most = max(most, plan.generic_count)
@@ -174,15 +176,15 @@ def is_small(robot: Robot, targets: IKTargets, options: AnswerOptions) -> bool:
     """:attr:`Cost.small`, decided without building anything (a plan or a collision model not yet kept makes the
     work not small): the closed form of a kept plan, no search, no family, an answer of at most
     :data:`SMALL_ROWS` rows, and a collision check of at most :data:`SMALL_PAIR_CHECKS` pair distances."""
-    kinds = np.asarray(targets.kinds)
-    if robot.dof > 6 or options.free_joints is not None or (kinds == DIRECTION).any():
+    per_kind = targets.per_kind
+    if robot.dof > 6 or options.free_joints is not None or per_kind[DIRECTION]:
         return False
     if options.collisions is not None and not model_is_kept(robot, options.collisions):
         return False  # compiling the pairs may take milliseconds
-    if robot.dof > 3 and (kinds == POSITION).any():  # a held joint may leave a point to the search
+    if robot.dof > 3 and per_kind[POSITION]:  # a held joint may leave a point to the search
         return False
     most = 0
-    for constrained in np.unique(kinds == POSE).tolist():
+    for constrained in [kind == POSE for kind in (POSITION, POSE) if per_kind[kind]]:
         if not plan_is_kept(robot, constrain_orientation=constrained, reference=options.reference):
             return False
         plan = cached_plan(robot, constrain_orientation=constrained, reference=options.reference)
@@ -193,5 +195,6 @@ def is_small(robot: Robot, targets: IKTargets, options: AnswerOptions) -> bool:
     kept = options.max_equivalents if options.ordering.max_solutions is None else min(
         options.max_equivalents, options.ordering.max_solutions)
     rows, _ = worst_answer_per_target(most, equivalents_per_solution(robot, limits), kept)
-    checks = 0 if options.collisions is None else len(kinds) * most * len(model_for(robot, options.collisions).pairs)
-    return len(kinds) * rows <= SMALL_ROWS and checks <= SMALL_PAIR_CHECKS
+    count = len(targets.kinds)
+    checks = 0 if options.collisions is None else count * most * len(model_for(robot, options.collisions).pairs)
+    return count * rows <= SMALL_ROWS and checks <= SMALL_PAIR_CHECKS

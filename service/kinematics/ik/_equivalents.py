@@ -44,12 +44,10 @@ def equivalents_per_solution(robot: Robot, limits: Limits) -> int:
     more only when a value lands exactly on both bounds. Examples: a ±160° joint 1, a ±360° joint 2 (a UR5 has at
     most 2⁶ = 64 per solution).
     """
-    both = limits.multi_valued(robot)
-    spans = np.where(both, limits.upper - limits.lower, 0.0)
-    per_joint = np.where(both, np.maximum(np.ceil(spans / _TWO_PI), 1), 1)
     product = 1
-    for factor in per_joint.tolist():
-        product = min(product * int(factor), COUNT_CAP)
+    for both, lower, upper in zip(limits.multi_valued(robot).tolist(), limits.lower.tolist(), limits.upper.tolist()):
+        if both:  # (a few joints: Python floats cost less than numpy's per-call overhead)
+            product = min(product * max(math.ceil((upper - lower) / _TWO_PI), 1), COUNT_CAP)
     return product
 
 

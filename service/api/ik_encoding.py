@@ -55,11 +55,13 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
     orientation = _listed(table.orientation, np.isnan)
     within = table.within_limits.tolist()
     branches = table.branches()
-    lower, upper = _listed(answer.limits.lower / scale, np.isinf), _listed(answer.limits.upper / scale, np.isinf)
     violations: dict[int, list[dict]] = {}
-    for k, j in zip(*np.nonzero(outside)):
-        violations.setdefault(int(k), []).append(
-            {"joint": int(j), "value": joints[k][j], "lower": lower[j], "upper": upper[j]})
+    rows, columns = np.nonzero(outside)
+    if len(rows):
+        lower, upper = _listed(answer.limits.lower / scale, np.isinf), _listed(answer.limits.upper / scale, np.isinf)
+        for k, j in zip(rows.tolist(), columns.tolist()):
+            violations.setdefault(k, []).append({"joint": j, "value": joints[k][j], "lower": lower[j],
+                                                 "upper": upper[j]})
     targets = table.target.tolist()
     per_target: list[list[dict]] = [[] for _ in free_of_target]
     any_free = any(free_of_target)

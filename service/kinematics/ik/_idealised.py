@@ -166,7 +166,9 @@ class IdealisedPlan(Sealed):
             singular[rows[near_singular]] = True
         for mask, _ in ideal.singularities.entries:
             singular |= mask
-        complete = converged & distinct & ~near_miss & ~singular & ~rescued
+        # a row where the idealised family gave no candidate at all (not even a least-squares one) has no near miss
+        # to measure: its "no solution" is the idealised arm's, which the true one need not share
+        complete = converged & distinct & ~near_miss & ~singular & ~rescued & finite.any(axis=1)
         return Candidates(joints, accepted, ideal.singularities, complete=complete)
 
     def _refined(self, q: np.ndarray, world_T_targets: np.ndarray, steps: int) -> np.ndarray:

@@ -179,7 +179,7 @@ def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
             # a roll: the joints before it place a point of its axis (one joint before it: OneRevolute)
             if not model.is_revolute[k]:
                 continue
-            point, wrist = geometry.point(k), Roll(geometry, k)
+            point, wrist = _roll_point(geometry, k), Roll(geometry, k)
         elif not wrist_joints:
             point, wrist = model.home[:3, 3], None
         else:
@@ -191,6 +191,21 @@ def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
             continue  # a joint the position leaves free turns the tool: only a spherical wrist takes that up
         return DecoupledPlan(positioner, wrist, point, model.home, n)
     return None
+
+
+def _roll_point(geometry: Geometry, k: int) -> np.ndarray:
+    """A point (3,) of the roll's axis k for the joints before it to place: the model's own point of the axis,
+    unless it lies on an earlier revolute axis (that joint would not move it, and the position would leave the
+    joint free where the orientation fixes it, which a roll cannot take up); then the first of the points a
+    whole number of the arm's lengths along the axis that lies on none (k + 1 of them suffice)."""
+    base, direction = geometry.point(k), geometry.direction(k)
+    earlier = [j for j in range(k) if geometry.model.is_revolute[j]]
+    for step in range(k + 1):
+        offset = (step + 1) // 2 * (1 if step % 2 else -1)  # 0, 1, −1, 2, −2, …
+        point = base + offset * geometry.length_scale * direction
+        if not any(geometry.on_axis(j, point) for j in earlier):
+            return point
+    return base
 
 
 def _position_plan(geometry: Geometry, n: int, reference: np.ndarray | None) -> Plan | None:

@@ -8,7 +8,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..._tolerances import GEOMETRY_TOLERANCE
+from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
 from ..._forward import JointTrig
 from .._screws import rotate_about
 from .._structure import Geometry
@@ -68,7 +68,9 @@ class OffsetShoulderParallelElbow(Positioner):
         if geometry.model.is_revolute[i]:
             if geometry.parallel(i, j):
                 return None
-        elif abs(float(geometry.direction(i) @ u)) <= GEOMETRY_TOLERANCE:
+        elif abs(float(geometry.direction(i) @ u)) <= RECOGNITION_TOLERANCE:
+            # a slide (nearly) normal to u moves the point across the plane, not along u: the height equation
+            # would divide by its component along u, turning a rounding of the geometry into a long slide
             return None
         if geometry.model.is_revolute[i]:
             shoulder_on_1, shoulder = _common_normal_feet(geometry.point(i), geometry.direction(i),

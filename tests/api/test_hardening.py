@@ -341,3 +341,17 @@ def test_a_batch_shares_the_servers_numeric_time(tmp_path):
         response = capped.post("/v1/robots/numeric_arm/ik/batch",
                                json={"targets": [target] * 4, "numeric": {"starts": 2000, "time_budget_ms": 10_000}})
     assert_problem(response, 503, match="deadline of 40 ms during the numeric search")
+
+
+def test_axes_rounded_1e_8_off_parallel_are_answered_not_a_500(client):
+    """Axes 2 and 3 1.03e-8 rad off parallel (1 − cos² of that rounds to 0): the pose from the arm's own FK is
+    answered with the configuration that made it, where the skew-axes fit once divided by zero."""
+    robot = {"convention": "standard", "joints": [{"a": 0.1, "alpha": np.pi / 2, "d": 0.4},
+                                                  {"a": 0.5, "alpha": 1.03e-8, "d": 0.05}, {"a": 0.4}]}
+    q = [0.3, 0.7, -1.1]
+    pose = client.post("/v1/fk", json={"joints": q, "robot": robot}).json()["pose"]
+    response = client.post("/v1/ik", json={"target": {"position": pose["position"]}, "robot": robot})
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    assert answer["status"] == "ok"
+    assert min(np.abs(np.array(s["joints"]) - q).max() for s in answer["solutions"]) < 1e-6

@@ -416,7 +416,10 @@ def _directions(robot: Robot, targets: IKTargets, options: AnswerOptions, timing
                 "The target position is outside the workspace (farther from the base than the arm can reach)."
                 if bool(beyond_reach(robot, goal.positions[local])) else
                 "No joint vector puts the tool at this position with its axis along the direction (every "
-                "solution of the closed form was checked).")
+                "solution of the closed form was checked)." if verified.complete[local] else
+                "The closed form found no joint vector that puts the tool at this position with its axis along "
+                "the direction, and cannot promise there is none (it met a condition where solutions may be "
+                "missed).")
         parts.append(_timed(timings, part, started))
     return parts
 

@@ -198,7 +198,7 @@ def direction_candidates(robot: Robot, plan: DirectionPlan, goal: DirectionGoal,
     for mask, flag in candidates.singularities.entries:  # conditions that involve the virtual joint are not the arm's
         if all(j < n for j in flag.joints):
             singular.add(mask, flag)
-    return Candidates(joints, valid, singular, labels=labels)
+    return Candidates(joints, valid, singular, labels=labels, complete=candidates.complete)
 
 
 def tool_roll(plan: DirectionPlan) -> Singularity | None:

@@ -190,15 +190,17 @@ class IdealisedPlan(Sealed):
         An arm with fewer joints than the target constrains reaches a δ-thin neighbourhood of the idealised
         family's targets on several sheets (e.g. a SCARA's two assembly modes); on the true arm a target from one
         sheet is generally missed by the other by about δ. There Gauss–Newton stalls at a positive residual: one
-        more step lowers it by less than 1 %, and it is at least 1e-3 δ (far above the acceptance tolerance), so
-        no solution lies near that candidate.
+        more step lowers it by less than 1 %, and it is at least 1e-3 δ (far above the acceptance tolerance) and
+        within the near-miss band, so no solution lies near that candidate.
         """
         rows, slots = np.nonzero(missed)
         stepped = self._refined(joints[rows, slots], world_T_targets[rows], 1)
         position, orientation = residual_arrays(self.robot, stepped[:, None, :], world_T_targets[rows])
         now, before = self._size(position, orientation)[:, 0], after[rows, slots]
         apart = np.zeros_like(missed)
-        apart[rows, slots] = (before >= 1e-3 * self.deviation) & (now >= 0.99 * before)
+        # (a refinement that left the near band, its steps thrown off by a near-singular Jacobian, proves nothing)
+        apart[rows, slots] = (before >= 1e-3 * self.deviation) & (now >= 0.99 * before) \
+            & (before <= NEAR_MISS * self.deviation)
         return apart
 
     def _smallest_singular_value(self, joints: np.ndarray) -> np.ndarray:

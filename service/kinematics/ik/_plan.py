@@ -13,8 +13,9 @@ from typing import Protocol
 import numpy as np
 
 from .._cache import memo
-from .._forward import JointTrig, link_frames, screw_model
+from .._forward import JointTrig, cross, link_frames, screw_model
 from .._robot import Robot
+from .._tolerances import RECOGNITION_TOLERANCE
 from ._coaxial import CoaxialPlan, coaxial_pair, without_joint
 from ._decoupled import DecoupledPlan
 from ._general_6r import General6RPlan
@@ -195,15 +196,17 @@ def _decoupled_pose_plan(geometry: Geometry, n: int) -> DecoupledPlan | None:
 
 def _roll_point(geometry: Geometry, k: int) -> np.ndarray:
     """A point (3,) of the roll's axis k for the joints before it to place: the model's own point of the axis,
-    unless it lies on an earlier revolute axis (that joint would not move it, and the position would leave the
-    joint free where the orientation fixes it, which a roll cannot take up); then the first of the points a
-    whole number of the arm's lengths along the axis that lies on none (k + 1 of them suffice)."""
-    base, direction = geometry.point(k), geometry.direction(k)
+    unless it lies on or near an earlier revolute axis (within RECOGNITION_TOLERANCE of the arm's size: that joint
+    would not move it, or hardly, and the position would leave the joint free, or ill-conditioned, where the
+    orientation fixes it, which a roll cannot take up); then the first of the points a whole number of the arm's
+    lengths along the axis that lies near none (k + 1 of them suffice)."""
+    base, direction, scale = geometry.point(k), geometry.direction(k), geometry.length_scale
     earlier = [j for j in range(k) if geometry.model.is_revolute[j]]
     for step in range(k + 1):
         offset = (step + 1) // 2 * (1 if step % 2 else -1)  # 0, 1, −1, 2, −2, …
-        point = base + offset * geometry.length_scale * direction
-        if not any(geometry.on_axis(j, point) for j in earlier):
+        point = base + offset * scale * direction
+        offsets = [np.linalg.norm(cross(geometry.direction(j), point - geometry.point(j))) for j in earlier]
+        if not any(offset <= RECOGNITION_TOLERANCE * scale for offset in offsets):
             return point
     return base
 

@@ -255,15 +255,17 @@ def default_free_joints(robot: Robot) -> tuple[int, ...] | None:
     or an iiwa's q7: their shoulder is then a spherical wrist at the base), the first (a Gen3's q1), the third
     (the SRS arms' other classic choice, their q3), then the others. End joints come first because the locked
     arm is then the same for every value: the samples solve as one vectorised batch, about four times faster
-    than one plan per value. At most :data:`_CHOICES_TRIED` choices are tried, and none when the free joints
-    are too many to sample even twice each within :data:`MAX_FREE_VALUES`.
+    than one plan per value. A slide without limits is never chosen: it has no range to sample (a request may
+    still free it with its own values). At most :data:`_CHOICES_TRIED` choices are tried, and none when the free
+    joints are too many to sample even twice each within :data:`MAX_FREE_VALUES`.
     """
     def choose() -> tuple[int, ...] | None:
         n = robot.dof
         extra = n - 6
         if extra < 1 or _default_samples(extra, MAX_FREE_VALUES) == 0:
             return None  # nothing to free, or too many free joints to sample each: the numeric search answers
-        order = list(dict.fromkeys([n - 1, 0, 2, *range(n)]))
+        samplable = [j for j in range(n) if robot.is_revolute[j] or np.isfinite([robot.lower[j], robot.upper[j]]).all()]
+        order = [j for j in dict.fromkeys([n - 1, 0, 2, *range(n)]) if j in samplable]
         candidates = itertools.islice(itertools.combinations(order, extra), _CHOICES_TRIED)
         general = None  # a decomposable class wins over the general solver (an eigenproblem per value)
         for free in candidates:

@@ -194,6 +194,8 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
        three axes (a wrist), the first three (a wrist at the base), then consecutive pairs (a shoulder, the
        UR type's axes 4–5 and 5–6). A pair whose first axis already meets another keeps that axis and
        translates the second onto it; an axis is moved once at most.
+    3. A revolute axis left out of step 2 that passes within ``tolerance`` × size of the tool point (the flange
+       origin at q = 0) is moved through it.
 
     Lines turn about their canonical points, which lie on the arm, so a turn by ε moves no part of the arm by much
     more than ε × size.
@@ -244,6 +246,13 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
             for g in members:
                 points[g] = centre
         assigned.update(members)
+    # 3. the tool point near a revolute axis that meets no other (a flange on the last axis, as most arms have it):
+    # step 1 turned that axis about its canonical point, off the flange by up to the turn × the arm's length, and
+    # the families would see a tool point off the axis that joint does not move on the true arm
+    flange = model.home[:3, 3]
+    for j in sorted(revolute - assigned):
+        if _line_distance(flange, points[j], directions[j]) <= tolerance * scale:
+            points[j] = flange
     # how far each line moved: its angle, and its displacement at the canonical point
     angle = np.linalg.norm(cross(model.directions, directions), axis=1)
     shift = np.array([_line_distance(model.points[i], points[i], directions[i]) for i in range(n)]) / scale

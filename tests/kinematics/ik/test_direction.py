@@ -11,8 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import forward_kinematics
-from service.kinematics.ik import solve_direction, target_kinds
+from service.kinematics import Joint, Robot, forward_kinematics
+from service.kinematics.ik import (DIRECTION, AnswerOptions, IKTargets, answer_ik, solve_direction, target_kinds,
+                                   unlimited)
 from service.kinematics.ik._direction import rotations_to
 from tests.ik_helpers import find
 from tests.arms import published_arm
@@ -68,3 +69,22 @@ def test_rotations_to_take_the_axis_onto_the_direction_also_when_opposite():
 def test_target_kinds_name_the_direction_kind_for_arms_of_five_joints_or_more():
     assert target_kinds(published_arm("so101_like")) == ["pose", "position", "position_direction"]
     assert target_kinds(published_arm("iiwa14")) == ["pose", "position", "position_direction"]
+
+
+def test_an_incomplete_closed_form_does_not_promise_unreachable():
+    """A random R-P-R-R-R arm whose last joint rolls about the tool axis: its direction targets go to the general
+    5R1P solver with a virtual joint, which cannot promise every solution for this one. The answer once dropped
+    that flag and said `unreachable, complete` of a pose from the arm's own FK."""
+    h = np.pi / 2
+    rows = [("revolute", 0.0, -h, 0.0, 0.0), ("prismatic", 0.0, h, 0.2, 0.0), ("revolute", 0.0, -h, 0.0, h),
+            ("revolute", 0.6059950341551361, h, 0.0, h),
+            ("revolute", 0.5248144502421734, np.pi, 0.2, -0.710926735853691)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="probe", convention="modified")
+    T = forward_kinematics(robot, np.array([-0.729844197, -0.15513631, 0.228209683, -1.552625249, -0.553408862]))
+    matrices = np.eye(4)[None].copy()
+    matrices[0, :3, 3] = T[:3, 3]
+    targets = IKTargets(matrices, np.array([DIRECTION]), np.array([[0, 0, 1.0]]), T[None, :3, 2].copy())
+    answer = answer_ik(robot, targets, AnswerOptions(limits=unlimited(robot), filter_limits=False))
+    report = answer.solvers[answer.solver[0]]
+    assert answer.status[0] != "unreachable", answer.detail_list()[0]
+    assert answer.status[0] == "ok" or not report.complete  # found, or not promised

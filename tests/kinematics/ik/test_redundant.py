@@ -11,9 +11,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import InvalidInputError, forward_kinematics
+from service.kinematics import InvalidInputError, Joint, Robot, forward_kinematics
 from service.kinematics.ik import (FreeJoint, beyond_reach, distance_to_reference, free_joints_for,
-                                   solve_free_joint_family)
+                                   solve_free_joint_family, solve_ik)
 from service.kinematics.ik._redundant import default_free_joints, family_for, sample_values
 from tests.arms import published_arm
 from tests.ik_helpers import angle_gap, find
@@ -41,6 +41,24 @@ def test_default_free_joint_is_an_end_joint_whose_locking_leaves_a_family():
     assert default_free_joints(published_arm("gen3")) == (0,)
     assert family_for(published_arm("iiwa14"), (0,)).ends_only
     assert not family_for(published_arm("iiwa14"), (2,)).ends_only
+
+
+@pytest.mark.parametrize("track_limits, free", [(None, (2,)), ((-1.5, 1.5), (0,))])
+def test_a_track_without_limits_is_not_the_default_free_joint(track_limits, free):
+    """A PUMA on a linear track: locking the track leaves the PUMA's family, but a slide without limits has no
+    range to sample, and the default answer was a 4xx asking for its values. Another joint is freed instead."""
+    h = np.pi / 2
+    puma = [(0, h, 0), (0.4318, 0, 0), (0.0203, -h, 0.15005), (0, h, 0.4318), (0, -h, 0), (0, 0, 0)]
+    track = Joint("track", "prismatic", 0.0, -h, 0.3, 0.0, *(track_limits or ()))
+    robot = Robot([track] + [Joint(f"q{i + 1}", "revolute", a, alpha, d, 0.0) for i, (a, alpha, d) in enumerate(puma)],
+                  name="PUMA on a track", convention="standard")
+    assert default_free_joints(robot) == free
+    q = np.array([0.7, 0.3, -0.5, 0.4, 1.0, -0.6, 0.2])
+    target = forward_kinematics(robot, q)
+    result = solve_ik(robot, target)
+    assert result.status == "ok" and result.free_joints == list(free)
+    for solution in result.solutions:
+        assert np.allclose(forward_kinematics(robot, solution.joints), target, atol=1e-8)
 
 
 def test_a_locked_class_that_is_degenerate_is_not_chosen():

@@ -15,7 +15,7 @@ from fnmatch import fnmatchcase
 import numpy as np
 
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
-from ..._forward import JointTrig
+from ..._forward import JointTrig, cross
 from .._screws import chain_motion, move_point
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity, Sealed
@@ -59,7 +59,8 @@ def _common_normal_feet(p1: np.ndarray, d1: np.ndarray, p2: np.ndarray, d2: np.n
     """The points of two non-parallel lines (point, unit direction) nearest each other: the common normal's feet."""
     w = p1 - p2
     b, d, e = float(d1 @ d2), float(d1 @ w), float(d2 @ w)
-    denominator = 1.0 - b * b
+    normal = cross(d1, d2)
+    denominator = float(normal @ normal)  # sin² of the angle, without the cancellation of 1 − b²
     s, t = (b * e - d) / denominator, (e - b * d) / denominator
     return p1 + s * d1, p2 + t * d2
 

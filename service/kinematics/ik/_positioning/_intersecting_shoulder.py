@@ -13,7 +13,7 @@ from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
-from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3
+from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3, subproblem_4
 from ._base import Needs, Positioner, PositionerResult, _flag_rows, _unit, side_codes
 from ._slide_through_axis_2 import SlideThroughAxis2
 
@@ -75,7 +75,10 @@ class IntersectingShoulder(Positioner):
             third = subproblem_3(g.direction(k), w - g.point(k), c - g.point(k), reach)
             q3 = third.theta
             if self.free_joints:  # degenerate: the representative is the reference value (or 0), not SP3's 0
-                q3 = np.where(third.valid, 0.0 if reference is None else reference[k], q3)
+                held = np.full(n_targets, 0.0 if reference is None else float(reference[k]))
+                if g.on_axis(k, c):
+                    held = self._turn_that_reaches(held, targets)
+                q3 = np.where(third.valid, held[:, None], q3)
             w3 = g.point(k) + rotate_about(g.direction(k), q3, w - g.point(k))
         else:
             third = prismatic_to_distance(w, g.direction(k), c, reach)
@@ -136,6 +139,38 @@ class IntersectingShoulder(Positioner):
             _flag_rows(third.merged, Singularity("reach", (k,), "boundary",
                                                  "the point is at the nearest reach of the prismatic joint"), singular)
         return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
+
+    def _turn_that_reaches(self, held: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """Joint 3's value (N,) when its axis passes through the centre c, for targets x (N, 3).
+
+        Joints 1 to 3 then all turn the point p about c: a one-parameter family of solutions, of which joint 3
+        picks the member. Joints 1 and 2 reach x from p₃ = R(ω₃, q₃)(w − c) (subproblem 2) iff z = ω₂·p₃ lies
+        in ``h c₁₂ ± s₁₂ √(r² − h²)``, with h = ω₁·(x − c), r = ‖x − c‖, c₁₂ and s₁₂ the cosine and sine of the
+        angle between axes 1 and 2 (the projections of a sphere's points onto two axes fill an ellipse). Where
+        ``held`` (N,) leaves z outside that band, joint 3 takes the value nearest it that puts z mid-band
+        (subproblem 4), so that no reachable target is answered unreachable for the value held.
+        """
+        g, (i, j, k) = self.geometry, self.joints
+        w1, w2, w3 = g.direction(i), g.direction(j), g.direction(k)
+        p, x = self.point - self.centre, targets - self.centre
+        h, r = x @ w1, np.linalg.norm(x, axis=-1)
+        half_band = float(np.linalg.norm(cross(w1, w2))) * np.sqrt(np.maximum(r * r - h * h, 0.0))
+        low, high = h * float(w1 @ w2) - half_band, h * float(w1 @ w2) + half_band
+        along = float(w3 @ p)  # z(q₃) = z₀ + ρ cos(q₃ − φ): its range is z₀ ± ρ
+        z0, rho = along * float(w2 @ w3), float(np.linalg.norm(cross(w2, w3))) * float(np.linalg.norm(cross(w3, p)))
+        tolerance = GEOMETRY_TOLERANCE * g.length_scale
+        z_held = rotate_about(w3, held, p) @ w2
+        move = ((z_held < low - tolerance) | (z_held > high + tolerance)) \
+            & (np.maximum(low, z0 - rho) <= np.minimum(high, z0 + rho))  # else out of reach for every value
+        if not move.any():
+            return held
+        middle = 0.5 * (np.maximum(low, z0 - rho) + np.minimum(high, z0 + rho))[move]
+        turns = subproblem_4(w2, w3, p, middle).theta  # (M, 2)
+        distance = np.abs(wrap_angle(turns - held[move, None]))
+        nearest = np.argmin(np.where(np.isnan(distance), np.inf, distance), axis=1)
+        held = held.copy()
+        held[move] = turns[np.arange(len(turns)), nearest]
+        return held
 
     def _near_axis_2_at_fold(self, third, point: np.ndarray, scale: np.ndarray) -> np.ndarray:
         """Which points (N, 2) joint 2 cannot place: within ``FOLD_TOLERANCE`` of axis 2 (relative to

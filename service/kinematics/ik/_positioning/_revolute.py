@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._tolerances import GEOMETRY_TOLERANCE
+from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
 from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry
@@ -179,10 +179,14 @@ class SkewAxes(Positioner):
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "SkewAxes | None":
         _, j, k = joints
-        if geometry.parallel(j, k) or geometry.intersection(j, k) is not None or geometry.on_axis(k, point):
-            return None
-        return cls(geometry, joints, point, feet=_common_normal_feet(geometry.point(j), geometry.direction(j),
-                                                                     geometry.point(k), geometry.direction(k)))
+        if np.linalg.norm(cross(geometry.direction(j), geometry.direction(k))) <= RECOGNITION_TOLERANCE:
+            return None  # (nearly) parallel: the common normal's feet run off to where the rounding puts them
+        feet = _common_normal_feet(geometry.point(j), geometry.direction(j), geometry.point(k), geometry.direction(k))
+        near = RECOGNITION_TOLERANCE * geometry.length_scale
+        off_axis_3 = np.linalg.norm(cross(geometry.direction(k), point - feet[1]))
+        if np.linalg.norm(feet[1] - feet[0]) <= near or off_axis_3 <= near:
+            return None  # axes that (nearly) meet, a point (nearly) on axis 3: the idealised arm's families answer
+        return cls(geometry, joints, point, feet=feet)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, (i, j, k) = self.geometry, self.joints

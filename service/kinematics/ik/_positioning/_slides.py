@@ -105,9 +105,11 @@ class OneRevoluteTwoPrismatic(Positioner):
         slides = tuple(joint for joint in joints if joint != revolute)
         omega = geometry.direction(revolute)
         axial = np.array([omega @ geometry.direction(s) for s in slides])
-        if np.abs(axial).max() <= GEOMETRY_TOLERANCE:
+        # (within RECOGNITION_TOLERANCE: the equations below would divide by the rounding of the geometry; the
+        # idealised arm's families answer such an arm)
+        if np.abs(axial).max() <= RECOGNITION_TOLERANCE:
             return None  # no slide along the axis: the height equation does not fix them
-        if geometry.parallel(*slides):
+        if np.linalg.norm(cross(geometry.direction(slides[0]), geometry.direction(slides[1]))) <= RECOGNITION_TOLERANCE:
             return None  # parallel slides move the point along one line: only their sum is fixed
         return cls(geometry, joints, point, revolute=revolute, slides=slides)
 

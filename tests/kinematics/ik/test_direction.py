@@ -88,3 +88,22 @@ def test_an_incomplete_closed_form_does_not_promise_unreachable():
     report = answer.solvers[answer.solver[0]]
     assert answer.status[0] != "unreachable", answer.detail_list()[0]
     assert answer.status[0] == "ok" or not report.complete  # found, or not promised
+
+
+def test_a_gimbal_whose_axes_all_meet_is_not_promised_unreachable():
+    """Five revolute axes through one point, the tool there too (a gimbal): the virtual roll's 6-joint arm places
+    its point at the shoulder's centre, where subproblems 2 and 3 judged 1e-16 of rounding against itself and
+    gave no candidate, and the answer said `unreachable, complete` of the arm's own FK pose."""
+    h = np.pi / 2
+    rows = [(0.0, 2.9552007457290577, -0.6229685060125036), (0.0, -2.1102717999823857, 0.0), (0.0, -h, 0.0),
+            (0.0, h, 0.0), (0.0, 3.0087290532683735, 0.0)]
+    robot = Robot([Joint(f"q{i}", "revolute", a, alpha, d, 0.0) for i, (a, alpha, d) in enumerate(rows)],
+                  name="gimbal", convention="standard")
+    T = forward_kinematics(robot, np.array([-1.380173228, -2.680064972, -0.598100873, 1.450488122, -0.587071736]))
+    matrices = np.eye(4)[None].copy()
+    matrices[0, :3, 3] = T[:3, 3]
+    targets = IKTargets(matrices, np.array([DIRECTION]), np.array([[0, 0, 1.0]]), T[None, :3, 2].copy())
+    answer = answer_ik(robot, targets, AnswerOptions(limits=unlimited(robot), filter_limits=False))
+    report = answer.solvers[answer.solver[0]]
+    assert answer.status[0] != "unreachable", answer.detail_list()[0]
+    assert answer.status[0] == "ok" or not report.complete  # found, or not promised

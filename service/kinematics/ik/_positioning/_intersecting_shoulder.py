@@ -8,7 +8,7 @@ from functools import cached_property
 import numpy as np
 
 from ..._rotations import wrap_angle
-from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE
+from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
 from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry
@@ -90,9 +90,12 @@ class IntersectingShoulder(Positioner):
         # subproblem 2 is degenerate when the target is on axis 1 (joint 1 free), or when the point is on axis 2
         # (joint 2 free: an elbow that lines the point up with it, as the stretched elbow of a 7R arm does)
         reach_scale = np.maximum(reach[:, None], np.linalg.norm(w3 - c, axis=-1))  # (N, 2)
-        on_axis_1 = (np.linalg.norm(cross(g.direction(i), targets - c), axis=-1)[:, None]
-                     <= GEOMETRY_TOLERANCE * reach_scale)
-        free_shoulder = pair.degenerate & on_axis_1  # (N, 2)
+        # the target and the placed point both at the centre, within the target's rounding (an arm whose axes all
+        # meet there): subproblem 2 would judge their dust against itself; joints 1 and 2 are both free
+        at_centre = reach_scale <= ROUNDING_TOLERANCE * g.length_scale
+        on_axis_1 = at_centre | (np.linalg.norm(cross(g.direction(i), targets - c), axis=-1)[:, None]
+                                 <= GEOMETRY_TOLERANCE * reach_scale)
+        free_shoulder = (pair.degenerate | at_centre) & on_axis_1  # (N, 2)
         free_second = (pair.degenerate | self._near_axis_2_at_fold(third, w3 - c, reach_scale)) & ~on_axis_1
         if free_second.any():  # joint 2 at the reference value (or 0); joint 1 turns the point so placed
             q2_held = np.where(free_second, 0.0 if reference is None else reference[j], q2[..., 0])
@@ -109,7 +112,7 @@ class IntersectingShoulder(Positioner):
             back = rotate_about(g.direction(i), -start, (targets - c)[:, None, :])
             second = subproblem_1(g.direction(j), w3 - c, back)
             # the point at the shoulder centre itself (zero-length links): joint 2 is free as well
-            free_both = free_shoulder & second.degenerate
+            free_both = free_shoulder & (second.degenerate | at_centre)
             q2_free = np.where(free_both, 0.0 if reference is None else reference[j], second.theta[..., 0])
             _flag_rows(free_both.any(axis=1), Singularity(
                 "shoulder", (i, j), "free", "the point is at the shoulder's centre; joints 1 and 2 are set to the "
@@ -120,8 +123,8 @@ class IntersectingShoulder(Positioner):
         joints[..., 0], joints[..., 1] = q1, q2
         joints[..., 2] = q3[:, :, None]
         # a near tangency (merged, not exact) is the touching root: verification refines it
-        valid = third.valid[:, :, None] & third.exact[:, :, None] & (
-            (pair.valid & (pair.exact | pair.merged[..., None])) | free_second[..., None])
+        valid = ((third.valid & third.exact) | at_centre)[:, :, None] & (
+            (pair.valid & (pair.exact | pair.merged[..., None])) | free_second[..., None] | at_centre[..., None])
         valid[:, :, 1] &= ~(free_shoulder | free_second)  # one representative when a shoulder joint is free
         _flag_rows(free_shoulder.any(axis=1) & ~free_both.any(axis=1),
                    Singularity("shoulder", (i,), "free", "the point is on the first joint's axis; "

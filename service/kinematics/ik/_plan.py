@@ -205,8 +205,8 @@ def _roll_point(geometry: Geometry, k: int) -> np.ndarray:
     for step in range(k + 1):
         offset = (step + 1) // 2 * (1 if step % 2 else -1)  # 0, 1, −1, 2, −2, …
         point = base + offset * scale * direction
-        offsets = [np.linalg.norm(cross(geometry.direction(j), point - geometry.point(j))) for j in earlier]
-        if not any(offset <= RECOGNITION_TOLERANCE * scale for offset in offsets):
+        distances = [np.linalg.norm(cross(geometry.direction(j), point - geometry.point(j))) for j in earlier]
+        if not any(distance <= RECOGNITION_TOLERANCE * scale for distance in distances):
             return point
     return base
 

@@ -13,7 +13,7 @@ from typing import Protocol
 import numpy as np
 
 from .._cache import memo
-from .._forward import JointTrig, cross, link_frames, screw_model
+from .._forward import JointTrig, link_frames, screw_model
 from .._robot import Robot
 from .._tolerances import RECOGNITION_TOLERANCE
 from ._coaxial import CoaxialPlan, coaxial_pair, without_joint
@@ -205,8 +205,7 @@ def _roll_point(geometry: Geometry, k: int) -> np.ndarray:
     for step in range(k + 1):
         offset = (step + 1) // 2 * (1 if step % 2 else -1)  # 0, 1, −1, 2, −2, …
         point = base + offset * scale * direction
-        distances = [np.linalg.norm(cross(geometry.direction(j), point - geometry.point(j))) for j in earlier]
-        if not any(distance <= RECOGNITION_TOLERANCE * scale for distance in distances):
+        if not any(geometry.axis_distance(j, point) <= RECOGNITION_TOLERANCE * scale for j in earlier):
             return point
     return base
 

@@ -66,6 +66,12 @@ class Geometry:
         """Whether the axes (or sliding directions) of joints i and j are parallel or anti-parallel."""
         return bool(np.linalg.norm(cross(self.direction(i), self.direction(j))) <= GEOMETRY_TOLERANCE * 10)
 
+    def nearly_parallel(self, i: int, j: int) -> bool:
+        """Whether the axes (or sliding directions) of joints i and j are within ``RECOGNITION_TOLERANCE`` (rad)
+        of parallel: a family that solves from the angle between them would divide by a rounding of the geometry
+        there, and declines; the idealised arm's parallel families answer (see :func:`idealised`)."""
+        return bool(np.linalg.norm(cross(self.direction(i), self.direction(j))) <= RECOGNITION_TOLERANCE)
+
     def intersection(self, i: int, j: int) -> np.ndarray | None:
         """The point where two non-parallel revolute axes meet, or None if they are skew or parallel."""
         if self.parallel(i, j):
@@ -88,8 +94,11 @@ class Geometry:
 
     def on_axis(self, i: int, point: np.ndarray) -> bool:
         """Whether ``point`` lies on the axis of revolute joint i."""
-        offset = point - self.point(i)
-        return bool(np.linalg.norm(cross(self.direction(i), offset)) <= GEOMETRY_TOLERANCE * 10 * self.length_scale)
+        return self.axis_distance(i, point) <= GEOMETRY_TOLERANCE * 10 * self.length_scale
+
+    def axis_distance(self, i: int, point: np.ndarray) -> float:
+        """The distance of ``point`` (3,) from the axis (line) of joint i."""
+        return float(np.linalg.norm(cross(self.direction(i), point - self.point(i))))
 
 
 def _closest_common_point(points: list[np.ndarray], directions: list[np.ndarray], scale: float) -> np.ndarray | None:

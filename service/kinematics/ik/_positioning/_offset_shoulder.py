@@ -9,7 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
-from ..._forward import JointTrig, cross
+from ..._forward import JointTrig
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -66,7 +66,7 @@ class OffsetShoulderParallelElbow(Positioner):
         elif abs(float(geometry.direction(k) @ u)) > GEOMETRY_TOLERANCE:
             return None
         if geometry.model.is_revolute[i]:
-            if np.linalg.norm(cross(geometry.direction(i), u)) <= RECOGNITION_TOLERANCE:
+            if geometry.nearly_parallel(i, j):
                 return None  # (nearly) parallel to u: joint 1 hardly changes the height subproblem 4 solves for
         elif abs(float(geometry.direction(i) @ u)) <= RECOGNITION_TOLERANCE:
             # a slide (nearly) normal to u moves the point across the plane, not along u: the height equation

@@ -179,12 +179,11 @@ class SkewAxes(Positioner):
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "SkewAxes | None":
         _, j, k = joints
-        if np.linalg.norm(cross(geometry.direction(j), geometry.direction(k))) <= RECOGNITION_TOLERANCE:
-            return None  # (nearly) parallel: the common normal's feet run off to where the rounding puts them
+        if geometry.nearly_parallel(j, k):
+            return None  # the common normal's feet would run off to where the rounding puts them
         feet = _common_normal_feet(geometry.point(j), geometry.direction(j), geometry.point(k), geometry.direction(k))
         near = RECOGNITION_TOLERANCE * geometry.length_scale
-        off_axis_3 = np.linalg.norm(cross(geometry.direction(k), point - feet[1]))
-        if np.linalg.norm(feet[1] - feet[0]) <= near or off_axis_3 <= near:
+        if np.linalg.norm(feet[1] - feet[0]) <= near or geometry.axis_distance(k, point) <= near:
             return None  # axes that (nearly) meet, a point (nearly) on axis 3: the idealised arm's families answer
         return cls(geometry, joints, point, feet=feet)
 

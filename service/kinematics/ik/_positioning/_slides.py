@@ -109,7 +109,7 @@ class OneRevoluteTwoPrismatic(Positioner):
         # idealised arm's families answer such an arm)
         if np.abs(axial).max() <= RECOGNITION_TOLERANCE:
             return None  # no slide along the axis: the height equation does not fix them
-        if np.linalg.norm(cross(geometry.direction(slides[0]), geometry.direction(slides[1]))) <= RECOGNITION_TOLERANCE:
+        if geometry.nearly_parallel(*slides):
             return None  # parallel slides move the point along one line: only their sum is fixed
         return cls(geometry, joints, point, revolute=revolute, slides=slides)
 

@@ -285,30 +285,39 @@ class General6RPlan(Sealed):
         accounted for."""
         every = np.arange(6)
         done = np.zeros(len(rows), dtype=bool)
+        # the pairs as the scan meets them: both valid, within FOLD_PAIR (a pair whose root an earlier pair
+        # replaced is skipped below, so each pair's roots and step are as the scan would find them)
+        pairs = []
         for row, members in _by_target(rows, fold):
             for other, k in itertools.combinations(members.tolist(), 2):
-                if done[k] or done[other] or not (valid[row, slots[k]] and valid[row, slots[other]]):
+                if valid[row, slots[k]] and valid[row, slots[other]]:
+                    step = self._difference(joints[row, slots[k]] - joints[row, slots[other]], every)
+                    if np.abs(step).max() <= FOLD_PAIR:
+                        pairs.append((row, other, k, step))
+        if not pairs:
+            return done
+        # Newton's steps from both sides of every pair's middle in one run (each candidate's steps are its own)
+        pair_rows = np.array([row for row, *_ in pairs])
+        middles = np.array([joints[row, slots[other]] + 0.5 * step for row, other, _, step in pairs])
+        sides = SPLIT_STEP * motion[[other for _, other, _, _ in pairs]]
+        starts = np.stack([middles + sides, middles - sides], axis=1).reshape(-1, 6)
+        targets = A[np.repeat(pair_rows, 2)]
+        split = newton(self.directions, self.points, self.revolute, targets, starts, steps=SPLIT_NEWTON_STEPS,
+                       tolerance=SPLIT_TOLERANCE, rcond=SPLIT_RCOND)
+        reached = self._reached(targets, split).reshape(-1, 2).all(axis=1)
+        for (row, other, k, _), halves, both_reached in zip(pairs, split.reshape(-1, 2, 6), reached.tolist()):
+            if done[k] or done[other] or not both_reached:
+                continue
+            gap = self._difference(halves[0] - halves[1], every)
+            if np.abs(gap).max() > DUPLICATE_TOLERANCE:
+                joints[row, slots[other]], joints[row, slots[k]] = halves
+            else:  # one root, and a double one only where the Jacobian is singular: else a root is missing
+                middle = halves[1] + 0.5 * gap
+                if not singular_motion(self.directions, self.points, self.revolute, middle[None])[0][0]:
                     continue
-                first = joints[row, slots[other]]
-                step = self._difference(joints[row, slots[k]] - first, every)
-                if np.abs(step).max() > FOLD_PAIR:
-                    continue
-                sides = np.array([[1.0], [-1.0]]) * SPLIT_STEP * motion[other]
-                targets = A[[row, row]]
-                split = newton(self.directions, self.points, self.revolute, targets, first + 0.5 * step + sides,
-                                steps=SPLIT_NEWTON_STEPS, tolerance=SPLIT_TOLERANCE, rcond=SPLIT_RCOND)
-                if not self._reached(targets, split).all():
-                    continue
-                gap = self._difference(split[0] - split[1], every)
-                if np.abs(gap).max() > DUPLICATE_TOLERANCE:
-                    joints[row, slots[other]], joints[row, slots[k]] = split
-                else:  # one root, and a double one only where the Jacobian is singular: else a root is missing
-                    middle = split[1] + 0.5 * gap
-                    if not singular_motion(self.directions, self.points, self.revolute, middle[None])[0][0]:
-                        continue
-                    joints[row, slots[other]] = middle
-                    valid[row, slots[k]] = False
-                done[[other, k]] = True
+                joints[row, slots[other]] = middle
+                valid[row, slots[k]] = False
+            done[[other, k]] = True
         return done
 
     def _difference(self, difference: np.ndarray, joints: np.ndarray) -> np.ndarray:

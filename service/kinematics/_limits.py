@@ -66,25 +66,54 @@ class Limits:
         return np.where(robot.is_revolute, LIMIT_TOLERANCE, LIMIT_TOLERANCE * robot.characteristic_length)
 
     def continuous(self, robot: Robot) -> np.ndarray:
-        """Which joints are revolute with no bounds at all, shape (n,) bool."""
-        return robot.is_revolute & np.isneginf(self.lower) & np.isposinf(self.upper)
+        """Which joints are revolute with no bounds at all, shape (n,) bool, read-only (:class:`Widened`)."""
+        return self.widened(robot).continuous
 
     def multi_valued(self, robot: Robot) -> np.ndarray:
-        """Which joints are revolute with both bounds finite: those expanded into their 2π-equivalents."""
-        return robot.is_revolute & np.isfinite(self.lower) & np.isfinite(self.upper)
+        """Which joints are revolute with both bounds finite: those expanded into their 2π-equivalents. Shape (n,)
+        bool, read-only (:class:`Widened`)."""
+        return self.widened(robot).multi_valued
 
-    def widened(self, robot: Robot) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The bounds with their tolerance, ``lower − tolerance`` and ``upper + tolerance``, and
-        :meth:`multi_valued`: shape (n,) each, read-only. Kept on the robot for the last
+    def widened(self, robot: Robot) -> "Widened":
+        """The bounds as the checks apply them (:class:`Widened`). Kept on the robot for the last
         :data:`_WIDENED_KEPT` limits asked by value (every answer applies its limits, mostly the same few)."""
-        def build() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        def build() -> Widened:
             tolerance = self.tolerance(robot)
-            arrays = (self.lower - tolerance, self.upper + tolerance, self.multi_valued(robot))
+            lower, upper = self.lower - tolerance, self.upper + tolerance
+            multi_valued = robot.is_revolute & np.isfinite(self.lower) & np.isfinite(self.upper)
+            continuous = robot.is_revolute & np.isneginf(self.lower) & np.isposinf(self.upper)
+            # the interval of _one_turn_each, where only multi-valued joints count
+            one_turn_low = np.where(multi_valued, np.maximum(lower, upper - _TWO_PI + _INTERIOR_MARGIN), -np.inf)
+            one_turn_high = np.where(multi_valued, np.minimum(upper, lower + _TWO_PI - _INTERIOR_MARGIN), np.inf)
+            arrays = (lower, upper, multi_valued, continuous, one_turn_low, one_turn_high)
             for array in arrays:
                 array.flags.writeable = False
-            return arrays
+            return Widened(*arrays, every_multi_valued=bool(multi_valued.all()),
+                           any_multi_valued=bool(multi_valued.any()),
+                           one_turn_possible=bool((one_turn_low < one_turn_high).all()))
         key = (self.lower.dtype.str, self.lower.tobytes(), self.upper.dtype.str, self.upper.tobytes())
         return bounded_memo(robot, "widened_limits", key, build, _WIDENED_KEPT)
+
+
+@dataclass(frozen=True)
+class Widened:
+    """Limits as the checks apply them, per joint (n,) each, read-only.
+
+    ``lower − tolerance`` and ``upper + tolerance``; ``multi_valued`` (revolute, both bounds finite) and
+    ``continuous`` (revolute, no bounds); and the open interval (``one_turn_low``, ``one_turn_high``) inside which a multi-valued joint's value has the turns
+    [0, 0] alone (:func:`_one_turn_each`; ±∞ at the other joints). The flags say whether every joint, and any, is
+    multi-valued, and whether every such interval is non-empty (limits of at most about one turn).
+    """
+
+    lower: np.ndarray
+    upper: np.ndarray
+    multi_valued: np.ndarray
+    continuous: np.ndarray
+    one_turn_low: np.ndarray
+    one_turn_high: np.ndarray
+    every_multi_valued: bool
+    any_multi_valued: bool
+    one_turn_possible: bool
 
 
 #: How many limits :meth:`Limits.widened` keeps per robot.
@@ -103,8 +132,8 @@ class Violation:
 
 def within(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray:
     """Whether each row of q (shape (..., n)) is inside every bound, tolerance included."""
-    lower, upper, _ = limits.widened(robot)
-    return np.all((q >= lower) & (q <= upper), axis=-1)
+    bounds = limits.widened(robot)
+    return np.all((q >= bounds.lower) & (q <= bounds.upper), axis=-1)
 
 
 def violations(robot: Robot, limits: Limits, q: np.ndarray) -> list[Violation]:
@@ -115,8 +144,8 @@ def violations(robot: Robot, limits: Limits, q: np.ndarray) -> list[Violation]:
     A PUMA 560 wrist (q5 in [−100°, 100°]) at 120° gives one violation,
     ``Violation(4, 2.094…, −1.745…, 1.745…)``.
     """
-    lower, upper, _ = limits.widened(robot)
-    outside = (q < lower) | (q > upper)
+    bounds = limits.widened(robot)
+    outside = (q < bounds.lower) | (q > bounds.upper)
     return [Violation(int(i), float(q[i]), float(limits.lower[i]), float(limits.upper[i]))
             for i in np.flatnonzero(outside)]
 
@@ -137,30 +166,35 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
     A joint limited to ±270° at 100° has turns [−1, 0]: −260° and 100°.
     """
     q = np.asarray(q, dtype=float)
-    lower, upper, both = limits.widened(robot)
+    bounds = limits.widened(robot)
+    lower, upper, both = bounds.lower, bounds.upper, bounds.multi_valued
     low = high = None  # the both-bounded columns' turns, None where every one is 0
-    if both.any():  # every both-bounded column at once (whole rows: a column alone strides through them all)
-        value, low_bound, high_bound = (q, lower, upper) if both.all() else (q[..., both], lower[both], upper[both])
-        if not (value.size >= _CHECKED_FROM and _one_turn_each(value, low_bound, high_bound)):
-            # in place, a few (..., n) arrays in all: a batch's table has tens of thousands of rows
-            low = np.subtract(low_bound, value)
-            low /= _TWO_PI
-            np.ceil(low, out=low)
-            high = np.subtract(high_bound, value)
-            high /= _TWO_PI
-            np.floor(high, out=high)
-            end = np.multiply(low, _TWO_PI)  # the end values q + 2kπ, checked against the bounds
-            end += value
-            low += end < low_bound
-            np.multiply(high, _TWO_PI, out=end)
-            end += value
-            high -= end > high_bound
-            if both.all():
-                return low, high
-    first, last = np.zeros_like(q), np.zeros_like(q)
+    if bounds.any_multi_valued and not (q.size >= _CHECKED_FROM and bounds.one_turn_possible
+                                        and _one_turn_each(q, bounds)):
+        # every both-bounded column at once (whole rows: a column alone strides through them all)
+        every = bounds.every_multi_valued
+        value, low_bound, high_bound = (q, lower, upper) if every else (q[..., both], lower[both], upper[both])
+        # in place, a few (..., n) arrays in all: a batch's table has tens of thousands of rows
+        low = np.subtract(low_bound, value)
+        low /= _TWO_PI
+        np.ceil(low, out=low)
+        high = np.subtract(high_bound, value)
+        high /= _TWO_PI
+        np.floor(high, out=high)
+        end = np.multiply(low, _TWO_PI)  # the end values q + 2kπ, checked against the bounds
+        end += value
+        low += end < low_bound
+        np.multiply(high, _TWO_PI, out=end)
+        end += value
+        high -= end > high_bound
+        if every:
+            return low, high
+    first, last = np.zeros(q.shape), np.zeros(q.shape)
     if low is not None:
         first[..., both], last[..., both] = low, high
-    continuous = limits.continuous(robot)
+    if bounds.every_multi_valued:
+        return first, last
+    continuous = bounds.continuous
     for j in np.flatnonzero(~both).tolist():  # one kind of joint per column
         value = q[..., j]
         if robot.is_revolute[j] and not continuous[j]:
@@ -177,18 +211,18 @@ def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray
 
 #: How far inside the values :func:`_one_turn_each` takes are from where a turn's quotient may round to a whole one.
 _INTERIOR_MARGIN = 1e-6
-#: The fewest values :func:`turn_ranges` checks with :func:`_one_turn_each` first: below, its few calls cost more
-#: than the quotients (one target's rows).
-_CHECKED_FROM = 1024
+#: The fewest values :func:`turn_ranges` checks with :func:`_one_turn_each` first. Its intervals are kept with the
+#: limits (:class:`Widened`), so the check is three comparisons at any size: one target's rows take it too.
+_CHECKED_FROM = 0
 
 
-def _one_turn_each(q: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> bool:
-    """Whether every value of q (..., n) lies inside its bounds (n,) and so far from the bounds moved by a whole
-    turn either way that :func:`turn_ranges` would give it the turns [0, 0] alone (as +0.0): three comparisons
-    instead of the quotients, for the usual batch under limits of about one turn."""
-    inside_low = np.maximum(lower, upper - _TWO_PI + _INTERIOR_MARGIN)
-    inside_high = np.minimum(upper, lower + _TWO_PI - _INTERIOR_MARGIN)
-    return bool(((q > inside_low) & (q < inside_high)).all())  # an empty interval fails every value
+def _one_turn_each(q: np.ndarray, bounds: Widened) -> bool:
+    """Whether every multi-valued joint's value in q (..., n) lies so far inside its bounds, and from the bounds
+    moved by a whole turn either way, that :func:`turn_ranges` would give it the turns [0, 0] alone (as +0.0):
+    three comparisons instead of the quotients, for the usual answer under limits of about one turn. (A NaN
+    fails, and takes the quotients.)"""
+    inside = (q > bounds.one_turn_low) & (q < bounds.one_turn_high)
+    return np.count_nonzero(inside) == inside.size
 
 
 def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray,
@@ -220,14 +254,14 @@ def closest_turns(robot: Robot, limits: Limits, q: np.ndarray, first: np.ndarray
     −1 turn, to −160°.
     """
     turns = np.minimum(np.maximum(first, 0.0), last)
-    outside = np.flatnonzero(last < first)  # usually few joints: only these need the nearer side worked out
+    outside = (last < first).ravel().nonzero()[0]  # usually few joints: only these need the nearer side worked out
     if len(outside):
         joint = outside % q.shape[-1]
-        value, below, above = (np.take(a, outside) for a in (q, last, first))
+        value, below, above = (a.take(outside) for a in (q, last, first))
         with np.errstate(invalid="ignore"):
             below_by = limits.lower[joint] - (value + _TWO_PI * below)
             above_by = (value + _TWO_PI * above) - limits.upper[joint]
-        np.put(turns, outside, np.where(limits.multi_valued(robot)[joint] & (below_by < above_by), below, above))
+        turns.put(outside, np.where(limits.multi_valued(robot)[joint] & (below_by < above_by), below, above))
     return turns
 
 

@@ -204,9 +204,9 @@ def _continued(robot: Robot, limits: Limits, q: np.ndarray, previous: np.ndarray
     half_turn = robot.is_revolute & (np.abs(np.abs(difference) - np.pi) <= 1e-9)
     if half_turn.any():
         other = near - 2.0 * np.pi * np.sign(difference)
-        lower, upper, _ = limits.widened(robot)
-        inside = (near >= lower) & (near <= upper)
-        other_inside = (other >= lower) & (other <= upper)
+        bounds = limits.widened(robot)
+        inside = (near >= bounds.lower) & (near <= bounds.upper)
+        other_inside = (other >= bounds.lower) & (other <= bounds.upper)
         prefer_other = (other_inside & ~inside) | ((other_inside == inside) & (np.abs(other) < np.abs(near)))
         near = np.where(half_turn & prefer_other, other, near)
     return near

@@ -698,7 +698,7 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
         if part.unfinished is not None:
             flags += part.unfinished
         lookup = np.zeros(4, dtype=int)
-        for code in np.flatnonzero(np.bincount(flags, minlength=4)).tolist():  # the codes met, ascending
+        for code in np.bincount(flags, minlength=4).nonzero()[0].tolist():  # the codes met, ascending
             report = SolverReport(part.method, part.structure, code >= 2, code % 2 == 1, part.free_joints)
             if report not in reports:
                 reports.append(report)
@@ -725,13 +725,16 @@ def _assembled(robot: Robot, n_targets: int, parts: list[_Part], limits: Limits,
                                max_equivalents=options.max_equivalents, excluded=excluded, budget=options.budget)
     status = chosen.status.copy()
     unproven = ~complete | sampled
-    if unproven.any():
+    if np.count_nonzero(unproven):
         status[(status == "unreachable") & unproven] = "not_found"
     # solver reports numbered by first appearance in target order
     by_appearance = list(dict.fromkeys(report_of.tolist()))
-    renumber = np.zeros(max(len(reports), 1), dtype=int)
-    renumber[by_appearance] = np.arange(len(by_appearance))
-    solvers, solver = [reports[i] for i in by_appearance], renumber[report_of]
+    if by_appearance == list(range(len(reports))):  # numbered so already (one solver, the usual answer)
+        solvers, solver = reports, report_of
+    else:
+        renumber = np.zeros(max(len(reports), 1), dtype=int)
+        renumber[by_appearance] = np.arange(len(by_appearance))
+        solvers, solver = [reports[i] for i in by_appearance], renumber[report_of]
     singular_rows = sorted(singular_of)
     distinct: dict[Singularity, int] = {}
     numbered = {row: [distinct.setdefault(flag, len(distinct)) for flag in singular_of[row]] for row in singular_rows}
@@ -761,9 +764,9 @@ def _detail(part, local: int, notes) -> str | None:
 
 def _violations(robot: Robot, limits: Limits, table: SolutionTable) -> np.ndarray:
     """Which joints (S, n) of each row outside the limits break them (tolerance included); False elsewhere."""
-    if table.within_limits.all():  # the usual kept table: nothing to compare
+    if np.count_nonzero(table.within_limits) == len(table):  # the usual kept table: nothing to compare
         return np.zeros(table.joints.shape, dtype=bool)
-    lower, upper, _ = limits.widened(robot)
-    outside = (table.joints < lower) | (table.joints > upper)
+    bounds = limits.widened(robot)
+    outside = (table.joints < bounds.lower) | (table.joints > bounds.upper)
     return outside & ~table.within_limits[:, None]
 

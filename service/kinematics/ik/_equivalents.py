@@ -112,7 +112,7 @@ def combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_
             cheapest, direction, ahead, behind = _ranked_turns(q, first, last, reference, weights)
             turns = cheapest[owner] + _rank_offsets(ranks, direction[owner], ahead[owner], behind[owner])
             return owner, np.where(single[owner, None], first[owner], turns)
-    multi = np.flatnonzero(~single)
+    multi = (~single).nonzero()[0]
     caps = ranks_cap[multi]
     cheapest, direction, ahead, behind = _ranked_turns(q[multi], first[multi], last[multi], reference, weights)
     owner, ranks = _rank_tuples(caps, row_limit[multi])
@@ -123,7 +123,7 @@ def combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_
     per_row[multi] = np.bincount(owner, minlength=len(multi))
     offset = np.cumsum(per_row) - per_row
     turns = np.empty((int(per_row.sum()), q.shape[1]))
-    singles = np.flatnonzero(single)
+    singles = single.nonzero()[0]
     turns[offset[singles]] = first[singles]
     turns[offset[multi][owner] + position_in_group(owner)] = multi_turns
     return np.repeat(np.arange(len(q)), per_row), turns
@@ -139,9 +139,9 @@ def _tabled_turns(caps: np.ndarray, owner: np.ndarray, ranks: np.ndarray, cheape
     rank = np.arange(len(entry)) - table_start.ravel()[entry]
     table = [a.ravel()[entry] for a in (cheapest, direction, ahead, behind)]
     table = table[0] + _rank_offsets(rank, *table[1:])
-    at = np.take(table_start, owner, axis=0)  # np.take: a plain gather, faster than indexing with arrays
+    at = table_start.take(owner, axis=0)  # take: a plain gather, faster than indexing with arrays
     at += ranks
-    return np.take(table, at)
+    return table.take(at)
 
 
 def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, reference: np.ndarray | None,

@@ -38,7 +38,7 @@ capped at :data:`.._budget.COUNT_CAP`.
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -193,7 +193,8 @@ def effective_reference(robot: Robot, limits: Limits, reference: np.ndarray) -> 
     >>> effective_reference(arm, Limits.of(arm), np.array([4.0])).round(4).tolist()
     [-2.2832]
     """
-    lower, upper, multi_valued = limits.widened(robot)
+    bounds = limits.widened(robot)
+    lower, upper, multi_valued = bounds.lower, bounds.upper, bounds.multi_valued
     outside = multi_valued & ((reference < lower) | (reference > upper))
     if not outside.any():
         return reference
@@ -249,8 +250,8 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     keepable = fits if filter_limits else np.ones(len(q), dtype=bool)
     if excluded is not None:
         keepable = keepable & ~excluded
-    dropped = np.flatnonzero(~keepable)  # rejected at their closest equivalent
-    misfits = np.flatnonzero(~fits)
+    dropped = (~keepable).nonzero()[0]  # rejected at their closest equivalent
+    misfits = (~fits).nonzero()[0]
     misfit_q = q.take(misfits, axis=0)
     misfit_turns = (closest_turns(robot, limits, misfit_q, first.take(misfits, axis=0), last.take(misfits, axis=0))
                     if len(misfits) else misfit_q)
@@ -260,7 +261,7 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     else:  # a solution that does not fit and stays (limits flag it) has one value: its closest equivalent
         if not filter_limits and len(misfits):
             first[misfits], last[misfits] = misfit_turns, misfit_turns
-        candidates = np.flatnonzero(keepable)
+        candidates = keepable.nonzero()[0]
         c_target, c_q, c_first, c_last = (a.take(candidates, axis=0) for a in (target, q, first, last))
     counts = c_last - c_first + 1.0  # ≥ 1: every candidate has a usable turn per joint
     combinations = capped_products(counts)  # (C,) each candidate's usable combinations
@@ -314,20 +315,35 @@ def _outcome(rows: np.ndarray, kept: SolutionTable, n_kept: np.ndarray, rejected
     ``lowered_to`` the limit :func:`enumerable_limit` imposed, if any.
     """
     n_targets = len(rows)
-    n_rejected = rejected.counts(n_targets)
-    outside = np.bincount(kept.target[~kept.within_limits], minlength=n_targets)
-    none_kept = (candidates == 0) & (n_rejected > 0)  # a target with no row at all rejects none either
-    no_fit = none_kept & (collided == 0)
-    reached = rows > 0
+    nothing, none = np.zeros(n_targets, dtype=np.int64), np.zeros(n_targets, dtype=bool)
+    # each column worked out only where it can be other than nothing: one target's answer is a handful of rows,
+    # and each array operation costs far more than its arithmetic there
+    n_rejected = rejected.counts(n_targets) if len(rejected) else nothing
+    flagged = np.count_nonzero(kept.within_limits) < len(kept)
+    outside = np.bincount(kept.target[~kept.within_limits], minlength=n_targets) if flagged else nothing
     status = _all_ok(n_targets)
-    status[no_fit] = "no_solution_within_limits"
-    status[none_kept & (collided > 0)] = "no_collision_free_solution"
-    status[~reached] = "unreachable"
-    truncated = (available > n_kept) & (not capped)
-    trimmed = np.minimum(with_all_moves - available + ((available - n_kept) if capped else 0), COUNT_CAP)
-    noted = (no_fit | (outside > 0) | truncated | (reached & ~none_kept & (n_kept == 0) & (with_all_moves > 0))
-             | (collided > 0))
-    notes = TargetNotes(np.flatnonzero(noted), status, n_rejected, outside, truncated, available, n_kept,
+    none_kept = no_fit = none
+    if len(rejected):
+        none_kept = (candidates == 0) & (n_rejected > 0)  # a target with no row at all rejects none either
+        no_fit = none_kept & (collided == 0)
+        status[no_fit] = "no_solution_within_limits"
+        status[none_kept & (collided > 0)] = "no_collision_free_solution"
+    unreached = rows == 0
+    if np.count_nonzero(unreached):
+        status[unreached] = "unreachable"
+    truncated = np.zeros(n_targets, dtype=bool) if capped else available > n_kept  # its own: the answer holds it
+    trimmed = with_all_moves - available
+    if capped:
+        trimmed += available - n_kept
+    np.minimum(trimmed, COUNT_CAP, out=trimmed)
+    noted = no_fit | truncated
+    if flagged:
+        noted |= outside > 0
+    if np.count_nonzero(collided):
+        noted |= collided > 0
+    if np.count_nonzero(n_kept) < n_targets:  # a reached target with none kept, though some fit before the move
+        noted |= ~unreached & ~none_kept & (n_kept == 0) & (with_all_moves > 0)
+    notes = TargetNotes(noted.nonzero()[0], status, n_rejected, outside, truncated, available, n_kept,
                         with_all_moves, collided, max_equivalents, has_reference, lowered_to, n)
     return Selection(status, truncated, trimmed, available, notes, kept, rejected)
 
@@ -341,7 +357,7 @@ def _each_once(robot: Robot, limits: Limits, table: SolutionTable, n_targets: in
     row one combination), in a few array operations."""
     target, q = table.target, table.joints
     turns = first
-    misfits = np.flatnonzero(~fits)
+    misfits = (~fits).nonzero()[0]
     if len(misfits):  # each at its closest equivalent: rejected, or kept and flagged
         turns = first.copy()
         turns[misfits] = closest_turns(robot, limits, q[misfits], first[misfits], last[misfits])
@@ -350,7 +366,7 @@ def _each_once(robot: Robot, limits: Limits, table: SolutionTable, n_targets: in
     rows = table.counts(n_targets)
     candidates = rows if not len(dropped) else np.bincount(np.delete(target, dropped), minlength=n_targets)
     if not len(misfits) and candidates.max(initial=0) <= max_equivalents:  # every row kept as it stands
-        kept, n_kept = replace(table, joints=values, within_limits=fits), rows
+        kept, n_kept = table.listed_at(values, fits), rows
     else:
         keep = np.delete(np.arange(len(target)), dropped)
         if candidates.max(initial=0) > max_equivalents:  # the cap: each target's first rows
@@ -458,9 +474,9 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
             continue
         block = slice(filled, filled + len(pick))
         rows_out[block] = picked
-        if values is None:  # q + 2πk, as 2πk + q (the same sum); np.take: a plain gather, faster than indexing
-            np.multiply(np.take(turns, pick, axis=0), _TWO_PI, out=values_out[block])
-            values_out[block] += np.take(q, picked, axis=0)
+        if values is None:  # q + 2πk, as 2πk + q (the same sum); take: a plain gather, faster than indexing
+            np.multiply(turns.take(pick, axis=0), _TWO_PI, out=values_out[block])
+            values_out[block] += q.take(picked, axis=0)
         else:
             values_out[block] = values[pick]
         filled = block.stop

@@ -83,6 +83,11 @@ class SolutionTable:
                              None if self.contacts is None else self.contacts.take(index),
                              None if self.roll is None else self.roll[index])
 
+    def listed_at(self, joints: np.ndarray, within_limits: np.ndarray) -> "SolutionTable":
+        """The same rows listed at other joint values (S, n) and limit flags (S,): a selection's 2π-equivalents."""
+        return SolutionTable(self.target, joints, within_limits, self.position, self.orientation, self.labels,
+                             self.clearance, self.contacts, self.roll)
+
     def with_targets(self, target: np.ndarray) -> "SolutionTable":
         """The same rows numbered by other targets (``target`` (S,) non-decreasing), as when a part's rows
         take their place among a whole answer's."""

@@ -49,22 +49,24 @@ def newton(directions: np.ndarray, points: np.ndarray, revolute: np.ndarray, A_t
     """
     q = q.copy()
     R_A, p_A = A_targets[:, :3, :3], A_targets[:, :3, 3]
+    stepped = np.arange(len(q))  # the candidates whose error may have changed: the others keep theirs
     for _ in range(steps + 1):
-        R, p, twists = chain_twists(directions, points, revolute, q)
-        error = error_twist(R, p, R_A, p_A)
+        R, p, twists = chain_twists(directions, points, revolute, q[stepped])
+        error = error_twist(R, p, R_A[stepped], p_A[stepped])
         active = np.abs(error).max(axis=1) > tolerance
         if _ == steps or not active.any():
             break
+        stepped = stepped[active]
         J = twists[active]
         fixed = np.zeros(J.shape[:2])
         if held is not None:
-            J[np.arange(len(J)), held[active]] = 0.0
-            fixed[np.arange(len(J)), held[active]] = 1.0
+            J[np.arange(len(J)), held[stepped]] = 0.0
+            fixed[np.arange(len(J)), held[stepped]] = 1.0
         if rcond is not None:  # the pseudo-inverse: every singular value above rcond · σ_max counts in full
-            q[active] += np.einsum("kij,kj->ki", np.linalg.pinv(np.swapaxes(J, -1, -2), rcond=rcond), error[active])
+            q[stepped] += np.einsum("kij,kj->ki", np.linalg.pinv(np.swapaxes(J, -1, -2), rcond=rcond), error[active])
             continue
         JJt = J @ np.swapaxes(J, -1, -2) + 1e-14 * np.eye(6) + fixed[..., None] * np.eye(6)
-        q[active] += solve_each(JJt, J @ error[active][..., None])[..., 0]
+        q[stepped] += solve_each(JJt, J @ error[active][..., None])[..., 0]
     return q
 
 

@@ -100,9 +100,10 @@ class Widened:
     """Limits as the checks apply them, per joint (n,) each, read-only.
 
     ``lower − tolerance`` and ``upper + tolerance``; ``multi_valued`` (revolute, both bounds finite) and
-    ``continuous`` (revolute, no bounds); and the open interval (``one_turn_low``, ``one_turn_high``) inside which a multi-valued joint's value has the turns
-    [0, 0] alone (:func:`_one_turn_each`; ±∞ at the other joints). The flags say whether every joint, and any, is
-    multi-valued, and whether every such interval is non-empty (limits of at most about one turn).
+    ``continuous`` (revolute, no bounds); and the open interval (``one_turn_low``, ``one_turn_high``) inside
+    which a multi-valued joint's value has the turns [0, 0] alone (:func:`_one_turn_each`; ±∞ at the other
+    joints). The flags say whether every joint, and any, is multi-valued, and whether every such interval is
+    non-empty (limits of at most about one turn).
     """
 
     lower: np.ndarray

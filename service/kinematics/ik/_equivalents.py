@@ -153,20 +153,18 @@ def _ranked_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, reference:
     turns lie beyond the cheapest in that direction and in the other. The cost grows outwards from the
     cheapest, so the ranks alternate between the two sides until one runs out (:func:`_rank_offsets`).
     """
-    if reference is None:
-        q = centre = np.zeros(first.shape)
+    if reference is None:  # the cost |k|·w: 0 is cheapest, then −1 before +1 (equal costs: the lower value)
+        cheapest, direction = np.zeros(first.shape), np.full(first.shape, -1.0)
     else:
-        centre = reference
+        def cost(k):
+            return np.abs(q + _TWO_PI * k - reference) * weights
 
-    def cost(k):
-        return np.abs(q + _TWO_PI * k - centre) * weights
-
-    below = np.floor((centre - q) / _TWO_PI)
-    above = below + 1.0
-    at_above = cost(above)
-    lower_costs_more = at_above < cost(below)
-    cheapest = np.where(lower_costs_more, above, below)
-    direction = np.where(lower_costs_more | (cost(below - 1.0) <= at_above), -1.0, 1.0)
+        below = np.floor((reference - q) / _TWO_PI)
+        above = below + 1.0
+        at_above = cost(above)
+        lower_costs_more = at_above < cost(below)
+        cheapest = np.where(lower_costs_more, above, below)
+        direction = np.where(lower_costs_more | (cost(below - 1.0) <= at_above), -1.0, 1.0)
     indifferent = weights == 0  # every value costs 0: ascending values
     if indifferent.any():
         cheapest, direction = np.where(indifferent, first, cheapest), np.where(indifferent, 1.0, direction)

@@ -73,6 +73,33 @@ def test_the_one_turn_shortcut_gives_the_quotients_turns(robot, monkeypatch):
             assert a.tobytes() == b.tobytes()
 
 
+@pytest.mark.parametrize("robot", [
+    arm(*[("revolute", -math.pi, math.pi)] * 6),  # ±π: the one-turn interval is the whole range, less its margin
+    arm(*[("revolute", -170 * DEG, 170 * DEG)] * 5, ("revolute", -266 * DEG, 266 * DEG)),  # a PUMA's joint 6
+    MIXED], ids=["pi", "one joint over a turn", "mixed"])
+def test_the_one_turn_shortcut_on_one_targets_few_rows(robot, monkeypatch):
+    """One target's few rows (as a single-pose answer selects) take the shortcut too: the same (first, last), bit
+    for bit, as the quotients, for rows inside the limits, on a bound, a hair inside the one-turn interval's
+    margin, and outside."""
+    from service.kinematics import _limits
+
+    rng = np.random.default_rng(11)
+    limits = Limits.of(robot)
+    lower, upper = np.maximum(robot.lower, -4.0), np.minimum(robot.upper, 4.0)
+    rows = [rng.uniform(lower, upper, (8, robot.dof)), np.tile(robot.lower, (2, 1)), np.tile(robot.upper, (2, 1)),
+            rng.uniform(-7.0, 7.0, (8, robot.dof))]
+    near_margin = rng.uniform(lower, upper, (4, robot.dof))
+    near_margin[:, 0] = robot.upper[0] - np.array([0.5e-6, 1e-6, 2e-6, 1e-3])
+    for q in (*rows, near_margin, np.zeros((1, robot.dof)), np.zeros((0, robot.dof))):
+        q = np.where(np.isfinite(q), q, 0.5)
+        shortcut = turn_ranges(robot, limits, q)
+        monkeypatch.setattr(_limits, "_CHECKED_FROM", math.inf)
+        quotients = turn_ranges(robot, limits, q)
+        monkeypatch.undo()
+        for a, b in zip(shortcut, quotients):
+            assert a.tobytes() == b.tobytes()
+
+
 def test_turn_ranges_count_huge_limits_without_generating_them():
     wide = arm(("revolute", -1e6, 1e6))
     first, last = turn_ranges(wide, Limits.of(wide), np.array([0.5]))

@@ -172,11 +172,12 @@ class FreeJointFamily:
         gap = np.abs(wrap_revolute(robot, found.joints - q)).max(axis=1)
         return bool((gap < DUPLICATE_TOLERANCE).any())
 
-    def solve_rows(self, world_T_targets: np.ndarray, values: np.ndarray, reference: np.ndarray | None
-                   ) -> Candidates:
+    def solve_rows(self, world_T_targets: np.ndarray, values: np.ndarray, reference: np.ndarray | None, *,
+                   budget: Budget = UNLIMITED) -> Candidates:
         """Candidates (S, m, n) for targets (S, 4, 4), row s with the free joints at ``values[s]`` (S, f): full
         joint vectors, the free joints holding their row's values, labelled by the locked family. A row whose
-        locked arm has no plan has no candidate and is not complete."""
+        locked arm has no plan has no candidate and is not complete. ``budget`` is checked before each row whose
+        locked arm is solved on its own (building its plan, the first time, takes tens of milliseconds)."""
         n_rows, n = len(world_T_targets), self.robot.dof
         locked_reference = None if reference is None else reference[self.kept]
         if self.ends_only:
@@ -185,6 +186,7 @@ class FreeJointFamily:
         else:
             parts = []
             for row in range(n_rows):
+                budget.check("the free-joint family")
                 plan = self.locked_plan(values[row])
                 if plan is not None:
                     parts.append((np.array([row]), plan, plan.solve(world_T_targets[row:row + 1], locked_reference)))
@@ -409,7 +411,7 @@ def solve_family(robot: Robot, family: FreeJointFamily, goal: PoseGoal, free: li
     targets, refined = [], []
     for index, target in enumerate(goal.world_T_targets):
         budget.check("the free-joint family")
-        grid = solve_at(robot, family, target, values, reference)
+        grid = solve_at(robot, family, target, values, reference, budget=budget)
         parts = [grid]
         if reference is not None and len(family.free) == 1:
             extra = refine_nearest(robot, family, target, values[:, 0], grid, reference,
@@ -468,13 +470,14 @@ def solve_free_joint_family(robot: Robot, world_T_targets: np.ndarray, free: lis
 
 
 def solve_at(robot: Robot, family: FreeJointFamily, target: np.ndarray, values: np.ndarray,
-             reference: np.ndarray | None) -> Verified:
-    """Every solution of one target (4, 4) at each row of free values (S, f), one verified row each."""
+             reference: np.ndarray | None, *, budget: Budget = UNLIMITED) -> Verified:
+    """Every solution of one target (4, 4) at each row of free values (S, f), one verified row each; ``budget``
+    as :meth:`FreeJointFamily.solve_rows` checks it."""
     targets = np.broadcast_to(target, (len(values), 4, 4))
     held = np.zeros(robot.dof, dtype=bool)
     held[list(family.free)] = True
-    return verify(robot, PoseGoal(np.ascontiguousarray(targets)), family.solve_rows(targets, values, reference),
-                  reference, held=held)
+    return verify(robot, PoseGoal(np.ascontiguousarray(targets)),
+                  family.solve_rows(targets, values, reference, budget=budget), reference, held=held)
 
 
 def free_joint_solutions(robot: Robot, requested: Requested | None, refined: bool) -> int | None:

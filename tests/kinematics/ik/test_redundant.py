@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import InvalidInputError, Joint, Robot, forward_kinematics
+from service.kinematics import Budget, BudgetExhausted, InvalidInputError, Joint, Robot, forward_kinematics
 from service.kinematics.ik import (FreeJoint, beyond_reach, distance_to_reference, free_joints_for,
                                    solve_free_joint_family, solve_ik)
 from service.kinematics.ik._redundant import default_free_joints, family_for, sample_values
@@ -263,3 +263,27 @@ def test_a_reference_that_solves_the_pose_comes_first_even_between_grid_values(r
                        AnswerOptions(reference=q, filter_limits=False))
     assert answer.status[0] == "ok"
     assert distance_to_reference(robot, answer.solutions.joints[0], q) <= 1e-6
+
+
+def test_a_free_joint_grid_checks_the_budget_at_every_locked_arm():
+    """A skew 7R locked at each of 16 free values is 16 arms, each solved (and its plan built, the first time) on
+    its own: the request's budget is checked before each, so a grid of many samples stops at its deadline rather
+    than seconds later (256 samples ran 5.4 s past the first check under a 3 s deadline before)."""
+    robot = Robot([Joint(f"q{i + 1}", "revolute", 0.1 * i, 0.3 + 0.2 * i, 0.05 * (i % 3), 0.0) for i in range(7)],
+                  name="skew 7R")
+    target = forward_kinematics(robot, np.array([[0.3, -0.4, 0.5, 0.2, -0.6, 0.7, 0.1]]))
+    checks = []
+    budget = Budget(between_chunks=lambda: checks.append(1))
+    solve_free_joint_family(robot, target, [FreeJoint(3, np.linspace(-3.0, 3.0, 16))], None, budget=budget)
+    assert len(checks) >= 16
+    stopped_at = []
+
+    def cancel_after_three() -> None:
+        stopped_at.append(1)
+        if len(stopped_at) == 3:
+            cancelling.cancel()
+
+    cancelling = Budget(between_chunks=cancel_after_three)
+    with pytest.raises(BudgetExhausted):
+        solve_free_joint_family(robot, target, [FreeJoint(3, np.linspace(-3.0, 3.0, 16))], None, budget=cancelling)
+    assert len(stopped_at) == 3

@@ -463,21 +463,21 @@ def _at_rolls(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int,
         budget.check("the roll family")
         chunk = slice(start, start + ROLL_CHUNK)
         parts.append(_solved_at(robot, family, goal, index, all_rolls[chunk], None if free is None else free[chunk],
-                                reference))
+                                reference, budget))
     return parts[0] if len(parts) == 1 else joined(parts, robot.dof)
 
 
 def _solved_at(robot: Robot, family: RollFamily, goal: DirectionGoal, index: int, rolls: np.ndarray,
-               free: np.ndarray | None, reference: np.ndarray | None) -> Verified:
+               free: np.ndarray | None, reference: np.ndarray | None, budget: Budget = UNLIMITED) -> Verified:
     """Every solution of target ``index`` of the goal at each roll (K,), a redundant arm's free joints at
-    ``free`` (K, f) row by row, verified against the direction target (one row each), each table row carrying
-    its roll (read off its FK)."""
+    ``free`` (K, f) row by row (``budget`` checked before each locked arm solved on its own), verified against
+    the direction target (one row each), each table row carrying its roll (read off its FK)."""
     poses = roll_poses(goal.tool_axis, goal.positions[index], goal.directions[index], rolls)
     held, label_codes = None, None
     if family.family is None:
         candidates, label_codes = family.plan.solve(poses, reference), family.plan.label_codes
     else:
-        candidates = family.family.solve_rows(poses, free, reference)
+        candidates = family.family.solve_rows(poses, free, reference, budget=budget)
         held = np.zeros(robot.dof, dtype=bool)
         held[list(family.free_joints)] = True
     verified = verify(robot, goal.take(np.full(len(rolls), index)), candidates, reference, label_codes, held=held)

@@ -15,7 +15,7 @@ from service.kinematics import Budget, BudgetExhausted, InvalidInputError, Joint
 from service.kinematics.ik import (FreeJoint, beyond_reach, distance_to_reference, free_joints_for,
                                    solve_free_joint_family, solve_ik)
 from service.kinematics.ik._redundant import default_free_joints, family_for, sample_values
-from tests.arms import published_arm
+from tests.arms import SKEW_7R, published_arm
 from tests.ik_helpers import angle_gap, find
 
 def solutions_of(answer, row: int = 0) -> np.ndarray:
@@ -269,8 +269,8 @@ def test_a_free_joint_grid_checks_the_budget_at_every_locked_arm():
     """A skew 7R locked at each of 16 free values is 16 arms, each solved (and its plan built, the first time) on
     its own: the request's budget is checked before each, so a grid of many samples stops at its deadline rather
     than seconds later (256 samples ran 5.4 s past the first check under a 3 s deadline before)."""
-    robot = Robot([Joint(f"q{i + 1}", "revolute", 0.1 * i, 0.3 + 0.2 * i, 0.05 * (i % 3), 0.0) for i in range(7)],
-                  name="skew 7R")
+    robot = Robot([Joint(f"q{i + 1}", joint["type"], joint["a"], joint["alpha"], joint["d"], 0.0)
+                   for i, joint in enumerate(SKEW_7R["joints"])], name="skew 7R")  # the live test's slow arm
     target = forward_kinematics(robot, np.array([[0.3, -0.4, 0.5, 0.2, -0.6, 0.7, 0.1]]))
     checks = []
     budget = Budget(between_chunks=lambda: checks.append(1))

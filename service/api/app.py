@@ -19,7 +19,7 @@ from ..kinematics import BudgetExhausted
 from .budget import InFlight, budget_exhausted
 from .gate import RequestGate
 from .robot_cache import RobotCache
-from .observability import configure_logging, metrics_router
+from .observability import configure_logging, metrics_router, restore_log_level
 from .examples import add_examples
 from .pages import install_pages
 from .problems import PROBLEM_MEDIA_TYPE, Problem, install_problem_handlers
@@ -85,6 +85,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         if settings.robots_dir is not None:
             directories.append(settings.robots_dir)
         app.state.shutting_down = False
+        log_level_before = configure_logging(settings.log_level)  # the process's level while this app serves
         app.state.catalogue = load_catalogue(directories, max_joints=settings.max_joints,
                                              max_file_bytes=settings.max_robot_file_bytes)
         logger.info("catalogue loaded: %d robots from %s", len(app.state.catalogue),
@@ -95,6 +96,7 @@ def create_app(settings: Settings | None = None) -> FastAPI:
         app.state.shutting_down = True  # /readyz: 503 from here on (the catalogue is dropped below)
         gc.unfreeze()  # an application started again in this process (tests) must not pile frozen objects up
         gc.set_threshold(*thresholds)
+        restore_log_level(log_level_before)
         app.state.catalogue = None
 
     app = FastAPI(
@@ -112,7 +114,6 @@ def create_app(settings: Settings | None = None) -> FastAPI:
     app.state.shutting_down = False
     app.state.in_flight = InFlight(settings.max_in_flight)
     app.state.inline_robots = RobotCache("inline", settings.robot_cache_size)
-    configure_logging(settings.log_level)
     install_problem_handlers(app)
     app.add_exception_handler(BudgetExhausted, budget_exhausted)
     # One ASGI layer in front of the routes: request id + access log + metrics → CORS (when configured; answers

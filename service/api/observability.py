@@ -118,15 +118,26 @@ class _StdoutHandler(logging.StreamHandler):
         super().emit(record)
 
 
-def configure_logging(level: str) -> None:
-    """Send the ``service`` loggers to stdout as JSON lines, once per process."""
+def configure_logging(level: str) -> int:
+    """Send the ``service`` loggers to stdout as JSON lines (one handler per process) at ``level``.
+
+    The level is the process's: the caller that sets it while it serves (the app's lifespan) gives the returned
+    previous level back to ``restore_log_level`` when it stops, so that an app started and stopped in the same
+    process (tests) leaves the loggers of another app as it found them.
+    """
     logger = logging.getLogger("service")
     if not any(isinstance(handler, _StdoutHandler) for handler in logger.handlers):
         handler = _StdoutHandler()
         handler.setFormatter(JsonFormatter())
         logger.addHandler(handler)
+    previous = logger.level
     logger.setLevel(logging.DEBUG if level == "trace" else level.upper())
     logger.propagate = False
+    return previous
+
+
+def restore_log_level(previous: int) -> None:
+    logging.getLogger("service").setLevel(previous)
 
 
 # --------------------------------------------------------------------------- request ids (the gate gives them)

@@ -84,6 +84,20 @@ def test_one_json_access_line_per_request(client):
     assert re.fullmatch(r"\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\.\d{3}\+00:00", line["ts"])
 
 
+def test_an_app_started_and_stopped_in_the_process_leaves_the_serving_apps_log_level(client):
+    """The log level is the process's: a quieter app holds it while it serves and gives it back when it stops.
+
+    Built and started at ``warning`` (as several tests do), such an app once left the ``service`` loggers at
+    WARNING for good, and the session client's access lines (INFO) vanished in whatever test ran after it.
+    """
+    with TestClient(create_app(Settings(_env_file=None, log_level="warning"))):
+        assert logging.getLogger("service").getEffectiveLevel() == logging.WARNING
+    stream = _capture("service.access")
+    client.post("/v1/robots/ur5/fk", json={"joints": [0.0] * 6}, headers={"X-Request-ID": "after-quiet-app"})
+    requests = [json.loads(line)["request_id"] for line in stream.getvalue().splitlines()]
+    assert requests == ["after-quiet-app"]
+
+
 # --------------------------------------------------------------------------- metrics
 
 

@@ -11,7 +11,8 @@ solver's promise that a target's solutions are all of them is weighed against wh
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
+import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -135,7 +136,7 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
             if n_targets else ok.copy()
     if n_targets == 1:
         kept = ok.copy()
-        kept[0] = first_of_each_slot(robot, joints[0], kept[0].tolist())
+        kept[0] = first_of_each_slot(robot, joints[0].tolist(), kept[0].tolist())
         return kept
     earlier, later = _slot_pairs(m)
     chunk = max(1, _PAIR_ENTRIES // max(1, len(later) * n))
@@ -153,19 +154,39 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
     return kept
 
 
-def first_of_each_slot(robot: Robot, joints: np.ndarray, ok: list[bool]) -> list[bool]:
-    """:func:`first_of_each` of one target's few slots ``joints`` (m, n), m at most :data:`_PAIRWISE_SLOTS`, the
-    ``ok`` ones and the result as lists (m,): every pair of slots at once, then the scan on Python booleans where
-    two slots are one solution. (Unlike :func:`_same_pairs`, no screen on the last joint first: the UR type's
-    slots share their last joint in pairs.)"""
-    m = len(ok)
-    if m < 2:
-        return list(ok)
-    same = _same(np.abs(joints[:, None] - joints[None]), duplicate_tolerance(robot), robot.is_revolute)
-    earlier, later = _slot_pairs(m)
-    if not same[later, earlier].any():  # no two slots one solution: nothing to drop
-        return list(ok)
-    return _scanned_pairs(same.tolist(), list(ok))
+def first_of_each_slot(robot: Robot, rows: Sequence[Sequence[float]], ok: list[bool]) -> list[bool]:
+    """:func:`first_of_each` of one target's few slots ``rows`` (m, n: lists of floats), ``ok`` and the result as
+    lists (m,): each ok slot against the distinct slots kept before it, joint by joint until one is apart. For a
+    handful of slots this is a few comparisons per pair, where the pairwise arrays cost a dozen array operations.
+
+    The comparisons are :func:`_same`'s on the same values: a revolute gap past π is taken from 2π (numpy's
+    ``minimum(gap, 2π − gap)``, an infinite gap included), and a NaN gap is apart."""
+    rule = _duplicate_rule(robot)
+    pi, two_pi = math.pi, 2 * math.pi
+    kept: list[bool] = []
+    distinct: list[Sequence[float]] = []
+    for q, keep in zip(rows, ok):
+        if keep:
+            for other in distinct:
+                for a, b, (turns, within) in zip(q, other, rule):
+                    gap = abs(a - b)
+                    if turns and gap > pi:
+                        gap = two_pi - gap
+                    if not gap <= within:
+                        break  # this joint is apart: another solution
+                else:  # every joint within its tolerance: the same solution as one kept before
+                    keep = False
+                    break
+            if keep:
+                distinct.append(q)
+        kept.append(keep)
+    return kept
+
+
+def _duplicate_rule(robot: Robot) -> list[tuple[bool, float]]:
+    """Per joint, whether it is revolute and its :func:`duplicate_tolerance`, as floats (kept per robot)."""
+    return memo(robot, "ik_duplicate_rule",
+                lambda: list(zip(robot.is_revolute.tolist(), duplicate_tolerance(robot).tolist())))
 
 
 def _same_pairs(joints: np.ndarray, earlier: np.ndarray, later: np.ndarray, tolerance: np.ndarray,
@@ -191,20 +212,6 @@ def _same(gap: np.ndarray, tolerance: np.ndarray, revolute: np.ndarray) -> np.nd
     elif revolute.any():
         gap[..., revolute] = np.minimum(gap[..., revolute], 2 * np.pi - gap[..., revolute])
     return (gap <= tolerance).all(axis=-1)
-
-
-def _scanned_pairs(same: list[list[bool]], kept: list[bool]) -> list[bool]:
-    """The scan of :func:`first_of_each_slot` (one target): ``same`` (m × m) says which slots are one solution,
-    ``kept`` (m,) the ok slots; a slot is dropped when it equals a slot kept before it."""
-    distinct: list[int] = []
-    for slot, keep in enumerate(kept):
-        if keep:
-            row = same[slot]
-            if any(row[earlier] for earlier in distinct):
-                kept[slot] = False
-            else:
-                distinct.append(slot)
-    return kept
 
 
 @functools.lru_cache(maxsize=_PAIRWISE_SLOTS)
@@ -330,23 +337,22 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     sizes = error_size(robot, position, orientation, constrained).tolist()
     if any(size != size or polished(size) for size in sizes):  # a NaN error, or one verify would polish
         return None
-    joints = np.array(rows, dtype=float).reshape(len(rows), robot.dof)
-    kept = [row for row, keep in enumerate(first_of_each_slot(robot, joints, [size <= ACCEPT_RESIDUAL
-                                                                              for size in sizes])) if keep]
-    if reference is not None and len(kept) > 1:
-        nearest_first = np.argsort(distance_to_reference(robot, joints[kept], reference), kind="stable")
-        kept = [kept[i] for i in nearest_first.tolist()]
+    kept = [row for row, keep in enumerate(first_of_each_slot(robot, rows, [size <= ACCEPT_RESIDUAL
+                                                                            for size in sizes])) if keep]
+    count = len(kept)
+    joints = np.array([rows[row] for row in kept], dtype=float).reshape(count, robot.dof)
+    if reference is not None and count > 1:
+        nearest_first = np.argsort(distance_to_reference(robot, joints, reference), kind="stable").tolist()
+        kept, joints = [kept[i] for i in nearest_first], joints[nearest_first]
     codes = [one_pose.codes[slots[row]] for row in kept]
     if any(None in row for row in codes):
         return None
-    count = len(kept)
     nearest = np.array([min(sizes, default=np.inf)])
     complete = promised(one_pose, np.array([count]), nearest, constrained)
     columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)
     labels = {name: (values, column) for name, values, column in zip(one_pose.names, one_pose.values, columns)}
     if kept != list(range(len(rows))):  # else every row is kept, in slot order: no copy
-        kept = np.array(kept, dtype=np.intp)
-        joints, position, orientation = joints[kept], position[kept], orientation[kept]
+        position, orientation = position[kept], orientation[kept]
     table = SolutionTable(np.zeros(count, dtype=np.int64), joints, np.ones(count, dtype=bool), position,
                           orientation if constrained else np.full(count, np.nan), labels)
     return Verified(table, complete, nearest, one_pose.singularities)

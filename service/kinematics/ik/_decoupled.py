@@ -100,10 +100,32 @@ class DecoupledPlan(Sealed):
         full = np.repeat(joints[:, :, None, :], m_wrist, axis=2)
         full[..., list(self.wrist.joints)] = wrist_joints
         valid = arm_valid[:, :, None] & wrist_valid
+        complete = self._promised_with_held_joints(singular, arm_valid)
         for mask, flag in wrist.singularities.entries:
             singular.add((mask.reshape(n_targets, m_arm) & arm_valid).any(axis=1), flag)
         return Candidates(full.reshape(n_targets, m_arm * m_wrist, self.dof), valid.reshape(n_targets, -1),
-                          singular)
+                          singular, complete=complete)
+
+    def _promised_with_held_joints(self, singular: SingularFlags, arm_valid: np.ndarray) -> np.ndarray | None:
+        """Which targets (N,) the plan can promise every solution for, given the positioner's flags (N rows) and
+        its valid slots ``arm_valid`` (N, m); None for all of them.
+
+        A positioning joint the point leaves free (the point on its axis) is taken up by a spherical wrist, or
+        set from the orientation (:meth:`_turn_free_joints`); a two-axis wrist cannot take it up, nor a roll two
+        such joints, and it stays where the positioner held it. Where the point was reached, other values of it
+        may reach the orientation the held one misses: those targets are not promised (the FK check's verdict
+        on the wrist's slots, which the verifier's promise rule reads as "the position out of reach", would
+        else promise them unreachable)."""
+        wrist = self.wrist
+        if isinstance(wrist, SphericalWrist) or wrist is None:
+            return None
+        most = 1 if isinstance(wrist, Roll) else 0  # a roll takes up one free joint; a two-axis wrist none
+        held = np.zeros(len(arm_valid), dtype=bool)
+        for mask, flag in singular.entries:
+            if flag.relation == "free" and len(flag.joints) > most:
+                held |= mask
+        held &= arm_valid.any(axis=1)
+        return ~held if held.any() else None
 
     def _turn_free_joints(self, joints: np.ndarray, valid: np.ndarray, singular: SingularFlags,
                           R_target: np.ndarray) -> None:

@@ -221,7 +221,8 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
                 break
     leaders = [i for i in range(n) if group_of[i] == i]
     for position, j in enumerate(leaders):
-        earlier = [directions[i] for i in leaders[:position] if abs(float(directions[i] @ directions[j])) <= tolerance]
+        earlier = _spanning([directions[i] for i in leaders[:position]
+                             if abs(float(directions[i] @ directions[j])) <= tolerance])
         if 0 < len(earlier) < 3:  # remove the components along the span of those directions
             E = np.array(earlier).T  # (3, m)
             projected = directions[j] - E @ np.linalg.solve(E.T @ E, E.T @ directions[j])
@@ -241,9 +242,9 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
         fixed = [g for g in members if g in assigned]
         if not set(members) <= revolute or len(fixed) == len(members) or (fixed and len(members) > 2):
             continue
-        if all(np.linalg.norm(cross(directions[members[0]], directions[g])) <= 10 * GEOMETRY_TOLERANCE
+        if all(np.linalg.norm(cross(directions[members[0]], directions[g])) <= _CONCURRENT_SINE
                for g in members[1:]):
-            continue  # all parallel: no common point
+            continue  # all parallel, or so nearly that rounding sets their common point: none to snap to
         centre = _least_squares_point(points[members], directions[members])
         if max(_line_distance(centre, points[g], directions[g]) for g in members) > tolerance * scale:
             continue
@@ -270,6 +271,35 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
     ideal = Geometry(ScrewModel(directions, points, model.is_revolute.copy(), model.home.copy()), scale,
                      up=geometry.up, link_x=geometry.link_x)
     return Idealisation(ideal, deviation)
+
+
+#: Lines whose directions are all within this sine of the first's have no common point :func:`idealised` snaps
+#: to: their least-squares point is set by rounding (its matrix's smallest eigenvalue is about sine² / 2, and at
+#: 1e-8 that is singular to machine precision: a LinAlgError, a 500 over HTTP).
+_CONCURRENT_SINE = 1e-6
+#: A direction adds to the span :func:`_spanning` keeps only where it leaves the span of those before it by at
+#: least this (the sine of its angle to it).
+_SPANNING_SINE = 0.5
+
+
+def _spanning(directions: list[np.ndarray]) -> list[np.ndarray]:
+    """The directions (unit, each (3,)) that span their plane or space well: each kept only where it leaves the span
+    of those kept before it by at least :data:`_SPANNING_SINE`.
+
+    Two directions a little more than the tolerance apart (a pair the parallel test left in two groups, as
+    rounding to the tolerance's order leaves them) span a plane set by their tiny difference: removing a third
+    direction's components along it turned that direction by up to the tolerance over their angle (0.6 rad on an
+    arm rounded to 1e-8, which then solved as another arm). Dropping the second moves the third by about the
+    tolerance, and leaves it perpendicular to both within about the tolerance."""
+    kept: list[np.ndarray] = []
+    for k in directions:
+        if kept:
+            E = np.array(kept).T  # (3, m)
+            leaving = k - E @ np.linalg.solve(E.T @ E, E.T @ k)
+            if np.linalg.norm(leaving) < _SPANNING_SINE:
+                continue
+        kept.append(k)
+    return kept
 
 
 def _least_squares_point(points: np.ndarray, directions: np.ndarray) -> np.ndarray:

@@ -234,9 +234,9 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
     def match(cls, geometry: Geometry) -> "ThreeParallelPlan | None":
         if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
             return None
-        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.parallel(0, 1):
+        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.nearly_parallel(0, 1):
             return None
-        if geometry.parallel(1, 4):
+        if geometry.nearly_parallel(1, 4):
             return None
         centre = geometry.intersection(4, 5)
         if centre is None:
@@ -300,9 +300,9 @@ class SkewWristThreeParallelPlan(_AxesTwoToFourParallel):
     def match(cls, geometry: Geometry) -> "SkewWristThreeParallelPlan | None":
         if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
             return None
-        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.parallel(0, 1):
+        if not (geometry.parallel(1, 2) and geometry.parallel(1, 3)) or geometry.nearly_parallel(0, 1):
             return None
-        if geometry.parallel(1, 4) or geometry.intersection(4, 5) is not None:
+        if geometry.nearly_parallel(1, 4) or geometry.intersection(4, 5) is not None:
             return None
         return cls(geometry, geometry.point(5))
 

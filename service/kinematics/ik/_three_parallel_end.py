@@ -47,7 +47,13 @@ class ThreeParallelAtEndPlan(Sealed):
     def match(cls, geometry: Geometry) -> "ThreeParallelAtEndPlan | None":
         if geometry.dof != 6 or geometry.kinds() != "RRRRRR":
             return None
-        if not (geometry.parallel(3, 4) and geometry.parallel(3, 5)) or geometry.parallel(2, 3):
+        if not (geometry.parallel(3, 4) and geometry.parallel(3, 5)) or geometry.nearly_parallel(2, 3):
+            return None
+        # step 1 turns ω_2 by q_1 and ω by q_3: axes 1 and 2, or 2 and 3, (nearly) parallel leave one of them
+        # fixed only by a rounding of the geometry; axis 1 exactly parallel to ω is the free base, nearly parallel
+        # goes to the idealised arm
+        if geometry.nearly_parallel(0, 1) or geometry.nearly_parallel(1, 2) \
+                or (geometry.nearly_parallel(0, 3) and not geometry.parallel(0, 3)):
             return None
         return cls(geometry)
 

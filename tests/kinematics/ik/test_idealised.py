@@ -307,3 +307,21 @@ def test_ur_stretched_elbow_at_wrist_singularity_is_never_called_unreachable(cli
             assert not result.complete
             if row == 0:
                 assert gap < 1e-4, (q_true, gap)
+
+
+def test_idealising_an_arm_rounded_at_the_tolerance_moves_no_axis_by_much_more():
+    """A six-joint arm rounded at 1e-8 and idealised at 1e-8: of its twists that should be 0, π or π/2, some lie
+    within the tolerance and some just outside, so two axes 1.5e-8 apart stay in two parallel groups. Snapping a
+    third axis perpendicular to the plane those two span (a plane set by their tiny difference) turned it 0.6 rad;
+    each axis now moves by about the tolerance (its own rounding, and its snapping)."""
+    from service.kinematics.ik._structure import idealised
+
+    rows = [(-0.0, 3.141592623, 0.242191, -6e-09), (0.0, -1.570796345, 0.0, 6e-09), (0.0, 1.570796322, 0.2, -7e-09),
+            (0.0, -1.57079633, 0.0, -2.4e-08), (-0.0, 1.570796341, 0.2, 1e-08), (0.3, -1.570796323, -0.0, 1.570796312)]
+    robot = Robot([Joint(f"q{i}", "revolute", a, alpha, d, theta) for i, (a, alpha, d, theta) in enumerate(rows)],
+                  name="rounded", convention="modified")
+    geometry = geometry_of(robot)
+    for tolerance in (1e-8, 2e-8, 5e-8):
+        ideal = idealised(geometry, tolerance)
+        turned = np.linalg.norm(np.cross(geometry.model.directions, ideal.geometry.model.directions), axis=1)
+        assert turned.max() <= 1e-7 and ideal.deviation <= 1e-7, (tolerance, turned)

@@ -137,6 +137,12 @@ def within(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray:
     return np.all((q >= bounds.lower) & (q <= bounds.upper), axis=-1)
 
 
+def outside_limits(robot: Robot, limits: Limits, q: np.ndarray) -> np.ndarray:
+    """Which joints of each row of q (shape (..., n)) break a bound, tolerance included: shape (..., n)."""
+    bounds = limits.widened(robot)
+    return (q < bounds.lower) | (q > bounds.upper)
+
+
 def violations(robot: Robot, limits: Limits, q: np.ndarray) -> list[Violation]:
     """Every joint of q (shape (n,)) outside its bounds, with the bounds it breaks.
 
@@ -145,10 +151,51 @@ def violations(robot: Robot, limits: Limits, q: np.ndarray) -> list[Violation]:
     A PUMA 560 wrist (q5 in [−100°, 100°]) at 120° gives one violation,
     ``Violation(4, 2.094…, −1.745…, 1.745…)``.
     """
-    bounds = limits.widened(robot)
-    outside = (q < bounds.lower) | (q > bounds.upper)
+    return _violations_of(limits, q, outside_limits(robot, limits, q))
+
+
+def _violations_of(limits: Limits, q: np.ndarray, outside: np.ndarray) -> list[Violation]:
+    """The :class:`Violation` of each joint of q (n,) that ``outside`` (n,) marks."""
     return [Violation(int(i), float(q[i]), float(limits.lower[i]), float(limits.upper[i]))
             for i in np.flatnonzero(outside)]
+
+
+@dataclass(frozen=True)
+class LimitsCheck:
+    """Joint vectors q (N, n) checked against limits, every row at once (:func:`check_limits`).
+
+    ``inside`` (N,) says which rows are within every bound; ``outside`` (N, n) which joints break one;
+    ``equivalent`` (N, n) holds, for each row outside, its 2π-equivalent that fits and moves each joint least
+    (:func:`nearest_fitting_equivalent`), where ``fits`` (N,); NaN elsewhere (no equivalent fits, or the row is
+    inside).
+    """
+
+    q: np.ndarray
+    limits: Limits
+    inside: np.ndarray
+    outside: np.ndarray
+    equivalent: np.ndarray
+    fits: np.ndarray
+
+    def violations(self, row: int) -> list[Violation]:
+        """Row ``row``'s :func:`violations`."""
+        return _violations_of(self.limits, self.q[row], self.outside[row])
+
+
+def check_limits(robot: Robot, limits: Limits, q: np.ndarray) -> LimitsCheck:
+    """:func:`within`, :func:`violations` and :func:`nearest_fitting_equivalent` of every row of q (N, n) at
+    once: a few array operations for the batch, where a row at a time cost ~100 µs each."""
+    q = np.asarray(q, dtype=float)
+    outside = outside_limits(robot, limits, q)
+    inside = ~outside.any(axis=-1)
+    equivalent = np.full(q.shape, np.nan)
+    fits = np.zeros(len(q), dtype=bool)
+    rows = np.flatnonzero(~inside)
+    if len(rows):
+        closest = closest_equivalent(robot, limits, q[rows])
+        fits[rows] = within(robot, limits, closest)
+        equivalent[fits] = closest[fits[rows]]
+    return LimitsCheck(q, limits, inside, outside, equivalent, fits)
 
 
 def turn_ranges(robot: Robot, limits: Limits, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

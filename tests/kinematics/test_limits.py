@@ -13,6 +13,7 @@ from service.kinematics import (
     Joint,
     Limits,
     Robot,
+    check_limits,
     closest_equivalent,
     nearest_fitting_equivalent,
     turn_ranges,
@@ -135,6 +136,29 @@ def test_nearest_fitting_equivalent_picks_the_nearest_of_several():
     nearest = nearest_fitting_equivalent(ur5, Limits.of(ur5), q)
     # 7 − 2π = 0.717 and 7 − 4π = −5.566 both fit; the nearest to 7 is 0.717.
     np.testing.assert_allclose(nearest, [7.0 - 2 * np.pi, -7.0 + 2 * np.pi, 0.0, 1.0, 2 * np.pi, -3.0])
+
+
+def test_a_batch_check_is_each_rows_check():
+    """check_limits (the limits endpoint's batch, every row at once) gives each row what within, violations and
+    nearest_fitting_equivalent give it alone: the mixed arm's kinds of joint, values on and just past the bounds
+    (the tolerance), whole turns away, and rows no turn fixes."""
+    limits = Limits.of(MIXED)
+    rng = np.random.default_rng(3)
+    q = rng.uniform(-12, 12, (400, 5))
+    q[:, 1] = rng.uniform(0.0, 1.1, 400)  # the slide: inside, and a little out on either side
+    q[::7, 0] = 270 * DEG + rng.choice([-1, 1], len(q[::7])) * LIMIT_TOLERANCE * rng.choice([0.5, 2.0], len(q[::7]))
+    q[::5] = 0.5 * (limits.lower + np.where(np.isfinite(limits.upper), limits.upper, limits.lower + 1.0))
+    q[::5, 2:4] = [1.0, 0.5]
+    check = check_limits(MIXED, limits, q)
+    assert check.inside.any() and (~check.inside & check.fits).any() and (~check.inside & ~check.fits).any()
+    for row in range(len(q)):
+        assert bool(check.inside[row]) == bool(within(MIXED, limits, q[row]))
+        assert check.violations(row) == violations(MIXED, limits, q[row])
+        nearest = None if check.inside[row] else nearest_fitting_equivalent(MIXED, limits, q[row])
+        if nearest is None:
+            assert not check.fits[row] and np.isnan(check.equivalent[row]).all()
+        else:
+            assert check.fits[row] and np.array_equal(check.equivalent[row], nearest)
 
 
 def test_bounds_are_inclusive_with_the_documented_tolerance():

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from fastapi import APIRouter, Depends, Request
 
-from ...kinematics import LIMIT_TOLERANCE, nearest_fitting_equivalent, violations, within
+from ...kinematics import LIMIT_TOLERANCE, check_limits
 from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, violation_to_wire
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
 from ..problems import problem_responses
@@ -22,14 +22,13 @@ def _check(request: Request, ref: RobotRef, body: LimitsRequest) -> dict:
         rows = joints_to_core(robot, body.joints, body.angle_unit, batch=True)
     with located("body", "limits"):
         limits = limits_to_core(robot, body.limits, body.angle_unit)
-    results = []
-    for q, inside in zip(rows, within(robot, limits, rows)):
-        broken = [] if inside else violations(robot, limits, q)
-        nearest = None if inside else nearest_fitting_equivalent(robot, limits, q)
-        equivalent = None if nearest is None else joints_from_core(robot, nearest, body.angle_unit).tolist()
-        results.append({"within_limits": bool(inside),
-                        "violations": [violation_to_wire(robot, v, body.angle_unit) for v in broken],
-                        "equivalent": equivalent})
+    check = check_limits(robot, limits, rows)
+    equivalents = joints_from_core(robot, check.equivalent, body.angle_unit).tolist()
+    results = [{"within_limits": inside,
+                "violations": [] if inside else [violation_to_wire(robot, v, body.angle_unit)
+                                                 for v in check.violations(row)],
+                "equivalent": equivalents[row] if fits else None}
+               for row, (inside, fits) in enumerate(zip(check.inside.tolist(), check.fits.tolist()))]
     return {"robot_id": ref.id, "joint_names": robot.joint_names, "tolerance": LIMIT_TOLERANCE, "results": results}
 
 

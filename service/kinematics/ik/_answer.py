@@ -28,7 +28,7 @@ import numpy as np
 from .._budget import UNLIMITED, Budget
 from .._errors import InvalidInputError, KinematicsError
 from .._forward import JointTrig
-from .._limits import Limits
+from .._limits import Limits, outside_limits
 from .._robot import Robot
 from ..collision import CollisionRequest, at_collisions, clearances
 from ._closed_form import cached_plan, solve_closed_form
@@ -766,7 +766,5 @@ def _violations(robot: Robot, limits: Limits, table: SolutionTable) -> np.ndarra
     """Which joints (S, n) of each row outside the limits break them (tolerance included); False elsewhere."""
     if np.count_nonzero(table.within_limits) == len(table):  # the usual kept table: nothing to compare
         return np.zeros(table.joints.shape, dtype=bool)
-    bounds = limits.widened(robot)
-    outside = (table.joints < bounds.lower) | (table.joints > bounds.upper)
-    return outside & ~table.within_limits[:, None]
+    return outside_limits(robot, limits, table.joints) & ~table.within_limits[:, None]
 

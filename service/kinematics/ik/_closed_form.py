@@ -71,11 +71,12 @@ def solve_closed_form(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.nd
     """Every verified solution of the goal's N targets by the plan, vectorised over the targets (see the module
     docstring). ``reference`` (n,) sets the joints a target leaves free."""
     n_targets = len(goal)
-    if n_targets <= CHUNK:
+    chunk = getattr(plan, "targets_per_chunk", CHUNK)
+    if n_targets <= min(chunk, CHUNK):
         budget.check("the analytic solve")
         return _solved(robot, plan, goal, reference)
     threads = threads or os.cpu_count() or 1
-    edges = chunk_edges(n_targets, threads, getattr(plan, "targets_per_chunk", CHUNK))
+    edges = chunk_edges(n_targets, threads, chunk)
 
     def solve(start: int, stop: int) -> Verified:
         budget.check("the analytic solve")

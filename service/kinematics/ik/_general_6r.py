@@ -113,6 +113,10 @@ class General6RPlan(Sealed):
     method = "analytic"
     generic_count = 16
     free_joints: list[int] = []
+    #: ~0.3–0.6 ms a target in a batch: chunks of 256 keep each under ~0.15 s (the request's budget is checked
+    #: between chunks) and spread a few hundred targets over the threads (2,000 targets of the xArm 6 on two
+    #: threads: 0.30 ms a target against 0.62 in one chunk of 2,000; 6,000: 0.27 against 0.25 in two of 3,000)
+    targets_per_chunk = 256
 
     @classmethod
     def match(cls, geometry: Geometry) -> "General6RPlan | None":

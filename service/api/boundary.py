@@ -339,7 +339,7 @@ WIRE_NOTES = {
 
 def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:
     """A violation in the request's units; an open side of the range is null."""
-    scale = radians_per(unit) if robot.is_revolute[violation.joint] else 1.0  # _unit_scale's, of one joint
+    scale = float(_unit_scale(robot, unit)[violation.joint])
     lower = None if math.isinf(violation.lower) else violation.lower / scale
     upper = None if math.isinf(violation.upper) else violation.upper / scale
     return {"joint": violation.joint, "value": violation.value / scale, "lower": lower, "upper": upper}

@@ -57,8 +57,6 @@ def test_the_one_turn_shortcut_gives_the_quotients_turns(robot, monkeypatch):
     """A large batch whose bounded values all sit well inside limits of about one turn takes every such turn as
     0 without the quotients: the same (first, last), bit for bit (+0.0), as the quotients, for batches that take
     the shortcut and batches one value near a bound keeps from it."""
-    from service.kinematics import _limits
-
     rng = np.random.default_rng(4)
     limits = Limits.of(robot)
     inside = np.clip(rng.uniform(-1.5, 1.5, (2_000, robot.dof)), np.maximum(robot.lower, -1.5) + 0.01,
@@ -66,12 +64,7 @@ def test_the_one_turn_shortcut_gives_the_quotients_turns(robot, monkeypatch):
     near_bound = inside.copy()
     near_bound[7, 0] = robot.upper[0] - 1e-9
     for q in (inside, near_bound):
-        shortcut = turn_ranges(robot, limits, q)
-        monkeypatch.setattr(_limits, "_CHECKED_FROM", math.inf)
-        quotients = turn_ranges(robot, limits, q)
-        monkeypatch.undo()
-        for a, b in zip(shortcut, quotients):
-            assert a.tobytes() == b.tobytes()
+        _assert_the_shortcut_gives_the_quotients_turns(robot, limits, q, monkeypatch)
 
 
 @pytest.mark.parametrize("robot", [
@@ -82,8 +75,6 @@ def test_the_one_turn_shortcut_on_one_targets_few_rows(robot, monkeypatch):
     """One target's few rows (as a single-pose answer selects) take the shortcut too: the same (first, last), bit
     for bit, as the quotients, for rows inside the limits, on a bound, a hair inside the one-turn interval's
     margin, and outside."""
-    from service.kinematics import _limits
-
     rng = np.random.default_rng(11)
     limits = Limits.of(robot)
     lower, upper = np.maximum(robot.lower, -4.0), np.minimum(robot.upper, 4.0)
@@ -93,12 +84,19 @@ def test_the_one_turn_shortcut_on_one_targets_few_rows(robot, monkeypatch):
     near_margin[:, 0] = robot.upper[0] - np.array([0.5e-6, 1e-6, 2e-6, 1e-3])
     for q in (*rows, near_margin, np.zeros((1, robot.dof)), np.zeros((0, robot.dof))):
         q = np.where(np.isfinite(q), q, 0.5)
-        shortcut = turn_ranges(robot, limits, q)
-        monkeypatch.setattr(_limits, "_CHECKED_FROM", math.inf)
-        quotients = turn_ranges(robot, limits, q)
-        monkeypatch.undo()
-        for a, b in zip(shortcut, quotients):
-            assert a.tobytes() == b.tobytes()
+        _assert_the_shortcut_gives_the_quotients_turns(robot, limits, q, monkeypatch)
+
+
+def _assert_the_shortcut_gives_the_quotients_turns(robot, limits, q, monkeypatch):
+    """turn_ranges of q with its one-turn shortcut and without it (the quotients alone): the same, bit for bit."""
+    from service.kinematics import _limits
+
+    shortcut = turn_ranges(robot, limits, q)
+    monkeypatch.setattr(_limits, "_CHECKED_FROM", math.inf)
+    quotients = turn_ranges(robot, limits, q)
+    monkeypatch.undo()
+    for a, b in zip(shortcut, quotients):
+        assert a.tobytes() == b.tobytes()
 
 
 def test_turn_ranges_count_huge_limits_without_generating_them():

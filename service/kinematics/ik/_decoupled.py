@@ -83,11 +83,16 @@ class DecoupledPlan(Sealed):
         model = self.positioner.model if self.positioner else None
         # the joints' rotation R_1 ⋯ R_n = world_T_target · home⁻¹ (rotation part), shape (N, 3, 3)
         R_target = world_T_targets[:, :3, :3] @ self.home_inverse[:3, :3]
+        complete = None
         if self.positioner is not None:
-            self._turn_free_joints(joints, arm_valid, singular, R_target)
+            held = self._turn_free_joints(joints, arm_valid, singular, R_target) & arm_valid.any(axis=1)
             arm_joints = joints[..., :k]
+            # where the point was reached, other values of a joint held where the positioner put it may reach
+            # the orientation the held one misses: those targets are not promised (the verifier's promise rule
+            # would read "no valid slot" as the position out of reach)
+            complete = ~held if held.any() else None
         if self.wrist is None:
-            return Candidates(joints, arm_valid, singular)
+            return Candidates(joints, arm_valid, singular, complete=complete)
         # the wrist's rotation R_H = R_Gᵀ · R_target (G the positioning joints' motion), applied to the vectors
         # the wrist reads: R_target's images, as rows, times R_G
         seen = seen_by(self.wrist, R_target)[:, None]  # (N, 1, j, 3)
@@ -100,35 +105,13 @@ class DecoupledPlan(Sealed):
         full = np.repeat(joints[:, :, None, :], m_wrist, axis=2)
         full[..., list(self.wrist.joints)] = wrist_joints
         valid = arm_valid[:, :, None] & wrist_valid
-        complete = self._promised_with_held_joints(singular, arm_valid)
         for mask, flag in wrist.singularities.entries:
             singular.add((mask.reshape(n_targets, m_arm) & arm_valid).any(axis=1), flag)
         return Candidates(full.reshape(n_targets, m_arm * m_wrist, self.dof), valid.reshape(n_targets, -1),
                           singular, complete=complete)
 
-    def _promised_with_held_joints(self, singular: SingularFlags, arm_valid: np.ndarray) -> np.ndarray | None:
-        """Which targets (N,) the plan can promise every solution for, given the positioner's flags (N rows) and
-        its valid slots ``arm_valid`` (N, m); None for all of them.
-
-        A positioning joint the point leaves free (the point on its axis) is taken up by a spherical wrist, or
-        set from the orientation (:meth:`_turn_free_joints`); a two-axis wrist cannot take it up, nor a roll two
-        such joints, and it stays where the positioner held it. Where the point was reached, other values of it
-        may reach the orientation the held one misses: those targets are not promised (the FK check's verdict
-        on the wrist's slots, which the verifier's promise rule reads as "the position out of reach", would
-        else promise them unreachable)."""
-        wrist = self.wrist
-        if isinstance(wrist, SphericalWrist) or wrist is None:
-            return None
-        most = 1 if isinstance(wrist, Roll) else 0  # a roll takes up one free joint; a two-axis wrist none
-        held = np.zeros(len(arm_valid), dtype=bool)
-        for mask, flag in singular.entries:
-            if flag.relation == "free" and len(flag.joints) > most:
-                held |= mask
-        held &= arm_valid.any(axis=1)
-        return ~held if held.any() else None
-
     def _turn_free_joints(self, joints: np.ndarray, valid: np.ndarray, singular: SingularFlags,
-                          R_target: np.ndarray) -> None:
+                          R_target: np.ndarray) -> np.ndarray:
         """Set, in place, positioning joints the position leaves free from the target's orientation.
 
         ``joints`` (N, m, n) with the positioner's values, ``valid`` (N, m), ``singular`` the positioner's flags
@@ -143,17 +126,23 @@ class DecoupledPlan(Sealed):
           M ω_j for θ_i, and then θ_j as for one joint with ``Cᵀ R(ω_i, θ_i)ᵀ M``.
 
         Where a subproblem is degenerate (the vector on the axis: only a sum is fixed) the positioner's values
-        stay; with a spherical wrist the wrist absorbs them, so they stay free; with two free joints and a roll,
-        or a two-axis wrist, they stay as the positioner set them (the row is then not promised complete when
-        nothing verifies: ``_promised`` in :mod:`._arrays`).
+        stay; with a spherical wrist the wrist absorbs them, so they stay free. With two free joints and a roll,
+        more than two and no wrist, or a two-axis wrist, nothing here can set them and they stay as the
+        positioner set them: the targets (N,) where that happened are returned (the caller does not promise
+        them).
         """
-        if self.wrist is not None and not isinstance(self.wrist, Roll):
-            return
+        held_rows = np.zeros(len(joints), dtype=bool)
+        if isinstance(self.wrist, SphericalWrist):
+            return held_rows
         model, k = self.positioner.model, len(self.positioner.joints)
+        settable = 0 if self.wrist is not None and not isinstance(self.wrist, Roll) else (
+            1 if self.wrist is not None else 2)  # how many free joints the orientation sets here
         for mask, flag in list(singular.entries):
             free = flag.joints
-            if (flag.relation != "free" or len(free) > (1 if self.wrist is not None else 2) or max(free) >= k
-                    or not model.is_revolute[list(free)].all()):
+            if flag.relation != "free" or max(free) >= k or not model.is_revolute[list(free)].all():
+                continue
+            if len(free) > settable:
+                held_rows |= mask
                 continue
             rows = np.flatnonzero(mask)
             q = np.nan_to_num(joints[rows])  # (r, m, n)
@@ -185,6 +174,7 @@ class DecoupledPlan(Sealed):
             q[..., j] = last.theta[..., 0]
             joints[rows, :, i] = np.where(held, joints[rows, :, i], q[..., i])
             joints[rows, :, j] = np.where(held, joints[rows, :, j], q[..., j])
+        return held_rows
 
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """Branch labels of full joint vectors (M, n) as arrays: the positioner's, then the wrist's.

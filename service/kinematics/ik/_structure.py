@@ -224,8 +224,7 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
         earlier = _spanning([directions[i] for i in leaders[:position]
                              if abs(float(directions[i] @ directions[j])) <= tolerance])
         if 0 < len(earlier) < 3:  # remove the components along the span of those directions
-            E = np.array(earlier).T  # (3, m)
-            projected = directions[j] - E @ np.linalg.solve(E.T @ E, E.T @ directions[j])
+            projected = _across(directions[j], earlier)
             directions[j] = projected / np.linalg.norm(projected)
     for j in range(n):
         leader = directions[group_of[j]]
@@ -293,13 +292,15 @@ def _spanning(directions: list[np.ndarray]) -> list[np.ndarray]:
     tolerance, and leaves it perpendicular to both within about the tolerance."""
     kept: list[np.ndarray] = []
     for k in directions:
-        if kept:
-            E = np.array(kept).T  # (3, m)
-            leaving = k - E @ np.linalg.solve(E.T @ E, E.T @ k)
-            if np.linalg.norm(leaving) < _SPANNING_SINE:
-                continue
-        kept.append(k)
+        if not kept or np.linalg.norm(_across(k, kept)) >= _SPANNING_SINE:
+            kept.append(k)
     return kept
+
+
+def _across(k: np.ndarray, span: list[np.ndarray]) -> np.ndarray:
+    """``k`` (3,) less its components along the span of ``span`` (1 to 3 independent (3,) directions)."""
+    E = np.array(span).T  # (3, m)
+    return k - E @ np.linalg.solve(E.T @ E, E.T @ k)
 
 
 def _least_squares_point(points: np.ndarray, directions: np.ndarray) -> np.ndarray:

@@ -320,6 +320,14 @@ def random_ur_type_arm(seed: int, convention: str, two_arcs: bool, skew: bool = 
     return restated_6r(a, alpha, d, theta, convention, base, tool)
 
 
+def moved(robot: Robot, rng: np.random.Generator, sigma: float) -> Robot:
+    """A DH arm with each of its parameters (a, alpha, d, theta) moved by N(0, sigma): metres and radians."""
+    return Robot([Joint(j.name, j.kind, j.a + rng.normal(0, sigma), j.alpha + rng.normal(0, sigma),
+                        j.d + rng.normal(0, sigma), j.theta + rng.normal(0, sigma)) for j in robot.joints],
+                 name="moved", convention=robot.convention, world_T_base=robot.world_T_base,
+                 flange_T_tool=robot.flange_T_tool)
+
+
 def rounded(robot: Robot, seed: int, *, base_and_tool: bool = True) -> Robot:
     """``robot`` as a CAD export writes it: angles in radians to 4 decimals (π/2 → 1.5708), parallel axes
     (α = 0 or π) 1e-5 rad off, lengths to 0.1 mm (the robot's unit taken as metres), and, with

@@ -29,6 +29,13 @@ FOLD_TOLERANCE = float(np.sqrt(GEOMETRY_TOLERANCE))
 #: three decimals (Doosan: 1.571, 2.0e-4 rad off; 3.142 is 4.1e-4 off), which sets this bound.
 RECOGNITION_TOLERANCE = 5e-4
 
+#: An arm whose relations hold within exact recognition (``10 GEOMETRY_TOLERANCE``) but not within this (radians,
+#: or fraction of the arm's size) is solved as an idealised arm (see :mod:`.ik._idealised`): a closed form that
+#: assumes them errs by a few times the deviation, and near a singularity by far more (a double root by its square
+#: root, an angle seen on a small radius by the deviation over the radius), beyond what its FK check's polish can
+#: mend. URDFs written to nine or more digits deviate by ~1e-11; one written to eight, by ~1e-9.
+EXACT_DEVIATION = 1e-10
+
 #: An IK solution is accepted when its FK position error is below this
 #: fraction of the robot's characteristic length, and its orientation error
 #: (radians) below the same number.

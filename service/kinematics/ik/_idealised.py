@@ -191,16 +191,20 @@ class IdealisedPlan(Sealed):
         family's targets on several sheets (e.g. a SCARA's two assembly modes); on the true arm a target from one
         sheet is generally missed by the other by about δ. There Gauss–Newton stalls at a positive residual: one
         more step lowers it by less than 1 %, and it is at least 1e-3 δ (far above the acceptance tolerance) and
-        within the near-miss band, so no solution lies near that candidate.
+        within the near-miss band, so no solution lies near that candidate, unless the candidate is near a
+        singularity of the true arm (σ_min within :data:`SINGULAR_MARGIN` δ: a spherical wrist with its outer axes
+        aligned), where Gauss–Newton stalls beside a solution.
         """
         rows, slots = np.nonzero(missed)
         stepped = self._refined(joints[rows, slots], world_T_targets[rows], 1)
         position, orientation = residual_arrays(self.robot, stepped[:, None, :], world_T_targets[rows])
         now, before = self._size(position, orientation)[:, 0], after[rows, slots]
         apart = np.zeros_like(missed)
-        # (a refinement that left the near band, its steps thrown off by a near-singular Jacobian, proves nothing)
+        # (a refinement that left the near band, its steps thrown off by a near-singular Jacobian, proves nothing;
+        # nor does a stall at a singular configuration, where the step cannot move the way the target lies)
         apart[rows, slots] = (before >= 1e-3 * self.deviation) & (now >= 0.99 * before) \
-            & (before <= NEAR_MISS * self.deviation)
+            & (before <= NEAR_MISS * self.deviation) \
+            & (self._smallest_singular_value(stepped) > SINGULAR_MARGIN * self.deviation)
         return apart
 
     def _smallest_singular_value(self, joints: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ import numpy as np
 from .._cache import memo
 from .._forward import JointTrig, link_frames, screw_model
 from .._robot import Robot
-from .._tolerances import RECOGNITION_TOLERANCE
+from .._tolerances import EXACT_DEVIATION, RECOGNITION_TOLERANCE
 from ._coaxial import CoaxialPlan, coaxial_pair, without_joint
 from ._decoupled import DecoupledPlan
 from ._general_6r import General6RPlan
@@ -24,7 +24,7 @@ from ._positioning import find_positioner
 from ._reversed import ReversedPlan, reversed_geometry
 from ._screws import apply, chain_motion
 from ._slide_after_wrist import SlideAfterSphericalWrist
-from ._structure import Geometry, canonical_model, idealised
+from ._structure import Geometry, canonical_model, exactly_idealised, idealised
 from ._three_parallel import SkewWristThreeParallelPlan, ThreeParallelPlan
 from ._three_parallel_end import ThreeParallelAtEndPlan, parallel_elbow_codes
 from ._types import Candidates, LabelCodes
@@ -61,8 +61,9 @@ def _geometry_of(robot: Robot) -> Geometry:
 def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
     """The analytic plan for this robot and kind of target, or None when no family applies.
 
-    A closed-form family is looked for in the arm as given (tolerance ``GEOMETRY_TOLERANCE``), then in its
-    idealisation (relations within ``RECOGNITION_TOLERANCE`` made exact, :func:`idealised`): that plan solves the
+    A closed-form family is looked for in the arm as given (tolerance ``GEOMETRY_TOLERANCE``; an arm that holds its
+    relations only to more than ``EXACT_DEVIATION`` is solved with them made exact and refined, as below), then
+    in its idealisation (relations within ``RECOGNITION_TOLERANCE`` made exact, :func:`idealised`): that plan solves the
     idealised arm and refines on the true one (:class:`IdealisedPlan`). A 6R pose target that neither finds goes
     to the general 6R solver, last, because a rounded Pieper arm is nearly degenerate for its elimination.
     """
@@ -71,14 +72,16 @@ def plan_for(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray
     if pair is not None:  # only the pair's sum is fixed: no plan of the whole arm says so
         return _coaxial_plan(geometry, pair, constrain_orientation, reference)
     plan = _family_plan(geometry, constrain_orientation, reference)
-    if plan is not None:
+    if plan is not None and exactly_idealised(geometry).deviation <= EXACT_DEVIATION:
         return plan
     ideal = idealised(geometry)
     if ideal.deviation > 0.0:
-        plan = _family_plan(ideal.geometry, constrain_orientation, reference)
-        if plan is not None:
-            return IdealisedPlan(plan, ideal.geometry.model, robot, ideal.deviation, geometry.length_scale,
+        ideal_plan = _family_plan(ideal.geometry, constrain_orientation, reference)
+        if ideal_plan is not None:
+            return IdealisedPlan(ideal_plan, ideal.geometry.model, robot, ideal.deviation, geometry.length_scale,
                                  constrain_orientation)
+    if plan is not None:
+        return plan
     return General6RPlan.match(geometry) if constrain_orientation else None
 
 

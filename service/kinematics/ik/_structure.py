@@ -131,6 +131,13 @@ def arm_size(robot) -> float:
 _FOOT_SINE = 0.1
 
 
+#: The polyline of an arm with a slide shorter than this (length units) is rounding dust, not a size: a P-R-P arm
+#: with zero offsets written with 1e-9 rounding would otherwise measure 1e-9, and its residuals, relative to that
+#: while its slides carry the tool 0.3 away, reject every solution. (An arm of revolute joints alone keeps a tiny
+#: size: its fixed lengths are its scale.)
+_DUST_LENGTH = 1e-6
+
+
 def canonical_model(model: ScrewModel, base_origin: np.ndarray) -> tuple[ScrewModel, float]:
     """The screw model with every revolute axis represented by a point near the arm, and the arm's size.
 
@@ -141,7 +148,9 @@ def canonical_model(model: ScrewModel, base_origin: np.ndarray) -> tuple[ScrewMo
     the lines only, not on where a description puts its frames.
 
     The size is the length of the polyline base origin → canonical points → tool origin at q = 0 (1 when that is
-    zero): the sum of the arm's offsets and link lengths, measured on the lines themselves.
+    zero): the sum of the arm's offsets and link lengths, measured on the lines themselves. An arm with a slide
+    whose polyline is rounding dust (:data:`_DUST_LENGTH`) measures 1 too: its scale is its slides' travel, which
+    no fixed length states.
     """
     directions, points = model.directions, model.points.copy()
     revolute = [i for i in range(len(directions)) if model.is_revolute[i]]
@@ -159,6 +168,8 @@ def canonical_model(model: ScrewModel, base_origin: np.ndarray) -> tuple[ScrewMo
     for i in revolute:
         points[i] = nearest[i]
     size = _polyline([base_origin, *(points[i] for i in revolute), model.home[:3, 3]])
+    if size <= _DUST_LENGTH and not model.is_revolute.all():
+        size = 1.0
     return ScrewModel(directions.copy(), points, model.is_revolute.copy(), model.home.copy()), size
 
 
@@ -271,6 +282,13 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
                      up=geometry.up, link_x=geometry.link_x)
     return Idealisation(ideal, deviation)
 
+
+
+def exactly_idealised(geometry: Geometry) -> Idealisation:
+    """The arm with the relations exact recognition accepts (those within ``10 GEOMETRY_TOLERANCE``, as
+    :meth:`Geometry.parallel`) made exact, and how far that moved it: a closed form that assumes those relations
+    sees its vectors off by about that deviation (0 for an arm whose relations hold to the last digit)."""
+    return idealised(geometry, 10 * GEOMETRY_TOLERANCE)
 
 #: Lines whose directions are all within this sine of the first's have no common point :func:`idealised` snaps
 #: to: their least-squares point is set by rounding (its matrix's smallest eigenvalue is about sine² / 2, and at

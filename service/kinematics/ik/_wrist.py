@@ -22,7 +22,7 @@ from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERAN
 from .._rotations import wrap_angle
 from .._forward import JointTrig, cross
 from ._screws import perpendicular_unit, rotate_about
-from ._structure import Geometry, idealised
+from ._structure import Geometry, exactly_idealised
 from .subproblems import subproblem_1, subproblem_2_chain
 from ._types import LabelCodes, SingularFlags, Singularity, Sealed
 
@@ -170,8 +170,7 @@ class SphericalWrist(Sealed):
         :meth:`Geometry.parallel`; relations rounded more coarsely, which this plan does not assume, do not
         count), over the radius, would move q_a by more than ``DUPLICATE_TOLERANCE``. An exact arm keeps
         subproblem 2's own test, ``GEOMETRY_TOLERANCE``."""
-        deviation = idealised(self.geometry, 10 * GEOMETRY_TOLERANCE).deviation
-        return max(GEOMETRY_TOLERANCE, deviation / DUPLICATE_TOLERANCE)
+        return max(GEOMETRY_TOLERANCE, exactly_idealised(self.geometry).deviation / DUPLICATE_TOLERANCE)
 
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         middle = self.joints[1]

@@ -332,3 +332,37 @@ def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets(
     result = solve_ik(robot, forward_kinematics(robot, q))
     assert result.status == "ok", result.detail
     assert min(_distance(robot, s.joints, q) for s in result.solutions) <= 1e-6
+
+
+def test_a_polar_arm_written_to_eleven_digits_reaches_its_pose_pointing_along_its_first_axis():
+    """The polar R-R-P arm with each parameter moved by ~3e-11 (a URDF's rounding), the slide along axis 1: the
+    point was 1e-11 off that axis by the arm's own deviation, q1 was read off that error, the orientation that
+    fixes q1 was missed, and the pose was promised unreachable. The frame's rounding band now counts the arm's
+    deviation: the point is on axis 1, and the orientation sets q1."""
+    rows = [("revolute", -1.3927337749124449e-11, 1.5707963267805374, 0.9999999999783605, -1.5592793171105364e-11),
+            ("revolute", 4.806801189522729e-12, -1.5707963268063072, 3.013255584975195e-12, 5.70356160009977e-11),
+            ("prismatic", 1.4373544523908304e-11, -4.7282695363056785e-11, 5.2005887568393204e-11,
+             1.0434311099656063e-11)]
+    robot = Robot([Joint(f"q{i}", kind, a, alpha, d, theta) for i, (kind, a, alpha, d, theta) in enumerate(rows)],
+                  name="polar", convention="standard")
+    q = np.array([1e-9, -3.141592654589793, 0.17012525416153662])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok", result.detail
+    assert min(_distance(robot, s.joints, q) for s in result.solutions) <= 1e-6
+
+
+def test_a_spherical_arm_written_to_twelve_digits_reaches_its_pose_with_the_point_by_its_first_axis():
+    """Spong's spherical R-R-P moved by ~3e-12, the slide 1e-9 rad off axis 1: the point 1.7e-10 from that axis
+    (inside the FK check's acceptance of any q1) had its azimuth read off the arm's 1e-12 error, 1e-3 rad wrong,
+    beyond the polish, and the pose was promised unreachable. Within half the acceptance of axis 1, q1 is now
+    free and the orientation sets it."""
+    rows = [("revolute", -1.3927337749124449e-12, 1.5707963267934606, 0.49999999999783606, -1.5592793171105365e-12),
+            ("revolute", 4.806801189522729e-13, 1.5707963267937555, 3.0132555849751955e-13, 5.703561600099771e-12),
+            ("prismatic", 1.4373544523908305e-12, -4.728269536305679e-12, 5.20058875683932e-12,
+             1.0434311099656064e-12)]
+    robot = Robot([Joint(f"q{i}", kind, a, alpha, d, theta) for i, (kind, a, alpha, d, theta) in enumerate(rows)],
+                  name="spherical arm", convention="standard")
+    q = np.array([1e-09, -3.141592654589793, 0.17012525416153662])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok", result.detail
+    assert min(_distance(robot, s.joints, q) for s in result.solutions) <= 1e-6

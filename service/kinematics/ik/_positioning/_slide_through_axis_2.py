@@ -16,7 +16,7 @@ from ..._forward import cross
 from ..._rotations import wrap_angle
 from ..._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
 from .._screws import rotate_about
-from .._structure import Geometry
+from .._structure import Geometry, exactly_idealised
 from .._types import SingularFlags, Singularity
 from ..subproblems import subproblem_1
 from ._base import PositionerResult, _flag_rows
@@ -41,6 +41,9 @@ class SlideThroughAxis2:
     psi0: float  #: ψ at q2 = 0, radians
     cos_alpha: float
     sin_alpha: float
+    #: how far the arm is from the relations this frame assumes (:func:`exactly_idealised`: radians, or fractions of
+    #: its size): the target's coordinates, as the frame sees them, carry that times their lever on top of rounding
+    deviation: float
 
     @classmethod
     def of(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray
@@ -60,7 +63,7 @@ class SlideThroughAxis2:
         n1 = n1 / sin_alpha
         n2 = cross(k2, n1)
         return cls(float(offset @ k2), -float(offset @ v), n1, n2, float(np.arctan2(v @ n2, v @ n1)), cos_alpha,
-                   sin_alpha)
+                   sin_alpha, exactly_idealised(geometry).deviation)
 
     def solve(self, geometry: Geometry, joints: tuple[int, ...], centre: np.ndarray, targets: np.ndarray,
               reference: np.ndarray | None) -> PositionerResult:
@@ -88,8 +91,11 @@ class SlideThroughAxis2:
         # a² = ‖y‖² − h² − B² = radius² − (h sin α − B cos α)²: a difference only where ±a meet
         inner = np.abs(h * self.sin_alpha - along * self.cos_alpha)
         across_squared = (radius - inner) * (radius + inner)  # (N,)
-        # the target's coordinates carry rounding relative to their size and the arm's
-        rounding = ROUNDING_TOLERANCE * (g.length_scale + np.linalg.norm(targets, axis=-1))
+        # the target's coordinates carry rounding relative to their size and the arm's, and the arm's own deviation
+        # from this frame's relations (a URDF's nine digits: 1e-11) times the same lever: a point that close to
+        # axis 1 is on it as far as the frame can tell (its azimuth would come from that error, and the orientation
+        # that fixes q1 of a polar arm's pose would be missed)
+        rounding = (ROUNDING_TOLERANCE + self.deviation) * (g.length_scale + np.linalg.norm(targets, axis=-1))
         band_along = rounding / self.sin_alpha
         band_squared = 2 * rounding * (radius + inner + band_along)
         met = across_squared <= band_squared  # the two shoulder solutions ±a meet: a = 0 represents them
@@ -117,7 +123,10 @@ class SlideThroughAxis2:
         t = np.stack([t, -t], axis=-1)
         turned = h * g.direction(j) + t[..., None] * (np.cos(psi)[..., None] * self.n1
                                                       + np.sin(psi)[..., None] * self.n2)
-        first = subproblem_1(k1, turned, y[:, None, None, :], free_below=rounding[:, None, None])
+        # likewise a point within half the acceptance of axis 1: every q1 reaches it, and its azimuth, known to
+        # rounding over that radius, could miss the orientation that fixes q1 of a three-joint arm's pose
+        on_first_axis = np.maximum(rounding, 0.5 * ACCEPT_RESIDUAL * g.length_scale)
+        first = subproblem_1(k1, turned, y[:, None, None, :], free_below=on_first_axis[:, None, None])
         q1 = first.theta[..., 0]
         free_first = first.degenerate | at_centre[:, None, None]  # the target on axis 1 (a polar arm without offset)
         if reference is not None:  # an azimuth seen on a radius r is known to rounding / r

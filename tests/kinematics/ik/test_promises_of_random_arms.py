@@ -326,12 +326,7 @@ def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets(
     ``test_an_arm_of_tiny_links_answers_a_direction_target_out_of_reach``.)"""
     rows = [("prismatic", 1e-9, 2e-9, 0.0, -1e-9), ("revolute", -1e-9, -H + 1e-9, 1e-9, 2e-9),
             ("prismatic", 2e-9, -1e-9, 0.0, 1e-9)]
-    robot = Robot([Joint(f"q{i}", kind, a, alpha, d, theta) for i, (kind, a, alpha, d, theta) in enumerate(rows)],
-                  name="probe", convention="standard")
-    q = np.array([0.263669908578, -np.pi - 1e-9, 0.265509952059])
-    result = solve_ik(robot, forward_kinematics(robot, q))
-    assert result.status == "ok", result.detail
-    assert min(_distance(robot, s.joints, q) for s in result.solutions) <= 1e-6
+    _assert_reaches_its_own_pose(rows, [0.263669908578, -np.pi - 1e-9, 0.265509952059])
 
 
 def test_a_polar_arm_written_to_eleven_digits_reaches_its_pose_pointing_along_its_first_axis():
@@ -343,12 +338,7 @@ def test_a_polar_arm_written_to_eleven_digits_reaches_its_pose_pointing_along_it
             ("revolute", 4.806801189522729e-12, -1.5707963268063072, 3.013255584975195e-12, 5.70356160009977e-11),
             ("prismatic", 1.4373544523908304e-11, -4.7282695363056785e-11, 5.2005887568393204e-11,
              1.0434311099656063e-11)]
-    robot = Robot([Joint(f"q{i}", kind, a, alpha, d, theta) for i, (kind, a, alpha, d, theta) in enumerate(rows)],
-                  name="polar", convention="standard")
-    q = np.array([1e-9, -3.141592654589793, 0.17012525416153662])
-    result = solve_ik(robot, forward_kinematics(robot, q))
-    assert result.status == "ok", result.detail
-    assert min(_distance(robot, s.joints, q) for s in result.solutions) <= 1e-6
+    _assert_reaches_its_own_pose(rows, [1e-9, -3.141592654589793, 0.17012525416153662])
 
 
 def test_a_spherical_arm_written_to_twelve_digits_reaches_its_pose_with_the_point_by_its_first_axis():
@@ -360,9 +350,15 @@ def test_a_spherical_arm_written_to_twelve_digits_reaches_its_pose_with_the_poin
             ("revolute", 4.806801189522729e-13, 1.5707963267937555, 3.0132555849751955e-13, 5.703561600099771e-12),
             ("prismatic", 1.4373544523908305e-12, -4.728269536305679e-12, 5.20058875683932e-12,
              1.0434311099656064e-12)]
+    _assert_reaches_its_own_pose(rows, [1e-09, -3.141592654589793, 0.17012525416153662])
+
+
+def _assert_reaches_its_own_pose(rows: list[tuple], q: list[float]) -> None:
+    """The standard-DH arm of ``rows`` (kind, a, alpha, d, theta) answers its own FK pose at q with q among the
+    solutions."""
     robot = Robot([Joint(f"q{i}", kind, a, alpha, d, theta) for i, (kind, a, alpha, d, theta) in enumerate(rows)],
-                  name="spherical arm", convention="standard")
-    q = np.array([1e-09, -3.141592654589793, 0.17012525416153662])
+                  name="probe", convention="standard")
+    q = np.array(q)
     result = solve_ik(robot, forward_kinematics(robot, q))
     assert result.status == "ok", result.detail
     assert min(_distance(robot, s.joints, q) for s in result.solutions) <= 1e-6

@@ -283,12 +283,12 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
     return Idealisation(ideal, deviation)
 
 
-
 def exactly_idealised(geometry: Geometry) -> Idealisation:
     """The arm with the relations exact recognition accepts (those within ``10 GEOMETRY_TOLERANCE``, as
     :meth:`Geometry.parallel`) made exact, and how far that moved it: a closed form that assumes those relations
     sees its vectors off by about that deviation (0 for an arm whose relations hold to the last digit)."""
     return idealised(geometry, 10 * GEOMETRY_TOLERANCE)
+
 
 #: Lines whose directions are all within this sine of the first's have no common point :func:`idealised` snaps
 #: to: their least-squares point is set by rounding (its matrix's smallest eigenvalue is about sine² / 2, and at

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._cache import memo
+from .._cache import DerivedStore, memo
 from .._forward import ScrewModel, cross, screw_model
 from .._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
 
@@ -46,6 +46,8 @@ class Geometry:
     length_scale: float
     up: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     link_x: np.ndarray | None = None
+    #: what is derived from this geometry alone, built once (:func:`exactly_idealised`)
+    derived: DerivedStore = field(default_factory=DerivedStore, init=False, compare=False, repr=False)
 
     @property
     def dof(self) -> int:
@@ -286,8 +288,9 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
 def exactly_idealised(geometry: Geometry) -> Idealisation:
     """The arm with the relations exact recognition accepts (those within ``10 GEOMETRY_TOLERANCE``, as
     :meth:`Geometry.parallel`) made exact, and how far that moved it: a closed form that assumes those relations
-    sees its vectors off by about that deviation (0 for an arm whose relations hold to the last digit)."""
-    return idealised(geometry, 10 * GEOMETRY_TOLERANCE)
+    sees its vectors off by about that deviation (0 for an arm whose relations hold to the last digit). Built once
+    per geometry: the plan choice, the spherical wrist and the polar shoulder all read it."""
+    return memo(geometry, "exactly_idealised", lambda: idealised(geometry, 10 * GEOMETRY_TOLERANCE))
 
 
 #: Lines whose directions are all within this sine of the first's have no common point :func:`idealised` snaps

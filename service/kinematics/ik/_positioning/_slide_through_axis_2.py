@@ -41,9 +41,6 @@ class SlideThroughAxis2:
     psi0: float  #: ψ at q2 = 0, radians
     cos_alpha: float
     sin_alpha: float
-    #: how far the arm is from the relations this frame assumes (:func:`exactly_idealised`: radians, or fractions of
-    #: its size): the target's coordinates, as the frame sees them, carry that times their lever on top of rounding
-    deviation: float
 
     @classmethod
     def of(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray
@@ -63,7 +60,7 @@ class SlideThroughAxis2:
         n1 = n1 / sin_alpha
         n2 = cross(k2, n1)
         return cls(float(offset @ k2), -float(offset @ v), n1, n2, float(np.arctan2(v @ n2, v @ n1)), cos_alpha,
-                   sin_alpha, exactly_idealised(geometry).deviation)
+                   sin_alpha)
 
     def solve(self, geometry: Geometry, joints: tuple[int, ...], centre: np.ndarray, targets: np.ndarray,
               reference: np.ndarray | None) -> PositionerResult:
@@ -95,7 +92,8 @@ class SlideThroughAxis2:
         # from this frame's relations (a URDF's nine digits: 1e-11) times the same lever: a point that close to
         # axis 1 is on it as far as the frame can tell (its azimuth would come from that error, and the orientation
         # that fixes q1 of a polar arm's pose would be missed)
-        rounding = (ROUNDING_TOLERANCE + self.deviation) * (g.length_scale + np.linalg.norm(targets, axis=-1))
+        deviation = exactly_idealised(g).deviation  # radians, or fractions of the arm's size
+        rounding = (ROUNDING_TOLERANCE + deviation) * (g.length_scale + np.linalg.norm(targets, axis=-1))
         band_along = rounding / self.sin_alpha
         band_squared = 2 * rounding * (radius + inner + band_along)
         met = across_squared <= band_squared  # the two shoulder solutions ±a meet: a = 0 represents them

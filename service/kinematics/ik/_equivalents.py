@@ -103,7 +103,7 @@ def combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_
     ranks of each joint worth enumerating. A row with one usable turn per joint (limits under a whole turn,
     the usual case) has one combination, its ``first`` turns (when every row is such, none is ranked).
     """
-    single = np.all(first == last, axis=1) & (row_limit > 0)
+    single = (first == last).all(axis=1) & (row_limit > 0)
     if single.all():
         return np.arange(len(q)), first
     if len(q) <= _FEW_ROWS:  # few rows: all ranked, the single ones keeping their ``first`` turns

@@ -244,8 +244,8 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     if unordered and (first == last).all():  # every row fits at one equivalent (one flat comparison: a batch's)
         return _each_once(robot, limits, table, n_targets, first, last, np.ones(len(q), dtype=bool), filter_limits,
                           max_equivalents)
-    fits = np.all(last >= first, axis=1)
-    if unordered and (np.all(first == last, axis=1) | ~fits).all():  # and the others at none
+    fits = (last >= first).all(axis=1)
+    if unordered and ((first == last).all(axis=1) | ~fits).all():  # and the others at none
         return _each_once(robot, limits, table, n_targets, first, last, fits, filter_limits, max_equivalents)
     keepable = fits if filter_limits else np.ones(len(q), dtype=bool)
     if excluded is not None:
@@ -273,7 +273,7 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
         available = capped_sums(c_target, combinations, n_targets)
 
     limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
-    lowered = limit > enumerable_limit(n) and bool(np.any(combinations > MAX_COMBINATIONS_PER_SOLUTION))
+    lowered = limit > enumerable_limit(n) and bool((combinations > MAX_COMBINATIONS_PER_SOLUTION).any())
     if lowered:
         limit = enumerable_limit(n)
     if reference is not None:

@@ -88,6 +88,17 @@ def error_size(robot: Robot, position: np.ndarray, orientation: np.ndarray, cons
     return np.maximum(size, orientation) if constrain_orientation else size
 
 
+def error_sizes_of_rows(robot: Robot, residuals: Sequence[tuple[float, float]], constrain_orientation: bool
+                        ) -> list[float]:
+    """:func:`error_size` of a few (position, orientation) pairs of floats (:func:`pose_residuals_of_rows`), as
+    floats; a NaN in either error gives a NaN size, as ``np.maximum`` does."""
+    scale = arm_size(robot)
+    if not constrain_orientation:
+        return [position / scale for position, _ in residuals]
+    return [max(position / scale, orientation) if orientation == orientation else orientation
+            for position, orientation in residuals]
+
+
 def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool) -> np.ndarray:
     """Which residuals pass the FK check."""
     return error_size(robot, position, orientation, constrain_orientation) <= ACCEPT_RESIDUAL
@@ -156,23 +167,24 @@ def first_of_each(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarra
 
 def first_of_each_slot(robot: Robot, rows: Sequence[Sequence[float]], ok: list[bool]) -> list[bool]:
     """:func:`first_of_each` of one target's few slots ``rows`` (m, n: lists of floats), ``ok`` and the result as
-    lists (m,): each ok slot against the distinct slots kept before it, joint by joint until one is apart. For a
-    handful of slots this is a few comparisons per pair, where the pairwise arrays cost a dozen array operations.
+    lists (m,): each ok slot against the distinct slots kept before it, joint by joint from the last (where
+    distinct solutions mostly differ, as :func:`_same_pairs` screens) until one is apart. For a handful of slots
+    this is a few comparisons per pair, where the pairwise arrays cost a dozen array operations.
 
     The comparisons are :func:`_same`'s on the same values: a revolute gap past π is taken from 2π (numpy's
     ``minimum(gap, 2π − gap)``, an infinite gap included), and a NaN gap is apart."""
-    rule = _duplicate_rule(robot)
+    joints, turns, within = _duplicate_rule(robot)
     pi, two_pi = math.pi, 2 * math.pi
     kept: list[bool] = []
     distinct: list[Sequence[float]] = []
     for q, keep in zip(rows, ok):
         if keep:
             for other in distinct:
-                for a, b, (turns, within) in zip(q, other, rule):
-                    gap = abs(a - b)
-                    if turns and gap > pi:
+                for j in joints:
+                    gap = abs(q[j] - other[j])
+                    if turns[j] and gap > pi:
                         gap = two_pi - gap
-                    if not gap <= within:
+                    if not gap <= within[j]:
                         break  # this joint is apart: another solution
                 else:  # every joint within its tolerance: the same solution as one kept before
                     keep = False
@@ -183,10 +195,12 @@ def first_of_each_slot(robot: Robot, rows: Sequence[Sequence[float]], ok: list[b
     return kept
 
 
-def _duplicate_rule(robot: Robot) -> list[tuple[bool, float]]:
-    """Per joint, whether it is revolute and its :func:`duplicate_tolerance`, as floats (kept per robot)."""
-    return memo(robot, "ik_duplicate_rule",
-                lambda: list(zip(robot.is_revolute.tolist(), duplicate_tolerance(robot).tolist())))
+def _duplicate_rule(robot: Robot) -> tuple[range, list[bool], list[float]]:
+    """The joints from the last to the first, and per joint whether it is revolute and its
+    :func:`duplicate_tolerance`, as floats (kept per robot)."""
+    return memo(robot, "ik_duplicate_check",
+                lambda: (range(robot.dof - 1, -1, -1), robot.is_revolute.tolist(),
+                         duplicate_tolerance(robot).tolist()))
 
 
 def _same_pairs(joints: np.ndarray, earlier: np.ndarray, later: np.ndarray, tolerance: np.ndarray,
@@ -322,19 +336,18 @@ def _unvouched(valid: np.ndarray, size: np.ndarray) -> np.ndarray:
 
 def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | None = None) -> Verified | None:
     """:func:`verify` of one target's candidates from a family's scalar path (a :class:`~._scalar.OnePose`: slots
-    as lists of floats, None where empty, each with its label codes), on floats and a few small arrays: the same
-    table, promise and nearest miss. Only the valid slots are checked, and only the rows kept need a clear label
-    (a least-squares slot the FK check rejects may sit where a label flips).
+    as lists of floats, None where empty, each with its label codes), on floats, with the arrays of the table
+    built once from the rows kept: the same table, promise and nearest miss. Only the valid slots are checked,
+    and only the rows kept need a clear label (a least-squares slot the FK check rejects may sit where a label
+    flips).
 
     None where :func:`verify` would polish a candidate, a candidate's error is NaN, or a kept row's label is not
     clear: then :func:`verify` of the candidates (or the array path) decides."""
     slots = [slot for slot, q in enumerate(one_pose.rows) if q is not None]
     rows = [one_pose.rows[slot] for slot in slots]  # revolute joints wrapped already: verify's wrap leaves them
     constrained = goal.constrain_orientation
-    residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist()) if rows else ()
-    # (2, k), each row contiguous: the encoder writes them as they are
-    position, orientation = np.array(list(zip(*residuals)) or ((), ()), dtype=float)
-    sizes = error_size(robot, position, orientation, constrained).tolist()
+    residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist()) if rows else []
+    sizes = error_sizes_of_rows(robot, residuals, constrained)
     if any(size != size or polished(size) for size in sizes):  # a NaN error, or one verify would polish
         return None
     kept = [row for row, keep in enumerate(first_of_each_slot(robot, rows, [size <= ACCEPT_RESIDUAL
@@ -351,8 +364,8 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     complete = promised(one_pose, np.array([count]), nearest, constrained)
     columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)
     labels = {name: (values, column) for name, values, column in zip(one_pose.names, one_pose.values, columns)}
-    if kept != list(range(len(rows))):  # else every row is kept, in slot order: no copy
-        position, orientation = position[kept], orientation[kept]
+    # (2, S), each row contiguous: the encoder writes them as they are
+    position, orientation = np.array([residuals[row] for row in kept], dtype=float).reshape(count, 2).T.copy()
     table = SolutionTable(np.zeros(count, dtype=np.int64), joints, np.ones(count, dtype=bool), position,
                           orientation if constrained else np.full(count, np.nan), labels)
     return Verified(table, complete, nearest, one_pose.singularities)

@@ -21,6 +21,7 @@ from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
 from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, perpendicular_unit, rotation_about
+from ._structure import target_error
 from .subproblems import subproblem_1
 from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Sealed
 from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, seen_by
@@ -300,7 +301,7 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
         d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
         p2 = scalar.vector_of(model.points[2])
         c, w = scalar.vector_of(positioner.centre), scalar.vector_of(plan.point)
-        self.centre = c
+        self.centre, self.geometry = c, positioner.geometry
         # subproblem 3 about axis 3 (the wrist point's distance from the centre), 2 about axes 1 and 2 (where the
         # arm turns it)
         self.elbow_turn = scalar.Turn(d[2])
@@ -325,13 +326,14 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
         d, c, shoulder = self.directions, self.centre, self.shoulder
         target = scalar.sub(point_world, c)
         goal = shoulder.goal(target)
+        error = target_error(self.geometry, scalar.norm(point_world), rounding=0.0)  # as the array path's
         rows, codes = [], []
         for q3 in self.elbow_turn.angles_at_distance(*self.elbow_coordinates, scalar.norm(target)):
             R_3 = scalar.rotation(d[2], q3)
             # the wrist point from the centre with joint 3 turned (joints 1 and 2 turn it about the centre)
             reach_local = scalar.add(scalar.mv(R_3, self.point_from_3), self.centre_to_3)
             elbow_side = self._elbow_side(reach_local)
-            for pair in shoulder.angles(shoulder.start(reach_local), goal):
+            for pair in shoulder.angles(shoulder.start(reach_local), goal, error):
                 if pair is None:  # no arm branch here: its wrist slots are empty too
                     self._empty(rows, codes, 2)
                     continue

@@ -215,10 +215,10 @@ class Turn:
         return x, y, z, radius, math.sqrt(radius * radius + z * z)
 
     @staticmethod
-    def angle(p: tuple[float, ...], q: tuple[float, ...]) -> float:
+    def angle(p: tuple[float, ...], q: tuple[float, ...], free_below: float = GEOMETRY_TOLERANCE) -> float:
         """Subproblem 1: θ with R(k, θ) p = q (least squares), p and q as :meth:`coordinates`; non-degenerate
-        only."""
-        theta = _rotate_onto_clear(p, q, MARGIN)
+        only (``free_below`` as :func:`.subproblems.subproblem_1`'s, relative to the vectors' length)."""
+        theta = _rotate_onto_clear(p, q, MARGIN, free_below)
         if theta is None:
             raise NotGeneric
         return theta
@@ -295,11 +295,12 @@ class TwoTurns:
         radius = math.sqrt(across * across + in_plane * in_plane) / self.sin
         return along, across, in_plane, radius, math.sqrt(along * along + radius * radius)
 
-    def angles(self, start: tuple[float, ...], goal: tuple[float, ...]) -> tuple[tuple[float, float] | None, ...]:
+    def angles(self, start: tuple[float, ...], goal: tuple[float, ...], error: float = 0.0
+               ) -> tuple[tuple[float, float] | None, ...]:
         """The two pairs, the +γ crossing first; where the cones clearly miss, the least-squares pair (as the
         array solver gives it, for the FK check to reject) and None for the empty slot
-        (:func:`.subproblems._paden_kahan._subproblem_2_chain_clear`)."""
-        pairs = _subproblem_2_chain_clear(goal, start, self.cos, self.sin, self.sin2, self.free_below, MARGIN)
+        (:func:`.subproblems._paden_kahan._subproblem_2_chain_clear`; ``error`` as there)."""
+        pairs = _subproblem_2_chain_clear(goal, start, self.cos, self.sin, self.sin2, self.free_below, MARGIN, error)
         if pairs is None:
             raise NotGeneric
         return pairs

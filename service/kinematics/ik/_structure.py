@@ -26,7 +26,7 @@ import numpy as np
 
 from .._cache import DerivedStore, memo
 from .._forward import ScrewModel, cross, screw_model
-from .._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
+from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, ROUNDING_TOLERANCE
 
 
 @dataclass(frozen=True)
@@ -291,6 +291,25 @@ def exactly_idealised(geometry: Geometry) -> Idealisation:
     sees its vectors off by about that deviation (0 for an arm whose relations hold to the last digit). Built once
     per geometry: the plan choice, the spherical wrist and the polar shoulder all read it."""
     return memo(geometry, "exactly_idealised", lambda: idealised(geometry, 10 * GEOMETRY_TOLERANCE))
+
+
+def read_off_below(geometry: Geometry) -> float:
+    """The radius (relative to the size of the unit vectors it is read off) at or below which a family holds an
+    angle as free rather than read it off a vector about its axis: where the arm's deviation from the relations
+    exact recognition accepted (:func:`exactly_idealised`), over that radius, would move the angle by more than
+    ``DUPLICATE_TOLERANCE`` (a vendor's URDF, 1e-11 off, reads it within 1e-5 of the axis' singularity). An exact
+    arm keeps the subproblems' own test, ``GEOMETRY_TOLERANCE``."""
+    return max(GEOMETRY_TOLERANCE, exactly_idealised(geometry).deviation / DUPLICATE_TOLERANCE)
+
+
+def target_error(geometry: Geometry, distance, rounding: float = ROUNDING_TOLERANCE):
+    """The error, in length units, with which a family of an exactly recognised arm sees a target ``distance``
+    from the base (a float, or an array of them): the target's ``rounding`` and the arm's own deviation from the
+    family's relations (:func:`exactly_idealised`: 1e-16 for a DH table, 1e-11 for a vendor's URDF), each relative
+    to the lever they act on, the arm's size plus that distance. Every band a family draws around a quantity it
+    reads off the target (a point on an axis, two roots meeting) is at least this wide. A subproblem that counts
+    its inputs' rounding itself takes ``rounding=0``."""
+    return (rounding + exactly_idealised(geometry).deviation) * (geometry.length_scale + distance)
 
 
 #: Lines whose directions are all within this sine of the first's have no common point :func:`idealised` snaps

@@ -40,7 +40,7 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
 from .._forward import JointTrig, cross
 from ._screws import apply, invert, joint_motion, move_point, perpendicular_unit, rotate_about
-from ._structure import Geometry
+from ._structure import Geometry, read_off_below
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
 from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 from ._wrist import wrist_codes
@@ -90,7 +90,8 @@ class _AxesTwoToFourParallel(Sealed):
         # 3. q6: R(ω_6, −q_6) R(ω_5, −q_5) ω_p = R_Aᵀ R_1 ω_p
         p = rotate_about(g.direction(4), -q5, w_p)  # (N, m, 3)
         q = np.einsum("...ji,...j->...i", R_A, rotate_about(g.direction(0), q1, w_p))
-        sixth = subproblem_1(g.direction(5), p, q)
+        # q6 read off unit vectors: held free where the arm's deviation over their radius would move it
+        sixth = subproblem_1(g.direction(5), p, q, free_below=read_off_below(g))
         q6 = -sixth.theta[..., 0]
         free_six = sixth.degenerate
         unrepresented = np.zeros(n, dtype=bool)
@@ -520,6 +521,7 @@ class _ThreeParallelOnePose:
         self.wrist = scalar.TwoTurns(w_p, d[4])
         self.wrist_start = self.wrist.start(d[5])
         self.sixth, self.second = scalar.Turn(d[5]), scalar.Turn(d[1])
+        self.sixth_free_below = read_off_below(plan.geometry)  # as the array solver's q6
         self.parallel = scalar.Turn(w_p)
         self.normal_p_coordinates = self.parallel.coordinates(self.normal_p)
         self.elbow_turn = scalar.Turn(d[2])
@@ -562,7 +564,8 @@ class _ThreeParallelOnePose:
                     codes += [(None, None, None)] * 2
                     continue
                 q5 = pair[1]
-                q6 = -Turn.angle(self.sixth.coordinates(scalar.rotate(d[4], -q5, w_p)), wanted_p)
+                q6 = -Turn.angle(self.sixth.coordinates(scalar.rotate(d[4], -q5, w_p)), wanted_p,
+                                 self.sixth_free_below)
                 R5, R6 = scalar.rotation(d[4], q5), scalar.rotation(d[5], q6)
                 # R234 = R_rest R6ᵀ R5ᵀ, applied to the normal of ω_p
                 R234_normal = scalar.mv(R_rest, scalar.mtv(R6, scalar.mtv(R5, self.normal_p)))

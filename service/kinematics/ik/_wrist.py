@@ -18,11 +18,11 @@ from functools import cached_property
 
 import numpy as np
 
-from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
+from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE
 from .._rotations import wrap_angle
 from .._forward import JointTrig, cross
 from ._screws import perpendicular_unit, rotate_about
-from ._structure import Geometry, exactly_idealised
+from ._structure import Geometry, read_off_below
 from .subproblems import subproblem_1, subproblem_2_chain
 from ._types import LabelCodes, SingularFlags, Singularity, Sealed
 
@@ -163,14 +163,12 @@ class SphericalWrist(Sealed):
         a, b, c = self.axes
         return float(a @ cross(b, c)), float(a @ cross(b, cross(b, c)))
 
-    @cached_property
+    @property
     def free_below(self) -> float:
-        """The radius of ``R_w ω_c`` about ω_a (unit vectors) at or below which q_a is held as free: where the
-        arm's deviation from the relations exact recognition accepted (those within ``10 GEOMETRY_TOLERANCE``, as
-        :meth:`Geometry.parallel`; relations rounded more coarsely, which this plan does not assume, do not
-        count), over the radius, would move q_a by more than ``DUPLICATE_TOLERANCE``. An exact arm keeps
-        subproblem 2's own test, ``GEOMETRY_TOLERANCE``."""
-        return max(GEOMETRY_TOLERANCE, exactly_idealised(self.geometry).deviation / DUPLICATE_TOLERANCE)
+        """The radius of ``R_w ω_c`` about ω_a (unit vectors) at or below which q_a is held as free
+        (:func:`read_off_below`: relations rounded more coarsely than exact recognition accepts, which this plan
+        does not assume, do not count)."""
+        return read_off_below(self.geometry)
 
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         middle = self.joints[1]

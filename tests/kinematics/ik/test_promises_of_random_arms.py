@@ -319,6 +319,74 @@ def test_a_ur_type_1e9_off_its_relations_at_its_wrist_singularity_lists_its_own_
     assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
 
 
+def test_a_puma_written_to_eleven_digits_at_its_shoulder_boundary_flags_the_roots_it_merges(client):
+    """The PUMA 560 with each DH parameter moved by ~1e-11 (a URDF's rounding; seeded), q2 = 1e-6 with the
+    forearm folded back (q3 = π/2, the wrist point near axis 2) and q5 = 1e-12: the two shoulder roots meet
+    there, and the arm's 4e-11 deviation from its family split them by 2.3e-4 rad in q2. The answer listed both
+    halves (each within the FK check: the pose barely moves along that direction) with their wrists not aligned,
+    was complete, flagged nothing, and missed this configuration by 1.44 rad. Roots that close, as the
+    deviation can split them, are now one, flagged: the configuration is listed or the flags say why not."""
+    puma = catalogue_robot(client, "puma560_standard")
+    rows = [(5.015015400352544e-12, 1.5707963267902052, -2.221795195036084e-12, 4.330923938780863e-12),
+            (0.43180000000773006, -3.983814353660961e-12, -2.480230204188387e-12, 1.4191473705700787e-11),
+            (0.02030000001431475, -1.5707963268041958, 0.1500499999995356, -3.5198911710499078e-12),
+            (4.5460597261010904e-12, 1.5707963267814267, 0.43179999999782737, -4.018184537129556e-12),
+            (8.088311936354928e-12, -1.5707963267984892, 6.748586921242256e-12, -5.107800272314678e-13),
+            (7.64376527859857e-12, 4.725347040878915e-13, -1.3274545809567144e-12, 7.074437384891993e-12)]
+    robot = Robot([Joint(f"q{i}", "revolute", *row) for i, row in enumerate(rows)], name="moved puma",
+                  convention=puma.convention, world_T_base=puma.world_T_base, flange_T_tool=puma.flange_T_tool)
+    q = np.array([-0.948205065831635, 1e-06, 1.5707963267958966, -1.5707963257948965, 1e-12, -3.141591653589793])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok"
+    listed = min(_distance(robot, s.joints, q) for s in result.solutions)
+    assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
+    assert {"boundary", "sum"} <= {s.relation for s in result.singularities}, result.singularities
+
+
+def test_a_ur10e_written_to_eleven_digits_1e9_from_its_wrist_singularity_flags_the_wrist(client):
+    """The UR10e with each DH parameter moved by ~1e-11 (a URDF's rounding; seeded), q5 1e-9 from π and the elbow
+    1e-6 from folded: q6 was read off a vector 1e-9 long that the arm's 3e-11 deviation turned by 0.02 rad, the
+    elbow then missed its fold, and the answer was complete, flagged nothing and missed this configuration by
+    3.12 rad. The wrist now holds q6 free where the deviation over that radius would move it by more than the
+    duplicate tolerance (as the spherical wrist holds its first joint): the wrist's sum is flagged."""
+    ur10e = catalogue_robot(client, "ur10e")
+    rows = [(4.251487353319089e-12, 1.5707963267977207, 0.18069999998840702, 8.333425966696617e-12),
+            (-0.6127000000059044, -1.0560789503141859e-11, -9.004750699990517e-12, -3.905453443553229e-12),
+            (-0.571549999983727, -1.1755359049207804e-11, 1.6007589253434075e-12, -2.1378243580905772e-11),
+            (-1.5669331451969057e-14, 1.5707963268038923, 0.17414999999763336, -6.293549238833418e-12),
+            (2.3151106405853766e-12, -1.570796326787895, 0.11985000000663658, 1.9724738539297916e-11),
+            (2.0916747233627676e-12, -5.924100997529326e-12, 0.1165499999987402, -7.249854561981204e-13)]
+    robot = Robot([Joint(f"q{i}", "revolute", *row) for i, row in enumerate(rows)], name="moved ur10e",
+                  convention=ur10e.convention, world_T_base=ur10e.world_T_base, flange_T_tool=ur10e.flange_T_tool)
+    q = np.array([-0.744601864433796, 0.023894640786203958, -3.141591653589793,
+                  -0.040391080111737754, 3.141592654589793, -1.5707963277948966])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok"
+    listed = min(_distance(robot, s.joints, q) for s in result.solutions)
+    assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
+    assert "sum" in {s.relation for s in result.singularities}, result.singularities
+
+
+def test_a_spherical_arm_written_to_eleven_digits_pointing_along_its_first_axis_reaches_its_pose(client):
+    """Spong's spherical R-R-P arm with each DH parameter moved by ~1e-11 (seeded), its slide along axis 1
+    (q2 1e-9 from −π): the point lay 3e-10 from axis 1, outside half the acceptance, and q1 was read off its
+    azimuth, which the arm's deviation over that radius turned by 0.03 rad; the orientation that fixes q1 was
+    missed and the pose was promised unreachable. A point so near the axis that its azimuth is known worse than
+    the polish can mend is on it: q1 is free, and the orientation sets it."""
+    spherical = catalogue_robot(client, "spong_sec4_3_spherical_arm_rrp")
+    rows = [('revolute', -1.2878035021494676e-11, 1.5707963267836835, 0.5000000000083237, 1.9404745873255363e-12),
+            ('revolute', 9.175069079598725e-12, 1.5707963267986187, -4.556331887894872e-12, -1.2989039183107999e-11),
+            ('prismatic', -4.210923102252835e-12, -1.4847571131226895e-11,
+             1.9582524625539643e-11, 2.203930465859092e-12)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="moved spherical arm",
+                  convention=spherical.convention, world_T_base=spherical.world_T_base,
+                  flange_T_tool=spherical.flange_T_tool)
+    q = np.array([-1.8588017588366752, -3.141592654589793, 0.275922712371556])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok", (result.status, result.detail)
+    assert min(_distance(robot, s.joints, q) for s in result.solutions) <= 1e-3
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

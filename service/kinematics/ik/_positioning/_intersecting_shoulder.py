@@ -11,7 +11,7 @@ from ..._rotations import wrap_angle
 from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
 from ..._forward import JointTrig, cross
 from .._screws import rotate_about
-from .._structure import Geometry
+from .._structure import Geometry, target_error
 from .._types import LabelCodes, SingularFlags, Singularity
 from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3, subproblem_4
 from ._base import Needs, Positioner, PositionerResult, _flag_rows, _unit, side_codes
@@ -84,7 +84,10 @@ class IntersectingShoulder(Positioner):
             third = prismatic_to_distance(w, g.direction(k), c, reach)
             q3 = third.s
             w3 = w + g.direction(k) * q3[..., None]
-        pair = subproblem_2_chain(g.direction(i), g.direction(j), w3 - c, (targets - c)[:, None, :])
+        # two shoulder roots as close as the arm's own deviation from this family can bring them are one: the
+        # deviation splits a boundary's double root by its square root, and each half then misses its target
+        error = target_error(g, np.linalg.norm(targets, axis=-1), rounding=0.0)[:, None]
+        pair = subproblem_2_chain(g.direction(i), g.direction(j), w3 - c, (targets - c)[:, None, :], error=error)
         q1, q2 = pair.theta1, pair.theta2  # (N, 2 third roots, 2 pair roots)
         singular = SingularFlags(n_targets)
         # subproblem 2 is degenerate when the target is on axis 1 (joint 1 free), or when the point is on axis 2

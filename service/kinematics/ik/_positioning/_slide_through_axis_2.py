@@ -14,9 +14,9 @@ import numpy as np
 
 from ..._forward import cross
 from ..._rotations import wrap_angle
-from ..._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
+from ..._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, POLISH_RESIDUAL
 from .._screws import rotate_about
-from .._structure import Geometry, exactly_idealised
+from .._structure import Geometry, target_error
 from .._types import SingularFlags, Singularity
 from ..subproblems import subproblem_1
 from ._base import PositionerResult, _flag_rows
@@ -92,8 +92,7 @@ class SlideThroughAxis2:
         # from this frame's relations (a URDF's nine digits: 1e-11) times the same lever: a point that close to
         # axis 1 is on it as far as the frame can tell (its azimuth would come from that error, and the orientation
         # that fixes q1 of a polar arm's pose would be missed)
-        deviation = exactly_idealised(g).deviation  # radians, or fractions of the arm's size
-        rounding = (ROUNDING_TOLERANCE + deviation) * (g.length_scale + np.linalg.norm(targets, axis=-1))
+        rounding = target_error(g, np.linalg.norm(targets, axis=-1))
         band_along = rounding / self.sin_alpha
         band_squared = 2 * rounding * (radius + inner + band_along)
         met = across_squared <= band_squared  # the two shoulder solutions ±a meet: a = 0 represents them
@@ -121,9 +120,10 @@ class SlideThroughAxis2:
         t = np.stack([t, -t], axis=-1)
         turned = h * g.direction(j) + t[..., None] * (np.cos(psi)[..., None] * self.n1
                                                       + np.sin(psi)[..., None] * self.n2)
-        # likewise a point within half the acceptance of axis 1: every q1 reaches it, and its azimuth, known to
-        # rounding over that radius, could miss the orientation that fixes q1 of a three-joint arm's pose
-        on_first_axis = np.maximum(rounding, 0.5 * ACCEPT_RESIDUAL * g.length_scale)
+        # likewise a point within half the acceptance of axis 1 (every q1 reaches it), or so near it that its
+        # azimuth, known to the target's error over that radius, is known worse than the polish can mend: the
+        # orientation that fixes q1 of a three-joint arm's pose would be missed
+        on_first_axis = np.maximum(rounding / POLISH_RESIDUAL, 0.5 * ACCEPT_RESIDUAL * g.length_scale)
         first = subproblem_1(k1, turned, y[:, None, None, :], free_below=on_first_axis[:, None, None])
         q1 = first.theta[..., 0]
         free_first = first.degenerate | at_centre[:, None, None]  # the target on axis 1 (a polar arm without offset)
@@ -133,9 +133,11 @@ class SlideThroughAxis2:
         else:
             q1 = np.where(free_first, 0.0, q1)
         joints = np.stack([q1, wrap_angle(psi - self.psi0), self.foot + t], axis=-1)
-        # exact to the arm's size (subproblem 1 measures against the point's own, tiny near the centre)
+        # exact to the arm's size (subproblem 1 measures against the point's own, tiny near the centre); a free q1
+        # misses by up to twice the point's radius, within its band: the orientation may set it, the FK check
+        # judges
         miss = np.linalg.norm(rotate_about(k1, q1, turned) - y[:, None, None, :], axis=-1)
-        valid = miss <= GEOMETRY_TOLERANCE * g.length_scale
+        valid = (miss <= GEOMETRY_TOLERANCE * g.length_scale) | free_first
         valid[:, 1, :] &= ~met[:, None]  # −a is +a
         valid[..., 1] &= ~free[:, None]  # −t with ψ + π is t with ψ when joint 2 is free
         singular = SingularFlags(n_targets)

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..._rotations import wrap_angle
-from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, ROUNDING_TOLERANCE
+from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
 from ..._forward import JointTrig, cross
 from .._screws import rotate_about
-from .._structure import Geometry
+from .._structure import Geometry, target_error
 from .._types import LabelCodes, SingularFlags, Singularity
 from ..subproblems import prismatic_to_plane, quadratic_roots, subproblem_1, subproblem_3, subproblem_5_prismatic
 from ._base import Needs, Positioner, PositionerResult, _flag_rows, side_codes
@@ -138,8 +138,8 @@ class OneRevoluteTwoPrismatic(Positioner):
         slides = s0[:, None, :] + t[..., None] * nullspace  # (N, 2, 2)
         body = self.point - p + slides @ V_post.T
         world = targets[:, None, :] - p - slides @ V_pre.T
-        # an azimuth seen on a radius is known to the target's rounding / radius: free only within rounding
-        band = ROUNDING_TOLERANCE * (g.length_scale + np.linalg.norm(targets, axis=-1))[:, None]
+        # an azimuth seen on a radius is known to the target's error / radius: free only within that error
+        band = target_error(g, np.linalg.norm(targets, axis=-1))[:, None]
         turn = subproblem_1(omega, body, world, free_below=band, scale=g.length_scale)
         theta = turn.theta[..., 0]
         free = turn.degenerate

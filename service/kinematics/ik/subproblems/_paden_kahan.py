@@ -16,7 +16,8 @@ from ..._errors import InvalidInputError
 from ..._rotations import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE
 from .._screws import axis_frame
-from ._records import _GAP_ROUNDING, _MERGE_SIN_SQUARED, _NEAR_TANGENT_GAP, AnglePairSolutions, AngleSolutions
+from ._records import (_GAP_PER_ERROR, _GAP_ROUNDING, _MERGE_SIN_SQUARED, _NEAR_TANGENT_GAP, AnglePairSolutions,
+                       AngleSolutions)
 from ._roots import _harmonic
 from ._vectors import _coords, _cross3, _distances, _hypot, _norm, _pair, _points, _rotate_onto, _unit
 
@@ -80,7 +81,8 @@ def subproblem_1(k: ArrayLike, p: ArrayLike, q: ArrayLike, free_below: ArrayLike
     )
 
 
-def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> AnglePairSolutions:
+def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike, *, error: ArrayLike = 0.0
+                 ) -> AnglePairSolutions:
     """Paden-Kahan 2, IK-Geo form: solve ``R(k1, theta1) p = R(k2, theta2) q``; else least squares.
 
     The common point ``x`` lies on the circle that ``p`` sweeps about ``k1`` and
@@ -107,6 +109,10 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
         Unit axes through the origin, not parallel.
     p, q : array_like, shape (..., 3)
         ``p`` is rotated about ``k1``, ``q`` about ``k2``.
+    error : array_like, shape (...), optional
+        How far (length units) ``p`` and ``q`` may be from the vectors the caller means, beyond their rounding
+        (which is counted here): two crossings that an error that size could have split from a tangency are
+        one root, ``merged``.
 
     Returns
     -------
@@ -203,7 +209,10 @@ def subproblem_2(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> An
     # that rounding split). A test on the midpoint's residual, g (1/rho1 + 1/rho2) <= 1e-12, merged roots
     # 1e-6 / sqrt(rho) apart instead: the Stanford shoulder at theta2 = 6e-7 came back 1.5e-6 off.
     rho = np.minimum(rho1, rho2)
-    close = g <= np.maximum(_MERGE_SIN_SQUARED * rho, _GAP_ROUNDING) * rho
+    merge_below = np.maximum(_MERGE_SIN_SQUARED * rho, _GAP_ROUNDING)
+    if np.any(error):  # and within what the inputs' error can make of a tangency
+        merge_below = np.maximum(merge_below, _GAP_PER_ERROR * np.asarray(error) / np.where(scale > 0.0, scale, 1.0))
+    close = g <= merge_below * rho
     two = meet & ~close & ~degenerate
     gamma = np.sqrt(np.maximum(g, 0.0)) * two / sin
 
@@ -272,7 +281,7 @@ def _circle_gap(rho, offset):
 
 
 def _subproblem_2_chain_clear(p: tuple[float, ...], q: tuple[float, ...], cos: float, sin: float, sin2: float,
-                              free_below: float, margin: float
+                              free_below: float, margin: float, error: float = 0.0
                               ) -> tuple[tuple[float, float], tuple[float, float] | None] | None:
     """:func:`subproblem_2_chain` on floats where its answer is clear, for the one-pose paths (numpy's per-call
     cost would exceed the arithmetic): :func:`subproblem_2` with ``theta1`` negated.
@@ -280,8 +289,8 @@ def _subproblem_2_chain_clear(p: tuple[float, ...], q: tuple[float, ...], cos: f
     ``p`` (the chain's goal) is ``(p1, pn, d1, radius_p, norm_p)`` and ``q`` (its start) ``(q2, qn, e2, radius_q,
     norm_q)``, as :func:`subproblem_2` names them; ``cos``, ``sin`` and ``sin2`` are ``k1 . k2``, ``||k1 x k2||``
     and its square as :func:`subproblem_2` computes them; ``free_below`` the radius (relative to the vectors'
-    size) at or below which the caller holds a joint free. Returns the two ``(theta1, theta2)`` slots, the
-    +gamma crossing first; where the cones clearly miss (beyond a near tangency,
+    size) at or below which the caller holds a joint free, ``error`` :func:`subproblem_2`'s. Returns the two
+    ``(theta1, theta2)`` slots, the +gamma crossing first; where the cones clearly miss (beyond a near tangency,
     :data:`._records._NEAR_TANGENT_GAP`, that :func:`subproblem_2` reports merged) the least-squares pair and
     None; and None where a quantity is within ``margin`` times its band of one of :func:`subproblem_2`'s
     thresholds (a free joint, norms that differ, crossings that merge).
@@ -299,9 +308,7 @@ def _subproblem_2_chain_clear(p: tuple[float, ...], q: tuple[float, ...], cos: f
         rho, g = rho1, _circle_gap(rho1, beta * sin)
     else:
         rho, g = rho2, _circle_gap(rho2, alpha * sin)
-    merge_below = _MERGE_SIN_SQUARED * rho
-    if merge_below < _GAP_ROUNDING:
-        merge_below = _GAP_ROUNDING
+    merge_below = max(_MERGE_SIN_SQUARED * rho, _GAP_ROUNDING, _GAP_PER_ERROR * error / size)
     atan2, wrap = math.atan2, wrap_float
     s1, c1, s2, c2 = -beta * pn, beta * d1, alpha * qn, alpha * e2
     if not g > margin * merge_below * rho:
@@ -314,14 +321,15 @@ def _subproblem_2_chain_clear(p: tuple[float, ...], q: tuple[float, ...], cos: f
             (wrap(-wrap(atan2(s1 - t1, c1 - u1))), wrap(atan2(s2 + t2, c2 - u2))))
 
 
-def subproblem_2_chain(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike) -> AnglePairSolutions:
+def subproblem_2_chain(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike, *, error: ArrayLike = 0.0
+                       ) -> AnglePairSolutions:
     """Paden-Kahan 2, chain form: solve ``R(k1, theta1) R(k2, theta2) p = q``; else least squares.
 
     This is :func:`subproblem_2` applied to ``R(k1, -theta1) q = R(k2, theta2) p``.
     It minimises the same residual, because rotations preserve length. Flags,
     slots and tolerances are as in :func:`subproblem_2`. In this form
     ``theta2`` is free when ``p`` lies on ``k2``, and ``theta1`` is free when
-    ``q`` lies on ``k1``.
+    ``q`` lies on ``k1``. ``error`` is :func:`subproblem_2`'s.
 
     Parameters
     ----------
@@ -338,7 +346,7 @@ def subproblem_2_chain(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike)
     >>> np.degrees(sol.theta1).round(9).tolist(), np.degrees(sol.theta2).round(9).tolist()
     ([-90.0, 90.0], [-90.0, 90.0])
     """
-    sol = subproblem_2(k1, k2, q, p)
+    sol = subproblem_2(k1, k2, q, p, error=error)
     return sol._replace(theta1=wrap_angle(-sol.theta1))
 
 

@@ -100,6 +100,10 @@ _MERGE_SIN_SQUARED = math.sin(DUPLICATE_TOLERANCE / 2.0) ** 2
 # Rounding error of that g relative to rho: exact tangencies give |g| up to 86 ulps of rho (tests/kinematics/ik/
 # subproblems/test_subproblems.py's tangent cones); this bound keeps a factor 3 above it.
 _GAP_ROUNDING = 256 * np.finfo(float).eps
+# How much that g (relative to rho) moves per unit of error in the directions of p and q (radians): a tangency
+# seen through inputs that carry an error (the arm's own deviation from its family) has |g| up to about
+# (2 + 4 / sin) rho times that error, sin the sine between the axes; this keeps a margin above it.
+_GAP_PER_ERROR = 16.0
 # Two cones (subproblem 2) that miss by at most this gap on the unit sphere are a tangency that an error of the
 # inputs split: an angle found upstream at a double root (subproblem 3 at its fold: a stretched elbow) is known
 # only to the square root of its inputs' error (FOLD_TOLERANCE), and moves the point by that much. Their

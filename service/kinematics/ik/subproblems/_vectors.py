@@ -138,13 +138,15 @@ def _rotate_onto(
     return np.where(degenerate, 0.0, wrap_angle(theta)), exact, degenerate
 
 
-def _rotate_onto_clear(p: tuple[float, ...], q: tuple[float, ...], margin: float) -> float | None:
+def _rotate_onto_clear(p: tuple[float, ...], q: tuple[float, ...], margin: float,
+                       free_below: float = GEOMETRY_TOLERANCE) -> float | None:
     """:func:`_rotate_onto` on floats where its answer is clear, for the one-pose paths (numpy's per-call cost
     would exceed the arithmetic): ``p`` and ``q`` as ``(x, y, z, radius, length)`` in the axis frame; theta, or
-    None where either lies within ``margin`` times the tolerance of the axis (degenerate)."""
+    None where either lies within ``margin`` times ``free_below`` (relative to the longer one) of the axis
+    (degenerate)."""
     px, py, _, radius_p, length_p = p
     qx, qy, _, radius_q, length_q = q
-    tol = GEOMETRY_TOLERANCE * (length_p if length_p > length_q else length_q)
+    tol = free_below * (length_p if length_p > length_q else length_q)
     if not (radius_p > margin * tol and radius_q > margin * tol):
         return None
     return wrap_float(math.atan2(px * qy - py * qx, px * qx + py * qy))

@@ -357,6 +357,33 @@ def test_sp2_tangency_split_by_rounding_returns_the_touching_root(rng, split):
     assert np.abs(turned - np.array([1.0, 0.0, 1.0]) / np.sqrt(2)).max() <= 2 * split + 1e-12
 
 
+@pytest.mark.parametrize("split", [1e-12, 1e-10, 1e-8])
+def test_sp2_crossing_an_input_error_can_make_of_a_tangency_is_one_root(rng, split):
+    """The same tangency with q's cone made ``split`` wider: the cones cross, at two roots about √split apart
+    (5e-5 rad at 1e-9: each half misses the tangency the caller means by that much). Given inputs that carry an
+    error of ``split`` (an arm's deviation from the family that computed them), such crossings are one root,
+    merged, within the split of the touching direction; an error a thousand times smaller leaves them two."""
+    k1, k2 = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    p = rotate(k1, rng.uniform(-np.pi, np.pi, N_ROWS), np.array([1.0, 0.0, 1.0]) / np.sqrt(2))
+    q = rotate(k2, rng.uniform(-np.pi, np.pi, N_ROWS), np.array([np.cos(np.pi / 4 + split),
+                                                                 np.sin(np.pi / 4 + split), 0.0]))
+    apart = subproblem_2(k1, k2, p, q, error=split / 1000)
+    assert not apart.merged.any() and apart.valid.all()
+    assert (pair_gap_of_slots(apart) > 0.1 * np.sqrt(split)).all()
+    sol = subproblem_2(k1, k2, p, q, error=split)
+    assert sol.merged.all() and not sol.degenerate.any()
+    assert sol.valid[:, 0].all() and not sol.valid[:, 1].any()
+    turned = rotate(k1, sol.theta1[:, 0], p)
+    assert np.abs(turned - np.array([1.0, 0.0, 1.0]) / np.sqrt(2)).max() <= 2 * split + 1e-12
+    chain = subproblem_2_chain(k1, k2, q, p, error=split)  # the chain form passes it on
+    assert chain.merged.all()
+
+
+def pair_gap_of_slots(sol) -> np.ndarray:
+    """How far apart (rad, the larger of the two joints) each row's two roots are."""
+    return np.maximum(angle_gap(sol.theta1[:, 0], sol.theta1[:, 1]), angle_gap(sol.theta2[:, 0], sol.theta2[:, 1]))
+
+
 def test_sp2_clear_miss_is_not_a_tangency(rng):
     """Cones apart by 1e-3 (far beyond sqrt(GEOMETRY_TOLERANCE)) are a miss: least squares, not merged."""
     k1, k2 = np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])

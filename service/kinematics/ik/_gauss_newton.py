@@ -10,9 +10,11 @@ the minimum-norm step when J is wide (a redundant arm, a position target) and th
 (JᵀJ + μI)⁻¹ Jᵀ e in every case (the two are equal). The system is r × r (r = 3 or 6 rows), whatever the
 number of joints.
 
-* **Newton** (``adaptive`` false): μ stays at :data:`NEWTON_DAMPING` and every step is taken; a row stops when
-  its error is below ``tolerance``, or (``contraction`` given) when a step shrinks it by less than that factor:
-  off the branch's reach, Newton's quadratic convergence is lost.
+* **Newton** (``adaptive`` false): μ stays at :data:`NEWTON_DAMPING` and every step that does not raise the error
+  is taken; a row stops when its error is below ``tolerance``, when a step would raise it (the row stays where
+  it was: near a singularity a Newton step along the near-singular direction can throw a candidate 1e-7 off its
+  target 1e-3 off), or (``contraction`` given) when a step shrinks it by less than that factor: off the
+  branch's reach, Newton's quadratic convergence is lost.
 * **Levenberg–Marquardt** (``adaptive`` true): μ = λ · max(1, tr J Jᵀ); a step is taken only if it lowers ‖e‖²;
   λ is divided by 3.3 after a success and multiplied by 10 after a failure, and a row stops below ``tolerance``
   or once λ passes :data:`GIVE_UP_DAMPING`.
@@ -81,8 +83,8 @@ def gauss_newton(robot: Robot, goal: Goal, q: np.ndarray, rows: np.ndarray, *, s
         if adaptive:  # Levenberg–Marquardt: keep a step only if it lowers the cost (an overflow is a failure)
             taken = np.isfinite(trial_cost) & (trial_cost < cost[index])
             damping[index] = np.where(taken, np.maximum(damping[index] * 0.3, LEAST_DAMPING), damping[index] * 10.0)
-        else:
-            taken = np.isfinite(trial_cost)
+        else:  # Newton: a step that raises the error has left the root's reach; the row stops before it
+            taken = np.isfinite(trial_cost) & (trial_size <= size[index])
         better = index[taken]
         previous = size[better]
         q[better], error[better] = trial[taken], trial_error[taken]

@@ -210,15 +210,15 @@ class IdealisedPlan(Sealed):
     def _smallest_singular_value(self, joints: np.ndarray) -> np.ndarray:
         """σ_min of the true arm's Jacobian at joints (k, n), position rows in arm sizes; shape (k,).
 
-        From the eigenvalues of JᵀJ (6 × 6 at most): σ_min² is far above their rounding (1e-16 σ_max²) at the
-        margins it is compared with (SINGULAR_MARGIN δ ≥ 1e-5).
+        From the singular values of J itself, accurate to about 1e-16 σ_max: an arm 1e-10 off its family compares
+        σ_min with SINGULAR_MARGIN δ = 1e-9, where the eigenvalues of JᵀJ (σ_min² beside a rounding of
+        1e-16 σ_max²) would read a σ_min of 1e-9 as anything up to 1e-8.
         """
         J = geometric_jacobian(self.robot, joints)
         J[:, :3, :] /= self.size
         if not self.constrain_orientation:
             J = J[:, :3, :]
-        gram = np.swapaxes(J, -1, -2) @ J if J.shape[-1] <= J.shape[-2] else J @ np.swapaxes(J, -1, -2)
-        return np.sqrt(np.maximum(np.linalg.eigvalsh(gram)[:, 0], 0.0))
+        return np.linalg.svd(J, compute_uv=False)[:, -1]
 
     def _ideal_error(self, joints: np.ndarray, world_T_targets: np.ndarray) -> np.ndarray:
         """The idealised arm's residual at joints (N, m, n): position / size, or the larger with the orientation."""

@@ -367,6 +367,32 @@ def test_a_ur10e_written_to_eleven_digits_1e9_from_its_wrist_singularity_flags_t
     assert "sum" in {s.relation for s in result.singularities}, result.singularities
 
 
+def test_a_stanford_arm_written_to_eleven_digits_is_not_promised_unreachable_where_its_polish_overshoots(client):
+    """The Stanford arm with each DH parameter moved by ~1e-11 (a URDF's rounding; seeded), q2 1e-9 from π (the
+    shoulder's boundary) and q5 = 1e-6 (the wrist 1e-6 from aligned, held free within the arm's deviation over
+    that radius): both candidates missed by 8e-7, and the polish's Newton steps, along the near-singular
+    direction, threw them 1e-3 off; the nearest miss then read as clear, and this pose of the arm's own was
+    promised unreachable. A Newton step that raises the error is no longer taken: the narrow miss stands, the
+    flags make it no proof, and the numeric search completes the answer."""
+    stanford = catalogue_robot(client, "spong_ex3_5_stanford")
+    rows = [('revolute', 9.446865829548147e-13, -1.5707963268073808, 2.966803890430878e-11, 4.663183956211561e-12),
+            ('revolute', -1.7195465855225482e-11, 1.5707963268050356, 0.15400000000712433, 3.9682575357203044e-12),
+            ('prismatic', 2.6275205808531668e-12, -4.709456252281336e-12,
+             -1.0998918111116394e-12, -1.946672803641399e-11),
+            ('revolute', 1.387857854546278e-11, -1.5707963267739915, 5.801870215506985e-12, 6.9466457536328505e-12),
+            ('revolute', -1.2913711684230084e-11, 1.5707963267913707, -1.3465156438916998e-11, -1.2385643305969746e-11),
+            ('revolute', 6.135305658124752e-12, 1.4941329345542943e-11, 0.2630000000000492, 2.5590224113796677e-11)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="moved stanford",
+                  convention=stanford.convention, world_T_base=stanford.world_T_base,
+                  flange_T_tool=stanford.flange_T_tool)
+    q = np.array([1.5707963267958966, 3.141592654589793, 0.25360229428036896,
+                  -0.8791115140702122, 1e-06, -1.5707963267948966])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status != "unreachable" or not result.complete, (result.status, result.structure, result.detail)
+    for solution in result.solutions:
+        assert np.allclose(forward_kinematics(robot, solution.joints), forward_kinematics(robot, q), atol=1e-8)
+
+
 def test_a_spherical_arm_written_to_eleven_digits_pointing_along_its_first_axis_reaches_its_pose(client):
     """Spong's spherical R-R-P arm with each DH parameter moved by ~1e-11 (seeded), its slide along axis 1
     (q2 1e-9 from −π): the point lay 3e-10 from axis 1, outside half the acceptance, and q1 was read off its
@@ -385,6 +411,29 @@ def test_a_spherical_arm_written_to_eleven_digits_pointing_along_its_first_axis_
     result = solve_ik(robot, forward_kinematics(robot, q))
     assert result.status == "ok", (result.status, result.detail)
     assert min(_distance(robot, s.joints, q) for s in result.solutions) <= 1e-3
+
+
+def test_a_ur5e_1e10_off_its_family_1e9_from_its_wrist_singularity_is_not_promised(client):
+    """The UR5e with each DH parameter moved by ~1e-10 (seeded: 2.5e-10 off its family, so solved as an idealised
+    arm, whose promise is withheld within 10 δ of a singularity of the true arm), q5 1e-9 from 0 and the elbow
+    1e-9 from folded: σ_min, about 1e-9 there, was read from the eigenvalues of JᵀJ, which cannot tell it from
+    1e-8; the answer was complete, flagged nothing and missed this configuration by 1.15 rad. σ_min now comes
+    from J's singular values: the promise is withheld and the numeric search completes the answer."""
+    ur5e = catalogue_robot(client, "ur5e")
+    rows = [(-8.330299635529903e-11, 1.5707963267280856, 0.16250000006657822, 2.3466983708612993e-10),
+            (-0.42500000026303675, 7.239161378227218e-11, -2.110471830216745e-11, 7.793647137401867e-11),
+            (-0.39219999991322785, 5.2838085038548e-12, -1.0159735470221951e-10, -1.3970518935029944e-10),
+            (-1.8741786885931647e-10, 1.5707963269171312, 0.13329999997902978, -5.4027496735855584e-11),
+            (-2.7771941082639357e-11, -1.5707963269288434, 0.09970000003046145, 1.3187014960437955e-10),
+            (1.1384606307709629e-10, -1.56579907122772e-10, 0.09960000013635119, -7.642368947263355e-11)]
+    robot = Robot([Joint(f"q{i}", "revolute", *row) for i, row in enumerate(rows)], name="moved ur5e",
+                  convention=ur5e.convention, world_T_base=ur5e.world_T_base, flange_T_tool=ur5e.flange_T_tool)
+    q = np.array([1.3112491413544998, -1.8575579994334768, 3.141592652589793,
+                  0.0019764330722424894, -1e-09, -1.5707953267948966])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok"
+    listed = min(_distance(robot, s.joints, q) for s in result.solutions)
+    assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
 
 
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():

@@ -135,9 +135,10 @@ _FOOT_SINE = 0.1
 
 #: The polyline of an arm with a slide shorter than this (length units) is rounding dust, not a size: a P-R-P arm
 #: with zero offsets written with 1e-9 rounding would otherwise measure 1e-9, and its residuals, relative to that
-#: while its slides carry the tool 0.3 away, reject every solution. (An arm of revolute joints alone keeps a tiny
-#: size: its fixed lengths are its scale.)
-_DUST_LENGTH = 1e-6
+#: while its slides carry the tool 0.3 away, reject every solution; an R-R-P-R arm whose lines all meet in one point,
+#: its angles rounded as CAD rounds them (1e-5), measures the distance between its nearly concurrent lines, 5e-5.
+#: (An arm of revolute joints alone keeps a tiny size: its fixed lengths are its scale.)
+_DUST_LENGTH = 1e-3
 
 
 def canonical_model(model: ScrewModel, base_origin: np.ndarray) -> tuple[ScrewModel, float]:

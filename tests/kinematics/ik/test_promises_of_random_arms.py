@@ -436,6 +436,28 @@ def test_a_ur5e_1e10_off_its_family_1e9_from_its_wrist_singularity_is_not_promis
     assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
 
 
+def test_a_spherical_rrpr_arm_with_cad_rounding_is_measured_by_its_slide_not_its_rounding(client):
+    """The R-R-P-R spherical arm (every line through one point, every fixed length zero) with each DH parameter
+    moved by ~1e-5 (seeded, as CAD angles and lengths are rounded): its polyline, the size the tolerances are
+    relative to, was the rounding (5e-5), the candidate nearest this pose, 1.7e-7 away, was 3e-3 of that and
+    beyond the polish, and the pose was promised unreachable (49 of 100 draws). A polyline of an arm with
+    slides below 1e-3 length units is rounding dust: the arm measures one unit, as one written exactly does."""
+    rrpr = catalogue_robot(client, "ex004_3_spherical_rrpr")
+    rows = [('revolute', 4.752837687918262e-06, -1.5707822316015019, -1.1604202756212202e-06, -7.754593330029318e-06),
+            ('revolute', 1.960003761199626e-06, 1.5707919027314632, 2.669860754078399e-05, -4.233657402804076e-06),
+            ('prismatic', -4.869237673923428e-06, -7.952608162329764e-06,
+             1.7600104376827376e-05, -1.5259749828009654e-05),
+            ('revolute', -4.4691124372757035e-06, -3.262506190415764e-06,
+             -4.969980582954652e-06, -1.8692217938243649e-06)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="rounded rrpr",
+                  convention=rrpr.convention, world_T_base=rrpr.world_T_base, flange_T_tool=rrpr.flange_T_tool)
+    q = np.array([3.1415936535897933, -0.12957287423083663, 0.14897462308504672, 2.6532503585973375])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok", (result.status, result.detail)
+    listed = min(_distance(robot, s.joints, q) for s in result.solutions)
+    assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

@@ -559,6 +559,10 @@ def _fallback_note(plan) -> str:
     if plan.structure.startswith(GENERAL_STRUCTURES):
         return ("The general solver (6R, or 5R with one slide) cannot promise every solution for this target (an "
                 "ill-conditioned eigenproblem or a near-double root), so the numeric search completed its answer.")
+    if getattr(plan, "free_joint_steers_wrist", False):
+        return (f"The {plan.structure} family leaves a joint free for every target, held at one value, and the "
+                f"wrist cannot reach every orientation: another value of that joint may bring this orientation "
+                f"within its reach, so the numeric search completed the answer.")
     if isinstance(plan, IdealisedPlan):
         return (f"The arm is within rounding of the {plan.structure} family but not exactly of it; its closed "
                 f"form, refined on the arm as given, cannot promise every solution for this target (a pair of "

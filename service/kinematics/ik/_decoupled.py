@@ -59,6 +59,14 @@ class DecoupledPlan(Sealed):
         positioner = self.positioner.free_joints if self.positioner is not None else ()
         return sorted(set(self.fixed) | set(positioner))
 
+    @property
+    def free_joint_steers_wrist(self) -> bool:
+        """Whether a joint the position leaves free for every target (held at one value) also decides which
+        orientations the wrist reaches: a spherical wrist that does not turn every way (its consecutive axes not
+        perpendicular), where another value of that joint may bring an orientation within its reach."""
+        return (self.positioner is not None and bool(self.positioner.free_joints)
+                and isinstance(self.wrist, SphericalWrist) and not self.wrist.turns_every_way)
+
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         """Candidates (N, m, n) for targets (N, 4, 4)."""
         n_targets = len(world_T_targets)
@@ -100,6 +108,8 @@ class DecoupledPlan(Sealed):
         if self.positioner is not None:
             seen = seen @ chain_rotation(model.directions[:k], model.is_revolute[:k], np.nan_to_num(arm_joints))
         wrist = self.wrist.solve(seen.reshape((-1,) + seen.shape[-2:]), reference)
+        if self.free_joint_steers_wrist:  # no target is promised: the fallback searches over that joint
+            complete = np.zeros(n_targets, dtype=bool)
         m_wrist = wrist.joints.shape[1]
         wrist_joints = wrist.joints.reshape(n_targets, m_arm, m_wrist, -1)
         wrist_valid = wrist.valid.reshape(n_targets, m_arm, m_wrist)

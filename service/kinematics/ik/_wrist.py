@@ -164,6 +164,13 @@ class SphericalWrist(Sealed):
         return float(a @ cross(b, c)), float(a @ cross(b, cross(b, c)))
 
     @property
+    def turns_every_way(self) -> bool:
+        """Whether the wrist reaches every orientation: its consecutive axes are perpendicular (the angle between
+        its first axis and its last one's image ranges over |θ_ab − θ_bc| … θ_ab + θ_bc, all of 0 … π only then)."""
+        a, b, c = self.axes
+        return abs(float(a @ b)) <= GEOMETRY_TOLERANCE and abs(float(b @ c)) <= GEOMETRY_TOLERANCE
+
+    @property
     def free_below(self) -> float:
         """The radius of ``R_w ω_c`` about ω_a (unit vectors) at or below which q_a is held as free
         (:func:`read_off_below`: relations rounded more coarsely than exact recognition accepts, which this plan

@@ -458,6 +458,27 @@ def test_a_spherical_rrpr_arm_with_cad_rounding_is_measured_by_its_slide_not_its
     assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
 
 
+def test_a_free_positioning_joint_is_not_held_where_the_wrist_cannot_turn_every_way():
+    """A five-joint arm (a random arm of the sweep, as written): two parallel axes place the wrist point, which
+    lies on axis 2, so q2 is free for every target and held at 0; its spherical wrist's last two axes are 171°
+    apart, so it cannot reach every orientation. At q2 = 0 this pose's orientation was out of the wrist's reach,
+    and the pose was promised unreachable, though q2 = −2.2 reaches it. No target of such a plan is promised
+    now: the fallback searches over the free joint."""
+    rows = [('revolute', 0.3, 1.5707963267948966, 0.2, 0.0),
+            ('revolute', 0.2985023878068389, 3.141592653589793, 0.0, 1.5707963267948966),
+            ('revolute', 0.0, 1.5707963267948966, 0.0, 0.0),
+            ('revolute', 0.0, 2.9893005919130973, 0.0, 0.0),
+            ('revolute', 0.0, 1.5707963267948966, 0.0, -0.42839626955156795)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="sweep 402", convention="modified")
+    q = np.array([2.3542331889983634, -2.200441823674018, -0.3453230541470522, -1.8916532486479227, -0.401309767358375])
+    target = forward_kinematics(robot, q)
+    result = solve_ik(robot, target)
+    assert result.status != "unreachable" or not result.complete, (result.structure, result.detail)
+    assert not result.complete and "cannot reach every orientation" in result.detail
+    for solution in result.solutions:
+        assert np.allclose(forward_kinematics(robot, solution.joints), target, atol=1e-8)
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

@@ -108,8 +108,6 @@ class DecoupledPlan(Sealed):
         if self.positioner is not None:
             seen = seen @ chain_rotation(model.directions[:k], model.is_revolute[:k], np.nan_to_num(arm_joints))
         wrist = self.wrist.solve(seen.reshape((-1,) + seen.shape[-2:]), reference)
-        if self.free_joint_steers_wrist:  # no target is promised: the fallback searches over that joint
-            complete = np.zeros(n_targets, dtype=bool)
         m_wrist = wrist.joints.shape[1]
         wrist_joints = wrist.joints.reshape(n_targets, m_arm, m_wrist, -1)
         wrist_valid = wrist.valid.reshape(n_targets, m_arm, m_wrist)
@@ -137,13 +135,16 @@ class DecoupledPlan(Sealed):
           M ω_j for θ_i, and then θ_j as for one joint with ``Cᵀ R(ω_i, θ_i)ᵀ M``.
 
         Where a subproblem is degenerate (the vector on the axis: only a sum is fixed) the positioner's values
-        stay; with a spherical wrist the wrist absorbs them, so they stay free. With two free joints and a roll,
-        more than two and no wrist, or a two-axis wrist, nothing here can set them and they stay as the
-        positioner set them: the targets (N,) where that happened are returned (the caller does not promise
-        them).
+        stay; with a spherical wrist that turns every way the wrist absorbs them, so they stay free. With two free
+        joints and a roll, more than two and no wrist, a two-axis wrist, or a spherical wrist that does not turn
+        every way (:attr:`free_joint_steers_wrist`: a joint free for every target is held for every target too),
+        nothing here can set them and they stay as the positioner set them: the targets (N,) where that happened
+        are returned (the caller does not promise them).
         """
+        if self.free_joint_steers_wrist:
+            return np.ones(len(joints), dtype=bool)
         held_rows = np.zeros(len(joints), dtype=bool)
-        if isinstance(self.wrist, SphericalWrist):
+        if isinstance(self.wrist, SphericalWrist) and self.wrist.turns_every_way:
             return held_rows
         model, k = self.positioner.model, len(self.positioner.joints)
         settable = 0 if self.wrist is not None and not isinstance(self.wrist, Roll) else (

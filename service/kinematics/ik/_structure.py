@@ -303,7 +303,8 @@ def read_off_below(geometry: Geometry) -> float:
     return max(GEOMETRY_TOLERANCE, exactly_idealised(geometry).deviation / DUPLICATE_TOLERANCE)
 
 
-def target_error(geometry: Geometry, distance, rounding: float = ROUNDING_TOLERANCE):
+def target_error(geometry: Geometry, distance: float | np.ndarray, rounding: float = ROUNDING_TOLERANCE
+                 ) -> float | np.ndarray:
     """The error, in length units, with which a family of an exactly recognised arm sees a target ``distance``
     from the base (a float, or an array of them): the target's ``rounding`` and the arm's own deviation from the
     family's relations (:func:`exactly_idealised`: 1e-16 for a DH table, 1e-11 for a vendor's URDF), each relative

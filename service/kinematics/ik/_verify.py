@@ -88,17 +88,6 @@ def error_size(robot: Robot, position: np.ndarray, orientation: np.ndarray, cons
     return np.maximum(size, orientation) if constrain_orientation else size
 
 
-def error_sizes_of_rows(robot: Robot, residuals: Sequence[tuple[float, float]], constrain_orientation: bool
-                        ) -> list[float]:
-    """:func:`error_size` of a few (position, orientation) pairs of floats (:func:`pose_residuals_of_rows`), as
-    floats; a NaN in either error gives a NaN size, as ``np.maximum`` does."""
-    scale = arm_size(robot)
-    if not constrain_orientation:
-        return [position / scale for position, _ in residuals]
-    return [max(position / scale, orientation) if orientation == orientation else orientation
-            for position, orientation in residuals]
-
-
 def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool) -> np.ndarray:
     """Which residuals pass the FK check."""
     return error_size(robot, position, orientation, constrain_orientation) <= ACCEPT_RESIDUAL
@@ -347,7 +336,8 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     rows = [one_pose.rows[slot] for slot in slots]  # revolute joints wrapped already: verify's wrap leaves them
     constrained = goal.constrain_orientation
     residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist()) if rows else []
-    sizes = error_sizes_of_rows(robot, residuals, constrained)
+    position, orientation = np.array(residuals, dtype=float).reshape(-1, 2).T
+    sizes = error_size(robot, position, orientation, constrained).tolist()
     if any(size != size or polished(size) for size in sizes):  # a NaN error, or one verify would polish
         return None
     kept = [row for row, keep in enumerate(first_of_each_slot(robot, rows, [size <= ACCEPT_RESIDUAL
@@ -364,8 +354,7 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     complete = promised(one_pose, np.array([count]), nearest, constrained)
     columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)
     labels = {name: (values, column) for name, values, column in zip(one_pose.names, one_pose.values, columns)}
-    # (2, S), each row contiguous: the encoder writes them as they are
-    position, orientation = np.array([residuals[row] for row in kept], dtype=float).reshape(count, 2).T.copy()
+    position, orientation = position[kept], orientation[kept]  # gathered: contiguous, as the encoder writes them
     table = SolutionTable(np.zeros(count, dtype=np.int64), joints, np.ones(count, dtype=bool), position,
                           orientation if constrained else np.full(count, np.nan), labels)
     return Verified(table, complete, nearest, one_pose.singularities)

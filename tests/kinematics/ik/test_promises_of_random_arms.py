@@ -458,6 +458,27 @@ def test_a_spherical_rrpr_arm_with_cad_rounding_is_measured_by_its_slide_not_its
     assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
 
 
+def test_a_spherical_rrpr_arm_rounded_to_1e7_is_solved_as_its_idealised_family(client):
+    """The R-R-P-R spherical arm with each DH parameter moved by ~1e-7 (seeded), q2 = π/2: its plan was the
+    inverse chain's skew-axes-with-slide positioner, where the base origin lies ~1e-7 from axis 2, so q2 was read
+    off a circle of that radius; the quartic gave no valid root and the pose was promised unreachable (18 of 60
+    draws). A circle within RECOGNITION_TOLERANCE of a point is the idealised family's, refined on the arm."""
+    rrpr = catalogue_robot(client, "ex004_3_spherical_rrpr")
+    rows = [("revolute", 2.2447566264860494e-07, -1.5707964099672147, -6.239435864439058e-08, 2.0540394606469886e-08),
+            ("revolute", 4.930132914123563e-08, 1.57079630915429, -2.0593033025321645e-08, 7.024629551205442e-08),
+            ("prismatic", 5.199076370338984e-08, -1.0336758320736887e-07, -7.918131861584183e-09,
+             3.528684866147413e-09),
+            ("revolute", -1.0544846220491103e-07, 2.5983910067436334e-08, -8.579564771765438e-08,
+             9.720667079170426e-08)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="rounded rrpr",
+                  convention=rrpr.convention, world_T_base=rrpr.world_T_base, flange_T_tool=rrpr.flange_T_tool)
+    q = np.array([-3.051924124247, np.pi / 2, 0.2870310153527, 1e-12])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert result.status == "ok", (result.status, result.detail)
+    listed = min(_distance(robot, s.joints, q) for s in result.solutions)
+    assert listed <= 1e-6 or not result.complete or result.singularities, (listed, result.structure)
+
+
 def test_a_free_positioning_joint_is_not_held_where_the_wrist_cannot_turn_every_way():
     """A five-joint arm (a random arm of the sweep, as written): two parallel axes place the wrist point, which
     lies on axis 2, so q2 is free for every target and held at 0; its spherical wrist's last two axes are 171°

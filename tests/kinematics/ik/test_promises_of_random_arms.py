@@ -500,6 +500,17 @@ def test_a_free_positioning_joint_is_not_held_where_the_wrist_cannot_turn_every_
         assert np.allclose(forward_kinematics(robot, solution.joints), target, atol=1e-8)
 
 
+def test_a_three_joint_arm_whose_tool_point_is_rounded_off_its_elbow_centre_reaches_its_own_pose():
+    """A three-joint arm of the sweep with its parameters rounded as CAD rounds (~1e-5): axes 2 and 3 meet at a
+    point c, and the tool point, which a pose target positions, lies 1.6e-5 from c. The offset-shoulder family
+    read q2 and q3 off that 1.6e-5 vector, found no valid root, and the pose was promised unreachable. A point
+    within RECOGNITION_TOLERANCE of c is the idealised family's."""
+    rows = [("revolute", 0.300014, -1.570806855, 0.200012, -2.774e-06),
+            ("revolute", -0.0, 1.522016164, 5e-06, -5.704e-06),
+            ("revolute", 1.5e-05, -2.106e-05, 6e-06, 1.570796539)]
+    _assert_reaches_its_own_pose(rows, [-1.613335228076747, -0.06253870726424182, 1.5881217477318739])
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

@@ -216,7 +216,9 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
        through it (their least-squares point), for the groups the families look for, in this order: the last
        three axes (a wrist), the first three (a wrist at the base), then consecutive pairs (a shoulder, the
        UR type's axes 4–5 and 5–6). A pair whose first axis already meets another keeps that axis and
-       translates the second onto it; an axis is moved once at most.
+       translates the second onto it: through the point where the kept axis meets the others when the second
+       passes within ``tolerance`` × size of it (four axes through one point), else through the foot of their
+       common normal. An axis is moved once at most.
     3. A revolute axis left out of step 2 that passes within ``tolerance`` × size of the tool point (the flange
        origin at q = 0) is moved through it.
 
@@ -263,8 +265,11 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
             continue
         if fixed:  # a pair whose first axis already meets another: translate the free one onto it
             (kept,), (moved,) = fixed, [g for g in members if g not in fixed]
-            foot_kept = _common_normal_foot(points[kept], directions[kept], points[moved], directions[moved], 0.0)
-            points[moved] = foot_kept  # on both lines now: the moved line passes through the kept one's foot
+            if _line_distance(points[kept], points[moved], directions[moved]) <= tolerance * scale:
+                points[moved] = points[kept]  # through the point where the kept axis meets the others (a 4th axis)
+            else:  # on both lines now: the moved line passes through the kept one's foot
+                points[moved] = _common_normal_foot(points[kept], directions[kept], points[moved],
+                                                    directions[moved], 0.0)
         else:
             for g in members:
                 points[g] = centre

@@ -511,6 +511,28 @@ def test_a_three_joint_arm_whose_tool_point_is_rounded_off_its_elbow_centre_reac
     _assert_reaches_its_own_pose(rows, [-1.613335228076747, -0.06253870726424182, 1.5881217477318739])
 
 
+def test_a_four_joint_arm_whose_axes_nearly_meet_at_one_point_is_not_promised_unreachable():
+    """A four-joint arm of the sweep with its parameters rounded as CAD rounds (~1e-5): all four axes pass within
+    3e-5 of one point and the tool is 0.2 from it. The idealisation made axes 2–4 a spherical wrist and moved axis
+    1 onto axis 2 at the foot of their common normal, 2.5e-5 from the wrist's centre; joint 1 was then read off
+    the centre's azimuth about axis 1, 0.19 rad off, and the pose of the arm's own FK was promised unreachable.
+    Axis 1 now passes through the centre: q1 is free on the idealised arm, the target is not promised, and the
+    numeric search finds the pose's configuration."""
+    rows = [("revolute", -1e-06, 1.570804144, -7e-06, 2.543e-06),
+            ("revolute", -1.8e-05, -2.952651236, 2.2e-05, 1.6556e-05),
+            ("revolute", 6e-06, -1.570785243, -2e-06, 2.865e-06),
+            ("revolute", 5e-06, -1.570791435, 0.200001, 0.487610516)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="sweep 504", convention="standard")
+    q = np.array([-2.567450896052436, 2.035929554063638, -2.4005686891481055, 0.25374332080357265])
+    target = forward_kinematics(robot, q)
+    result = solve_ik(robot, target)
+    assert result.status == "ok", (result.structure, result.detail)
+    for solution in result.solutions:
+        assert np.allclose(forward_kinematics(robot, solution.joints), target, atol=1e-8)
+    listed = min(_distance(robot, s.joints, q) for s in result.solutions)
+    assert listed <= 1e-6 or not result.complete, (listed, result.structure)
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

@@ -32,7 +32,9 @@ boundary or singular target). A row is claimed complete only when
    all, no candidate is (there a step of the closed form is ill-conditioned:
    the UR type's q6 from q5 ≈ 0 turns by O(1) under a δ change of the target,
    so the least-squares answers after it may lie far from a solution the true
-   arm has, and criterion 2 would not see it).
+   arm has, and criterion 2 would not see it); and no idealised solution has
+   its spherical wrist within √(:data:`WRIST_ALIGNMENT_BAND` × δ) of aligning
+   its outer axes (see there).
 
 The true arm, a general arm near a decoupled one, may have more solutions in
 the complex domain (up to 16 for a 6R); the extra ones come from infinity
@@ -53,11 +55,14 @@ from .._forward import JointTrig, ScrewModel, geometric_jacobian
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL
 from ._screws import chain_motion
+from ._decoupled import DecoupledPlan
+from ._reversed import ReversedPlan
 from ._structure import arm_size
 from ._types import Candidates, LabelCodes, Sealed
 from ._gauss_newton import gauss_newton
 from ._goals import PoseGoal
 from ._verify import POLISH_FROM, first_of_each, residual_arrays, wrap_revolute
+from ._wrist import SphericalWrist
 
 #: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
 #: the idealisation's deviation marks the row incomplete: the perturbation moves the tool by at most a few δ
@@ -74,6 +79,15 @@ IDEAL_RESIDUAL = 1e-7
 #: follow, so the row is not claimed complete. (Root pairs meeting at a fold need no such margin: a pair that
 #: vanishes fails criterion 1, a pair that appears is a near miss, criterion 2.)
 SINGULAR_MARGIN = 10.0
+
+#: An idealised solution whose spherical wrist is within √(this × δ) of aligning its outer axes (the wrist's volume,
+#: :meth:`~._wrist.SphericalWrist.volume`) marks the row incomplete. At the alignment the idealised arm has a
+#: one-parameter family (only q_a ± q_c fixed), the true arm isolated roots along it, and the idealised flip pair
+#: meets there: a pair that meets moves by √δ under a change δ, not by δ. Within that band the refinement reaches the
+#: true roots nearest the idealised read-off of q_a, not every one: the PUMA and Stanford arms moved by 1e-8 … 1e-5 at
+#: q5 ≈ π put their flip pair 1e-4 … 1e-2 from the alignment, refined to verified solutions clear of the true arm's
+#: singularities, and the pose's own configuration, 1.1 … 1.2 rad from every listed one, was left out.
+WRIST_ALIGNMENT_BAND = 10.0
 
 #: Newton (Gauss–Newton) steps from an idealised solution onto the true arm. The start is δ-close, so a regular root
 #: is reached to machine precision in two or three; more steps only help near a fold, which criterion 3 excludes.
@@ -166,10 +180,20 @@ class IdealisedPlan(Sealed):
             singular[rows[near_singular]] = True
         for mask, _ in ideal.singularities.entries:
             singular |= mask
+        singular |= self._near_wrist_alignment(np.where(finite[..., None], ideal.joints, 0.0), finite & ideal.valid)
         # a row where the idealised family gave no candidate at all (not even a least-squares one) has no near miss
         # to measure: its "no solution" is the idealised arm's, which the true one need not share
         complete = converged & distinct & ~near_miss & ~singular & ~rescued & finite.any(axis=1)
         return Candidates(joints, accepted, ideal.singularities, complete=complete)
+
+    def _near_wrist_alignment(self, ideal_joints: np.ndarray, valid: np.ndarray) -> np.ndarray:
+        """Which targets (N,) have a ``valid`` idealised candidate (N, m, n) whose spherical wrist is within the
+        band of :data:`WRIST_ALIGNMENT_BAND` of aligning its outer axes (all False for a family without one)."""
+        wrist, middle = _spherical_wrist(self.inner)
+        if wrist is None:
+            return np.zeros(len(valid), dtype=bool)
+        volume = wrist.volume(ideal_joints[..., middle])
+        return (valid & (volume <= np.sqrt(WRIST_ALIGNMENT_BAND * self.deviation))).any(axis=1)
 
     def _refined(self, q: np.ndarray, world_T_targets: np.ndarray, steps: int) -> np.ndarray:
         """Gauss–Newton steps on the true arm from joint vectors q (k, n) towards their targets (k, 4, 4)."""
@@ -263,6 +287,16 @@ class IdealisedPlan(Sealed):
                 own[near[flips]] = -1
             out[name] = (values, own)
         return out
+
+
+def _spherical_wrist(plan) -> tuple[SphericalWrist | None, int]:
+    """A plan's spherical wrist and the chain index of its middle joint (a reversed plan's wrist is at the base),
+    or (None, −1)."""
+    if isinstance(plan, ReversedPlan):
+        wrist, middle = _spherical_wrist(plan.inner)
+        return (wrist, plan.dof - 1 - middle) if wrist is not None else (None, -1)
+    wrist = plan.wrist if isinstance(plan, DecoupledPlan) else None
+    return (wrist, wrist.joints[1]) if isinstance(wrist, SphericalWrist) else (None, -1)
 
 
 def _distinct_counts(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:

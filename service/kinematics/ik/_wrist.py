@@ -116,7 +116,7 @@ class SphericalWrist(Sealed):
         # or the axes nearly align (their volume below ALIGNED_BELOW), the target fixes q_a only within a band:
         # the root nearest the reference takes its value where that reaches R_w ω_c within BAND_MISS
         met = pair.merged[..., 0] & ~free
-        aligned = (self._volume(qb) <= ALIGNED_BELOW) & pair.exact[..., 0, :]  # (..., 2); a miss's pair is coplanar
+        aligned = (self.volume(qb) <= ALIGNED_BELOW) & pair.exact[..., 0, :]  # (..., 2); a miss's pair is coplanar
         band = (met[..., None] | aligned) & valid & ~free[..., None]
         if reference is not None and band.any():
             held = reference[self.joints[0]]
@@ -150,7 +150,7 @@ class SphericalWrist(Sealed):
             f"only within a band, and set to the reference value where it lies in it"))
         return WristResult(joints, valid, singular)
 
-    def _volume(self, qb: np.ndarray) -> np.ndarray:
+    def volume(self, qb: np.ndarray) -> np.ndarray:
         """|det| of the wrist's three unit axes at q_b (...,), which q_a turns together (so it does not count):
         the wrist's part of the arm's Jacobian is singular where it vanishes. a·(b × R(b, q_b) c) is
         u cos q_b + w sin q_b (:attr:`volume_terms`)."""

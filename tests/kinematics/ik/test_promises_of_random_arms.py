@@ -479,6 +479,45 @@ def test_a_spherical_rrpr_arm_rounded_to_1e7_is_solved_as_its_idealised_family(c
     assert listed <= 1e-6 or not result.complete or result.singularities, (listed, result.structure)
 
 
+@pytest.mark.parametrize("robot_id, rows, q", [
+    ("spong_ex3_5_stanford",  # moved by ~1e-7, pointing straight down (q2 = π) with the wrist aligned (q5 = −π)
+     [("revolute", 1.175162283715759e-08, -1.5707962337227737, 7.662865194239447e-08, -1.5274427015592382e-07),
+      ("revolute", -1.297653844365023e-07, 1.5707964612883216, 0.15400004041241794, -2.0672042611667085e-07),
+      ("prismatic", -1.3341706086519083e-07, 4.009436013953038e-09, -9.646182850527058e-08, 4.8522256307855294e-08),
+      ("revolute", 9.518151593992928e-09, -1.570796276007036, -1.1506435083824126e-07, 6.393343145917087e-08),
+      ("revolute", 1.9783288003861855e-07, 1.5707962492084786, 1.33382313158553e-07, 1.0021175020067765e-07),
+      ("revolute", 6.64990148884758e-08, -4.457911399299577e-09, 0.26299988594290347, -8.561702802149688e-08)],
+     [-0.28140618966186226, 3.141592654589793, 0.17924061232993777, -1.2197206025973604, -3.141592653589793,
+      -2.026179705815653]),
+    ("puma560_modified",  # moved by ~1e-8, q5 1e-9 from −π
+     [("revolute", -4.683696355156561e-09, -1.1370194538146072e-08, 9.734624192553719e-09, 2.1594537806027896e-09),
+      ("revolute", -6.268072306679835e-09, -1.5707963357984074, -1.7922495160833749e-09, 7.368571385445571e-09),
+      ("revolute", 0.43179998874732783, 1.420220863366918e-08, 0.1500499984772588, -5.143109994479598e-09),
+      ("revolute", 0.02030000347164116, -1.5707963287326716, 0.4317999943032294, -5.958111931909399e-09),
+      ("revolute", 2.1478317350975193e-08, 1.5707963317353628, 4.778907363609364e-09, -2.661048508909923e-09),
+      ("revolute", -4.993827445359702e-09, -1.5707963274185301, 5.1287116638010534e-09, -5.304256749349524e-09)],
+     [1.5707963277948966, 3.089598162858816, 1.5707963277948966, 1.2673283266506639, -3.141592652589793,
+      -1.5707963267948966]),
+])
+def test_an_arm_rounded_off_its_family_near_its_wrist_alignment_does_not_promise_the_refined_roots(
+        client, robot_id, rows, q):
+    """Catalogue arms with each DH parameter moved by 1e-8 … 1e-7 (seeded) at a pose with the wrist 1e-9 from
+    aligned: the idealised arm's flip pair sat 1e-4 … 1e-3 from its alignment (a root pair meeting moves by √δ),
+    refined to verified solutions of the true arm clear of its singularities, and the answer was complete and
+    flagged nothing while the pose's own configuration, 1.1 … 1.2 rad from every listed one, was missing."""
+    base = catalogue_robot(client, robot_id)
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name=f"moved {robot_id}",
+                  convention=base.convention, world_T_base=base.world_T_base, flange_T_tool=base.flange_T_tool)
+    q = np.array(q)
+    target = forward_kinematics(robot, q)
+    result = solve_ik(robot, target)
+    assert result.status == "ok", (result.status, result.detail)
+    for solution in result.solutions:
+        assert np.allclose(forward_kinematics(robot, solution.joints), target, atol=1e-8)
+    listed = min(_distance(robot, s.joints, q) for s in result.solutions)
+    assert listed <= 1e-3 or not result.complete or result.singularities, (listed, result.structure)
+
+
 def test_a_free_positioning_joint_is_not_held_where_the_wrist_cannot_turn_every_way():
     """A five-joint arm (a random arm of the sweep, as written): two parallel axes place the wrist point, which
     lies on axis 2, so q2 is free for every target and held at 0; its spherical wrist's last two axes are 171°

@@ -563,6 +563,11 @@ def _fallback_note(plan) -> str:
         return (f"The {plan.structure} family leaves a joint free for every target, held at one value, and the "
                 f"wrist cannot reach every orientation: another value of that joint may bring this orientation "
                 f"within its reach, so the numeric search completed the answer.")
+    if isinstance(plan, IdealisedPlan) and plan.constrain_orientation and plan.free_joints:
+        free = ", ".join(f"q{joint + 1}" for joint in plan.free_joints)
+        return (f"The arm is within rounding of the {plan.structure} family but not exactly of it, and that family "
+                f"leaves {free} free for every target: the arm as given has isolated solutions along it, which its "
+                f"closed form cannot list, so the numeric search completed the answer.")
     if isinstance(plan, IdealisedPlan):
         return (f"The arm is within rounding of the {plan.structure} family but not exactly of it; its closed "
                 f"form, refined on the arm as given, cannot promise every solution for this target (a pair of "

@@ -34,7 +34,13 @@ boundary or singular target). A row is claimed complete only when
    so the least-squares answers after it may lie far from a solution the true
    arm has, and criterion 2 would not see it); and no idealised solution has
    its spherical wrist within √(:data:`WRIST_ALIGNMENT_BAND` × δ) of aligning
-   its outer axes (see there).
+   its outer axes (see there);
+4. the idealised family promises the target on its own arm, and leaves no
+   joint free for every pose target: along such a joint the idealised arm has a
+   one-parameter family, the true arm isolated roots or none, and refining the
+   value it was held at finds at most the nearest (a five-joint arm of a sweep,
+   rounded by 1e-5, whose point lies on axis 2: held at q2 = 0, refined to a
+   stall, and its own pose at q2 = −0.12 promised unreachable).
 
 The true arm, a general arm near a decoupled one, may have more solutions in
 the complex domain (up to 16 for a 6R); the extra ones come from infinity
@@ -184,6 +190,11 @@ class IdealisedPlan(Sealed):
         # a row where the idealised family gave no candidate at all (not even a least-squares one) has no near miss
         # to measure: its "no solution" is the idealised arm's, which the true one need not share
         complete = converged & distinct & ~near_miss & ~singular & ~rescued & finite.any(axis=1)
+        # 4. what the idealised family does not promise on its arm, and a joint it leaves free for every target
+        if ideal.complete is not None:
+            complete &= ideal.complete
+        if self.constrain_orientation and self.inner.free_joints:
+            complete[:] = False
         return Candidates(joints, accepted, ideal.singularities, complete=complete)
 
     def _near_wrist_alignment(self, ideal_joints: np.ndarray, valid: np.ndarray) -> np.ndarray:

@@ -572,6 +572,28 @@ def test_a_four_joint_arm_whose_axes_nearly_meet_at_one_point_is_not_promised_un
     assert listed <= 1e-6 or not result.complete, (listed, result.structure)
 
 
+def test_an_arm_rounded_off_a_family_with_a_joint_free_for_every_target_is_not_promised():
+    """A five-joint arm of the sweep rounded as CAD rounds (~1e-5): its idealised family places the point with two
+    parallel axes, the point on axis 2, so q2 is free for every target; its wrist's last twist is 146°. The
+    idealised plan held q2 at 0, the refinement stalled, and the pose of the arm's own FK (q2 = −0.12) was
+    promised unreachable. Along a joint its family leaves free the arm as given has isolated solutions, which the
+    closed form cannot list: no target is promised, and the answer says why."""
+    rows = [("revolute", 0.299997, 1.1665e-05, 0.199992, -1.7914e-05),
+            ("revolute", 0.883382, 3.141595921, 0.0, 1.0906e-05),
+            ("revolute", -1e-06, 1.57081572, 7e-06, 1.570803452),
+            ("revolute", 1e-06, 1.570802307, 1.8e-05, 5.158e-06),
+            ("revolute", 3e-06, 2.540238154, -9e-06, 3.187e-06)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="sweep 603", convention="modified")
+    q = np.array([-2.580261803057393, -0.11774150191979027, 1.6011072922630207, -3.0110131999936876,
+                  2.3301121482087774])
+    target = forward_kinematics(robot, q)
+    result = solve_ik(robot, target)
+    assert not result.complete, (result.status, result.detail)
+    assert result.status != "unreachable" and "leaves q2 free for every target" in result.detail
+    for solution in result.solutions:
+        assert np.allclose(forward_kinematics(robot, solution.joints), target, atol=1e-8)
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

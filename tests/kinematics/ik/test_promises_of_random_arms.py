@@ -594,6 +594,18 @@ def test_an_arm_rounded_off_a_family_with_a_joint_free_for_every_target_is_not_p
         assert np.allclose(forward_kinematics(robot, solution.joints), target, atol=1e-8)
 
 
+def test_a_three_joint_arm_whose_tool_point_is_rounded_off_joint_3s_axis_reaches_its_own_pose():
+    """A three-joint arm of the sweep rounded to ~1e-4: axes 2 and 3 meet, and the tool point, which a pose target
+    positions, lies 2e-5 off axis 3. The offset-shoulder family read q3 off that 2e-5 circle (2.9 rad off) and the
+    pose of the arm's own FK was promised unreachable. A point within RECOGNITION_TOLERANCE of axis 3 is not placed
+    by that family; the inverse chain's (a roll and an intersecting pair) answers, and lists the pose's
+    configuration."""
+    rows = [("revolute", 0.300085, -1.570665645, 0.41916, 1.57079029),
+            ("revolute", 0.00011, 1.57067855, 0.199901, 1.570827591),
+            ("revolute", -2e-05, 0.42747988, 0.200024, -0.000127811)]
+    _assert_reaches_its_own_pose(rows, [-3.008681314549422, -1.5301634577447034, -2.0193621674336226])
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

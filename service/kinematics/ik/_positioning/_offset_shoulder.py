@@ -204,8 +204,8 @@ class OffsetShoulderIntersectingElbow(Positioner):
             return None  # the point at c (or nearly, as rounded: joints 2 and 3 read off it): the idealised family's
         if geometry.model.is_revolute[joints[0]] and geometry.on_axis(joints[0], centre):
             return None  # all three axes through one point: it cannot place a point
-        if geometry.on_axis(joints[2], point):
-            return None  # joint 3 never moves the point: two joints cannot place it
+        if geometry.axis_distance(joints[2], point) <= RECOGNITION_TOLERANCE * geometry.length_scale:
+            return None  # joint 3 never moves the point (two joints cannot place it), or nearly: q3 read off it
         return cls(geometry, joints, point, centre)
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:

@@ -28,7 +28,9 @@ boundary or singular target). A row is claimed complete only when
 3. the idealised family reports no singularity for the target (a free joint or
    merged roots, whose continuation under the perturbation is not isolated),
    and no solution is within :data:`SINGULAR_MARGIN` × δ of a singularity of
-   the true arm (σ_min of its scaled Jacobian); for a row with no solution at
+   the true arm (σ_min of its scaled Jacobian, and of its position rows alone
+   for an arm with fewer joints than the pose constrains, whose positioning
+   joints may be singular where the whole Jacobian is not); for a row with no solution at
    all, no candidate is (there a step of the closed form is ill-conditioned:
    the UR type's q6 from q5 ≈ 0 turns by O(1) under a δ change of the target,
    so the least-squares answers after it may lie far from a solution the true
@@ -182,7 +184,14 @@ class IdealisedPlan(Sealed):
         unanswered = ~accepted.any(axis=1)
         rows, slots = np.nonzero(accepted | (finite & ideal.valid & unanswered[:, None]))
         if len(rows):
-            near_singular = self._smallest_singular_value(joints[rows, slots]) <= SINGULAR_MARGIN * self.deviation
+            checked = joints[rows, slots]
+            near_singular = self._smallest_singular_value(checked) <= SINGULAR_MARGIN * self.deviation
+            if self.under_determined and self.constrain_orientation:
+                # an arm with fewer joints than the pose constrains is placed by its positioning joints: where their
+                # position Jacobian is singular (a joint the position leaves free), the family reads that joint off
+                # a radius the deviation turns, though the whole Jacobian keeps its rank
+                near_singular |= self._smallest_singular_value(checked, position_only=True) \
+                    <= SINGULAR_MARGIN * self.deviation
             singular[rows[near_singular]] = True
         for mask, _ in ideal.singularities.entries:
             singular |= mask
@@ -227,8 +236,10 @@ class IdealisedPlan(Sealed):
         sheet is generally missed by the other by about δ. There Gauss–Newton stalls at a positive residual: one
         more step lowers it by less than 1 %, and it is at least 1e-3 δ (far above the acceptance tolerance) and
         within the near-miss band, so no solution lies near that candidate, unless the candidate is near a
-        singularity of the true arm (σ_min within :data:`SINGULAR_MARGIN` δ: a spherical wrist with its outer axes
-        aligned), where Gauss–Newton stalls beside a solution.
+        singularity of the true arm, where Gauss–Newton stalls beside a solution: σ_min within √(SINGULAR_MARGIN
+        δ), as the roots that meet there move by the square root of the deviation (a five-joint arm rounded by
+        1e-6, its wrist 1e-9 from aligned: a stall at σ_min 1.5e-4 of residual 1.5e-6, its own pose 3.5e-3 rad
+        away).
         """
         rows, slots = np.nonzero(missed)
         stepped = self._refined(joints[rows, slots], world_T_targets[rows], 1)
@@ -239,11 +250,12 @@ class IdealisedPlan(Sealed):
         # nor does a stall at a singular configuration, where the step cannot move the way the target lies)
         apart[rows, slots] = (before >= 1e-3 * self.deviation) & (now >= 0.99 * before) \
             & (before <= NEAR_MISS * self.deviation) \
-            & (self._smallest_singular_value(stepped) > SINGULAR_MARGIN * self.deviation)
+            & (self._smallest_singular_value(stepped) > np.sqrt(SINGULAR_MARGIN * self.deviation))
         return apart
 
-    def _smallest_singular_value(self, joints: np.ndarray) -> np.ndarray:
-        """σ_min of the true arm's Jacobian at joints (k, n), position rows in arm sizes; shape (k,).
+    def _smallest_singular_value(self, joints: np.ndarray, *, position_only: bool = False) -> np.ndarray:
+        """σ_min of the true arm's Jacobian at joints (k, n), position rows in arm sizes (those rows alone with
+        ``position_only``, as for a position target); shape (k,).
 
         From the singular values of J itself, accurate to about 1e-16 σ_max: an arm 1e-10 off its family compares
         σ_min with SINGULAR_MARGIN δ = 1e-9, where the eigenvalues of JᵀJ (σ_min² beside a rounding of
@@ -251,7 +263,7 @@ class IdealisedPlan(Sealed):
         """
         J = geometric_jacobian(self.robot, joints)
         J[:, :3, :] /= self.size
-        if not self.constrain_orientation:
+        if position_only or not self.constrain_orientation:
             J = J[:, :3, :]
         return np.linalg.svd(J, compute_uv=False)[:, -1]
 

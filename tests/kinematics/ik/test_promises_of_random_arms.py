@@ -593,6 +593,37 @@ def test_a_three_joint_arm_whose_tool_point_is_rounded_off_joint_3s_axis_reaches
     _assert_reaches_its_own_pose(rows, [-3.008681314549422, -1.5301634577447034, -2.0193621674336226])
 
 
+def test_a_four_joint_arm_near_its_positioners_free_set_is_not_promised_unreachable():
+    """A four-joint arm of the near-singular sweep, rounded by ~1e-6, its pose 1e-6 from where the elbow turns the
+    positioned point onto axis 2 (q3 = π/2). The idealised family read q2 off a radius of ~1e-6 of the arm's size,
+    its candidates missed by 0.56 rad and more, and the pose was promised unreachable; the whole Jacobian (6 × 4)
+    kept its rank there, so no singularity was seen. For an arm with fewer joints than the pose constrains the
+    position rows' own σ_min counts too: not promised, and the numeric search finds the pose's configuration."""
+    rows = [("revolute", 1.070334281768157e-06, 1.5707958505705777, -0.9555658316973983, 1.2389579613473114e-06),
+            ("revolute", 0.300001900679964, -1.5707969962954804, 7.251657429950265e-07, 1.570796208413322),
+            ("revolute", 3.982850870355375e-07, 1.5707955348916023, 7.415543489365675e-07, 4.287554448986891e-08),
+            ("revolute", 0.3000008755510665, 1.6566853303943556e-06, -6.622584868677892e-07, 0.867160318248052)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="sweep 723", convention="modified")
+    q = np.array([-2.791687894585458, -1.064078589241101, 1.5707973267948965, -3.141592654589793])
+    _assert_keeps_its_promise(robot, q, within=1e-6, excused_by_flags=False)
+
+
+def test_a_five_joint_arm_stalled_beside_its_own_pose_near_a_singularity_is_not_promised_unreachable():
+    """A five-joint arm of the near-singular sweep, rounded by ~1e-6, its wrist 1e-9 from aligned (q4 = −1e-9):
+    the idealised candidates missed by 1.5e-6 and Gauss–Newton stalled there (σ_min 1.5e-4 ≫ 10 δ), so the
+    rule for arms with fewer joints than the pose constrains called them apart, and the pose was promised
+    unreachable; its own configuration is 3.5e-3 rad from the stall. Near a singular set the roots move by √δ:
+    a stall within √(10 δ) of one proves nothing."""
+    rows = [("revolute", -1.6798312695602342e-06, 1.5707965262089334, 0.20000049110636506, -2.749680929838284),
+            ("revolute", 0.29999854255918057, 3.14159202387889, -1.2698269613380168e-08, 7.206843382229519e-07),
+            ("revolute", 6.226916261831822e-07, -2.712596771311501, 0.20000015822411374, -2.2614114871794025e-07),
+            ("revolute", -6.52941326463675e-07, 2.3253759298508743, -6.002408243313934e-08, -3.1238371215542493),
+            ("revolute", 0.299998983955689, -1.570796725522443, 0.19999882995341597, -5.284731424165392e-07)]
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="sweep 741", convention="standard")
+    q = np.array([-1.5707963267938965, 1.4380159426344248, 3.141592652589793, -1e-09, 1.5707963267948966])
+    _assert_keeps_its_promise(robot, q, within=1e-6, excused_by_flags=False)
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

@@ -292,7 +292,10 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
     kept = first_of_each(robot, joints, checked & (size <= ACCEPT_RESIDUAL))
     count = kept.sum(axis=1)
     nearest = np.where(valid, size, np.inf).min(axis=1, initial=np.inf)
-    complete = promised(candidates, count, nearest, constrained)
+    nearest_position = None
+    if isinstance(goal, PoseGoal) and constrained and robot.dof < 6:  # fewer joints than the pose constrains
+        nearest_position = np.where(checked, position, np.inf).min(axis=1, initial=np.inf) / arm_size(robot)
+    complete = promised(candidates, count, nearest, constrained, nearest_position)
     if candidates.promise_needs_every_slot:  # the solver's promise holds only if every valid slot gave a solution
         complete &= count == valid.sum(axis=1)
     labels = candidates.labels if candidates.labels is not None else (
@@ -366,15 +369,19 @@ def _residuals_at(robot: Robot, goal: Goal, q: np.ndarray, rows: np.ndarray) -> 
     return position[:, 0], orientation[:, 0]
 
 
-def promised(candidates: Candidates, count: np.ndarray, nearest: np.ndarray, constrain_orientation: bool
-             ) -> np.ndarray:
+def promised(candidates: Candidates, count: np.ndarray, nearest: np.ndarray, constrain_orientation: bool,
+             nearest_position: np.ndarray | None = None) -> np.ndarray:
     """Which rows (N,) may claim every solution: the family's own word (:attr:`Candidates.complete`), except for
     rows with no verified solution where the family set a joint it found free or saw two roots meet:
 
     * whose nearest candidate missed by less than ``POLISH_RESIDUAL`` (``nearest`` (N,): fraction of the arm's
       size, or radians): the representative it chose, or the double root, failed narrowly; another value of
       that joint, or the root pair a rounding error moved off the real line, may not (an arm whose remaining
-      axes are not exactly aligned with the free one, as rounded geometry gives);
+      axes are not exactly aligned with the free one, as rounded geometry gives). For an arm with fewer joints
+      than the pose constrains (``nearest_position`` (N,) given: the smallest position error of any candidate
+      checked, fraction of the arm's size), a narrow miss of the position alone counts too: the orientation it
+      missed follows from joints the family read off that fragile position solution (a P-R-R arm rounded by
+      1e-6 at a double root: the position missed by 3.5e-7, q2, read off a radius of that order, by 0.72 rad);
     * on a pose target, a joint left free (relation ``free``) where some candidate reached the position: the
       position does not fix that joint, the orientation (or the joints after it) may, and the value the family
       held it at is one of many. Where no candidate was valid, the family found the position out of reach
@@ -387,6 +394,8 @@ def promised(candidates: Candidates, count: np.ndarray, nearest: np.ndarray, con
         return complete
     empty = count == 0
     narrow = empty & (nearest <= POLISH_RESIDUAL)
+    if nearest_position is not None:
+        narrow |= empty & (nearest_position <= POLISH_RESIDUAL)
     for mask, flag in candidates.singularities.entries:
         if flag.relation in FRAGILE_RELATIONS:
             complete &= ~(mask & narrow)

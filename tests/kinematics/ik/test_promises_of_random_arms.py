@@ -624,6 +624,18 @@ def test_a_five_joint_arm_stalled_beside_its_own_pose_near_a_singularity_is_not_
     _assert_keeps_its_promise(robot, q, within=1e-6, excused_by_flags=False)
 
 
+def test_a_three_joint_arm_at_a_double_root_of_its_positioner_is_not_promised_unreachable():
+    """A P-R-R arm of the near-singular sweep, its parameters rounded to ~1e-6, at q3 = 0: its positioner's two
+    roots meet there, and the merged one placed the point to 3.5e-7 while q2, read off a radius of that order,
+    was 0.72 rad off, so the orientation missed by as much; the narrow-miss rule looked at that orientation
+    error and promised the pose of the arm's own FK unreachable. For an arm with fewer joints than the pose
+    constrains, a narrow miss of the position alone counts."""
+    rows = [("prismatic", 0.30000019147780377, -1.0523051419013132, -0.8390737351736826, 1.5707942721045842),
+            ("revolute", 8.438427349662273e-08, 1.570794521556151, 0.20000168616269912, 2.184037802990984),
+            ("revolute", 0.7075453957214651, 1.570796450167174, 2.2566546448975947e-07, 1.5707951379318636)]
+    _assert_reaches_its_own_pose(rows, [-0.362147421407922, 0.6650162024210045, 0.0])
+
+
 def test_an_arm_with_slides_is_not_measured_by_the_rounding_of_its_zero_offsets():
     """The P-R-P arm (every offset 0: its revolute axis passes through the base origin and the tool point) with
     its parameters written to 1e-9: its size was that 1e-9, every solution's 1e-10 m residual was 0.1 of it, and

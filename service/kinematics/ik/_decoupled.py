@@ -188,6 +188,13 @@ class DecoupledPlan(Sealed):
             joints[rows, :, j] = np.where(held, joints[rows, :, j], q[..., j])
         return held_rows
 
+    def wrist_volume(self, joints: np.ndarray) -> np.ndarray | None:
+        """The spherical wrist's volume (:meth:`SphericalWrist.volume`) at joint vectors (..., n), shape (...,): 0
+        where its outer axes align; None for a plan without a spherical wrist."""
+        if not isinstance(self.wrist, SphericalWrist):
+            return None
+        return self.wrist.volume(joints[..., self.wrist.joints[1]])
+
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """Branch labels of full joint vectors (M, n) as arrays: the positioner's, then the wrist's.
 

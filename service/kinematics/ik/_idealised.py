@@ -63,14 +63,11 @@ from .._forward import JointTrig, ScrewModel, geometric_jacobian
 from .._robot import Robot
 from .._tolerances import ACCEPT_RESIDUAL
 from ._screws import chain_motion
-from ._decoupled import DecoupledPlan
-from ._reversed import ReversedPlan
 from ._structure import arm_size
 from ._types import Candidates, LabelCodes, Sealed
 from ._gauss_newton import gauss_newton
 from ._goals import PoseGoal
 from ._verify import POLISH_FROM, first_of_each, residual_arrays, wrap_revolute
-from ._wrist import SphericalWrist
 
 #: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
 #: the idealisation's deviation marks the row incomplete: the perturbation moves the tool by at most a few δ
@@ -89,7 +86,7 @@ IDEAL_RESIDUAL = 1e-7
 SINGULAR_MARGIN = 10.0
 
 #: An idealised solution whose spherical wrist is within √(this × δ) of aligning its outer axes (the wrist's volume,
-#: :meth:`~._wrist.SphericalWrist.volume`) marks the row incomplete. At the alignment the idealised arm has a
+#: :meth:`~._decoupled.DecoupledPlan.wrist_volume`) marks the row incomplete. At the alignment the idealised arm has a
 #: one-parameter family (only q_a ± q_c fixed), the true arm isolated roots along it, and the idealised flip pair
 #: meets there: a pair that meets moves by √δ under a change δ, not by δ. Within that band the refinement reaches the
 #: true roots nearest the idealised read-off of q_a, not every one: the PUMA and Stanford arms moved by 1e-8 … 1e-5 at
@@ -131,9 +128,11 @@ class IdealisedPlan(Sealed):
         ideal = self.inner.solve(world_T_targets, reference)
         robot = self.robot
         finite = np.isfinite(ideal.joints).all(axis=-1)
-        joints = wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0))
+        ideal_joints = wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0))
+        joints = ideal_joints.copy()  # refined in place below
         # the idealised arm's own solutions (its closed form is exact up to rounding near a singularity)
-        solutions = ideal.valid & finite & (self._ideal_error(joints, world_T_targets) <= IDEAL_RESIDUAL)
+        solutions = ideal.valid & finite & (self._ideal_error(ideal_joints, world_T_targets) <= IDEAL_RESIDUAL)
+        near_alignment = self._near_wrist_alignment(ideal_joints, finite & ideal.valid)
         position, orientation = residual_arrays(robot, joints, world_T_targets)
         near_before = finite & (self._size(position, orientation) <= NEAR_MISS * self.deviation)
         # refine the idealised solutions, and every other candidate that comes close (an arm with fewer joints than
@@ -173,8 +172,8 @@ class IdealisedPlan(Sealed):
         near_miss = missed.any(axis=1)
         # 1. every idealised solution refined to a verified one, and no two to the same one
         converged = ~(solutions & ~accepted).any(axis=1)
-        distinct = _distinct_counts(robot, joints, solutions & accepted) == _distinct_counts(
-            robot, wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0)), solutions)
+        distinct = _distinct_counts(robot, joints, solutions & accepted) == _distinct_counts(robot, ideal_joints,
+                                                                                             solutions)
         # 3. no singular target: none flagged by the family, and every solution clear of the true arm's
         # singularities (where the idealised family's roots may meet or split)
         singular = np.zeros(len(world_T_targets), dtype=bool)
@@ -184,18 +183,15 @@ class IdealisedPlan(Sealed):
         unanswered = ~accepted.any(axis=1)
         rows, slots = np.nonzero(accepted | (finite & ideal.valid & unanswered[:, None]))
         if len(rows):
-            checked = joints[rows, slots]
-            near_singular = self._smallest_singular_value(checked) <= SINGULAR_MARGIN * self.deviation
-            if self.under_determined and self.constrain_orientation:
-                # an arm with fewer joints than the pose constrains is placed by its positioning joints: where their
-                # position Jacobian is singular (a joint the position leaves free), the family reads that joint off
-                # a radius the deviation turns, though the whole Jacobian keeps its rank
-                near_singular |= self._smallest_singular_value(checked, position_only=True) \
-                    <= SINGULAR_MARGIN * self.deviation
-            singular[rows[near_singular]] = True
+            # an arm with fewer joints than the pose constrains is placed by its positioning joints: where their
+            # position Jacobian is singular (a joint the position leaves free), the family reads that joint off a
+            # radius the deviation turns, though the whole Jacobian keeps its rank
+            smallest = self._smallest_singular_value(joints[rows, slots],
+                                                     with_position_rows=self.under_determined)
+            singular[rows[smallest <= SINGULAR_MARGIN * self.deviation]] = True
         for mask, _ in ideal.singularities.entries:
             singular |= mask
-        singular |= self._near_wrist_alignment(np.where(finite[..., None], ideal.joints, 0.0), finite & ideal.valid)
+        singular |= near_alignment
         # a row where the idealised family gave no candidate at all (not even a least-squares one) has no near miss
         # to measure: its "no solution" is the idealised arm's, which the true one need not share
         complete = converged & distinct & ~near_miss & ~singular & ~rescued & finite.any(axis=1)
@@ -209,10 +205,9 @@ class IdealisedPlan(Sealed):
     def _near_wrist_alignment(self, ideal_joints: np.ndarray, valid: np.ndarray) -> np.ndarray:
         """Which targets (N,) have a ``valid`` idealised candidate (N, m, n) whose spherical wrist is within the
         band of :data:`WRIST_ALIGNMENT_BAND` of aligning its outer axes (all False for a family without one)."""
-        wrist, middle = _spherical_wrist(self.inner)
-        if wrist is None:
+        volume = self.inner.wrist_volume(ideal_joints) if hasattr(self.inner, "wrist_volume") else None
+        if volume is None:
             return np.zeros(len(valid), dtype=bool)
-        volume = wrist.volume(ideal_joints[..., middle])
         return (valid & (volume <= np.sqrt(WRIST_ALIGNMENT_BAND * self.deviation))).any(axis=1)
 
     def _refined(self, q: np.ndarray, world_T_targets: np.ndarray, steps: int) -> np.ndarray:
@@ -253,9 +248,10 @@ class IdealisedPlan(Sealed):
             & (self._smallest_singular_value(stepped) > np.sqrt(SINGULAR_MARGIN * self.deviation))
         return apart
 
-    def _smallest_singular_value(self, joints: np.ndarray, *, position_only: bool = False) -> np.ndarray:
-        """σ_min of the true arm's Jacobian at joints (k, n), position rows in arm sizes (those rows alone with
-        ``position_only``, as for a position target); shape (k,).
+    def _smallest_singular_value(self, joints: np.ndarray, *, with_position_rows: bool = False) -> np.ndarray:
+        """σ_min of the true arm's Jacobian at joints (k, n), position rows in arm sizes (those rows alone for a
+        position target); with ``with_position_rows``, the smaller of that and the σ_min of the position rows
+        alone (the same Jacobian); shape (k,).
 
         From the singular values of J itself, accurate to about 1e-16 σ_max: an arm 1e-10 off its family compares
         σ_min with SINGULAR_MARGIN δ = 1e-9, where the eigenvalues of JᵀJ (σ_min² beside a rounding of
@@ -263,9 +259,12 @@ class IdealisedPlan(Sealed):
         """
         J = geometric_jacobian(self.robot, joints)
         J[:, :3, :] /= self.size
-        if position_only or not self.constrain_orientation:
+        if not self.constrain_orientation:
             J = J[:, :3, :]
-        return np.linalg.svd(J, compute_uv=False)[:, -1]
+        smallest = np.linalg.svd(J, compute_uv=False)[:, -1]
+        if with_position_rows and self.constrain_orientation:
+            smallest = np.minimum(smallest, np.linalg.svd(J[:, :3, :], compute_uv=False)[:, -1])
+        return smallest
 
     def _ideal_error(self, joints: np.ndarray, world_T_targets: np.ndarray) -> np.ndarray:
         """The idealised arm's residual at joints (N, m, n): position / size, or the larger with the orientation."""
@@ -310,16 +309,6 @@ class IdealisedPlan(Sealed):
                 own[near[flips]] = -1
             out[name] = (values, own)
         return out
-
-
-def _spherical_wrist(plan) -> tuple[SphericalWrist | None, int]:
-    """A plan's spherical wrist and the chain index of its middle joint (a reversed plan's wrist is at the base),
-    or (None, −1)."""
-    if isinstance(plan, ReversedPlan):
-        wrist, middle = _spherical_wrist(plan.inner)
-        return (wrist, plan.dof - 1 - middle) if wrist is not None else (None, -1)
-    wrist = plan.wrist if isinstance(plan, DecoupledPlan) else None
-    return (wrist, wrist.joints[1]) if isinstance(wrist, SphericalWrist) else (None, -1)
 
 
 def _distinct_counts(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:

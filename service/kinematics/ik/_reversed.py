@@ -75,6 +75,11 @@ class ReversedPlan(Sealed):
         detail = re.sub(r"(\bq|\bjoints? |\baxis )(\d+)", one_based, detail)
         return Singularity(flag.kind, tuple(sorted(n - 1 - j for j in flag.joints)), flag.relation, detail)
 
+    def wrist_volume(self, joints: np.ndarray) -> np.ndarray | None:
+        """The inverse chain's :meth:`DecoupledPlan.wrist_volume` at joint vectors (..., n) of the chain itself
+        (its wrist at the base)."""
+        return self.inner.wrist_volume(joints[..., ::-1])
+
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """The inverse chain's labels (its wrist flip and its positioner's branches) of joint vectors (M, n)."""
         if self.own_label_codes is not None:

@@ -102,6 +102,17 @@ class Geometry:
         """The distance of ``point`` (3,) from the axis (line) of joint i."""
         return float(np.linalg.norm(cross(self.direction(i), point - self.point(i))))
 
+    def nearly_on_axis(self, i: int, point: np.ndarray) -> bool:
+        """Whether ``point`` lies within ``RECOGNITION_TOLERANCE`` of the arm's size of the axis of joint i (on it
+        included): a family that reads an angle off the point's radius about that axis would read it off a rounding
+        of the geometry there, and declines, as :meth:`nearly_parallel`."""
+        return self.axis_distance(i, point) <= RECOGNITION_TOLERANCE * self.length_scale
+
+    def nearly_coincident(self, point: np.ndarray, other: np.ndarray) -> bool:
+        """Whether two points (3,) lie within ``RECOGNITION_TOLERANCE`` of the arm's size of each other: angles read
+        off the vector between them would be read off a rounding (see :meth:`nearly_on_axis`)."""
+        return bool(np.linalg.norm(point - other) <= RECOGNITION_TOLERANCE * self.length_scale)
+
 
 def _closest_common_point(points: list[np.ndarray], directions: list[np.ndarray], scale: float) -> np.ndarray | None:
     """Least-squares point nearest to every line; None unless it lies on all of them."""

@@ -347,3 +347,21 @@ def test_an_arm_holding_its_relations_only_to_1e9_is_solved_as_an_idealised_arm(
     assert isinstance(plan, IdealisedPlan) == idealised
     assert plan.structure == cached_plan(catalogue_robot(client, robot_id), constrain_orientation=True,
                                          reference=None).structure
+
+
+def test_a_wrist_at_the_base_measures_its_alignment_at_its_own_middle_joint():
+    """The band about a spherical wrist's alignment (``WRIST_ALIGNMENT_BAND``) reads the wrist's volume through the
+    plan; a wrist at the base is the inverse chain's, whose joints run backwards: its middle joint is the chain's
+    joint 2, and the volume is |sin q2| for these right-angled axes, whatever joint 5 (the inverse chain's second)
+    does."""
+    from service.kinematics.ik._closed_form import cached_plan
+
+    h = math.pi / 2
+    rows = [(0, -h, 0.3, 0), (0, h, 0, 0), (0.4, 0, 0.1, 0), (0.35, 0, 0, 0), (0, h, 0, 0), (0, 0, 0.1, 0)]
+    robot = Robot([Joint(f"q{i}", "revolute", *row) for i, row in enumerate(rows)], name="wrist at the base")
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    assert plan.structure.startswith("spherical_wrist+")
+    q = np.zeros((3, 6))
+    q[:, 1] = [0.0, h, 1e-3]
+    q[:, 4] = 0.7
+    assert np.allclose(plan.wrist_volume(q), [0.0, 1.0, math.sin(1e-3)], atol=1e-12)

@@ -200,11 +200,11 @@ class OffsetShoulderIntersectingElbow(Positioner):
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
              ) -> "OffsetShoulderIntersectingElbow | None":
-        if np.linalg.norm(point - centre) <= RECOGNITION_TOLERANCE * geometry.length_scale:
+        if geometry.nearly_coincident(point, centre):
             return None  # the point at c (or nearly, as rounded: joints 2 and 3 read off it): the idealised family's
         if geometry.model.is_revolute[joints[0]] and geometry.on_axis(joints[0], centre):
             return None  # all three axes through one point: it cannot place a point
-        if geometry.axis_distance(joints[2], point) <= RECOGNITION_TOLERANCE * geometry.length_scale:
+        if geometry.nearly_on_axis(joints[2], point):
             return None  # joint 3 never moves the point (two joints cannot place it), or nearly: q3 read off it
         return cls(geometry, joints, point, centre)
 

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
+from ..._tolerances import GEOMETRY_TOLERANCE
 from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry
@@ -182,8 +182,7 @@ class SkewAxes(Positioner):
         if geometry.nearly_parallel(j, k):
             return None  # the common normal's feet would run off to where the rounding puts them
         feet = _common_normal_feet(geometry.point(j), geometry.direction(j), geometry.point(k), geometry.direction(k))
-        near = RECOGNITION_TOLERANCE * geometry.length_scale
-        if np.linalg.norm(feet[1] - feet[0]) <= near or geometry.axis_distance(k, point) <= near:
+        if geometry.nearly_coincident(*feet) or geometry.nearly_on_axis(k, point):
             return None  # axes that (nearly) meet, a point (nearly) on axis 3: the idealised arm's families answer
         return cls(geometry, joints, point, feet=feet)
 

@@ -236,10 +236,8 @@ class SkewAxesWithSlide(Positioner):
                 return None  # the intersecting shoulder
         else:
             eliminated, circle = revolute
-            if geometry.on_axis(circle, point):
-                return None  # the circle is a point: joint b does not move it
-            if geometry.axis_distance(circle, point) <= RECOGNITION_TOLERANCE * geometry.length_scale:
-                return None  # nearly a point (a rounded R-R-P-R): q_b read off it; the idealised family answers
+            if geometry.nearly_on_axis(circle, point):
+                return None  # the circle is a point (joint b does not move it), or nearly (a rounded R-R-P-R)
         along = abs(float(geometry.direction(eliminated) @ geometry.direction(slide)))
         normal = along <= GEOMETRY_TOLERANCE
         if normal and geometry.parallel(eliminated, circle):

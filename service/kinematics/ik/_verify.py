@@ -80,12 +80,16 @@ def residual_arrays(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) ->
     return PoseGoal(np.asarray(world_T_targets, dtype=float)).residuals(robot, np.asarray(q, dtype=float))
 
 
-def error_size(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool
-               ) -> np.ndarray:
+def error_size(robot: Robot, position, orientation, constrain_orientation: bool):
     """One number per residual pair: the position error as a fraction of the arm's size, or the larger of that
-    and the orientation error (radians)."""
+    and the orientation error (radians). Arrays, or one pair of floats (:func:`verify_one`); a NaN error either
+    way gives NaN."""
     size = position / arm_size(robot)
-    return np.maximum(size, orientation) if constrain_orientation else size
+    if not constrain_orientation:
+        return size
+    if type(size) is float:  # np.maximum's rule on floats, without its cost per call
+        return size if size >= orientation or size != size else orientation
+    return np.maximum(size, orientation)
 
 
 def accepted(robot: Robot, position: np.ndarray, orientation: np.ndarray, constrain_orientation: bool) -> np.ndarray:
@@ -339,27 +343,26 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     rows = [one_pose.rows[slot] for slot in slots]  # revolute joints wrapped already: verify's wrap leaves them
     constrained = goal.constrain_orientation
     residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist()) if rows else []
-    position, orientation = np.array(residuals, dtype=float).reshape(-1, 2).T
-    sizes = error_size(robot, position, orientation, constrained).tolist()
+    sizes = [error_size(robot, position, orientation, constrained) for position, orientation in residuals]
     if any(size != size or polished(size) for size in sizes):  # a NaN error, or one verify would polish
         return None
     kept = [row for row, keep in enumerate(first_of_each_slot(robot, rows, [size <= ACCEPT_RESIDUAL
                                                                             for size in sizes])) if keep]
     count = len(kept)
-    joints = np.array([rows[row] for row in kept], dtype=float).reshape(count, robot.dof)
     if reference is not None and count > 1:
-        nearest_first = np.argsort(distance_to_reference(robot, joints, reference), kind="stable").tolist()
-        kept, joints = [kept[i] for i in nearest_first], joints[nearest_first]
+        joints = np.array([rows[row] for row in kept], dtype=float)
+        kept = [kept[i] for i in np.argsort(distance_to_reference(robot, joints, reference), kind="stable").tolist()]
     codes = [one_pose.codes[slots[row]] for row in kept]
     if any(None in row for row in codes):
         return None
+    joints = np.array([rows[row] for row in kept], dtype=float).reshape(count, robot.dof)
     nearest = np.array([min(sizes, default=np.inf)])
     complete = promised(one_pose, np.array([count]), nearest, constrained)
     columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)
     labels = {name: (values, column) for name, values, column in zip(one_pose.names, one_pose.values, columns)}
-    position, orientation = position[kept], orientation[kept]  # gathered: contiguous, as the encoder writes them
-    table = SolutionTable(np.zeros(count, dtype=np.int64), joints, np.ones(count, dtype=bool), position,
-                          orientation if constrained else np.full(count, np.nan), labels)
+    errors = np.array([[residuals[row][0] for row in kept], [residuals[row][1] for row in kept]]).reshape(2, count)
+    table = SolutionTable(np.zeros(count, dtype=np.int64), joints, np.ones(count, dtype=bool), errors[0],
+                          errors[1] if constrained else np.full(count, np.nan), labels)
     return Verified(table, complete, nearest, one_pose.singularities)
 
 

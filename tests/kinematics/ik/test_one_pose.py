@@ -138,6 +138,20 @@ def test_the_scan_of_one_target_is_the_scan_of_many():
     assert _verify.first_of_each_slot(robot, cases[0], [True] * 4) == [True, False, True, True]
 
 
+def test_the_error_size_of_one_pair_of_floats_is_the_arrays():
+    """error_size of one (position, orientation) pair of floats, as verify_one takes it, is its value on arrays
+    (np.maximum's rule): NaN wherever either error is NaN, so that the one-pose path hands such a pose over."""
+    robot = _CATALOGUE.get("puma560_standard").robot
+    values = [0.0, 1e-12, 0.3, 2.0, np.inf, np.nan]
+    for position in values:
+        for orientation in values:
+            for constrained in (True, False):
+                on_floats = _verify.error_size(robot, float(position), float(orientation), constrained)
+                on_arrays = _verify.error_size(robot, np.array([position]), np.array([orientation]), constrained)
+                assert type(on_floats) is float
+                assert on_floats == on_arrays[0] or (np.isnan(on_floats) and np.isnan(on_arrays[0]))
+
+
 @pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)
 def test_the_float_check_of_one_pose_is_verify(robot_id):
     """verify_one (the FK check, the duplicate scan and the labels of one pose's scalar slots, on floats) gives

@@ -29,7 +29,6 @@ from tests.live import free_port
 
 ARTIFACTS_DIR = Path(os.environ.get("KIN_TEST_ARTIFACTS", Path(__file__).resolve().parent.parent / "test-artifacts"))
 #: Every screenshot saved in this run; tests/conftest.py lists them at the end of the run, so CI's log has them.
-SCREENSHOTS: list[Path] = []
 
 
 def chromium_path() -> str:
@@ -159,7 +158,6 @@ class Browser:
         path = ARTIFACTS_DIR / name
         path.write_bytes(base64.b64decode(self.send("Page.captureScreenshot", format="png")["data"]))
         print(f"screenshot: {path}")
-        SCREENSHOTS.append(path)
         return path
 
     def foreign_requests(self, origin: str) -> list[str]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,7 @@ from service.api.app import create_app
 from service.config import Settings
 
 DATA = Path(__file__).parent / "data"
+_STARTED = pytest.StashKey[float]()  # when the run began (the screenshots written since are this run's)
 
 
 @pytest.fixture(scope="session")
@@ -50,11 +52,20 @@ def catalogue_robot(client, robot_id: str):
     return client.app.state.catalogue.get(robot_id).robot
 
 
-def pytest_terminal_summary(terminalreporter) -> None:
-    """List the browser tests' screenshots (test artifacts) at the end of the run."""
-    from tests.browser import SCREENSHOTS
+def pytest_sessionstart(session) -> None:
+    session.config.stash[_STARTED] = time.time()
 
-    if SCREENSHOTS:
+
+def pytest_terminal_summary(terminalreporter, config) -> None:
+    """List the browser tests' screenshots (test artifacts) at the end of the run: the pictures this run wrote to
+    the artifacts directory, read from there (the tests may have run in worker processes)."""
+    from tests.browser import ARTIFACTS_DIR
+
+    started = config.stash.get(_STARTED, None)
+    if started is None or not ARTIFACTS_DIR.is_dir():
+        return
+    screenshots = sorted(path for path in ARTIFACTS_DIR.glob("*.png") if path.stat().st_mtime >= started - 1.0)
+    if screenshots:
         terminalreporter.section("screenshots (test artifacts)")
-        for path in SCREENSHOTS:
+        for path in screenshots:
             terminalreporter.write_line(str(path))

@@ -64,7 +64,7 @@ from ._assur_functions import (
     angle_function,
     distance_function,
 )
-from ._rotations import wrap_angle
+from ._angles import wrap_angle
 from ._tolerances import SINGULARITY_TOLERANCE
 
 __all__ = [

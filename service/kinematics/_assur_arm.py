@@ -45,7 +45,7 @@ import numpy as np
 from ._assur import AssurScaraSolution, assur_scara_inverse
 from ._forward import screw_model
 from ._robot import Robot
-from ._rotations import wrap_angle
+from ._angles import wrap_angle
 from ._tolerances import GEOMETRY_TOLERANCE, SINGULARITY_TOLERANCE
 
 __all__ = ["AssurScara", "AssurScaraRates", "assur_scara_of"]

@@ -34,10 +34,10 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._angles import wrap_angle
 from ._errors import InvalidInputError
 from ._tolerances import ORTHONORMAL_TOLERANCE, SINGULARITY_TOLERANCE
 
-_TWO_PI = 2.0 * np.pi
 
 __all__ = [
     "check_rotation",
@@ -54,7 +54,6 @@ __all__ = [
     "rot_y",
     "rot_z",
     "rpy_from_matrix",
-    "wrap_angle",
 ]
 
 # ---------------------------------------------------------------------------
@@ -135,9 +134,32 @@ def _check_rotation_stack(R: np.ndarray, tolerance: float, what: str) -> None:
         )
 
 
+def _clearly_rigid(rows: list[list[float]], tolerance: float) -> bool:
+    """Whether one matrix, its rows as lists of floats (a rotation (3, 3), or a transform (4, 4)), passes the
+    checks below (:func:`_check_finite`, the bottom row's, :func:`_check_rotation_stack`) with half the tolerance
+    to spare: a dozen float operations where the array checks make two dozen numpy calls, for the one target of a
+    request. Anything else (a NaN, an infinity, an entry near a bound) gives False, and the array checks decide and
+    word the error; the half keeps the two arithmetics, which differ in the last bits, from deciding otherwise."""
+    if not math.isfinite(sum(map(sum, rows))):  # inf, −inf + inf and NaN all propagate
+        return False
+    margin = 0.5 * tolerance
+    if len(rows) == 4:
+        x, y, z, w = rows[3]
+        if not (abs(x) <= margin and abs(y) <= margin and abs(z) <= margin and abs(w - 1.0) <= margin):
+            return False
+    (a0, b0, c0, *_), (a1, b1, c1, *_), (a2, b2, c2, *_) = rows[0], rows[1], rows[2]  # the columns a, b, c
+    gram_error = max(abs(a0 * a0 + a1 * a1 + a2 * a2 - 1.0), abs(b0 * b0 + b1 * b1 + b2 * b2 - 1.0),
+                     abs(c0 * c0 + c1 * c1 + c2 * c2 - 1.0), abs(a0 * b0 + a1 * b1 + a2 * b2),
+                     abs(a0 * c0 + a1 * c1 + a2 * c2), abs(b0 * c0 + b1 * c1 + b2 * c2))
+    determinant = a0 * (b1 * c2 - b2 * c1) - a1 * (b0 * c2 - b2 * c0) + a2 * (b0 * c1 - b1 * c0)
+    return gram_error <= margin and abs(determinant - 1.0) <= margin
+
+
 def _checked_rotations(R: ArrayLike, tolerance: float, batch: bool) -> np.ndarray:
     R = _as_float_array(R, "rotation matrix")
     _check_shape(R, (3, 3), batch, "rotation matrix")
+    if not batch and _clearly_rigid(R.tolist(), tolerance):
+        return R
     _check_finite(R, "rotation matrix")
     _check_rotation_stack(R, tolerance, "rotation matrix")
     return R
@@ -146,6 +168,8 @@ def _checked_rotations(R: ArrayLike, tolerance: float, batch: bool) -> np.ndarra
 def _checked_transforms(T: ArrayLike, tolerance: float, batch: bool) -> np.ndarray:
     T = _as_float_array(T, "transform")
     _check_shape(T, (4, 4), batch, "transform")
+    if not batch and _clearly_rigid(T.tolist(), tolerance):
+        return T
     _check_finite(T, "transform")
     deviation = np.abs(T[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0]))
     bad_row = np.max(deviation, axis=-1) > tolerance
@@ -739,62 +763,3 @@ def rpy_from_matrix(R: ArrayLike, *, free_angle: float = 0.0) -> tuple[np.ndarra
         math.atan2(R[1, 0], R[0, 0]),
     ]
     return wrap_angle(np.array(angles)), False
-
-
-# ---------------------------------------------------------------------------
-# Angles
-# ---------------------------------------------------------------------------
-
-
-def wrap_angle(x: ArrayLike) -> np.float64 | np.ndarray:
-    """Wrap angles to ``(-pi, pi]``: the one angle wrap of the core.
-
-    Values already in ``(-pi, pi]`` are returned unchanged, bit for bit.
-    ``-pi`` maps to ``pi``. NaN stays NaN; infinities become NaN. Angles within
-    one turn of the range (``|x| < 3 pi``, what sums of two wrapped angles give)
-    take one exact add or subtract of ``2 pi``; only others pay for a modulo.
-
-    Parameters
-    ----------
-    x : float or array_like
-        Radians, any shape.
-
-    Returns
-    -------
-    numpy.float64 (a float) for a scalar, or ndarray of the same shape
-
-    Examples
-    --------
-    >>> float(wrap_angle(3 * np.pi / 2)) == -np.pi / 2
-    True
-    >>> wrap_angle([-np.pi, 0.5, 100.0]).round(6).tolist() == [round(np.pi, 6), 0.5, round(100.0 - 32 * np.pi, 6)]
-    True
-    """
-    a = np.asarray(x, dtype=np.float64)
-    # For |a| <= 3π (3π is exact in floating point) a ∓ 2π is exact (Sterbenz), so it lands in (−π, π].
-    wrapped = a - (_TWO_PI * (a > np.pi) - _TWO_PI * (a <= -np.pi))  # a − 0.0 keeps a −0.0
-    far = np.abs(a) >= 3.0 * np.pi  # infinities too
-    if far.any():
-        # np.mod is exact here, and its remainder a multiple of ulp(2π), so it never rounds up to a full turn.
-        with np.errstate(invalid="ignore"):
-            wrapped = np.where(far, np.pi - np.mod(np.pi - a, _TWO_PI), wrapped)
-    return wrapped[()]  # a 0-d result as a numpy float, as numpy's own functions return it
-
-
-_PI, _THREE_PI = math.pi, 3.0 * math.pi
-
-
-def wrap_float(theta: float) -> float:
-    """:func:`wrap_angle` of one float in (−3π, 3π] (a sum of two wrapped angles), bit for bit, on floats."""
-    if theta > _PI:
-        return theta - _TWO_PI
-    if theta <= -_PI:
-        return theta + _TWO_PI
-    return theta
-
-
-def wrap_any_float(theta: float) -> float:
-    """:func:`wrap_angle` of one float of any size (as :func:`wrap_float` within three half-turns)."""
-    if -_THREE_PI < theta < _THREE_PI:
-        return wrap_float(theta)
-    return _PI - (_PI - theta) % _TWO_PI

@@ -27,15 +27,9 @@ from service.kinematics import (
     quaternions_from_matrices,
     rpy_from_matrix,
 )
-from service.kinematics._rotations import (
-    euler_zyz_from_matrix,
-    rot_x,
-    rot_y,
-    rot_z,
-    wrap_angle,
-    wrap_any_float,
-    wrap_float,
-)
+from service.kinematics import _angles
+from service.kinematics._angles import wrap_angle, wrap_any_float, wrap_float
+from service.kinematics._rotations import euler_zyz_from_matrix, rot_x, rot_y, rot_z
 from service.kinematics._tolerances import SINGULARITY_TOLERANCE
 from tests.oracles.rotations import axis_angle, matrix_of_quaternion, random_rotations
 
@@ -78,8 +72,9 @@ def raises_at(location: tuple, match: str):
 
 def test_docstring_examples_hold():
     result = doctest.testmod(_rotations, optionflags=doctest.NORMALIZE_WHITESPACE)
-    assert result.failed == 0
-    assert result.attempted >= 27
+    angles = doctest.testmod(_angles, optionflags=doctest.NORMALIZE_WHITESPACE)
+    assert result.failed == angles.failed == 0
+    assert result.attempted + angles.attempted >= 27
 
 
 def test_docstring_example_values():
@@ -486,6 +481,42 @@ def test_rotation_that_is_not_numbers_is_rejected():
         check_rotation([[1, 0, 0], [0, 1], [0, 0, 1]])
     with raises_at((), "must contain real numbers"):
         check_rotation(np.eye(3, dtype=complex))
+
+
+def _outcome(check, value):
+    """What a check says of a value: "ok", or its error's message and location."""
+    try:
+        check(value)
+    except InvalidInputError as error:
+        return str(error), error.location
+    return "ok"
+
+
+@pytest.mark.parametrize("size", [0.0, 1e-8, 3e-7, 1e-6, 3e-6, 1e-4])
+def test_one_matrix_is_judged_as_the_array_checks_judge_it(rng, size, monkeypatch):
+    """check_rotation and check_transform of one matrix first screen it on floats (half the tolerance to spare)
+    and leave anything doubtful to the array checks: the same verdict and the same words as the array checks
+    alone, for perturbations from well within the tolerance (1e-6) to well beyond it, NaN and infinite entries
+    and reflections included."""
+    cases = []
+    for R in random_rotations(rng, 300):
+        T = np.eye(4)
+        T[:3, :3], T[:3, 3] = R, rng.normal(size=3)
+        T += size * rng.normal(size=(4, 4)) * (rng.random((4, 4)) < 0.5)
+        choice = rng.random()
+        if choice < 0.05:
+            T[rng.integers(4), rng.integers(4)] = rng.choice([np.nan, np.inf, -np.inf])
+        elif choice < 0.1:
+            T[:3, :3] = T[:3, :3] @ np.diag([1.0, 1.0, -1.0])
+        cases.append(T)
+    screened = [(_outcome(check_transform, T), _outcome(check_rotation, T[:3, :3])) for T in cases]
+    monkeypatch.setattr(_rotations, "_clearly_rigid", lambda rows, tolerance: False)
+    assert screened == [(_outcome(check_transform, T), _outcome(check_rotation, T[:3, :3])) for T in cases]
+    accepted = sum(single == "ok" for single, _ in screened)
+    if size <= 1e-8:
+        assert accepted >= 250
+    if size >= 1e-4:
+        assert accepted <= 50
 
 
 def test_check_transform_errors_are_located_in_the_4x4():

@@ -21,7 +21,7 @@ import re
 import numpy as np
 
 from .._forward import JointTrig
-from .._rotations import wrap_angle
+from .._angles import wrap_angle
 from ._structure import Geometry
 from ._types import Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 

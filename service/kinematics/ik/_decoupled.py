@@ -15,7 +15,7 @@ from functools import cached_property
 
 import numpy as np
 
-from .._rotations import wrap_float
+from .._angles import wrap_float
 from .._tolerances import GEOMETRY_TOLERANCE
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner

@@ -48,7 +48,7 @@ from .._cache import bounded_memo
 from .._errors import InvalidInputError
 from .._forward import cross, forward_kinematics
 from .._robot import Robot
-from .._rotations import wrap_angle
+from .._angles import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._closed_form import cached_plan, joined
 from ._goals import DirectionGoal

@@ -15,7 +15,7 @@ from collections.abc import Callable
 import numpy as np
 
 from .._robot import Robot
-from .._rotations import wrap_angle
+from .._angles import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE
 from ._gauss_newton import gauss_newton
 from ._goals import PoseGoal

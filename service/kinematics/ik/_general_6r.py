@@ -48,7 +48,7 @@ from collections.abc import Iterator
 import numpy as np
 
 from .._forward import JointTrig
-from .._rotations import wrap_angle
+from .._angles import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE
 from ._general_6r_chain import NEWTON_TOLERANCE, chain_twists, error_twist, newton, singular_motion
 from ._general_6r_elimination import Arrangement, solve_arrangement

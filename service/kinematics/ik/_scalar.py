@@ -22,7 +22,7 @@ forms live beside their array code and share its constants and thresholds
 :func:`.subproblems._paden_kahan._subproblem_2_chain_clear`,
 :func:`~.subproblems._paden_kahan._distance_equation` and
 :func:`.subproblems._vectors._rotate_onto_clear`), as the angle wraps do
-(:func:`~service.kinematics._rotations.wrap_float`); this module reduces a
+(:func:`~service.kinematics._angles.wrap_float`); this module reduces a
 plan's fixed vectors to the coordinates they take.
 """
 

@@ -35,7 +35,7 @@ from functools import cached_property
 import numpy as np
 
 from . import _scalar as scalar
-from .._rotations import wrap_angle, wrap_any_float
+from .._angles import wrap_angle, wrap_any_float
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
 from .._forward import JointTrig, cross

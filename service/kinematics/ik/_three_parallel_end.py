@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._rotations import wrap_angle
+from .._angles import wrap_angle
 from ._positioning import side_codes
 from .._forward import JointTrig, cross
 from ._screws import (apply, chain_rotation, invert, joint_motion, move_point, perpendicular_unit, rotate_about,

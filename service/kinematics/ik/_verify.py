@@ -20,7 +20,7 @@ import numpy as np
 from .._cache import memo
 from .._forward import JointTrig
 from .._robot import Robot
-from .._rotations import wrap_angle
+from .._angles import wrap_angle
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
 from ._gauss_newton import gauss_newton
 from ._goals import Goal, PoseGoal, pose_residuals_of_rows

@@ -19,7 +19,7 @@ from functools import cached_property
 import numpy as np
 
 from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE
-from .._rotations import wrap_angle
+from .._angles import wrap_angle
 from .._forward import JointTrig, cross
 from ._screws import perpendicular_unit, rotate_about
 from ._structure import Geometry, read_off_below

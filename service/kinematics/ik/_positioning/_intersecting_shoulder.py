@@ -7,7 +7,7 @@ from functools import cached_property
 
 import numpy as np
 
-from ..._rotations import wrap_angle
+from ..._angles import wrap_angle
 from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
 from ..._forward import JointTrig, cross
 from .._screws import rotate_about

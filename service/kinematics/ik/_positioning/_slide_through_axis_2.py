@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..._forward import cross
-from ..._rotations import wrap_angle
+from ..._angles import wrap_angle
 from ..._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, POLISH_RESIDUAL
 from .._screws import rotate_about
 from .._structure import Geometry, target_error

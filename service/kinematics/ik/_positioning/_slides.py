@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..._rotations import wrap_angle
+from ..._angles import wrap_angle
 from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
 from ..._forward import JointTrig, cross
 from .._screws import rotate_about

@@ -13,7 +13,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._errors import InvalidInputError
-from ..._rotations import wrap_angle, wrap_float
+from ..._angles import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE
 from .._screws import axis_frame
 from ._records import (_GAP_PER_ERROR, _GAP_ROUNDING, _MERGE_SIN_SQUARED, _NEAR_TANGENT_GAP, AnglePairSolutions,

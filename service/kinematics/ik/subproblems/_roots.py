@@ -17,7 +17,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._rotations import wrap_angle, wrap_float
+from ..._angles import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
 from ._records import _MERGE_COS_GAP, AngleSolutions
 from ._vectors import _hypot, _pair

@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._rotations import wrap_angle
+from ..._angles import wrap_angle
 from ..._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from .._screws import axis_frame
 from ._records import AngleQuadSolutions

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from ..._cache import AxisCache
 from ..._errors import InvalidInputError
 from ..._forward import cross
-from ..._rotations import wrap_angle, wrap_float
+from ..._angles import wrap_angle, wrap_float
 from ..._tolerances import GEOMETRY_TOLERANCE, ORTHONORMAL_TOLERANCE
 
 

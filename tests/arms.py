@@ -135,10 +135,11 @@ def random_rigid(rng: np.random.Generator, scale: float) -> np.ndarray:
 
 
 def restated_6r(a: np.ndarray, alpha: np.ndarray, d: np.ndarray, theta: np.ndarray, convention: str,
-                world_T_base: np.ndarray, flange_T_tool: np.ndarray) -> Robot:
-    """The 6R arm of standard-DH rows (a, alpha, d, theta: each shape (6,)) with the given base and tool, restated
-    in ``convention``: Craig's rows shift a_i and alpha_i down one joint, the last pair going into the tool; a
-    Khalil row holds the same numbers as a Craig row, renamed. The same arm (the same FK) in every convention."""
+                world_T_base: np.ndarray, flange_T_tool: np.ndarray, kinds: str = "RRRRRR") -> Robot:
+    """The 6-joint arm of standard-DH rows (a, alpha, d, theta: each shape (6,)) with the given base and tool,
+    restated in ``convention``: Craig's rows shift a_i and alpha_i down one joint, the last pair going into the
+    tool; a Khalil row holds the same numbers as a Craig row, renamed. The same arm (the same FK) in every
+    convention. ``kinds``: R (revolute) or P (prismatic) per joint; a prismatic joint's d is its offset."""
     tool = flange_T_tool
     if convention == "standard":
         rows = zip(a, alpha, d, theta)
@@ -146,7 +147,8 @@ def restated_6r(a: np.ndarray, alpha: np.ndarray, d: np.ndarray, theta: np.ndarr
         rows = zip(np.r_[0.0, a[:5]], np.r_[0.0, alpha[:5]], d, theta)
         c, s = np.cos(alpha[5]), np.sin(alpha[5])
         tool = np.array([[1, 0, 0, a[5]], [0, c, -s, 0], [0, s, c, 0], [0, 0, 0, 1.0]]) @ tool
-    joints = [Joint(f"j{i + 1}", "revolute", *row) for i, row in enumerate(rows)]
+    joints = [Joint(f"j{i + 1}", "revolute" if kind == "R" else "prismatic", *row)
+              for i, (kind, row) in enumerate(zip(kinds, rows))]
     return Robot(joints, convention=convention, world_T_base=world_T_base, flange_T_tool=tool)
 
 
@@ -295,6 +297,21 @@ def random_family_arm(family: str, convention: str, seed: int, wrist_singular: b
             alpha[4] = abs(alpha[3]) * np.sign(alpha[4])
     base, tool = random_rigid(rng, 0.5), random_rigid(rng, 0.2)
     return restated_6r(a, alpha, d, theta, convention, base, tool)
+
+
+def random_stanford_type_arm(convention: str, seed: int) -> Robot:
+    """A random arm of the Stanford type: axes 1 and 2 meeting at a random angle, a slide normal to axis 2 whose
+    line crosses it at a random height (the shoulder offset), a spherical wrist centred on the slide's line
+    (random twists, equal in size), in standard DH restated in ``convention``, with a random base and tool."""
+    rng = np.random.default_rng(seed)
+    a, d, theta = np.zeros(6), rng.uniform(-0.4, 0.4, 6), rng.uniform(-np.pi, np.pi, 6)
+    alpha = rng.uniform(0.3, 2.8, 6) * rng.choice([-1, 1], 6)
+    alpha[1] = rng.choice([-1, 1]) * np.pi / 2  # the slide (axis 3) normal to axis 2, its line crossing it (a2 = 0)
+    d[3] = d[4] = 0.0  # axes 4, 5 and 6 meet on the slide's line
+    alpha[4] = abs(alpha[3]) * rng.choice([-1, 1])
+    a[5] = rng.uniform(-0.2, 0.2)
+    base, tool = random_rigid(rng, 0.5), random_rigid(rng, 0.2)
+    return restated_6r(a, alpha, d, theta, convention, base, tool, kinds="RRPRRR")
 
 
 def random_ur_type_arm(seed: int, convention: str, two_arcs: bool, skew: bool = False) -> Robot:

@@ -108,7 +108,7 @@ def _solved(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.ndarray | No
     generic, verified on floats where :func:`verify_one` can), verified."""
     candidates = None
     if len(goal) == 1 and hasattr(plan, "solve_one"):
-        one_pose = plan.solve_one(goal.world_T_targets[0])
+        one_pose = plan.solve_one(goal.world_T_targets[0], reference)
         verified = None if one_pose is None else verify_one(robot, goal, one_pose, reference)
         if verified is not None:
             return verified

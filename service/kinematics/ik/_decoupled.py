@@ -15,8 +15,8 @@ from functools import cached_property
 
 import numpy as np
 
-from .._angles import wrap_float
-from .._tolerances import GEOMETRY_TOLERANCE
+from .._angles import wrap_any_float, wrap_float
+from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, POLISH_RESIDUAL
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
 from .._forward import JointTrig
@@ -219,23 +219,25 @@ class DecoupledPlan(Sealed):
             codes.update(self.wrist.label_codes(joints, trig))
         return codes
 
-    def solve_one(self, world_T_target: np.ndarray) -> scalar.OnePose | None:
+    def solve_one(self, world_T_target: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose | None:
         """:meth:`solve` of one target (4, 4) in scalar arithmetic (:mod:`._scalar`), with the slots' branch
-        labels (:meth:`label_codes`) from the same quantities, or None when the plan is not the PUMA type or the
-        pose is not clearly generic (then :meth:`solve` and :meth:`label_codes` decide)."""
+        labels (:meth:`label_codes`) from the same quantities, or None when the plan has no scalar path or the
+        pose is not clearly generic (then :meth:`solve` and :meth:`label_codes` decide). ``reference`` (n,) as
+        :meth:`solve` takes it: only the Stanford type's path reads it (its bands take the reference's values
+        where the pose is generic too); the others decline wherever :meth:`solve` would read it."""
         one_pose = self._one_pose
         if one_pose is None:
             return None
         try:
-            return one_pose.solve(world_T_target)
+            return one_pose.solve(world_T_target, reference)
         except scalar.NotGeneric:
             return None
 
     @cached_property
     def _one_pose(self) -> "_SphericalWristOnePose | None":
         """The scalar solver when joints 4–6 are a spherical wrist and joints 1–3 an intersecting shoulder with a
-        revolute joint 3 (the PUMA type) or an offset shoulder with joints 2 ∥ 3, all revolute (the OPW type:
-        KUKA, ABB, Fanuc), else None."""
+        revolute joint 3 (the PUMA type) or with a slide through axis 2 (the Stanford type), or an offset shoulder
+        with joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB, Fanuc), else None."""
         positioner = self.positioner
         if not (positioner is not None and isinstance(self.wrist, SphericalWrist) and not self.fixed
                 and not positioner.free_joints
@@ -243,6 +245,8 @@ class DecoupledPlan(Sealed):
             return None
         if isinstance(positioner, IntersectingShoulder) and bool(positioner.model.is_revolute[2]):
             return _ShoulderWristOnePose(self)
+        if isinstance(positioner, IntersectingShoulder) and positioner.slide_through_axis_2 is not None:
+            return _SlideShoulderWristOnePose(self)
         if (isinstance(positioner, OffsetShoulderParallelElbow) and bool(positioner.model.is_revolute[:3].all())
                 and positioner.forward is not None):
             return _OffsetShoulderWristOnePose(self)
@@ -290,7 +294,7 @@ class _SphericalWristOnePose:
         for roots in pairs:
             if roots is None:
                 rows.append(None)
-                codes.append((None, None, None))
+                codes.append((None,) * len(self.names))
                 continue
             qa, qb = roots
             # the wrist's axes nearly aligned at a root (not at the least-squares pair of cones that miss, which
@@ -303,11 +307,10 @@ class _SphericalWristOnePose:
             rows.append([*arm, qa, qb, qc])
             codes.append((*arm_codes, scalar.wrist_code(qb)))
 
-    @staticmethod
-    def _empty(rows: list, codes: list, count: int) -> None:
+    def _empty(self, rows: list, codes: list, count: int) -> None:
         """``count`` empty slots: an arm branch that does not exist, and its wrist's."""
         rows += [None] * count
-        codes += [(None, None, None)] * count
+        codes += [(None,) * len(self.names)] * count
 
 
 class _ShoulderWristOnePose(_SphericalWristOnePose):
@@ -338,8 +341,9 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
         self.elbow = scalar.reject(elbow, d[1]) if self.in_plane else elbow
         self.elbow_length = scalar.norm(self.elbow)
 
-    def solve(self, T: np.ndarray) -> scalar.OnePose:
-        """The eight slots for a target (4, 4), or NotGeneric."""
+    def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
+        """The eight slots for a target (4, 4), or NotGeneric (``reference``: not read, see
+        :meth:`DecoupledPlan.solve_one`)."""
         point_world, axis_c, normal = self._target(T)
         d, c, shoulder = self.directions, self.centre, self.shoulder
         target = scalar.sub(point_world, c)
@@ -381,6 +385,89 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
                 scalar.side_code(scalar.dot(scalar.mv(R_2, elbow_side), self.up), self.elbow_length))
 
 
+class _SlideShoulderWristOnePose(_SphericalWristOnePose):
+    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` whose third joint slides normal to axis 2
+    along a line crossing it (the Stanford type) and a spherical wrist: the shoulder and the slide in the slide's
+    frame as :meth:`.SlideThroughAxis2.solve` works them out, a reference's values taken where they lie in the
+    bands (near the fold, a reference in the band of a moves it by up to band² / 2a: far more than rounding), then
+    subproblem 1 for joint 1, in its slot order (the two shoulder solutions ±a, each with the slide's two signs),
+    and the shoulder's label (a slide has no elbow label)."""
+
+    names = ("shoulder", "wrist")
+    values = (("left", "right"), ("no_flip", "flip"))
+
+    def __init__(self, plan: DecoupledPlan) -> None:
+        super().__init__(plan)
+        positioner, model = plan.positioner, plan.positioner.model
+        self.frame = positioner.slide_through_axis_2
+        self.first, self.second = scalar.vector_of(model.directions[0]), scalar.vector_of(model.directions[1])
+        self.first_turn = scalar.Turn(self.first)
+        self.n1, self.n2 = scalar.vector_of(self.frame.n1), scalar.vector_of(self.frame.n2)
+        self.centre, self.geometry = scalar.vector_of(positioner.centre), positioner.geometry
+        self.forward = scalar.vector_of(positioner.label_constants[0])
+        size = positioner.geometry.length_scale
+        self.exact_within, self.at_centre = GEOMETRY_TOLERANCE * size, 0.5 * ACCEPT_RESIDUAL * size
+
+    def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
+        """The eight slots for a target (4, 4), or NotGeneric; ``reference`` (n,) as :meth:`DecoupledPlan.solve`."""
+        point_world, axis_c, normal = self._target(T)
+        frame, k1, k2, n1, n2 = self.frame, self.first, self.second, self.n1, self.n2
+        y = scalar.sub(point_world, self.centre)
+        height = scalar.dot(y, k1)
+        radius = scalar.norm((y[0] - height * k1[0], y[1] - height * k1[1], y[2] - height * k1[2]))
+        along = (height - frame.height * frame.cos_alpha) / frame.sin_alpha
+        inner = abs(frame.height * frame.sin_alpha - along * frame.cos_alpha)
+        across_squared = (radius - inner) * (radius + inner)
+        rounding = target_error(self.geometry, scalar.norm(point_world))
+        band_along = rounding / frame.sin_alpha
+        band_squared = 2 * rounding * (radius + inner + band_along)
+        # clear of the bands: the two shoulder solutions apart (so joint 2 not free), the point off the centre
+        if not (across_squared > scalar.MARGIN * band_squared and scalar.norm(y) > scalar.MARGIN * self.at_centre):
+            raise scalar.NotGeneric
+        across, first_sign = math.sqrt(across_squared), 1.0
+        if reference is not None:  # its values where they lie clearly inside the bands, none where clearly outside
+            q1_ref, q2_ref, q3_ref = (float(value) for value in reference[:3])
+            slide_ref, turn_ref = q3_ref - frame.foot, frame.psi0 + q2_ref
+            along_ref, across_ref = slide_ref * math.cos(turn_ref), slide_ref * math.sin(turn_ref)
+            if _clearly_within(abs(along - along_ref), band_along):
+                along = along_ref
+            if _clearly_within(abs(across_ref * across_ref - across_squared), band_squared):
+                across, first_sign = abs(across_ref), (-1.0 if across_ref < 0 else 1.0)
+        on_first_axis = max(rounding / POLISH_RESIDUAL, self.at_centre)
+        goal = self.first_turn.coordinates(y)
+        rows, codes = [], []
+        for signed in (first_sign * across, -first_sign * across):
+            psi = math.atan2(signed, along)
+            t = along * math.cos(psi) + signed * math.sin(psi)  # the displacement along R(k2, q2) v
+            for turn, slide in ((psi, t), (psi + math.pi, -t)):
+                c, s = math.cos(turn), math.sin(turn)
+                turned = (frame.height * k2[0] + slide * (c * n1[0] + s * n2[0]),
+                          frame.height * k2[1] + slide * (c * n1[1] + s * n2[1]),
+                          frame.height * k2[2] + slide * (c * n1[2] + s * n2[2]))
+                start = self.first_turn.coordinates(turned)
+                q1 = scalar.Turn.angle(start, goal, on_first_axis / max(start[4], goal[4]))
+                if reference is not None and _clearly_within(abs(wrap_any_float(q1 - q1_ref)), rounding / radius):
+                    q1 = wrap_any_float(q1_ref)  # an azimuth seen on a radius r is known to rounding / r
+                if not scalar.MARGIN * scalar.norm(scalar.sub(scalar.rotate(k1, q1, turned), y)) \
+                        <= self.exact_within:
+                    raise scalar.NotGeneric
+                q2 = wrap_any_float(turn - frame.psi0)
+                shoulder_code = scalar.side_code(scalar.dot(turned, self.forward), scalar.norm(turned))
+                R_G = scalar.mm(scalar.rotation(k1, q1), scalar.rotation(k2, q2))
+                self._wrist_rows(R_G, axis_c, normal, [q1, q2, frame.foot + slide], (shoulder_code,), rows, codes)
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
+
+
+def _clearly_within(gap: float, band: float) -> bool:
+    """Whether ``gap`` is inside ``band`` (True) or outside it (False) by :data:`._scalar.MARGIN`; NotGeneric
+    between, where the array path decides."""
+    if gap * scalar.MARGIN <= band:
+        return True
+    if gap > scalar.MARGIN * band:
+        return False
+    raise scalar.NotGeneric
+
+
 class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
     """:class:`DecoupledPlan` with an :class:`OffsetShoulderParallelElbow` (joints 1–3 revolute, 2 ∥ 3: the OPW
     arms) and a spherical wrist: subproblem 4 for joint 1 (front and back), 3 for joint 3 (elbow up and down), 1
@@ -407,8 +494,9 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
         self.up = scalar.vector_of(positioner.geometry.upward(model.directions[0]))
         self.elbow_from_2 = scalar.sub(p3, p2)
 
-    def solve(self, T: np.ndarray) -> scalar.OnePose:
-        """The eight slots for a target (4, 4), or NotGeneric."""
+    def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
+        """The eight slots for a target (4, 4), or NotGeneric (``reference``: not read, see
+        :meth:`DecoupledPlan.solve_one`)."""
         point_world, axis_c, normal = self._target(T)
         d, o, p2, p3 = self.directions, self.origin, self.point_2, self.point_3
         from_origin = scalar.sub(point_world, o)

@@ -268,12 +268,12 @@ class ThreeParallelPlan(_AxesTwoToFourParallel):
         return (np.broadcast_to(q1[:, :, None], (n, 2, 2)).reshape(n, 4), wrist.theta2.reshape(n, 4),
                 valid.reshape(n, 4))
 
-    def solve_one(self, world_T_target: np.ndarray) -> scalar.OnePose | None:
+    def solve_one(self, world_T_target: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose | None:
         """:meth:`solve` of one target (4, 4) in scalar arithmetic (:mod:`._scalar`), with the slots' branch
         labels (:meth:`label_codes`) from the same quantities, or None when the pose is not clearly generic (then
         :meth:`solve` and :meth:`label_codes` decide). The one exception to "generic": the elbow may be clearly out
         of reach for some shoulder and wrist roots, which gives a least-squares slot and an empty one, as in
-        :meth:`solve`."""
+        :meth:`solve`. ``reference`` is not read: :meth:`solve` reads it only where this path declines."""
         try:
             return self._one_pose.solve(world_T_target)
         except scalar.NotGeneric:

@@ -25,11 +25,13 @@ ONE_POSE_ROBOTS = sorted(robot_id for robot_id, (robot, plan) in _PLANS.items() 
 
 
 def test_the_hot_families_are_covered():
-    """The PUMA type, the OPW type (KUKA, ABB, Fanuc: issue 24 asked for it) and the UR type."""
+    """The PUMA type, the OPW type (KUKA, ABB, Fanuc: issue 24 asked for it), the UR type and the Stanford type
+    (its slide through axis 2 shares the PUMA's structure name)."""
     structures = {cached_plan(_CATALOGUE.get(rid).robot, constrain_orientation=True, reference=None).structure
                   for rid in ONE_POSE_ROBOTS}
     assert structures == {"intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist",
                           "three_parallel"}
+    assert "spong_ex3_5_stanford" in ONE_POSE_ROBOTS
 
 
 @pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)
@@ -77,7 +79,7 @@ def test_single_pose_answers_do_not_depend_on_the_path(robot_id, monkeypatch):
     references = [None, random_configurations(robot, 1, seed=13)[0]]
     one_pose = [solve_ik(robot, T, reference=references[i % 2]) for i, T in enumerate(poses)]
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
-    monkeypatch.setattr(type(plan), "solve_one", lambda self, world_T_target: None)
+    monkeypatch.setattr(type(plan), "solve_one", lambda self, world_T_target, reference=None: None)
     for i, (T, fast) in enumerate(zip(poses, one_pose)):
         reference = references[i % 2]
         slow = solve_ik(robot, T, reference=reference)

@@ -12,14 +12,14 @@ from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
-from tests.arms import random_family_arm
+from tests.arms import random_family_arm, random_stanford_type_arm
 from tests.ik_helpers import stretched_elbow
 
 FAMILIES = ("intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist", "three_parallel")
 
 
 def _array_path(monkeypatch, plan) -> None:
-    monkeypatch.setattr(type(plan), "solve_one", lambda self, world_T_target: None)
+    monkeypatch.setattr(type(plan), "solve_one", lambda self, world_T_target, reference=None: None)
 
 
 def assert_same_answers(robot: Robot, fast: list, slow: list, tolerance: float) -> None:
@@ -72,6 +72,38 @@ def test_random_arms_of_the_families_answer_alike_on_both_paths(family, conventi
         monkeypatch.undo()
         assert_same_answers(robot, fast, slow, 1e-9)
     assert answered >= 0.9 * 4 * 40
+
+
+@pytest.mark.parametrize("convention", CONVENTIONS)
+def test_random_stanford_type_arms_answer_alike_on_both_paths(convention, monkeypatch):
+    """The Stanford type (a slide through axis 2, :class:`SlideThroughAxis2`, and a spherical wrist) on random arms
+    with random base and tool frames: poses from the arm's FK, a third of them with the slide within 1e-3 … 1e-12
+    of the crossing (where the shoulder's two solutions fold together and only the array path answers), with and
+    without the generating vector as reference. The scalar path answers most poses away from the crossing, and
+    both paths give the same solutions, labels and residuals, the generating vector among them there."""
+    answered = compared = 0
+    for seed in range(4):
+        robot = random_stanford_type_arm(convention, seed)
+        plan = cached_plan(robot, constrain_orientation=True, reference=None)
+        assert plan.positioner.slide_through_axis_2 is not None
+        foot = plan.positioner.slide_through_axis_2.foot
+        rng = np.random.default_rng(seed)
+        q = rng.uniform(-np.pi, np.pi, (45, 6))
+        q[:, 2] = rng.uniform(0.1, 0.6, 45) * rng.choice([-1, 1], 45)
+        q[::3, 2] = foot + rng.choice([1e-3, 1e-6, 1e-9, 1e-12], 15) * rng.choice([-1, 1], 15)
+        poses = forward_kinematics(robot, q)
+        references = [None if i % 2 else generating for i, generating in enumerate(q)]
+        answered += sum(plan.solve_one(T) is not None for T in poses[1::3])
+        fast = [solve_ik(robot, T, reference=reference) for T, reference in zip(poses, references)]
+        for generating, result in list(zip(q, fast))[1::3]:  # (near the crossing the pose may leave q2 free)
+            joints = np.array([s.joints for s in result.solutions])
+            assert np.abs(joint_difference(robot, joints, generating)).max(axis=1).min() <= 1e-7
+        _array_path(monkeypatch, plan)
+        slow = [solve_ik(robot, T, reference=reference) for T, reference in zip(poses, references)]
+        monkeypatch.undo()
+        assert_same_answers(robot, fast, slow, 1e-9)
+        compared += len(poses)
+    assert answered >= 0.9 * 4 * 15 and compared == 4 * 45
 
 
 _CATALOGUE = load_catalogue([Settings().builtin_robots_dir], max_joints=32)

@@ -38,7 +38,6 @@ from ._angles import wrap_angle
 from ._errors import InvalidInputError
 from ._tolerances import ORTHONORMAL_TOLERANCE, SINGULARITY_TOLERANCE
 
-
 __all__ = [
     "check_rotation",
     "check_transform",

@@ -415,12 +415,8 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
         y = scalar.sub(point_world, self.centre)
         height = scalar.dot(y, k1)
         radius = scalar.norm((y[0] - height * k1[0], y[1] - height * k1[1], y[2] - height * k1[2]))
-        along = (height - frame.height * frame.cos_alpha) / frame.sin_alpha
-        inner = abs(frame.height * frame.sin_alpha - along * frame.cos_alpha)
-        across_squared = (radius - inner) * (radius + inner)
         rounding = target_error(self.geometry, scalar.norm(point_world))
-        band_along = rounding / frame.sin_alpha
-        band_squared = 2 * rounding * (radius + inner + band_along)
+        along, _, across_squared, band_along, band_squared = frame.reach(height, radius, rounding)
         # clear of the bands: the two shoulder solutions apart (so joint 2 not free), the point off the centre
         if not (across_squared > scalar.MARGIN * band_squared and scalar.norm(y) > scalar.MARGIN * self.at_centre):
             raise scalar.NotGeneric
@@ -429,9 +425,9 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
             q1_ref, q2_ref, q3_ref = (float(value) for value in reference[:3])
             slide_ref, turn_ref = q3_ref - frame.foot, frame.psi0 + q2_ref
             along_ref, across_ref = slide_ref * math.cos(turn_ref), slide_ref * math.sin(turn_ref)
-            if _clearly_within(abs(along - along_ref), band_along):
+            if scalar.clearly_within(abs(along - along_ref), band_along):
                 along = along_ref
-            if _clearly_within(abs(across_ref * across_ref - across_squared), band_squared):
+            if scalar.clearly_within(abs(across_ref * across_ref - across_squared), band_squared):
                 across, first_sign = abs(across_ref), (-1.0 if across_ref < 0 else 1.0)
         on_first_axis = max(rounding / POLISH_RESIDUAL, self.at_centre)
         goal = self.first_turn.coordinates(y)
@@ -446,7 +442,7 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
                           frame.height * k2[2] + slide * (c * n1[2] + s * n2[2]))
                 start = self.first_turn.coordinates(turned)
                 q1 = scalar.Turn.angle(start, goal, on_first_axis / max(start[4], goal[4]))
-                if reference is not None and _clearly_within(abs(wrap_any_float(q1 - q1_ref)), rounding / radius):
+                if reference is not None and scalar.clearly_within(abs(wrap_any_float(q1 - q1_ref)), rounding / radius):
                     q1 = wrap_any_float(q1_ref)  # an azimuth seen on a radius r is known to rounding / r
                 if not scalar.MARGIN * scalar.norm(scalar.sub(scalar.rotate(k1, q1, turned), y)) \
                         <= self.exact_within:
@@ -456,16 +452,6 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
                 R_G = scalar.mm(scalar.rotation(k1, q1), scalar.rotation(k2, q2))
                 self._wrist_rows(R_G, axis_c, normal, [q1, q2, frame.foot + slide], (shoulder_code,), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
-
-
-def _clearly_within(gap: float, band: float) -> bool:
-    """Whether ``gap`` is inside ``band`` (True) or outside it (False) by :data:`._scalar.MARGIN`; NotGeneric
-    between, where the array path decides."""
-    if gap * scalar.MARGIN <= band:
-        return True
-    if gap > scalar.MARGIN * band:
-        return False
-    raise scalar.NotGeneric
 
 
 class _OffsetShoulderWristOnePose(_SphericalWristOnePose):

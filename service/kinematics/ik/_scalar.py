@@ -100,6 +100,16 @@ class OnePose:
         return table
 
 
+def clearly_within(gap: float, band: float) -> bool:
+    """Whether ``gap`` is inside ``band`` (True) or outside it (False) by :data:`MARGIN`; NotGeneric between, where
+    the array path decides (a reference value it takes within a band, say)."""
+    if gap * MARGIN <= band:
+        return True
+    if gap > MARGIN * band:
+        return False
+    raise NotGeneric
+
+
 def side_code(side: float, size: float) -> int | None:
     """:func:`._positioning.side_codes` for one value, None unless clear of its thresholds."""
     if abs(side) <= MARGIN * DUPLICATE_TOLERANCE * size:

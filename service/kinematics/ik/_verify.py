@@ -349,13 +349,13 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     kept = [row for row, keep in enumerate(first_of_each_slot(robot, rows, [size <= ACCEPT_RESIDUAL
                                                                             for size in sizes])) if keep]
     count = len(kept)
+    joints = np.array([rows[row] for row in kept], dtype=float).reshape(count, robot.dof)
     if reference is not None and count > 1:
-        joints = np.array([rows[row] for row in kept], dtype=float)
-        kept = [kept[i] for i in np.argsort(distance_to_reference(robot, joints, reference), kind="stable").tolist()]
+        nearest_first = np.argsort(distance_to_reference(robot, joints, reference), kind="stable").tolist()
+        kept, joints = [kept[i] for i in nearest_first], joints[nearest_first]
     codes = [one_pose.codes[slots[row]] for row in kept]
     if any(None in row for row in codes):
         return None
-    joints = np.array([rows[row] for row in kept], dtype=float).reshape(count, robot.dof)
     nearest = np.array([min(sizes, default=np.inf)])
     complete = promised(one_pose, np.array([count]), nearest, constrained)
     columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)

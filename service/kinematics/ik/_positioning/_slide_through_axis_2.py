@@ -62,6 +62,16 @@ class SlideThroughAxis2:
         return cls(float(offset @ k2), -float(offset @ v), n1, n2, float(np.arctan2(v @ n2, v @ n1)), cos_alpha,
                    sin_alpha)
 
+    def reach(self, height, radius, rounding) -> tuple:
+        """What a target y (from c) gives in this frame, from its ``height`` along axis 1, its ``radius`` from it
+        and its ``rounding`` (arrays, or floats for the one-pose path): ``B`` (``along``), ``|h sin α − B cos α|``
+        (``inner``), ``a² = radius² − inner²`` (a difference only where ±a meet) and the bands of B and of a²."""
+        along = (height - self.height * self.cos_alpha) / self.sin_alpha
+        inner = abs(self.height * self.sin_alpha - along * self.cos_alpha)
+        across_squared = (radius - inner) * (radius + inner)
+        band_along = rounding / self.sin_alpha
+        return along, inner, across_squared, band_along, 2 * rounding * (radius + inner + band_along)
+
     def solve(self, geometry: Geometry, joints: tuple[int, ...], centre: np.ndarray, targets: np.ndarray,
               reference: np.ndarray | None) -> PositionerResult:
         """The shoulder and its slide together (see the class for the frame and the equations): the joints
@@ -84,17 +94,12 @@ class SlideThroughAxis2:
         height = y @ k1
         radius = np.linalg.norm(y - height[:, None] * k1, axis=-1)  # from axis 1
         h = self.height
-        along = (height - h * self.cos_alpha) / self.sin_alpha  # B (N,)
-        # a² = ‖y‖² − h² − B² = radius² − (h sin α − B cos α)²: a difference only where ±a meet
-        inner = np.abs(h * self.sin_alpha - along * self.cos_alpha)
-        across_squared = (radius - inner) * (radius + inner)  # (N,)
         # the target's coordinates carry rounding relative to their size and the arm's, and the arm's own deviation
         # from this frame's relations (a URDF's nine digits: 1e-11) times the same lever: a point that close to
         # axis 1 is on it as far as the frame can tell (its azimuth would come from that error, and the orientation
         # that fixes q1 of a polar arm's pose would be missed)
         rounding = target_error(g, np.linalg.norm(targets, axis=-1))
-        band_along = rounding / self.sin_alpha
-        band_squared = 2 * rounding * (radius + inner + band_along)
+        along, inner, across_squared, band_along, band_squared = self.reach(height, radius, rounding)  # (N,) each
         met = across_squared <= band_squared  # the two shoulder solutions ±a meet: a = 0 represents them
         free = met & (np.abs(along) <= band_along)  # the point on axis 2: joint 2 does not move it
         # the point within half the acceptance of the centre (an arm without shoulder offset): every q1, q2

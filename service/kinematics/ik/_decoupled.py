@@ -20,7 +20,7 @@ from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, POLISH_RESIDUAL
 from . import _scalar as scalar
 from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
 from .._forward import JointTrig
-from ._screws import apply, chain_rotation, invert, perpendicular_unit, rotation_about
+from ._screws import apply, chain_rotation, invert, move_point, perpendicular_unit, rotate_about, rotation_about
 from ._structure import target_error
 from .subproblems import subproblem_1
 from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Sealed
@@ -194,6 +194,31 @@ class DecoupledPlan(Sealed):
         if not isinstance(self.wrist, SphericalWrist):
             return None
         return self.wrist.volume(joints[..., self.wrist.joints[1]])
+
+    def positioning_jacobian(self, joints: np.ndarray, size: float) -> np.ndarray | None:
+        """How the positioning joints steer the wrist centre at joint vectors (..., n): the centre's Jacobian over
+        their rates, shape (..., 3, 3), a revolute column ω_i × (c − p_i) in arm sizes ``size``, a prismatic one
+        its direction. It is written with joint 1's turn undone (its singular values, what it is for, are those of
+        any frame): there axes 1 and 2 are at home, joint 2 turns axis 3, and joints 2 and 3 move the centre.
+        None for a plan without a three-joint positioner and a spherical wrist."""
+        positioner = self.positioner
+        if not isinstance(self.wrist, SphericalWrist) or positioner is None or len(positioner.joints) != 3:
+            return None
+        model = positioner.model
+        directions, points, revolute = model.directions, model.points, model.is_revolute
+        q = joints[..., :3]
+        centre_by_3 = move_point(directions[2:], points[2:], revolute[2:], q[..., 2:], self.point)
+        centre = move_point(directions[1:2], points[1:2], revolute[1:2], q[..., 1:2], centre_by_3)
+
+        def column(i: int, at: np.ndarray) -> np.ndarray:
+            if revolute[i]:
+                return np.cross(directions[i], at - points[i]) / size
+            return np.broadcast_to(directions[i], at.shape)
+
+        third = column(2, centre_by_3)  # with joint 2's turn undone too: that turn brings it beside the others
+        if revolute[1]:
+            third = rotate_about(directions[1], q[..., 1], third)
+        return np.stack([column(0, centre), column(1, centre), third], axis=-1)
 
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """Branch labels of full joint vectors (M, n) as arrays: the positioner's, then the wrist's.

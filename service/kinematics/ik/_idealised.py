@@ -36,7 +36,8 @@ boundary or singular target). A row is claimed complete only when
    so the least-squares answers after it may lie far from a solution the true
    arm has, and criterion 2 would not see it); and no idealised solution has
    its spherical wrist within √(:data:`WRIST_ALIGNMENT_BAND` × δ) of aligning
-   its outer axes (see there);
+   its outer axes, a band that widens where the positioning joints steer the
+   wrist point poorly (see there);
 4. the idealised family promises the target on its own arm, and leaves no
    joint free for every pose target: along such a joint the idealised arm has a
    one-parameter family, the true arm isolated roots or none, and refining the
@@ -92,6 +93,13 @@ SINGULAR_MARGIN = 10.0
 #: true roots nearest the idealised read-off of q_a, not every one: the PUMA and Stanford arms moved by 1e-8 … 1e-5 at
 #: q5 ≈ π put their flip pair 1e-4 … 1e-2 from the alignment, refined to verified solutions clear of the true arm's
 #: singularities, and the pose's own configuration, 1.1 … 1.2 rad from every listed one, was left out.
+#:
+#: The change the wrist sees is δ through positioning joints that steer the wrist point well, and δ / σ through joints
+#: whose Jacobian at the point has a smallest singular value σ (in arm sizes,
+#: :meth:`~._decoupled.DecoupledPlan.positioning_jacobian`): their values, and the frame they hand the wrist, move
+#: by that much. So the band is √(max(this, 1 / σ) × δ). A Stanford arm moved by 1e-10 at q2 ≈ π (its wrist point
+#: 3e-6 from steering singular) and q5 ≈ 0 had its flip pair at 3.3 √δ, outside √(10 δ), and was promised without the
+#: pose's own configuration; with 1 / σ the band is 0.015 there.
 WRIST_ALIGNMENT_BAND = 10.0
 
 #: Newton (Gauss–Newton) steps from an idealised solution onto the true arm. The start is δ-close, so a regular root
@@ -204,11 +212,19 @@ class IdealisedPlan(Sealed):
 
     def _near_wrist_alignment(self, ideal_joints: np.ndarray, valid: np.ndarray) -> np.ndarray:
         """Which targets (N,) have a ``valid`` idealised candidate (N, m, n) whose spherical wrist is within the
-        band of :data:`WRIST_ALIGNMENT_BAND` of aligning its outer axes (all False for a family without one)."""
+        band of :data:`WRIST_ALIGNMENT_BAND` of aligning its outer axes, widened by how poorly the positioning
+        joints steer the wrist centre there (all False for a family without a spherical wrist)."""
         volume = self.inner.wrist_volume(ideal_joints) if hasattr(self.inner, "wrist_volume") else None
         if volume is None:
             return np.zeros(len(valid), dtype=bool)
-        return (valid & (volume <= np.sqrt(WRIST_ALIGNMENT_BAND * self.deviation))).any(axis=1)
+        near = valid & (volume ** 2 <= WRIST_ALIGNMENT_BAND * self.deviation)
+        # the others: within √(δ / σ), σ the steering's smallest singular value, where that is the wider band
+        rows, slots = np.nonzero(valid & ~near)
+        steering = self.inner.positioning_jacobian(ideal_joints[rows, slots], self.size) if len(rows) else None
+        if steering is not None:
+            widened = _smallest_singular_value_at_most(steering, self.deviation / volume[rows, slots] ** 2)
+            near[rows[widened], slots[widened]] = True
+        return near.any(axis=1)
 
     def _refined(self, q: np.ndarray, world_T_targets: np.ndarray, steps: int) -> np.ndarray:
         """Gauss–Newton steps on the true arm from joint vectors q (k, n) towards their targets (k, 4, 4)."""
@@ -314,3 +330,16 @@ class IdealisedPlan(Sealed):
 def _distinct_counts(robot: Robot, joints: np.ndarray, ok: np.ndarray) -> np.ndarray:
     """How many distinct joint vectors (revolute joints modulo 2π, within 1e-6) each row's ``ok`` slots hold."""
     return first_of_each(robot, joints, ok).sum(axis=1)
+
+
+def _smallest_singular_value_at_most(matrices: np.ndarray, bound: np.ndarray) -> np.ndarray:
+    """Whether each 3 × 3 matrix (K, 3, 3) has its smallest singular value at most ``bound`` (K,). σ₃ ≥ 2 |det| /
+    ‖·‖²_F (σ₁ σ₂ ≤ (σ₁² + σ₂²) / 2), so only the matrices that bound does not clear need their singular values:
+    a batch's steering is mostly far from singular."""
+    at_most = np.zeros(len(matrices), dtype=bool)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        floor = 2.0 * np.abs(np.linalg.det(matrices)) / np.einsum("kij,kij->k", matrices, matrices)
+    doubtful = np.flatnonzero(~(floor > bound))  # (a NaN floor, of a zero matrix, is doubtful)
+    if len(doubtful):
+        at_most[doubtful] = np.linalg.svd(matrices[doubtful], compute_uv=False)[:, -1] <= bound[doubtful]
+    return at_most

@@ -80,6 +80,11 @@ class ReversedPlan(Sealed):
         (its wrist at the base)."""
         return self.inner.wrist_volume(joints[..., ::-1])
 
+    def positioning_jacobian(self, joints: np.ndarray, size: float) -> np.ndarray | None:
+        """The inverse chain's :meth:`DecoupledPlan.positioning_jacobian` at joint vectors (..., n) of the chain
+        itself (its positioning joints are the chain's last three)."""
+        return self.inner.positioning_jacobian(joints[..., ::-1], size)
+
     def label_codes(self, joints: np.ndarray, trig: JointTrig | None = None) -> LabelCodes:
         """The inverse chain's labels (its wrist flip and its positioner's branches) of joint vectors (M, n)."""
         if self.own_label_codes is not None:

@@ -365,3 +365,88 @@ def test_a_wrist_at_the_base_measures_its_alignment_at_its_own_middle_joint():
     q[:, 1] = [0.0, h, 1e-3]
     q[:, 4] = 0.7
     assert np.allclose(plan.wrist_volume(q), [0.0, 1.0, math.sin(1e-3)], atol=1e-12)
+
+
+def _crossing(directions: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """The point nearest two lines (directions (2, 3), points (2, 3)): where a spherical wrist's axes cross."""
+    (a, b), (p, q) = directions, points
+    # p + s a and q + t b nearest each other: the normal equations of (p + s a) − (q + t b) ⟂ a, b
+    matrix = np.array([[a @ a, -(a @ b)], [a @ b, -(b @ b)]])
+    s, _ = np.linalg.solve(matrix, [(q - p) @ a, (q - p) @ b])
+    return p + s * a
+
+
+@pytest.mark.parametrize("arm", ["puma560_standard", "spong_ex3_5_stanford", "wrist at the base"])
+def test_the_positioning_jacobian_is_how_the_positioning_joints_move_the_wrist_centre(client, arm):
+    """The singular values of ``positioning_jacobian`` (what widens the band about a wrist's alignment) against an
+    independent
+    computation: the wrist centre where the DH frames' wrist axes cross, moved by central differences of the three
+    positioning joints (for a wrist at the base, the base's wrist centre as the tool frame sees it, moved by the
+    last three joints), revolute columns in arm sizes. Random poses, and poses where the centre steers singularly
+    (the PUMA's elbow stretched, the Stanford's slide along axis 1: the smallest reads ~0)."""
+    from service.kinematics._forward import joint_screws
+    from service.kinematics.ik._closed_form import cached_plan
+    from service.kinematics.ik._structure import arm_size
+
+    if arm == "wrist at the base":
+        h = math.pi / 2
+        rows = [(0, -h, 0.3, 0), (0, h, 0, 0), (0.4, 0, 0.1, 0), (0.35, 0, 0, 0), (0, h, 0, 0), (0, 0, 0.1, 0)]
+        robot = Robot([Joint(f"q{i}", "revolute", *row) for i, row in enumerate(rows)], name=arm)
+        steering, wrist = [5, 4, 3], [0, 1]
+    else:
+        robot = catalogue_robot(client, arm)
+        steering, wrist = [0, 1, 2], [3, 4]
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    size = arm_size(robot)
+
+    def centre(q: np.ndarray) -> np.ndarray:
+        screws = joint_screws(robot, q)
+        point = _crossing(screws.directions[wrist], screws.points[wrist])
+        if arm == "wrist at the base":  # the base's wrist centre in the tool frame
+            tool = screws.world_T_tool
+            return tool[:3, :3].T @ (point - tool[:3, 3])
+        return point
+
+    rng = np.random.default_rng(11)
+    q = rng.uniform(-np.pi, np.pi, (12, 6))
+    if arm == "spong_ex3_5_stanford":
+        q[:, 2] = rng.uniform(0.05, 0.4, 12)
+        q[0, 1] = 0.0  # the slide along axis 1: joints 1 and 3 move the centre along one line
+    if arm == "puma560_standard":  # the elbow stretched: forearm (a3, d4) in line with the upper arm
+        q[0, 2] = math.pi / 2 + math.atan2(robot.joints[2].a, robot.joints[3].d)
+    expected = []
+    for row in q:
+        columns = []
+        for j in steering:
+            step = np.zeros(6)
+            step[j] = 1e-6
+            change = (centre(row + step) - centre(row - step)) / 2e-6
+            columns.append(change / size if robot.is_revolute[j] else change)
+        expected.append(np.linalg.svd(np.stack(columns, axis=-1), compute_uv=False))
+    steering = plan.positioning_jacobian(q, size)
+    assert steering.shape == (12, 3, 3)
+    actual = np.linalg.svd(steering, compute_uv=False)
+    assert np.allclose(actual, expected, rtol=1e-5, atol=1e-8), (actual, expected)
+    assert actual[1:, -1].min() > 1e-3
+    if arm != "wrist at the base":
+        assert actual[0, -1] < 1e-9
+
+
+def test_the_smallest_singular_value_screen_agrees_with_the_singular_values():
+    """The wrist band's test "σ_min ≤ bound" of 3 × 3 steering Jacobians screens by 2 |det| / ‖·‖²_F before any
+    SVD: the same verdicts as the singular values themselves, on random, near-singular, rank-deficient and zero
+    matrices, with bounds on either side."""
+    from service.kinematics.ik._idealised import _smallest_singular_value_at_most
+
+    rng = np.random.default_rng(5)
+    u, _, vt = np.linalg.svd(rng.normal(size=(400, 3, 3)))
+    singular = np.sort(rng.uniform(0, 2, (400, 3)), axis=1)[:, ::-1]
+    singular[:100, 2] = 10.0 ** rng.uniform(-14, -2, 100)
+    singular[100:120, 2] = 0.0
+    singular[120:130] = 0.0
+    matrices = u @ (singular[..., None] * vt)
+    smallest = singular[:, 2]
+    for bound in (smallest * 0.9, smallest * 1.1 + 1e-300, np.full(400, 0.05), np.zeros(400)):
+        verdicts = _smallest_singular_value_at_most(matrices, bound)
+        exact = np.linalg.svd(matrices, compute_uv=False)[:, -1] <= bound
+        assert np.array_equal(verdicts, exact)

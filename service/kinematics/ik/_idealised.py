@@ -27,7 +27,8 @@ boundary or singular target). A row is claimed complete only when
    at least 1e-3 δ is clearly apart and does not count);
 3. the idealised family reports no singularity for the target (a free joint or
    merged roots, whose continuation under the perturbation is not isolated),
-   and no solution is within :data:`SINGULAR_MARGIN` × δ of a singularity of
+   and no solution is within :data:`SINGULAR_MARGIN` × δ (or
+   :data:`SINGULAR_FLOOR` × √δ) of a singularity of
    the true arm (σ_min of its scaled Jacobian, and of its position rows alone
    for an arm with fewer joints than the pose constrains, whose positioning
    joints may be singular where the whole Jacobian is not); for a row with no solution at
@@ -85,6 +86,15 @@ IDEAL_RESIDUAL = 1e-7
 #: follow, so the row is not claimed complete. (Root pairs meeting at a fold need no such margin: a pair that
 #: vanishes fails criterion 1, a pair that appears is a near miss, criterion 2.)
 SINGULAR_MARGIN = 10.0
+
+#: ... and within this many times √δ, where that is wider (arms moved by less than (this / SINGULAR_MARGIN)² = 1e-6).
+#: Where two singular sets meet, σ_min is about the product of the distances from each, and the idealised family's
+#: root pairs there meet, which moves them by √δ, not δ: Stanford arms moved by 1e-10 with the slide 1e-7 from the
+#: shoulder's centre and the wrist at q5 ≈ π read σ_min of 15–35 δ (5e-4 √δ) at the refined solutions, eight of them
+#: verified, and the pose's own configuration, 1.5 rad from every one, was left out; UR5s moved by 1e-10 with q5 and
+#: q2 near singular (23 of 150 such poses) listed none within 1e-3 … 0.05 rad of their own. At this floor the arms
+#: rounded as CAD exports round (δ ≥ 1e-6) keep their margin of 10 δ.
+SINGULAR_FLOOR = 0.01
 
 #: An idealised solution whose spherical wrist is within √(this × δ) of aligning its outer axes (the wrist's volume,
 #: :meth:`~._decoupled.DecoupledPlan.wrist_volume`) marks the row incomplete. At the alignment the idealised arm has a
@@ -196,7 +206,8 @@ class IdealisedPlan(Sealed):
             # radius the deviation turns, though the whole Jacobian keeps its rank
             smallest = self._smallest_singular_value(joints[rows, slots],
                                                      with_position_rows=self.under_determined)
-            singular[rows[smallest <= SINGULAR_MARGIN * self.deviation]] = True
+            margin = max(SINGULAR_MARGIN * self.deviation, SINGULAR_FLOOR * np.sqrt(self.deviation))
+            singular[rows[smallest <= margin]] = True
         for mask, _ in ideal.singularities.entries:
             singular |= mask
         singular |= near_alignment

@@ -552,6 +552,45 @@ def test_a_rounded_stanford_arm_near_its_wrist_and_steering_singularities_keeps_
     _assert_keeps_its_promise(robot, np.array(q), within=1e-3)
 
 
+def test_a_rounded_stanford_arm_with_its_slide_at_the_shoulder_centre_and_its_wrist_aligned_keeps_its_promise(
+        client):
+    """A Stanford arm moved by ~1e-10 (probe of compound singular poses, seed 1) with its slide 4e-7 from the
+    shoulder's centre and q5 ≈ π: the idealised arm's eight solutions refined to verified ones, 1.5 rad from the
+    pose's own configuration, at σ_min 19 δ (5e-4 √δ), above the margin 10 δ: promised complete without it. The
+    margin is now at least 0.01 √δ."""
+    rows = [("revolute", 1.4895120514085116e-10, -1.5707963267941887, -8.60679215850809e-11, 1.2136573526519552e-10),
+            ("revolute", 2.5848465054587603e-10, 1.5707963267925467, 0.15400000014184123, -1.398549236535486e-11),
+            ("prismatic", 1.3811515428893074e-10, -2.1146916317834153e-11, 1.363629613548333e-10,
+             5.7786419353016376e-11),
+            ("revolute", -1.468555652024755e-11, -1.5707963267673095, -5.0071549158475175e-11, -1.0825896458679949e-10),
+            ("revolute", -1.010638872726471e-10, 1.5707963267940355, -1.0073091864192881e-10, 4.9346385291007784e-11),
+            ("revolute", 5.872507858431451e-11, 5.28747238860147e-11, 0.2629999999563055, 1.1835167154327166e-11)]
+    base = catalogue_robot(client, "spong_ex3_5_stanford")
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="moved spong_ex3_5_stanford",
+                  convention=base.convention, world_T_base=base.world_T_base, flange_T_tool=base.flange_T_tool)
+    q = np.array([1.5899246242258913, 1.0974361765670679e-05, 4.1364345501173705e-07, -2.8979363845847823,
+                  3.1411454200269935, 0.9926683740336069])
+    _assert_keeps_its_promise(robot, q, within=1e-3)
+
+
+def test_a_rounded_ur5_at_its_wrist_and_shoulder_singularities_keeps_its_promise(client):
+    """A UR5 moved by ~1e-10 (probe of compound singular poses, seed 2: 23 of 150 such poses were promised complete
+    without their own configuration) at q5 = −5e-9 (axes 4 and 6 parallel) and q2 = −3e-4: the nearest listed
+    solution was 0.054 rad from the pose's own, σ_min there 2e-4 √δ. The margin is now at least 0.01 √δ."""
+    rows = [("revolute", -8.015427671500807e-11, 1.5707963267393033, 0.08915899979698207, 8.364267122819928e-12),
+            ("revolute", -0.4250000001026891, -5.558396885780595e-11, -5.270033876704208e-12, 3.13835120636449e-11),
+            ("revolute", -0.39224999981108283, 2.043963634083679e-11, -1.4132649523126865e-10, 1.307464965923751e-11),
+            ("revolute", -5.957258433447798e-11, 1.570796326834835, 0.10914999993144722, -7.084067849532788e-11),
+            ("revolute", -5.112637703176611e-11, -1.5707963268576528, 0.0946499998175219, -6.68271701024572e-11),
+            ("revolute", -1.4011094578567577e-12, 1.2004887538923004e-10, 0.0822999999706822, -3.717423549172949e-11)]
+    base = catalogue_robot(client, "ur5")
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="moved ur5", convention=base.convention,
+                  world_T_base=base.world_T_base, flange_T_tool=base.flange_T_tool)
+    q = np.array([-0.19523239657124147, -0.0003168676918203973, -1.5707963146406647, 1.258938078284765,
+                  -4.565993401326053e-09, -1.8134090148719715])
+    _assert_keeps_its_promise(robot, q, within=1e-3)
+
+
 def test_a_free_positioning_joint_is_not_held_where_the_wrist_cannot_turn_every_way():
     """A five-joint arm (a random arm of the sweep, as written): two parallel axes place the wrist point, which
     lies on axis 2, so q2 is free for every target and held at 0; its spherical wrist's last two axes are 171°

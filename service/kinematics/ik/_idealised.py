@@ -197,9 +197,13 @@ class IdealisedPlan(Sealed):
         singular = np.zeros(len(world_T_targets), dtype=bool)
         # (a row without a verified solution is checked at every candidate: at a singularity a downstream step of
         # the closed form is ill-conditioned, e.g. q6 from q5 ≈ 0, so a least-squares answer's residual there
-        # does not bound how far the target is from a root pair, and "unreachable" could not be promised)
+        # does not bound how far the target is from a root pair, and "unreachable" could not be promised; so is
+        # every slot the family left empty whose value comes within √δ, the distance a root pair that meets moves:
+        # where two singular sets meet, a subproblem's least-squares answer is not the arm's closest approach, and
+        # a Stanford arm moved by 1e-8 missed its own poses by 80–350 δ from there, promised unreachable)
         unanswered = ~accepted.any(axis=1)
-        rows, slots = np.nonzero(accepted | (finite & ideal.valid & unanswered[:, None]))
+        close = finite & (after <= np.sqrt(self.deviation))
+        rows, slots = np.nonzero(accepted | (finite & (ideal.valid | close) & unanswered[:, None]))
         if len(rows):
             # an arm with fewer joints than the pose constrains is placed by its positioning joints: where their
             # position Jacobian is singular (a joint the position leaves free), the family reads that joint off a

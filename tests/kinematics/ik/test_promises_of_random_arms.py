@@ -591,6 +591,28 @@ def test_a_rounded_ur5_at_its_wrist_and_shoulder_singularities_keeps_its_promise
     _assert_keeps_its_promise(robot, q, within=1e-3)
 
 
+def test_a_rounded_stanford_arm_whose_least_squares_answers_miss_at_a_compound_singularity_is_not_unreachable(
+        client):
+    """A Stanford arm moved by ~1e-8 (probe of compound singular poses, seed 2: 13 of 150 such poses were promised
+    unreachable) with its slide 2e-6 from the shoulder's centre, q2 ≈ π and q5 ≈ π: the idealised family left
+    every slot empty, its least-squares answers 80 δ from the target (not the arm's closest approach, which is a
+    few δ: the pose is the arm's own), outside the near-miss margin 50 δ; the row had no solution at which to
+    measure σ_min. Those answers come within √δ, where σ_min is 0.03 δ: not promised, and the search finds it."""
+    rows = [("revolute", 1.0056038349126575e-09, -1.5707963199524808, -4.298193691923153e-09, -1.7912308228410455e-08),
+            ("revolute", -5.312556589354431e-09, 1.5707963344248492, 0.1539999991546734, 2.297891839639593e-09),
+            ("prismatic", -1.0804018069049535e-08, 1.4322291081554303e-09, 7.281669899188168e-09,
+             3.644802049061874e-10),
+            ("revolute", 1.9080145903201174e-08, -1.5707963288728324, -1.0413502363373356e-08, -1.6176592423461078e-08),
+            ("revolute", 1.1520058911926843e-08, 1.5707963262047142, 1.0116217798624403e-08, 4.576689187720854e-09),
+            ("revolute", 1.6250842905757967e-08, 1.2661073627611317e-08, 0.2629999962244544, 2.7388490091419323e-09)]
+    base = catalogue_robot(client, "spong_ex3_5_stanford")
+    robot = Robot([Joint(f"q{i}", *row) for i, row in enumerate(rows)], name="moved spong_ex3_5_stanford",
+                  convention=base.convention, world_T_base=base.world_T_base, flange_T_tool=base.flange_T_tool)
+    q = np.array([-0.20203957259769467, 3.141605039122987, 1.894284620827778e-06, -1.8733925332519352,
+                  3.141399597915735, 0.7402717338248985])
+    _assert_keeps_its_promise(robot, q, within=1e-3)
+
+
 def test_a_free_positioning_joint_is_not_held_where_the_wrist_cannot_turn_every_way():
     """A five-joint arm (a random arm of the sweep, as written): two parallel axes place the wrist point, which
     lies on axis 2, so q2 is free for every target and held at 0; its spherical wrist's last two axes are 171°

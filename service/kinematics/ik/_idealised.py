@@ -32,7 +32,8 @@ boundary or singular target). A row is claimed complete only when
    the true arm (σ_min of its scaled Jacobian, and of its position rows alone
    for an arm with fewer joints than the pose constrains, whose positioning
    joints may be singular where the whole Jacobian is not); for a row with no solution at
-   all, no candidate is (there a step of the closed form is ill-conditioned:
+   all, no candidate is, nor any slot left empty whose value comes within √δ
+   of the target (there a step of the closed form is ill-conditioned:
    the UR type's q6 from q5 ≈ 0 turns by O(1) under a δ change of the target,
    so the least-squares answers after it may lie far from a solution the true
    arm has, and criterion 2 would not see it); and no idealised solution has

@@ -39,7 +39,7 @@ boundary or singular target). A row is claimed complete only when
    arm has, and criterion 2 would not see it); and no idealised solution has
    its spherical wrist within √(:data:`WRIST_ALIGNMENT_BAND` × δ) of aligning
    its outer axes, a band that widens where the positioning joints steer the
-   wrist point poorly (see there);
+   wrist centre poorly (see there);
 4. the idealised family promises the target on its own arm, and leaves no
    joint free for every pose target: along such a joint the idealised arm has a
    one-parameter family, the true arm isolated roots or none, and refining the
@@ -105,11 +105,11 @@ SINGULAR_FLOOR = 0.01
 #: q5 ≈ π put their flip pair 1e-4 … 1e-2 from the alignment, refined to verified solutions clear of the true arm's
 #: singularities, and the pose's own configuration, 1.1 … 1.2 rad from every listed one, was left out.
 #:
-#: The change the wrist sees is δ through positioning joints that steer the wrist point well, and δ / σ through joints
-#: whose Jacobian at the point has a smallest singular value σ (in arm sizes,
+#: The change the wrist sees is δ through positioning joints that steer the wrist centre well, and δ / σ through joints
+#: whose Jacobian at the centre has a smallest singular value σ (in arm sizes,
 #: :meth:`~._decoupled.DecoupledPlan.positioning_jacobian`): their values, and the frame they hand the wrist, move
-#: by that much. So the band is √(max(this, 1 / σ) × δ). A Stanford arm moved by 1e-10 at q2 ≈ π (its wrist point
-#: 3e-6 from steering singular) and q5 ≈ 0 had its flip pair at 3.3 √δ, outside √(10 δ), and was promised without the
+#: by that much. So the band is √(max(this, 1 / σ) × δ). A Stanford arm moved by 1e-10 at q2 ≈ π (the steering's σ
+#: 3e-6) and q5 ≈ 0 had its flip pair at 3.3 √δ, outside √(10 δ), and was promised without the
 #: pose's own configuration; with 1 / σ the band is 0.015 there.
 WRIST_ALIGNMENT_BAND = 10.0
 

@@ -808,8 +808,8 @@ def test_rounded_arms_keep_their_promises_where_two_singular_sets_meet(client, r
     """Catalogue arms moved by ``sigma`` (every DH parameter), at poses near two singular sets at once: q2 and q5
     1e-9 … 1e-3 from 0, ±π/2 or π, and joint 3 often too (the Stanford's slide 1e-7 … 1e-2 from the shoulder's
     centre). No pose of the arm's own FK is promised unreachable, and a complete answer without a flag lists the
-    pose's own configuration. Before the seventeenth stop 1 pose in 8 of the Stanford's and UR5's broke one of
-    these (compound probe, 150 poses each); most such poses answer ``complete: false`` now, honestly."""
+    pose's own configuration. Before the seventeenth stop 19 of 150 of the Stanford's poses and 23 of 150 of the
+    UR5's broke one of these (compound probe); most such poses answer ``complete: false`` now, honestly."""
     rng = np.random.default_rng(seed)
     base = catalogue_robot(client, robot_id)
     for _ in range(30):

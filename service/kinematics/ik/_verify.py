@@ -339,23 +339,30 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
 
     None where :func:`verify` would polish a candidate, a candidate's error is NaN, or a kept row's label is not
     clear: then :func:`verify` of the candidates (or the array path) decides."""
-    slots = [slot for slot, q in enumerate(one_pose.rows) if q is not None]
-    rows = [one_pose.rows[slot] for slot in slots]  # revolute joints wrapped already: verify's wrap leaves them
+    rows, codes = [], []  # the valid slots' joints (revolute ones wrapped already: verify's wrap leaves them)
+    for q, code in zip(one_pose.rows, one_pose.codes):
+        if q is not None:
+            rows.append(q)
+            codes.append(code)
     constrained = goal.constrain_orientation
     residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist()) if rows else []
-    sizes = [error_size(robot, position, orientation, constrained) for position, orientation in residuals]
-    if any(size != size or polished(size) for size in sizes):  # a NaN error, or one verify would polish
-        return None
-    kept = [row for row, keep in enumerate(first_of_each_slot(robot, rows, [size <= ACCEPT_RESIDUAL
-                                                                            for size in sizes])) if keep]
+    sizes, ok = [], []
+    for position, orientation in residuals:
+        size = error_size(robot, position, orientation, constrained)
+        if size != size or polished(size):  # a NaN error, or one verify would polish
+            return None
+        sizes.append(size)
+        ok.append(size <= ACCEPT_RESIDUAL)
+    kept = [row for row, keep in enumerate(first_of_each_slot(robot, rows, ok)) if keep]
     count = len(kept)
     joints = np.array([rows[row] for row in kept], dtype=float).reshape(count, robot.dof)
     if reference is not None and count > 1:
         nearest_first = np.argsort(distance_to_reference(robot, joints, reference), kind="stable").tolist()
         kept, joints = [kept[i] for i in nearest_first], joints[nearest_first]
-    codes = [one_pose.codes[slots[row]] for row in kept]
-    if any(None in row for row in codes):
-        return None
+    codes = [codes[row] for row in kept]
+    for row in codes:
+        if None in row:
+            return None
     nearest = np.array([min(sizes, default=np.inf)])
     complete = promised(one_pose, np.array([count]), nearest, constrained)
     columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)

@@ -39,7 +39,9 @@ boundary or singular target). A row is claimed complete only when
    arm has, and criterion 2 would not see it); and no idealised solution has
    its spherical wrist within √(:data:`WRIST_ALIGNMENT_BAND` × δ) of aligning
    its outer axes, a band that widens where the positioning joints steer the
-   wrist centre poorly (see there);
+   wrist centre poorly (see there), nor its wrist centre within
+   √(:data:`AXIS_2_BAND` × δ) arm sizes of axis 2, where joint 2 is free (for a
+   row with no solution, no candidate's);
 4. the idealised family promises the target on its own arm, and leaves no
    joint free for every pose target: along such a joint the idealised arm has a
    one-parameter family, the true arm isolated roots or none, and refining the
@@ -112,6 +114,21 @@ SINGULAR_FLOOR = 0.01
 #: 3e-6) and q5 ≈ 0 had its flip pair at 3.3 √δ, outside √(10 δ), and was promised without the
 #: pose's own configuration; with 1 / σ the band is 0.015 there.
 WRIST_ALIGNMENT_BAND = 10.0
+
+#: An idealised candidate whose wrist centre is within √(this × δ) arm sizes of axis 2 marks the row incomplete: there
+#: joint 2 turns the centre about itself (it is free on the axis), the idealised arm has a one-parameter family, and
+#: the true arm's roots near it are not the idealised ones continued. The Stanford type passes its slide through
+#: axis 2; an idealised arm whose slide line misses the axis by δ is solved from the reach alone (the slide known to
+#: √(h δ) there, h the shoulder's offset). Stanford arms moved by 1e-6 (δ 2.5e-6) with the slide 1e-7 … 1e-5 from the
+#: crossing listed eight refined solutions whose centre was 0.9 … 1.7 √δ from the axis, clear of the true
+#: arm's singularities (σ_min 2e-4 … 4e-4 against a margin of 2.5e-5), and not the pose's own configuration (slide
+#: 1e-7, 1.6 rad from every listed one): 5 of 100 such poses at each of two seeds; a third promised one unreachable,
+#: its least-squares candidates at the crossing (so a candidate of a row without a solution counts too). At 5 the
+#: rounded catalogue arms and the Doosan M1013 URDF keep their promises but for 5 of 500 of the Fanuc LR Mate's (8 →
+#: 13). Axis 1 needs no band: its distance is the shoulder's free joint of every arm, where 0 of 500 poses of KR6,
+#: IRB120 and LR Mate arms moved by 1e-10 … 1e-6 with the centre 1e-7 … 1e-2 from it broke a promise, and a band
+#: of 10 δ on every positioning axis withdrew 39 of the Doosan's 500 (35 → 74 incomplete).
+AXIS_2_BAND = 5.0
 
 #: Newton (Gauss–Newton) steps from an idealised solution onto the true arm. The start is δ-close, so a regular root
 #: is reached to machine precision in two or three; more steps only help near a fold, which criterion 3 excludes.
@@ -216,6 +233,7 @@ class IdealisedPlan(Sealed):
         for mask, _ in ideal.singularities.entries:
             singular |= mask
         singular |= near_alignment
+        singular |= self._near_axis_2(ideal_joints, finite & (ideal.valid | unanswered[:, None]))
         # a row where the idealised family gave no candidate at all (not even a least-squares one) has no near miss
         # to measure: its "no solution" is the idealised arm's, which the true one need not share
         complete = converged & distinct & ~near_miss & ~singular & ~rescued & finite.any(axis=1)
@@ -241,6 +259,20 @@ class IdealisedPlan(Sealed):
             widened = _smallest_singular_value_at_most(steering, self.deviation / volume[rows, slots] ** 2)
             near[rows[widened], slots[widened]] = True
         return near.any(axis=1)
+
+    def _near_axis_2(self, ideal_joints: np.ndarray, valid: np.ndarray) -> np.ndarray:
+        """Which targets (N,) have a ``valid`` idealised candidate (N, m, n) whose wrist centre is within
+        √(:data:`AXIS_2_BAND` × δ) arm sizes of axis 2, where joint 2 turns it about itself: the norm of joint 2's
+        column of the positioning Jacobian (all False for a family without a spherical wrist and a three-joint
+        positioner)."""
+        near = np.zeros(len(valid), dtype=bool)
+        rows, slots = np.nonzero(valid)
+        steering = self.inner.positioning_jacobian(ideal_joints[rows, slots], self.size) \
+            if len(rows) and hasattr(self.inner, "positioning_jacobian") else None
+        if steering is not None:
+            from_axis_2 = np.linalg.norm(steering[:, :, 1], axis=-1)
+            near[rows[from_axis_2 ** 2 <= AXIS_2_BAND * self.deviation]] = True
+        return near
 
     def _refined(self, q: np.ndarray, world_T_targets: np.ndarray, steps: int) -> np.ndarray:
         """Gauss–Newton steps on the true arm from joint vectors q (k, n) towards their targets (k, 4, 4)."""

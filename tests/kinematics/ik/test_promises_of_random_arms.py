@@ -772,6 +772,52 @@ def test_a_spherical_arm_written_to_twelve_digits_reaches_its_pose_with_the_poin
     _assert_reaches_its_own_pose(rows, [1e-09, -3.141592654589793, 0.17012525416153662])
 
 
+#: Spong's Stanford arm with every DH parameter moved by N(0, 1e-6) (δ 2.5e-6), standard DH rows (kind, a, alpha, d,
+#: theta): the compound probe's seed 7, pose 11, whose own configuration has the slide 1.2e-7 from axis 2.
+_STANFORD_MOVED_SEED_7 = [
+    ("revolute", -1.1509135213108616e-06, -1.5707952146876247, 1.0626506057881553e-06, 1.0847512652964208e-06),
+    ("revolute", -4.7405047060852816e-07, 1.5707968413154598, 0.15399986793049478, -3.8881206140248164e-07),
+    ("prismatic", -3.391456571420661e-07, -1.2997152730341505e-06, -1.443863695895121e-06, 7.943147908760457e-07),
+    ("revolute", -1.9123540391952005e-07, -1.5707961103700454, 1.0017103884541198e-06, -1.7331324950160742e-06),
+    ("revolute", -7.841300738158939e-07, 1.57079650212974, 3.9209478666557293e-07, -3.7707445040109675e-07),
+    ("revolute", 1.0291792326978485e-06, 2.103949388296369e-07, 0.2629987866178612, -9.307637759906452e-07)]
+
+#: ... and seed 10, pose 89 (the slide 7.6e-4 from axis 2, the wrist 4e-6 from aligned).
+_STANFORD_MOVED_SEED_10 = [
+    ("revolute", -1.1096791460933325e-06, -1.5707968045446785, 5.312215909420461e-07, 1.563521275339339e-06),
+    ("revolute", -1.2142375481266075e-06, 1.5707974413891117, 0.1539999820936785, -4.916837155387072e-07),
+    ("prismatic", -4.526780112827665e-07, -9.066129258633622e-08, -3.5095103153257084e-07, -4.6823083069970067e-07),
+    ("revolute", 8.046801763028485e-08, -1.5707968648866668, 1.3363937977454958e-06, 1.4773558180697829e-06),
+    ("revolute", 5.275002557708878e-07, 1.5707964913554253, 1.135667641899068e-06, -8.025715205538531e-07),
+    ("revolute", 4.348472332124233e-07, 3.2233183115715275e-07, 0.263001573944104, -1.3727694123155524e-06)]
+
+
+def _standard_arm(rows: list[tuple]) -> Robot:
+    return Robot([Joint(f"q{i}", kind, a, alpha, d, theta) for i, (kind, a, alpha, d, theta) in enumerate(rows)],
+                 name="probe", convention="standard")
+
+
+def test_a_moved_stanford_arm_with_its_slide_by_axis_2_is_not_promised_complete_without_its_own_pose():
+    """The idealised arm's slide line misses axis 2 by δ, so it is solved from the reach alone, and its eight
+    solutions put the wrist centre 6e-4 (0.9 √δ arm sizes) from the axis, where joint 2 is all but free; the pose's
+    own configuration (the slide 1.2e-7 from the axis) is another root of the arm as given, 1.6 rad from every one
+    of them, and the answer was complete. Within √(5 δ) of axis 2 the promise is withdrawn."""
+    _assert_keeps_its_promise(_standard_arm(_STANFORD_MOVED_SEED_7),
+                              np.array([-0.5335151064635508, -4.121261871964126e-05, 1.1944346257137793e-07,
+                                        -1.036247927725244, 2.3283721322089746e-05, -1.828171883847134]),
+                              within=1e-3)
+
+
+def test_a_moved_stanford_arm_with_its_slide_by_axis_2_is_not_promised_unreachable():
+    """The idealised arm found its own pose out of reach (the slide read off the reach, 9e-7 past the crossing),
+    its least-squares candidates 1.8e-3 away with the wrist centre at the axis; the pose was promised
+    unreachable. A row without a solution whose candidate sits by axis 2 is not a proof; the numeric search finds
+    the pose's own configuration."""
+    q = np.array([1.0080954748727127, -2.2892165023308265e-07, 0.0007632251260355309, -2.2540736773986914,
+                  4.083093560321396e-06, -1.8154812487428995])
+    _assert_keeps_its_promise(_standard_arm(_STANFORD_MOVED_SEED_10), q, within=1e-6, excused_by_flags=False)
+
+
 def _assert_keeps_its_promise(robot: Robot, q: np.ndarray, *, within: float, excused_by_flags: bool = True) -> None:
     """The pose of the arm's own FK at q is answered ``ok``, every solution FK-verified, and a complete answer lists
     q within ``within`` (rad, or length units), unless (``excused_by_flags``) it names a singularity that makes q one

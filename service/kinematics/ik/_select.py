@@ -37,6 +37,7 @@ capped at :data:`.._budget.COUNT_CAP`.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
@@ -72,6 +73,11 @@ NOTE_WORDING = {
     "collide": "{collided} solutions collide (a pair of shapes closer than the margin); they are listed in "
                "'rejected' with their collisions.",
 }
+
+#: Up to this many combinations in all, one target's solutions without a reference are put in order on Python
+#: integers (:func:`_few_in_turn`), where :func:`_nearest`'s few dozen array steps cost more than the arithmetic: a
+#: PUMA 560 with its catalogue limits has 8 … 40 per pose.
+_FEW_COMBINATIONS = 64
 
 #: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
 _CHUNK_ROWS = 1 << 18
@@ -276,12 +282,15 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     lowered = limit > enumerable_limit(n) and bool((combinations > MAX_COMBINATIONS_PER_SOLUTION).any())
     if lowered:
         limit = enumerable_limit(n)
-    if reference is not None:
-        row_limit = np.full(len(c_target), limit, dtype=np.int64)
-    else:  # round robin: no solution gives more than the rounds needed to reach the limit
-        row_limit = rounds_needed(c_target, combinations, n_targets, limit)[c_target]
-    kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
-                                      reference, ordering, budget)
+    if reference is None and n_targets == 1 and int(combinations.sum()) <= _FEW_COMBINATIONS:
+        kept_rows, kept_values = _few_in_turn(c_q, c_first, c_last, limit)
+    else:
+        if reference is not None:
+            row_limit = np.full(len(c_target), limit, dtype=np.int64)
+        else:  # round robin: no solution gives more than the rounds needed to reach the limit
+            row_limit = rounds_needed(c_target, combinations, n_targets, limit)[c_target]
+        kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
+                                          reference, ordering, budget)
     kept_rows = candidates[kept_rows]
     kept = table.take(kept_rows, joints=kept_values, within_limits=fits[kept_rows])
 
@@ -491,6 +500,37 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     rows, values = rows[order], values[order]
     first_few = position_in_group(target[rows]) < limit
     return rows[first_few], values[first_few]
+
+
+def _few_in_turn(q: np.ndarray, first: np.ndarray, last: np.ndarray, limit: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_nearest` of one target's candidate rows without a reference where they have few combinations in
+    all (:data:`_FEW_COMBINATIONS`), on Python integers: the same kept rows (K,) and values (K, n), in the same
+    order. ``q``, ``first``, ``last`` (S, n) are the rows' values and usable turns.
+
+    Each row's combinations come cheapest first (Σ|k|), equal costs in the lexicographic order of their rank
+    tuples, a joint's turns ranked by |k| and the lower first (:func:`._equivalents._ranked_turns` without a
+    reference); the rows take turns, one combination each, and the first ``limit`` are kept. :func:`_nearest`
+    enumerates only the rank tuples with ∏(r_j + 1) within a row's share of the rounds, which holds every
+    combination this order puts among the first ``limit``: the ∏(r_j + 1) tuples at or below a tuple cost no more
+    and precede it."""
+    streams = []
+    for row_first, row_last in zip(first.astype(np.int64).tolist(), last.astype(np.int64).tolist()):
+        if row_first == row_last:  # one usable turn per joint (limits within a turn): one combination
+            streams.append([tuple(row_first)])
+            continue
+        ranked = [(low,) if low == high else sorted(range(low, high + 1), key=lambda k: (abs(k), k))
+                  for low, high in zip(row_first, row_last)]
+        streams.append(sorted(itertools.product(*ranked), key=lambda turns: sum(map(abs, turns))))  # stable
+    rows, turns = [], []
+    for position in range(max(map(len, streams), default=0)):
+        for row, stream in enumerate(streams):
+            if position < len(stream):
+                rows.append(row)
+                turns.append(stream[position])
+    rows, turns = rows[:limit], turns[:limit]
+    # q + 2πk as _nearest computes it: 2πk first, then q added
+    values = np.array(turns, dtype=float).reshape(len(rows), q.shape[1]) * _TWO_PI + q.take(rows, axis=0)
+    return np.array(rows, dtype=np.int64), values
 
 
 def _target_edges(target: np.ndarray, before: np.ndarray, bound: np.ndarray, edges: np.ndarray) -> np.ndarray:

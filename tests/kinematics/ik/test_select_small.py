@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from service.config import Settings
-from service.kinematics import Limits, forward_kinematics
+from service.kinematics import UNLIMITED, Limits, forward_kinematics
 from service.kinematics.ik import AnswerOptions, IKTargets, Ordering, SolutionTable, answer_ik, select, solve_ik_arrays
 from service.kinematics.ik import _equivalents, _select
 from tests.selection import table_of_arrays
@@ -108,7 +108,7 @@ def _select_both(robot, target, options, rng, monkeypatch):
 @pytest.fixture
 def calls(monkeypatch):
     """Counts of the selection's few-rows and general forms, as the cases call them."""
-    counted = {"few rows": 0, "general": 0, "each once": 0}
+    counted = {"few rows": 0, "general": 0, "each once": 0, "few in turn": 0}
 
     def counting(function, key):
         def wrapper(*args, **kwargs):
@@ -119,6 +119,7 @@ def calls(monkeypatch):
     monkeypatch.setattr(_equivalents, "_row_rank_tuples", counting(_equivalents._row_rank_tuples, "few rows"))
     monkeypatch.setattr(_equivalents, "_tabled_turns", counting(_equivalents._tabled_turns, "general"))
     monkeypatch.setattr(_select, "_each_once", counting(_select._each_once, "each once"))
+    monkeypatch.setattr(_select, "_few_in_turn", counting(_select._few_in_turn, "few in turn"))
     return counted
 
 
@@ -138,9 +139,50 @@ def test_one_target_selects_as_the_general_path(monkeypatch, calls):
         assert _rows(answer.rejected, 0) == _rows(mine.rejected, 0), case
         assert (answer.status[0], answer.available[0], answer.trimmed[0]) == (
             mine.status[0], mine.available[0], mine.trimmed[0])
-    # the cases exercise the few-rows forms, the rows kept once each and the general one, and rank many equivalents
-    assert ranked > 50 and calls["general"] > 50 and calls["each once"] > 30 and kept_many > 100, (
-        ranked, calls, kept_many)
+    # the cases exercise the few-rows forms, the few combinations put in turn on integers, the rows kept once each
+    # and the general one, and rank many equivalents
+    assert ranked > 50 and calls["general"] > 50 and calls["each once"] > 30 and calls["few in turn"] > 20 \
+        and kept_many > 100, (ranked, calls, kept_many)
+
+
+def test_few_combinations_without_a_reference_come_in_the_general_paths_order(monkeypatch, calls):
+    """Without a reference, one target's few combinations (``_select._FEW_COMBINATIONS``) are put in order on
+    Python integers: the same rows, values and counts as the general path, over the random cases without their
+    reference and orderings."""
+    rng = np.random.default_rng(20261205)
+    for case in range(200):
+        robot, target, options = _random_case(rng)
+        options = AnswerOptions(limits=options.limits, filter_limits=options.filter_limits,
+                                max_equivalents=options.max_equivalents)
+        mine, general = _select_both(robot, target, options, rng, monkeypatch)
+        _assert_identical(mine, 0, general, 3)
+    assert calls["few in turn"] > 40, calls
+
+
+def test_few_in_turn_is_the_general_ranking_of_random_turn_ranges():
+    """``_select._few_in_turn`` against ``_select._nearest`` on random rows: usable turns anywhere from −3 to +5
+    (0 inside, or every turn on one side), up to 200 combinations, any limit: the same rows and values, bit for
+    bit."""
+    rng = np.random.default_rng(7)
+    robot = CATALOGUE.get("puma560_standard").robot
+    limits = Limits.of(robot)
+    for case in range(300):
+        rows = int(rng.integers(1, 9))
+        first = rng.integers(-3, 3, (rows, 6)).astype(float)
+        last = first + rng.choice([0, 0, 0, 1, 1, 2], (rows, 6))
+        counts = last - first + 1.0
+        if np.prod(counts, axis=1).sum() > 200:
+            continue
+        q = rng.uniform(-np.pi, np.pi, (rows, 6))
+        limit = int(rng.integers(1, 80))
+        target = np.zeros(rows, dtype=np.int64)
+        combinations = np.prod(counts, axis=1).astype(np.int64)
+        row_limit = _equivalents.rounds_needed(target, combinations, 1, limit)[target]
+        expected = _select._nearest(robot, limits, target, q, first, last, counts, row_limit, limit, None, Ordering(),
+                                    UNLIMITED)
+        got = _select._few_in_turn(q, first, last, limit)
+        assert got[0].tolist() == expected[0].tolist(), case
+        assert got[1].tobytes() == expected[1].tobytes(), case
 
 
 def test_joint_exactly_at_its_limits_and_reference_between_equivalents(monkeypatch):

@@ -168,7 +168,6 @@ class IdealisedPlan(Sealed):
         joints = ideal_joints.copy()  # refined in place below
         # the idealised arm's own solutions (its closed form is exact up to rounding near a singularity)
         solutions = ideal.valid & finite & (self._ideal_error(ideal_joints, world_T_targets) <= IDEAL_RESIDUAL)
-        near_alignment = self._near_wrist_alignment(ideal_joints, finite & ideal.valid)
         position, orientation = residual_arrays(robot, joints, world_T_targets)
         near_before = finite & (self._size(position, orientation) <= NEAR_MISS * self.deviation)
         # refine the idealised solutions, and every other candidate that comes close (an arm with fewer joints than
@@ -232,8 +231,12 @@ class IdealisedPlan(Sealed):
             singular[rows[smallest <= margin]] = True
         for mask, _ in ideal.singularities.entries:
             singular |= mask
-        singular |= near_alignment
-        singular |= self._near_axis_2(ideal_joints, finite & (ideal.valid | unanswered[:, None]))
+        # the wrist's alignment and axis 2, where the positioning joints' steering of the wrist centre tells
+        steered = np.nonzero(finite & (ideal.valid | unanswered[:, None]))
+        steering = self.inner.positioning_jacobian(ideal_joints[steered], self.size) \
+            if len(steered[0]) and hasattr(self.inner, "positioning_jacobian") else None
+        singular |= self._near_wrist_alignment(ideal_joints, finite & ideal.valid, steered, steering)
+        singular |= self._near_axis_2(steered, steering, len(world_T_targets))
         # a row where the idealised family gave no candidate at all (not even a least-squares one) has no near miss
         # to measure: its "no solution" is the idealised arm's, which the true one need not share
         complete = converged & distinct & ~near_miss & ~singular & ~rescued & finite.any(axis=1)
@@ -244,34 +247,35 @@ class IdealisedPlan(Sealed):
             complete[:] = False
         return Candidates(joints, accepted, ideal.singularities, complete=complete)
 
-    def _near_wrist_alignment(self, ideal_joints: np.ndarray, valid: np.ndarray) -> np.ndarray:
+    def _near_wrist_alignment(self, ideal_joints: np.ndarray, valid: np.ndarray,
+                              steered: tuple[np.ndarray, np.ndarray], steering: np.ndarray | None) -> np.ndarray:
         """Which targets (N,) have a ``valid`` idealised candidate (N, m, n) whose spherical wrist is within the
         band of :data:`WRIST_ALIGNMENT_BAND` of aligning its outer axes, widened by how poorly the positioning
-        joints steer the wrist centre there (all False for a family without a spherical wrist)."""
+        joints steer the wrist centre there (all False for a family without a spherical wrist). ``steering``
+        (K, 3, 3) is :meth:`~._decoupled.DecoupledPlan.positioning_jacobian` at the candidates ``steered`` (rows
+        and slots (K,) each, every valid one among them), or None."""
         volume = self.inner.wrist_volume(ideal_joints) if hasattr(self.inner, "wrist_volume") else None
         if volume is None:
             return np.zeros(len(valid), dtype=bool)
         near = valid & (volume ** 2 <= WRIST_ALIGNMENT_BAND * self.deviation)
         # the others: within √(δ / σ), σ the steering's smallest singular value, where that is the wider band
-        rows, slots = np.nonzero(valid & ~near)
-        steering = self.inner.positioning_jacobian(ideal_joints[rows, slots], self.size) if len(rows) else None
         if steering is not None:
-            widened = _smallest_singular_value_at_most(steering, self.deviation / volume[rows, slots] ** 2)
+            rows, slots = steered
+            others = (valid & ~near)[rows, slots]
+            rows, slots = rows[others], slots[others]
+            widened = _smallest_singular_value_at_most(steering[others], self.deviation / volume[rows, slots] ** 2)
             near[rows[widened], slots[widened]] = True
         return near.any(axis=1)
 
-    def _near_axis_2(self, ideal_joints: np.ndarray, valid: np.ndarray) -> np.ndarray:
-        """Which targets (N,) have a ``valid`` idealised candidate (N, m, n) whose wrist centre is within
-        √(:data:`AXIS_2_BAND` × δ) arm sizes of axis 2, where joint 2 turns it about itself: the norm of joint 2's
-        column of the positioning Jacobian (all False for a family without a spherical wrist and a three-joint
-        positioner)."""
-        near = np.zeros(len(valid), dtype=bool)
-        rows, slots = np.nonzero(valid)
-        steering = self.inner.positioning_jacobian(ideal_joints[rows, slots], self.size) \
-            if len(rows) and hasattr(self.inner, "positioning_jacobian") else None
+    def _near_axis_2(self, steered: tuple[np.ndarray, np.ndarray], steering: np.ndarray | None,
+                     n_targets: int) -> np.ndarray:
+        """Which targets (N,) have a candidate among ``steered`` (rows and slots (K,) each, with their ``steering``
+        (K, 3, 3) as in :meth:`_near_wrist_alignment`) whose wrist centre is within √(:data:`AXIS_2_BAND` × δ) arm
+        sizes of axis 2, where joint 2 turns it about itself: the norm of joint 2's column of the steering."""
+        near = np.zeros(n_targets, dtype=bool)
         if steering is not None:
             from_axis_2 = np.linalg.norm(steering[:, :, 1], axis=-1)
-            near[rows[from_axis_2 ** 2 <= AXIS_2_BAND * self.deviation]] = True
+            near[steered[0][from_axis_2 ** 2 <= AXIS_2_BAND * self.deviation]] = True
         return near
 
     def _refined(self, q: np.ndarray, world_T_targets: np.ndarray, steps: int) -> np.ndarray:

@@ -161,13 +161,18 @@ class IdealisedPlan(Sealed):
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         """Candidates (N, m, n), refined on the true arm, with ``complete`` (N,) set by the criteria above."""
-        ideal = self.inner.solve(world_T_targets, reference)
         robot = self.robot
-        finite = np.isfinite(ideal.joints).all(axis=-1)
-        ideal_joints = wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0))
+        ideal = self._generic_one_pose(world_T_targets, reference)
+        if ideal is not None:  # every slot an idealised solution: the array solve would give the same ones
+            ideal_joints, solutions = ideal.joints, ideal.valid
+            finite = solutions.copy()
+        else:
+            ideal = self.inner.solve(world_T_targets, reference)
+            finite = np.isfinite(ideal.joints).all(axis=-1)
+            ideal_joints = wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0))
+            # the idealised arm's own solutions (its closed form is exact up to rounding near a singularity)
+            solutions = ideal.valid & finite & (self._ideal_error(ideal_joints, world_T_targets) <= IDEAL_RESIDUAL)
         joints = ideal_joints.copy()  # refined in place below
-        # the idealised arm's own solutions (its closed form is exact up to rounding near a singularity)
-        solutions = ideal.valid & finite & (self._ideal_error(ideal_joints, world_T_targets) <= IDEAL_RESIDUAL)
         position, orientation = residual_arrays(robot, joints, world_T_targets)
         near_before = finite & (self._size(position, orientation) <= NEAR_MISS * self.deviation)
         # refine the idealised solutions, and every other candidate that comes close (an arm with fewer joints than
@@ -246,6 +251,21 @@ class IdealisedPlan(Sealed):
         if self.constrain_orientation and self.inner.free_joints:
             complete[:] = False
         return Candidates(joints, accepted, ideal.singularities, complete=complete)
+
+    def _generic_one_pose(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates | None:
+        """For one target (1, 4, 4), the idealised family's scalar path (``solve_one``) as candidates when it
+        answers and every slot holds one of the idealised arm's solutions (its residual there within
+        :data:`IDEAL_RESIDUAL`): a clearly generic pose, where the array solve gives the same slots, all valid, and
+        no singularity, for a fraction of the time. None elsewhere (then the array solve answers)."""
+        if len(world_T_targets) != 1 or not hasattr(self.inner, "solve_one"):
+            return None
+        one_pose = self.inner.solve_one(world_T_targets[0], reference)
+        if one_pose is None or any(q is None for q in one_pose.rows):
+            return None
+        candidates = Candidates(wrap_revolute(self.robot, one_pose.joints), one_pose.valid, one_pose.singularities)
+        if not (self._ideal_error(candidates.joints, world_T_targets) <= IDEAL_RESIDUAL).all():
+            return None
+        return candidates
 
     def _near_wrist_alignment(self, ideal_joints: np.ndarray, valid: np.ndarray,
                               steered: tuple[np.ndarray, np.ndarray], steering: np.ndarray | None) -> np.ndarray:

@@ -530,10 +530,9 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
     target near a singularity, which the closed form hands over, keeps the labels a client holds along a path
     (issue 22.11)."""
     verified = closed.verified
-    if verified.count.all() and verified.complete.all():  # the usual answer: every target solved and promised
-        return [_timed(timings, closed, started)]
-    for local in np.flatnonzero((verified.count == 0) & verified.complete).tolist():
-        closed.details[local] = unreachable_detail(robot, goal, local, verified)
+    if not verified.count.all():  # (the usual answer has every target solved: nothing to word)
+        for local in np.flatnonzero((verified.count == 0) & verified.complete).tolist():
+            closed.details[local] = unreachable_detail(robot, goal, local, verified)
     if verified.complete.all():
         return [_timed(timings, closed, started)]
     broken = np.flatnonzero(~verified.complete)

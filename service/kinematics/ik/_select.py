@@ -302,8 +302,7 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     if reference is not None and len(dropped):
         order = np.lexsort((travel(robot, limits, dropped_values, reference, ordering), target[dropped]))
         dropped, dropped_values = dropped[order], dropped_values[order]
-    rejected = (table.take(dropped, joints=dropped_values, within_limits=fits[dropped]) if len(dropped)
-                else table.take(slice(0, 0)))
+    rejected = table.take(dropped, joints=dropped_values, within_limits=fits[dropped])
 
     collided = np.zeros(n_targets, dtype=np.int64)  # rejected for a collision alone (within the limits, or flagged)
     if excluded is not None:
@@ -383,8 +382,7 @@ def _each_once(robot: Robot, limits: Limits, table: SolutionTable, n_targets: in
             keep = keep[position_in_group(target[keep]) < max_equivalents]
         kept = table.take(keep, joints=values[keep], within_limits=fits[keep])
         n_kept = kept.counts(n_targets)
-    rejected = (table.take(dropped, joints=values[dropped], within_limits=fits[dropped]) if len(dropped)
-                else table.take(slice(0, 0)))  # none (the usual): no gathers of nothing
+    rejected = table.take(dropped, joints=values[dropped], within_limits=fits[dropped])
     nothing = np.zeros(n_targets, dtype=np.int64)
     return _outcome(rows, kept, n_kept, rejected, candidates, candidates, candidates, nothing, False,
                     max_equivalents, False, None, robot.dof)

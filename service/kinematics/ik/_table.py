@@ -79,6 +79,8 @@ class SolutionTable:
         """The rows ``index`` (indices, a boolean mask or a slice), in that order; with ``joints`` (K, n) and
         ``within_limits`` (K,), listed at those values and flags instead of their own (a selection's
         2π-equivalents: the rows' own are then not gathered)."""
+        if isinstance(index, np.ndarray) and index.dtype != bool and not len(index):
+            index = slice(0, 0)  # none (a selection's usual rejected rows): views, not nine gathers of nothing
         return SolutionTable(self.target[index], self.joints[index] if joints is None else joints,
                              self.within_limits[index] if within_limits is None else within_limits,
                              self.position[index], self.orientation[index],

@@ -23,8 +23,8 @@ from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, move_point, perpendicular_unit, rotate_about, rotation_about
 from ._structure import target_error
 from .subproblems import subproblem_1
-from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Sealed
-from ._wrist import ALIGNED_BELOW, Roll, SphericalWrist, seen_by
+from ._types import LEAN_CHUNK, NEAR_SINGULAR, Candidates, LabelCodes, SingularFlags, Sealed
+from ._wrist import Roll, SphericalWrist, seen_by
 
 
 #: Rows from which :meth:`DecoupledPlan.label_codes` labels one row per run: below, finding the runs costs more
@@ -116,8 +116,14 @@ class DecoupledPlan(Sealed):
         valid = arm_valid[:, :, None] & wrist_valid
         for mask, flag in wrist.singularities.entries:
             singular.add((mask.reshape(n_targets, m_arm) & arm_valid).any(axis=1), flag)
+        near = None  # the slots near a singular set of the wrist, or of the positioner, for the isolation check
+        if isinstance(self.wrist, SphericalWrist) and self.positioner is not None:
+            near = (self.wrist.volume(wrist.joints[..., 1]) <= NEAR_SINGULAR).reshape(n_targets, m_arm, m_wrist)
+            if arm.near_singular is not None:
+                near |= arm.near_singular[..., None]
+            near = near.reshape(n_targets, -1)
         return Candidates(full.reshape(n_targets, m_arm * m_wrist, self.dof), valid.reshape(n_targets, -1),
-                          singular, complete=complete)
+                          singular, complete=complete, near_singular=near)
 
     def _turn_free_joints(self, joints: np.ndarray, valid: np.ndarray, singular: SingularFlags,
                           R_target: np.ndarray) -> np.ndarray:
@@ -322,10 +328,11 @@ class _SphericalWristOnePose:
                 codes.append((None,) * len(self.names))
                 continue
             qa, qb = roots
-            # the wrist's axes nearly aligned at a root (not at the least-squares pair of cones that miss, which
-            # is coplanar): the array path holds q_a within its band (SphericalWrist)
+            # the wrist's axes near aligned at a root (not at the least-squares pair of cones that miss, which
+            # is coplanar): the array path holds q_a within its band (SphericalWrist), and checks that the
+            # solutions there are isolated (NEAR_SINGULAR: far wider than that band)
             u, w = self.wrist_volume
-            if pairs[1] is not None and abs(u * math.cos(qb) + w * math.sin(qb)) <= scalar.MARGIN * ALIGNED_BELOW:
+            if pairs[1] is not None and abs(u * math.cos(qb) + w * math.sin(qb)) <= NEAR_SINGULAR:
                 raise scalar.NotGeneric
             unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
             qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))
@@ -360,6 +367,7 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
         forward, self.in_plane, up = positioner.label_constants
         self.forward, self.up = scalar.vector_of(forward), scalar.vector_of(up)
         self.on_axis = GEOMETRY_TOLERANCE * 10 * positioner.geometry.length_scale
+        self.near_axis = NEAR_SINGULAR * positioner.geometry.length_scale
         # the elbow (point on axis 3) from the centre before joints 1 and 2 turn it, in the arm's plane if the
         # labels work there (axes 2 ∥ 3), and its length
         elbow = scalar.sub(p2, c)
@@ -380,7 +388,10 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
             # the wrist point from the centre with joint 3 turned (joints 1 and 2 turn it about the centre)
             reach_local = scalar.add(scalar.mv(R_3, self.point_from_3), self.centre_to_3)
             elbow_side = self._elbow_side(reach_local)
-            for pair in shoulder.angles(shoulder.start(reach_local), goal, error):
+            start = shoulder.start(reach_local)
+            if goal[3] <= self.near_axis or start[3] <= self.near_axis:  # IntersectingShoulder's near_singular:
+                raise scalar.NotGeneric  # the array path checks that the solutions there are isolated
+            for pair in shoulder.angles(start, goal, error):
                 if pair is None:  # no arm branch here: its wrist slots are empty too
                     self._empty(rows, codes, 2)
                     continue
@@ -432,6 +443,7 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
         self.forward = scalar.vector_of(positioner.label_constants[0])
         size = positioner.geometry.length_scale
         self.exact_within, self.at_centre = GEOMETRY_TOLERANCE * size, 0.5 * ACCEPT_RESIDUAL * size
+        self.near_axis = NEAR_SINGULAR * size
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
         """The eight slots for a target (4, 4), or NotGeneric; ``reference`` (n,) as :meth:`DecoupledPlan.solve`."""
@@ -460,6 +472,8 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
         for signed in (first_sign * across, -first_sign * across):
             psi = math.atan2(signed, along)
             t = along * math.cos(psi) + signed * math.sin(psi)  # the displacement along R(k2, q2) v
+            if abs(t) <= self.near_axis or radius <= self.near_axis:  # (SlideThroughAxis2.solve's near_singular)
+                raise scalar.NotGeneric  # the array path checks that the solutions there are isolated
             for turn, slide in ((psi, t), (psi + math.pi, -t)):
                 c, s = math.cos(turn), math.sin(turn)
                 turned = (frame.height * k2[0] + slide * (c * n1[0] + s * n2[0]),

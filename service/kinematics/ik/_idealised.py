@@ -250,7 +250,8 @@ class IdealisedPlan(Sealed):
             complete &= ideal.complete
         if self.constrain_orientation and self.inner.free_joints:
             complete[:] = False
-        return Candidates(joints, accepted, ideal.singularities, complete=complete)
+        return Candidates(joints, accepted, ideal.singularities, complete=complete,
+                          near_singular=ideal.near_singular)  # the slots are the idealised family's
 
     def _generic_one_pose(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates | None:
         """For one target (1, 4, 4), the idealised family's scalar path (``solve_one``) as candidates when it

@@ -319,6 +319,14 @@ def read_off_below(geometry: Geometry) -> float:
     return max(GEOMETRY_TOLERANCE, exactly_idealised(geometry).deviation / DUPLICATE_TOLERANCE)
 
 
+def read_off_error(geometry: Geometry) -> float:
+    """The error (relative to their size) of the unit vectors a family reads an angle off about an axis: the
+    target's rounding, or the arm's deviation from the relations exact recognition accepted
+    (:func:`exactly_idealised`), whichever is larger. Over the vectors' radius about the axis, it is the angle's
+    error (the reading :func:`read_off_below` holds free where that would pass ``DUPLICATE_TOLERANCE``)."""
+    return max(ROUNDING_TOLERANCE, exactly_idealised(geometry).deviation)
+
+
 def target_error(geometry: Geometry, distance: float | np.ndarray, rounding: float = ROUNDING_TOLERANCE
                  ) -> float | np.ndarray:
     """The error, in length units, with which a family of an exactly recognised arm sees a target ``distance``

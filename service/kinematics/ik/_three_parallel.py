@@ -40,9 +40,9 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
 from .._forward import JointTrig, cross
 from ._screws import apply, invert, joint_motion, move_point, perpendicular_unit, rotate_about
-from ._structure import Geometry, read_off_below
+from ._structure import Geometry, read_off_below, read_off_error
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
-from ._types import LEAN_CHUNK, Candidates, LabelCodes, SingularFlags, Singularity, Sealed
+from ._types import LEAN_CHUNK, NEAR_SINGULAR, Candidates, LabelCodes, SingularFlags, Singularity, Sealed
 from ._wrist import wrist_codes
 
 
@@ -66,6 +66,23 @@ class _AxesTwoToFourParallel(Sealed):
         forward = _unit(cross(geometry.direction(0), self.omega_p))
         reach = geometry.point(3) - geometry.point(0)
         self.forward = forward if forward @ reach >= 0 else -forward
+        # the elbow's subproblem 3 (the point on axis 4 about axis 3, at a distance from axis 2): its radii's
+        # product ρ, from its least and greatest distances; and the error q6 is read off with (step 3)
+        least, greatest = _distance_range(geometry.direction(2), geometry.point(3) - geometry.point(2),
+                                          geometry.point(1) - geometry.point(2))
+        self.elbow_rho = float(greatest**2 - least**2) / 4
+        self.sixth_error = read_off_error(geometry)
+
+    def split_band(self, distance, sixth_radius, lever_radius):
+        """How far apart (rad) the two elbow roots may be and still be one double root split by the error of q6
+        (floats, or arrays of candidates): :data:`SPLIT_DOUBLE_ROOT`, or wider where q6 was read off a short
+        ``sixth_radius`` (the wrist near its singularity: axis 6 nearly along ω_p). q6's error, the read-off error
+        over that radius, moves the point on axis 4 by its ``lever_radius`` about axis 6 times as much, and the
+        ``distance`` asked of the elbow with it; the roots ±half about a double root move by ρ (1 − cos half) =
+        distance · that error, so roots within 2 √(2 distance · error / ρ) of each other cannot be told from one
+        (a UR3e folded to 6e-7 rad with q5 1.3e-9 from π: q6 known to 2.5e-7, the roots ±1.5e-4 rad)."""
+        moved = lever_radius * self.sixth_error / sixth_radius
+        return 2.0 * (2.0 * distance * moved / self.elbow_rho) ** 0.5
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         A = world_T_targets @ self.home_inverse  # (N, 4, 4)
@@ -106,6 +123,7 @@ class _AxesTwoToFourParallel(Sealed):
         # it is). Both undo joint 5, then joint 6, then the target, then joint 1.
         undone_5 = rotate_about(g.direction(4), -q5[..., None], np.stack([self.normal_p, g.point(3) - g.point(4)]))
         undone_5[..., 1, :] += g.point(4) - g.point(5)
+        lever = undone_5[..., 1, :]  # the point on axis 4 from axis 6's point, before q6 turns it (N, m, 3)
         undone_6 = rotate_about(g.direction(5), -q6[..., None], undone_5)  # (N, m, 2, 3)
         undone_6[..., 1, :] += g.point(5)
         in_world = np.einsum("...ij,...kj->...ki", R_A, undone_6)
@@ -113,8 +131,8 @@ class _AxesTwoToFourParallel(Sealed):
         undone_1 = rotate_about(g.direction(0), -q1[..., None], in_world)
         angle_sum = subproblem_1(w_p, self.normal_p, undone_1[..., 0, :]).theta[..., 0]  # (N, m)
         z = undone_1[..., 1, :] + g.point(0)  # (N, m, 3)
-        elbow = subproblem_3(g.direction(2), g.point(3) - g.point(2), g.point(1) - g.point(2),
-                             np.linalg.norm(z - g.point(1), axis=-1))
+        distance = np.linalg.norm(z - g.point(1), axis=-1)
+        elbow = subproblem_3(g.direction(2), g.point(3) - g.point(2), g.point(1) - g.point(2), distance)
         q3 = elbow.theta  # (N, m, 2)
         moved = g.point(2) + rotate_about(g.direction(2), q3, g.point(3) - g.point(2))
         second = subproblem_1(g.direction(1), moved - g.point(1), (z - g.point(1))[..., None, :])
@@ -137,7 +155,13 @@ class _AxesTwoToFourParallel(Sealed):
         singular.add(unrepresented, Singularity(
             "wrist", (1, 2, 3, 5), relation, "the values of q6 the elbow reaches with form two separate arcs "
             "and no candidate slot was left for the second one: its solutions are missing (complete: false)"))
-        merged = (elbow.merged | _split_double_root(q3, valid)) & valid[..., 0]
+        if free_six.any():  # a second arc may have moved slots: axis 6 as their q5 turns it now
+            p = rotate_about(g.direction(4), -q5, w_p)
+        sixth_radius = _radius_about(g.direction(5), p)  # axis 6's sine with ω_p: the wrist's alignment
+        with np.errstate(divide="ignore", invalid="ignore"):
+            band = self.split_band(distance, sixth_radius, _radius_about(g.direction(5), lever))
+        band = np.where(free_six, SPLIT_DOUBLE_ROOT, np.fmax(band, SPLIT_DOUBLE_ROOT))  # q6 held, not read: exact
+        merged = (elbow.merged | _split_double_root(q3, valid, band)) & valid[..., 0]
         merged_rows = merged.any(axis=1)
         if merged_rows.any():
             first = np.argmax(merged, axis=1)  # the first merged slot of each row, as argwhere found it
@@ -151,8 +175,9 @@ class _AxesTwoToFourParallel(Sealed):
             if flag.kind == "shoulder" and flag.relation == "free":
                 shoulder_free |= mask
         unpromised = unrepresented | (shoulder_free & ~valid.any(axis=(1, 2)))
+        near = np.repeat(sixth_radius <= NEAR_SINGULAR, 2, axis=1)  # both elbow roots of each (q1, q5)
         return Candidates(joints.reshape(n, 2 * m, 6), valid.reshape(n, 2 * m), singular,
-                          complete=~unpromised if unpromised.any() else None)
+                          complete=~unpromised if unpromised.any() else None, near_singular=near)
 
     def _reachable_sixth(self, A: np.ndarray, q1: np.ndarray, q5: np.ndarray, q6: np.ndarray,
                          free: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -492,10 +517,17 @@ def _second_arc_slots(q1: np.ndarray, q5: np.ndarray, q6: np.ndarray, valid: np.
 SPLIT_DOUBLE_ROOT = 1e-4
 
 
-def _split_double_root(elbow: np.ndarray, valid: np.ndarray) -> np.ndarray:
-    """Where the two elbow roots (..., 2) are both valid and a split double root apart."""
+def _split_double_root(elbow: np.ndarray, valid: np.ndarray, band: float | np.ndarray = SPLIT_DOUBLE_ROOT
+                       ) -> np.ndarray:
+    """Where the two elbow roots (..., 2) are both valid and a split double root apart: within ``band`` (rad; a
+    float, or one per candidate (...)) of each other."""
     gap = np.abs(wrap_angle(elbow[..., 0] - elbow[..., 1]))
-    return valid[..., 0] & valid[..., 1] & (np.nan_to_num(gap, nan=np.inf) <= SPLIT_DOUBLE_ROOT)
+    return valid[..., 0] & valid[..., 1] & (np.nan_to_num(gap, nan=np.inf) <= band)
+
+
+def _radius_about(k: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """The distance of points v (..., 3) from the axis k (a unit vector through the origin)."""
+    return np.linalg.norm(v - (v @ k)[..., None] * k, axis=-1)
 
 
 class _ThreeParallelOnePose:
@@ -529,6 +561,10 @@ class _ThreeParallelOnePose:
         self.elbow_coordinates = (self.elbow_turn.coordinates(self.p4_from_3),
                                   self.elbow_turn.coordinates(scalar.sub(p[1], p[2])))
         self.p4_from_5 = scalar.sub(p[3], p[4])
+        # the array solver's split double root of the elbow: its band, with the point on axis 4's radius about
+        # axis 6 bounded by the arm's constants (a wider band: this path declines wherever that one may merge)
+        self.split_band = plan.split_band
+        self.lever_bound = scalar.norm(self.p4_from_5) + scalar.norm(scalar.sub(p[4], p[5]))
         # the labels' constants, and the elbow (point on axis 3 from axis 2) in the plane normal to ω_p
         self.forward = scalar.vector_of(plan.forward)
         self.up = scalar.vector_of(plan.geometry.upward(plan.geometry.direction(0)))
@@ -564,8 +600,10 @@ class _ThreeParallelOnePose:
                     codes += [(None, None, None)] * 2
                     continue
                 q5 = pair[1]
-                q6 = -Turn.angle(self.sixth.coordinates(scalar.rotate(d[4], -q5, w_p)), wanted_p,
-                                 self.sixth_free_below)
+                sixth_from = self.sixth.coordinates(scalar.rotate(d[4], -q5, w_p))
+                if sixth_from[3] <= NEAR_SINGULAR:  # the array solver checks that the solutions there are isolated
+                    raise scalar.NotGeneric
+                q6 = -Turn.angle(sixth_from, wanted_p, self.sixth_free_below)
                 R5, R6 = scalar.rotation(d[4], q5), scalar.rotation(d[5], q6)
                 # R234 = R_rest R6ᵀ R5ᵀ, applied to the normal of ω_p
                 R234_normal = scalar.mv(R_rest, scalar.mtv(R6, scalar.mtv(R5, self.normal_p)))
@@ -586,7 +624,12 @@ class _ThreeParallelOnePose:
                 # this shoulder and wrist may leave the point out of the elbow's reach: a least-squares root
                 # (then rejected by the FK check) and an empty slot, as in the array solver
                 z1_coordinates = self.second.coordinates(z1)
-                for q3 in Turn.angles_at_distance(*self.elbow_coordinates, scalar.norm(z1), out_of_reach=True):
+                distance = scalar.norm(z1)
+                elbow_roots = Turn.angles_at_distance(*self.elbow_coordinates, distance, out_of_reach=True)
+                band = max(SPLIT_DOUBLE_ROOT, self.split_band(distance, sixth_from[3], self.lever_bound))
+                if abs(wrap(elbow_roots[0] - elbow_roots[1])) <= scalar.MARGIN * band:  # (False for a NaN)
+                    raise scalar.NotGeneric  # maybe one split double root: the array solver flags it
+                for q3 in elbow_roots:
                     if math.isnan(q3):
                         rows.append(None)
                         codes.append((None, None, None))

@@ -120,6 +120,11 @@ class Candidates:
     ``labels`` are the slots' branch labels (name → (values, codes (N, m))), computed by the family from the
     candidates it proposes, so that nothing about the call stays on the plan. None while a family still labels
     through its plan's ``label_codes``.
+
+    ``near_singular`` (N, m), when a family gives it, marks the slots it solved within :data:`NEAR_SINGULAR` of
+    a singular set, where a step reads an angle off a short radius and amplifies the errors of the others: the
+    verification checks that each one kept is an isolated solution, and where one is not, on a target the family
+    flagged nothing for, the promise is withdrawn (:func:`._verify.not_isolated`).
     """
 
     joints: np.ndarray
@@ -128,6 +133,18 @@ class Candidates:
     complete: np.ndarray | None = None
     promise_needs_every_slot: bool = False
     labels: LabelCodes | None = None
+    near_singular: np.ndarray | None = None
+
+
+#: How near a singular set a family marks a slot for the isolation check (:attr:`Candidates.near_singular`),
+#: relative: a spherical wrist's volume (the sine that aligns its outer axes), a point's distance from the axis
+#: that reads an angle off it over the arm's size. Where two singular sets meet, the errors of the steps before
+#: over that short radius leave solutions that FK cannot tell apart: the catalogue's PUMA with its shoulder
+#: solutions 2.3e-6 rad apart and q5 2.6e-8 from 0 listed one 0.8 rad (in q4 and q6) from the pose's own, the
+#: Jacobian's least singular value 2e-16 there; a UR3e folded within 6e-7 rad at q5 1.3e-9 from π, 1.2e-3 rad.
+#: The check withdraws a promise only under :data:`._verify.ISOLATED_BELOW`, which a solution near one set alone
+#: does not reach.
+NEAR_SINGULAR = 1e-3
 
 
 @dataclass(frozen=True)

@@ -300,6 +300,8 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
     if isinstance(goal, PoseGoal) and constrained and robot.dof < 6:  # fewer joints than the pose constrains
         nearest_position = np.where(checked, position, np.inf).min(axis=1, initial=np.inf) / arm_size(robot)
     complete = promised(candidates, count, nearest, constrained, nearest_position)
+    if candidates.near_singular is not None and constrained and complete.any():
+        complete &= ~not_isolated(robot, goal, joints, kept & candidates.near_singular, candidates.singularities)
     if candidates.promise_needs_every_slot:  # the solver's promise holds only if every valid slot gave a solution
         complete &= count == valid.sum(axis=1)
     labels = candidates.labels if candidates.labels is not None else (
@@ -318,6 +320,31 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
                           {name: (values, codes[rows, slots].astype(np.int8, copy=False))
                            for name, (values, codes) in labels.items()})
     return Verified(table, complete, nearest, candidates.singularities)
+
+
+#: The least singular value of the arm's Jacobian (position rows over the arm's size, :meth:`PoseGoal.jacobian`)
+#: below which a verified solution is taken as not isolated in double precision: other joint vectors along its
+#: null motion reach the pose to rounding as well. Where two singular sets meet the value is about the product of
+#: the distances from each: 2e-16 … 3e-14 at the solutions of the promises the probes found broken (they listed
+#: members 1.2e-3 … 0.8 rad from the pose's own configuration, :data:`._types.NEAR_SINGULAR`). Near one set alone
+#: the solution stays held though the value falls with the square of the distance at a fold: the Stanford arm with
+#: its slide 1e-6 of its size from axis 2, 3e-13 to 5e-13, its own configuration listed within 6e-5 rad.
+ISOLATED_BELOW = 1e-13
+
+
+def not_isolated(robot: Robot, goal: PoseGoal, joints: np.ndarray, checked: np.ndarray,
+                 singularities: SingularFlags) -> np.ndarray:
+    """The targets (N,) with a solution among the ``checked`` slots (N, m) of ``joints`` (N, m, n) that is not
+    isolated (:data:`ISOLATED_BELOW`), on a target the family flagged no singular condition for (a flag states
+    what the listed solutions represent). Such a target's solutions are one of many joint vectors that reach it
+    within rounding: the family's list cannot promise to hold each of the others."""
+    checked = checked & ~singularities.any()[:, None]
+    rows, slots = np.nonzero(checked)
+    outcome = np.zeros(len(joints), dtype=bool)
+    if len(rows):
+        least = np.linalg.svd(goal.jacobian(robot, joints[rows, slots], rows), compute_uv=False)[:, -1]
+        outcome[rows[least < ISOLATED_BELOW]] = True
+    return outcome
 
 
 def _unvouched(valid: np.ndarray, size: np.ndarray) -> np.ndarray:

@@ -25,12 +25,15 @@ from .._types import LabelCodes, SingularFlags, Singularity, Sealed
 class PositionerResult:
     """Candidate joint values for the positioning joints.
 
-    ``joints`` (N, m, k); ``valid`` (N, m); ``singularities`` a list of N lists.
+    ``joints`` (N, m, k); ``valid`` (N, m); ``singularities`` a list of N lists; ``near_singular`` (N, m), when
+    the positioner gives it, the slots it read an angle off a short radius for (see
+    :attr:`~.._types.Candidates.near_singular`).
     """
 
     joints: np.ndarray
     valid: np.ndarray
     singularities: SingularFlags = field(default_factory=lambda: SingularFlags(0))
+    near_singular: np.ndarray | None = None
 
 
 def _unit(v: np.ndarray) -> np.ndarray | None:

@@ -12,7 +12,7 @@ from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE, ROUNDING_TOLERANC
 from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry, target_error
-from .._types import LabelCodes, SingularFlags, Singularity
+from .._types import NEAR_SINGULAR, LabelCodes, SingularFlags, Singularity
 from ..subproblems import prismatic_to_distance, subproblem_1, subproblem_2_chain, subproblem_3, subproblem_4
 from ._base import Needs, Positioner, PositionerResult, _flag_rows, _unit, side_codes
 from ._slide_through_axis_2 import SlideThroughAxis2
@@ -144,7 +144,12 @@ class IntersectingShoulder(Positioner):
         elif not g.model.is_revolute[k]:
             _flag_rows(third.merged, Singularity("reach", (k,), "boundary",
                                                  "the point is at the nearest reach of the prismatic joint"), singular)
-        return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
+        # subproblem 2 reads q1 off the target's radius about axis 1 and q2 off the placed point's about axis 2
+        near = NEAR_SINGULAR * g.length_scale
+        near_axes = ((np.linalg.norm(cross(g.direction(i), targets - c), axis=-1) <= near)[:, None]
+                     | (np.linalg.norm(cross(g.direction(j), w3 - c), axis=-1) <= near))  # (N, 2 third roots)
+        return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular,
+                                np.repeat(near_axes, 2, axis=1))
 
     def _turn_that_reaches(self, held: np.ndarray, targets: np.ndarray) -> np.ndarray:
         """Joint 3's value (N,) when its axis passes through the centre c, for targets x (N, 3).

@@ -17,7 +17,7 @@ from ..._angles import wrap_angle
 from ..._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, POLISH_RESIDUAL
 from .._screws import rotate_about
 from .._structure import Geometry, target_error
-from .._types import SingularFlags, Singularity
+from .._types import NEAR_SINGULAR, SingularFlags, Singularity
 from ..subproblems import subproblem_1
 from ._base import PositionerResult, _flag_rows
 
@@ -159,4 +159,8 @@ class SlideThroughAxis2:
                                             "point is as near axis 1 as the shoulder allows"), singular)
         _flag_rows(free, Singularity("reach", (k,), "boundary",
                                      "the point is at the nearest reach of the prismatic joint"), singular)
-        return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular)
+        # q1 is read off the target's radius about axis 1, q2 off the point's distance from axis 2 (the slide's)
+        near = NEAR_SINGULAR * g.length_scale
+        near_axes = (np.abs(t) <= near) | (radius <= near)[:, None, None]
+        return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular,
+                                near_axes.reshape(n_targets, 4))

@@ -204,9 +204,14 @@ class IdealisedPlan(Sealed):
             accepted[rows, slots] = True
             rescued[rows] = True
         # 2. near misses: a candidate that came within NEAR_MISS δ of the target on the true arm, before or after
-        # refinement, without reaching it
+        # refinement, without reaching it; or, on an arm with as many joints as the target constrains, reaching it
+        # though the idealised arm does not (a least-squares answer): a pair of roots appears there, and
+        # refinement finds one of them at most (a UR10e moved by 1.2e-6, its elbow 1.9e-3 rad from stretched where
+        # the idealised arm's is just beyond: of the true arm's roots ±1.9e-3, one was refined to and listed, the
+        # pose's own was left out). An under-determined arm's idealised family reaches no target exactly.
         after = self._size(position, orientation)
-        missed = (near_before | (tried & (after <= NEAR_MISS * self.deviation))) & ~accepted
+        reached = accepted if self.under_determined else accepted & solutions
+        missed = (near_before | (tried & (after <= NEAR_MISS * self.deviation))) & ~reached
         if self.under_determined and missed.any():
             missed &= ~self._stalled_apart(joints, world_T_targets, missed, after)
         near_miss = missed.any(axis=1)

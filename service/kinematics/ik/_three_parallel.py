@@ -84,6 +84,13 @@ class _AxesTwoToFourParallel(Sealed):
         moved = lever_radius * self.sixth_error / sixth_radius
         return 2.0 * (2.0 * distance * moved / self.elbow_rho) ** 0.5
 
+    def wrist_volume(self, joints: np.ndarray) -> np.ndarray:
+        """How far the wrist is from its singularity at joint vectors (..., n), shape (...,): the sine of the angle
+        between axis 6 and the parallel axes, which depends on q5 alone (joints 1–4 turn both alike), 0 where they
+        align (:meth:`.DecoupledPlan.wrist_volume`'s counterpart, which :class:`.IdealisedPlan` bands)."""
+        return _radius_about(self.geometry.direction(5), rotate_about(self.geometry.direction(4), -joints[..., 4],
+                                                                       self.omega_p))
+
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         A = world_T_targets @ self.home_inverse  # (N, 4, 4)
         singular = SingularFlags(len(A))

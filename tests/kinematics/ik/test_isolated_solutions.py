@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import forward_kinematics, geometric_jacobian
+from service.kinematics import Joint, Robot, forward_kinematics, geometric_jacobian
 from service.kinematics.ik import distance_to_reference, solve_ik, solve_ik_batch
 from service.kinematics.ik._goals import PoseGoal
 from service.kinematics.ik._structure import arm_size
@@ -147,3 +147,41 @@ def test_one_pose_path_agrees_with_the_batch_on_both_sides_of_the_near_singular_
         assert [s.branch for s in single.solutions] == [s.branch for s in batch.solutions]
         np.testing.assert_allclose([s.joints for s in single.solutions], [s.joints for s in batch.solutions],
                                    atol=1e-9)
+
+
+def test_a_rounded_ur_arm_near_its_wrist_singularity_and_folded_is_not_promised(client):
+    """A UR16e as a CAD export writes it, q5 1e-8 from π and the elbow 1e-4 rad from folded: the idealised
+    family's solutions refined to four verified ones, 0.36 rad and more from the pose's own. Three checks now
+    withdraw the promise, each alone: the band a spherical wrist has, which the UR type's wrist now has too
+    (``wrist_volume``: the sine of axis 6 with the parallel axes), criterion 2's near miss of a candidate that
+    only the true arm reaches, and the isolation check of the family's near-singular slots."""
+    robot = rounded(catalogue_robot(client, "ur16e"), 769395683)
+    q = np.array([1.4058016621531513, 1.9323037111184513, 3.1414933099846305, -1.570792119192901,
+                  3.1415926433624177, -1.3812719461643931e-05])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert _promise_held(robot, q, result)
+    assert not result.complete
+
+
+#: a UR10e with every DH entry moved by ~1e-7 (a, alpha, d, theta per joint, standard DH): no exact family
+MOVED_UR10E = [(7.273155642977794e-08, 1.5707962758179461, 0.18070031914764215, -8.729822925626831e-08),
+               (-0.612700429746356, -1.0190820915728072e-07, -2.6763358725251525e-07, -3.3850538250279167e-07),
+               (-0.5715500816159276, -1.3466031094579254e-07, -6.07678489720987e-07, -3.5427268597286483e-07),
+               (5.783654262949629e-07, 1.5707965894439022, 0.1741498463810797, -3.15690811934134e-07),
+               (1.9599213225272623e-07, -1.5707964118700934, 0.11984990831544749, -3.283629197083689e-08),
+               (2.830342591138886e-08, -1.876245235822796e-07, 0.11655016011976005, -3.1610305259235033e-08)]
+
+
+def test_a_root_pair_that_appears_on_the_true_arm_is_not_promised_from_the_one_refined(client):
+    """The moved UR10e with its elbow 1.9e-3 rad from stretched, where the idealised arm's is just out of reach:
+    its least-squares answer refined to one of the true arm's roots ±1.9e-3, and the pose's own (the other) was
+    left out under ``complete: true``. A candidate that reaches the target only on the true arm now counts as a
+    near miss (criterion 2): the pair appears there."""
+    base = catalogue_robot(client, "ur10e")
+    robot = Robot([Joint(joint.name, joint.kind, *row) for joint, row in zip(base.joints, MOVED_UR10E)],
+                  convention="standard", world_T_base=base.world_T_base, flange_T_tool=base.flange_T_tool)
+    q = np.array([-2.964620571926538, 0.7105914508949902, 0.0019187083697822882, 3.1415926535759016,
+                  -1.570796326793793, -2.2789112124149855])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert _promise_held(robot, q, result)
+    assert not result.complete

@@ -846,10 +846,9 @@ def _assert_reaches_its_own_pose(rows: list[tuple], q: list[float]) -> None:
 @pytest.mark.parametrize("robot_id, sigma, seed", [("spong_ex3_5_stanford", 1e-10, 1),
                                                    ("spong_ex3_5_stanford", 1e-8, 2), ("ur5", 1e-10, 1),
                                                    ("puma560_standard", 1e-10, 3),
-                                                   pytest.param("ur5", 1e-10, 3, marks=pytest.mark.xfail(
-                                                       strict=True, reason="known: three singular sets (q2 ≈ π, "
-                                                       "q3 ≈ π/2, q5 ≈ 4e-7): nearest listed 1.5e-3 rad, the tube "
-                                                       "precision of the seventeenth stop's note"))])
+                                                   # three singular sets (q2 ≈ π, q3 ≈ π/2, q5 ≈ 4e-7), nearest
+                                                   # listed 1.5e-3 rad before the UR wrist's band (IdealisedPlan)
+                                                   ("ur5", 1e-10, 3)])
 def test_rounded_arms_keep_their_promises_where_two_singular_sets_meet(client, robot_id, sigma, seed):
     """Catalogue arms moved by ``sigma`` (every DH parameter), at poses near two singular sets at once: q2 and q5
     1e-9 … 1e-3 from 0, ±π/2 or π, and joint 3 often too (the Stanford's slide 1e-7 … 1e-2 from the shoulder's

@@ -568,10 +568,13 @@ class _ThreeParallelOnePose:
         self.elbow_coordinates = (self.elbow_turn.coordinates(self.p4_from_3),
                                   self.elbow_turn.coordinates(scalar.sub(p[1], p[2])))
         self.p4_from_5 = scalar.sub(p[3], p[4])
-        # the array solver's split double root of the elbow: its band, with the point on axis 4's radius about
-        # axis 6 bounded by the arm's constants (a wider band: this path declines wherever that one may merge)
-        self.split_band = plan.split_band
-        self.lever_bound = scalar.norm(self.p4_from_5) + scalar.norm(scalar.sub(p[4], p[5]))
+        # the widest band the array solver's split double root of the elbow has where this path answers (axis 6
+        # at least NEAR_SINGULAR from the parallel axes): the elbow's greatest distance, and the point on axis 4's
+        # radius about axis 6 bounded by the arm's constants; roots within it (times the margin) are declined
+        greatest = float(_distance_range(plan.geometry.direction(2), plan.geometry.point(3) - plan.geometry.point(2),
+                                         plan.geometry.point(1) - plan.geometry.point(2))[1])
+        lever = scalar.norm(self.p4_from_5) + scalar.norm(scalar.sub(p[4], p[5]))
+        self.split_within = scalar.MARGIN * max(SPLIT_DOUBLE_ROOT, plan.split_band(greatest, NEAR_SINGULAR, lever))
         # the labels' constants, and the elbow (point on axis 3 from axis 2) in the plane normal to ω_p
         self.forward = scalar.vector_of(plan.forward)
         self.up = scalar.vector_of(plan.geometry.upward(plan.geometry.direction(0)))
@@ -631,10 +634,8 @@ class _ThreeParallelOnePose:
                 # this shoulder and wrist may leave the point out of the elbow's reach: a least-squares root
                 # (then rejected by the FK check) and an empty slot, as in the array solver
                 z1_coordinates = self.second.coordinates(z1)
-                distance = scalar.norm(z1)
-                elbow_roots = Turn.angles_at_distance(*self.elbow_coordinates, distance, out_of_reach=True)
-                band = max(SPLIT_DOUBLE_ROOT, self.split_band(distance, sixth_from[3], self.lever_bound))
-                if abs(wrap(elbow_roots[0] - elbow_roots[1])) <= scalar.MARGIN * band:  # (False for a NaN)
+                elbow_roots = Turn.angles_at_distance(*self.elbow_coordinates, scalar.norm(z1), out_of_reach=True)
+                if abs(wrap(elbow_roots[0] - elbow_roots[1])) <= self.split_within:  # (False for a NaN)
                     raise scalar.NotGeneric  # maybe one split double root: the array solver flags it
                 for q3 in elbow_roots:
                     if math.isnan(q3):

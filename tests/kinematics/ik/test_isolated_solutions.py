@@ -185,3 +185,29 @@ def test_a_root_pair_that_appears_on_the_true_arm_is_not_promised_from_the_one_r
     result = solve_ik(robot, forward_kinematics(robot, q))
     assert _promise_held(robot, q, result)
     assert not result.complete
+
+
+#: a Fanuc LR Mate 200iD with every DH entry moved by ~3e-11 (a, alpha, d, theta per joint, modified DH): close
+#: enough to its family that the closed form answers it as it stands
+MOVED_LR_MATE = [(3.474574808972921e-11, -6.007505535404666e-11, 0.3299999999847783, 5.979184497374509e-11),
+                 (0.05000000003318478, -1.5707963267878384, -9.001607237849006e-12, -1.5707963267972087),
+                 (0.32999999996545193, 3.141592653627399, 2.3091977860831352e-11, 3.1415926535585568),
+                 (-0.03500000006365375, 1.5707963267739915, -0.33500000002673563, -4.3911129558301185e-11),
+                 (-8.875880146536604e-12, -1.5707963267657663, 5.647421300079202e-12, 6.647576549620826e-12),
+                 (1.905588366448663e-11, 1.570796326773793, -0.08000000000249419, 3.1415926535888583)]
+
+
+def test_an_offset_shoulder_with_its_elbow_folded_near_axis_2_keeps_both_shoulder_branches(client):
+    """The moved LR Mate with its wrist centre a few millimetres from axis 2 (elbow folded): subproblem 1 for q2
+    judged the point's height along axis 2 against 1e-9 of that short distance, which the arm's 3e-11 deviation
+    exceeds, and the whole front branch (the pose's own) was dropped under ``complete: true``. Judged against the
+    arm's size, as every other positioner's subproblem 1, the branch is there (its wrist at the aligned pose,
+    reported)."""
+    base = catalogue_robot(client, "fanuc_lrmate200id")
+    robot = Robot([Joint(joint.name, joint.kind, *row) for joint, row in zip(base.joints, MOVED_LR_MATE)],
+                  convention="modified", world_T_base=base.world_T_base, flange_T_tool=base.flange_T_tool)
+    q = np.array([2.9186381526278122, -1.5707974984923394, -1.6512723361783548, -1.023724756673627,
+                  3.141592653602855, 1.8644742315190053])
+    result = solve_ik(robot, forward_kinematics(robot, q))
+    assert _promise_held(robot, q, result)
+    assert any(abs(s.joints[0] - q[0]) < 1e-6 for s in result.solutions)  # the front branch is listed

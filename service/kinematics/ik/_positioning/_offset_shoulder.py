@@ -105,7 +105,10 @@ class OffsetShoulderParallelElbow(Positioner):
             third = prismatic_to_distance(in_plane @ (w - g.point(j)), g.direction(k), np.zeros(3), reach)
             q3 = third.s
             w3 = w + q3[..., None] * g.direction(k)
-        second = subproblem_1(u, w3 - g.point(j), y[:, :, None, :] - g.point(j))
+        # judged against the arm's size, as every positioner's subproblem 1 is: with the elbow folded the point is
+        # near axis 2, and an arm exact recognition accepted (within 1e-8 of its size) misses its height along
+        # axis 2 by more than 1e-9 of that short distance (a LR Mate moved by ~1e-11 lost its front branch)
+        second = subproblem_1(u, w3 - g.point(j), y[:, :, None, :] - g.point(j), scale=g.length_scale)
         q2 = second.theta[..., 0]
         if second.degenerate.any():  # the point on axis 2 (the elbow folded onto it)
             q2 = np.where(second.degenerate, 0.0 if reference is None else reference[j], q2)

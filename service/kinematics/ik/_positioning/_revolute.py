@@ -79,7 +79,7 @@ class PlanarTwoLink(Positioner):
         if self.free_joints:  # degenerate: the representative is the reference value (or 0), not SP3's 0
             q2 = np.where(elbow.valid, 0.0 if reference is None else reference[j], q2)
         w2 = g.point(j) + rotate_about(g.direction(j), q2, self.point - g.point(j))
-        first = subproblem_1(u, w2 - g.point(i), (targets - g.point(i))[:, None, :])
+        first = subproblem_1(u, w2 - g.point(i), (targets - g.point(i))[:, None, :], scale=g.length_scale)
         q1 = first.theta[..., 0]
         free = first.degenerate
         if free.any():

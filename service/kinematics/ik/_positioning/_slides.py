@@ -47,7 +47,7 @@ class ParallelShoulder(Positioner):
                              reach)
         q2 = elbow.theta  # (N, 2)
         w2 = g.point(j) + rotate_about(g.direction(j), q2, (w3 - g.point(j)))  # (N, 2, 3)
-        first = subproblem_1(u, w2 - g.point(i), (targets - g.point(i))[:, None, :])
+        first = subproblem_1(u, w2 - g.point(i), (targets - g.point(i))[:, None, :], scale=g.length_scale)
         q1 = first.theta[..., 0]
         free = first.degenerate
         if free.any():

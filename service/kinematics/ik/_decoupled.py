@@ -117,10 +117,10 @@ class DecoupledPlan(Sealed):
         for mask, flag in wrist.singularities.entries:
             singular.add((mask.reshape(n_targets, m_arm) & arm_valid).any(axis=1), flag)
         near = None  # the slots near a singular set of the wrist, or of the positioner, for the isolation check
-        if isinstance(self.wrist, SphericalWrist) and self.positioner is not None:
-            near = (self.wrist.volume(wrist.joints[..., 1]) <= NEAR_SINGULAR).reshape(n_targets, m_arm, m_wrist)
+        if wrist.near_singular is not None and self.positioner is not None:
+            near = wrist.near_singular.reshape(n_targets, m_arm, m_wrist)
             if arm.near_singular is not None:
-                near |= arm.near_singular[..., None]
+                near = near | arm.near_singular[..., None]
             near = near.reshape(n_targets, -1)
         return Candidates(full.reshape(n_targets, m_arm * m_wrist, self.dof), valid.reshape(n_targets, -1),
                           singular, complete=complete, near_singular=near)
@@ -466,13 +466,15 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
                 along = along_ref
             if scalar.clearly_within(abs(across_ref * across_ref - across_squared), band_squared):
                 across, first_sign = abs(across_ref), (-1.0 if across_ref < 0 else 1.0)
+        if radius <= self.near_axis:  # the target near axis 1: the array path checks the solutions there
+            raise scalar.NotGeneric
         on_first_axis = max(rounding / POLISH_RESIDUAL, self.at_centre)
         goal = self.first_turn.coordinates(y)
         rows, codes = [], []
         for signed in (first_sign * across, -first_sign * across):
             psi = math.atan2(signed, along)
             t = along * math.cos(psi) + signed * math.sin(psi)  # the displacement along R(k2, q2) v
-            if abs(t) <= self.near_axis or radius <= self.near_axis:  # (SlideThroughAxis2.solve's near_singular)
+            if abs(t) <= self.near_axis:  # (SlideThroughAxis2.solve's near_singular, as the radius below)
                 raise scalar.NotGeneric  # the array path checks that the solutions there are isolated
             for turn, slide in ((psi, t), (psi + math.pi, -t)):
                 c, s = math.cos(turn), math.sin(turn)

@@ -255,8 +255,9 @@ class IdealisedPlan(Sealed):
             complete &= ideal.complete
         if self.constrain_orientation and self.inner.free_joints:
             complete[:] = False
-        return Candidates(joints, accepted, ideal.singularities, complete=complete,
-                          near_singular=ideal.near_singular)  # the slots are the idealised family's
+        # (no near_singular for the verifier's isolation check: criterion 3 already withdrew every row with an
+        # accepted solution whose σ_min is within max(10 δ, 0.01 √δ), a margin far above ISOLATED_BELOW)
+        return Candidates(joints, accepted, ideal.singularities, complete=complete)
 
     def _generic_one_pose(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates | None:
         """For one target (1, 4, 4), the idealised family's scalar path (``solve_one``) as candidates when it

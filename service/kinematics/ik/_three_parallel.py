@@ -66,10 +66,11 @@ class _AxesTwoToFourParallel(Sealed):
         forward = _unit(cross(geometry.direction(0), self.omega_p))
         reach = geometry.point(3) - geometry.point(0)
         self.forward = forward if forward @ reach >= 0 else -forward
-        # the elbow's subproblem 3 (the point on axis 4 about axis 3, at a distance from axis 2): its radii's
-        # product ρ, from its least and greatest distances; and the error q6 is read off with (step 3)
+        # the elbow's subproblem 3 (the point on axis 4 about axis 3, at a distance from axis 2): its least and
+        # greatest distances and their radii's product ρ; and the error q6 is read off with (step 3)
         least, greatest = _distance_range(geometry.direction(2), geometry.point(3) - geometry.point(2),
                                           geometry.point(1) - geometry.point(2))
+        self.elbow_range = float(least), float(greatest)
         self.elbow_rho = float(greatest**2 - least**2) / 4
         self.sixth_error = read_off_error(geometry)
 
@@ -88,8 +89,11 @@ class _AxesTwoToFourParallel(Sealed):
         """How far the wrist is from its singularity at joint vectors (..., n), shape (...,): the sine of the angle
         between axis 6 and the parallel axes, which depends on q5 alone (joints 1–4 turn both alike), 0 where they
         align (:meth:`.DecoupledPlan.wrist_volume`'s counterpart, which :class:`.IdealisedPlan` bands)."""
-        return _radius_about(self.geometry.direction(5), rotate_about(self.geometry.direction(4), -joints[..., 4],
-                                                                       self.omega_p))
+        return self._sixth_radius(joints[..., 4])
+
+    def _sixth_radius(self, q5: np.ndarray) -> np.ndarray:
+        """ω_p turned back by q5 about axis 5, as step 3 reads q6 off it: its radius about axis 6 (...,)."""
+        return _radius_about(self.geometry.direction(5), rotate_about(self.geometry.direction(4), -q5, self.omega_p))
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         A = world_T_targets @ self.home_inverse  # (N, 4, 4)
@@ -162,9 +166,7 @@ class _AxesTwoToFourParallel(Sealed):
         singular.add(unrepresented, Singularity(
             "wrist", (1, 2, 3, 5), relation, "the values of q6 the elbow reaches with form two separate arcs "
             "and no candidate slot was left for the second one: its solutions are missing (complete: false)"))
-        if free_six.any():  # a second arc may have moved slots: axis 6 as their q5 turns it now
-            p = rotate_about(g.direction(4), -q5, w_p)
-        sixth_radius = _radius_about(g.direction(5), p)  # axis 6's sine with ω_p: the wrist's alignment
+        sixth_radius = self._sixth_radius(q5)  # (q5 as the slots hold it after a second arc)
         with np.errstate(divide="ignore", invalid="ignore"):
             band = self.split_band(distance, sixth_radius, _radius_about(g.direction(5), lever))
         band = np.where(free_six, SPLIT_DOUBLE_ROOT, np.fmax(band, SPLIT_DOUBLE_ROOT))  # q6 held, not read: exact
@@ -484,8 +486,7 @@ def _nearer_root_on_line(w: np.ndarray, w_slope: np.ndarray, u: np.ndarray, u_sl
 def _distance_range(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The least and greatest of ``||R(k, θ) p − q||`` over θ (k a unit axis through the origin)."""
     along = (p - q) @ k
-    radius_p = np.linalg.norm(p - (p @ k)[..., None] * k, axis=-1)
-    radius_q = np.linalg.norm(q - (q @ k)[..., None] * k, axis=-1)
+    radius_p, radius_q = _radius_about(k, p), _radius_about(k, q)
     return np.hypot(radius_p - radius_q, along), np.hypot(radius_p + radius_q, along)
 
 
@@ -571,10 +572,9 @@ class _ThreeParallelOnePose:
         # the widest band the array solver's split double root of the elbow has where this path answers (axis 6
         # at least NEAR_SINGULAR from the parallel axes): the elbow's greatest distance, and the point on axis 4's
         # radius about axis 6 bounded by the arm's constants; roots within it (times the margin) are declined
-        greatest = float(_distance_range(plan.geometry.direction(2), plan.geometry.point(3) - plan.geometry.point(2),
-                                         plan.geometry.point(1) - plan.geometry.point(2))[1])
         lever = scalar.norm(self.p4_from_5) + scalar.norm(scalar.sub(p[4], p[5]))
-        self.split_within = scalar.MARGIN * max(SPLIT_DOUBLE_ROOT, plan.split_band(greatest, NEAR_SINGULAR, lever))
+        self.split_within = scalar.MARGIN * max(SPLIT_DOUBLE_ROOT,
+                                                plan.split_band(plan.elbow_range[1], NEAR_SINGULAR, lever))
         # the labels' constants, and the elbow (point on axis 3 from axis 2) in the plane normal to ω_p
         self.forward = scalar.vector_of(plan.forward)
         self.up = scalar.vector_of(plan.geometry.upward(plan.geometry.direction(0)))

@@ -24,7 +24,7 @@ from .._forward import JointTrig, cross
 from ._screws import perpendicular_unit, rotate_about
 from ._structure import Geometry, read_off_below
 from .subproblems import subproblem_1, subproblem_2_chain
-from ._types import LabelCodes, SingularFlags, Singularity, Sealed
+from ._types import NEAR_SINGULAR, LabelCodes, SingularFlags, Singularity, Sealed
 
 
 def seen_by(wrist, R_w: np.ndarray) -> np.ndarray:
@@ -35,11 +35,13 @@ def seen_by(wrist, R_w: np.ndarray) -> np.ndarray:
 
 @dataclass
 class WristResult:
-    """``joints`` (N, m, k) for the wrist joints, ``valid`` (N, m), singular flags per target."""
+    """``joints`` (N, m, k) for the wrist joints, ``valid`` (N, m), singular flags per target, and, when the wrist
+    gives it, the slots (N, m) it solved near its alignment (see :attr:`~._types.Candidates.near_singular`)."""
 
     joints: np.ndarray
     valid: np.ndarray
     singularities: SingularFlags
+    near_singular: np.ndarray | None = None
 
 
 def wrist_codes(sine: np.ndarray) -> LabelCodes:
@@ -116,7 +118,8 @@ class SphericalWrist(Sealed):
         # or the axes nearly align (their volume below ALIGNED_BELOW), the target fixes q_a only within a band:
         # the root nearest the reference takes its value where that reaches R_w ω_c within BAND_MISS
         met = pair.merged[..., 0] & ~free
-        aligned = (self.volume(qb) <= ALIGNED_BELOW) & pair.exact[..., 0, :]  # (..., 2); a miss's pair is coplanar
+        volume = self.volume(qb)
+        aligned = (volume <= ALIGNED_BELOW) & pair.exact[..., 0, :]  # (..., 2); a miss's pair is coplanar
         band = (met[..., None] | aligned) & valid & ~free[..., None]
         if reference is not None and band.any():
             held = reference[self.joints[0]]
@@ -148,7 +151,8 @@ class SphericalWrist(Sealed):
         singular.add(band.any(axis=-1) & ~met, Singularity(
             "wrist", self.joints, "aligned", f"the wrist axes are nearly aligned: q{self.joints[0] + 1} is fixed "
             f"only within a band, and set to the reference value where it lies in it"))
-        return WristResult(joints, valid, singular)
+        # (a root moved to the reference's q_a lies in the band, far inside NEAR_SINGULAR: its volume stands)
+        return WristResult(joints, valid, singular, volume <= NEAR_SINGULAR)
 
     def volume(self, qb: np.ndarray) -> np.ndarray:
         """|det| of the wrist's three unit axes at q_b (...,), which q_a turns together (so it does not count):

@@ -151,10 +151,10 @@ def test_one_pose_path_agrees_with_the_batch_on_both_sides_of_the_near_singular_
 
 def test_a_rounded_ur_arm_near_its_wrist_singularity_and_folded_is_not_promised(client):
     """A UR16e as a CAD export writes it, q5 1e-8 from π and the elbow 1e-4 rad from folded: the idealised
-    family's solutions refined to four verified ones, 0.36 rad and more from the pose's own. Three checks now
+    family's solutions refined to four verified ones, 0.36 rad and more from the pose's own. Two checks now
     withdraw the promise, each alone: the band a spherical wrist has, which the UR type's wrist now has too
-    (``wrist_volume``: the sine of axis 6 with the parallel axes), criterion 2's near miss of a candidate that
-    only the true arm reaches, and the isolation check of the family's near-singular slots."""
+    (``wrist_volume``: the sine of axis 6 with the parallel axes), and criterion 2's near miss of a candidate that
+    only the true arm reaches."""
     robot = rounded(catalogue_robot(client, "ur16e"), 769395683)
     q = np.array([1.4058016621531513, 1.9323037111184513, 3.1414933099846305, -1.570792119192901,
                   3.1415926433624177, -1.3812719461643931e-05])

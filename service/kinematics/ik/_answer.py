@@ -43,7 +43,7 @@ from ._plan import Plan, geometry_of
 from ._redundant import (FreeJoint, beyond_reach, family_for, free_joints_for, no_solution_detail, solve_family)
 from ._select import MAX_EQUIVALENTS, NOTE_WORDING, Ordering, Selection, check_options, select
 from ._table import SolutionTable
-from ._types import LabelCodes, Singularity
+from ._types import LabelCodes, Singularity, every
 from ._verify import Verified, verify
 
 #: Target kinds (:attr:`IKTargets.kinds`).
@@ -530,10 +530,10 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
     target near a singularity, which the closed form hands over, keeps the labels a client holds along a path
     (issue 22.11)."""
     verified = closed.verified
-    if not verified.count.all():  # (the usual answer has every target solved: nothing to word)
+    if not every(verified.count):  # (the usual answer has every target solved: nothing to word)
         for local in np.flatnonzero((verified.count == 0) & verified.complete).tolist():
             closed.details[local] = unreachable_detail(robot, goal, local, verified)
-    if verified.complete.all():
+    if every(verified.complete):
         return [_timed(timings, closed, started)]
     broken = np.flatnonzero(~verified.complete)
     promised = np.flatnonzero(verified.complete)

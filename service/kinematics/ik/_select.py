@@ -51,6 +51,7 @@ from .._robot import Robot
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, capped_products, capped_sums, combination_turns,
                            down_set_size, enumerable_limit, position_in_group, rounds_needed)
 from ._table import SolutionTable
+from ._types import every
 
 Norm = Literal["linf", "l2"]
 
@@ -247,11 +248,11 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     target, q = table.target, table.joints
     first, last = turn_ranges(robot, limits, q)
     unordered = reference is None and excluded is None
-    if unordered and (first == last).all():  # every row fits at one equivalent (one flat comparison: a batch's)
+    if unordered and every(first == last):  # every row fits at one equivalent (one flat comparison: a batch's)
         return _each_once(robot, limits, table, n_targets, first, last, np.ones(len(q), dtype=bool), filter_limits,
                           max_equivalents)
     fits = (last >= first).all(axis=1)
-    if unordered and ((first == last).all(axis=1) | ~fits).all():  # and the others at none
+    if unordered and every((first == last).all(axis=1) | ~fits):  # and the others at none
         return _each_once(robot, limits, table, n_targets, first, last, fits, filter_limits, max_equivalents)
     keepable = fits if filter_limits else np.ones(len(q), dtype=bool)
     if excluded is not None:

@@ -27,6 +27,7 @@ from ._plan import Plan
 from ._select import select
 from ._table import SolutionTable
 from ._types import IKResult, LabelCodes, SingularFlags, Solution
+from ._verify import OnePoseVerified
 
 
 def unlimited(robot: Robot) -> Limits:
@@ -53,11 +54,15 @@ def solve_ik(robot: Robot, world_T_target: np.ndarray, *, constrain_orientation:
     """
     target = np.asarray(world_T_target, dtype=float)
     if constrain_orientation and reference is None:
-        closed = _closed_form_result(robot, target, options or IKOptions())
+        closed = _closed_form_result(robot, target, options or _SEARCH_DEFAULTS)
         if closed is not None:
             return closed
     return solve_ik_batch(robot, target[None], constrain_orientation=constrain_orientation, reference=reference,
                           options=options)[0]
+
+
+#: The search's bounds and budget where a caller gives none (a value: nothing changes it).
+_SEARCH_DEFAULTS = IKOptions()
 
 
 def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) -> IKResult | None:
@@ -75,18 +80,22 @@ def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) ->
     if not verified.complete[0]:
         return None
     report = SolverReport("analytic", plan.structure, True, False, tuple(plan.free_joints))
-    table = verified.table  # one target: its rows are the table's
-    if not len(table):
+    if not verified.count[0]:
         detail = unreachable_detail(robot, goal, 0, verified)
         return _result([], "unreachable", report, verified.singularities[0], detail)
-    # the joints as the selection lists them, q + 2π·0 (a −0.0 becomes 0.0)
-    return _result(_solutions(table, table.joints + 0.0), "ok", report, verified.singularities[0], None)
+    # one target: its rows are the table's, the joints as the selection lists them, q + 2π·0 (a −0.0 becomes 0.0)
+    if isinstance(verified, OnePoseVerified):  # the scalar path's rows, on floats: no table to make
+        rows = verified.rows
+        solutions = list(map(Solution, np.array(rows.joints) + 0.0, rows.branches(), *zip(*rows.residuals)))
+    else:
+        solutions = _solutions(verified.table, verified.table.joints + 0.0)
+    return _result(solutions, "ok", report, verified.singularities[0], None)
 
 
 def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,
                    reference: np.ndarray | None = None, options: IKOptions | None = None) -> list[IKResult]:
     """:func:`solve_ik` for targets of shape (N, 4, 4); the closed forms run vectorised over N."""
-    options = options or IKOptions()
+    options = options or _SEARCH_DEFAULTS
     targets = IKTargets.poses(np.asarray(world_T_targets, dtype=float), constrain_orientation=constrain_orientation)
     answer = answer_ik(robot, targets, AnswerOptions(reference=reference, limits=unlimited(robot),
                                                      filter_limits=False, search=options, budget=options.budget))
@@ -113,10 +122,9 @@ def result_of(answer: IKAnswer, row: int) -> IKResult:
 
 def _solutions(table: SolutionTable, joints: np.ndarray | None = None) -> list[Solution]:
     """Every row of a table as a :class:`Solution`, in table order, its joints a row view of the table's (or of
-    ``joints`` (S, n), the same rows' values as listed) and its branch a dict of its own (the table shares them)."""
-    return [Solution(q, dict(branch), position, orientation) for q, branch, position, orientation in
-            zip(table.joints if joints is None else joints, table.branches(), table.position.tolist(),
-                table.orientation.tolist())]
+    ``joints`` (S, n), the same rows' values as listed) and its branch a dict of its own."""
+    return list(map(Solution, table.joints if joints is None else joints, table.branches(own=True),
+                    table.position.tolist(), table.orientation.tolist()))
 
 
 def _result(solutions: list[Solution], status: str, solver: SolverReport, singularities: list, detail: str | None

@@ -132,11 +132,13 @@ class SolutionTable:
             table = table.take(np.argsort(table.target, kind="stable"))
         return table
 
-    def branches(self) -> list[dict]:
+    def branches(self, *, own: bool = False) -> list[dict]:
         """Each row's branch labels as a dict, name → label (a name left out where the row's code is −1). Rows
         with the same codes may share one dict (read-only by convention): an answer has a handful of distinct
-        branches among thousands of rows."""
+        branches among thousands of rows. With ``own``, each row has a dict of its own (the caller's to keep)."""
         if not self.labels or not len(self.target):
+            if own:
+                return [{} for _ in range(len(self.target))]
             empty: dict = {}
             return [empty] * len(self.target)
         if len(self.target) <= _ROWS_OF_ONE_TARGET:  # a dict per row, filled a column at a time
@@ -159,6 +161,8 @@ class SolutionTable:
             codes_of = dict(zip(distinct.tolist(), (codes[first] - 1).tolist()))
         shared = {key: {name: self.labels[name][0][code] for name, code in zip(names, row) if code >= 0}
                   for key, row in codes_of.items()}
+        if own:
+            return [dict(shared[key]) for key in keys]
         return list(map(shared.__getitem__, keys))
 
     def bounds(self, n_targets: int) -> tuple[np.ndarray, np.ndarray]:

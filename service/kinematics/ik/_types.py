@@ -181,6 +181,12 @@ class IKResult:
 LEAN_CHUNK = 8192
 
 
+def every(mask: np.ndarray) -> bool:
+    """``mask.all()`` at a quarter of its fixed cost (``np.count_nonzero`` skips a reduction's setup): the one-pose
+    paths ask it of arrays of one or a few entries, where that cost is all there is."""
+    return np.count_nonzero(mask) == mask.size
+
+
 class Sealed:
     """An object that concurrent requests share once built (a plan and its parts): attributes are set while it
     is built, and :meth:`seal` ends that. Setting one afterwards (per-call state kept on a shared object) raises

@@ -26,7 +26,7 @@ from ._gauss_newton import gauss_newton
 from ._goals import Goal, PoseGoal, pose_residuals_of_rows
 from ._structure import arm_size
 from ._table import SolutionTable
-from ._types import Candidates, LabelCodes, SingularFlags
+from ._types import Candidates, LabelCodes, SingularFlags, every
 
 #: Candidates with errors above this (and up to ``POLISH_RESIDUAL``) get Gauss–Newton steps before the check.
 POLISH_FROM = ACCEPT_RESIDUAL * 1e-3
@@ -80,11 +80,11 @@ def residual_arrays(robot: Robot, q: np.ndarray, world_T_targets: np.ndarray) ->
     return PoseGoal(np.asarray(world_T_targets, dtype=float)).residuals(robot, np.asarray(q, dtype=float))
 
 
-def error_size(robot: Robot, position, orientation, constrain_orientation: bool):
-    """One number per residual pair: the position error as a fraction of the arm's size, or the larger of that
-    and the orientation error (radians). Arrays, or one pair of floats (:func:`verify_one`); a NaN error either
-    way gives NaN."""
-    size = position / arm_size(robot)
+def error_size(robot: Robot, position, orientation, constrain_orientation: bool, size_of_arm: float | None = None):
+    """One number per residual pair: the position error as a fraction of the arm's size (``size_of_arm``, read
+    once by a caller with many floats, or :func:`arm_size`), or the larger of that and the orientation error
+    (radians). Arrays, or one pair of floats (:func:`verify_one`); a NaN error either way gives NaN."""
+    size = position / (arm_size(robot) if size_of_arm is None else size_of_arm)
     if not constrain_orientation:
         return size
     if type(size) is float:  # np.maximum's rule on floats, without its cost per call
@@ -359,8 +359,8 @@ def _unvouched(valid: np.ndarray, size: np.ndarray) -> np.ndarray:
 
 def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | None = None) -> Verified | None:
     """:func:`verify` of one target's candidates from a family's scalar path (a :class:`~._scalar.OnePose`: slots
-    as lists of floats, None where empty, each with its label codes), on floats, with the arrays of the table
-    built once from the rows kept: the same table, promise and nearest miss. Only the valid slots are checked,
+    as lists of floats, None where empty, each with its label codes), on floats: the same table (made from the
+    rows kept when first read, :class:`OnePoseVerified`), promise and nearest miss. Only the valid slots are checked,
     and only the rows kept need a clear label (a least-squares slot the FK check rejects may sit where a label
     flips).
 
@@ -373,31 +373,76 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
             codes.append(code)
     constrained = goal.constrain_orientation
     residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist()) if rows else []
+    size_of_arm = arm_size(robot)
     sizes, ok = [], []
     for position, orientation in residuals:
-        size = error_size(robot, position, orientation, constrained)
+        size = error_size(robot, position, orientation, constrained, size_of_arm)
         if size != size or polished(size):  # a NaN error, or one verify would polish
             return None
         sizes.append(size)
         ok.append(size <= ACCEPT_RESIDUAL)
     kept = [row for row, keep in enumerate(first_of_each_slot(robot, rows, ok)) if keep]
-    count = len(kept)
-    joints = np.array([rows[row] for row in kept], dtype=float).reshape(count, robot.dof)
-    if reference is not None and count > 1:
-        nearest_first = np.argsort(distance_to_reference(robot, joints, reference), kind="stable").tolist()
-        kept, joints = [kept[i] for i in nearest_first], joints[nearest_first]
-    codes = [codes[row] for row in kept]
-    for row in codes:
-        if None in row:
+    for row in kept:
+        if None in codes[row]:
             return None
+    if reference is not None and len(kept) > 1:
+        distance = distance_to_reference(robot, np.array([rows[row] for row in kept]), reference)
+        kept = [kept[i] for i in np.argsort(distance, kind="stable").tolist()]
     nearest = np.array([min(sizes, default=np.inf)])
-    complete = promised(one_pose, np.array([count]), nearest, constrained)
-    columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(one_pose.names), count)
-    labels = {name: (values, column) for name, values, column in zip(one_pose.names, one_pose.values, columns)}
-    errors = np.array([[residuals[row][0] for row in kept], [residuals[row][1] for row in kept]]).reshape(2, count)
-    table = SolutionTable(np.zeros(count, dtype=np.int64), joints, np.ones(count, dtype=bool), errors[0],
-                          errors[1] if constrained else np.full(count, np.nan), labels)
-    return Verified(table, complete, nearest, one_pose.singularities)
+    complete = promised(one_pose, np.array([len(kept)]), nearest, constrained)
+    no_orientation = math.nan  # a position target's orientation residual, as the table holds it
+    kept_rows = OnePoseRows([rows[row] for row in kept],
+                            [residuals[row] if constrained else (residuals[row][0], no_orientation) for row in kept],
+                            [codes[row] for row in kept], one_pose.names, one_pose.values)
+    return OnePoseVerified(kept_rows, robot.dof, complete, nearest, one_pose.singularities)
+
+
+@dataclass(frozen=True)
+class OnePoseRows:
+    """One target's verified, distinct solutions as :func:`verify_one` keeps them, on floats: ``joints`` (lists of
+    n floats, revolute joints wrapped) in output order, their ``residuals`` ((position, orientation) pairs, the
+    orientation NaN for a position target) and label ``codes`` (a tuple per row, one code per name of ``names``,
+    read in ``values``)."""
+
+    joints: list[list[float]]
+    residuals: list[tuple[float, float]]
+    codes: list[tuple[int, ...]]
+    names: tuple[str, ...]
+    values: tuple[tuple[str, ...], ...]
+
+    def table(self, dof: int) -> SolutionTable:
+        """The rows as target 0's :class:`SolutionTable`."""
+        count = len(self.joints)  # each column contiguous (the arrays form encodes them as they stand)
+        position, orientation = zip(*self.residuals) if count else ((), ())
+        columns = np.array(list(zip(*self.codes)), dtype=np.int8).reshape(len(self.names), count)
+        labels = {name: (values, column) for name, values, column in zip(self.names, self.values, columns)}
+        return SolutionTable(np.zeros(count, dtype=np.int64), np.array(self.joints, dtype=float).reshape(count, dof),
+                             np.ones(count, dtype=bool), np.array(position, dtype=float),
+                             np.array(orientation, dtype=float), labels)
+
+    def branches(self) -> list[dict]:
+        """Each row's branch labels as a dict of its own (:meth:`SolutionTable.branches` of :meth:`table`)."""
+        return [{name: labels[code] for name, labels, code in zip(self.names, self.values, codes) if code >= 0}
+                for codes in self.codes]
+
+
+class OnePoseVerified(Verified):
+    """:class:`Verified` of one target from :func:`verify_one`: its ``rows`` (:class:`OnePoseRows`) on floats, the
+    table made from them when first read (a one-pose record reads the floats and needs no table)."""
+
+    def __init__(self, rows: OnePoseRows, dof: int, complete: np.ndarray, nearest: np.ndarray,
+                 singularities: SingularFlags) -> None:
+        for name, value in (("rows", rows), ("dof", dof), ("complete", complete), ("nearest", nearest),
+                            ("singularities", singularities)):
+            object.__setattr__(self, name, value)  # a frozen dataclass's fields
+
+    @functools.cached_property
+    def table(self) -> SolutionTable:
+        return self.rows.table(self.dof)
+
+    @functools.cached_property
+    def count(self) -> np.ndarray:
+        return _read_only(np.array([len(self.rows.joints)]))
 
 
 def _residuals_at(robot: Robot, goal: Goal, q: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -427,7 +472,7 @@ def promised(candidates: Candidates, count: np.ndarray, nearest: np.ndarray, con
 
     Those rows go to the fallback."""
     complete = np.ones(len(count), dtype=bool) if candidates.complete is None else candidates.complete.copy()
-    if count.all():  # both exceptions are about rows without a solution
+    if every(count):  # both exceptions are about rows without a solution
         return complete
     empty = count == 0
     narrow = empty & (nearest <= POLISH_RESIDUAL)

@@ -210,6 +210,10 @@ def _float_check_against_verify(robot, plan, poses: np.ndarray, references: list
             np.testing.assert_array_equal(fast.table.orientation, slow.table.orientation)
             np.testing.assert_array_equal(fast.nearest, slow.nearest)
         np.testing.assert_array_equal(fast.table.target, slow.table.target)
+        # contiguous columns, as the arrays form encodes them (orjson refuses strided arrays: a 500)
+        assert all(column.flags.c_contiguous for column in (fast.table.joints, fast.table.position,
+                                                            fast.table.orientation,
+                                                            *(codes for _, codes in fast.table.labels.values())))
         np.testing.assert_array_equal(fast.table.within_limits, slow.table.within_limits)
         np.testing.assert_array_equal(fast.complete, slow.complete)
         assert list(fast.table.labels) == list(slow.table.labels)

@@ -97,7 +97,7 @@ def test_records_of_a_batch_are_each_targets_record():
 @pytest.mark.parametrize("rows", [1, 7, _FEW_ROWS, _FEW_ROWS + 1, 500])
 def test_branches_word_each_rows_labels_on_both_sides_of_the_few_rows_path(rows):
     """SolutionTable.branches keys a few rows by their code tuples and many by one integer: either way each row's
-    dict names exactly its labels whose code is not −1."""
+    dict names exactly its labels whose code is not −1; with ``own`` each row's dict is its own object."""
     from service.kinematics.ik._table import SolutionTable
     rng = np.random.default_rng(rows)
     labels = {name: (values, rng.integers(-1, len(values), rows).astype(np.int8))
@@ -108,3 +108,5 @@ def test_branches_word_each_rows_labels_on_both_sides_of_the_few_rows_path(rows)
     expected = [{name: values[codes[k]] for name, (values, codes) in labels.items() if codes[k] >= 0}
                 for k in range(rows)]
     assert table.branches() == expected
+    own = table.branches(own=True)
+    assert own == expected and len({id(branch) for branch in own}) == rows

@@ -126,8 +126,9 @@ def wrist_code(middle: float) -> int | None:
 
 
 def reject(v: Vector, unit: Vector) -> Vector:
-    along = dot(v, unit)
-    return (v[0] - along * unit[0], v[1] - along * unit[1], v[2] - along * unit[2])
+    (x, y, z), (a, b, c) = v, unit
+    along = x * a + y * b + z * c
+    return (x - along * a, y - along * b, z - along * c)
 
 
 # --- vector algebra on tuples ---------------------------------------------------------------------------
@@ -161,7 +162,9 @@ def norm(a: Vector) -> float:
 
 
 def mv(R: Matrix, v: Vector) -> Vector:
-    return (dot(R[0], v), dot(R[1], v), dot(R[2], v))
+    (a, b, c), (d, e, f), (g, h, i) = R
+    x, y, z = v
+    return (a * x + b * y + c * z, d * x + e * y + f * z, g * x + h * y + i * z)
 
 
 def mtv(R: Matrix, v: Vector) -> Vector:

@@ -313,12 +313,12 @@ def _subproblem_2_chain_clear(p: tuple[float, ...], q: tuple[float, ...], cos: f
     s1, c1, s2, c2 = -beta * pn, beta * d1, alpha * qn, alpha * e2
     if not g > margin * merge_below * rho:
         if -g > 2 * margin * _NEAR_TANGENT_GAP * (rho1 + rho2):
-            return (wrap(-wrap(atan2(s1, c1))), wrap(atan2(s2, c2))), None
+            return (wrap(-atan2(s1, c1)), wrap(atan2(s2, c2))), None
         return None
     gamma = math.sqrt(g) / sin
     t1, u1, t2, u2 = gamma * d1, gamma * pn, gamma * e2, gamma * qn
-    return ((wrap(-wrap(atan2(s1 + t1, c1 + u1))), wrap(atan2(s2 - t2, c2 + u2))),
-            (wrap(-wrap(atan2(s1 - t1, c1 - u1))), wrap(atan2(s2 + t2, c2 - u2))))
+    return ((wrap(-atan2(s1 + t1, c1 + u1)), wrap(atan2(s2 - t2, c2 + u2))),
+            (wrap(-atan2(s1 - t1, c1 - u1)), wrap(atan2(s2 + t2, c2 - u2))))
 
 
 def subproblem_2_chain(k1: ArrayLike, k2: ArrayLike, p: ArrayLike, q: ArrayLike, *, error: ArrayLike = 0.0

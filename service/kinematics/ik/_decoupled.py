@@ -321,7 +321,9 @@ class _SphericalWristOnePose:
         the wrist, R_Gᵀ · R_target, applied to its last axis and normal."""
         wanted = scalar.mtv(R_G, normal)
         a, b = self.wrist_axes
+        u, w = self.wrist_volume
         pairs = self.wrist.angles(self.wrist_start, self.wrist.goal(scalar.mtv(R_G, axis_c)))
+        both = pairs[1] is not None
         for roots in pairs:
             if roots is None:
                 rows.append(None)
@@ -331,8 +333,7 @@ class _SphericalWristOnePose:
             # the wrist's axes near aligned at a root (not at the least-squares pair of cones that miss, which
             # is coplanar): the array path holds q_a within its band (SphericalWrist), and checks that the
             # solutions there are isolated (NEAR_SINGULAR: far wider than that band)
-            u, w = self.wrist_volume
-            if pairs[1] is not None and abs(u * math.cos(qb) + w * math.sin(qb)) <= NEAR_SINGULAR:
+            if both and abs(u * math.cos(qb) + w * math.sin(qb)) <= NEAR_SINGULAR:
                 raise scalar.NotGeneric
             unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
             qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))

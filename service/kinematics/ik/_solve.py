@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .._budget import UNLIMITED, Budget
+from .._cache import memo
 from .._limits import Limits
 from .._robot import Robot
 from ._answer import (DIRECTION, AnswerOptions, IKAnswer, IKOptions, IKTargets, SolverReport, answer_ik,
@@ -79,17 +80,19 @@ def _closed_form_result(robot: Robot, target: np.ndarray, options: IKOptions) ->
     verified = solve_closed_form(robot, plan, goal, None, budget=options.budget)
     if not verified.complete[0]:
         return None
-    report = SolverReport("analytic", plan.structure, True, False, tuple(plan.free_joints))
+    report = memo(robot, ("ik_report", "pose"),
+                  lambda: SolverReport("analytic", plan.structure, True, False, tuple(plan.free_joints)))
+    if isinstance(verified, OnePoseVerified) and verified.rows.joints:  # the scalar path's rows, on floats
+        rows = verified.rows
+        joints = np.array(rows.joints)
+        joints += 0.0  # the joints as the selection lists them, q + 2π·0 (a −0.0 becomes 0.0)
+        solutions = list(map(Solution, joints, rows.branches(), *zip(*rows.residuals)))
+        return _result(solutions, "ok", report, verified.singularities[0], None)
     if not verified.count[0]:
         detail = unreachable_detail(robot, goal, 0, verified)
         return _result([], "unreachable", report, verified.singularities[0], detail)
-    # one target: its rows are the table's, the joints as the selection lists them, q + 2π·0 (a −0.0 becomes 0.0)
-    if isinstance(verified, OnePoseVerified):  # the scalar path's rows, on floats: no table to make
-        rows = verified.rows
-        solutions = list(map(Solution, np.array(rows.joints) + 0.0, rows.branches(), *zip(*rows.residuals)))
-    else:
-        solutions = _solutions(verified.table, verified.table.joints + 0.0)
-    return _result(solutions, "ok", report, verified.singularities[0], None)
+    table = verified.table  # one target: its rows are the table's
+    return _result(_solutions(table, table.joints + 0.0), "ok", report, verified.singularities[0], None)
 
 
 def solve_ik_batch(robot: Robot, world_T_targets: np.ndarray, *, constrain_orientation: bool = True,

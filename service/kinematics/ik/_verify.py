@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable, Sequence
+from typing import NamedTuple
 from dataclasses import dataclass
 
 import numpy as np
@@ -397,8 +398,7 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     return OnePoseVerified(kept_rows, robot.dof, complete, nearest, one_pose.singularities)
 
 
-@dataclass(frozen=True)
-class OnePoseRows:
+class OnePoseRows(NamedTuple):
     """One target's verified, distinct solutions as :func:`verify_one` keeps them, on floats: ``joints`` (lists of
     n floats, revolute joints wrapped) in output order, their ``residuals`` ((position, orientation) pairs, the
     orientation NaN for a position target) and label ``codes`` (a tuple per row, one code per name of ``names``,
@@ -432,9 +432,8 @@ class OnePoseVerified(Verified):
 
     def __init__(self, rows: OnePoseRows, dof: int, complete: np.ndarray, nearest: np.ndarray,
                  singularities: SingularFlags) -> None:
-        for name, value in (("rows", rows), ("dof", dof), ("complete", complete), ("nearest", nearest),
-                            ("singularities", singularities)):
-            object.__setattr__(self, name, value)  # a frozen dataclass's fields
+        # a frozen dataclass's fields, set as its own __init__ would (without a call per field)
+        self.__dict__.update(rows=rows, dof=dof, complete=complete, nearest=nearest, singularities=singularities)
 
     @functools.cached_property
     def table(self) -> SolutionTable:

@@ -169,12 +169,20 @@ def first_of_each_slot(robot: Robot, rows: Sequence[Sequence[float]], ok: list[b
     ``minimum(gap, 2π − gap)``, an infinite gap included), and a NaN gap is apart."""
     joints, turns, within = _duplicate_rule(robot)
     pi, two_pi = math.pi, 2 * math.pi
+    last, before_last = joints[0], joints[1:]
+    last_turns, last_within = turns[last], within[last]
     kept: list[bool] = []
-    distinct: list[Sequence[float]] = []
+    distinct: list[tuple[Sequence[float], float]] = []  # the slots kept, each with its last joint's value
     for q, keep in zip(rows, ok):
         if keep:
-            for other in distinct:
-                for j in joints:
+            value = q[last]
+            for other, other_value in distinct:
+                gap = abs(value - other_value)
+                if last_turns and gap > pi:
+                    gap = two_pi - gap
+                if not gap <= last_within:
+                    continue  # the last joint is apart: another solution (most pairs end here)
+                for j in before_last:
                     gap = abs(q[j] - other[j])
                     if turns[j] and gap > pi:
                         gap = two_pi - gap
@@ -184,7 +192,7 @@ def first_of_each_slot(robot: Robot, rows: Sequence[Sequence[float]], ok: list[b
                     keep = False
                     break
             if keep:
-                distinct.append(q)
+                distinct.append((q, value))
         kept.append(keep)
     return kept
 

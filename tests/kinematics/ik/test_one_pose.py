@@ -122,6 +122,30 @@ def test_the_scan_of_many_slots_is_the_pairwise_scan(robot_id, monkeypatch):
         assert (scanned[0] == pairwise[0]).all() and (pairwise[1:] == pairwise[0]).all()
 
 
+@pytest.mark.parametrize("robot_id", ["puma560_khalil", "spong_ex3_5_stanford"])
+def test_the_scan_of_one_target_is_the_scan_of_many_on_random_slots(robot_id):
+    """first_of_each_slot screens each pair by the last joint before the others: on random slots with copies
+    moved within and beyond the tolerance, in the last joint or only in earlier ones, the last joint near the 2π
+    wrap and some slots not ok, it keeps what first_of_each keeps."""
+    robot = _CATALOGUE.get(robot_id).robot
+    rng = np.random.default_rng(21)
+    for _ in range(300):
+        m = int(rng.integers(2, 10))
+        joints = random_configurations(robot, m, seed=int(rng.integers(1 << 30)))
+        if robot.is_revolute[-1]:
+            joints[rng.random(m) < 0.4, -1] = np.pi - rng.choice([0.0, 1e-12, 1e-8], m)[:1]
+        for row in range(1, m):
+            if rng.random() < 0.6:
+                joints[row] = joints[int(rng.integers(row))]
+                joint = int(rng.integers(robot.dof))
+                joints[row, joint] += rng.choice([0.0, 1e-12, 1e-7, 1e-3, -2 * np.pi * robot.is_revolute[joint]])
+        joints = wrap_revolute(robot, joints)
+        ok = (rng.random(m) < 0.85).tolist()
+        # two targets: first_of_each screens them pairwise (one target it would hand to first_of_each_slot)
+        expected = _verify.first_of_each(robot, np.repeat(joints[None], 2, axis=0), np.array([ok, ok]))
+        assert _verify.first_of_each_slot(robot, joints.tolist(), ok) == expected[0].tolist()
+
+
 def test_the_scan_of_one_target_is_the_scan_of_many():
     """first_of_each_slot (one target's slots, the one-pose path) keeps the slots first_of_each keeps for a batch
     (several targets, screened pairwise), whatever the values: duplicates beside rows that are not finite, whose

@@ -13,8 +13,8 @@ from __future__ import annotations
 import functools
 import math
 from collections.abc import Callable, Sequence
-from typing import NamedTuple
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -436,7 +436,8 @@ class OnePoseRows(NamedTuple):
 
 class OnePoseVerified(Verified):
     """:class:`Verified` of one target from :func:`verify_one`: its ``rows`` (:class:`OnePoseRows`) on floats, the
-    table made from them when first read (a one-pose record reads the floats and needs no table)."""
+    table made from them when first read (a one-pose record reads the floats and needs no table). Built here only
+    (``dataclasses.replace`` does not rebuild it: a caller changing a table starts from :func:`verify`'s)."""
 
     def __init__(self, rows: OnePoseRows, dof: int, complete: np.ndarray, nearest: np.ndarray,
                  singularities: SingularFlags) -> None:

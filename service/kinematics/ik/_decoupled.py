@@ -117,10 +117,12 @@ class DecoupledPlan(Sealed):
         for mask, flag in wrist.singularities.entries:
             singular.add((mask.reshape(n_targets, m_arm) & arm_valid).any(axis=1), flag)
         near = None  # the slots near a singular set of the wrist, or of the positioner, for the isolation check
-        if wrist.near_singular is not None and self.positioner is not None:
+        if wrist.near_singular is not None:
             near = wrist.near_singular.reshape(n_targets, m_arm, m_wrist)
-            if arm.near_singular is not None:
-                near = near | arm.near_singular[..., None]
+        if self.positioner is not None and arm.near_singular is not None:
+            arm_near = np.repeat(arm.near_singular[..., None], m_wrist, axis=2)
+            near = arm_near if near is None else near | arm_near
+        if near is not None:
             near = near.reshape(n_targets, -1)
         return Candidates(full.reshape(n_targets, m_arm * m_wrist, self.dof), valid.reshape(n_targets, -1),
                           singular, complete=complete, near_singular=near)
@@ -521,6 +523,7 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
         self.forward, self.shoulder = scalar.vector_of(positioner.forward), scalar.vector_of(positioner.shoulder)
         self.up = scalar.vector_of(positioner.geometry.upward(model.directions[0]))
         self.elbow_from_2 = scalar.sub(p3, p2)
+        self.near_axis = NEAR_SINGULAR * positioner.geometry.length_scale
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
         """The eight slots for a target (4, 4), or NotGeneric (``reference``: not read, see
@@ -528,6 +531,8 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
         point_world, axis_c, normal = self._target(T)
         d, o, p2, p3 = self.directions, self.origin, self.point_2, self.point_3
         from_origin = scalar.sub(point_world, o)
+        if scalar.norm(scalar.reject(from_origin, d[0])) <= self.near_axis:  # OffsetShoulderParallelElbow's
+            raise scalar.NotGeneric  # near_singular: the array path checks that the solutions there are isolated
         thetas = scalar.Height.angles(self.front_back.of(from_origin), self.height)
         if math.isnan(thetas[1]):  # clearly out of reach: the array path words why
             raise scalar.NotGeneric
@@ -546,7 +551,10 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
                 continue
             for q3 in elbows:
                 point_3 = scalar.add(scalar.sub(p3, p2), scalar.rotate(d[2], q3, self.point_from_3))
-                q2 = self.second_turn.angle(self.second_turn.coordinates(point_3), target_2)
+                placed = self.second_turn.coordinates(point_3)
+                if placed[3] <= self.near_axis:  # the placed point near axis 2 (as above)
+                    raise scalar.NotGeneric
+                q2 = self.second_turn.angle(placed, target_2)
                 R_2 = scalar.rotation(d[1], q2)
                 elbow_code = self._elbow_code(R_2, y_from_origin)
                 R_G = scalar.mm(scalar.mm(scalar.rotation(d[0], q1), R_2), scalar.rotation(d[2], q3))

@@ -22,7 +22,7 @@ from .._cache import memo
 from .._forward import JointTrig
 from .._robot import Robot
 from .._angles import wrap_angle
-from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL
+from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL, ROUNDING_TOLERANCE
 from ._gauss_newton import gauss_newton
 from ._goals import Goal, PoseGoal, pose_residuals_of_rows
 from ._structure import arm_size
@@ -310,7 +310,8 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
         nearest_position = np.where(checked, position, np.inf).min(axis=1, initial=np.inf) / arm_size(robot)
     complete = promised(candidates, count, nearest, constrained, nearest_position)
     if candidates.near_singular is not None and constrained and complete.any():
-        complete &= ~not_isolated(robot, goal, joints, kept & candidates.near_singular, candidates.singularities)
+        complete &= ~not_isolated(robot, goal, joints, kept & candidates.near_singular, size,
+                                  candidates.singularities)
     if candidates.promise_needs_every_slot:  # the solver's promise holds only if every valid slot gave a solution
         complete &= count == valid.sum(axis=1)
     labels = candidates.labels if candidates.labels is not None else (
@@ -340,19 +341,31 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
 #: its slide 1e-6 of its size from axis 2, 3e-13 to 5e-13, its own configuration listed within 6e-5 rad.
 ISOLATED_BELOW = 1e-13
 
+#: How far (radians, or fractions of the arm's size) a verified solution may be from the arm's exact solution
+#: for it to stand for that one: its residual over the least singular value bounds that distance to first order.
+#: A residual within ``ROUNDING_TOLERANCE`` is the FK's own rounding and says nothing of that distance: there
+#: the least singular value alone decides (:data:`ISOLATED_BELOW`, the bound at a residual of 1e-16). Above it
+#: the residual is the family's own miss: an OPW arm 1e-11 off its family, its wrist centre 1.6e-9 from axis 1,
+#: listed q1 0.018 rad from the pose's own with a residual of 8e-12 and σ_min 3e-10 (a bound of 0.027).
+ISOLATION_SPREAD = 1e-3
 
-def not_isolated(robot: Robot, goal: PoseGoal, joints: np.ndarray, checked: np.ndarray,
+
+def not_isolated(robot: Robot, goal: PoseGoal, joints: np.ndarray, checked: np.ndarray, size: np.ndarray,
                  singularities: SingularFlags) -> np.ndarray:
     """The targets (N,) with a solution among the ``checked`` slots (N, m) of ``joints`` (N, m, n) that is not
-    isolated (:data:`ISOLATED_BELOW`), on a target the family flagged no singular condition for (a flag states
-    what the listed solutions represent). Such a target's solutions are one of many joint vectors that reach it
-    within rounding: the family's list cannot promise to hold each of the others."""
+    isolated, on a target the family flagged no singular condition for (a flag states what the listed solutions
+    represent): its residual (``size`` (N, m), :func:`error_size`; one of rounding counts as ``ISOLATED_BELOW ·
+    ISOLATION_SPREAD``) over the least singular value of the Jacobian is more than :data:`ISOLATION_SPREAD`. Such
+    a target's solutions are one of many joint vectors that reach it within that residual: the family's list
+    cannot promise to hold each of the others."""
     checked = checked & ~singularities.any()[:, None]
     rows, slots = np.nonzero(checked)
     outcome = np.zeros(len(joints), dtype=bool)
     if len(rows):
         least = np.linalg.svd(goal.jacobian(robot, joints[rows, slots], rows), compute_uv=False)[:, -1]
-        outcome[rows[least < ISOLATED_BELOW]] = True
+        residual = size[rows, slots]
+        residual = np.where(residual > ROUNDING_TOLERANCE, residual, ISOLATED_BELOW * ISOLATION_SPREAD)
+        outcome[rows[residual > ISOLATION_SPREAD * least]] = True
     return outcome
 
 

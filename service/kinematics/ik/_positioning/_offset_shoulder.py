@@ -9,10 +9,10 @@ from functools import cached_property
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
-from ..._forward import JointTrig
+from ..._forward import JointTrig, cross
 from .._screws import rotate_about
 from .._structure import Geometry
-from .._types import LabelCodes, SingularFlags, Singularity
+from .._types import NEAR_SINGULAR, LabelCodes, SingularFlags, Singularity
 from ..subproblems import (
     prismatic_to_distance,
     prismatic_to_plane,
@@ -141,7 +141,14 @@ class OffsetShoulderParallelElbow(Positioner):
         _flag_rows((second.degenerate & first_ok[:, :, None]).any(axis=(1, 2)),
                    Singularity("elbow", (j,), "free", "the point is on axis 2; joint 2 is set to the reference "
                                "value (or 0)"), singular)
-        return PositionerResult(joints, valid, singular)
+        # subproblem 4 reads q1 off the target's radius about axis 1, subproblem 1 q2 off the placed point's about
+        # axis 2 (as IntersectingShoulder's): slots solved near either are checked for isolation
+        near = NEAR_SINGULAR * g.length_scale
+        near_axis_2 = np.linalg.norm(cross(u, w3 - g.point(j)), axis=-1) <= near  # (N, m1, 2)
+        if g.model.is_revolute[i]:
+            near_axis_2 = near_axis_2 | (np.linalg.norm(cross(g.direction(i), targets - g.point(i)), axis=-1)
+                                         <= near)[:, None, None]
+        return PositionerResult(joints, valid, singular, near_axis_2.reshape(n_targets, m))
 
     @cached_property
     def _plane_constants(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

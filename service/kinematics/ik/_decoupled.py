@@ -87,8 +87,9 @@ class DecoupledPlan(Sealed):
         joints[..., :k] = arm_joints
         for index, value in self.fixed.items():
             joints[..., index] = value
-        if self.home_inverse is None:
-            return Candidates(joints, arm_valid, singular)
+        if self.home_inverse is None:  # (a position target: the positioner's marks are the answer's)
+            return Candidates(joints, arm_valid, singular,
+                              near_singular=None if self.positioner is None else arm.near_singular)
         model = self.positioner.model if self.positioner else None
         # the joints' rotation R_1 ⋯ R_n = world_T_target · home⁻¹ (rotation part), shape (N, 3, 3)
         R_target = world_T_targets[:, :3, :3] @ self.home_inverse[:3, :3]
@@ -101,7 +102,8 @@ class DecoupledPlan(Sealed):
             # would read "no valid slot" as the position out of reach)
             complete = ~held if held.any() else None
         if self.wrist is None:
-            return Candidates(joints, arm_valid, singular, complete=complete)
+            return Candidates(joints, arm_valid, singular, complete=complete,
+                              near_singular=None if self.positioner is None else arm.near_singular)
         # the wrist's rotation R_H = R_Gᵀ · R_target (G the positioning joints' motion), applied to the vectors
         # the wrist reads: R_target's images, as rows, times R_G
         seen = seen_by(self.wrist, R_target)[:, None]  # (N, 1, j, 3)

@@ -309,7 +309,7 @@ def verify(robot: Robot, goal: Goal, candidates: Candidates, reference: np.ndarr
     if isinstance(goal, PoseGoal) and constrained and robot.dof < 6:  # fewer joints than the pose constrains
         nearest_position = np.where(checked, position, np.inf).min(axis=1, initial=np.inf) / arm_size(robot)
     complete = promised(candidates, count, nearest, constrained, nearest_position)
-    if candidates.near_singular is not None and constrained and complete.any():
+    if candidates.near_singular is not None and complete.any():
         complete &= ~not_isolated(robot, goal, joints, kept & candidates.near_singular, size,
                                   candidates.singularities)
     if candidates.promise_needs_every_slot:  # the solver's promise holds only if every valid slot gave a solution

@@ -270,3 +270,21 @@ def test_the_offset_shoulder_marks_the_slots_it_reads_off_a_short_radius(client)
     candidates = plan.solve(T[None], None)
     assert candidates.near_singular[0].all()
     assert plan.solve_one(T, None) is None
+
+
+def test_a_position_target_keeps_its_positioners_marks():
+    """A position target is answered by the positioner alone, whose marks the plan passed on only with a wrist: the
+    polar offset R-R-P arm (ex004_4) moved by ~1e-11, its point 5e-10 from axis 1, listed q1 0.024 rad from the
+    pose's own (residual 1.8e-11, σ_min of the position rows 7e-10) under complete: true before."""
+    robot = Robot([Joint("q1", "revolute", -3.671409225836322e-11, 1.570796326794762, 0.9999999999929009,
+                         -7.664008844631751e-12),
+                   Joint("q2", "revolute", 0.30000000001926386, -1.5707963267906269, 1.3958399953506183e-11,
+                         7.677718967063042e-12),
+                   Joint("q3", "prismatic", 2.093612618372814e-11, -3.177024552640575e-12, -3.2645018733798213e-12,
+                         -1.2280370689580416e-12)])
+    q = np.array([-1.8277319150065001, -2.119440309706755, 0.1833723071780205])
+    result = solve_ik(robot, forward_kinematics(robot, q), constrain_orientation=False)
+    assert _promise_held(robot, q, result)
+    assert not result.complete and "numeric search completed" in result.detail
+    for solution in result.solutions:
+        assert solution.position_residual <= 1e-9 * arm_size(robot)

@@ -77,19 +77,18 @@ class DecoupledPlan(Sealed):
         k = len(self.positioner.joints) if self.positioner else 0
         if self.positioner is not None:
             arm = self.positioner.solve(point_world, reference)
-            arm_joints, arm_valid, singular = arm.joints, arm.valid, arm.singularities
+            arm_joints, arm_valid, singular, arm_near = arm.joints, arm.valid, arm.singularities, arm.near_singular
         else:
             arm_joints = np.zeros((n_targets, 1, 0))
             arm_valid = np.ones((n_targets, 1), dtype=bool)
-            singular = SingularFlags(n_targets)
+            singular, arm_near = SingularFlags(n_targets), None
         m_arm = arm_joints.shape[1]
         joints = np.zeros((n_targets, m_arm, self.dof))
         joints[..., :k] = arm_joints
         for index, value in self.fixed.items():
             joints[..., index] = value
         if self.home_inverse is None:  # (a position target: the positioner's marks are the answer's)
-            return Candidates(joints, arm_valid, singular,
-                              near_singular=None if self.positioner is None else arm.near_singular)
+            return Candidates(joints, arm_valid, singular, near_singular=arm_near)
         model = self.positioner.model if self.positioner else None
         # the joints' rotation R_1 ⋯ R_n = world_T_target · home⁻¹ (rotation part), shape (N, 3, 3)
         R_target = world_T_targets[:, :3, :3] @ self.home_inverse[:3, :3]
@@ -102,8 +101,7 @@ class DecoupledPlan(Sealed):
             # would read "no valid slot" as the position out of reach)
             complete = ~held if held.any() else None
         if self.wrist is None:
-            return Candidates(joints, arm_valid, singular, complete=complete,
-                              near_singular=None if self.positioner is None else arm.near_singular)
+            return Candidates(joints, arm_valid, singular, complete=complete, near_singular=arm_near)
         # the wrist's rotation R_H = R_Gᵀ · R_target (G the positioning joints' motion), applied to the vectors
         # the wrist reads: R_target's images, as rows, times R_G
         seen = seen_by(self.wrist, R_target)[:, None]  # (N, 1, j, 3)
@@ -121,8 +119,8 @@ class DecoupledPlan(Sealed):
         near = None  # the slots near a singular set of the wrist, or of the positioner, for the isolation check
         if wrist.near_singular is not None:
             near = wrist.near_singular.reshape(n_targets, m_arm, m_wrist)
-        if self.positioner is not None and arm.near_singular is not None:
-            arm_near = np.repeat(arm.near_singular[..., None], m_wrist, axis=2)
+        if arm_near is not None:
+            arm_near = np.repeat(arm_near[..., None], m_wrist, axis=2)
             near = arm_near if near is None else near | arm_near
         if near is not None:
             near = near.reshape(n_targets, -1)

@@ -144,11 +144,10 @@ class OffsetShoulderParallelElbow(Positioner):
         # subproblem 4 reads q1 off the target's radius about axis 1, subproblem 1 q2 off the placed point's about
         # axis 2 (as IntersectingShoulder's): slots solved near either are checked for isolation
         near = NEAR_SINGULAR * g.length_scale
-        near_axis_2 = np.linalg.norm(cross(u, w3 - g.point(j)), axis=-1) <= near  # (N, m1, 2)
-        if g.model.is_revolute[i]:
-            near_axis_2 = near_axis_2 | (np.linalg.norm(cross(g.direction(i), targets - g.point(i)), axis=-1)
-                                         <= near)[:, None, None]
-        return PositionerResult(joints, valid, singular, near_axis_2.reshape(n_targets, m))
+        near_axes = np.linalg.norm(cross(u, w3 - g.point(j)), axis=-1) <= near  # (N, m1, 2): axis 2
+        if g.model.is_revolute[i]:  # and axis 1, for every slot of the target
+            near_axes |= (np.linalg.norm(cross(g.direction(i), targets - g.point(i)), axis=-1) <= near)[:, None, None]
+        return PositionerResult(joints, valid, singular, near_axes.reshape(n_targets, m))
 
     @cached_property
     def _plane_constants(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

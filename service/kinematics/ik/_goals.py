@@ -75,13 +75,8 @@ class PoseGoal:
         x, y, z, p = (c.reshape(3, n_targets, m) for c in tool_columns(robot, joints.reshape(-1, n), trig))
         target = np.moveaxis(self.world_T_targets[:, :3, :], 0, -1)[..., None]  # (3, 4, N, 1)
         tx, ty, tz, tp = target[:, 0], target[:, 1], target[:, 2], target[:, 3]
-        delta = p - tp
-        position = np.sqrt(_dot(delta, delta))
-        # relative = target_R^T · R: entry (i, j) is target column i · column j
-        cosine = 0.5 * (_dot(tx, x) + _dot(ty, y) + _dot(tz, z) - 1.0)
-        sine = 0.5 * np.sqrt((_dot(tz, y) - _dot(ty, z)) ** 2 + (_dot(tx, z) - _dot(tz, x)) ** 2
-                             + (_dot(ty, x) - _dot(tx, y)) ** 2)
-        return position, np.arctan2(sine, cosine)
+        delta, dx, dy, dz = p - tp, x - tx, y - ty, z - tz
+        return np.sqrt(_dot(delta, delta)), turn_of_chord(_dot(dx, dx) + _dot(dy, dy) + _dot(dz, dz))
 
     def error(self, robot: Robot, q: np.ndarray, rows: np.ndarray) -> np.ndarray:
         """The normalised error (K, 3 or 6) of joint vectors q (K, n) against their targets ``rows`` (K,)."""
@@ -101,16 +96,15 @@ def pose_residuals_of_rows(robot: Robot, candidates: list[list[float]], target: 
     of its matrix, as lists), on the scalar FK (the same chain program, without the fixed cost of array
     operations). Returns (position, orientation) per candidate."""
     (tx0, ty0, tz0, tp0), (tx1, ty1, tz1, tp1), (tx2, ty2, tz2, tp2) = target
-    sqrt, atan2 = math.sqrt, math.atan2
+    sqrt, asin = math.sqrt, math.asin
     out = []
     for (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) in tool_columns_scalar_rows(robot, candidates):
         d0, d1, d2 = p0 - tp0, p1 - tp1, p2 - tp2
-        cosine = 0.5 * ((tx0 * x0 + tx1 * x1 + tx2 * x2) + (ty0 * y0 + ty1 * y1 + ty2 * y2)
-                        + (tz0 * z0 + tz1 * z1 + tz2 * z2) - 1.0)
-        sine = 0.5 * sqrt(((tz0 * y0 + tz1 * y1 + tz2 * y2) - (ty0 * z0 + ty1 * z1 + ty2 * z2)) ** 2
-                          + ((tx0 * z0 + tx1 * z1 + tx2 * z2) - (tz0 * x0 + tz1 * x1 + tz2 * x2)) ** 2
-                          + ((ty0 * x0 + ty1 * x1 + ty2 * x2) - (tx0 * y0 + tx1 * y1 + tx2 * y2)) ** 2)
-        out.append((sqrt(d0 * d0 + d1 * d1 + d2 * d2), atan2(sine, cosine)))
+        a0, a1, a2, b0, b1, b2 = x0 - tx0, x1 - tx1, x2 - tx2, y0 - ty0, y1 - ty1, y2 - ty2
+        c0, c1, c2 = z0 - tz0, z1 - tz1, z2 - tz2
+        half_sine = _HALF_SINE_PER_CHORD * sqrt(a0 * a0 + a1 * a1 + a2 * a2 + b0 * b0 + b1 * b1 + b2 * b2
+                                                + c0 * c0 + c1 * c1 + c2 * c2)
+        out.append((sqrt(d0 * d0 + d1 * d1 + d2 * d2), 2.0 * asin(half_sine if half_sine < 1.0 else 1.0)))
     return out
 
 
@@ -162,6 +156,18 @@ class DirectionGoal:
 
 
 Goal = PoseGoal | DirectionGoal
+
+
+#: sin(θ/2) per unit of ‖R − R*‖ (Frobenius), the chord between two rotations θ apart: ‖R − R*‖² =
+#: 2 tr(I − R*ᵀR) = 4 (1 − cos θ) = 8 sin²(θ/2).
+_HALF_SINE_PER_CHORD = 1.0 / math.sqrt(8.0)
+
+
+def turn_of_chord(chord_squared: np.ndarray) -> np.ndarray:
+    """The angle (radians) of the turn between two rotations from ‖R − R*‖² (Frobenius, any shape): exact
+    differences of the matrices' entries, so as precise near zero as the entries are, and no trace to cancel.
+    (:func:`pose_residuals_of_rows` writes it on floats, with the same constant.)"""
+    return 2.0 * np.arcsin(np.minimum(_HALF_SINE_PER_CHORD * np.sqrt(chord_squared), 1.0))
 
 
 def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -71,7 +71,7 @@ from ._screws import chain_motion
 from ._structure import arm_size
 from ._types import Candidates, LabelCodes, Sealed
 from ._gauss_newton import gauss_newton
-from ._goals import PoseGoal
+from ._goals import PoseGoal, turn_of_chord
 from ._verify import POLISH_FROM, first_of_each, residual_arrays, wrap_revolute
 
 #: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
@@ -366,11 +366,8 @@ class IdealisedPlan(Sealed):
         model = self.inner_model
         world_T_tool = chain_motion(model.directions, model.points, model.is_revolute, joints) @ model.home
         position = np.linalg.norm(world_T_tool[..., :3, 3] - world_T_targets[:, None, :3, 3], axis=-1)
-        relative = np.swapaxes(world_T_targets[:, None, :3, :3], -1, -2) @ world_T_tool[..., :3, :3]
-        cosine = np.clip(0.5 * (np.trace(relative, axis1=-2, axis2=-1) - 1.0), -1.0, 1.0)
-        skew = relative - np.swapaxes(relative, -1, -2)
-        sine = 0.5 * np.linalg.norm(np.stack([skew[..., 2, 1], skew[..., 0, 2], skew[..., 1, 0]], axis=-1), axis=-1)
-        return self._size(position, np.arctan2(sine, cosine))
+        chord = world_T_tool[..., :3, :3] - world_T_targets[:, None, :3, :3]
+        return self._size(position, turn_of_chord(np.einsum("...ij,...ij->...", chord, chord)))
 
     def _size(self, position: np.ndarray, orientation: np.ndarray) -> np.ndarray:
         size = position / self.size

@@ -10,6 +10,9 @@ encodes them as they stand. Label codes are merged in one place
 
 from __future__ import annotations
 
+import functools
+import itertools
+from collections.abc import Mapping
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -25,6 +28,16 @@ _ROWS_OF_ONE_TARGET = 64
 #: Up to this many rows, :meth:`SolutionTable.branches` keys the rows by their codes in Python (the two ways
 #: cost about the same at 300 rows).
 _FEW_ROWS = 256
+
+
+@functools.lru_cache(maxsize=64)
+def branch_labels(names: tuple[str, ...], values: tuple[tuple[str, ...], ...]) -> Mapping[tuple[int, ...], dict]:
+    """Every branch a family's labels can word: codes (a tuple, one per name of ``names``, −1 where the label is
+    left out) → its dict, name → label (``values`` per name). A family has a few names of two values each, so the
+    combinations are few; the dicts are shared, read-only by convention (a caller copies the one it hands out)."""
+    choices = [range(-1, len(labels)) for labels in values]
+    return {codes: {name: labels[code] for name, labels, code in zip(names, values, codes) if code >= 0}
+            for codes in itertools.product(*choices)}
 
 
 @dataclass(frozen=True)

@@ -26,7 +26,7 @@ from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL,
 from ._gauss_newton import gauss_newton
 from ._goals import Goal, PoseGoal, pose_residuals_of_rows
 from ._structure import arm_size
-from ._table import SolutionTable
+from ._table import SolutionTable, branch_labels
 from ._types import Candidates, LabelCodes, SingularFlags, every
 
 #: Candidates with errors above this (and up to ``POLISH_RESIDUAL``) get Gauss–Newton steps before the check.
@@ -443,8 +443,8 @@ class OnePoseRows(NamedTuple):
 
     def branches(self) -> list[dict]:
         """Each row's branch labels as a dict of its own (:meth:`SolutionTable.branches` of :meth:`table`)."""
-        return [{name: labels[code] for name, labels, code in zip(self.names, self.values, codes) if code >= 0}
-                for codes in self.codes]
+        by_codes = branch_labels(self.names, self.values)
+        return [by_codes[codes].copy() for codes in self.codes]
 
 
 class OnePoseVerified(Verified):
@@ -454,8 +454,13 @@ class OnePoseVerified(Verified):
 
     def __init__(self, rows: OnePoseRows, dof: int, complete: np.ndarray, nearest: np.ndarray,
                  singularities: SingularFlags) -> None:
-        # a frozen dataclass's fields, set as its own __init__ would (without a call per field)
-        self.__dict__.update(rows=rows, dof=dof, complete=complete, nearest=nearest, singularities=singularities)
+        # a frozen dataclass's fields, set as its generated __init__ sets them
+        set_field = object.__setattr__
+        set_field(self, "rows", rows)
+        set_field(self, "dof", dof)
+        set_field(self, "complete", complete)
+        set_field(self, "nearest", nearest)
+        set_field(self, "singularities", singularities)
 
     @functools.cached_property
     def table(self) -> SolutionTable:

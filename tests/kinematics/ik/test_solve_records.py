@@ -110,3 +110,19 @@ def test_branches_word_each_rows_labels_on_both_sides_of_the_few_rows_path(rows)
     assert table.branches() == expected
     own = table.branches(own=True)
     assert own == expected and len({id(branch) for branch in own}) == rows
+
+
+def test_one_pose_rows_word_every_code_combination_as_the_table_does():
+    """OnePoseRows.branches reads each row's dict from the family's combinations (branch_labels): for every
+    combination of codes it names what the table would, and each row's dict is its own (changing one changes
+    no other row and no later answer)."""
+    import itertools
+    from service.kinematics.ik._verify import OnePoseRows
+    names, values = ("shoulder", "elbow", "wrist"), (("left", "right"), ("up", "down"), ("no_flip", "flip"))
+    codes = list(itertools.product(range(2), repeat=3)) * 2
+    rows = OnePoseRows([[0.0] * 6] * len(codes), [(0.0, 0.0)] * len(codes), codes, names, values)
+    expected = [{name: labels[code] for name, labels, code in zip(names, values, row)} for row in codes]
+    branches = rows.branches()
+    assert branches == rows.table(6).branches(own=True) == expected
+    branches[0]["shoulder"] = "changed"
+    assert rows.branches() == expected and len({id(branch) for branch in branches}) == len(codes)

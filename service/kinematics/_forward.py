@@ -15,7 +15,9 @@ vectors in plain floats, for which array operations cost more than they save.
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numpy as np
@@ -362,15 +364,14 @@ def tool_columns_scalar(robot: Robot, q: list[float]) -> tuple[tuple[float, floa
 
 def tool_columns_scalar_rows(robot: Robot, rows: list[list[float]]) -> list[tuple[tuple[float, float, float], ...]]:
     """:func:`tool_columns` for a few joint vectors (lists of floats), in scalar arithmetic: the same
-    :class:`ChainProgram`, without the fixed cost of array operations. A row that shares its first joints' values
-    with the row before it (as the IK solutions of one branch of the arm do) starts from the frame those joints
-    gave it: the same operations on the same numbers, done once.
+    :class:`ChainProgram`, without the fixed cost of array operations (:class:`ScalarChain`). A row that shares its
+    first joints' values with the row before it (as the IK solutions of one branch of the arm do) starts from the
+    frame those joints gave it: the same operations on the same numbers, done once.
 
     Returns, per row, the columns x, y, z, p of ``world_T_tool`` as tuples of three floats.
     """
-    program = chain_program(robot)
-    operations, joint_steps = program.operations, program.joint_steps
-    cos, sin = math.cos, math.sin
+    chain = scalar_chain(robot)
+    start, run = chain.start, chain.run
     frames: list[tuple[float, ...]] = []  # frames[j]: the frame before the operations of joint j, last row
     previous: list[float] = []
     out = []
@@ -381,51 +382,134 @@ def tool_columns_scalar_rows(robot: Robot, rows: list[list[float]]) -> list[tupl
                 break
             shared += 1
         if shared < len(frames):
-            x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = frames[shared]
+            frame = frames[shared]
             del frames[shared:]
-            first = joint_steps[shared]
+            out.append(run(q, frames, shared + 1, *frame))
         else:
-            x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = program.start
             frames.clear()
-            first = 0
-        for kind, joint, value in operations[first:]:
-            if kind == _TURN:
-                frames.append((x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2))
-                angle = q[joint] + value
-                c, s = cos(angle), sin(angle)
-                x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
-                                          y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
-            elif kind == _QUARTER:  # a twist of ±90°: the y and z columns swap (a sign changes)
-                if value > 0:
-                    y0, y1, y2, z0, z1, z2 = z0, z1, z2, -y0, -y1, -y2
-                else:
-                    y0, y1, y2, z0, z1, z2 = -z0, -z1, -z2, y0, y1, y2
-            elif kind == _MOVE_X:
-                p0, p1, p2 = p0 + x0 * value, p1 + x1 * value, p2 + x2 * value
-            elif kind == _MOVE_Z:
-                p0, p1, p2 = p0 + z0 * value, p1 + z1 * value, p2 + z2 * value
-            elif kind == _TWIST:
-                c, s = value
-                y0, y1, y2, z0, z1, z2 = (y0 * c + z0 * s, y1 * c + z1 * s, y2 * c + z2 * s,
-                                          z0 * c - y0 * s, z1 * c - y1 * s, z2 * c - y2 * s)
-            elif kind == _SLIDE:
-                frames.append((x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2))
-                d = q[joint] + value
-                p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d
-            elif kind == _TURN_BY:
-                c, s = value
-                x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s,
-                                          y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)
-            else:
-                a0, a1, a2, b0, b1, b2, c0, c1, c2, t0, t1, t2 = value
-                p0, p1, p2 = (p0 + x0 * t0 + y0 * t1 + z0 * t2, p1 + x1 * t0 + y1 * t1 + z1 * t2,
-                              p2 + x2 * t0 + y2 * t1 + z2 * t2)
-                x0, x1, x2, y0, y1, y2, z0, z1, z2 = (
-                    x0 * a0 + y0 * a1 + z0 * a2, x1 * a0 + y1 * a1 + z1 * a2, x2 * a0 + y2 * a1 + z2 * a2,
-                    x0 * b0 + y0 * b1 + z0 * b2, x1 * b0 + y1 * b1 + z1 * b2, x2 * b0 + y2 * b1 + z2 * b2,
-                    x0 * c0 + y0 * c1 + z0 * c2, x1 * c0 + y1 * c1 + z1 * c2, x2 * c0 + y2 * c1 + z2 * c2)
-        out.append(((x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)))
+            out.append(run(q, frames, 0, *start))
         previous = q
+    return out
+
+
+class ScalarChain(NamedTuple):
+    """A robot's :class:`ChainProgram` on one joint vector of floats, as straight-line arithmetic (no loop over
+    operations, none dispatched by kind). ``run(q, frames, segment, x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1,
+    p2)`` runs the operations from ``segment`` on (0: from ``start``, every one; j + 1: from joint j's, on the
+    frame before it), appends the frame before each joint it turns or slides to ``frames`` (for a later row that
+    shares those joints) and returns the tool's columns x, y, z, p."""
+
+    start: tuple[float, ...]
+    run: Callable
+
+
+def scalar_chain(robot: Robot) -> ScalarChain:
+    """The robot's :class:`ScalarChain` (memoised on the robot). The code is compiled once per shape of program
+    (the operations' kinds and joints, :func:`_chain_code`): a robot binds its own constants to it."""
+    return memo(robot, "scalar_chain", lambda: _scalar_chain(chain_program(robot)))
+
+
+def _scalar_chain(program: ChainProgram) -> ScalarChain:
+    shape = tuple((kind, joint, _shape_of(kind, value)) for kind, joint, value in program.operations)
+    constants = [number for kind, _, value in program.operations for number in _constants(kind, value)]
+    return ScalarChain(program.start, _chain_code(shape, program.joint_steps)(math.cos, math.sin, *constants))
+
+
+def _shape_of(kind: int, value) -> object:
+    """What of an operation's constant its code depends on: a quarter turn's sign, whether a joint's offset is
+    zero (then it is not added); nothing for the others, whose constants are bound, not written."""
+    if kind == _QUARTER:
+        return value > 0
+    if kind in (_TURN, _SLIDE):
+        return value != 0.0
+    return None
+
+
+def _constants(kind: int, value) -> tuple[float, ...]:
+    """The constants an operation's code reads, in the order :func:`_operation_lines` names them."""
+    if kind in (_TURN, _SLIDE):
+        return (value,) if value != 0.0 else ()
+    if kind in (_MOVE_X, _MOVE_Z):
+        return (value,)
+    if kind in (_TWIST, _TURN_BY, _FIXED):
+        return tuple(value)
+    return ()
+
+
+_FRAME = "x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2"
+#: How many constants an operation of a fixed kind reads (:func:`_constants`); a joint's, one where its offset
+#: is not zero.
+_CONSTANT_COUNT = {_MOVE_X: 1, _MOVE_Z: 1, _TWIST: 2, _TURN_BY: 2, _FIXED: 12, _QUARTER: 0}
+
+
+def _operation_lines(kind: int, joint: int, shape: object, names: list[str]) -> list[str]:
+    """One operation as lines of float arithmetic on the frame's columns (the same as :func:`_run` does on
+    arrays), its constants read from ``names`` (as :func:`_constants` lists them)."""
+    if kind in (_TURN, _SLIDE):
+        value = f"q[{joint}] + {names[0]}" if shape else f"q[{joint}]"
+        if kind == _SLIDE:
+            return [f"frames.append(({_FRAME}))", f"d = {value}", "p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d"]
+        return [f"frames.append(({_FRAME}))", f"angle = {value}", "c, s = cos(angle), sin(angle)",
+                "x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s, "
+                "y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)"]
+    if kind == _QUARTER:  # a twist of ±90°: the y and z columns swap (a sign changes)
+        return ["y0, y1, y2, z0, z1, z2 = z0, z1, z2, -y0, -y1, -y2" if shape
+                else "y0, y1, y2, z0, z1, z2 = -z0, -z1, -z2, y0, y1, y2"]
+    if kind in (_MOVE_X, _MOVE_Z):
+        column, (k,) = ("x" if kind == _MOVE_X else "z"), names
+        return [f"p0, p1, p2 = p0 + {column}0 * {k}, p1 + {column}1 * {k}, p2 + {column}2 * {k}"]
+    if kind == _TWIST:
+        c, s = names
+        return [f"y0, y1, y2, z0, z1, z2 = (y0 * {c} + z0 * {s}, y1 * {c} + z1 * {s}, y2 * {c} + z2 * {s}, "
+                f"z0 * {c} - y0 * {s}, z1 * {c} - y1 * {s}, z2 * {c} - y2 * {s})"]
+    if kind == _TURN_BY:
+        c, s = names
+        return [f"x0, x1, x2, y0, y1, y2 = (x0 * {c} + y0 * {s}, x1 * {c} + y1 * {s}, x2 * {c} + y2 * {s}, "
+                f"y0 * {c} - x0 * {s}, y1 * {c} - x1 * {s}, y2 * {c} - x2 * {s})"]
+    a0, a1, a2, b0, b1, b2, c0, c1, c2, t0, t1, t2 = names
+    return [f"p0, p1, p2 = (p0 + x0 * {t0} + y0 * {t1} + z0 * {t2}, p1 + x1 * {t0} + y1 * {t1} + z1 * {t2}, "
+            f"p2 + x2 * {t0} + y2 * {t1} + z2 * {t2})",
+            f"x0, x1, x2, y0, y1, y2, z0, z1, z2 = ("
+            f"x0 * {a0} + y0 * {a1} + z0 * {a2}, x1 * {a0} + y1 * {a1} + z1 * {a2}, x2 * {a0} + y2 * {a1} + z2 * {a2}, "
+            f"x0 * {b0} + y0 * {b1} + z0 * {b2}, x1 * {b0} + y1 * {b1} + z1 * {b2}, x2 * {b0} + y2 * {b1} + z2 * {b2}, "
+            f"x0 * {c0} + y0 * {c1} + z0 * {c2}, x1 * {c0} + y1 * {c1} + z1 * {c2}, x2 * {c0} + y2 * {c1} + z2 * {c2})"]
+
+
+@functools.lru_cache(maxsize=256)
+def _chain_code(shape: tuple[tuple[int, int, object], ...], joint_steps: tuple[int, ...]) -> Callable:
+    """The operations of ``shape`` ((kind, joint, :func:`_shape_of`) each) compiled to one function: a factory
+    that takes cos, sin and the constants (:func:`_constants` of each operation, in order) and returns the
+    ``run`` :class:`ScalarChain` describes. Segment 0 holds the operations before the first joint's, segment
+    j + 1 those from joint j's to the next joint's (``joint_steps``); each runs where ``segment`` is at most its
+    number. Only the kinds' fixed lines, joint indices and generated names enter the source; the numbers are
+    bound as arguments."""
+    lines, names = [], []
+    segment_starts = dict(zip(joint_steps, range(1, len(joint_steps) + 1)))
+    lines.append("if segment <= 0:")
+    for index, (kind, joint, operation_shape) in enumerate(shape):
+        if index in segment_starts:
+            lines.append(f"if segment <= {segment_starts[index]}:")
+        count = int(operation_shape) if kind in (_TURN, _SLIDE) else _CONSTANT_COUNT[kind]
+        own = [f"k{len(names) + i}" for i in range(count)]
+        names += own
+        lines += ["    " + line for line in _operation_lines(kind, joint, operation_shape, own)]
+    body = "".join(f"        {line}\n" for line in _with_empty_segments(lines))
+    source = (f"def factory(cos, sin{''.join(', ' + name for name in names)}):\n"
+              f"    def run(q, frames, segment, {_FRAME}):\n{body}"
+              f"        return (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)\n"
+              f"    return run\n")
+    namespace: dict = {}
+    exec(compile(source, "<scalar chain>", "exec"), namespace)
+    return namespace["factory"]
+
+
+def _with_empty_segments(lines: list[str]) -> list[str]:
+    """``lines`` with ``pass`` under an ``if`` that guards no operation (no fixed operation before joint 0)."""
+    out = []
+    for line, following in zip(lines, lines[1:] + [""]):
+        out.append(line)
+        if line.startswith("if ") and not following.startswith("    "):
+            out.append("    pass")
     return out
 
 

@@ -217,3 +217,52 @@ def test_the_core_cross_product_is_numpys_bit_for_bit(shapes):
         ours, numpys = cross(a, b), np.cross(a, b)
         assert ours.shape == numpys.shape and ours.dtype == numpys.dtype
         np.testing.assert_array_equal(ours, numpys)
+
+
+def _scalar_chain_arms() -> list:
+    """Arms of every operation the chain program has: three conventions of random DH rows with revolute and
+    prismatic joints, offsets (θ, d) zero or not, quarter and general twists, a base and a tool; the same arms
+    as screws (fixed motions between joints)."""
+    from tests.arms import stated_three_ways
+
+    rng = np.random.default_rng(29)
+    arms = []
+    for kinds in ("RRRRRR", "RRPRRR", "PRRPRR", "RPR"):
+        table = [(float(rng.uniform(-1, 1)) if rng.random() < 0.7 else 0.0,
+                  float(rng.choice([np.pi / 2, -np.pi / 2, 0.0, rng.uniform(-3, 3)])),
+                  float(rng.uniform(-1, 1)) if rng.random() < 0.6 else 0.0,
+                  float(rng.uniform(-1, 1)) if rng.random() < 0.5 else 0.0) for _ in kinds]
+        arms += stated_three_ways(rng, table, kinds)
+    return arms + [_as_screws(arm) for arm in arms[:6]]
+
+
+def _as_screws(robot: Robot) -> Robot:
+    """The same arm from its joint screws at q = 0 (fixed motions between the joints)."""
+    from service.kinematics import ScrewJoint
+    from service.kinematics._forward import joint_screws
+
+    screws = joint_screws(robot, np.zeros(robot.dof))
+    joints = [ScrewJoint(f"s{i}", "revolute" if revolute else "prismatic", tuple(axis), tuple(point))
+              for i, (revolute, axis, point) in enumerate(zip(robot.is_revolute, screws.directions, screws.points))]
+    return Robot.from_screws(joints, screws.world_T_tool)
+
+
+def test_the_scalar_chain_is_the_array_chain_bit_for_bit(client):
+    """tool_columns_scalar_rows runs the chain program as straight-line float code compiled per program shape;
+    on every kind of operation it must give tool_columns's values to the last bit, for rows that share their
+    first joints with the row before them (resumed from a kept frame), equal rows and rows that share none: on
+    random arms, every catalogue arm and CAD-rounded ones."""
+    from service.kinematics._forward import tool_columns, tool_columns_scalar_rows
+    from tests.arms import rounded
+
+    rng = np.random.default_rng(31)
+    catalogue = [entry.robot for entry in client.app.state.catalogue.entries()]
+    for arm in _scalar_chain_arms() + catalogue + [rounded(arm, seed=3) for arm in catalogue[:8]]:
+        q = rng.uniform(-3, 3, (7, arm.dof))
+        q[1, :2] = q[0, :2]
+        q[3] = q[2]
+        q[4, :-1] = q[3, :-1]
+        q[6, :1] = q[5, :1]
+        x, y, z, p = tool_columns(arm, q)
+        scalar = np.array(tool_columns_scalar_rows(arm, q.tolist()))  # (7, 4 columns, 3)
+        assert np.array_equal(scalar, np.stack([x, y, z, p]).transpose(2, 0, 1)), arm.convention

@@ -325,18 +325,20 @@ class _SphericalWristOnePose:
         a, b = self.wrist_axes
         u, w = self.wrist_volume
         pairs = self.wrist.angles(self.wrist_start, self.wrist.goal(scalar.mtv(R_G, axis_c)))
-        both = pairs[1] is not None
+        # the wrist's axes near aligned (not at the least-squares pair of cones that miss, which is coplanar):
+        # the array path holds q_a within its band (SphericalWrist), and checks that the solutions there are
+        # isolated (NEAR_SINGULAR: far wider than that band). The two roots' volumes are equal up to sign (the
+        # last axis's two images mirror each other across the plane of the first two), so one is read.
+        if pairs[1] is not None:
+            qb = pairs[0][1]
+            if abs(u * math.cos(qb) + w * math.sin(qb)) <= NEAR_SINGULAR:
+                raise scalar.NotGeneric
         for roots in pairs:
             if roots is None:
                 rows.append(None)
                 codes.append((None,) * len(self.names))
                 continue
             qa, qb = roots
-            # the wrist's axes near aligned at a root (not at the least-squares pair of cones that miss, which
-            # is coplanar): the array path holds q_a within its band (SphericalWrist), and checks that the
-            # solutions there are isolated (NEAR_SINGULAR: far wider than that band)
-            if both and abs(u * math.cos(qb) + w * math.sin(qb)) <= NEAR_SINGULAR:
-                raise scalar.NotGeneric
             unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
             qc = scalar.Turn.angle(self.last_normal, self.last_turn.coordinates(unwound))
             rows.append([*arm, qa, qb, qc])

@@ -388,11 +388,9 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
 
     None where :func:`verify` would polish a candidate, a candidate's error is NaN, or a kept row's label is not
     clear: then :func:`verify` of the candidates (or the array path) decides."""
-    rows, codes = [], []  # the valid slots' joints (revolute ones wrapped already: verify's wrap leaves them)
-    for q, code in zip(one_pose.rows, one_pose.codes):
-        if q is not None:
-            rows.append(q)
-            codes.append(code)
+    # the valid slots' joints (revolute ones wrapped already: verify's wrap leaves them) and label codes
+    rows = [q for q in one_pose.rows if q is not None]
+    codes = [code for q, code in zip(one_pose.rows, one_pose.codes) if q is not None]
     constrained = goal.constrain_orientation
     residuals = pose_residuals_of_rows(robot, rows, goal.world_T_targets[0, :3].tolist()) if rows else []
     size_of_arm = arm_size(robot)

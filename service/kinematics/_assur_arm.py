@@ -43,7 +43,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._assur import AssurScaraSolution, assur_scara_inverse
-from ._forward import screw_model
+from ._forward import radius_about, screw_model
 from ._robot import Robot
 from ._angles import wrap_angle
 from ._tolerances import GEOMETRY_TOLERANCE, SINGULARITY_TOLERANCE
@@ -133,7 +133,7 @@ def assur_scara_of(robot: Robot) -> AssurScara | None:
     model = screw_model(robot)
     tol = GEOMETRY_TOLERANCE * 10
     d1, d2, d3 = model.directions
-    if np.linalg.norm(np.cross(d1, d2)) > tol or np.linalg.norm(np.cross(d1, d3)) > tol:
+    if radius_about(d1, d2) > tol or radius_about(d1, d3) > tol:
         return None
     z = -d1 if d1[2] < -1e-12 else d1
     x = np.array([1.0, 0.0, 0.0]) - z[0] * z

@@ -611,3 +611,10 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
+def radius_about(axis: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """‖axis × v‖ along the last axis, v (..., 3) → (...): the distance of the point v from the line through the
+    origin along the unit vector ``axis`` (of a point p from the line through c, ``radius_about(axis, p − c)``), or
+    for a unit v the sine of the angle between the two."""
+    return np.linalg.norm(cross(axis, v), axis=-1)

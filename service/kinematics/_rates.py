@@ -64,7 +64,7 @@ from typing import Literal
 import numpy as np
 
 from ._errors import InvalidInputError
-from ._forward import cross, geometric_jacobian, joint_screws, screw_model
+from ._forward import cross, geometric_jacobian, joint_screws, radius_about, screw_model
 from ._robot import Robot, rotation_with_z
 from ._tolerances import GEOMETRY_TOLERANCE, RATE_SINGULARITY_TOLERANCE
 
@@ -193,7 +193,7 @@ def task_space(robot: Robot, *, constrain_orientation: bool, free_joints: tuple[
     u = None
     if revolute:
         first = model.directions[revolute[0]]
-        if all(np.linalg.norm(cross(first, model.directions[i])) <= GEOMETRY_TOLERANCE * 10 for i in revolute):
+        if all(radius_about(first, model.directions[i]) <= GEOMETRY_TOLERANCE * 10 for i in revolute):
             u = -first if first[2] < -1e-12 else first
     linear = identity
     linear_names = [f"v{a}" for a in _AXES]

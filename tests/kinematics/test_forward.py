@@ -266,3 +266,21 @@ def test_the_scalar_chain_is_the_array_chain_bit_for_bit(client):
         x, y, z, p = tool_columns(arm, q)
         scalar = np.array(tool_columns_scalar_rows(arm, q.tolist()))  # (7, 4 columns, 3)
         assert np.array_equal(scalar, np.stack([x, y, z, p]).transpose(2, 0, 1)), arm.convention
+
+
+def test_radius_about_is_the_distance_from_the_axis():
+    """radius_about(axis, v): the distance of v from the line along the unit vector axis, against the
+    projection v − (v·axis) axis, on single vectors and broadcast batches; for a unit v, the sine of the angle."""
+    from service.kinematics._forward import radius_about
+
+    rng = np.random.default_rng(17)
+    for _ in range(50):
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        v = rng.normal(size=(4, 5, 3)) * 10.0 ** rng.uniform(-6, 3)
+        expected = np.linalg.norm(v - (v @ axis)[..., None] * axis, axis=-1)
+        np.testing.assert_allclose(radius_about(axis, v), expected, rtol=1e-12, atol=1e-15 * np.abs(v).max())
+        assert radius_about(axis, v[0, 0]).shape == ()
+    angle = 0.3
+    assert np.isclose(radius_about(np.array([0.0, 0.0, 1.0]), np.array([np.sin(angle), 0.0, np.cos(angle)])),
+                      np.sin(angle))

@@ -46,7 +46,7 @@ import numpy as np
 from .._budget import UNLIMITED, Budget
 from .._cache import bounded_memo
 from .._errors import InvalidInputError
-from .._forward import cross, forward_kinematics
+from .._forward import cross, forward_kinematics, radius_about
 from .._robot import Robot
 from .._angles import wrap_angle
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
@@ -123,7 +123,7 @@ def direction_plan(robot: Robot, tool_axis: np.ndarray) -> DirectionPlan | None:
         axis_world = R_home @ a
         last = robot.dof - 1
         along_last = (bool(model.is_revolute[last])
-                      and np.linalg.norm(cross(model.directions[last], axis_world)) <= GEOMETRY_TOLERANCE * 10
+                      and radius_about(model.directions[last], axis_world) <= GEOMETRY_TOLERANCE * 10
                       and geometry.on_axis(last, origin))
         if not along_last:
             plan = plan_for_geometry(_with_virtual_roll(geometry, axis_world), constrain_orientation=True,

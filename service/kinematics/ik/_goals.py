@@ -22,7 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._forward import JointTrig, cross, forward_kinematics, geometric_jacobian, tool_columns, tool_columns_scalar_rows
+from .._forward import (JointTrig, forward_kinematics, geometric_jacobian, radius_about, tool_columns,
+                        tool_columns_scalar_rows)
 from .._robot import Robot
 from ._structure import arm_size
 
@@ -133,7 +134,7 @@ class DirectionGoal:
         T = forward_kinematics(robot, joints.reshape(-1, robot.dof)).reshape(joints.shape[:-1] + (4, 4))
         position = np.linalg.norm(T[..., :3, 3] - self.positions[:, None], axis=-1)
         pointing = T[..., :3, :3] @ self.tool_axis
-        angle = np.arctan2(np.linalg.norm(cross(pointing, self.directions[:, None]), axis=-1),
+        angle = np.arctan2(radius_about(pointing, self.directions[:, None]),
                            np.einsum("nmi,ni->nm", pointing, self.directions))
         return position, angle
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._cache import DerivedStore, memo
-from .._forward import ScrewModel, cross, screw_model
+from .._forward import ScrewModel, cross, radius_about, screw_model
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE, ROUNDING_TOLERANCE
 
 
@@ -66,13 +66,13 @@ class Geometry:
 
     def parallel(self, i: int, j: int) -> bool:
         """Whether the axes (or sliding directions) of joints i and j are parallel or anti-parallel."""
-        return bool(np.linalg.norm(cross(self.direction(i), self.direction(j))) <= GEOMETRY_TOLERANCE * 10)
+        return bool(radius_about(self.direction(i), self.direction(j)) <= GEOMETRY_TOLERANCE * 10)
 
     def nearly_parallel(self, i: int, j: int) -> bool:
         """Whether the axes (or sliding directions) of joints i and j are within ``RECOGNITION_TOLERANCE`` (rad)
         of parallel: a family that solves from the angle between them would divide by a rounding of the geometry
         there, and declines; the idealised arm's parallel families answer (see :func:`idealised`)."""
-        return bool(np.linalg.norm(cross(self.direction(i), self.direction(j))) <= RECOGNITION_TOLERANCE)
+        return bool(radius_about(self.direction(i), self.direction(j)) <= RECOGNITION_TOLERANCE)
 
     def intersection(self, i: int, j: int) -> np.ndarray | None:
         """The point where two non-parallel revolute axes meet, or None if they are skew or parallel."""
@@ -100,7 +100,7 @@ class Geometry:
 
     def axis_distance(self, i: int, point: np.ndarray) -> float:
         """The distance of ``point`` (3,) from the axis (line) of joint i."""
-        return float(np.linalg.norm(cross(self.direction(i), point - self.point(i))))
+        return float(radius_about(self.direction(i), point - self.point(i)))
 
     def nearly_on_axis(self, i: int, point: np.ndarray) -> bool:
         """Whether ``point`` lies within ``RECOGNITION_TOLERANCE`` of the arm's size of the axis of joint i (on it
@@ -126,7 +126,7 @@ def _closest_common_point(points: list[np.ndarray], directions: list[np.ndarray]
         return None
     x = np.linalg.solve(A, b)
     for p, k in zip(points, directions):
-        if np.linalg.norm(cross(k, x - p)) > GEOMETRY_TOLERANCE * 10 * scale:
+        if radius_about(k, x - p) > GEOMETRY_TOLERANCE * 10 * scale:
             return None
     return x
 
@@ -243,7 +243,7 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
     group_of = list(range(n))
     for j in range(n):
         for i in range(j):
-            if group_of[i] == i and np.linalg.norm(cross(directions[i], directions[j])) <= tolerance:
+            if group_of[i] == i and radius_about(directions[i], directions[j]) <= tolerance:
                 group_of[j] = i
                 break
     leaders = [i for i in range(n) if group_of[i] == i]
@@ -268,15 +268,15 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
         fixed = [g for g in members if g in assigned]
         if not set(members) <= revolute or len(fixed) == len(members) or (fixed and len(members) > 2):
             continue
-        if all(np.linalg.norm(cross(directions[members[0]], directions[g])) <= _CONCURRENT_SINE
+        if all(radius_about(directions[members[0]], directions[g]) <= _CONCURRENT_SINE
                for g in members[1:]):
             continue  # all parallel, or so nearly that rounding sets their common point: none to snap to
         centre = _least_squares_point(points[members], directions[members])
-        if max(_line_distance(centre, points[g], directions[g]) for g in members) > tolerance * scale:
+        if max(radius_about(directions[g], centre - points[g]) for g in members) > tolerance * scale:
             continue
         if fixed:  # a pair whose first axis already meets another: translate the free one onto it
             (kept,), (moved,) = fixed, [g for g in members if g not in fixed]
-            if _line_distance(points[kept], points[moved], directions[moved]) <= tolerance * scale:
+            if radius_about(directions[moved], points[kept] - points[moved]) <= tolerance * scale:
                 points[moved] = points[kept]  # through the point where the kept axis meets the others (a 4th axis)
             else:  # on both lines now: the moved line passes through the kept one's foot
                 points[moved] = _common_normal_foot(points[kept], directions[kept], points[moved],
@@ -290,11 +290,11 @@ def idealised(geometry: Geometry, tolerance: float = RECOGNITION_TOLERANCE) -> I
     # the families would see a tool point off the axis that joint does not move on the true arm
     flange = model.home[:3, 3]
     for j in sorted(revolute - assigned):
-        if _line_distance(flange, points[j], directions[j]) <= tolerance * scale:
+        if radius_about(directions[j], flange - points[j]) <= tolerance * scale:
             points[j] = flange
     # how far each line moved: its angle, and its displacement at the canonical point
-    angle = np.linalg.norm(cross(model.directions, directions), axis=1)
-    shift = np.array([_line_distance(model.points[i], points[i], directions[i]) for i in range(n)]) / scale
+    angle = radius_about(model.directions, directions)
+    shift = np.array([radius_about(directions[i], model.points[i] - points[i]) for i in range(n)]) / scale
     shift[~model.is_revolute] = 0.0
     deviation = float((angle + shift).max()) if n else 0.0
     ideal = Geometry(ScrewModel(directions, points, model.is_revolute.copy(), model.home.copy()), scale,
@@ -374,6 +374,3 @@ def _least_squares_point(points: np.ndarray, directions: np.ndarray) -> np.ndarr
     projectors = np.eye(3) - directions[:, :, None] * directions[:, None, :]
     return np.linalg.solve(projectors.sum(axis=0), np.einsum("kij,kj->i", projectors, points))
 
-
-def _line_distance(x: np.ndarray, p: np.ndarray, k: np.ndarray) -> float:
-    return float(np.linalg.norm(cross(k, x - p)))

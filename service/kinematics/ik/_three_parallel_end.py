@@ -26,7 +26,7 @@ import numpy as np
 
 from .._angles import wrap_angle
 from ._positioning import side_codes
-from .._forward import JointTrig, cross
+from .._forward import JointTrig, cross, radius_about
 from ._screws import (apply, chain_rotation, invert, joint_motion, move_point, perpendicular_unit, rotate_about,
                       rotation_about)
 from ._structure import Geometry
@@ -148,7 +148,7 @@ class ThreeParallelAtEndPlan(Sealed):
         y = apply(y, p4)  # (N, 4, 3): G_2 G_3 p_4
         # the distance that joint 1 sweeps, [near, far], meets the reach of the pair 4, 5 (the pose is reached)
         tip = np.broadcast_to((apply(A, g.point(5)) - p1)[:, None], y.shape)
-        radial = np.linalg.norm(cross(h1, tip), axis=-1), np.linalg.norm(cross(h1, y - p1), axis=-1)
+        radial = radius_about(h1, tip), radius_about(h1, y - p1)
         rise = (tip - (y - p1)) @ h1
         near, far = np.hypot(radial[0] - radial[1], rise), np.hypot(radial[0] + radial[1], rise)
         low, high = np.maximum(near, self.reach[0]), np.minimum(far, self.reach[1])

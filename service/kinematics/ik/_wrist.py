@@ -20,7 +20,7 @@ import numpy as np
 
 from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE
 from .._angles import wrap_angle
-from .._forward import JointTrig, cross
+from .._forward import JointTrig, cross, radius_about
 from ._screws import perpendicular_unit, rotate_about
 from ._structure import Geometry, read_off_below
 from .subproblems import subproblem_1, subproblem_2_chain
@@ -105,7 +105,7 @@ class SphericalWrist(Sealed):
         target_axis = seen[..., 0, :]  # (..., 3)
         pair = subproblem_2_chain(a, b, c, target_axis[..., None, :])
         qa, qb = pair.theta1[..., 0, :], pair.theta2[..., 0, :]  # (..., 2)
-        free = pair.degenerate[..., 0] | (np.linalg.norm(cross(a, target_axis), axis=-1) <= self.free_below)
+        free = pair.degenerate[..., 0] | (radius_about(a, target_axis) <= self.free_below)
         if free.any():
             start = 0.0 if reference is None else reference[self.joints[0]]
             back = rotate_about(a, -start, target_axis)

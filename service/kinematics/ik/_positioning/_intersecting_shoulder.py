@@ -9,7 +9,7 @@ import numpy as np
 
 from ..._angles import wrap_angle
 from ..._tolerances import FOLD_TOLERANCE, GEOMETRY_TOLERANCE, ROUNDING_TOLERANCE
-from ..._forward import JointTrig, cross
+from ..._forward import JointTrig, cross, radius_about
 from .._screws import rotate_about
 from .._structure import Geometry, target_error
 from .._types import NEAR_SINGULAR, LabelCodes, SingularFlags, Singularity
@@ -96,7 +96,7 @@ class IntersectingShoulder(Positioner):
         # the target and the placed point both at the centre, within the target's rounding (an arm whose axes all
         # meet there): subproblem 2 would judge their dust against itself; joints 1 and 2 are both free
         at_centre = reach_scale <= ROUNDING_TOLERANCE * g.length_scale
-        on_axis_1 = at_centre | (np.linalg.norm(cross(g.direction(i), targets - c), axis=-1)[:, None]
+        on_axis_1 = at_centre | (radius_about(g.direction(i), targets - c)[:, None]
                                  <= GEOMETRY_TOLERANCE * reach_scale)
         free_shoulder = (pair.degenerate | at_centre) & on_axis_1  # (N, 2)
         free_second = (pair.degenerate | self._near_axis_2_at_fold(third, w3 - c, reach_scale)) & ~on_axis_1
@@ -146,8 +146,8 @@ class IntersectingShoulder(Positioner):
                                                  "the point is at the nearest reach of the prismatic joint"), singular)
         # subproblem 2 reads q1 off the target's radius about axis 1 and q2 off the placed point's about axis 2
         near = NEAR_SINGULAR * g.length_scale
-        near_axes = ((np.linalg.norm(cross(g.direction(i), targets - c), axis=-1) <= near)[:, None]
-                     | (np.linalg.norm(cross(g.direction(j), w3 - c), axis=-1) <= near))  # (N, 2 third roots)
+        near_axes = ((radius_about(g.direction(i), targets - c) <= near)[:, None]
+                     | (radius_about(g.direction(j), w3 - c) <= near))  # (N, 2 third roots)
         return PositionerResult(joints.reshape(n_targets, 4, 3), valid.reshape(n_targets, 4), singular,
                                 np.repeat(near_axes, 2, axis=1))
 
@@ -165,10 +165,10 @@ class IntersectingShoulder(Positioner):
         w1, w2, w3 = g.direction(i), g.direction(j), g.direction(k)
         p, x = self.point - self.centre, targets - self.centre
         h, r = x @ w1, np.linalg.norm(x, axis=-1)
-        half_band = float(np.linalg.norm(cross(w1, w2))) * np.sqrt(np.maximum(r * r - h * h, 0.0))
+        half_band = float(radius_about(w1, w2)) * np.sqrt(np.maximum(r * r - h * h, 0.0))
         low, high = h * float(w1 @ w2) - half_band, h * float(w1 @ w2) + half_band
         along = float(w3 @ p)  # z(q₃) = z₀ + ρ cos(q₃ − φ): its range is z₀ ± ρ
-        z0, rho = along * float(w2 @ w3), float(np.linalg.norm(cross(w2, w3))) * float(np.linalg.norm(cross(w3, p)))
+        z0, rho = along * float(w2 @ w3), float(radius_about(w2, w3)) * float(radius_about(w3, p))
         tolerance = GEOMETRY_TOLERANCE * g.length_scale
         z_held = rotate_about(w3, held, p) @ w2
         move = ((z_held < low - tolerance) | (z_held > high + tolerance)) \
@@ -195,7 +195,7 @@ class IntersectingShoulder(Positioner):
             return np.zeros(point.shape[:2], dtype=bool)
         half = 0.5 * np.abs(wrap_angle(third.theta[:, 0] - third.theta[:, 1]))
         at_fold = third.merged | (np.nan_to_num(half, nan=0.0) <= FOLD_TOLERANCE)  # (N,)
-        radius = np.linalg.norm(cross(g.direction(j), point), axis=-1)
+        radius = radius_about(g.direction(j), point)
         return at_fold[:, None] & (radius <= FOLD_TOLERANCE * scale)
 
     def _stretched(self, q3: np.ndarray, w: np.ndarray, c: np.ndarray) -> np.ndarray:

@@ -9,7 +9,7 @@ from functools import cached_property
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
-from ..._forward import JointTrig, cross
+from ..._forward import JointTrig, radius_about
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import NEAR_SINGULAR, LabelCodes, SingularFlags, Singularity
@@ -144,9 +144,9 @@ class OffsetShoulderParallelElbow(Positioner):
         # subproblem 4 reads q1 off the target's radius about axis 1, subproblem 1 q2 off the placed point's about
         # axis 2 (as IntersectingShoulder's): slots solved near either are checked for isolation
         near = NEAR_SINGULAR * g.length_scale
-        near_axes = np.linalg.norm(cross(u, w3 - g.point(j)), axis=-1) <= near  # (N, m1, 2): axis 2
+        near_axes = radius_about(u, w3 - g.point(j)) <= near  # (N, m1, 2): axis 2
         if g.model.is_revolute[i]:  # and axis 1, for every slot of the target
-            near_axes |= (np.linalg.norm(cross(g.direction(i), targets - g.point(i)), axis=-1) <= near)[:, None, None]
+            near_axes |= (radius_about(g.direction(i), targets - g.point(i)) <= near)[:, None, None]
         return PositionerResult(joints, valid, singular, near_axes.reshape(n_targets, m))
 
     @cached_property

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..._tolerances import GEOMETRY_TOLERANCE
-from ..._forward import JointTrig, cross
+from ..._forward import JointTrig, cross, radius_about
 from .._screws import rotate_about
 from .._structure import Geometry
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -128,7 +128,7 @@ class IntersectingPair(Positioner):
         start = {i: 0.0 if reference is None else float(reference[i]), j: 0.0 if reference is None
                  else float(reference[j])}
         # the chain form's theta1 is free with the target on axis 1, theta2 with the point on axis 2
-        on_axis_1 = np.linalg.norm(cross(g.direction(i), targets - c), axis=-1) <= GEOMETRY_TOLERANCE * g.length_scale
+        on_axis_1 = radius_about(g.direction(i), targets - c) <= GEOMETRY_TOLERANCE * g.length_scale
         on_axis_2 = pair.degenerate & ~on_axis_1
         both = on_axis_1 & (np.linalg.norm(self.point - c) <= GEOMETRY_TOLERANCE * g.length_scale)
         if pair.degenerate.any():

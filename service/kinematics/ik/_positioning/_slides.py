@@ -8,7 +8,7 @@ import numpy as np
 
 from ..._angles import wrap_angle
 from ..._tolerances import GEOMETRY_TOLERANCE, RECOGNITION_TOLERANCE
-from ..._forward import JointTrig, cross
+from ..._forward import JointTrig, cross, radius_about
 from .._screws import rotate_about
 from .._structure import Geometry, target_error
 from .._types import LabelCodes, SingularFlags, Singularity
@@ -242,7 +242,7 @@ class SkewAxesWithSlide(Positioner):
         normal = along <= GEOMETRY_TOLERANCE
         if normal and geometry.parallel(eliminated, circle):
             return None  # planar: the height along the parallel axes never changes
-        turn = float(np.linalg.norm(cross(geometry.direction(eliminated), geometry.direction(circle))))
+        turn = float(radius_about(geometry.direction(eliminated), geometry.direction(circle)))
         if GEOMETRY_TOLERANCE < along <= RECOGNITION_TOLERANCE \
                 or 10 * GEOMETRY_TOLERANCE < turn <= RECOGNITION_TOLERANCE:
             return None  # nearly special (a rounded SCARA): the idealised family answers, refined on this arm

@@ -30,6 +30,7 @@ import sys
 from contextvars import ContextVar
 from datetime import datetime, timezone
 
+import orjson
 from fastapi import APIRouter
 from fastapi.responses import Response
 from prometheus_client import CONTENT_TYPE_LATEST, REGISTRY, CollectorRegistry, Counter, Histogram, generate_latest
@@ -107,7 +108,10 @@ class JsonFormatter(logging.Formatter):
             entry.update(fields)
         if record.exc_info:
             entry["exc"] = self.formatException(record.exc_info)
-        return json.dumps(entry, default=str, ensure_ascii=False)
+        try:  # a tenth of json.dumps's time, a line per request; NaN and infinities written as null (valid JSON)
+            return orjson.dumps(entry, default=str, option=orjson.OPT_NON_STR_KEYS).decode()
+        except TypeError:  # what orjson refuses (an integer beyond 64 bits): the standard encoder, as before
+            return json.dumps(entry, default=str, ensure_ascii=False)
 
 
 class _StdoutHandler(logging.StreamHandler):

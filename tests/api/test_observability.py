@@ -204,3 +204,19 @@ def test_several_workers_serve_and_metrics_add_up_across_them(tmp_path):
             counts.add(_sample(text, "kin_http_requests_total", method="GET", route="/v1/robots", status="200"))
         assert counts == {40.0}
         assert len(list(tmp_path.glob("counter_*.db"))) >= 1
+
+
+def test_a_log_line_is_json_whatever_its_fields_hold():
+    """Every record is one line of valid JSON: a non-finite float as null (the standard encoder wrote NaN, which
+    JSON has not), non-ASCII text as it is, an object through str, an integer beyond 64 bits as its digits."""
+    record = logging.LogRecord("service.test", logging.WARNING, __file__, 1, "ünïcode %s", ("ok",), None)
+    record.fields = {"residual": float("nan"), "limit": float("inf"), "robot": "Roboter-Arm Ω", "path": Path("/x"),
+                     "count": 7}
+    line = JsonFormatter().format(record)
+    assert "\n" not in line
+    entry = json.loads(line, parse_constant=lambda name: pytest.fail(f"{name} is not JSON"))
+    assert entry["residual"] is None and entry["limit"] is None and entry["count"] == 7
+    assert entry["robot"] == "Roboter-Arm Ω" and entry["msg"] == "ünïcode ok" and entry["path"] == "/x"
+    assert entry["level"] == "warning" and entry["logger"] == "service.test"
+    record.fields = {"huge": 2 ** 70}
+    assert json.loads(JsonFormatter().format(record))["huge"] == 2 ** 70

@@ -284,3 +284,21 @@ def test_radius_about_is_the_distance_from_the_axis():
     angle = 0.3
     assert np.isclose(radius_about(np.array([0.0, 0.0, 1.0]), np.array([np.sin(angle), 0.0, np.cos(angle)])),
                       np.sin(angle))
+
+
+def test_a_nan_joint_gives_the_same_residuals_on_floats_and_on_arrays(monkeypatch):
+    """A candidate whose last joint is NaN keeps a finite position on an arm whose last joint moves no point, and a
+    NaN orientation error on both paths (a clamped arcsine must not turn it into π, a miss the check would trust):
+    verify_one then leaves the candidate to the array path, as before the chord formula."""
+    from service.kinematics.ik import _goals, _verify
+
+    robot = Robot([Joint("q1", "revolute", 0.4, 0.3, 0.2, 0.0), Joint("q2", "revolute", 0.0, 0.0, 0.0, 0.0)])
+    q = np.array([[[0.3, np.nan], [0.3, 0.2]]])
+    targets = forward_kinematics(robot, np.array([[0.3, 0.1]]))
+    scalar = _verify.residual_arrays(robot, q, targets)
+    monkeypatch.setattr(_goals, "SCALAR_CANDIDATES", 0)
+    arrays = _verify.residual_arrays(robot, q, targets)
+    for a, b in zip(scalar, arrays):
+        np.testing.assert_array_equal(np.isnan(a), np.isnan(b))
+        np.testing.assert_allclose(a[~np.isnan(a)], b[~np.isnan(b)], rtol=0, atol=1e-14)
+    assert np.isnan(scalar[1][0, 0]) and np.isfinite(scalar[0][0, 0])

@@ -105,7 +105,8 @@ def pose_residuals_of_rows(robot: Robot, candidates: list[list[float]], target: 
         c0, c1, c2 = z0 - tz0, z1 - tz1, z2 - tz2
         half_sine = _HALF_SINE_PER_CHORD * sqrt(a0 * a0 + a1 * a1 + a2 * a2 + b0 * b0 + b1 * b1 + b2 * b2
                                                 + c0 * c0 + c1 * c1 + c2 * c2)
-        out.append((sqrt(d0 * d0 + d1 * d1 + d2 * d2), 2.0 * asin(half_sine if half_sine < 1.0 else 1.0)))
+        # clamped at π as np.minimum clamps, a NaN kept (a NaN candidate's error is NaN, as on arrays)
+        out.append((sqrt(d0 * d0 + d1 * d1 + d2 * d2), 2.0 * asin(1.0 if half_sine > 1.0 else half_sine)))
     return out
 
 

@@ -410,19 +410,17 @@ def scalar_chain(robot: Robot) -> ScalarChain:
 
 
 def _scalar_chain(program: ChainProgram) -> ScalarChain:
-    shape = tuple((kind, joint, _shape_of(kind, value)) for kind, joint, value in program.operations)
-    constants = [number for kind, _, value in program.operations for number in _constants(kind, value)]
-    return ScalarChain(program.start, _chain_code(shape, program.joint_steps)(math.cos, math.sin, *constants))
+    constants = [_constants(kind, value) for kind, _, value in program.operations]
+    shape = tuple((kind, joint, _shape_of(kind, value), len(numbers))
+                  for (kind, joint, value), numbers in zip(program.operations, constants))
+    bound = [number for numbers in constants for number in numbers]
+    return ScalarChain(program.start, _chain_code(shape, program.joint_steps)(math.cos, math.sin, *bound))
 
 
-def _shape_of(kind: int, value) -> object:
-    """What of an operation's constant its code depends on: a quarter turn's sign, whether a joint's offset is
-    zero (then it is not added); nothing for the others, whose constants are bound, not written."""
-    if kind == _QUARTER:
-        return value > 0
-    if kind in (_TURN, _SLIDE):
-        return value != 0.0
-    return None
+def _shape_of(kind: int, value) -> bool | None:
+    """What of an operation's constant its code depends on: a quarter turn's sign; nothing for the others, whose
+    constants are bound, not written (a joint's offset, where it is zero, is not bound: :func:`_constants`)."""
+    return value > 0 if kind == _QUARTER else None
 
 
 def _constants(kind: int, value) -> tuple[float, ...]:
@@ -437,23 +435,21 @@ def _constants(kind: int, value) -> tuple[float, ...]:
 
 
 _FRAME = "x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2"
-#: How many constants an operation of a fixed kind reads (:func:`_constants`); a joint's, one where its offset
-#: is not zero.
-_CONSTANT_COUNT = {_MOVE_X: 1, _MOVE_Z: 1, _TWIST: 2, _TURN_BY: 2, _FIXED: 12, _QUARTER: 0}
 
 
-def _operation_lines(kind: int, joint: int, shape: object, names: list[str]) -> list[str]:
+def _operation_lines(kind: int, joint: int, positive: bool | None, names: list[str]) -> list[str]:
     """One operation as lines of float arithmetic on the frame's columns (the same as :func:`_run` does on
-    arrays), its constants read from ``names`` (as :func:`_constants` lists them)."""
+    arrays), its constants read from ``names`` (as :func:`_constants` lists them; a joint's offset only where it
+    is not zero); ``positive``: a quarter turn's sign."""
     if kind in (_TURN, _SLIDE):
-        value = f"q[{joint}] + {names[0]}" if shape else f"q[{joint}]"
+        value = f"q[{joint}] + {names[0]}" if names else f"q[{joint}]"
         if kind == _SLIDE:
             return [f"frames.append(({_FRAME}))", f"d = {value}", "p0, p1, p2 = p0 + z0 * d, p1 + z1 * d, p2 + z2 * d"]
         return [f"frames.append(({_FRAME}))", f"angle = {value}", "c, s = cos(angle), sin(angle)",
                 "x0, x1, x2, y0, y1, y2 = (x0 * c + y0 * s, x1 * c + y1 * s, x2 * c + y2 * s, "
                 "y0 * c - x0 * s, y1 * c - x1 * s, y2 * c - x2 * s)"]
     if kind == _QUARTER:  # a twist of ±90°: the y and z columns swap (a sign changes)
-        return ["y0, y1, y2, z0, z1, z2 = z0, z1, z2, -y0, -y1, -y2" if shape
+        return ["y0, y1, y2, z0, z1, z2 = z0, z1, z2, -y0, -y1, -y2" if positive
                 else "y0, y1, y2, z0, z1, z2 = -z0, -z1, -z2, y0, y1, y2"]
     if kind in (_MOVE_X, _MOVE_Z):
         column, (k,) = ("x" if kind == _MOVE_X else "z"), names
@@ -476,41 +472,30 @@ def _operation_lines(kind: int, joint: int, shape: object, names: list[str]) -> 
 
 
 @functools.lru_cache(maxsize=256)
-def _chain_code(shape: tuple[tuple[int, int, object], ...], joint_steps: tuple[int, ...]) -> Callable:
-    """The operations of ``shape`` ((kind, joint, :func:`_shape_of`) each) compiled to one function: a factory
-    that takes cos, sin and the constants (:func:`_constants` of each operation, in order) and returns the
-    ``run`` :class:`ScalarChain` describes. Segment 0 holds the operations before the first joint's, segment
-    j + 1 those from joint j's to the next joint's (``joint_steps``); each runs where ``segment`` is at most its
-    number. Only the kinds' fixed lines, joint indices and generated names enter the source; the numbers are
-    bound as arguments."""
+def _chain_code(shape: tuple[tuple[int, int, bool | None, int], ...], joint_steps: tuple[int, ...]) -> Callable:
+    """The operations of ``shape`` ((kind, joint, :func:`_shape_of`, how many constants) each) compiled to one
+    function: a factory that takes cos, sin and the constants (:func:`_constants` of each operation, in order) and
+    returns the ``run`` :class:`ScalarChain` describes. Segment 0 holds the operations before the first joint's,
+    segment j + 1 those from joint j's to the next joint's (``joint_steps``); each runs where ``segment`` is at
+    most its number. Only the kinds' fixed lines, joint indices and generated names enter the source; the numbers
+    are bound as arguments."""
+    bounds = [0, *joint_steps, len(shape)]
     lines, names = [], []
-    segment_starts = dict(zip(joint_steps, range(1, len(joint_steps) + 1)))
-    lines.append("if segment <= 0:")
-    for index, (kind, joint, operation_shape) in enumerate(shape):
-        if index in segment_starts:
-            lines.append(f"if segment <= {segment_starts[index]}:")
-        count = int(operation_shape) if kind in (_TURN, _SLIDE) else _CONSTANT_COUNT[kind]
-        own = [f"k{len(names) + i}" for i in range(count)]
-        names += own
-        lines += ["    " + line for line in _operation_lines(kind, joint, operation_shape, own)]
-    body = "".join(f"        {line}\n" for line in _with_empty_segments(lines))
+    for number, (first, end) in enumerate(zip(bounds[:-1], bounds[1:])):
+        body = []
+        for kind, joint, positive, count in shape[first:end]:
+            own = [f"k{len(names) + i}" for i in range(count)]
+            names += own
+            body += _operation_lines(kind, joint, positive, own)
+        lines += [f"if segment <= {number}:", *(f"    {line}" for line in body or ["pass"])]
     source = (f"def factory(cos, sin{''.join(', ' + name for name in names)}):\n"
-              f"    def run(q, frames, segment, {_FRAME}):\n{body}"
-              f"        return (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)\n"
-              f"    return run\n")
+              f"    def run(q, frames, segment, {_FRAME}):\n"
+              + "".join(f"        {line}\n" for line in lines) +
+              "        return (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2)\n"
+              "    return run\n")
     namespace: dict = {}
     exec(compile(source, "<scalar chain>", "exec"), namespace)
     return namespace["factory"]
-
-
-def _with_empty_segments(lines: list[str]) -> list[str]:
-    """``lines`` with ``pass`` under an ``if`` that guards no operation (no fixed operation before joint 0)."""
-    out = []
-    for line, following in zip(lines, lines[1:] + [""]):
-        out.append(line)
-        if line.startswith("if ") and not following.startswith("    "):
-            out.append("    pass")
-    return out
 
 
 def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:

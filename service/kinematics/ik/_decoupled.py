@@ -308,6 +308,8 @@ class _SphericalWristOnePose:
         self.last_turn = scalar.Turn(axis_c)
         self.last_normal = self.last_turn.coordinates(scalar.vector_of(wrist.normal))
         self.dof = plan.dof
+        # the positioner's isolation band (its near_singular): a point this near an axis it reads an angle about
+        self.near_axis = NEAR_SINGULAR * plan.positioner.geometry.length_scale
 
     def _target(self, T: np.ndarray) -> tuple[scalar.Vector, scalar.Vector, scalar.Vector]:
         """The wrist point (T · home⁻¹ · point), and the wrist's last axis and normal as the target (4, 4) turns
@@ -372,7 +374,6 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
         forward, self.in_plane, up = positioner.label_constants
         self.forward, self.up = scalar.vector_of(forward), scalar.vector_of(up)
         self.on_axis = GEOMETRY_TOLERANCE * 10 * positioner.geometry.length_scale
-        self.near_axis = NEAR_SINGULAR * positioner.geometry.length_scale
         # the elbow (point on axis 3) from the centre before joints 1 and 2 turn it, in the arm's plane if the
         # labels work there (axes 2 ∥ 3), and its length
         elbow = scalar.sub(p2, c)
@@ -448,7 +449,6 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
         self.forward = scalar.vector_of(positioner.label_constants[0])
         size = positioner.geometry.length_scale
         self.exact_within, self.at_centre = GEOMETRY_TOLERANCE * size, 0.5 * ACCEPT_RESIDUAL * size
-        self.near_axis = NEAR_SINGULAR * size
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
         """The eight slots for a target (4, 4), or NotGeneric; ``reference`` (n,) as :meth:`DecoupledPlan.solve`."""
@@ -525,7 +525,6 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
         self.forward, self.shoulder = scalar.vector_of(positioner.forward), scalar.vector_of(positioner.shoulder)
         self.up = scalar.vector_of(positioner.geometry.upward(model.directions[0]))
         self.elbow_from_2 = scalar.sub(p3, p2)
-        self.near_axis = NEAR_SINGULAR * positioner.geometry.length_scale
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
         """The eight slots for a target (4, 4), or NotGeneric (``reference``: not read, see

@@ -38,7 +38,7 @@ from . import _scalar as scalar
 from .._angles import wrap_angle, wrap_any_float
 from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._positioning import _flag_rows, _unit, side_codes
-from .._forward import JointTrig, cross
+from .._forward import JointTrig, cross, radius_about
 from ._screws import apply, invert, joint_motion, move_point, perpendicular_unit, rotate_about
 from ._structure import Geometry, read_off_below, read_off_error
 from .subproblems import subproblem_1, subproblem_2, subproblem_3, subproblem_4, subproblem_6
@@ -93,7 +93,7 @@ class _AxesTwoToFourParallel(Sealed):
 
     def _sixth_radius(self, q5: np.ndarray) -> np.ndarray:
         """ω_p turned back by q5 about axis 5, as step 3 reads q6 off it: its radius about axis 6 (...,)."""
-        return _radius_about(self.geometry.direction(5), rotate_about(self.geometry.direction(4), -q5, self.omega_p))
+        return radius_about(self.geometry.direction(5), rotate_about(self.geometry.direction(4), -q5, self.omega_p))
 
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         A = world_T_targets @ self.home_inverse  # (N, 4, 4)
@@ -168,7 +168,7 @@ class _AxesTwoToFourParallel(Sealed):
             "and no candidate slot was left for the second one: its solutions are missing (complete: false)"))
         sixth_radius = self._sixth_radius(q5)  # (q5 as the slots hold it after a second arc)
         with np.errstate(divide="ignore", invalid="ignore"):
-            band = self.split_band(distance, sixth_radius, _radius_about(g.direction(5), lever))
+            band = self.split_band(distance, sixth_radius, radius_about(g.direction(5), lever))
         band = np.where(free_six, SPLIT_DOUBLE_ROOT, np.fmax(band, SPLIT_DOUBLE_ROOT))  # q6 held, not read: exact
         merged = (elbow.merged | _split_double_root(q3, valid, band)) & valid[..., 0]
         merged_rows = merged.any(axis=1)
@@ -486,7 +486,7 @@ def _nearer_root_on_line(w: np.ndarray, w_slope: np.ndarray, u: np.ndarray, u_sl
 def _distance_range(k: np.ndarray, p: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The least and greatest of ``||R(k, θ) p − q||`` over θ (k a unit axis through the origin)."""
     along = (p - q) @ k
-    radius_p, radius_q = _radius_about(k, p), _radius_about(k, q)
+    radius_p, radius_q = radius_about(k, p), radius_about(k, q)
     return np.hypot(radius_p - radius_q, along), np.hypot(radius_p + radius_q, along)
 
 
@@ -531,11 +531,6 @@ def _split_double_root(elbow: np.ndarray, valid: np.ndarray, band: float | np.nd
     float, or one per candidate (...)) of each other."""
     gap = np.abs(wrap_angle(elbow[..., 0] - elbow[..., 1]))
     return valid[..., 0] & valid[..., 1] & (np.nan_to_num(gap, nan=np.inf) <= band)
-
-
-def _radius_about(k: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """The distance of points v (..., 3) from the axis k (a unit vector through the origin)."""
-    return np.linalg.norm(v - (v @ k)[..., None] * k, axis=-1)
 
 
 class _ThreeParallelOnePose:

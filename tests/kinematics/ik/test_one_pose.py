@@ -245,3 +245,32 @@ def _float_check_against_verify(robot, plan, poses: np.ndarray, references: list
             assert values == slow.table.labels[name][0]
             np.testing.assert_array_equal(codes, slow.table.labels[name][1])
     return checked, against_arrays
+
+
+def test_the_two_wrist_roots_are_equally_near_the_wrists_singularity():
+    """The scalar spherical wrist reads the volume |u cos q_b + w sin q_b| at its first root only: the last axis's
+    two images mirror each other across the plane of the first two axes, so both roots are equally near aligned.
+    On random wrists (perpendicular or not) and goals, subproblem 2's two roots give the same volume."""
+    from service.kinematics.ik import _scalar as scalar
+
+    rng = np.random.default_rng(41)
+    compared = 0
+    for _ in range(2000):
+        a, b, c = (v / np.linalg.norm(v) for v in rng.normal(size=(3, 3)))
+        if rng.random() < 0.5:  # the usual wrist: consecutive axes perpendicular
+            b = np.cross(a, b) / np.linalg.norm(np.cross(a, b))
+            c = np.cross(b, c) / np.linalg.norm(np.cross(b, c))
+        goal = rng.normal(size=3)
+        goal /= np.linalg.norm(goal)
+        turns = scalar.TwoTurns(tuple(a), tuple(b))
+        try:
+            pairs = turns.angles(turns.start(tuple(c)), turns.goal(tuple(goal)))
+        except scalar.NotGeneric:
+            continue
+        if pairs[1] is None:
+            continue
+        u, w = float(a @ np.cross(b, c)), float(a @ np.cross(b, np.cross(b, c)))
+        first, second = (abs(u * np.cos(qb) + w * np.sin(qb)) for _, qb in pairs)
+        assert first == pytest.approx(second, abs=1e-12)
+        compared += 1
+    assert compared > 500

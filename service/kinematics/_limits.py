@@ -19,6 +19,7 @@ How each kind of joint is treated:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Sequence
 
@@ -85,12 +86,20 @@ class Limits:
             # the interval of _one_turn_each, where only multi-valued joints count
             one_turn_low = np.where(multi_valued, np.maximum(lower, upper - _TWO_PI + _INTERIOR_MARGIN), -np.inf)
             one_turn_high = np.where(multi_valued, np.minimum(upper, lower + _TWO_PI - _INTERIOR_MARGIN), np.inf)
-            arrays = (lower, upper, multi_valued, continuous, one_turn_low, one_turn_high)
+            # and the interval where any joint's value has them, and fits (its own bounds, at other joints)
+            zero_turn_low = np.where(multi_valued, one_turn_low, lower)
+            zero_turn_high = np.where(multi_valued, one_turn_high, upper)
+            arrays = (lower, upper, multi_valued, continuous, one_turn_low, one_turn_high, zero_turn_low,
+                      zero_turn_high)
             for array in arrays:
                 array.flags.writeable = False
+            kind = np.where(multi_valued, MULTI_VALUED, np.where(robot.is_revolute & ~continuous, ONE_SIDED,
+                                                                   FITS_OR_NOT))
+            rules = tuple(zip(kind.tolist(), lower.tolist(), upper.tolist(), one_turn_low.tolist(),
+                              one_turn_high.tolist(), self.lower.tolist(), self.upper.tolist()))
             return Widened(*arrays, every_multi_valued=bool(multi_valued.all()),
                            any_multi_valued=bool(multi_valued.any()),
-                           one_turn_possible=bool((one_turn_low < one_turn_high).all()))
+                           one_turn_possible=bool((one_turn_low < one_turn_high).all()), rules=rules)
         key = (self.lower.dtype.str, self.lower.tobytes(), self.upper.dtype.str, self.upper.tobytes())
         return bounded_memo(robot, "widened_limits", key, build, _WIDENED_KEPT)
 
@@ -102,8 +111,12 @@ class Widened:
     ``lower − tolerance`` and ``upper + tolerance``; ``multi_valued`` (revolute, both bounds finite) and
     ``continuous`` (revolute, no bounds); and the open interval (``one_turn_low``, ``one_turn_high``) inside
     which a multi-valued joint's value has the turns [0, 0] alone (:func:`_one_turn_each`; ±∞ at the other
-    joints). The flags say whether every joint, and any, is multi-valued, and whether every such interval is
-    non-empty (limits of at most about one turn).
+    joints); (``zero_turn_low``, ``zero_turn_high``) is that interval at the multi-valued joints and the bounds at
+    the others: a value inside has the turns [0, 0] alone, whatever its joint. The flags say whether every joint,
+    and any, is multi-valued, and whether every one-turn interval is non-empty (limits of at most about one turn).
+    ``rules`` holds the same per joint on Python floats, for one target's few rows (:func:`turn_ranges_of_rows`):
+    (kind, lower, upper, one_turn_low, one_turn_high, and the bounds without their tolerance), the kind one of
+    :data:`MULTI_VALUED`, :data:`ONE_SIDED`, :data:`FITS_OR_NOT`.
     """
 
     lower: np.ndarray
@@ -112,9 +125,18 @@ class Widened:
     continuous: np.ndarray
     one_turn_low: np.ndarray
     one_turn_high: np.ndarray
+    zero_turn_low: np.ndarray
+    zero_turn_high: np.ndarray
     every_multi_valued: bool
     any_multi_valued: bool
     one_turn_possible: bool
+    rules: tuple[tuple[int, float, float, float, float, float, float], ...]
+
+
+#: How a joint's turns are found (:attr:`Widened.rules`): revolute with both bounds finite (every turn inside);
+#: revolute bounded on one side (the one turn inside nearest its value); continuous revolute or prismatic (its
+#: value fits or it does not).
+MULTI_VALUED, ONE_SIDED, FITS_OR_NOT = 0, 1, 2
 
 
 #: How many limits :meth:`Limits.widened` keeps per robot.
@@ -271,6 +293,62 @@ def _one_turn_each(q: np.ndarray, bounds: Widened) -> bool:
     fails, and takes the quotients.)"""
     inside = (q > bounds.one_turn_low) & (q < bounds.one_turn_high)
     return np.count_nonzero(inside) == inside.size
+
+
+def turn_ranges_of_rows(bounds: Widened, rows: list[list[float]]
+                        ) -> tuple[list[list[float]], list[list[float]]] | None:
+    """:func:`turn_ranges` of a few rows of joint values (lists of n floats) on Python floats: the same turns, in
+    the same arithmetic, where one target's answer would spend more on the arrays' fixed costs than on the
+    quotients. None where a value is not finite and its joint takes a quotient (the arrays' rules for NaN and
+    infinities then apply)."""
+    firsts, lasts = [], []
+    for row in rows:
+        first, last = [], []
+        for value, (kind, lower, upper, one_turn_low, one_turn_high, _, _) in zip(row, bounds.rules):
+            if kind == FITS_OR_NOT:
+                first.append(0.0)
+                last.append(0.0 if lower <= value <= upper else -1.0)
+                continue
+            if kind == MULTI_VALUED and one_turn_low < value < one_turn_high:  # the usual case: this turn alone
+                first.append(0.0)
+                last.append(0.0)
+                continue
+            if not -math.inf < value < math.inf:
+                return None
+            if kind == MULTI_VALUED:  # the end values q + 2kπ checked against the bounds, as the arrays do
+                low = float(math.ceil((lower - value) / _TWO_PI))
+                high = float(math.floor((upper - value) / _TWO_PI))
+                if low * _TWO_PI + value < lower:
+                    low += 1.0
+                if high * _TWO_PI + value > upper:
+                    high -= 1.0
+                first.append(low)
+                last.append(high)
+                continue
+            turn = 0.0  # one-sided: the turn inside nearest the value
+            if value < lower and lower > -math.inf:
+                turn = float(math.ceil((lower - value) / _TWO_PI))
+            elif value > upper and upper < math.inf:
+                turn = float(math.floor((upper - value) / _TWO_PI))
+            first.append(turn)
+            last.append(turn)
+        firsts.append(first)
+        lasts.append(last)
+    return firsts, lasts
+
+
+def closest_turns_of_row(bounds: Widened, row: list[float], first: list[float], last: list[float]) -> list[float]:
+    """:func:`closest_turns` of one row on Python floats (its values and :func:`turn_ranges_of_rows`' turns,
+    finite), the same turns."""
+    turns = []
+    for value, low, high, (kind, _, _, _, _, lower, upper) in zip(row, first, last, bounds.rules):
+        if high >= low:
+            turns.append(min(max(low, 0.0), high))
+        elif kind == MULTI_VALUED and lower - (value + _TWO_PI * high) < (value + _TWO_PI * low) - upper:
+            turns.append(high)  # the equivalent below the range is the nearer
+        else:
+            turns.append(low)
+    return turns
 
 
 def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray,

@@ -99,6 +99,46 @@ def _assert_the_shortcut_gives_the_quotients_turns(robot, limits, q, monkeypatch
         assert a.tobytes() == b.tobytes()
 
 
+@pytest.mark.parametrize("robot", [
+    arm(*[("revolute", -math.pi, math.pi)] * 6),
+    arm(*[("revolute", -170 * DEG, 170 * DEG)] * 5, ("revolute", -266 * DEG, 266 * DEG)),
+    arm(*[("revolute", -2 * math.pi, 2 * math.pi)] * 6),
+    arm(("revolute", 10 * DEG, 20 * DEG), ("revolute", -5 * math.pi, 3 * math.pi), ("revolute", -1e6, 1e6),
+        ("revolute", -math.inf, 30 * DEG), ("revolute", -30 * DEG, math.inf), ("prismatic", -0.2, 0.3)),
+    MIXED], ids=["pi", "one joint over a turn", "two pi", "assorted", "mixed"])
+def test_turn_ranges_on_floats_are_the_arrays_turns(robot):
+    """``turn_ranges_of_rows`` and ``closest_turns_of_row`` (one target's rows on Python floats) against
+    ``turn_ranges`` and ``closest_turns`` on random rows, rows on each bound and a tolerance either side of it,
+    whole turns away from them, and far outside: the same turns, bit for bit; None for a value that is not
+    finite where its joint takes a quotient."""
+    from service.kinematics._limits import closest_turns, closest_turns_of_row, turn_ranges_of_rows
+
+    rng = np.random.default_rng(23)
+    limits = Limits.of(robot)
+    bounds = limits.widened(robot)
+    lower, upper = np.maximum(robot.lower, -8.0), np.minimum(robot.upper, 8.0)
+    tolerance = limits.tolerance(robot)
+    edges = [robot.lower, robot.upper, robot.lower - tolerance, robot.upper + tolerance,
+             robot.lower - 1.0001 * tolerance, robot.upper + 1.0001 * tolerance,
+             robot.lower + 2 * np.pi, robot.upper - 2 * np.pi, robot.lower - 2 * np.pi]
+    rows = np.concatenate([rng.uniform(lower, upper, (200, robot.dof)), rng.uniform(-20, 20, (200, robot.dof)),
+                           *(np.where(np.isfinite(edge), edge, 0.5)[None] for edge in edges),
+                           rng.uniform(-1e3, 1e3, (20, robot.dof))])
+    first, last = turn_ranges(robot, limits, rows)
+    closest = closest_turns(robot, limits, rows, first, last)
+    floats = turn_ranges_of_rows(bounds, rows.tolist())
+    assert floats is not None
+    assert np.array(floats[0]).tobytes() == first.tobytes()
+    assert np.array(floats[1]).tobytes() == last.tobytes()
+    for row, row_first, row_last, expected in zip(rows.tolist(), *floats, closest):
+        assert closest_turns_of_row(bounds, row, row_first, row_last) == expected.tolist()
+    quotient_joints = np.flatnonzero(robot.is_revolute & ~bounds.continuous)
+    for bad in (math.nan, math.inf, -math.inf):
+        row = rows[0].tolist()
+        row[quotient_joints[0]] = bad
+        assert turn_ranges_of_rows(bounds, [row]) is None
+
+
 def test_turn_ranges_count_huge_limits_without_generating_them():
     wide = arm(("revolute", -1e6, 1e6))
     first, last = turn_ranges(wide, Limits.of(wide), np.array([0.5]))

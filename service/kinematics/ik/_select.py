@@ -38,6 +38,7 @@ capped at :data:`.._budget.COUNT_CAP`.
 from __future__ import annotations
 
 import itertools
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
@@ -46,7 +47,7 @@ import numpy as np
 
 from .._budget import COUNT_CAP, UNLIMITED, Budget
 from .._errors import InvalidInputError
-from .._limits import Limits, closest_turns, turn_ranges
+from .._limits import Limits, closest_turns, closest_turns_of_row, turn_ranges, turn_ranges_of_rows
 from .._robot import Robot
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, capped_products, capped_sums, combination_turns,
                            down_set_size, enumerable_limit, position_in_group, rounds_needed)
@@ -75,10 +76,11 @@ NOTE_WORDING = {
                "'rejected' with their collisions.",
 }
 
-#: Up to this many combinations in all, one target's solutions without a reference are put in order on Python
-#: integers (:func:`_few_in_turn`), where :func:`_nearest`'s few dozen array steps cost more than the arithmetic: a
-#: PUMA 560 with its catalogue limits has 8 … 40 per pose.
-_FEW_COMBINATIONS = 64
+#: One target's answer without a reference or a collision filter, of up to this many rows and this many
+#: combinations in all, is selected on Python floats and integers (:func:`_one_target`), where the array path's
+#: few dozen steps cost more than the arithmetic: a PUMA 560 with its catalogue limits has 8 … 40 combinations
+#: per pose.
+_ONE_TARGET_ROWS, _FEW_COMBINATIONS = 64, 64
 
 #: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
 _CHUNK_ROWS = 1 << 18
@@ -244,6 +246,11 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     if reference is not None:
         reference = effective_reference(robot, limits, reference)
     budget.check("selection")
+    if (n_targets == 1 and reference is None and excluded is None and len(table) <= _ONE_TARGET_ROWS
+            and limits.widened(robot).one_turn_possible):  # limits over a turn (±2π) give most rows many combinations
+        chosen = _one_target(robot, limits, table, filter_limits, max_equivalents)
+        if chosen is not None:
+            return chosen
     n = robot.dof
     target, q = table.target, table.joints
     first, last = turn_ranges(robot, limits, q)
@@ -283,15 +290,12 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     lowered = limit > enumerable_limit(n) and bool((combinations > MAX_COMBINATIONS_PER_SOLUTION).any())
     if lowered:
         limit = enumerable_limit(n)
-    if reference is None and n_targets == 1 and int(combinations.sum()) <= _FEW_COMBINATIONS:
-        kept_rows, kept_values = _few_in_turn(c_q, c_first, c_last, limit)
-    else:
-        if reference is not None:
-            row_limit = np.full(len(c_target), limit, dtype=np.int64)
-        else:  # round robin: no solution gives more than the rounds needed to reach the limit
-            row_limit = rounds_needed(c_target, combinations, n_targets, limit)[c_target]
-        kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
-                                          reference, ordering, budget)
+    if reference is not None:
+        row_limit = np.full(len(c_target), limit, dtype=np.int64)
+    else:  # round robin: no solution gives more than the rounds needed to reach the limit
+        row_limit = rounds_needed(c_target, combinations, n_targets, limit)[c_target]
+    kept_rows, kept_values = _nearest(robot, limits, c_target, c_q, c_first, c_last, counts, row_limit, limit,
+                                      reference, ordering, budget)
     kept_rows = candidates[kept_rows]
     kept = table.take(kept_rows, joints=kept_values, within_limits=fits[kept_rows])
 
@@ -503,10 +507,73 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     return rows[first_few], values[first_few]
 
 
-def _few_in_turn(q: np.ndarray, first: np.ndarray, last: np.ndarray, limit: int) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`_nearest` of one target's candidate rows without a reference where they have few combinations in
-    all (:data:`_FEW_COMBINATIONS`), on Python integers: the same kept rows (K,) and values (K, n), in the same
-    order. ``q``, ``first``, ``last`` (S, n) are the rows' values and usable turns.
+def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limits: bool,
+                max_equivalents: int) -> Selection | None:
+    """:func:`select` of one target's rows (``table``) without a reference or excluded rows, in a few steps on
+    Python floats and integers: the same selection, field by field. None where its rows have more than
+    :data:`_FEW_COMBINATIONS` in all, or a value that is not finite meets a quotient (the array path then
+    selects them).
+
+    Every row that fits (or, with ``filter_limits`` false, every row) may be kept: each has its stream of
+    combinations (one, at its closest equivalent, for a row that does not fit), and the streams take turns
+    (:func:`_in_turn`); a row that does not fit and is filtered is rejected at its closest equivalent. Rows whose
+    every value has the turns [0, 0] alone (the usual answer: limits within a turn) are found in one comparison."""
+    bounds = limits.widened(robot)
+    q = table.joints
+    n_rows, n = q.shape
+    at_zero = ((q > bounds.zero_turn_low) & (q < bounds.zero_turn_high)).all(axis=1).tolist()
+    if all(at_zero) and n_rows <= max_equivalents:  # every row kept as it stands, at q + 2π·0 as the arrays list it
+        counts = np.array([n_rows], dtype=np.int64)
+        return _outcome(counts, table.listed_at(q + 0.0, np.ones(n_rows, dtype=bool)), counts,
+                        table.take(slice(0, 0)), counts, counts, counts, np.zeros(1, dtype=np.int64), False,
+                        max_equivalents, False, None, n)
+    zero = [0.0] * n
+    fits, firsts, lasts, candidates, dropped, dropped_turns, combinations = [], [], [], [], [], [], 0
+    for row, (simple, values) in enumerate(zip(at_zero, q.tolist())):
+        if simple:
+            fits.append(True)
+            candidates.append(row)
+            firsts.append(zero)
+            lasts.append(zero)
+            combinations += 1
+            continue
+        ranges = turn_ranges_of_rows(bounds, [values])
+        if ranges is None:
+            return None
+        first, last = ranges[0][0], ranges[1][0]
+        row_fits = all(high >= low for low, high in zip(first, last))
+        fits.append(row_fits)
+        if not row_fits:
+            first = last = closest_turns_of_row(bounds, values, first, last)
+            if filter_limits:
+                dropped.append(row)
+                dropped_turns.append(first)
+                continue
+        candidates.append(row)  # kept, and flagged if it does not fit, at its closest equivalent
+        firsts.append(first)
+        lasts.append(last)
+        combinations += math.prod(int(high - low) + 1 for low, high in zip(first, last))
+        if combinations > _FEW_COMBINATIONS:
+            return None
+    kept_of, turns = _in_turn(firsts, lasts, max_equivalents)
+    kept_rows = np.array(candidates, dtype=np.int64)[kept_of] if kept_of else np.zeros(0, dtype=np.int64)
+    fits = np.array(fits, dtype=bool)
+    # q + 2πk as the arrays list them: 2πk first, then q added (the same sum either way round)
+    kept = table.take(kept_rows, joints=np.array(turns, dtype=float).reshape(len(kept_rows), n) * _TWO_PI
+                      + q.take(kept_rows, axis=0), within_limits=fits[kept_rows])
+    dropped = np.array(dropped, dtype=np.int64)
+    rejected = table.take(dropped, joints=np.array(dropped_turns, dtype=float).reshape(len(dropped), n) * _TWO_PI
+                          + q.take(dropped, axis=0), within_limits=fits[dropped])
+    rows, n_kept, n_candidates, available = (np.array([count], dtype=np.int64) for count in (
+        n_rows, len(kept_rows), len(candidates), combinations))
+    return _outcome(rows, kept, n_kept, rejected, n_candidates, available, available, np.zeros(1, dtype=np.int64),
+                    False, max_equivalents, False, None, n)
+
+
+def _in_turn(firsts: list[list[float]], lasts: list[list[float]], limit: int) -> tuple[list[int], list[tuple]]:
+    """:func:`_nearest` of one target's rows without a reference, on Python integers: the kept rows (K,) and
+    each one's turns (K tuples of n), in answer order. ``firsts``, ``lasts`` are the rows' usable turns (n
+    whole floats each, ``last ≥ first``).
 
     Each row's combinations come cheapest first (Σ|k|), equal costs in the lexicographic order of their rank
     tuples, a joint's turns ranked by |k| and the lower first (:func:`._equivalents._ranked_turns` without a
@@ -515,23 +582,22 @@ def _few_in_turn(q: np.ndarray, first: np.ndarray, last: np.ndarray, limit: int)
     combination this order puts among the first ``limit``: the ∏(r_j + 1) tuples at or below a tuple cost no more
     and precede it."""
     streams = []
-    for row_first, row_last in zip(first.astype(np.int64).tolist(), last.astype(np.int64).tolist()):
-        if row_first == row_last:  # one usable turn per joint (limits within a turn): one combination
-            streams.append([tuple(row_first)])
+    for first, last in zip(firsts, lasts):
+        if first == last:  # one usable turn per joint (limits within a turn): one combination
+            streams.append([tuple(first)])
             continue
-        ranked = [(low,) if low == high else sorted(range(low, high + 1), key=lambda k: (abs(k), k))
-                  for low, high in zip(row_first, row_last)]
+        ranked = [(low,) if low == high else sorted(range(int(low), int(high) + 1), key=lambda k: (abs(k), k))
+                  for low, high in zip(first, last)]
         streams.append(sorted(itertools.product(*ranked), key=lambda turns: sum(map(abs, turns))))  # stable
+    if len(streams) == sum(map(len, streams)):  # one combination each: the rows in order
+        return list(range(len(streams)))[:limit], [stream[0] for stream in streams][:limit]
     rows, turns = [], []
     for position in range(max(map(len, streams), default=0)):
         for row, stream in enumerate(streams):
             if position < len(stream):
                 rows.append(row)
                 turns.append(stream[position])
-    rows, turns = rows[:limit], turns[:limit]
-    # q + 2πk as _nearest computes it: 2πk first, then q added
-    values = np.array(turns, dtype=float).reshape(len(rows), q.shape[1]) * _TWO_PI + q.take(rows, axis=0)
-    return np.array(rows, dtype=np.int64), values
+    return rows[:limit], turns[:limit]
 
 
 def _target_edges(target: np.ndarray, before: np.ndarray, bound: np.ndarray, edges: np.ndarray) -> np.ndarray:

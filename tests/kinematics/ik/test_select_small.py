@@ -108,7 +108,7 @@ def _select_both(robot, target, options, rng, monkeypatch):
 @pytest.fixture
 def calls(monkeypatch):
     """Counts of the selection's few-rows and general forms, as the cases call them."""
-    counted = {"few rows": 0, "general": 0, "each once": 0, "few in turn": 0}
+    counted = {"few rows": 0, "general": 0, "each once": 0, "few in turn": 0, "one target": 0}
 
     def counting(function, key):
         def wrapper(*args, **kwargs):
@@ -119,7 +119,15 @@ def calls(monkeypatch):
     monkeypatch.setattr(_equivalents, "_row_rank_tuples", counting(_equivalents._row_rank_tuples, "few rows"))
     monkeypatch.setattr(_equivalents, "_tabled_turns", counting(_equivalents._tabled_turns, "general"))
     monkeypatch.setattr(_select, "_each_once", counting(_select._each_once, "each once"))
-    monkeypatch.setattr(_select, "_few_in_turn", counting(_select._few_in_turn, "few in turn"))
+    monkeypatch.setattr(_select, "_in_turn", counting(_select._in_turn, "few in turn"))
+
+    selects_one_target = _select._one_target
+
+    def one_target(*args, **kwargs):  # counted where it selects (it declines many combinations)
+        chosen = selects_one_target(*args, **kwargs)
+        counted["one target"] += chosen is not None
+        return chosen
+    monkeypatch.setattr(_select, "_one_target", one_target)
     return counted
 
 
@@ -139,9 +147,9 @@ def test_one_target_selects_as_the_general_path(monkeypatch, calls):
         assert _rows(answer.rejected, 0) == _rows(mine.rejected, 0), case
         assert (answer.status[0], answer.available[0], answer.trimmed[0]) == (
             mine.status[0], mine.available[0], mine.trimmed[0])
-    # the cases exercise the few-rows forms, the few combinations put in turn on integers, the rows kept once each
-    # and the general one, and rank many equivalents
-    assert ranked > 50 and calls["general"] > 50 and calls["each once"] > 30 and calls["few in turn"] > 20 \
+    # the cases exercise the few-rows forms, one target selected on floats (its few combinations put in turn on
+    # integers) and the general form, and rank many equivalents
+    assert ranked > 50 and calls["general"] > 50 and calls["one target"] > 30 and calls["few in turn"] > 20 \
         and kept_many > 100, (ranked, calls, kept_many)
 
 
@@ -159,8 +167,8 @@ def test_few_combinations_without_a_reference_come_in_the_general_paths_order(mo
     assert calls["few in turn"] > 40, calls
 
 
-def test_few_in_turn_is_the_general_ranking_of_random_turn_ranges():
-    """``_select._few_in_turn`` against ``_select._nearest`` on random rows: usable turns anywhere from −3 to +5
+def test_in_turn_is_the_general_ranking_of_random_turn_ranges():
+    """``_select._in_turn`` against ``_select._nearest`` on random rows: usable turns anywhere from −3 to +5
     (0 inside, or every turn on one side), up to 200 combinations, any limit: the same rows and values, bit for
     bit."""
     rng = np.random.default_rng(7)
@@ -180,9 +188,11 @@ def test_few_in_turn_is_the_general_ranking_of_random_turn_ranges():
         row_limit = _equivalents.rounds_needed(target, combinations, 1, limit)[target]
         expected = _select._nearest(robot, limits, target, q, first, last, counts, row_limit, limit, None, Ordering(),
                                     UNLIMITED)
-        got = _select._few_in_turn(q, first, last, limit)
-        assert got[0].tolist() == expected[0].tolist(), case
-        assert got[1].tobytes() == expected[1].tobytes(), case
+        rows_kept, turns = _select._in_turn(first.tolist(), last.tolist(), limit)
+        assert rows_kept == expected[0].tolist(), case
+        values = [[turn * TWO_PI + value for turn, value in zip(row_turns, q[row].tolist())]
+                  for row, row_turns in zip(rows_kept, turns)]  # as _select._one_target lists them
+        assert np.array(values).reshape(-1, 6).tobytes() == expected[1].tobytes(), case
 
 
 def test_joint_exactly_at_its_limits_and_reference_between_equivalents(monkeypatch):

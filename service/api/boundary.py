@@ -199,6 +199,10 @@ def ik_targets_to_core(targets: Sequence[PoseTarget] | MatrixRows, unit: AngleUn
         return IKTargets.poses(_matrices_of_rows(targets.matrices, *prefix, "matrices"))
     def at(index: int):
         return located(*prefix, index) if indexed else located(*prefix)
+    if len(targets) == 1 and not isinstance(targets[0].orientation, DirectionOrientation):  # a single IK's pose
+        with at(0):
+            matrix, constrained = target_matrix(targets[0], unit)
+        return IKTargets(matrix[None], np.array([POSE if constrained else POSITION]), indexed=indexed)
     directions = {}
     for index, target in enumerate(targets):
         with at(index):

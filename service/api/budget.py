@@ -16,9 +16,9 @@
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable
 
-import numpy as np
 from fastapi import Request
 from fastapi.responses import JSONResponse
 
@@ -82,11 +82,12 @@ def too_much_work(detail: str) -> ProblemError:
 def check_turns(settings: Settings, robot: Robot, limits: Limits, location: tuple) -> None:
     """422 when a revolute joint's limits span more turns than ``KIN_MAX_TURNS_PER_JOINT``."""
     cap = settings.max_turns_per_joint
-    spans = np.where(robot.is_revolute & np.isfinite(limits.lower) & np.isfinite(limits.upper),
-                     limits.upper - limits.lower, 0.0) / (2 * np.pi)
-    over = np.flatnonzero(spans > cap)
-    if len(over):
-        joint = int(over[0])
+    multi_valued = limits.widened(robot).multi_valued  # revolute, both bounds finite
+    spans = [(upper - lower) / (2 * math.pi) if both else 0.0  # a few joints: floats cost less than arrays
+             for both, lower, upper in zip(multi_valued.tolist(), limits.lower.tolist(), limits.upper.tolist())]
+    over = [joint for joint, span in enumerate(spans) if span > cap]
+    if over:
+        joint = over[0]
         raise ProblemError(422, "validation-error", "Request is not valid",
                            f"joint {joint}: its limits span {spans[joint]:.6g} turns, more than "
                            f"KIN_MAX_TURNS_PER_JOINT = {cap} (by {spans[joint] - cap:.6g}); a joint that turns "

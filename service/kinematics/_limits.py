@@ -20,11 +20,12 @@ How each kind of joint is treated:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Sequence
 
 import numpy as np
 
+from ._budget import COUNT_CAP
 from ._cache import bounded_memo
 from ._errors import InvalidInputError
 from ._robot import Robot, check_limit_pair
@@ -37,11 +38,15 @@ _TWO_PI = 2.0 * np.pi
 class Limits:
     """Lower and upper bounds for every joint, shape (n,) each; ±inf where unlimited.
 
-    Radians for revolute joints, the robot's length unit for prismatic ones.
+    Radians for revolute joints, the robot's length unit for prismatic ones. The bounds are read as they stand
+    when first applied to a robot (:meth:`widened`): change them by making other limits, not in place.
     """
 
     lower: np.ndarray
     upper: np.ndarray
+    #: The :class:`Widened` bounds already applied to a robot: id → (robot, widened). An answer applies the same
+    #: limits half a dozen times; looking them up by value each time cost more than the rest of the check.
+    _applied: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @classmethod
     def of(cls, robot: Robot) -> "Limits":
@@ -97,11 +102,21 @@ class Limits:
                                                                    FITS_OR_NOT))
             rules = tuple(zip(kind.tolist(), lower.tolist(), upper.tolist(), one_turn_low.tolist(),
                               one_turn_high.tolist(), self.lower.tolist(), self.upper.tolist()))
+            equivalents = 1  # Π_j ceil(span_j / 2π) over the multi-valued joints, capped
+            for both, span in zip(multi_valued.tolist(), (self.upper - self.lower).tolist()):
+                if both:
+                    equivalents = min(equivalents * max(math.ceil(span / _TWO_PI), 1), COUNT_CAP)
             return Widened(*arrays, every_multi_valued=bool(multi_valued.all()),
                            any_multi_valued=bool(multi_valued.any()),
-                           one_turn_possible=bool((one_turn_low < one_turn_high).all()), rules=rules)
+                           one_turn_possible=bool((one_turn_low < one_turn_high).all()), rules=rules,
+                           equivalents_per_solution=equivalents)
+        applied = self._applied.get(id(robot))
+        if applied is not None and applied[0] is robot:
+            return applied[1]
         key = (self.lower.dtype.str, self.lower.tobytes(), self.upper.dtype.str, self.upper.tobytes())
-        return bounded_memo(robot, "widened_limits", key, build, _WIDENED_KEPT)
+        widened = bounded_memo(robot, "widened_limits", key, build, _WIDENED_KEPT)
+        self._applied[id(robot)] = (robot, widened)
+        return widened
 
 
 @dataclass(frozen=True)
@@ -116,7 +131,8 @@ class Widened:
     and any, is multi-valued, and whether every one-turn interval is non-empty (limits of at most about one turn).
     ``rules`` holds the same per joint on Python floats, for one target's few rows (:func:`turn_ranges_of_rows`):
     (kind, lower, upper, one_turn_low, one_turn_high, and the bounds without their tolerance), the kind one of
-    :data:`MULTI_VALUED`, :data:`ONE_SIDED`, :data:`FITS_OR_NOT`.
+    :data:`MULTI_VALUED`, :data:`ONE_SIDED`, :data:`FITS_OR_NOT`. ``equivalents_per_solution``: see
+    :func:`.ik.equivalents_per_solution`.
     """
 
     lower: np.ndarray
@@ -131,6 +147,7 @@ class Widened:
     any_multi_valued: bool
     one_turn_possible: bool
     rules: tuple[tuple[int, float, float, float, float, float, float], ...]
+    equivalents_per_solution: int
 
 
 #: How a joint's turns are found (:attr:`Widened.rules`): revolute with both bounds finite (every turn inside);

@@ -353,3 +353,20 @@ def test_cap_and_max_solutions_say_which_one_cut(max_solutions, cap, kept, trunc
                        ordering=Ordering(max_solutions=max_solutions), max_equivalents=cap)
     assert (len(selection.solutions), selection.expansion_truncated, selection.trimmed) == (kept, truncated, trimmed)
     assert selection.available == 12
+
+
+def test_limits_applied_to_two_robots_widen_for_each():
+    """Limits keep the bounds they have applied to each robot (an answer applies them half a dozen times): the
+    same limits on two arms of different sizes widen a slide by each arm's own tolerance, each time asked, and
+    equal limits made anew find the robot's kept bounds."""
+    small = arm(("prismatic", 0.1, 1.0), ("revolute", -1.0, 1.0))
+    large = Robot([Joint("q1", "prismatic", 50.0, 0.0, 0.0, 0.0, 0.1, 1.0),
+                   Joint("q2", "revolute", 50.0, 0.0, 0.0, 0.0, -1.0, 1.0)], name="large arm")
+    limits = Limits(np.array([0.1, -1.0]), np.array([1.0, 1.0]))
+    for _ in range(2):
+        for robot in (small, large):
+            widened = limits.widened(robot)
+            np.testing.assert_array_equal(widened.lower, limits.lower - limits.tolerance(robot))
+            assert widened.equivalents_per_solution == 1
+    assert limits.widened(small).lower[0] != limits.widened(large).lower[0]
+    assert Limits(limits.lower.copy(), limits.upper.copy()).widened(large) is limits.widened(large)

@@ -44,11 +44,7 @@ def equivalents_per_solution(robot: Robot, limits: Limits) -> int:
     more only when a value lands exactly on both bounds. Examples: a ±160° joint 1, a ±360° joint 2 (a UR5 has at
     most 2⁶ = 64 per solution).
     """
-    product = 1
-    for both, lower, upper in zip(limits.multi_valued(robot).tolist(), limits.lower.tolist(), limits.upper.tolist()):
-        if both:  # (a few joints: Python floats cost less than numpy's per-call overhead)
-            product = min(product * max(math.ceil((upper - lower) / _TWO_PI), 1), COUNT_CAP)
-    return product
+    return limits.widened(robot).equivalents_per_solution  # worked out once per limits, with them
 
 
 def worst_answer_per_target(solutions: int, equivalents: int, kept: int) -> tuple[int, int]:

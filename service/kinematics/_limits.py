@@ -129,7 +129,7 @@ class Widened:
     joints); (``zero_turn_low``, ``zero_turn_high``) is that interval at the multi-valued joints and the bounds at
     the others: a value inside has the turns [0, 0] alone, whatever its joint. The flags say whether every joint,
     and any, is multi-valued, and whether every one-turn interval is non-empty (limits of at most about one turn).
-    ``rules`` holds the same per joint on Python floats, for one target's few rows (:func:`turn_ranges_of_rows`):
+    ``rules`` holds the same per joint on Python floats, for one target's few rows (:func:`turns_of_row`):
     (kind, lower, upper, one_turn_low, one_turn_high, and the bounds without their tolerance), the kind one of
     :data:`MULTI_VALUED`, :data:`ONE_SIDED`, :data:`FITS_OR_NOT`. ``equivalents_per_solution``: see
     :func:`.ik.equivalents_per_solution`.
@@ -312,60 +312,58 @@ def _one_turn_each(q: np.ndarray, bounds: Widened) -> bool:
     return np.count_nonzero(inside) == inside.size
 
 
-def turn_ranges_of_rows(bounds: Widened, rows: list[list[float]]
-                        ) -> tuple[list[list[float]], list[list[float]]] | None:
-    """:func:`turn_ranges` of a few rows of joint values (lists of n floats) on Python floats: the same turns, in
-    the same arithmetic, where one target's answer would spend more on the arrays' fixed costs than on the
-    quotients. None where a value is not finite and its joint takes a quotient (the arrays' rules for NaN and
-    infinities then apply)."""
-    firsts, lasts = [], []
-    for row in rows:
-        first, last = [], []
-        for value, (kind, lower, upper, one_turn_low, one_turn_high, _, _) in zip(row, bounds.rules):
-            if kind == FITS_OR_NOT:
-                first.append(0.0)
-                last.append(0.0 if lower <= value <= upper else -1.0)
-                continue
-            if kind == MULTI_VALUED and one_turn_low < value < one_turn_high:  # the usual case: this turn alone
-                first.append(0.0)
+def turns_of_row(bounds: Widened, row: list[float]) -> tuple[list[float], list[float], bool] | None:
+    """One row of joint values (n floats) against the limits on Python floats, where one target's answer would
+    spend more on the arrays' fixed costs than on the arithmetic: its :func:`turn_ranges` (first, last) and True
+    when it fits; when it does not, its :func:`closest_turns` twice and False. The same turns as the arrays', in
+    the same arithmetic. None where a value is not finite and its joint takes a quotient (the arrays' rules for NaN
+    and infinities then apply)."""
+    first, last, fits = [], [], True
+    for value, (kind, lower, upper, one_turn_low, one_turn_high, _, _) in zip(row, bounds.rules):
+        if kind == FITS_OR_NOT:
+            first.append(0.0)
+            if lower <= value <= upper:
                 last.append(0.0)
-                continue
-            if not -math.inf < value < math.inf:
-                return None
-            if kind == MULTI_VALUED:  # the end values q + 2kπ checked against the bounds, as the arrays do
-                low = float(math.ceil((lower - value) / _TWO_PI))
-                high = float(math.floor((upper - value) / _TWO_PI))
-                if low * _TWO_PI + value < lower:
-                    low += 1.0
-                if high * _TWO_PI + value > upper:
-                    high -= 1.0
-                first.append(low)
-                last.append(high)
-                continue
-            turn = 0.0  # one-sided: the turn inside nearest the value
-            if value < lower and lower > -math.inf:
-                turn = float(math.ceil((lower - value) / _TWO_PI))
-            elif value > upper and upper < math.inf:
-                turn = float(math.floor((upper - value) / _TWO_PI))
-            first.append(turn)
-            last.append(turn)
-        firsts.append(first)
-        lasts.append(last)
-    return firsts, lasts
-
-
-def closest_turns_of_row(bounds: Widened, row: list[float], first: list[float], last: list[float]) -> list[float]:
-    """:func:`closest_turns` of one row on Python floats (its values and :func:`turn_ranges_of_rows`' turns,
-    finite), the same turns."""
-    turns = []
+            else:
+                last.append(-1.0)
+                fits = False
+            continue
+        if kind == MULTI_VALUED and one_turn_low < value < one_turn_high:  # the usual case: this turn alone
+            first.append(0.0)
+            last.append(0.0)
+            continue
+        if not -math.inf < value < math.inf:
+            return None
+        if kind == MULTI_VALUED:  # the end values q + 2kπ checked against the bounds, as the arrays do
+            low = float(math.ceil((lower - value) / _TWO_PI))
+            high = float(math.floor((upper - value) / _TWO_PI))
+            if low * _TWO_PI + value < lower:
+                low += 1.0
+            if high * _TWO_PI + value > upper:
+                high -= 1.0
+            first.append(low)
+            last.append(high)
+            if high < low:
+                fits = False
+            continue
+        turn = 0.0  # one-sided: the turn inside nearest the value
+        if value < lower and lower > -math.inf:
+            turn = float(math.ceil((lower - value) / _TWO_PI))
+        elif value > upper and upper < math.inf:
+            turn = float(math.floor((upper - value) / _TWO_PI))
+        first.append(turn)
+        last.append(turn)
+    if fits:
+        return first, last, True
+    closest = []  # closest_turns: the turn nearest 0 where one fits; else the nearer side's
     for value, low, high, (kind, _, _, _, _, lower, upper) in zip(row, first, last, bounds.rules):
         if high >= low:
-            turns.append(min(max(low, 0.0), high))
+            closest.append(min(max(low, 0.0), high))
         elif kind == MULTI_VALUED and lower - (value + _TWO_PI * high) < (value + _TWO_PI * low) - upper:
-            turns.append(high)  # the equivalent below the range is the nearer
+            closest.append(high)  # the equivalent below the range is the nearer
         else:
-            turns.append(low)
-    return turns
+            closest.append(low)
+    return closest, closest, False
 
 
 def closest_equivalent(robot: Robot, limits: Limits, q: np.ndarray,

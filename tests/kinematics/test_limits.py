@@ -107,11 +107,11 @@ def _assert_the_shortcut_gives_the_quotients_turns(robot, limits, q, monkeypatch
         ("revolute", -math.inf, 30 * DEG), ("revolute", -30 * DEG, math.inf), ("prismatic", -0.2, 0.3)),
     MIXED], ids=["pi", "one joint over a turn", "two pi", "assorted", "mixed"])
 def test_turn_ranges_on_floats_are_the_arrays_turns(robot):
-    """``turn_ranges_of_rows`` and ``closest_turns_of_row`` (one target's rows on Python floats) against
-    ``turn_ranges`` and ``closest_turns`` on random rows, rows on each bound and a tolerance either side of it,
-    whole turns away from them, and far outside: the same turns, bit for bit; None for a value that is not
-    finite where its joint takes a quotient."""
-    from service.kinematics._limits import closest_turns, closest_turns_of_row, turn_ranges_of_rows
+    """``turns_of_row`` (one target's rows on Python floats) against ``turn_ranges`` and ``closest_turns`` on
+    random rows, rows on each bound and a tolerance either side of it, whole turns away from them, and far
+    outside: a row that fits gets its turn ranges, one that does not its closest turns, the same bit for bit;
+    None for a value that is not finite where its joint takes a quotient."""
+    from service.kinematics._limits import closest_turns, turns_of_row
 
     rng = np.random.default_rng(23)
     limits = Limits.of(robot)
@@ -125,18 +125,22 @@ def test_turn_ranges_on_floats_are_the_arrays_turns(robot):
                            *(np.where(np.isfinite(edge), edge, 0.5)[None] for edge in edges),
                            rng.uniform(-1e3, 1e3, (20, robot.dof))])
     first, last = turn_ranges(robot, limits, rows)
+    fits = (last >= first).all(axis=1)
     closest = closest_turns(robot, limits, rows, first, last)
-    floats = turn_ranges_of_rows(bounds, rows.tolist())
-    assert floats is not None
-    assert np.array(floats[0]).tobytes() == first.tobytes()
-    assert np.array(floats[1]).tobytes() == last.tobytes()
-    for row, row_first, row_last, expected in zip(rows.tolist(), *floats, closest):
-        assert closest_turns_of_row(bounds, row, row_first, row_last) == expected.tolist()
+    assert fits.any()
+    if not np.all(robot.upper - robot.lower >= 2 * np.pi):  # a joint some value cannot reach: rows that misfit
+        assert not fits.all()
+    for row, row_fits, row_first, row_last, row_closest in zip(rows.tolist(), fits, first, last, closest):
+        got = turns_of_row(bounds, row)
+        assert got is not None and got[2] == row_fits
+        expected = (row_first, row_last) if row_fits else (row_closest, row_closest)
+        assert np.array(got[0]).tobytes() == expected[0].tobytes()
+        assert np.array(got[1]).tobytes() == expected[1].tobytes()
     quotient_joints = np.flatnonzero(robot.is_revolute & ~bounds.continuous)
     for bad in (math.nan, math.inf, -math.inf):
         row = rows[0].tolist()
         row[quotient_joints[0]] = bad
-        assert turn_ranges_of_rows(bounds, [row]) is None
+        assert turns_of_row(bounds, row) is None
 
 
 def test_turn_ranges_count_huge_limits_without_generating_them():

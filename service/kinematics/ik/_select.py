@@ -47,7 +47,7 @@ import numpy as np
 
 from .._budget import COUNT_CAP, UNLIMITED, Budget
 from .._errors import InvalidInputError
-from .._limits import Limits, closest_turns, closest_turns_of_row, turn_ranges, turn_ranges_of_rows
+from .._limits import Limits, closest_turns, turn_ranges, turns_of_row
 from .._robot import Robot
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, capped_products, capped_sums, combination_turns,
                            down_set_size, enumerable_limit, position_in_group, rounds_needed)
@@ -537,22 +537,19 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
             lasts.append(zero)
             combinations += 1
             continue
-        ranges = turn_ranges_of_rows(bounds, [values])
-        if ranges is None:
+        turns = turns_of_row(bounds, values)
+        if turns is None:
             return None
-        first, last = ranges[0][0], ranges[1][0]
-        row_fits = all(high >= low for low, high in zip(first, last))
+        first, last, row_fits = turns
         fits.append(row_fits)
-        if not row_fits:
-            first = last = closest_turns_of_row(bounds, values, first, last)
-            if filter_limits:
-                dropped.append(row)
-                dropped_turns.append(first)
-                continue
+        if not row_fits and filter_limits:  # rejected at its closest equivalent (first, last)
+            dropped.append(row)
+            dropped_turns.append(first)
+            continue
         candidates.append(row)  # kept, and flagged if it does not fit, at its closest equivalent
         firsts.append(first)
         lasts.append(last)
-        combinations += math.prod(int(high - low) + 1 for low, high in zip(first, last))
+        combinations += 1 if first == last else math.prod(int(high - low) + 1 for low, high in zip(first, last))
         if combinations > _FEW_COMBINATIONS:
             return None
     kept_of, turns = _in_turn(firsts, lasts, max_equivalents)

@@ -37,6 +37,7 @@ capped at :data:`.._budget.COUNT_CAP`.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Mapping
@@ -77,10 +78,16 @@ NOTE_WORDING = {
 }
 
 #: One target's answer without a reference or a collision filter, of up to this many rows and this many
-#: combinations in all, is selected on Python floats and integers (:func:`_one_target`), where the array path's
-#: few dozen steps cost more than the arithmetic: a PUMA 560 with its catalogue limits has 8 … 40 combinations
-#: per pose.
-_ONE_TARGET_ROWS, _FEW_COMBINATIONS = 64, 64
+#: combinations in all, is selected row by row (:func:`_one_target`), where the array path's few dozen steps
+#: cost more than the arithmetic: a PUMA 560 with its catalogue limits has 8 … 40 combinations per pose, a UR5
+#: with ±2π about 512.
+_ONE_TARGET_ROWS, _ONE_TARGET_COMBINATIONS = 64, 4096
+#: A row's stream of combinations (:func:`_stream`) is kept for its turn ranges up to this length, for this many
+#: ranges (a ±2π arm's rows meet a few dozen; at most 6 MB).
+_KEPT_STREAM, _KEPT_STREAMS = 256, 512
+#: Up to this many combinations in all, :func:`_in_turn` takes the rounds on Python lists (numpy's fixed costs
+#: outweigh the work).
+_FEW_IN_TURN = 64
 
 #: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
 _CHUNK_ROWS = 1 << 18
@@ -246,8 +253,7 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     if reference is not None:
         reference = effective_reference(robot, limits, reference)
     budget.check("selection")
-    if (n_targets == 1 and reference is None and excluded is None and len(table) <= _ONE_TARGET_ROWS
-            and limits.widened(robot).one_turn_possible):  # limits over a turn (±2π) give most rows many combinations
+    if n_targets == 1 and reference is None and excluded is None and len(table) <= _ONE_TARGET_ROWS:
         chosen = _one_target(robot, limits, table, filter_limits, max_equivalents)
         if chosen is not None:
             return chosen
@@ -511,7 +517,7 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
                 max_equivalents: int) -> Selection | None:
     """:func:`select` of one target's rows (``table``) without a reference or excluded rows, in a few steps on
     Python floats and integers: the same selection, field by field. None where its rows have more than
-    :data:`_FEW_COMBINATIONS` in all, or a value that is not finite meets a quotient (the array path then
+    :data:`_ONE_TARGET_COMBINATIONS` in all, or a value that is not finite meets a quotient (the array path then
     selects them).
 
     Every row that fits (or, with ``filter_limits`` false, every row) may be kept: each has its stream of
@@ -550,14 +556,13 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
         firsts.append(first)
         lasts.append(last)
         combinations += 1 if first == last else math.prod(int(high - low) + 1 for low, high in zip(first, last))
-        if combinations > _FEW_COMBINATIONS:
+        if combinations > _ONE_TARGET_COMBINATIONS:
             return None
-    kept_of, turns = _in_turn(firsts, lasts, max_equivalents)
-    kept_rows = np.array(candidates, dtype=np.int64)[kept_of] if kept_of else np.zeros(0, dtype=np.int64)
+    kept_of, turns = _in_turn(firsts, lasts, max_equivalents, n)
+    kept_rows = np.array(candidates, dtype=np.int64)[kept_of]
     fits = np.array(fits, dtype=bool)
     # q + 2πk as the arrays list them: 2πk first, then q added (the same sum either way round)
-    kept = table.take(kept_rows, joints=np.array(turns, dtype=float).reshape(len(kept_rows), n) * _TWO_PI
-                      + q.take(kept_rows, axis=0), within_limits=fits[kept_rows])
+    kept = table.take(kept_rows, joints=turns * _TWO_PI + q.take(kept_rows, axis=0), within_limits=fits[kept_rows])
     dropped = np.array(dropped, dtype=np.int64)
     rejected = table.take(dropped, joints=np.array(dropped_turns, dtype=float).reshape(len(dropped), n) * _TWO_PI
                           + q.take(dropped, axis=0), within_limits=fits[dropped])
@@ -567,34 +572,60 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
                     False, max_equivalents, False, None, n)
 
 
-def _in_turn(firsts: list[list[float]], lasts: list[list[float]], limit: int) -> tuple[list[int], list[tuple]]:
-    """:func:`_nearest` of one target's rows without a reference, on Python integers: the kept rows (K,) and
-    each one's turns (K tuples of n), in answer order. ``firsts``, ``lasts`` are the rows' usable turns (n
-    whole floats each, ``last ≥ first``).
+def _in_turn(firsts: list[list[float]], lasts: list[list[float]], limit: int, n: int
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_nearest` of one target's rows without a reference: the kept rows (K,) and each one's turns (K, n),
+    in answer order. ``firsts``, ``lasts`` are the rows' usable turns (n whole floats each, ``last ≥ first``).
 
-    Each row's combinations come cheapest first (Σ|k|), equal costs in the lexicographic order of their rank
-    tuples, a joint's turns ranked by |k| and the lower first (:func:`._equivalents._ranked_turns` without a
-    reference); the rows take turns, one combination each, and the first ``limit`` are kept. :func:`_nearest`
-    enumerates only the rank tuples with ∏(r_j + 1) within a row's share of the rounds, which holds every
-    combination this order puts among the first ``limit``: the ∏(r_j + 1) tuples at or below a tuple cost no more
-    and precede it."""
-    streams = []
-    for first, last in zip(firsts, lasts):
-        if first == last:  # one usable turn per joint (limits within a turn): one combination
-            streams.append([tuple(first)])
-            continue
-        ranked = [(low,) if low == high else sorted(range(int(low), int(high) + 1), key=lambda k: (abs(k), k))
-                  for low, high in zip(first, last)]
-        streams.append(sorted(itertools.product(*ranked), key=lambda turns: sum(map(abs, turns))))  # stable
-    if len(streams) == sum(map(len, streams)):  # one combination each: the rows in order
-        return list(range(len(streams)))[:limit], [stream[0] for stream in streams][:limit]
-    rows, turns = [], []
-    for position in range(max(map(len, streams), default=0)):
-        for row, stream in enumerate(streams):
-            if position < len(stream):
-                rows.append(row)
-                turns.append(stream[position])
-    return rows[:limit], turns[:limit]
+    Each row's combinations come cheapest first (:func:`_stream`); the rows take turns, one combination each, and
+    the first ``limit`` are kept. :func:`_nearest` enumerates only the rank tuples with ∏(r_j + 1) within a row's
+    share of the rounds, which holds every combination this order puts among the first ``limit``: the ∏(r_j + 1)
+    tuples at or below a tuple cost no more and precede it."""
+    if firsts == lasts:  # one combination each (limits within a turn): the rows in order
+        return np.arange(min(len(firsts), limit)), np.array(firsts[:limit], dtype=float).reshape(-1, n)
+    streams = [_stream(tuple(first), tuple(last)) if first != last else None for first, last in zip(firsts, lasts)]
+    lengths = [1 if stream is None else len(stream) for stream in streams]
+    if sum(lengths) <= _FEW_IN_TURN:  # the rounds on lists (a PUMA's rows: a few, one or two combinations each)
+        lists = [[first] if stream is None else stream.tolist() for first, stream in zip(firsts, streams)]
+        rows, turns = [], []
+        for position in range(max(lengths)):
+            for row, stream in enumerate(lists):
+                if position < len(stream):
+                    rows.append(row)
+                    turns.append(stream[position])
+        return np.array(rows[:limit], dtype=np.int64), np.array(turns[:limit], dtype=float).reshape(-1, n)
+    streams = [np.array([first]) if stream is None else stream for first, stream in zip(firsts, streams)]
+    if min(lengths) == max(lengths):  # streams of one length (a ±2π arm's): round by round as they stand
+        every = len(streams) * lengths[0]
+        return np.arange(min(every, limit)) % len(streams), np.stack(streams, axis=1).reshape(every, n)[:limit]
+    turns = np.concatenate(streams)
+    rows = np.repeat(np.arange(len(streams)), lengths)
+    position = np.arange(len(rows)) - np.repeat(np.cumsum(lengths) - lengths, lengths)
+    order = np.lexsort((rows, position))[:limit]  # round by round, the rows in order within a round
+    return rows[order], turns[order]
+
+
+@functools.lru_cache(maxsize=_KEPT_STREAMS)
+def _kept_stream(first: tuple[float, ...], last: tuple[float, ...]) -> np.ndarray:
+    stream = _ranked_stream(first, last)
+    stream.flags.writeable = False
+    return stream
+
+
+def _stream(first: tuple[float, ...], last: tuple[float, ...]) -> np.ndarray:
+    """One row's combinations (C, n), cheapest first: the turns k of each joint within [first, last], the
+    combinations in order of Σ|k|, equal costs in the lexicographic order of their rank tuples, a joint's turns
+    ranked by |k| and the lower first (:func:`._equivalents._ranked_turns` without a reference). A function of the
+    ranges alone, kept for the short streams (a ±2π arm's rows meet a few dozen ranges)."""
+    if math.prod(int(high - low) + 1 for low, high in zip(first, last)) <= _KEPT_STREAM:
+        return _kept_stream(first, last)
+    return _ranked_stream(first, last)
+
+
+def _ranked_stream(first: tuple[float, ...], last: tuple[float, ...]) -> np.ndarray:
+    ranked = [sorted(range(int(low), int(high) + 1), key=lambda k: (abs(k), k)) for low, high in zip(first, last)]
+    combinations = sorted(itertools.product(*ranked), key=lambda turns: sum(map(abs, turns)))  # stable
+    return np.array(combinations, dtype=float).reshape(len(combinations), len(first))
 
 
 def _target_edges(target: np.ndarray, before: np.ndarray, bound: np.ndarray, edges: np.ndarray) -> np.ndarray:

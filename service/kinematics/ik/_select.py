@@ -32,7 +32,9 @@
 How the work stays bounded: only the rank tuples of :mod:`._equivalents` are enumerated and costed, in chunks
 of whole solutions of at most about :data:`_CHUNK_ROWS` combinations (one target's may span several), with
 ``budget`` checked between chunks; the counts (``available``, ``trimmed``) are products of interval lengths,
-capped at :data:`.._budget.COUNT_CAP`.
+capped at :data:`.._budget.COUNT_CAP`. One target without a reference or a collision filter, of at most
+:data:`_ONE_TARGET_COMBINATIONS` combinations, is selected row by row instead (:func:`_one_target`: a single
+pose's answer, where the chunks' fixed costs outweigh the work).
 """
 
 from __future__ import annotations

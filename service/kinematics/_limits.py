@@ -115,6 +115,8 @@ class Limits:
             return applied[1]
         key = (self.lower.dtype.str, self.lower.tobytes(), self.upper.dtype.str, self.upper.tobytes())
         widened = bounded_memo(robot, "widened_limits", key, build, _WIDENED_KEPT)
+        if len(self._applied) >= _WIDENED_KEPT:  # limits kept long and applied to many robots stay small
+            self._applied.clear()
         self._applied[id(robot)] = (robot, widened)
         return widened
 

@@ -374,3 +374,15 @@ def test_limits_applied_to_two_robots_widen_for_each():
             assert widened.equivalents_per_solution == 1
     assert limits.widened(small).lower[0] != limits.widened(large).lower[0]
     assert Limits(limits.lower.copy(), limits.upper.copy()).widened(large) is limits.widened(large)
+
+
+def test_limits_applied_to_many_robots_keep_a_few():
+    """The bounds a Limits keeps per robot stay few however many robots it is applied to (a Limits kept long,
+    say), and each robot still gets its own."""
+    from service.kinematics import _limits
+
+    limits = Limits(np.array([-1.0]), np.array([1.0]))
+    for index in range(3 * _limits._WIDENED_KEPT):
+        robot = Robot([Joint("q1", "prismatic", 0.5 + index, 0.0, 0.0, 0.0, -1.0, 1.0)], name=f"slide {index}")
+        assert limits.widened(robot).lower[0] == -1.0 - limits.tolerance(robot)[0]
+        assert len(limits._applied) <= _limits._WIDENED_KEPT

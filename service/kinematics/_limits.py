@@ -102,10 +102,12 @@ class Limits:
                                                                    FITS_OR_NOT))
             rules = tuple(zip(kind.tolist(), lower.tolist(), upper.tolist(), one_turn_low.tolist(),
                               one_turn_high.tolist(), self.lower.tolist(), self.upper.tolist()))
-            equivalents = 1  # Π_j ceil(span_j / 2π) over the multi-valued joints, capped
-            for both, span in zip(multi_valued.tolist(), (self.upper - self.lower).tolist()):
+            equivalents = 1  # Π_j ceil(span_j / 2π) over the multi-valued joints, capped (a span may overflow)
+            for both, low, high in zip(multi_valued.tolist(), self.lower.tolist(), self.upper.tolist()):
                 if both:
-                    equivalents = min(equivalents * max(math.ceil(span / _TWO_PI), 1), COUNT_CAP)
+                    turns = (high - low) / _TWO_PI
+                    equivalents = (min(equivalents * max(math.ceil(turns), 1), COUNT_CAP) if turns < COUNT_CAP
+                                   else COUNT_CAP)
             return Widened(*arrays, every_multi_valued=bool(multi_valued.all()),
                            any_multi_valued=bool(multi_valued.any()),
                            one_turn_possible=bool((one_turn_low < one_turn_high).all()), rules=rules,

@@ -386,3 +386,20 @@ def test_limits_applied_to_many_robots_keep_a_few():
         robot = Robot([Joint("q1", "prismatic", 0.5 + index, 0.0, 0.0, 0.0, -1.0, 1.0)], name=f"slide {index}")
         assert limits.widened(robot).lower[0] == -1.0 - limits.tolerance(robot)[0]
         assert len(limits._applied) <= _limits._WIDENED_KEPT
+
+
+def test_limits_as_wide_as_floats_go_count_their_equivalents_capped():
+    """Bounds at the ends of the float range (their span overflows to infinity) widen, count the cap of
+    equivalents and give a value its turns, as the arrays do."""
+    from service.kinematics import COUNT_CAP
+    from service.kinematics._limits import turns_of_row
+
+    wide = arm(("revolute", -1.7e308, 1.7e308), ("revolute", -1e300, 1e300), ("revolute", -1.0, 1.0))
+    limits = Limits.of(wide)
+    bounds = limits.widened(wide)
+    assert bounds.equivalents_per_solution == COUNT_CAP
+    q = np.array([[0.5, -0.5, 0.25]])
+    first, last = turn_ranges(wide, limits, q)
+    got = turns_of_row(bounds, q[0].tolist())
+    assert got is not None and got[2]
+    assert got[0] == first[0].tolist() and got[1] == last[0].tolist()

@@ -79,14 +79,13 @@ NOTE_WORDING = {
                "'rejected' with their collisions.",
 }
 
-#: One target's answer without a reference or a collision filter, of up to this many rows and this many
-#: combinations in all, is selected row by row (:func:`_one_target`), where the array path's few dozen steps
-#: cost more than the arithmetic: a PUMA 560 with its catalogue limits has 8 … 40 combinations per pose, a UR5
-#: with ±2π about 512.
-_ONE_TARGET_ROWS, _ONE_TARGET_COMBINATIONS = 64, 4096
-#: A row's stream of combinations (:func:`_stream`) is kept for its turn ranges up to this length, for this many
-#: ranges (a ±2π arm's rows meet a few dozen; at most 6 MB).
-_KEPT_STREAM, _KEPT_STREAMS = 256, 512
+#: One target's answer without a reference or a collision filter, of up to this many rows, this many
+#: combinations in all and this many in a row, is selected row by row (:func:`_one_target`), where the array
+#: path's few dozen steps cost more than the arithmetic: a PUMA 560 with its catalogue limits has 8 … 40
+#: combinations per pose, a UR5 with ±2π about 512 (64 a row). A row's combinations in answer order are worked
+#: out once per turn ranges and kept (:func:`_stream`, for this many ranges: at most 6 MB); past these sizes the
+#: array path ranks only the combinations it keeps, and wins.
+_ONE_TARGET_ROWS, _ONE_TARGET_COMBINATIONS, _ROW_COMBINATIONS, _KEPT_STREAMS = 64, 1024, 256, 512
 #: Up to this many combinations in all, :func:`_in_turn` takes the rounds on Python lists (numpy's fixed costs
 #: outweigh the work).
 _FEW_IN_TURN = 64
@@ -518,9 +517,9 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
 def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limits: bool,
                 max_equivalents: int) -> Selection | None:
     """:func:`select` of one target's rows (``table``) without a reference or excluded rows, in a few steps on
-    Python floats and integers: the same selection, field by field. None where its rows have more than
-    :data:`_ONE_TARGET_COMBINATIONS` in all, or a value that is not finite meets a quotient (the array path then
-    selects them).
+    Python floats and integers: the same selection, field by field. None where its rows have more combinations
+    than :data:`_ONE_TARGET_COMBINATIONS` in all or :data:`_ROW_COMBINATIONS` in one, or a value that is not
+    finite meets a quotient (the array path then selects them).
 
     Every row that fits (or, with ``filter_limits`` false, every row) may be kept: each has its stream of
     combinations (one, at its closest equivalent, for a row that does not fit), and the streams take turns
@@ -557,7 +556,12 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
         candidates.append(row)  # kept, and flagged if it does not fit, at its closest equivalent
         firsts.append(first)
         lasts.append(last)
-        combinations += 1 if first == last else math.prod(int(high - low) + 1 for low, high in zip(first, last))
+        if first != last:
+            row_combinations = math.prod(int(high - low) + 1 for low, high in zip(first, last))
+            if row_combinations > _ROW_COMBINATIONS:
+                return None
+            combinations += row_combinations - 1
+        combinations += 1
         if combinations > _ONE_TARGET_COMBINATIONS:
             return None
     kept_of, turns = _in_turn(firsts, lasts, max_equivalents, n)
@@ -608,26 +612,17 @@ def _in_turn(firsts: list[list[float]], lasts: list[list[float]], limit: int, n:
 
 
 @functools.lru_cache(maxsize=_KEPT_STREAMS)
-def _kept_stream(first: tuple[float, ...], last: tuple[float, ...]) -> np.ndarray:
-    stream = _ranked_stream(first, last)
-    stream.flags.writeable = False
-    return stream
-
-
 def _stream(first: tuple[float, ...], last: tuple[float, ...]) -> np.ndarray:
     """One row's combinations (C, n), cheapest first: the turns k of each joint within [first, last], the
     combinations in order of Σ|k|, equal costs in the lexicographic order of their rank tuples, a joint's turns
     ranked by |k| and the lower first (:func:`._equivalents._ranked_turns` without a reference). A function of the
-    ranges alone, kept for the short streams (a ±2π arm's rows meet a few dozen ranges)."""
-    if math.prod(int(high - low) + 1 for low, high in zip(first, last)) <= _KEPT_STREAM:
-        return _kept_stream(first, last)
-    return _ranked_stream(first, last)
-
-
-def _ranked_stream(first: tuple[float, ...], last: tuple[float, ...]) -> np.ndarray:
+    ranges alone, kept (read-only): a ±2π arm's rows meet a few dozen ranges. Its callers' rows have at most
+    :data:`_ROW_COMBINATIONS`, which bounds what is kept."""
     ranked = [sorted(range(int(low), int(high) + 1), key=lambda k: (abs(k), k)) for low, high in zip(first, last)]
     combinations = sorted(itertools.product(*ranked), key=lambda turns: sum(map(abs, turns)))  # stable
-    return np.array(combinations, dtype=float).reshape(len(combinations), len(first))
+    stream = np.array(combinations, dtype=float).reshape(len(combinations), len(first))
+    stream.flags.writeable = False
+    return stream
 
 
 def _target_edges(target: np.ndarray, before: np.ndarray, bound: np.ndarray, edges: np.ndarray) -> np.ndarray:

@@ -169,8 +169,8 @@ def test_few_combinations_without_a_reference_come_in_the_general_paths_order(mo
 
 def test_in_turn_is_the_general_ranking_of_random_turn_ranges():
     """``_select._in_turn`` against ``_select._nearest`` on random rows: usable turns anywhere from −3 to +6
-    (0 inside, or every turn on one side), up to 4,096 combinations (a ±2π arm's 8 × 64 among them), any limit:
-    the same rows and values, bit for bit, with the rows' streams kept or not."""
+    (0 inside, or every turn on one side), up to 1,024 combinations and 256 a row, as the one-target selection
+    takes them (a ±2π arm's 8 × 64 among them), any limit: the same rows and values, bit for bit."""
     rng = np.random.default_rng(7)
     robot = CATALOGUE.get("puma560_standard").robot
     limits = Limits.of(robot)
@@ -183,7 +183,8 @@ def test_in_turn_is_the_general_ranking_of_random_turn_ranges():
         else:
             last = first + rng.choice([0, 0, 0, 1, 1, 2, 3], (rows, 6))
         counts = last - first + 1.0
-        if np.prod(counts, axis=1).sum() > 4096:
+        if np.prod(counts, axis=1).sum() > _select._ONE_TARGET_COMBINATIONS or (
+                np.prod(counts, axis=1).max() > _select._ROW_COMBINATIONS):
             continue
         q = rng.uniform(-np.pi, np.pi, (rows, 6))
         limit = int(rng.choice([rng.integers(1, 80), rng.integers(80, 2000)]))

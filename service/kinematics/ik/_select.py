@@ -83,8 +83,8 @@ NOTE_WORDING = {
 #: combinations in all and this many in a row, is selected row by row (:func:`_one_target`), where the array
 #: path's few dozen steps cost more than the arithmetic: a PUMA 560 with its catalogue limits has 8 … 40
 #: combinations per pose, a UR5 with ±2π about 512 (64 a row). A row's combinations in answer order are worked
-#: out once per turn ranges and kept (:func:`_stream`, for this many ranges: at most 6 MB); past these sizes the
-#: array path ranks only the combinations it keeps, and wins.
+#: out once per turn ranges and kept (:func:`_stream`, for this many ranges: at most 512 × 256 rows of n floats,
+#: 6 MB for six joints); past these sizes the array path ranks only the combinations it keeps, and wins.
 _ONE_TARGET_ROWS, _ONE_TARGET_COMBINATIONS, _ROW_COMBINATIONS, _KEPT_STREAMS = 64, 1024, 256, 512
 #: Up to this many combinations in all, :func:`_in_turn` takes the rounds on Python lists (numpy's fixed costs
 #: outweigh the work).

@@ -21,20 +21,12 @@ from ..collision import Contacts
 from ._types import LabelCodes
 
 
-#: Up to this many rows (one target's answer, say), :meth:`SolutionTable.branches` builds each row's dict on its
-#: own: for 8 rows a third of the time of keying them by their codes (the two cost the same at about 128 rows).
-_ROWS_OF_ONE_TARGET = 64
-
-#: Up to this many rows, :meth:`SolutionTable.branches` keys the rows by their codes in Python (the two ways
-#: cost about the same at 300 rows).
-_FEW_ROWS = 256
-
-
 @functools.lru_cache(maxsize=64)
 def branch_labels(names: tuple[str, ...], values: tuple[tuple[str, ...], ...]) -> Mapping[tuple[int, ...], dict]:
-    """Every branch a family's labels can word: codes (a tuple, one per name of ``names``, −1 where the label is
-    left out) → its dict, name → label (``values`` per name). A family has a few names of two values each, so the
-    combinations are few; the dicts are shared, read-only by convention (a caller copies the one it hands out)."""
+    """Every branch labels can word: codes (a tuple, one per name of ``names``, −1 where the label is left out) →
+    its dict, name → label (``values`` per name). A family has a few names of two values each, and a table merges
+    its parts' vocabularies, so the combinations are few (27 for a shoulder, an elbow and a wrist); the dicts are
+    shared, read-only by convention (a caller copies the one it hands out). The one place labels are worded."""
     choices = [range(-1, len(labels)) for labels in values]
     return {codes: {name: labels[code] for name, labels, code in zip(names, values, codes) if code >= 0}
             for codes in itertools.product(*choices)}
@@ -146,37 +138,21 @@ class SolutionTable:
         return table
 
     def branches(self, *, own: bool = False) -> list[dict]:
-        """Each row's branch labels as a dict, name → label (a name left out where the row's code is −1). Rows
-        with the same codes may share one dict (read-only by convention): an answer has a handful of distinct
-        branches among thousands of rows. With ``own``, each row has a dict of its own (the caller's to keep)."""
+        """Each row's branch labels as a dict, name → label (a name left out where the row's code is −1), worded
+        once per combination of codes (:func:`branch_labels`). Rows with the same codes share one dict (read-only
+        by convention): an answer has a handful of distinct branches among thousands of rows. With ``own``, each
+        row has a dict of its own (the caller's to keep)."""
         if not self.labels or not len(self.target):
             if own:
                 return [{} for _ in range(len(self.target))]
             empty: dict = {}
             return [empty] * len(self.target)
-        if len(self.target) <= _ROWS_OF_ONE_TARGET:  # a dict per row, filled a column at a time
-            branches: list[dict] = [{} for _ in range(len(self.target))]
-            for name, (values, codes) in self.labels.items():
-                for branch, code in zip(branches, codes.tolist()):
-                    if code >= 0:
-                        branch[name] = values[code]
-            return branches
-        names = list(self.labels)
-        columns = [self.labels[name][1] for name in names]
-        if len(self.target) <= _FEW_ROWS:  # each row's codes as its key (numpy's fixed cost would dominate)
-            keys = list(zip(*(column.tolist() for column in columns)))
-            codes_of = dict(zip(keys, keys))
-        else:  # each row's codes as one integer, the distinct ones worded from their first rows
-            codes = np.stack(columns, axis=1).astype(np.int64) + 1  # (S, L), 0 = none
-            key_column = codes @ (int(codes.max()) + 1) ** np.arange(len(names), dtype=np.int64)
-            distinct, first = np.unique(key_column, return_index=True)
-            keys = key_column.tolist()
-            codes_of = dict(zip(distinct.tolist(), (codes[first] - 1).tolist()))
-        shared = {key: {name: self.labels[name][0][code] for name, code in zip(names, row) if code >= 0}
-                  for key, row in codes_of.items()}
+        names = tuple(self.labels)
+        by_codes = branch_labels(names, tuple(tuple(self.labels[name][0]) for name in names))
+        keys = zip(*(self.labels[name][1].tolist() for name in names))  # each row's codes
         if own:
-            return [dict(shared[key]) for key in keys]
-        return list(map(shared.__getitem__, keys))
+            return [by_codes[key].copy() for key in keys]
+        return list(map(by_codes.__getitem__, keys))
 
     def bounds(self, n_targets: int) -> tuple[np.ndarray, np.ndarray]:
         """Each target's rows as [start, stop), shape (N,) each."""

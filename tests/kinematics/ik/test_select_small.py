@@ -108,7 +108,7 @@ def _select_both(robot, target, options, rng, monkeypatch):
 @pytest.fixture
 def calls(monkeypatch):
     """Counts of the selection's few-rows and general forms, as the cases call them."""
-    counted = {"few rows": 0, "general": 0, "each once": 0, "few in turn": 0, "one target": 0}
+    counted = {"few rows": 0, "general": 0, "few in turn": 0, "one target": 0}
 
     def counting(function, key):
         def wrapper(*args, **kwargs):
@@ -118,7 +118,6 @@ def calls(monkeypatch):
 
     monkeypatch.setattr(_equivalents, "_row_rank_tuples", counting(_equivalents._row_rank_tuples, "few rows"))
     monkeypatch.setattr(_equivalents, "_tabled_turns", counting(_equivalents._tabled_turns, "general"))
-    monkeypatch.setattr(_select, "_each_once", counting(_select._each_once, "each once"))
     monkeypatch.setattr(_select, "_in_turn", counting(_select._in_turn, "few in turn"))
 
     selects_one_target = _select._one_target
@@ -174,6 +173,7 @@ def test_in_turn_is_the_general_ranking_of_random_turn_ranges():
     rng = np.random.default_rng(7)
     robot = CATALOGUE.get("puma560_standard").robot
     limits = Limits.of(robot)
+    ways = {"lists": 0, "stacked": 0, "lexsort": 0}  # how _in_turn takes the rounds, by the rows' sizes
     for case in range(300):
         rows = int(rng.integers(1, 9))
         first = rng.integers(-3, 3, (rows, 6)).astype(float)
@@ -183,20 +183,22 @@ def test_in_turn_is_the_general_ranking_of_random_turn_ranges():
         else:
             last = first + rng.choice([0, 0, 0, 1, 1, 2, 3], (rows, 6))
         counts = last - first + 1.0
-        if np.prod(counts, axis=1).sum() > _select._ONE_TARGET_COMBINATIONS or (
-                np.prod(counts, axis=1).max() > _select._ROW_COMBINATIONS):
+        sizes = np.prod(counts, axis=1)
+        if sizes.sum() > _select._ONE_TARGET_COMBINATIONS or sizes.max() > _select._ROW_COMBINATIONS:
             continue
+        ways["lists" if sizes.sum() <= _select._FEW_IN_TURN else "stacked" if sizes.min() == sizes.max()
+             else "lexsort"] += not (first == last).all()
         q = rng.uniform(-np.pi, np.pi, (rows, 6))
         limit = int(rng.choice([rng.integers(1, 80), rng.integers(80, 2000)]))
         target = np.zeros(rows, dtype=np.int64)
-        combinations = np.prod(counts, axis=1).astype(np.int64)
-        row_limit = _equivalents.rounds_needed(target, combinations, 1, limit)[target]
+        row_limit = _equivalents.rounds_needed(target, sizes.astype(np.int64), 1, limit)[target]
         expected = _select._nearest(robot, limits, target, q, first, last, counts, row_limit, limit, None, Ordering(),
                                     UNLIMITED)
         rows_kept, turns = _select._in_turn(first.tolist(), last.tolist(), limit, 6)
         assert rows_kept.tolist() == expected[0].tolist(), case
         values = turns * TWO_PI + q[rows_kept]  # as _select._one_target lists them
         assert values.tobytes() == expected[1].tobytes(), case
+    assert min(ways.values()) > 30, ways
 
 
 def test_joint_exactly_at_its_limits_and_reference_between_equivalents(monkeypatch):

@@ -12,7 +12,6 @@ from service.kinematics.ik import (AnswerOptions, IKResult, IKTargets, answer_ik
                                    solve_ik_batch, unlimited)
 from service.kinematics.ik import _solve
 from service.kinematics.ik._solve import _closed_form_result
-from service.kinematics.ik._table import _FEW_ROWS
 from service.robots.catalogue import load_catalogue
 from tests.arms import random_family_arm, random_three_parallel_arm
 from tests.ik_helpers import mixed_poses
@@ -94,9 +93,9 @@ def test_records_of_a_batch_are_each_targets_record():
     assert {record.status for record in every} == {"ok", "unreachable"}
 
 
-@pytest.mark.parametrize("rows", [1, 7, _FEW_ROWS, _FEW_ROWS + 1, 500])
+@pytest.mark.parametrize("rows", [1, 7, 256, 257, 500])
 def test_branches_word_each_rows_labels_on_both_sides_of_the_few_rows_path(rows):
-    """SolutionTable.branches keys a few rows by their code tuples and many by one integer: either way each row's
+    """SolutionTable.branches (a few rows, hundreds, the sizes its former few-rows path switched at): each row's
     dict names exactly its labels whose code is not −1; with ``own`` each row's dict is its own object."""
     from service.kinematics.ik._table import SolutionTable
     rng = np.random.default_rng(rows)

@@ -13,7 +13,6 @@ Counts that can grow combinatorially (the 2π-equivalents of a multi-turn arm) a
 
 from __future__ import annotations
 
-import threading
 import time
 from typing import Callable, Iterable
 
@@ -34,6 +33,17 @@ class BudgetExhausted(Exception):
             f"ran past its deadline of {timeout_seconds * 1000.0:g} ms" if timeout_seconds is not None
             else "ran past its deadline")
         super().__init__(f"The request {what} during {stage}.")
+
+
+class _Cancellation:
+    """A request's cancellation flag, shared by its budget and the budgets of its parts (:meth:`Budget.within`). Set
+    by the server's event loop, read by the thread doing the work: a plain attribute, whose write the reading thread
+    sees at its next check (no lock: nothing waits on the flag)."""
+
+    __slots__ = ("is_set",)
+
+    def __init__(self) -> None:
+        self.is_set = False
 
 
 class Budget:
@@ -58,17 +68,17 @@ class Budget:
                  between_chunks: Callable[[], None] | None = None) -> None:
         self.timeout_seconds = timeout_seconds
         self.deadline = None if timeout_seconds is None else time.monotonic() + timeout_seconds
-        self._cancelled = threading.Event()
+        self._cancelled = _Cancellation()
         #: called at every check, before it: a server lets the requests waiting for a core take their turn there
         self.between_chunks = between_chunks
 
     def cancel(self) -> None:
         """Stop the work at its next check (thread-safe: called from the server's event loop)."""
-        self._cancelled.set()
+        self._cancelled.is_set = True
 
     @property
     def cancelled(self) -> bool:
-        return self._cancelled.is_set()
+        return self._cancelled.is_set
 
     def expired(self) -> bool:
         return self.deadline is not None and time.monotonic() > self.deadline
@@ -89,7 +99,7 @@ class Budget:
         """Raise :class:`BudgetExhausted` when cancelled or past the deadline; ``stage`` names the work."""
         if self.between_chunks is not None:
             self.between_chunks()
-        if self._cancelled.is_set():
+        if self._cancelled.is_set:
             raise BudgetExhausted("cancelled", stage, self.timeout_seconds)
         if self.deadline is not None and time.monotonic() > self.deadline:
             raise BudgetExhausted("deadline", stage, self.timeout_seconds)

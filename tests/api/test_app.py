@@ -4,6 +4,7 @@ thread, /healthz included. What start-up built is frozen out of the passes, and 
 from __future__ import annotations
 
 import gc
+import re
 
 from fastapi.testclient import TestClient
 
@@ -26,3 +27,19 @@ def test_start_up_objects_are_left_out_of_the_passes_and_given_back_at_shutdown(
         robot = client.app.state.catalogue.get("puma560_standard").robot
         assert not any(o is robot for o in gc.get_objects())
     assert gc.get_freeze_count() == 0 and gc.get_threshold() == thresholds
+
+
+def test_no_path_of_one_router_is_matched_by_another_routers_route():
+    """The app tries its routers in :data:`~service.api.app._MATCHING_ORDER` (the routes most requests take first),
+    not in the document's order: that changes no answer only while no route of one router matches a path of
+    another's. Each route's path, its parameters filled in, is matched against every other router's routes."""
+    from service.api.app import _DOCUMENTED_ORDER, _MATCHING_ORDER
+
+    assert set(_MATCHING_ORDER) == set(_DOCUMENTED_ORDER)
+    for module in _MATCHING_ORDER:
+        for route in module.router.routes:
+            concrete = re.sub(r"\{[^}]+\}", "x", route.path)
+            assert route.path_regex.match(concrete)  # the filled-in path is one its own route takes
+            for other in _MATCHING_ORDER:
+                if other is not module:
+                    assert not [r.path for r in other.router.routes if r.path_regex.match(concrete)], route.path

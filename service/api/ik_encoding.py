@@ -63,24 +63,27 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
             violations.setdefault(k, []).append({"joint": j, "value": joints[k][j], "lower": lower[j],
                                                  "upper": upper[j]})
     targets = table.target.tolist()
-    per_target: list[list[dict]] = [[] for _ in free_of_target]
-    any_free = any(free_of_target)
-    for k, target in enumerate(targets):
-        per_target[target].append({
-            "joints": joints[k], "branch": branches[k],
-            "within_limits": within[k], "violations": violations.get(k, []),
-            "residual": {"position": position[k], "orientation": orientation[k]},
-            "free_values": {str(j): joints[k][j] for j in free_of_target[target]} if any_free else {}})
-    if table.roll is not None:
-        for solution, roll in zip((s for rows in per_target for s in rows), _rolls(table, angle)):
-            if roll is not None:
-                solution["free_values"]["roll"] = roll
+    row_violations = [violations.get(k, ()) for k in range(len(targets))] if violations else [()] * len(targets)
+    if any(free_of_target) or table.roll is not None:
+        free_values = [{str(j): q[j] for j in free_of_target[target]} for q, target in zip(joints, targets)]
+        if table.roll is not None:
+            for free, roll in zip(free_values, _rolls(table, angle)):
+                if roll is not None:
+                    free["roll"] = roll
+    else:
+        free_values = [{}] * len(targets)  # one empty dict, read-only as the branches' dicts are
+    solutions = [{"joints": q, "branch": branch, "within_limits": fits, "violations": violated,
+                  "residual": {"position": position_error, "orientation": orientation_error}, "free_values": free}
+                 for q, branch, fits, violated, position_error, orientation_error, free
+                 in zip(joints, branches, within, row_violations, position, orientation, free_values)]
     if table.clearance is not None:
-        for solution, clearance, contacts in zip((s for rows in per_target for s in rows),
-                                                 _listed(table.clearance, np.isinf),
-                                                 _contacts(table)):
+        for solution, clearance, contacts in zip(solutions, _listed(table.clearance, np.isinf), _contacts(table)):
             solution["clearance"], solution["collisions"] = clearance, contacts
-    return per_target
+    if len(free_of_target) == 1:
+        return [solutions]
+    # the table is grouped by target: each target's solutions are one slice
+    ends = np.cumsum(table.counts(len(free_of_target))).tolist()
+    return [solutions[start:end] for start, end in zip([0, *ends[:-1]], ends)]
 
 
 def _rolls(table: SolutionTable, angle: float) -> list[float | None]:
@@ -101,7 +104,10 @@ def _nulled(values: np.ndarray, missing: np.ufunc) -> np.ndarray | list[float | 
 
 def _with_none(values: np.ndarray, gaps: np.ndarray) -> list[float | None]:
     """``values`` (S,) as a list, None where ``gaps`` (S,) is true."""
-    return [None if gap else value for value, gap in zip(values.tolist(), gaps.tolist())]
+    gaps = gaps.tolist()
+    if True not in gaps:  # the usual column: as it stands
+        return values.tolist()
+    return [None if gap else value for value, gap in zip(values.tolist(), gaps)]
 
 
 def _contacts(table: SolutionTable) -> list[Sequence[dict]]:

@@ -22,11 +22,13 @@ from ._types import LabelCodes
 
 
 @functools.lru_cache(maxsize=64)
+@functools.lru_cache(maxsize=64)
 def branch_labels(names: tuple[str, ...], values: tuple[tuple[str, ...], ...]) -> Mapping[tuple[int, ...], dict]:
     """Every branch labels can word: codes (a tuple, one per name of ``names``, −1 where the label is left out) →
     its dict, name → label (``values`` per name). A family has a few names of two values each, and a table merges
     its parts' vocabularies, so the combinations are few (27 for a shoulder, an elbow and a wrist); the dicts are
-    shared, read-only by convention (a caller copies the one it hands out). The one place labels are worded."""
+    shared, read-only by convention (a caller copies the one it hands out), and kept for the next answer of the
+    same vocabularies (a few dozen of them at most). The one place labels are worded."""
     choices = [range(-1, len(labels)) for labels in values]
     return {codes: {name: labels[code] for name, labels, code in zip(names, values, codes) if code >= 0}
             for codes in itertools.product(*choices)}

@@ -47,6 +47,7 @@ def equivalents_per_solution(robot: Robot, limits: Limits) -> int:
     return limits.widened(robot).equivalents_per_solution  # worked out once per limits, with them
 
 
+@functools.lru_cache(maxsize=1024)  # a few arms' counts and limits: the same three integers per request
 def worst_answer_per_target(solutions: int, equivalents: int, kept: int) -> tuple[int, int]:
     """The most rows (kept plus rejected) one target's answer can hold, and how many of them are then rejected.
 

@@ -13,6 +13,10 @@ bodies go in through a Lua script):
   server as the framework's ceiling, each as a share of it;
 * the same single IK against two worker processes (``KIN_WORKERS=2``), for the
   scale-out ratio;
+* these rows run at ``KIN_LOG_LEVEL=warning``, with no access log; ``/healthz``,
+  the FK and the PUMA's single IK then run again at the default level (``info``:
+  one JSON access line per request, written to a file as a container's log
+  driver writes it), for what a default deployment pays per request;
 * poses/s for one IK batch of N targets (``format: arrays``, and the default
   objects form for comparison), against the core's own time for the same batch
   measured in this process (``solve_ik_arrays``);
@@ -56,6 +60,8 @@ ROOT = Path(__file__).resolve().parent.parent
 ROBOT = "puma560_standard"
 #: single-pose IK rows: the PUMA and UR5 families and one of the offset-shoulder (OPW) arms
 SINGLE_IK_ROBOTS = ("puma560_standard", "ur5", "kuka_kr6_r900_2")
+#: the rows run at the default log level, an access line per request
+INFO = "KIN_LOG_LEVEL=info (the default)"
 
 
 @dataclass
@@ -73,12 +79,19 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def start_server(port: int, max_batch: int, max_body: int, workers: int = 1) -> subprocess.Popen:
-    env = {**os.environ, "HOST": "127.0.0.1", "PORT": str(port), "KIN_LOG_LEVEL": "warning",
+def start_server(port: int, max_batch: int, max_body: int, workers: int = 1, log_level: str = "warning",
+                 log_file: Path | None = None) -> subprocess.Popen:
+    """``python -m service`` on ``port``; ``log_level`` ``warning`` writes no access lines, ``info`` (the default of
+    a deployment) one per request, to ``log_file`` (stdout as it is when None)."""
+    env = {**os.environ, "HOST": "127.0.0.1", "PORT": str(port), "KIN_LOG_LEVEL": log_level,
            "KIN_WORKERS": str(workers), "KIN_MAX_BATCH": str(max_batch), "KIN_MAX_BODY_BYTES": str(max_body),
            "KIN_REQUEST_TIMEOUT_MS": "300000"}  # a reachability-study batch may take longer than the default 5 s
     env.pop("PROMETHEUS_MULTIPROC_DIR", None)
-    server = subprocess.Popen([sys.executable, "-m", "service"], cwd=ROOT, env=env, start_new_session=True)
+    stdout = None if log_file is None else log_file.open("wb")
+    server = subprocess.Popen([sys.executable, "-m", "service"], cwd=ROOT, env=env, start_new_session=True,
+                              stdout=stdout)
+    if stdout is not None:
+        stdout.close()  # the server holds its own descriptor
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:
         try:
@@ -216,19 +229,35 @@ def main(argv: list[str] | None = None) -> int:
                                   f"http://127.0.0.1:{port}/v1/robots/{ROBOT}/ik", scripts[f"ik_{ROBOT}"], **single)
         finally:
             stop_server(server)
+        # the default log level (info): one JSON access line per request, written to a file as a container
+        # runtime's log driver writes it; the rows above run at warning, without it
+        port = free_port()
+        server = start_server(port, max_batch=10_000, max_body=max_body, log_level="info",
+                              log_file=folder / "access.log")
+        base = f"http://127.0.0.1:{port}"
+        try:
+            logged = [run_wrk(f"GET /healthz, {INFO}", f"{base}/healthz", scripts["healthz"], **single),
+                      run_wrk(f"POST fk, one configuration, {INFO}", f"{base}/v1/robots/{ROBOT}/fk", scripts["fk"],
+                              **single),
+                      run_wrk(f"POST ik, one pose, {ROBOT}, {INFO}", f"{base}/v1/robots/{ROBOT}/ik",
+                              scripts[f"ik_{ROBOT}"], **single)]
+        finally:
+            stop_server(server)
     loads.append(two_workers)
+    loads += logged
 
     print(f"machine: {machine()}")
-    print(f"server: python -m service (uvicorn, 1 worker unless said) on 127.0.0.1; wrk 1 thread on the same machine, "
+    print(f"server: python -m service (uvicorn, 1 worker unless said; KIN_LOG_LEVEL=warning unless said) on "
+          f"127.0.0.1; wrk 1 thread on the same machine, "
           f"{args.connections} connections for the single calls, 1 for the batches; {args.seconds:g} s per run; "
           f"batches on {ROBOT}\n")
-    ceiling = loads[0]
-    print("| endpoint | requests/s | share of /healthz | p50 ms | p99 ms | requests | poses/s |")
+    ceiling, ceiling_logged = loads[0], loads[-3]
+    print("| endpoint | requests/s | share of /healthz (same log level) | p50 ms | p99 ms | requests | poses/s |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for load in loads:
         poses = load.requests_per_second * args.batch if "batch" in load.name else None
-        print(f"| {load.name} | {load.requests_per_second:,.1f} | "
-              f"{load.requests_per_second / ceiling.requests_per_second:.2f} | {load.p50_ms:.2f} | "
+        share = load.requests_per_second / (ceiling_logged if INFO in load.name else ceiling).requests_per_second
+        print(f"| {load.name} | {load.requests_per_second:,.1f} | {share:.2f} | {load.p50_ms:.2f} | "
               f"{load.p99_ms:.2f} | {load.requests:,} | {'' if poses is None else f'{poses:,.0f}'} |")
     print(f"| core solve_ik_arrays, same {args.batch:,} targets, in process | {1 / core:,.1f} | | "
           f"{core * 1e3:.2f} | | | {args.batch / core:,.0f} |")
@@ -261,6 +290,14 @@ def main(argv: list[str] | None = None) -> int:
     matrices = by_name[f"POST ik/batch, {args.batch:,} targets, targets as matrix rows, format arrays"]
     print(f"- {args.batch:,}-target batch over HTTP (targets as matrix rows, arrays form, p50) / core batch time: "
           f"{(matrices.p50_ms / 1e3) / core:.2f}")
+    healthz_logged = by_name[f"GET /healthz, {INFO}"]
+    fk_logged = by_name[f"POST fk, one configuration, {INFO}"]
+    ik_logged = by_name[f"POST ik, one pose, {ROBOT}, {INFO}"]
+    print(f"- the access line of the default log level, per request (1 / requests/s at info - 1 / requests/s at "
+          f"warning): /healthz {_per_request_us(healthz_logged, ceiling):.0f} µs, FK "
+          f"{_per_request_us(fk_logged, fk):.0f} µs, single IK {_per_request_us(ik_logged, ik):.0f} µs; at info, "
+          f"FK / /healthz {fk_logged.requests_per_second / healthz_logged.requests_per_second:.2f}, single IK / "
+          f"/healthz {ik_logged.requests_per_second / healthz_logged.requests_per_second:.2f}")
     if eaik is None:
         print("- EAIK is not installed (pip install -e '.[bench]'): the limits-on batch has no anchor in this run")
     else:
@@ -269,6 +306,11 @@ def main(argv: list[str] | None = None) -> int:
         goal(f"{args.batch:,}-target batch over HTTP, targets as matrix rows, arrays form (p50) / EAIK's batched "
              f"in-process solve, per pose", (matrices.p50_ms / 1e3) / eaik, 8, at_least=False)
     return 0
+
+
+def _per_request_us(logged: Load, quiet: Load) -> float:
+    """What one request pays more at one rate than at the other, in µs (wrk's 16 connections on 2 cores)."""
+    return (1.0 / logged.requests_per_second - 1.0 / quiet.requests_per_second) * 1e6
 
 
 def _eaik_batch_seconds(robot, T: np.ndarray) -> float | None:

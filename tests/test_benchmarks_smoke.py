@@ -82,6 +82,9 @@ def test_http_benchmark_runs_with_tiny_sizes(capsys):
                 "POST ik, one pose, puma560_standard, 2 workers"):
         assert f"| {row} |" in out
     assert "targets, format arrays, catalogue limits |" in out
+    for row in ("GET /healthz", "POST fk, one configuration", "POST ik, one pose, puma560_standard"):
+        assert f"| {row}, KIN_LOG_LEVEL=info (the default) |" in out
+    assert "- the access line of the default log level, per request" in out
 
 
 def test_http_benchmark_says_when_wrk_is_missing(capsys, monkeypatch):

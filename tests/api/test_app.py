@@ -31,10 +31,11 @@ def test_start_up_objects_are_left_out_of_the_passes_and_given_back_at_shutdown(
 
 
 def test_a_single_answer_of_hundreds_of_solutions_is_built_between_young_passes():
-    """A UR5 pose under its ±2π limits lists hundreds of solutions (512 here), built as a few thousand short-lived dicts and
-    lists: with the interpreter's young threshold (700) the collector passed over them twice a request, walking
-    objects that were all about to go. With :data:`COLLECTOR_THRESHOLDS` a request nets fewer allocations than one
-    young pass waits for, so passes are rare (counted here over 20 requests, after the app's start-up freeze)."""
+    """A UR5 pose under its ±2π limits lists hundreds of solutions (512 here), built as a few thousand short-lived
+    dicts and lists: with the interpreter's young threshold (700) the collector passed over them twice a request,
+    walking objects that were all about to go. With :data:`COLLECTOR_THRESHOLDS` a request nets fewer allocations
+    than one young pass waits for, so passes are rare (counted here over 20 requests, after the app's start-up
+    freeze)."""
     passes = []
 
     def count(phase: str, info: dict) -> None:

@@ -141,9 +141,10 @@ class SolutionTable:
 
     def branches(self, *, own: bool = False) -> list[dict]:
         """Each row's branch labels as a dict, name → label (a name left out where the row's code is −1), worded
-        once per combination of codes (:func:`branch_labels`). Rows with the same codes share one dict (read-only
-        by convention): an answer has a handful of distinct branches among thousands of rows. With ``own``, each
-        row has a dict of its own (the caller's to keep)."""
+        once per combination of codes (:func:`branch_labels`). Rows with the same codes, in this table and in
+        others of the same vocabularies, share one dict (read-only by convention): an answer has a handful of
+        distinct branches among thousands of rows. With ``own``, each row has a dict of its own (the caller's to
+        keep)."""
         if not self.labels or not len(self.target):
             if own:
                 return [{} for _ in range(len(self.target))]

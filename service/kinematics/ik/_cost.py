@@ -25,8 +25,10 @@ from ._free_search import EXTRA_VALUES_WITH_REFERENCE
 from ._redundant import family_for, free_joints_for, grid_size
 
 #: The most rows a single-target answer may hold for its work to count as small (:attr:`Cost.small`): a
-#: closed-form solve, a selection and an encoding of a few milliseconds at most.
-SMALL_ROWS = 64
+#: closed-form solve, a selection and an encoding of a few milliseconds at most. 512 is a 6-joint arm's eight
+#: solutions under limits of two turns a joint (the UR arms' ±2π): such a whole request takes about 1.2 ms where it
+#: arrives, and the hand-over to a work loop would add about 200 µs to it.
+SMALL_ROWS = 512
 
 #: The most pair distances (distinct solutions × shape pairs) a collision check may measure for its work to count
 #: as small: a few hundred microseconds, every pair measured at once (a single PUMA pose with its catalogue

@@ -22,7 +22,6 @@ from ._types import LabelCodes
 
 
 @functools.lru_cache(maxsize=64)
-@functools.lru_cache(maxsize=64)
 def branch_labels(names: tuple[str, ...], values: tuple[tuple[str, ...], ...]) -> Mapping[tuple[int, ...], dict]:
     """Every branch labels can word: codes (a tuple, one per name of ``names``, −1 where the label is left out) →
     its dict, name → label (``values`` per name). A family has a few names of two values each, and a table merges

@@ -29,7 +29,6 @@ def test_start_up_objects_are_left_out_of_the_passes_and_given_back_at_shutdown(
     assert gc.get_freeze_count() == 0 and gc.get_threshold() == thresholds
 
 
-
 def test_a_single_answer_of_hundreds_of_solutions_is_built_between_young_passes():
     """A UR5 pose under its ±2π limits lists hundreds of solutions (512 here), built as a few thousand short-lived
     dicts and lists: with the interpreter's young threshold (700) the collector passed over them twice a request,
@@ -54,6 +53,7 @@ def test_a_single_answer_of_hundreds_of_solutions_is_built_between_young_passes(
         finally:
             gc.callbacks.remove(count)
     assert len(passes) <= 5, passes  # 40 with the thresholds (700, 10, 100)
+
 
 def test_no_path_of_one_router_is_matched_by_another_routers_route():
     """The app tries its routers in :data:`~service.api.app._MATCHING_ORDER` (the routes most requests take first),

@@ -119,7 +119,6 @@ def test_work_that_is_not_small_is_handed_over_before_it_starts(client, where):
     assert where == ["work", "work"]
 
 
-
 def test_a_single_ik_of_two_turns_a_joint_runs_where_it_arrives(fresh, where):
     """A UR5's catalogue limits (±2π on every joint) give up to 8 × 2⁶ = 512 rows: about a millisecond where the
     request arrives, where the hand-over would add about 200 µs. Up to 1,024 (±4π, above) goes to a work loop."""
@@ -130,6 +129,7 @@ def test_a_single_ik_of_two_turns_a_joint_runs_where_it_arrives(fresh, where):
     assert first.status_code == second.status_code == 200
     assert first.json() == second.json() and len(second.json()["solutions"]) > 64
     assert where == ["work", "here"]  # the first derives the UR5's plan
+
 
 def test_a_numeric_arm_and_a_new_inline_robot_are_handed_over(client, where, hand_overs):
     rows = [{"a": 0.1 * (i + 1), "alpha": 0.3 * (i + 1), "d": 0.05 * i, "theta": 0.0} for i in range(6)]

@@ -251,12 +251,13 @@ def main(argv: list[str] | None = None) -> int:
           f"127.0.0.1; wrk 1 thread on the same machine, "
           f"{args.connections} connections for the single calls, 1 for the batches; {args.seconds:g} s per run; "
           f"batches on {ROBOT}\n")
-    ceiling, ceiling_logged = loads[0], loads[-3]
+    ceiling = loads[0]
+    healthz_logged, fk_logged, ik_logged = logged  # /healthz, FK and the single IK at info
     print("| endpoint | requests/s | share of /healthz (same log level) | p50 ms | p99 ms | requests | poses/s |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for load in loads:
         poses = load.requests_per_second * args.batch if "batch" in load.name else None
-        share = load.requests_per_second / (ceiling_logged if INFO in load.name else ceiling).requests_per_second
+        share = load.requests_per_second / (healthz_logged if INFO in load.name else ceiling).requests_per_second
         print(f"| {load.name} | {load.requests_per_second:,.1f} | {share:.2f} | {load.p50_ms:.2f} | "
               f"{load.p99_ms:.2f} | {load.requests:,} | {'' if poses is None else f'{poses:,.0f}'} |")
     print(f"| core solve_ik_arrays, same {args.batch:,} targets, in process | {1 / core:,.1f} | | "
@@ -290,9 +291,6 @@ def main(argv: list[str] | None = None) -> int:
     matrices = by_name[f"POST ik/batch, {args.batch:,} targets, targets as matrix rows, format arrays"]
     print(f"- {args.batch:,}-target batch over HTTP (targets as matrix rows, arrays form, p50) / core batch time: "
           f"{(matrices.p50_ms / 1e3) / core:.2f}")
-    healthz_logged = by_name[f"GET /healthz, {INFO}"]
-    fk_logged = by_name[f"POST fk, one configuration, {INFO}"]
-    ik_logged = by_name[f"POST ik, one pose, {ROBOT}, {INFO}"]
     print(f"- the access line of the default log level, per request (1 / requests/s at info - 1 / requests/s at "
           f"warning): /healthz {_per_request_us(healthz_logged, ceiling):.0f} µs, FK "
           f"{_per_request_us(fk_logged, fk):.0f} µs, single IK {_per_request_us(ik_logged, ik):.0f} µs; at info, "

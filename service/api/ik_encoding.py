@@ -104,10 +104,10 @@ def _nulled(values: np.ndarray, missing: np.ufunc) -> np.ndarray | list[float | 
 
 def _with_none(values: np.ndarray, gaps: np.ndarray) -> list[float | None]:
     """``values`` (S,) as a list, None where ``gaps`` (S,) is true."""
-    gaps = gaps.tolist()
-    if True not in gaps:  # the usual column: as it stands
+    gap_list = gaps.tolist()
+    if True not in gap_list:  # the usual column: as it stands
         return values.tolist()
-    return [None if gap else value for value, gap in zip(values.tolist(), gaps)]
+    return [None if gap else value for value, gap in zip(values.tolist(), gap_list)]
 
 
 def _contacts(table: SolutionTable) -> list[Sequence[dict]]:

@@ -10,7 +10,8 @@ frame n is the flange (see :meth:`Robot.from_screws`).
 Every function takes joint values ``q`` with shape (n,) or a batch (N, n) and
 vectorises over N: there is no Python loop over configurations. The one
 exception is :func:`tool_columns_scalar_rows`, the same chain on a few joint
-vectors in plain floats, for which array operations cost more than they save.
+vectors in plain floats, for which array operations cost more than they save
+(:func:`forward_kinematics` of up to :data:`SCALAR_ROWS` rows takes it).
 """
 
 from __future__ import annotations
@@ -139,9 +140,12 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> np.ndarray:
     [1.36762, 0.38009]
     """
     q = np.asarray(q, dtype=float)
-    if q.ndim == 1:
-        return _tool_matrix(robot, q.tolist())
-    x, y, z, p = tool_columns(robot, q.reshape(-1, q.shape[-1]))
+    rows = q.reshape(-1, q.shape[-1])
+    if len(rows) <= SCALAR_ROWS:
+        world_T_tool = _tool_matrices(robot, rows.tolist())
+        if world_T_tool is not None:
+            return world_T_tool.reshape(q.shape[:-1] + (4, 4))
+    x, y, z, p = tool_columns(robot, rows)
     world_T_tool = np.empty((x.shape[1], 4, 4))
     for column, values in enumerate((x, y, z, p)):
         world_T_tool[:, :3, column] = values.T
@@ -193,7 +197,7 @@ class ChainProgram(NamedTuple):
     y and z columns, and a translation adds multiples of its columns to the
     position; terms that are zero for this robot (a = 0, d = 0, α = 0, an
     identity tool) are left out. :func:`tool_columns` runs it on a batch,
-    :func:`tool_columns_scalar` on one joint vector: the same operations.
+    :func:`tool_columns_scalar_rows` on a few joint vectors: the same operations.
     """
 
     start: tuple[float, ...]  # world_T_base (· F_0 for a screws robot's tool program): columns x, y, z, p
@@ -356,12 +360,6 @@ def _run(program: ChainProgram, qt: np.ndarray, frame_ends: tuple[int, ...], tri
 _IDENTITY = np.eye(4)
 
 
-def tool_columns_scalar(robot: Robot, q: list[float]) -> tuple[tuple[float, float, float], ...]:
-    """:func:`tool_columns` for one joint vector (a list of floats), in scalar arithmetic: the columns x, y, z, p
-    of ``world_T_tool`` as tuples of three floats (:func:`tool_columns_scalar_rows` of one row)."""
-    return tool_columns_scalar_rows(robot, [q])[0]
-
-
 def tool_columns_scalar_rows(robot: Robot, rows: list[list[float]]) -> list[tuple[tuple[float, float, float], ...]]:
     """:func:`tool_columns` for a few joint vectors (lists of floats), in scalar arithmetic: the same
     :class:`ChainProgram`, without the fixed cost of array operations (:class:`ScalarChain`). A row that shares its
@@ -498,10 +496,25 @@ def _chain_code(shape: tuple[tuple[int, int, bool | None, int], ...], joint_step
     return namespace["factory"]
 
 
-def _tool_matrix(robot: Robot, q: list[float]) -> np.ndarray:
-    """``world_T_tool`` for one joint vector: :func:`tool_columns` in scalar arithmetic (no array overhead)."""
-    (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = tool_columns_scalar(robot, q)
-    return np.array([[x0, y0, z0, p0], [x1, y1, z1, p1], [x2, y2, z2, p2], [0.0, 0.0, 0.0, 1.0]])
+#: Up to this many joint vectors, :func:`forward_kinematics` runs the scalar chain on each
+#: (:func:`tool_columns_scalar_rows`, the array chain's values bit for bit): the arrays' fixed cost is that of about
+#: a dozen rows on floats (a UR5 rounded as CAD exports round: 6 µs a row, against 71 µs for the arrays at one row
+#: and 76 at eight). Gauss–Newton's steps on one pose's few candidates, and on the last rows of a search still
+#: converging, take it.
+SCALAR_ROWS = 12
+
+_BOTTOM_ROW = (0.0, 0.0, 0.0, 1.0)
+
+
+def _tool_matrices(robot: Robot, rows: list[list[float]]) -> np.ndarray | None:
+    """``world_T_tool`` (K, 4, 4) for a few joint vectors: :func:`tool_columns` in scalar arithmetic (no array
+    overhead); None when a value is infinite (``math.cos`` refuses it; the arrays give NaN there)."""
+    try:
+        columns = tool_columns_scalar_rows(robot, rows)
+    except ValueError:
+        return None
+    return np.array([((x0, y0, z0, p0), (x1, y1, z1, p1), (x2, y2, z2, p2), _BOTTOM_ROW)
+                     for (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) in columns]).reshape(len(rows), 4, 4)
 
 
 class JointScrews(NamedTuple):

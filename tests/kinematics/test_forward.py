@@ -16,7 +16,7 @@ from service.kinematics import (
     screw_model,
 )
 from tests.arms import random_dh_robot, screw_exponential
-from tests.oracles.rotations import about
+from tests.oracles.rotations import about, axis_angle
 
 
 def _rot(axis: str, angle: float) -> np.ndarray:
@@ -266,6 +266,53 @@ def test_the_scalar_chain_is_the_array_chain_bit_for_bit(client):
         x, y, z, p = tool_columns(arm, q)
         scalar = np.array(tool_columns_scalar_rows(arm, q.tolist()))  # (7, 4 columns, 3)
         assert np.array_equal(scalar, np.stack([x, y, z, p]).transpose(2, 0, 1)), arm.convention
+
+
+def test_forward_kinematics_of_a_few_rows_is_the_array_chains_bit_for_bit(monkeypatch):
+    """Up to SCALAR_ROWS joint vectors take the scalar chain: the same matrices to the last bit as the array chain
+    (SCALAR_ROWS 0), in every batch shape; a row with an infinite value (which math.cos refuses) takes the array
+    chain and gives NaN there, as every row did before, and its neighbours their own poses."""
+    from service.kinematics import _forward
+    from tests.arms import rounded
+
+    rng = np.random.default_rng(37)
+    arms = _scalar_chain_arms()[:8]
+    arms += [rounded(arm, seed=5) for arm in arms[:3]]
+    for arm in arms:
+        for shape in [(arm.dof,), (1, arm.dof), (5, arm.dof), (2, 3, arm.dof), (_forward.SCALAR_ROWS, arm.dof)]:
+            q = rng.uniform(-3, 3, shape)
+            few = forward_kinematics(arm, q)
+            with monkeypatch.context() as patch:
+                patch.setattr(_forward, "SCALAR_ROWS", 0)
+                arrays = forward_kinematics(arm, q)
+            assert few.shape == shape[:-1] + (4, 4)
+            np.testing.assert_array_equal(few, arrays)
+    q = rng.uniform(-3, 3, (3, arms[0].dof))
+    q[1, 0] = np.inf
+    with np.errstate(invalid="ignore"):
+        poses = forward_kinematics(arms[0], q)
+    assert np.isnan(poses[1, :3]).any() and np.isfinite(poses[[0, 2]]).all()
+    np.testing.assert_array_equal(poses[2], forward_kinematics(arms[0], q[2]))
+
+
+def test_the_pose_error_is_half_the_sum_of_the_columns_cross_products():
+    """pose_error's rotation rows, ½ Σ_i r_i × r*_i over the columns of the current and target rotations, against
+    np.cross on the columns (to the last bit: the core's cross is np.cross's), and sin(angle)·axis for a small
+    turn about a known axis; its position rows the difference over the length scale."""
+    from service.kinematics.ik._goals import pose_error
+
+    rng = np.random.default_rng(41)
+    current, target = rng.normal(size=(2, 7, 4, 4))
+    error = pose_error(current, target, 0.5)
+    expected = 0.5 * np.sum(np.cross(current[:, :3, :3], target[:, :3, :3], axis=-2), axis=-1)
+    np.testing.assert_array_equal(error[:, 3:], expected)
+    np.testing.assert_array_equal(error[:, :3], (target[:, :3, 3] - current[:, :3, 3]) / 0.5)
+    axis = np.array([2.0, -1.0, 0.5]) / np.linalg.norm([2.0, -1.0, 0.5])
+    start = np.eye(4)
+    start[:3, :3] = axis_angle(np.array([0.6, 0.0, 0.8]), 0.7)
+    turned = start.copy()
+    turned[:3, :3] = axis_angle(axis, 1e-3) @ start[:3, :3]
+    np.testing.assert_allclose(pose_error(start, turned, 1.0)[3:], np.sin(1e-3) * axis, rtol=0, atol=1e-9)
 
 
 def test_radius_about_is_the_distance_from_the_axis():

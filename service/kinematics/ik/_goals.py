@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .._forward import (JointTrig, forward_kinematics, geometric_jacobian, radius_about, tool_columns,
+from .._forward import (JointTrig, cross, forward_kinematics, geometric_jacobian, radius_about, tool_columns,
                         tool_columns_scalar_rows)
 from .._robot import Robot
 from ._structure import arm_size
@@ -39,8 +39,9 @@ def pose_error(world_T_tool: np.ndarray, world_T_target: np.ndarray, length_scal
     (columns of the current and target rotations), which is sin(angle)·axis near the solution.
     """
     position = (world_T_target[..., :3, 3] - world_T_tool[..., :3, 3]) / length_scale
-    rotation = 0.5 * np.sum(np.cross(world_T_tool[..., :3, :3], world_T_target[..., :3, :3], axis=-2), axis=-1)
-    return np.concatenate([position, rotation], axis=-1)
+    # the columns' cross products (np.cross's values with the columns as rows, without its axis bookkeeping)
+    columns = cross(np.swapaxes(world_T_tool[..., :3, :3], -1, -2), np.swapaxes(world_T_target[..., :3, :3], -1, -2))
+    return np.concatenate([position, 0.5 * np.sum(columns, axis=-2)], axis=-1)
 
 
 @dataclass(frozen=True)

@@ -162,16 +162,12 @@ class IdealisedPlan(Sealed):
     def solve(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates:
         """Candidates (N, m, n), refined on the true arm, with ``complete`` (N,) set by the criteria above."""
         robot = self.robot
-        ideal = self._generic_one_pose(world_T_targets, reference)
-        if ideal is not None:  # every slot an idealised solution: the array solve would give the same ones
-            ideal_joints, solutions = ideal.joints, ideal.valid
-            finite = solutions.copy()
+        scalar = self._one_pose_start(world_T_targets, reference)
+        if scalar is not None:  # the array solve would give the same slots
+            ideal, (ideal_joints, finite, solutions) = scalar
         else:
             ideal = self.inner.solve(world_T_targets, reference)
-            finite = np.isfinite(ideal.joints).all(axis=-1)
-            ideal_joints = wrap_revolute(robot, np.where(finite[..., None], ideal.joints, 0.0))
-            # the idealised arm's own solutions (its closed form is exact up to rounding near a singularity)
-            solutions = ideal.valid & finite & (self._ideal_error(ideal_joints, world_T_targets) <= IDEAL_RESIDUAL)
+            ideal_joints, finite, solutions = self._idealised_slots(ideal, world_T_targets)
         joints = ideal_joints.copy()  # refined in place below
         position, orientation = residual_arrays(robot, joints, world_T_targets)
         near_before = finite & (self._size(position, orientation) <= NEAR_MISS * self.deviation)
@@ -259,20 +255,33 @@ class IdealisedPlan(Sealed):
         # accepted solution whose σ_min is within max(10 δ, 0.01 √δ), a margin far above ISOLATED_BELOW)
         return Candidates(joints, accepted, ideal.singularities, complete=complete)
 
-    def _generic_one_pose(self, world_T_targets: np.ndarray, reference: np.ndarray | None) -> Candidates | None:
-        """For one target (1, 4, 4), the idealised family's scalar path (``solve_one``) as candidates when it
-        answers and every slot holds one of the idealised arm's solutions (its residual there within
-        :data:`IDEAL_RESIDUAL`): a clearly generic pose, where the array solve gives the same slots, all valid, and
-        no singularity, for a fraction of the time. None elsewhere (then the array solve answers)."""
+    def _idealised_slots(self, ideal: Candidates, world_T_targets: np.ndarray
+                         ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The idealised family's candidates (N, m, n) as the criteria read them: their joints (revolute ones
+        wrapped, 0 where a value is not finite), which slots are finite (N, m), and which hold one of the idealised
+        arm's own solutions (N, m: valid, finite, and its residual there within :data:`IDEAL_RESIDUAL`, as its
+        closed form is exact up to rounding near a singularity)."""
+        finite = np.isfinite(ideal.joints).all(axis=-1)
+        joints = wrap_revolute(self.robot, np.where(finite[..., None], ideal.joints, 0.0))
+        return joints, finite, ideal.valid & finite & (self._ideal_error(joints, world_T_targets) <= IDEAL_RESIDUAL)
+
+    def _one_pose_start(self, world_T_targets: np.ndarray, reference: np.ndarray | None
+                        ) -> tuple[Candidates, tuple[np.ndarray, np.ndarray, np.ndarray]] | None:
+        """For one target (1, 4, 4), the idealised family's scalar path (``solve_one``) as candidates, with their
+        :meth:`_idealised_slots`, where it gives the array solve's slots for a fraction of the time: a clearly
+        generic pose whose every slot holds one of the idealised arm's solutions, or any pose it answers when its
+        slots are the array solver's (:attr:`~._scalar.OnePose.slots_as_array`: empty where that leaves a slot
+        undefined, least-squares where that does). None elsewhere (then the array solve answers)."""
         if len(world_T_targets) != 1 or not hasattr(self.inner, "solve_one"):
             return None
         one_pose = self.inner.solve_one(world_T_targets[0], reference)
-        if one_pose is None or any(q is None for q in one_pose.rows):
+        if one_pose is None or not (one_pose.slots_as_array or all(q is not None for q in one_pose.rows)):
             return None
-        candidates = Candidates(wrap_revolute(self.robot, one_pose.joints), one_pose.valid, one_pose.singularities)
-        if not (self._ideal_error(candidates.joints, world_T_targets) <= IDEAL_RESIDUAL).all():
+        candidates = Candidates(one_pose.joints, one_pose.valid, one_pose.singularities)
+        slots = self._idealised_slots(candidates, world_T_targets)
+        if not (one_pose.slots_as_array or slots[2].all()):
             return None
-        return candidates
+        return candidates, slots
 
     def _near_wrist_alignment(self, ideal_joints: np.ndarray, valid: np.ndarray,
                               steered: tuple[np.ndarray, np.ndarray], steering: np.ndarray | None) -> np.ndarray:

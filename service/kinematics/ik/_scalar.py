@@ -61,12 +61,18 @@ class OnePose:
     label quantity is within :data:`MARGIN` times the tolerance of where the
     label flips or is left out (then the array labeller decides). ``joints``
     (1, m, n), ``valid`` (1, m) and ``singularities`` (none: the pose is
-    generic) read it as :class:`Candidates`.
+    generic) read it as :class:`Candidates`. ``slots_as_array``: every slot is
+    the array solver's, an empty one where that leaves the slot undefined (NaN)
+    and a least-squares one where that gives the same least-squares value; a
+    family whose scalar path empties a slot the array solver fills with a
+    least-squares value (the OPW type's elbow out of reach) leaves it False.
     """
 
     def __init__(self, rows: list[list[float] | None], codes: list[tuple[int | None, ...]],
-                 names: tuple[str, ...], values: tuple[tuple[str, ...], ...], dof: int) -> None:
+                 names: tuple[str, ...], values: tuple[tuple[str, ...], ...], dof: int, *,
+                 slots_as_array: bool = False) -> None:
         self.rows, self.codes, self.names, self.values, self.dof = rows, codes, names, values, dof
+        self.slots_as_array = slots_as_array
         self.singularities = SingularFlags(1)
         self.complete = None
         self.promise_needs_every_slot = False

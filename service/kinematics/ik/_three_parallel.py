@@ -644,4 +644,4 @@ class _ThreeParallelOnePose:
                     side = None if line is None else scalar.side_code(
                         scalar.dot(scalar.reject(scalar.rotate(d[1], q2, self.elbow), line), self.up), self.elbow_length)
                     codes.append((shoulder, side, wrist_code))
-        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof, slots_as_array=True)

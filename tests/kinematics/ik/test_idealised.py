@@ -195,31 +195,36 @@ def test_lite6_seven_microradians_off_parallel_solves_its_own_poses():
 
 def test_one_pose_of_an_idealised_arm_answers_as_its_array_solve(client, monkeypatch):
     """One target of an idealised plan starts from the family's scalar path where every slot is one of the idealised
-    arm's solutions: the same promises as the array solve, and where promised the same solutions, on the Doosan
-    M1013 URDF, a rounded KUKA KR6 and a Stanford arm moved by 1e-6, at random poses and with q5 near 0 or π (where
-    the scalar path declines, or the promise is withdrawn and the numeric search, seeded by rounding-different
-    starts, may list other members of the wrist's family)."""
+    arm's solutions, or (the UR type, whose empty and least-squares slots are the array solver's) wherever that path
+    answers: the same promises as the array solve, and where promised the same solutions, on the Doosan M1013 URDF,
+    a rounded KUKA KR6, a Stanford arm moved by 1e-6 and a rounded UR5, at random poses and with q5 near 0 or π
+    (where the scalar path declines, or the promise is withdrawn and the numeric search, seeded by
+    rounding-different starts, may list other members of the wrist's family)."""
     joints = json.loads((DATA / "doosan_m1013_urdf_joints.json").read_text())["joints"]
     rng = np.random.default_rng(5)
     arms = [standard_dh_from_screws(*urdf_chain_screws(joints)), rounded(catalogue_robot(client, "kuka_kr6_r900_2"), 3),
-            moved(catalogue_robot(client, "spong_ex3_5_stanford"), rng, 1e-6)]
-    scalar = _idealised.IdealisedPlan._generic_one_pose
-    started_from_scalar = 0
+            moved(catalogue_robot(client, "spong_ex3_5_stanford"), rng, 1e-6),
+            rounded(catalogue_robot(client, "ur5"), 3)]
+    scalar = _idealised.IdealisedPlan._one_pose_start
+    started_from_scalar = with_empty_slots = 0
     for robot in arms:
         q = random_configurations(robot, 40, 5)
         q[::4, 4] = rng.choice([0.0, np.pi], len(q[::4])) + 10.0 ** rng.uniform(-9, -2, len(q[::4]))
         for target in forward_kinematics(robot, q):
             plan = cached_plan(robot, constrain_orientation=True, reference=None)
-            started_from_scalar += scalar(plan, target[None], None) is not None
+            start = scalar(plan, target[None], None)
+            started_from_scalar += start is not None
+            with_empty_slots += start is not None and not start[0].valid.all()
             one = solve_ik(robot, target)
             with monkeypatch.context() as forced:
-                forced.setattr(_idealised.IdealisedPlan, "_generic_one_pose", lambda self, targets, reference: None)
+                forced.setattr(_idealised.IdealisedPlan, "_one_pose_start", lambda self, targets, reference: None)
                 array = solve_ik(robot, target)
             assert (one.status, one.complete) == (array.status, array.complete)
             if one.complete:
                 assert same_set(robot, np.array([s.joints for s in one.solutions]).reshape(-1, robot.dof),
                                 np.array([s.joints for s in array.solutions]).reshape(-1, robot.dof))
-    assert started_from_scalar > 60, started_from_scalar
+    assert started_from_scalar > 90, started_from_scalar
+    assert with_empty_slots >= 5, with_empty_slots
 
 
 def test_doosan_m1013_urdf_with_three_decimal_angles_gets_the_closed_form():

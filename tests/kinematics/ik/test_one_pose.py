@@ -40,7 +40,7 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
     same branch labels wherever its labeller answers."""
     robot = _CATALOGUE.get(robot_id).robot
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
-    answered = labelled = 0
+    answered = labelled = as_array = 0
     for T in mixed_poses(robot, 400, seed=11):
         one_pose = plan.solve_one(T)
         if one_pose is None:
@@ -52,6 +52,9 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
         valid = array.valid[0]
         assert np.abs(joint_difference(robot, one_pose.joints[0, valid], array.joints[0, valid])).max() <= 1e-9
         assert np.isnan(one_pose.joints[0, ~valid]).any(axis=-1).all()
+        if one_pose.slots_as_array:  # and the array solver's empty slots are undefined too (no least-squares value)
+            assert not np.isfinite(array.joints[0, ~valid]).all(axis=-1).any()
+            as_array += 1
         joints = wrap_revolute(robot, np.nan_to_num(one_pose.joints))
         # as solve_ik: label the slots the FK check keeps (not the least-squares ones it rejects)
         position, orientation = residual_arrays(robot, joints, T[None])
@@ -66,6 +69,7 @@ def test_scalar_candidates_are_the_array_candidates(robot_id):
                 assert (codes[valid] == expected[name][1][valid]).all()
     assert answered >= 450  # generic poses are the common case (of 400 random, 100 snapped, 40 far)
     assert labelled >= 0.9 * answered
+    assert as_array == (answered if plan.structure == "three_parallel" else 0)
 
 
 @pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)

@@ -590,12 +590,45 @@ def geometric_jacobian(robot: Robot, q: np.ndarray) -> np.ndarray:
     -------
     ndarray, shape (6, n) or (N, 6, n)
     """
+    q = np.asarray(q, dtype=float)
+    rows = q.reshape(-1, q.shape[-1])
+    if len(rows) <= SCALAR_ROWS:
+        jacobians = _jacobians_scalar(robot, rows.tolist())
+        if jacobians is not None:
+            return jacobians.reshape(q.shape[:-1] + (6, robot.dof))
     directions, points, world_T_tool = joint_screws(robot, q)
     tool_position = world_T_tool[..., None, :3, 3]
     revolute = robot.is_revolute[:, None]
     linear = np.where(revolute, cross(directions, tool_position - points), directions)
     angular = np.where(revolute, directions, 0.0)
     return np.concatenate([np.swapaxes(linear, -1, -2), np.swapaxes(angular, -1, -2)], axis=-2)
+
+
+def _jacobians_scalar(robot: Robot, rows: list[list[float]]) -> np.ndarray | None:
+    """:func:`geometric_jacobian` (K, 6, n) of a few joint vectors on the scalar chain (:class:`ScalarChain`): each
+    joint's axis is the z column of the frame the chain reaches just before the joint's motion, and that frame's
+    origin a point on it; the tool point is where the chain ends. The same columns as :func:`joint_screws` gives
+    to rounding (it multiplies the link matrices; a point other than its frame's origin, on the same axis, where
+    a Craig table's d_i lies between them). None when a value is infinite (``math.cos`` refuses it)."""
+    chain = scalar_chain(robot)
+    start, run = chain.start, chain.run
+    revolute = robot.is_revolute.tolist()
+    jacobians = []
+    for q in rows:
+        frames: list[tuple[float, ...]] = []
+        try:
+            *_, (t0, t1, t2) = run(q, frames, 0, *start)
+        except ValueError:
+            return None
+        columns = []
+        for turns, (*_, z0, z1, z2, p0, p1, p2) in zip(revolute, frames):
+            if turns:  # [z × (tool − p); z]
+                d0, d1, d2 = t0 - p0, t1 - p1, t2 - p2
+                columns.append((z1 * d2 - z2 * d1, z2 * d0 - z0 * d2, z0 * d1 - z1 * d0, z0, z1, z2))
+            else:  # [z; 0]
+                columns.append((z0, z1, z2, 0.0, 0.0, 0.0))
+        jacobians.append(columns)
+    return np.ascontiguousarray(np.array(jacobians).reshape(len(rows), len(revolute), 6).transpose(0, 2, 1))
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -295,6 +295,34 @@ def test_forward_kinematics_of_a_few_rows_is_the_array_chains_bit_for_bit(monkey
     np.testing.assert_array_equal(poses[2], forward_kinematics(arms[0], q[2]))
 
 
+def test_the_jacobian_of_a_few_rows_is_the_array_jacobian(monkeypatch):
+    """Up to SCALAR_ROWS joint vectors, the Jacobian's columns come from the scalar chain's frames (each joint's
+    axis and a point on it, just before its motion): the array path's (the link matrices' products, SCALAR_ROWS 0)
+    to rounding, on arms of every operation (revolute and prismatic joints, three conventions, screws), rounded
+    ones, in every batch shape; a row with an infinite value takes the array path."""
+    from service.kinematics import _forward
+    from tests.arms import rounded
+
+    rng = np.random.default_rng(43)
+    arms = _scalar_chain_arms()
+    arms += [rounded(arm, seed=7) for arm in arms[:3]]
+    for arm in arms:
+        scale = max(1.0, float(np.abs(np.concatenate([arm.a, arm.d])).max()) if arm.convention != "screws" else 1.0)
+        for shape in [(arm.dof,), (1, arm.dof), (4, arm.dof), (2, 3, arm.dof)]:
+            q = rng.uniform(-3, 3, shape)
+            few = geometric_jacobian(arm, q)
+            with monkeypatch.context() as patch:
+                patch.setattr(_forward, "SCALAR_ROWS", 0)
+                arrays = geometric_jacobian(arm, q)
+            assert few.shape == arrays.shape == shape[:-1] + (6, arm.dof)
+            np.testing.assert_allclose(few, arrays, rtol=0, atol=1e-13 * scale)
+    q = rng.uniform(-3, 3, (2, arms[0].dof))
+    q[0, -1] = np.inf
+    with np.errstate(invalid="ignore"):
+        J = geometric_jacobian(arms[0], q)
+    assert np.isfinite(J[1]).all() and not np.isfinite(J[0]).all()
+
+
 def test_the_pose_error_is_half_the_sum_of_the_columns_cross_products():
     """pose_error's rotation rows, ½ Σ_i r_i × r*_i over the columns of the current and target rotations, against
     np.cross on the columns (to the last bit: the core's cross is np.cross's), and sin(angle)·axis for a small

@@ -23,9 +23,38 @@ def test_core_benchmark_runs_with_tiny_sizes(capsys):
         for limits in ("limits ±π, no filter", "catalogue limits"):
             assert f"| {robot} | IK answer, {limits}, single pose | core |" in out
             assert f"| {robot} | IK answer, {limits}, batch of 20 | core, solve only (solve_ik_arrays) |" in out
+    for robot in ("UR5", "KUKA KR6"):  # and what a CAD-rounded description of the arm pays
+        assert f"| {robot}, parallel axes 1e-5 rad off | IK answer, limits ±π, no filter, single pose | core |" in out
+        assert (f"arm with parallel axes 1e-5 rad off / the exact arm, core ({robot}): " in out)
     for name in anchors.LIBRARIES:
         if not anchors.installed(name):
             assert f"{name}: not installed" in out
+
+
+def test_the_cad_rounded_arms_leave_their_family_by_the_tilt_alone():
+    """cad_rounded moves each twist of 0 or π by 1e-5 rad, alternately up and down, and nothing else: the UR5 and
+    the KUKA KR6 so stated are answered by the refined closed form (IdealisedPlan), as a rounded URDF of them is,
+    so the rounded rows time that path."""
+    import numpy as np
+
+    from service.config import Settings
+    from service.kinematics.ik import cached_plan
+    from service.kinematics.ik._idealised import IdealisedPlan
+    from service.robots.catalogue import load_catalogue
+
+    catalogue = load_catalogue([Settings().builtin_robots_dir], max_joints=32)
+    for label in core.ROUNDED_ROBOTS:
+        exact = catalogue.get(core.ROBOTS[label]).robot
+        rounded = core.cad_rounded(exact)
+        moved = rounded.alpha - exact.alpha
+        parallel = np.abs(np.sin(exact.alpha)) < 1e-9
+        assert parallel.sum() >= 2
+        np.testing.assert_allclose(moved[parallel], core.ROUNDING_TILT * (-1.0) ** np.arange(parallel.sum()),
+                                   rtol=1e-6)
+        assert not moved[~parallel].any()
+        for name in ("a", "d", "theta", "world_T_base", "flange_T_tool"):
+            assert np.array_equal(getattr(rounded, name), getattr(exact, name))
+        assert isinstance(cached_plan(rounded, constrain_orientation=True, reference=None), IdealisedPlan)
 
 
 def test_request_profile_runs_with_tiny_sizes(capsys):

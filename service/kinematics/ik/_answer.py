@@ -31,7 +31,7 @@ from .._forward import JointTrig
 from .._limits import Limits, outside_limits
 from .._robot import Robot
 from ..collision import CollisionRequest, at_collisions, clearances
-from ._closed_form import cached_plan, solve_closed_form
+from ._closed_form import cached_plan, plan_candidates, solve_closed_form
 from ._coaxial import CoaxialPlan, coaxial_pair
 from ._direction import (DEFAULT_ROLL_SAMPLES, direction_candidates, direction_plan, distinct_rolls, roll_family,
                          roll_free_joints, roll_rows, roll_samples, solve_roll_family, tool_roll)
@@ -544,8 +544,11 @@ def _with_fallback(robot: Robot, goal: PoseGoal, closed: _Part, options: AnswerO
     for index, local in enumerate(broken.tolist()):
         start, stop = np.searchsorted(table.target, [local, local + 1])
         known[index, :stop - start] = table.joints[start:stop]
+    # the plan's candidates there (least-squares ones, refinements that stalled) are the search's own starts
+    options.budget.check("the numeric search")
+    seeds = plan_candidates(plan, goal.world_T_targets[broken], options.reference)
     fallback = _numeric(robot, goal.take(broken), closed.rows[broken], options, options.reference, known=known,
-                        label_codes=plan.label_codes)
+                        seeds=seeds, label_codes=plan.label_codes)
     fallback.verified.singularities.extend(verified.singularities, rows=broken)
     fallback.reported = np.ones(len(broken), dtype=bool)
     note = _fallback_note(plan)
@@ -580,16 +583,16 @@ def _fallback_note(plan) -> str:
 
 def _numeric(robot: Robot, goal: PoseGoal, rows: np.ndarray, options: AnswerOptions,
              reference: np.ndarray | None = None, *, known: np.ndarray | None = None,
-             free: list[FreeJoint] | None = None,
+             seeds: np.ndarray | None = None, free: list[FreeJoint] | None = None,
              label_codes: Callable[[np.ndarray, JointTrig], LabelCodes] | None = None) -> _Part:
-    """The numeric search's part for the goal's targets (their indices ``rows``), seeded with ``known``
-    solutions; with ``free``, once per combination of the free joints' values, those joints held. ``label_codes``
-    labels the solutions (a closed-form plan's, where the search completes its answer); None leaves them
-    unlabelled."""
+    """The numeric search's part for the goal's targets (their indices ``rows``), with ``known`` solutions and
+    each target's ``seeds`` (see :func:`~._numeric.search`); with ``free``, once per combination of the free
+    joints' values, those joints held. ``label_codes`` labels the solutions (a closed-form plan's, where the
+    search completes its answer); None leaves them unlabelled."""
     reference = options.reference if reference is None else reference
     search_options = options.search
     if free is None:
-        searched = search(robot, goal, search_options.numeric, reference, known=known, held=None,
+        searched = search(robot, goal, search_options.numeric, reference, known=known, seeds=seeds, held=None,
                           budget=search_options.budget)
         candidates, unfinished = searched.candidates, searched.unfinished
         free_joints: tuple[int, ...] = ()

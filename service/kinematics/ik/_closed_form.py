@@ -118,6 +118,14 @@ def _solved(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.ndarray | No
     return verify(robot, goal, candidates, reference, plan.label_codes)
 
 
+def plan_candidates(plan: Plan, world_T_targets: np.ndarray, reference: np.ndarray | None) -> np.ndarray:
+    """The plan's candidate joint vectors (N, m, n) for N targets (N, 4, 4), NaN where a slot is empty, solved
+    in chunks of at most :data:`CHUNK` targets (memory bounded as :func:`solve_closed_form`'s)."""
+    parts = [plan.solve(world_T_targets[start:start + CHUNK], reference).joints
+             for start in range(0, len(world_T_targets), CHUNK)]
+    return parts[0] if len(parts) == 1 else np.concatenate(parts)
+
+
 def _one_pose_candidates(one_pose) -> Candidates | None:
     """A family's scalar answer for one pose (``OnePose``) as candidates with their labels; None when it has none
     or a valid slot's label is not clear (the array path labels it then)."""

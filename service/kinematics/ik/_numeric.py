@@ -85,37 +85,47 @@ class Searched:
 
 
 def search(robot: Robot, goal: Goal, options: NumericOptions, reference: np.ndarray | None, *,
-           known: np.ndarray | None = None, held: dict[int, float] | None = None,
+           known: np.ndarray | None = None, seeds: np.ndarray | None = None, held: dict[int, float] | None = None,
            budget: Budget = UNLIMITED) -> Searched:
-    """Levenberg–Marquardt from ``options.starts`` starts per target of ``goal`` (N targets).
+    """Levenberg–Marquardt from ``options.starts`` starts per target of ``goal`` (N targets), and from its own
+    ``seeds``.
 
     ``known`` (N, k, n), NaN-padded, are solutions a caller already verified; they head each target's candidates.
-    ``held`` joints stay at their values (the free joints of a redundant arm a request fixed). On an arm with
-    two coaxial joints, each candidate is split with the second at the reference (or 0), as the closed form
-    splits it (:mod:`._coaxial`).
+    ``seeds`` (N, s, n), NaN-padded, are starts of each target's own (a closed form's candidates where it could
+    not promise the target: near a fold the roots it missed lie beside them, where the common starts seldom
+    lead); their candidates follow the common starts'. ``held`` joints stay at their values (the free joints of a
+    redundant arm a request fixed). On an arm with two coaxial joints, each candidate is split with the second at
+    the reference (or 0), as the closed form splits it (:mod:`._coaxial`).
     """
     n_targets, n = len(goal), robot.dof
-    starts = initial_guesses(robot, options.starts, np.random.default_rng(options.seed), reference)
+    common = initial_guesses(robot, options.starts, np.random.default_rng(options.seed), reference)
+    own = 0 if seeds is None else seeds.shape[1]
+    per_target = len(common) + own  # each target's starts: the common ones, then its seeds
     moving = None
     if held:
-        starts[:, list(held)] = list(held.values())
+        common[:, list(held)] = list(held.values())
         moving = np.ones(n, dtype=bool)
         moving[list(held)] = False
-    total = n_targets * len(starts)
+    total = n_targets * per_target
     joints = np.empty((total, n))
     error = np.empty(total)
     unfinished = np.zeros(n_targets, dtype=bool)
     chunk = chunk_rows(n)
     for begin in range(0, total, chunk):
-        end = min(begin + chunk, total)
-        rows = np.arange(begin, end) // len(starts)
-        reached = gauss_newton(robot, goal, starts[np.arange(begin, end) % len(starts)], rows,
-                               steps=options.max_iterations, tolerance=CONVERGED, adaptive=True, moving=moving,
-                               budget=budget, stage="the numeric search")
-        joints[begin:end], error[begin:end] = reached.joints, reached.error
+        index = np.arange(begin, min(begin + chunk, total))
+        rows, slots = np.divmod(index, per_target)
+        starts = common[np.minimum(slots, len(common) - 1)]
+        if own:
+            seeded = slots >= len(common)
+            starts[seeded] = seeds[rows[seeded], slots[seeded] - len(common)]  # not finite: never active
+            if held:
+                starts[:, list(held)] = list(held.values())
+        reached = gauss_newton(robot, goal, starts, rows, steps=options.max_iterations, tolerance=CONVERGED,
+                               adaptive=True, moving=moving, budget=budget, stage="the numeric search")
+        joints[index], error[index] = reached.joints, reached.error
         unfinished[rows[reached.unfinished]] = True
-    joints = joints.reshape(n_targets, len(starts), n)
-    valid = (error <= CANDIDATE).reshape(n_targets, len(starts))
+    joints = joints.reshape(n_targets, per_target, n)
+    valid = (error <= CANDIDATE).reshape(n_targets, per_target)
     pair = coaxial_pair(geometry_of(robot))
     if pair is not None:
         joints = held_split(joints, pair, reference)
@@ -126,3 +136,4 @@ def search(robot: Robot, goal: Goal, options: NumericOptions, reference: np.ndar
         joints = np.concatenate([np.nan_to_num(known), joints], axis=1)
         valid = np.concatenate([~np.isnan(known).any(axis=-1), valid], axis=1)
     return Searched(Candidates(joints, valid, singularities, complete=np.zeros(n_targets, dtype=bool)), unfinished)
+

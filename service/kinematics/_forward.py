@@ -140,6 +140,11 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> np.ndarray:
     [1.36762, 0.38009]
     """
     q = np.asarray(q, dtype=float)
+    if q.ndim == 1:  # one configuration: its matrix as the scalar chain gives it
+        try:
+            return np.array(_rows_of(tool_columns_scalar_rows(robot, [q.tolist()])[0]))
+        except ValueError:  # an infinite value (math.cos refuses it): the arrays give NaN there
+            pass
     rows = q.reshape(-1, q.shape[-1])
     if len(rows) <= SCALAR_ROWS:
         world_T_tool = _tool_matrices(robot, rows.tolist())
@@ -513,8 +518,13 @@ def _tool_matrices(robot: Robot, rows: list[list[float]]) -> np.ndarray | None:
         columns = tool_columns_scalar_rows(robot, rows)
     except ValueError:
         return None
-    return np.array([((x0, y0, z0, p0), (x1, y1, z1, p1), (x2, y2, z2, p2), _BOTTOM_ROW)
-                     for (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) in columns]).reshape(len(rows), 4, 4)
+    return np.array([_rows_of(tool) for tool in columns]) if columns else np.zeros((0, 4, 4))
+
+
+def _rows_of(columns: tuple[tuple[float, float, float], ...]) -> tuple[tuple[float, ...], ...]:
+    """The rows of ``world_T_tool`` (4 × 4) from its columns x, y, z, p (three floats each)."""
+    (x0, x1, x2), (y0, y1, y2), (z0, z1, z2), (p0, p1, p2) = columns
+    return (x0, y0, z0, p0), (x1, y1, z1, p1), (x2, y2, z2, p2), _BOTTOM_ROW
 
 
 class JointScrews(NamedTuple):

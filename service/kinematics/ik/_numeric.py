@@ -136,4 +136,3 @@ def search(robot: Robot, goal: Goal, options: NumericOptions, reference: np.ndar
         joints = np.concatenate([np.nan_to_num(known), joints], axis=1)
         valid = np.concatenate([~np.isnan(known).any(axis=-1), valid], axis=1)
     return Searched(Candidates(joints, valid, singularities, complete=np.zeros(n_targets, dtype=bool)), unfinished)
-

@@ -24,6 +24,7 @@ from ..kinematics import (
     check_joint_values,
     check_transform,
     check_transforms,
+    frame_quaternion,
     frame_quaternions,
     matrix_from_quaternion,
     quaternions_from_matrices,
@@ -260,8 +261,12 @@ def poses_from_matrices(matrices: np.ndarray) -> list[dict]:
 
 
 def pose_from_matrix(matrix: np.ndarray) -> dict:
-    """The wire pose of one transform, shape (4, 4)."""
-    return poses_from_matrices(np.asarray(matrix)[None])[0]
+    """The wire pose of one transform the core computed, shape (4, 4): :func:`poses_from_matrices` of one, on
+    floats (a single FK's whole encoding)."""
+    rows = np.asarray(matrix, dtype=float).tolist()
+    (r00, r01, r02, x), (r10, r11, r12, y), (r20, r21, r22, z), _ = rows
+    return {"matrix": rows, "position": [x, y, z],
+            "quaternion_wxyz": frame_quaternion([r00, r01, r02, r10, r11, r12, r20, r21, r22])}
 
 
 def limits_to_core(robot: Robot, overrides: Sequence | None, unit: AngleUnit) -> Limits:

@@ -44,6 +44,7 @@ __all__ = [
     "check_transforms",
     "check_unit_quaternion",
     "euler_zyz_from_matrix",
+    "frame_quaternion",
     "frame_quaternions",
     "matrix_from_euler_zyz",
     "matrix_from_quaternion",
@@ -457,9 +458,14 @@ def _quaternions_from_matrices(R: np.ndarray) -> np.ndarray:
     return _canonical_sign(q).reshape(*R.shape[:-2], 4)
 
 
-def _quaternion_of_rotation(r: list[float]) -> list[float]:
-    """:func:`_quaternions_from_matrices` of one rotation given as its nine entries row by row, on floats: the
-    same K, the same choice of its largest diagonal entry, the same normalisation and sign."""
+def frame_quaternion(r: list[float]) -> list[float]:
+    """The unit quaternion ``[w, x, y, z]`` of one rotation the core computed (an FK pose), given as its nine
+    entries row by row, on floats, without input checks: :func:`quaternions_from_matrices`'s K, the same choice of
+    its largest diagonal entry, the same normalisation and canonical sign, for a fraction of an array call's cost.
+
+    >>> [round(value, 6) for value in frame_quaternion([0.0, -1.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0])]
+    [0.707107, 0.0, 0.0, 0.707107]
+    """
     r00, r01, r02, r10, r11, r12, r20, r21, r22 = r
     trace = r00 + r11 + r22
     diagonal = (1.0 + trace, 1.0 + r00 - r11 - r22, 1.0 - r00 + r11 - r22, 1.0 - r00 - r11 + r22)
@@ -489,7 +495,7 @@ def frame_quaternions(R: ArrayLike) -> np.ndarray:
     """
     R = np.asarray(R, dtype=float)
     if R.shape[0] == 1:
-        return np.array([_quaternion_of_rotation(R.reshape(9).tolist())])
+        return np.array([frame_quaternion(R.reshape(9).tolist())])
     return _quaternions_from_matrices(R)
 
 

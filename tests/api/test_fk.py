@@ -155,3 +155,24 @@ def test_malformed_inline_robots_are_422(client):
 def test_batch_rows_are_checked(client):
     response = client.post("/v1/robots/spong_ex3_1_planar_rr/fk/batch", json={"joints": [[0, 0], [0, 0, 0]]})
     assert_problem(response, 422, loc=["body", "joints", 1])
+
+
+def test_the_wire_pose_of_one_matrix_is_the_stacks():
+    """pose_from_matrix (a single FK's encoding, on floats) gives each matrix of a stack the wire pose
+    poses_from_matrices gives it: the same matrix rows and position, and the same quaternion (the float formula
+    against the array one: within 4e-16), on random transforms, half turns and the identity."""
+    from service.api.boundary import pose_from_matrix, poses_from_matrices
+    from tests.arms import random_rigid
+
+    rng = np.random.default_rng(47)
+    stack = [random_rigid(rng, 2.0) for _ in range(40)]
+    for diagonal in ([1.0, 1.0, 1.0], [-1.0, 1.0, -1.0], [-1.0, -1.0, 1.0], [1.0, -1.0, -1.0]):
+        T = np.eye(4)
+        T[:3, :3] = np.diag(diagonal)
+        T[:3, 3] = rng.normal(size=3)
+        stack.append(T)
+    for T, expected in zip(stack, poses_from_matrices(np.stack(stack))):
+        one = pose_from_matrix(T)
+        assert set(one) == set(expected)
+        assert one["matrix"] == expected["matrix"] and one["position"] == expected["position"]
+        np.testing.assert_allclose(one["quaternion_wxyz"], expected["quaternion_wxyz"], rtol=0, atol=4e-16)

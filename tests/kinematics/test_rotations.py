@@ -20,6 +20,7 @@ from service.kinematics import (
     check_transform,
     check_transforms,
     check_unit_quaternion,
+    frame_quaternion,
     frame_quaternions,
     matrix_from_euler_zyz,
     matrix_from_quaternion,
@@ -624,14 +625,15 @@ def test_angle_arguments_are_validated():
 
 @pytest.mark.parametrize("angle", [0.0, 0.5, PI - 1e-9, PI])
 def test_frame_quaternions_of_one_rotation_on_floats_agree_with_the_batch(rng, angle):
-    """The FK encoder's conversion (frame_quaternions) takes one rotation on floats: the same quaternion as the
-    batch method, canonical sign included, for every case of Shepperd's method and half turns."""
+    """The FK encoder's conversion (frame_quaternions, frame_quaternion) takes one rotation on floats: the same
+    quaternion as the batch method, canonical sign included, for every case of Shepperd's method and half turns."""
     rotations = [axis_angle(axis, angle) for axis in random_unit_vectors(rng, 50)]
     rotations += [np.eye(3), rot_x(3.0), rot_y(3.0), rot_z(3.0), np.diag([-1.0, 1.0, -1.0]), np.diag([-1.0, -1.0, 1.0])]
     batch = quaternions_from_matrices(np.stack(rotations))
     for R, expected in zip(rotations, batch):
         one = frame_quaternions(R[None])
         assert one.shape == (1, 4)
+        assert frame_quaternion(R.reshape(9).tolist()) == one[0].tolist()  # the float path it takes
         np.testing.assert_allclose(one[0], expected, rtol=0, atol=4e-16)
         assert one[0, 0] >= 0.0 and not np.signbit(one[0, 0])
         np.testing.assert_allclose(matrix_of_quaternion(*one[0]), R, atol=1e-14)  # the test's own formula

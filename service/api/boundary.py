@@ -254,19 +254,20 @@ def poses_from_matrices(matrices: np.ndarray) -> list[dict]:
     """Wire poses for a stack of transforms the core computed (FK), shape (N, 4, 4)."""
     matrices = np.asarray(matrices, dtype=float)
     quaternions = frame_quaternions(matrices[:, :3, :3]).tolist()
-    return [
-        {"matrix": T, "position": [T[0][3], T[1][3], T[2][3]], "quaternion_wxyz": quaternion}
-        for T, quaternion in zip(matrices.tolist(), quaternions)
-    ]
+    return [_wire_pose(T, quaternion) for T, quaternion in zip(matrices.tolist(), quaternions)]
 
 
 def pose_from_matrix(matrix: np.ndarray) -> dict:
     """The wire pose of one transform the core computed, shape (4, 4): :func:`poses_from_matrices` of one, on
     floats (a single FK's whole encoding)."""
     rows = np.asarray(matrix, dtype=float).tolist()
-    (r00, r01, r02, x), (r10, r11, r12, y), (r20, r21, r22, z), _ = rows
-    return {"matrix": rows, "position": [x, y, z],
-            "quaternion_wxyz": frame_quaternion([r00, r01, r02, r10, r11, r12, r20, r21, r22])}
+    (r00, r01, r02, _), (r10, r11, r12, _), (r20, r21, r22, _), _ = rows
+    return _wire_pose(rows, frame_quaternion([r00, r01, r02, r10, r11, r12, r20, r21, r22]))
+
+
+def _wire_pose(rows: list[list[float]], quaternion: list[float]) -> dict:
+    """The wire pose of a transform given as its rows (4 lists of 4) and its rotation's quaternion."""
+    return {"matrix": rows, "position": [rows[0][3], rows[1][3], rows[2][3]], "quaternion_wxyz": quaternion}
 
 
 def limits_to_core(robot: Robot, overrides: Sequence | None, unit: AngleUnit) -> Limits:

@@ -81,9 +81,8 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
             solution["clearance"], solution["collisions"] = clearance, contacts
     if len(free_of_target) == 1:
         return [solutions]
-    # the table is grouped by target: each target's solutions are one slice
-    ends = np.cumsum(table.counts(len(free_of_target))).tolist()
-    return [solutions[start:end] for start, end in zip([0, *ends[:-1]], ends)]
+    starts, stops = table.bounds(len(free_of_target))  # grouped by target: each target's solutions are one slice
+    return [solutions[start:stop] for start, stop in zip(starts.tolist(), stops.tolist())]
 
 
 def _rolls(table: SolutionTable, angle: float) -> list[float | None]:

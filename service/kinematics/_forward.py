@@ -140,16 +140,18 @@ def forward_kinematics(robot: Robot, q: np.ndarray) -> np.ndarray:
     [1.36762, 0.38009]
     """
     q = np.asarray(q, dtype=float)
-    if q.ndim == 1:  # one configuration: its matrix as the scalar chain gives it
+    count = math.prod(q.shape[:-1])  # joint vectors: 1 for q of shape (n,)
+    if 0 < count <= SCALAR_ROWS:
         try:
-            return np.array(_rows_of(tool_columns_scalar_rows(robot, [q.tolist()])[0]))
+            tools = tool_columns_scalar_rows(robot, [q.tolist()] if q.ndim == 1 else
+                                             q.reshape(count, q.shape[-1]).tolist())
         except ValueError:  # an infinite value (math.cos refuses it): the arrays give NaN there
-            pass
+            tools = None
+        if tools is not None:
+            if q.ndim == 1:  # one configuration: its matrix as it comes
+                return np.array(_rows_of(tools[0]))
+            return np.array([_rows_of(tool) for tool in tools]).reshape(q.shape[:-1] + (4, 4))
     rows = q.reshape(-1, q.shape[-1])
-    if len(rows) <= SCALAR_ROWS:
-        world_T_tool = _tool_matrices(robot, rows.tolist())
-        if world_T_tool is not None:
-            return world_T_tool.reshape(q.shape[:-1] + (4, 4))
     x, y, z, p = tool_columns(robot, rows)
     world_T_tool = np.empty((x.shape[1], 4, 4))
     for column, values in enumerate((x, y, z, p)):
@@ -501,24 +503,15 @@ def _chain_code(shape: tuple[tuple[int, int, bool | None, int], ...], joint_step
     return namespace["factory"]
 
 
-#: Up to this many joint vectors, :func:`forward_kinematics` runs the scalar chain on each
-#: (:func:`tool_columns_scalar_rows`, the array chain's values bit for bit): the arrays' fixed cost is that of about
-#: a dozen rows on floats (a UR5 rounded as CAD exports round: 6 µs a row, against 71 µs for the arrays at one row
-#: and 76 at eight). Gauss–Newton's steps on one pose's few candidates, and on the last rows of a search still
-#: converging, take it.
+#: Up to this many joint vectors, :func:`forward_kinematics` and :func:`geometric_jacobian` run the scalar chain on
+#: each (:func:`tool_columns_scalar_rows`, the array chain's values bit for bit): the arrays' fixed cost is that of
+#: about a dozen rows on floats (FK of a UR5 rounded as CAD exports round: 6 µs a row, against 71 µs for the arrays
+#: at one row and 76 at eight). Gauss–Newton's steps on one pose's few candidates, and on the last rows of a search
+#: still converging, take it. (The FK check's residuals of a few candidates, computed on floats without building
+#: arrays, pay off up to more rows: ``ik._goals.SCALAR_CANDIDATES``.)
 SCALAR_ROWS = 12
 
 _BOTTOM_ROW = (0.0, 0.0, 0.0, 1.0)
-
-
-def _tool_matrices(robot: Robot, rows: list[list[float]]) -> np.ndarray | None:
-    """``world_T_tool`` (K, 4, 4) for a few joint vectors: :func:`tool_columns` in scalar arithmetic (no array
-    overhead); None when a value is infinite (``math.cos`` refuses it; the arrays give NaN there)."""
-    try:
-        columns = tool_columns_scalar_rows(robot, rows)
-    except ValueError:
-        return None
-    return np.array([_rows_of(tool) for tool in columns]) if columns else np.zeros((0, 4, 4))
 
 
 def _rows_of(columns: tuple[tuple[float, float, float], ...]) -> tuple[tuple[float, ...], ...]:
@@ -602,7 +595,7 @@ def geometric_jacobian(robot: Robot, q: np.ndarray) -> np.ndarray:
     """
     q = np.asarray(q, dtype=float)
     rows = q.reshape(-1, q.shape[-1])
-    if len(rows) <= SCALAR_ROWS:
+    if 0 < len(rows) <= SCALAR_ROWS:
         jacobians = _jacobians_scalar(robot, rows.tolist())
         if jacobians is not None:
             return jacobians.reshape(q.shape[:-1] + (6, robot.dof))

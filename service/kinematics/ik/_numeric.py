@@ -103,7 +103,6 @@ def search(robot: Robot, goal: Goal, options: NumericOptions, reference: np.ndar
     per_target = len(common) + own  # each target's starts: the common ones, then its seeds
     moving = None
     if held:
-        common[:, list(held)] = list(held.values())
         moving = np.ones(n, dtype=bool)
         moving[list(held)] = False
     total = n_targets * per_target
@@ -118,8 +117,8 @@ def search(robot: Robot, goal: Goal, options: NumericOptions, reference: np.ndar
         if own:
             seeded = slots >= len(common)
             starts[seeded] = seeds[rows[seeded], slots[seeded] - len(common)]  # not finite: never active
-            if held:
-                starts[:, list(held)] = list(held.values())
+        if held:
+            starts[:, list(held)] = list(held.values())
         reached = gauss_newton(robot, goal, starts, rows, steps=options.max_iterations, tolerance=CONVERGED,
                                adaptive=True, moving=moving, budget=budget, stage="the numeric search")
         joints[index], error[index] = reached.joints, reached.error

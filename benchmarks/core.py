@@ -13,7 +13,10 @@ libraries and the best repeat is kept, so that the load of a shared machine
 falls on all of them alike; ratios are taken within the run.
 
 The whole-answer rows (``answer_ik``: what a request pays in process) run on
-the PUMA 560, the UR5 and the KUKA KR6, and again on the UR5 and the KUKA KR6
+the PUMA 560, the UR5 and the KUKA KR6: one pose a call, a handful of poses a
+call (:data:`FEW_TARGETS_A_CALL`, a motion planner's few waypoints: EAIK at the
+faster of ``IK`` per pose and ``IK_batched`` on one thread), and a batch; and
+again on the UR5 and the KUKA KR6
 with their parallel axes 1e-5 rad off (:func:`cad_rounded`), as CAD exports and
 URDFs leave them: those arms are no longer exactly of their family, the service
 refines its closed form onto them, and what a user of such a description pays
@@ -199,6 +202,9 @@ ANSWER_LIMITS = {OPEN_LIMITS: "open", "catalogue limits": "catalogue"}
 #: the arms whose whole answer is timed again as CAD exports state them (:func:`cad_rounded`)
 ROUNDED_ROBOTS = ["UR5", "KUKA KR6"]
 ANSWER_SINGLE_TASK, ANSWER_BATCH_TASK = "IK answer, {limits}, single pose", "IK answer, {limits}, batch of {batch:,}"
+#: a motion planner's handful of waypoints in one call: the whole answer of that many targets a call, per pose
+ANSWER_FEW_TASK = "IK answer, {limits}, {few} targets a call"
+FEW_TARGETS_A_CALL = 4
 WHOLE_ANSWER = "core"  # the row the others are compared with: answer_ik, solve + select
 SOLVE_ONLY_SINGLE = "core, solve only (solve_closed_form: solve + FK check)"
 SOLVE_ONLY = "core, solve only (solve_ik_arrays)"
@@ -249,6 +255,8 @@ def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.
     q_batch = sample_configurations(robot, args.batch, seed=6)
     T_single, T_batch = forward_kinematics(robot, q_single), forward_kinematics(robot, q_batch)
     singles = [IKTargets.poses(T[None]) for T in T_single]
+    few = FEW_TARGETS_A_CALL
+    fews = [IKTargets.poses(T_single[start:start + few]) for start in range(0, len(T_single), few)]
     batch_targets = IKTargets.poses(T_batch)
     plan = cached_plan(robot, constrain_orientation=True, reference=None)
     goals = [PoseGoal(T[None]) for T in T_single]
@@ -264,6 +272,7 @@ def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.
         options = answer_options(robot, limits)
         single: dict[str, Callable[[], list]] = {
             WHOLE_ANSWER: lambda o=options: [answer_ik(robot, t, o) for t in singles]}
+        a_few: dict[str, Callable[[], list]] = {WHOLE_ANSWER: lambda o=options: [answer_ik(robot, t, o) for t in fews]}
         batch: dict[str, Callable[[], object]] = {
             WHOLE_ANSWER: lambda o=options: answer_ik(robot, batch_targets, o),
             SOLVE_ONLY: lambda: solve_ik_arrays(robot, T_batch)}
@@ -271,31 +280,37 @@ def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.
             single[SOLVE_ONLY_SINGLE] = lambda: [solve_closed_form(robot, plan, g, None) for g in goals]
         if eaik is not None:
             single["EAIK"] = lambda: [eaik.ik_single(T) for T in T_single]
+            a_few["EAIK (IK)"] = single["EAIK"]  # its best for a handful: IK per pose, or IK_batched on one thread
+            a_few["EAIK (IK_batched)"] = lambda: [solution for start in range(0, len(T_single), few)
+                                                  for solution in eaik.ik_batch_threads(T_single[start:start + few], 1)]
             for threads in EAIK_THREADS:
                 batch[f"EAIK ({threads})"] = (lambda k: lambda: eaik.ik_batch_threads(T_batch, k))(threads)
         solutions = {  # untimed: warm-up, and the answers for the solution counts and recall
             WHOLE_ANSWER: ([s for a in single[WHOLE_ANSWER]() for s in answer_solutions(a)],
+                           [s for a in a_few[WHOLE_ANSWER]() for s in answer_solutions(a)],
                            answer_solutions(batch[WHOLE_ANSWER]()))}
         if eaik is not None:
-            solutions["EAIK"] = (single["EAIK"](), batch[f"EAIK ({EAIK_THREADS[-1]})"]())
-        for task in (*single.values(), *batch.values()):
+            solutions["EAIK"] = (single["EAIK"](), a_few["EAIK (IK_batched)"](),
+                                 batch[f"EAIK ({EAIK_THREADS[-1]})"]())
+        for task in (*single.values(), *a_few.values(), *batch.values()):
             task()
         single_task = ANSWER_SINGLE_TASK.format(limits=limits_name)
+        few_task = ANSWER_FEW_TASK.format(limits=limits_name, few=few)
         batch_task = ANSWER_BATCH_TASK.format(limits=limits_name, batch=args.batch)
-        for task, tasks, truth in ((single_task, single, q_single), (batch_task, batch, q_batch)):
+        for kind, (task, tasks, truth) in enumerate(((single_task, single, q_single), (few_task, a_few, q_single),
+                                                     (batch_task, batch, q_batch))):
             best = best_of(tasks, args.repeats)
             eaik_rows = {name: seconds for name, seconds in best.items() if name.startswith("EAIK (")}
-            if eaik_rows:  # EAIK's batch at its fastest thread count
+            if eaik_rows:  # EAIK at its best: its fastest call (thread count, or IK against IK_batched)
                 fastest = min(eaik_rows, key=eaik_rows.get)
                 best = {name: s for name, s in best.items() if name not in eaik_rows}
                 best["EAIK"] = eaik_rows[fastest]
                 each = ", ".join(f"{k[6:-1]}: {v / len(truth) * 1e6:.2f}" for k, v in eaik_rows.items())
-                report.skipped.append(f"EAIK IK_batched on {label}, {limits_name}: fastest with {fastest[6:-1]} "
-                                      f"threads (µs per pose, by threads: {each})")
+                report.skipped.append(f"EAIK on {label}, {task}: fastest {fastest[6:-1]} (µs per pose: {each})")
             for name, seconds in best.items():
                 per_pose = found = None
                 if name in solutions:
-                    got = solutions[name][0 if tasks is single else 1]
+                    got = solutions[name][kind]
                     per_pose, found = recall(robot, truth, got)
                     if limits != "open":
                         found = None
@@ -373,6 +388,12 @@ def targets(report: Report, batch: int) -> list[str]:
                 (f"batch whole answer per pose, {limits_name}, core / EAIK IK_batched at its best ({robot})",
                  ratio(robot, ANSWER_BATCH_TASK.format(limits=limits_name, batch=batch), WHOLE_ANSWER, "EAIK"),
                  "<=", 1.5)]
+        few_task = ANSWER_FEW_TASK.format(limits=OPEN_LIMITS, few=FEW_TARGETS_A_CALL)
+        few_ratio, single_ratio = (ratio(robot, task, WHOLE_ANSWER, "EAIK") for task in (
+            few_task, ANSWER_SINGLE_TASK.format(limits=OPEN_LIMITS)))
+        if few_ratio is not None and single_ratio is not None:
+            out.append(f"- whole answer per pose, {FEW_TARGETS_A_CALL} targets a call, {OPEN_LIMITS}, core / EAIK at "
+                       f"its best ({robot}): {few_ratio:.2f} (single pose: {single_ratio:.2f}; no target of its own)")
     open_single = ANSWER_SINGLE_TASK.format(limits=OPEN_LIMITS)
     for robot in ROUNDED_ROBOTS:  # no target: what a CAD-rounded description costs against the exact arm
         rounded, exact = report.find(rounded_label(robot), open_single, WHOLE_ANSWER), report.find(

@@ -23,6 +23,7 @@ def test_core_benchmark_runs_with_tiny_sizes(capsys):
         for limits in ("limits ±π, no filter", "catalogue limits"):
             assert f"| {robot} | IK answer, {limits}, single pose | core |" in out
             assert f"| {robot} | IK answer, {limits}, batch of 20 | core, solve only (solve_ik_arrays) |" in out
+            assert f"| {robot} | IK answer, {limits}, {core.FEW_TARGETS_A_CALL} targets a call | core |" in out
     for robot in ("UR5", "KUKA KR6"):  # and what a CAD-rounded description of the arm pays
         assert f"| {robot}, parallel axes 1e-5 rad off | IK answer, limits ±π, no filter, single pose | core |" in out
         assert (f"arm with parallel axes 1e-5 rad off / the exact arm, core ({robot}): " in out)

@@ -1,5 +1,6 @@
 """Closed-form IK for a batch of targets: the robot's cached plan proposes candidates, :func:`~._verify.verify`
-checks them, with no loop over targets.
+checks them, with no loop over targets; up to :data:`FEW_TARGETS` targets, a plan with a scalar path answers them
+one at a time on floats, which costs less than the arrays' fixed cost.
 
 Plans are built once per robot and kind of target (:func:`cached_plan`) and kept on the robot: they are values,
 shared by concurrent requests, so a plan's call returns everything its caller needs. A batch larger than
@@ -22,13 +23,17 @@ from ._goals import PoseGoal
 from ._plan import Plan, plan_for
 from ._table import SolutionTable
 from ._types import Candidates, SingularFlags
-from ._verify import Verified, verify, verify_one
+from ._verify import OnePoseVerified, Verified, one_pose_table, verify, verify_one
 from ._types import Sealed
 
 #: Targets solved together: large enough that per-operation overhead is small, small enough that the
 #: (chunk × m × n) temporaries stay in cache and memory is bounded whatever the batch size. A family whose
 #: temporaries per target are a few dozen numbers solves more at once (its ``targets_per_chunk``).
 CHUNK = 4096
+#: Up to this many targets, a plan with a scalar path (``solve_one``) solves them one at a time on floats: the
+#: arrays' fixed cost (about 1.5 ms a chunk for the 6R families) is that of several scalar answers
+#: (benchmarks/core.py's few-targets rows measure the crossing).
+FEW_TARGETS = 8
 
 
 def cached_plan(robot: Robot, *, constrain_orientation: bool, reference: np.ndarray | None) -> Plan | None:
@@ -104,15 +109,26 @@ def chunk_edges(n_targets: int, threads: int, chunk: int = CHUNK) -> list[int]:
 
 
 def _solved(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.ndarray | None) -> Verified:
-    """One chunk: the plan's candidates (its scalar path for one pose when it has one and the pose is clearly
-    generic, verified on floats where :func:`verify_one` can), verified."""
-    candidates = None
-    if len(goal) == 1 and hasattr(plan, "solve_one"):
-        one_pose = plan.solve_one(goal.world_T_targets[0], reference)
-        verified = None if one_pose is None else verify_one(robot, goal, one_pose, reference)
-        if verified is not None:
-            return verified
-        candidates = _one_pose_candidates(one_pose)
+    """One chunk: the plan's candidates, verified. Up to :data:`FEW_TARGETS` targets go through its scalar path
+    one at a time when it has one and every pose is clearly generic (verified on floats where :func:`verify_one`
+    can); otherwise the whole chunk through its arrays."""
+    if len(goal) <= FEW_TARGETS and hasattr(plan, "solve_one"):
+        one_poses = [plan.solve_one(T, reference) for T in goal.world_T_targets]
+        if None not in one_poses:
+            parts = [_one_pose_verified(robot, plan, goal.take([index]) if len(goal) > 1 else goal, one_pose,
+                                        reference) for index, one_pose in enumerate(one_poses)]
+            return parts[0] if len(parts) == 1 else joined(parts, robot.dof)
+    return verify(robot, goal, plan.solve(goal.world_T_targets, reference), reference, plan.label_codes)
+
+
+def _one_pose_verified(robot: Robot, plan: Plan, goal: PoseGoal, one_pose, reference: np.ndarray | None
+                       ) -> Verified:
+    """One target's (``goal`` of one) scalar answer (``OnePose``) verified: on floats where :func:`verify_one`
+    can, else its candidates on arrays, else (a label not clear) the plan's arrays."""
+    verified = verify_one(robot, goal, one_pose, reference)
+    if verified is not None:
+        return verified
+    candidates = _one_pose_candidates(one_pose)
     if candidates is None:
         candidates = plan.solve(goal.world_T_targets, reference)
     return verify(robot, goal, candidates, reference, plan.label_codes)
@@ -142,8 +158,12 @@ def _one_pose_candidates(one_pose) -> Candidates | None:
 
 def joined(parts: list[Verified], dof: int) -> Verified:
     """One :class:`Verified` of consecutive groups of targets."""
-    offsets = np.cumsum([0] + [len(part.complete) for part in parts])
-    tables = [part.table.with_targets(part.table.target + offset) for part, offset in zip(parts, offsets)]
-    return Verified(SolutionTable.concat(tables, dof), np.concatenate([part.complete for part in parts]),
+    if all(isinstance(part, OnePoseVerified) for part in parts) and len({part.rows.names for part in parts}) == 1:
+        table = one_pose_table([part.rows for part in parts], dof)  # one target each: their floats built once
+    else:
+        offsets = np.cumsum([0] + [len(part.complete) for part in parts])
+        table = SolutionTable.concat([part.table.with_targets(part.table.target + offset)
+                                      for part, offset in zip(parts, offsets)], dof)
+    return Verified(table, np.concatenate([part.complete for part in parts]),
                     np.concatenate([part.nearest for part in parts]),
                     SingularFlags.concat([part.singularities for part in parts]))

@@ -431,18 +431,33 @@ class OnePoseRows(NamedTuple):
 
     def table(self, dof: int) -> SolutionTable:
         """The rows as target 0's :class:`SolutionTable`."""
-        count = len(self.joints)  # each column contiguous (the arrays form encodes them as they stand)
-        position, orientation = zip(*self.residuals) if count else ((), ())
-        columns = np.array(list(zip(*self.codes)), dtype=np.int8).reshape(len(self.names), count)
-        labels = {name: (values, column) for name, values, column in zip(self.names, self.values, columns)}
-        return SolutionTable(np.zeros(count, dtype=np.int64), np.array(self.joints, dtype=float).reshape(count, dof),
-                             np.ones(count, dtype=bool), np.array(position, dtype=float),
-                             np.array(orientation, dtype=float), labels)
+        return one_pose_table([self], dof)
 
     def branches(self) -> list[dict]:
         """Each row's branch labels as a dict of its own (:meth:`SolutionTable.branches` of :meth:`table`)."""
         by_codes = branch_labels(self.names, self.values)
         return [by_codes[codes].copy() for codes in self.codes]
+
+
+def one_pose_table(targets: list[OnePoseRows], dof: int) -> SolutionTable:
+    """The rows of consecutive targets (one :class:`OnePoseRows` each, all with the same label names) as one
+    :class:`SolutionTable`, its columns built once."""
+    counts = [len(rows.joints) for rows in targets]
+    count = sum(counts)  # each column contiguous (the arrays form encodes them as they stand)
+    first = targets[0]
+    if len(targets) == 1:
+        joints, residuals, codes = first.joints, first.residuals, first.codes
+        target = np.zeros(count, dtype=np.int64)
+    else:
+        joints = [q for rows in targets for q in rows.joints]
+        residuals = [pair for rows in targets for pair in rows.residuals]
+        codes = [code for rows in targets for code in rows.codes]
+        target = np.repeat(np.arange(len(targets), dtype=np.int64), counts)
+    position, orientation = zip(*residuals) if count else ((), ())
+    columns = np.array(list(zip(*codes)), dtype=np.int8).reshape(len(first.names), count)
+    labels = {name: (values, column) for name, values, column in zip(first.names, first.values, columns)}
+    return SolutionTable(target, np.array(joints, dtype=float).reshape(count, dof), np.ones(count, dtype=bool),
+                         np.array(position, dtype=float), np.array(orientation, dtype=float), labels)
 
 
 class OnePoseVerified(Verified):

@@ -9,7 +9,8 @@ from service.config import Settings
 from service.kinematics import forward_kinematics
 from service.kinematics.ik import _verify, joint_difference, solve_ik, wrap_revolute
 from service.kinematics.ik import cached_plan
-from service.kinematics.ik._closed_form import _one_pose_candidates
+from service.kinematics.ik import AnswerOptions, IKTargets, answer_ik, results_of
+from service.kinematics.ik._closed_form import FEW_TARGETS, _one_pose_candidates
 from service.kinematics.ik._goals import PoseGoal
 from service.kinematics.ik._verify import accepted, residual_arrays
 
@@ -105,6 +106,74 @@ def test_single_pose_answers_do_not_depend_on_the_path(robot_id, monkeypatch):
                 return np.abs(joint_difference(robot, np.array([s.joints for s in result.solutions]),
                                                reference)).max(axis=1)
             np.testing.assert_allclose(distances(fast), distances(slow), rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("robot_id", ["puma560_standard", "ur5", "kuka_kr6_r900_2", "spong_ex3_5_stanford"])
+def test_a_few_targets_answer_as_each_alone_and_as_the_arrays(robot_id, monkeypatch):
+    """Batches of up to FEW_TARGETS targets go through the scalar path one target at a time: each target's answer
+    (status, solutions in order, labels, residuals, singularities, detail) is the one it gets alone, with the
+    catalogue limits and with a reference; and the arrays' (the scalar path switched off) within 1e-9. A batch
+    with a pose the scalar path declines (snapped to a singular configuration, or out of reach) takes the
+    arrays as a whole, and answers the same."""
+    robot = _CATALOGUE.get(robot_id).robot
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    poses = mixed_poses(robot, 48, seed=31)
+    sizes = [2, 3, 5, FEW_TARGETS, FEW_TARGETS + 1]
+    batches, start = [], 0
+    while start < len(poses):
+        size = sizes[len(batches) % len(sizes)]
+        batches.append(poses[start:start + size])
+        start += size
+    reference = random_configurations(robot, 1, seed=32)[0]
+    scalar_answers = 0
+    counted = type(plan).solve_one
+
+    def counting(self, world_T_target, reference=None):
+        nonlocal scalar_answers
+        one_pose = counted(self, world_T_target, reference)
+        scalar_answers += one_pose is not None
+        return one_pose
+
+    for options in (AnswerOptions(), AnswerOptions(reference=reference)):
+        monkeypatch.setattr(type(plan), "solve_one", counting)
+        few = [results_of(answer_ik(robot, IKTargets.poses(batch), options)) for batch in batches]
+        monkeypatch.undo()
+        alone = [[results_of(answer_ik(robot, IKTargets.poses(T[None]), options))[0] for T in batch]
+                 for batch in batches]
+        monkeypatch.setattr(type(plan), "solve_one", lambda self, world_T_target, reference=None: None)
+        arrays = [results_of(answer_ik(robot, IKTargets.poses(batch), options)) for batch in batches]
+        monkeypatch.undo()
+        for few_results, alone_results, array_results in zip(few, alone, arrays):
+            for result, single, array in zip(few_results, alone_results, array_results):
+                _assert_same_answer(robot, result, single, ordered=options.reference is None)
+                _assert_same_answer(robot, result, array, ordered=options.reference is None)
+    # each pose of a batch of up to FEW_TARGETS answered on floats, but the few that the scalar path declines (and
+    # their batches' other poses, which take the arrays with them)
+    assert scalar_answers >= 0.7 * 2 * sum(len(batch) for batch in batches if len(batch) <= FEW_TARGETS)
+
+
+def _assert_same_answer(robot, a, b, *, ordered: bool) -> None:
+    """The same record, and each solution of ``a`` in ``b`` (in the same place when ``ordered``: nearest first may
+    swap two at one distance, the paths' last bits differing) within 1e-9, with its labels and residuals."""
+    assert _record(a) == _record(b)
+    b_joints = _joints(robot, b)
+    for index, solution in enumerate(a.solutions):
+        gaps = np.abs(joint_difference(robot, b_joints, solution.joints)).max(axis=1)
+        match = index if ordered else int(np.argmin(gaps))
+        assert gaps[match] <= 1e-9
+        other = b.solutions[match]
+        assert solution.branch == other.branch
+        assert abs(solution.position_residual - other.position_residual) <= 1e-12 * robot.characteristic_length
+        assert abs(solution.orientation_residual - other.orientation_residual) <= 1e-12
+
+
+def _record(result) -> tuple:
+    return (result.status, result.structure, result.singularities, result.free_joints, result.detail,
+            len(result.solutions))
+
+
+def _joints(robot, result) -> np.ndarray:
+    return np.array([s.joints for s in result.solutions]).reshape(-1, robot.dof)
 
 
 @pytest.mark.parametrize("robot_id", ["puma560_standard", "spong_ex3_5_stanford"])

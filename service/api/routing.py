@@ -25,8 +25,8 @@ its work is small.
   type, a body that orjson refuses or the model rejects, a path parameter its pattern rejects, overridden
   dependencies), FastAPI's handler runs instead, so every error is answered as before, in FastAPI's order of checks.
 * **Small work where it arrives.** The hand-over to a work loop and back costs more than a single FK and about as
-  much as a single IK (two thread wake-ups, a second loop's turn at the GIL). The routes motion planners call one
-  pose at a time (:func:`small_first`) therefore start on the server's loop when their body is small
+  much as a single IK (two thread wake-ups, a second loop's turn at the GIL). The routes motion planners call with
+  one pose or a few waypoints (:func:`small_first`: FK, IK, the IK batch) therefore start on the server's loop when their body is small
   (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes microseconds. After validation the endpoint
   decides, once, whether its work is small (bounded by a few milliseconds whatever the request asks, e.g. a
   closed-form IK whose worst-case answer is a few dozen rows: :func:`~service.kinematics.ik.estimate`), and hands

@@ -1,5 +1,5 @@
-"""Small work where it arrives (service.api.routing.small_first): single FK and IK requests whose work is small run on
-the server's loop; anything that can take longer (a plan to derive, a robot to build, a numeric search, a large
+"""Small work where it arrives (service.api.routing.small_first): single FK and IK requests and IK batches whose work
+is small run on the server's loop; anything that can take longer (a plan to derive, a robot to build, a numeric search, a large
 answer, a picture, a large body) starts again on a work loop before any of it is done, and is answered the same."""
 
 from __future__ import annotations
@@ -83,11 +83,15 @@ def test_the_same_answers_as_on_a_work_loop(client, monkeypatch):
         ("/v1/robots/puma560_standard/ik", {"target": {"position": [5.0, 5.0, 5.0], "quaternion_wxyz": [1, 0, 0, 0]}}),
         ("/v1/robots/puma560_standard/ik", {"target": {"matrix": target}, "reference": [0, 0, 0], "angle_unit": "deg"}),
         ("/v1/robots/ur5/ik", {"target": {"position": [0.3, 0.2, 0.4], "quaternion_wxyz": [0, 1, 0, 0]}}),
+        ("/v1/robots/puma560_standard/ik/batch", {"targets": [{"matrix": target}] * 3, "reference": PUMA_Q}),
+        ("/v1/robots/puma560_standard/ik/batch", {"targets": {"matrices": [np.ravel(target).tolist()] * 4},
+                                                  "format": "arrays"}),
+        ("/v1/robots/puma560_standard/ik/batch", {"targets": [{"matrix": target}, {"position": [5.0, 5.0, 5.0]}]}),
     ]
     here = [client.post(path, json=body) for path, body in requests]
     monkeypatch.setattr(routing, "SMALL_BODY_BYTES", -1)  # every request on a work loop
     on_work_loop = [client.post(path, json=body) for path, body in requests]
-    assert [r.status_code for r in here] == [200, 200, 200, 200, 422, 200]
+    assert [r.status_code for r in here] == [200, 200, 200, 200, 422, 200, 200, 200, 200]
     for small, handed in zip(here, on_work_loop):
         assert small.status_code == handed.status_code
         assert small.content == handed.content
@@ -146,11 +150,23 @@ def test_a_numeric_arm_and_a_new_inline_robot_are_handed_over(client, where, han
     assert where == ["work"]
 
 
-def test_batches_never_run_where_they_arrive(client, where):
+def test_a_few_waypoints_run_where_they_arrive_and_larger_batches_are_handed_over(client, where, hand_overs):
+    """A batch is small as a single IK is (its worst-case answer within SMALL_ROWS rows in all): a motion planner's
+    few waypoints run where they arrive; a batch that may answer more rows, or a body above SMALL_BODY_BYTES, goes
+    to a work loop before anything is solved."""
     target = _puma_target(client)
-    response = client.post("/v1/robots/puma560_standard/ik/batch", json={"targets": [{"matrix": target}]})
-    assert response.status_code == 200
-    assert where == ["work"]
+    client.post("/v1/robots/puma560_standard/ik", json={"target": {"matrix": target}})  # the plan is built
+    where.clear()
+    hand_overs.clear()
+    few = client.post("/v1/robots/puma560_standard/ik/batch", json={"targets": [{"matrix": target}] * 4})
+    assert few.status_code == 200 and len(few.json()["results"]) == 4
+    assert where == ["here"] and hand_overs == []
+    wide = [{"lower": -4 * np.pi, "upper": 4 * np.pi}] * 6  # up to 1,024 rows a target
+    assert client.post("/v1/robots/puma560_standard/ik/batch",
+                       json={"targets": [{"matrix": target}] * 2, "limits": wide}).status_code == 200
+    many = {"targets": {"matrices": [np.ravel(target).tolist()] * 100}, "format": "arrays"}
+    assert client.post("/v1/robots/puma560_standard/ik/batch", json=many).status_code == 200
+    assert where == ["here", "work", "work"] and len(hand_overs) == 2
 
 
 def test_a_small_request_still_meets_its_errors_as_problems(client, hand_overs):

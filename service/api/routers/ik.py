@@ -73,13 +73,19 @@ def _single_response(request: Request, asked: AskedIK, body: IKRequest, render: 
 
 @router.post("/robots/{robot_id}/ik/batch", operation_id="inverse_kinematics_batch",
              response_model=IKBatchResponse | IKBatchArraysResponse, responses=problem_responses(404, 413, 422))
-def inverse_kinematics_batch(request: Request, body: IKBatchRequest, ref: RobotRef = Depends(catalogue_robot)):
+@small_first  # a motion planner's few waypoints: computed where the request is, as a single IK
+async def inverse_kinematics_batch(request: Request, body: IKBatchRequest, ref: RobotRef = Depends(catalogue_robot)):
     """Every solution for each target; the analytic solvers run vectorised over the targets."""
     check_batch_size(request, body.target_count, "targets")
     asked = ik_request_in_core(request, ref, body)
+    small = is_small(asked.ref.robot, asked.targets, asked.options)
+    return await computed(lambda: _batch_response(request, asked, body, small), small=small)
+
+
+def _batch_response(request: Request, asked: AskedIK, body: IKBatchRequest, small: bool):
     encode = ik_columns if body.format == "arrays" else ik_objects
-    encoded = encode(asked.ref.id, asked.ref.robot, answered(request, asked, body.format), body.angle_unit,
-                     budget_of(request))
+    encoded = encode(asked.ref.id, asked.ref.robot, answered(request, asked, body.format, small=small),
+                     body.angle_unit, budget_of(request))
     # built field by field to the response models (a test validates them), so encoded as they stand: validating
     # tens of thousands of solution objects again would cost more than solving them
     return FastJSONResponse(encoded if body.format == "arrays" else {"robot_id": asked.ref.id, "results": encoded})

@@ -26,14 +26,15 @@ its work is small.
   dependencies), FastAPI's handler runs instead, so every error is answered as before, in FastAPI's order of checks.
 * **Small work where it arrives.** The hand-over to a work loop and back costs more than a single FK and about as
   much as a single IK (two thread wake-ups, a second loop's turn at the GIL). The routes motion planners call with
-  one pose or a few waypoints (:func:`small_first`: FK, IK, the IK batch) therefore start on the server's loop when their body is small
-  (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes microseconds. After validation the endpoint
-  decides, once, whether its work is small (bounded by a few milliseconds whatever the request asks, e.g. a
-  closed-form IK whose worst-case answer is a few dozen rows: :func:`~service.kinematics.ik.estimate`), and hands
-  it to :func:`computed`: small work runs where it is; other work goes to a work loop, in its turn, and the
-  endpoint awaits it. Nothing runs twice. Only while no request computes on a work loop: under mixed load, small
-  requests take their turns like the others, and the server's loop stays free for I/O and the health routes (in
-  the soak, running them where they arrived doubled ``/healthz``'s p99).
+  one pose or a few waypoints (:func:`small_first`: FK, IK and their batches) therefore start on the server's loop
+  when their body is small (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes microseconds. After
+  validation the endpoint decides, once, whether its work is small (bounded by a few milliseconds whatever the
+  request asks, e.g. a closed-form IK whose worst-case answer is a few dozen rows:
+  :func:`~service.kinematics.ik.estimate`), and hands it to :func:`computed`: small work runs where it is; other
+  work goes to a work loop, in its turn, and the endpoint awaits it. Nothing runs twice. Only while no request
+  computes on a work loop: under mixed load, small requests take their turns like the others, and the server's loop
+  stays free for I/O and the health routes (in the soak, running them where they arrived doubled ``/healthz``'s
+  p99).
 """
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from service.api.schemas.fk import FKResponse
+from service.api.schemas.fk import FKBatchResponse, FKResponse
 from tests.conftest import DATA, assert_problem
 from tests.oracles.closed_forms import CLOSED_FORMS
 from tests.oracles.rotations import matrix_of_quaternion
@@ -68,6 +68,21 @@ def test_batch_equals_single_calls(client):
     batch = client.post("/v1/robots/spong_ex3_5_stanford/fk/batch", json={"joints": q.tolist()}).json()["poses"]
     for row, pose in zip(q, batch):
         assert pose == _fk(client, "spong_ex3_5_stanford", row)["pose"]
+
+
+@pytest.mark.parametrize("rows", [1, 300, 3000])
+def test_the_batch_answer_is_its_response_model(client, rows):
+    """The batch's answer is built field by field, not through FKBatchResponse: it must be what the model says, in
+    degrees and with a tool too, for a small body (answered where it arrives) and a large one (on a work loop)."""
+    q = np.random.default_rng(rows).uniform(-180, 180, (rows, 6))
+    tool = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.1], [0.0, 0.0, 0.0, 1.0]]
+    body = {"joints": q.tolist(), "angle_unit": "deg", "tool": tool}
+    response = client.post("/v1/robots/ur5/fk/batch", json=body)
+    assert response.status_code == 200, response.text
+    answer = response.json()
+    assert FKBatchResponse.model_validate(answer).model_dump(mode="json") == answer
+    assert answer["robot_id"] == "ur5" and len(answer["poses"]) == rows
+    assert answer["poses"][-1] == _fk(client, "ur5", q[-1], angle_unit="deg", tool=body["tool"])["pose"]
 
 
 def test_degrees_equal_radians_and_prismatic_joints_are_not_converted(client):

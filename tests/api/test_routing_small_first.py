@@ -87,11 +87,12 @@ def test_the_same_answers_as_on_a_work_loop(client, monkeypatch):
         ("/v1/robots/puma560_standard/ik/batch", {"targets": {"matrices": [np.ravel(target).tolist()] * 4},
                                                   "format": "arrays"}),
         ("/v1/robots/puma560_standard/ik/batch", {"targets": [{"matrix": target}, {"position": [5.0, 5.0, 5.0]}]}),
+        ("/v1/robots/puma560_standard/fk/batch", {"joints": [PUMA_Q, [0.0] * 6], "angle_unit": "deg"}),
     ]
     here = [client.post(path, json=body) for path, body in requests]
     monkeypatch.setattr(routing, "SMALL_BODY_BYTES", -1)  # every request on a work loop
     on_work_loop = [client.post(path, json=body) for path, body in requests]
-    assert [r.status_code for r in here] == [200, 200, 200, 200, 422, 200, 200, 200, 200]
+    assert [r.status_code for r in here] == [200, 200, 200, 200, 422, 200, 200, 200, 200, 200]
     for small, handed in zip(here, on_work_loop):
         assert small.status_code == handed.status_code
         assert small.content == handed.content
@@ -167,6 +168,16 @@ def test_a_few_waypoints_run_where_they_arrive_and_larger_batches_are_handed_ove
     many = {"targets": {"matrices": [np.ravel(target).tolist()] * 100}, "format": "arrays"}
     assert client.post("/v1/robots/puma560_standard/ik/batch", json=many).status_code == 200
     assert where == ["here", "work", "work"] and len(hand_overs) == 2
+
+
+def test_an_fk_batch_of_a_small_body_runs_where_it_arrives(client, hand_overs):
+    """A body within SMALL_BODY_BYTES holds a few hundred rows at most: their FK and encoding are small work."""
+    hand_overs.clear()
+    rows = np.random.default_rng(2).uniform(-3, 3, (100, 6)).round(6).tolist()
+    assert client.post("/v1/robots/puma560_standard/fk/batch", json={"joints": rows[:50]}).status_code == 200
+    assert hand_overs == []
+    assert client.post("/v1/robots/puma560_standard/fk/batch", json={"joints": rows * 20}).status_code == 200
+    assert hand_overs == ["handed over"]
 
 
 def test_a_small_request_still_meets_its_errors_as_problems(client, hand_overs):

@@ -11,6 +11,8 @@ bodies go in through a Lua script):
   robots of three families (PUMA 560, UR5, KUKA KR 6 R900-2) and on an inline robot
   (the PUMA's description sent in the body), beside ``GET /healthz`` of the same
   server as the framework's ceiling, each as a share of it;
+* requests/s for an IK batch of a motion planner's few waypoints (:data:`WAYPOINTS`
+  targets, the objects form, the catalogue limits), as poses/s against the single IK's;
 * the same single IK against two worker processes (``KIN_WORKERS=2``), for the
   scale-out ratio;
 * these rows run at ``KIN_LOG_LEVEL=warning``, with no access log; ``/healthz``,
@@ -60,6 +62,9 @@ ROOT = Path(__file__).resolve().parent.parent
 ROBOT = "puma560_standard"
 #: single-pose IK rows: the PUMA and UR5 families and one of the offset-shoulder (OPW) arms
 SINGLE_IK_ROBOTS = ("puma560_standard", "ur5", "kuka_kr6_r900_2")
+#: a motion planner's handful of waypoints in one batch request
+WAYPOINTS = 4
+WAYPOINTS_ROW = f"POST ik/batch, {WAYPOINTS} waypoints, {ROBOT}"
 #: the rows run at the default log level, an access line per request
 INFO = "KIN_LOG_LEVEL=info (the default)"
 
@@ -179,6 +184,9 @@ def main(argv: list[str] | None = None) -> int:
         # no "limits": the catalogue's limits apply, as they do for a user who sends none
         "batch_limited": json.dumps({"targets": [{"matrix": m} for m in T.tolist()], "format": "arrays"}).encode(),
     }
+    # a motion planner's few waypoints in one call (the objects form, the catalogue limits): poses/s against the
+    # single IK's requests/s
+    bodies["batch_waypoints"] = json.dumps({"targets": [{"matrix": m} for m in T[:WAYPOINTS].tolist()]}).encode()
     for robot_id in SINGLE_IK_ROBOTS:  # one pose each from the arm's own FK, with its catalogue limits
         arm = catalogue.get(robot_id).robot
         pose = forward_kinematics(arm, sample_configurations(arm, 1, seed=5)[0])
@@ -209,6 +217,8 @@ def main(argv: list[str] | None = None) -> int:
                 loads.append(run_wrk(f"POST ik, one pose, {robot_id}", f"{base}/v1/robots/{robot_id}/ik",
                                      scripts[f"ik_{robot_id}"], **single))
             loads.append(run_wrk(f"POST /v1/ik, one pose, inline {ROBOT}", f"{base}/v1/ik", scripts["ik_inline"],
+                                 **single))
+            loads.append(run_wrk(WAYPOINTS_ROW, f"{base}/v1/robots/{ROBOT}/ik/batch", scripts["batch_waypoints"],
                                  **single))
             for form, what in (("arrays", "format arrays"), ("objects", "format objects"),
                                ("matrices", "targets as matrix rows, format arrays"),
@@ -256,7 +266,8 @@ def main(argv: list[str] | None = None) -> int:
     print("| endpoint | requests/s | share of /healthz (same log level) | p50 ms | p99 ms | requests | poses/s |")
     print("|---|---:|---:|---:|---:|---:|---:|")
     for load in loads:
-        poses = load.requests_per_second * args.batch if "batch" in load.name else None
+        poses = (load.requests_per_second * (WAYPOINTS if load.name == WAYPOINTS_ROW else args.batch)
+                 if "batch" in load.name else None)
         share = load.requests_per_second / (healthz_logged if INFO in load.name else ceiling).requests_per_second
         print(f"| {load.name} | {load.requests_per_second:,.1f} | {share:.2f} | {load.p50_ms:.2f} | "
               f"{load.p99_ms:.2f} | {load.requests:,} | {'' if poses is None else f'{poses:,.0f}'} |")
@@ -291,6 +302,9 @@ def main(argv: list[str] | None = None) -> int:
     matrices = by_name[f"POST ik/batch, {args.batch:,} targets, targets as matrix rows, format arrays"]
     print(f"- {args.batch:,}-target batch over HTTP (targets as matrix rows, arrays form, p50) / core batch time: "
           f"{(matrices.p50_ms / 1e3) / core:.2f}")
+    waypoints = by_name[WAYPOINTS_ROW]
+    print(f"- {WAYPOINTS} waypoints in one batch / one pose a request, poses/s ({ROBOT}, catalogue limits): "
+          f"{waypoints.requests_per_second * WAYPOINTS / ik.requests_per_second:.2f}")
     print(f"- the access line of the default log level, per request (1 / requests/s at info - 1 / requests/s at "
           f"warning): /healthz {_per_request_us(healthz_logged, ceiling):.0f} µs, FK "
           f"{_per_request_us(fk_logged, fk):.0f} µs, single IK {_per_request_us(ik_logged, ik):.0f} µs; at info, "

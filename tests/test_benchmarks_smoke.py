@@ -109,12 +109,13 @@ def test_http_benchmark_runs_with_tiny_sizes(capsys):
     assert "| GET /healthz (framework ceiling) |" in out
     assert "single IK on the PUMA or UR5 / GET /healthz" in out
     for row in ("POST ik, one pose, kuka_kr6_r900_2", "POST /v1/ik, one pose, inline puma560_standard",
-                "POST ik, one pose, puma560_standard, 2 workers"):
+                "POST ik, one pose, puma560_standard, 2 workers", http_throughput.WAYPOINTS_ROW):
         assert f"| {row} |" in out
     assert "targets, format arrays, catalogue limits |" in out
     for row in ("GET /healthz", "POST fk, one configuration", "POST ik, one pose, puma560_standard"):
         assert f"| {row}, KIN_LOG_LEVEL=info (the default) |" in out
     assert "- the access line of the default log level, per request" in out
+    assert f"- {http_throughput.WAYPOINTS} waypoints in one batch / one pose a request, poses/s" in out
 
 
 def test_http_benchmark_says_when_wrk_is_missing(capsys, monkeypatch):

@@ -20,16 +20,17 @@ its work is small.
 * **FastAPI's general solver skipped when it has nothing to do.** For a route whose parameters are one JSON body
   model, the ``Request``, optional query parameters and async dependencies that read only path parameters (the
   catalogue robot), :class:`_PlainArguments` finds the endpoint's arguments with the same validators FastAPI uses
-  (the body field's, the path parameters'): a whole FK request in process, about 115 µs against about 160 µs
-  through FastAPI's solver (benchmarks/request_profile.py prints both). Whenever anything is not as expected (a query string, another content
-  type, a body that orjson refuses or the model rejects, a path parameter its pattern rejects, overridden
-  dependencies), FastAPI's handler runs instead, so every error is answered as before, in FastAPI's order of checks.
+  (the body field's, the path parameters'): a whole FK request in process, about 115 µs against about 160 µs through
+  FastAPI's solver (benchmarks/request_profile.py prints both). Whenever anything is not as expected (a query
+  string, another content type, a body that orjson refuses or the model rejects, a path parameter its pattern
+  rejects, overridden dependencies), FastAPI's handler runs instead, so every error is answered as before, in
+  FastAPI's order of checks.
 * **Small work where it arrives.** The hand-over to a work loop and back costs more than a single FK and about as
   much as a single IK (two thread wake-ups, a second loop's turn at the GIL). The routes motion planners call with
-  one pose or a few waypoints (:func:`small_first`: FK, IK and their batches) therefore start on the server's loop
-  when their body is small (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes microseconds. After
-  validation the endpoint decides, once, whether its work is small (bounded by a few milliseconds whatever the
-  request asks, e.g. a closed-form IK whose worst-case answer is a few dozen rows:
+  one pose or a few waypoints (:func:`small_first`: FK, IK, their batches, the limits check) therefore start on the
+  server's loop when their body is small (:data:`SMALL_BODY_BYTES`): parsing and validating it there takes
+  microseconds. After validation the endpoint decides, once, whether its work is small (bounded by a few
+  milliseconds whatever the request asks, e.g. a closed-form IK whose worst-case answer is a few dozen rows:
   :func:`~service.kinematics.ik.estimate`), and hands it to :func:`computed`: small work runs where it is; other
   work goes to a work loop, in its turn, and the endpoint awaits it. Nothing runs twice. Only while no request
   computes on a work loop: under mixed load, small requests take their turns like the others, and the server's loop

@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 
+from service.api.schemas.limits import LimitsResponse
 from tests.conftest import assert_problem, catalogue_robot
 from tests.ik_helpers import wrapped
 
@@ -453,6 +454,27 @@ def test_limits_endpoint_in_degrees(client):
     assert first["equivalent"] == pytest.approx([0, 90, -90, 0, 0, -60])
     assert second["equivalent"] is None and [v["joint"] for v in second["violations"]] == [3]
     assert third["equivalent"] is None and third["violations"][0]["upper"] == pytest.approx(160)
+
+
+@pytest.mark.parametrize("rows", [40, 3000])
+def test_the_limits_answer_is_its_response_model(client, rows):
+    """The answer is built field by field, not through LimitsResponse: it must be what the model says, with
+    violations, equivalents and none, an override with an open bound, in degrees, for a small body (answered where
+    it arrives) and a large one, catalogue and inline."""
+    q = np.random.default_rng(rows).uniform(-500, 500, (rows, 6)).round(3)
+    limits = [{"lower": -90, "upper": 90}, {"lower": None, "upper": 45}] + [None] * 4
+    requests = [("/v1/robots/ur5/limits", {"joints": q.tolist(), "angle_unit": "deg"}),
+                ("/v1/robots/puma560_standard/limits", {"joints": q.tolist(), "angle_unit": "deg", "limits": limits}),
+                ("/v1/limits", {"robot": PLANAR, "joints": q[:, :2].tolist(), "angle_unit": "deg"})]
+    kinds = set()
+    for path, body in requests:
+        response = client.post(path, json=body)
+        assert response.status_code == 200, response.text
+        answer = response.json()
+        assert LimitsResponse.model_validate(answer).model_dump(mode="json") == answer
+        assert len(answer["results"]) == rows
+        kinds |= {(r["within_limits"], r["equivalent"] is None) for r in answer["results"]}
+    assert kinds == {(True, True), (False, False), (False, True)}  # within; outside, with and without an equivalent
 
 
 def test_limits_inline_with_an_override(client):

@@ -1,6 +1,7 @@
-"""Small work where it arrives (service.api.routing.small_first): single FK and IK requests and IK batches whose work
-is small run on the server's loop; anything that can take longer (a plan to derive, a robot to build, a numeric search, a large
-answer, a picture, a large body) starts again on a work loop before any of it is done, and is answered the same."""
+"""Small work where it arrives (service.api.routing.small_first): single FK and IK requests and their batches whose work
+is small run on the server's loop; anything that can take longer (a plan to derive, a robot to build, a numeric
+search, a large answer, a picture, a large body) starts again on a work loop before any of it is done, and is
+answered the same."""
 
 from __future__ import annotations
 
@@ -88,11 +89,12 @@ def test_the_same_answers_as_on_a_work_loop(client, monkeypatch):
                                                   "format": "arrays"}),
         ("/v1/robots/puma560_standard/ik/batch", {"targets": [{"matrix": target}, {"position": [5.0, 5.0, 5.0]}]}),
         ("/v1/robots/puma560_standard/fk/batch", {"joints": [PUMA_Q, [0.0] * 6], "angle_unit": "deg"}),
+        ("/v1/robots/puma560_standard/limits", {"joints": [PUMA_Q, [7.0] * 6]}),
     ]
     here = [client.post(path, json=body) for path, body in requests]
     monkeypatch.setattr(routing, "SMALL_BODY_BYTES", -1)  # every request on a work loop
     on_work_loop = [client.post(path, json=body) for path, body in requests]
-    assert [r.status_code for r in here] == [200, 200, 200, 200, 422, 200, 200, 200, 200, 200]
+    assert [r.status_code for r in here] == [200, 200, 200, 200, 422, 200, 200, 200, 200, 200, 200]
     for small, handed in zip(here, on_work_loop):
         assert small.status_code == handed.status_code
         assert small.content == handed.content

@@ -109,15 +109,19 @@ def chunk_edges(n_targets: int, threads: int, chunk: int = CHUNK) -> list[int]:
 
 
 def _solved(robot: Robot, plan: Plan, goal: PoseGoal, reference: np.ndarray | None) -> Verified:
-    """One chunk: the plan's candidates, verified. Up to :data:`FEW_TARGETS` targets go through its scalar path
-    one at a time when it has one and every pose is clearly generic (verified on floats where :func:`verify_one`
-    can); otherwise the whole chunk through its arrays."""
-    if len(goal) <= FEW_TARGETS and hasattr(plan, "solve_one"):
+    """One chunk: the plan's candidates, verified. One target, or up to :data:`FEW_TARGETS`, go through its scalar
+    path (one at a time) when it has one and every pose is clearly generic, verified on floats where
+    :func:`verify_one` can; otherwise the whole chunk through its arrays."""
+    n_targets = len(goal)
+    if n_targets == 1 and hasattr(plan, "solve_one"):
+        one_pose = plan.solve_one(goal.world_T_targets[0], reference)
+        if one_pose is not None:
+            return _one_pose_verified(robot, plan, goal, one_pose, reference)
+    elif n_targets <= FEW_TARGETS and hasattr(plan, "solve_one"):
         one_poses = [plan.solve_one(T, reference) for T in goal.world_T_targets]
         if None not in one_poses:
-            parts = [_one_pose_verified(robot, plan, goal.take([index]) if len(goal) > 1 else goal, one_pose,
-                                        reference) for index, one_pose in enumerate(one_poses)]
-            return parts[0] if len(parts) == 1 else joined(parts, robot.dof)
+            return joined([_one_pose_verified(robot, plan, goal.take([index]), one_pose, reference)
+                           for index, one_pose in enumerate(one_poses)], robot.dof)
     return verify(robot, goal, plan.solve(goal.world_T_targets, reference), reference, plan.label_codes)
 
 

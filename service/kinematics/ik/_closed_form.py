@@ -31,8 +31,8 @@ from ._types import Sealed
 #: temporaries per target are a few dozen numbers solves more at once (its ``targets_per_chunk``).
 CHUNK = 4096
 #: Up to this many targets, a plan with a scalar path (``solve_one``) solves them one at a time on floats: the
-#: arrays' fixed cost (about 1.5 ms a chunk for the 6R families) is that of several scalar answers
-#: (benchmarks/core.py's few-targets rows measure the crossing).
+#: arrays' fixed cost (about 1.5 ms a chunk for the 6R families) is that of several scalar answers. The two paths
+#: cross near 8 for the PUMA, UR and OPW types (a call of 8 targets 1.3–2.2 ms on floats, 1.4–2.4 on the arrays).
 FEW_TARGETS = 8
 
 

@@ -356,6 +356,23 @@ WIRE_NOTES = {
 }
 
 
+def violations_to_wire(limits: Limits, scale: np.ndarray, outside: np.ndarray, values: list[list[float]]
+                       ) -> dict[int, list[dict]]:
+    """The violations of S rows, keyed by row (rows without one are absent): each joint that ``outside`` (S, n)
+    marks, with its value as ``values`` (the rows as lists, in the request's unit) holds it and the bounds it breaks
+    in that unit (``scale`` (n,): the unit's factor to the core's, :func:`_unit_scale`), an open side null. What
+    :func:`violation_to_wire` gives each, with the bounds converted once for all rows."""
+    violations: dict[int, list[dict]] = {}
+    rows, columns = np.nonzero(outside)
+    if len(rows):
+        lower, upper = ([None if math.isinf(bound) else bound for bound in (side / scale).tolist()]
+                        for side in (limits.lower, limits.upper))
+        for k, j in zip(rows.tolist(), columns.tolist()):
+            violations.setdefault(k, []).append({"joint": j, "value": values[k][j], "lower": lower[j],
+                                                 "upper": upper[j]})
+    return violations
+
+
 def violation_to_wire(robot: Robot, violation: Violation, unit: AngleUnit) -> dict:
     """A violation in the request's units; an open side of the range is null."""
     scale = float(_unit_scale(robot, unit)[violation.joint])

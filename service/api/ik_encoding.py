@@ -15,7 +15,7 @@ import numpy as np
 from ..kinematics import Budget, Robot
 from ..kinematics.ik import IKAnswer, SolutionTable
 from ..units import radians_per
-from .boundary import WIRE_NOTES, _unit_scale
+from .boundary import WIRE_NOTES, _unit_scale, violations_to_wire
 
 
 def ik_objects(robot_id: str, robot: Robot, answer: IKAnswer, unit: str, budget: Budget) -> list[dict]:
@@ -55,13 +55,7 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
     orientation = _listed(table.orientation, np.isnan)
     within = table.within_limits.tolist()
     branches = table.branches()
-    violations: dict[int, list[dict]] = {}
-    rows, columns = np.nonzero(outside)
-    if len(rows):
-        lower, upper = _listed(answer.limits.lower / scale, np.isinf), _listed(answer.limits.upper / scale, np.isinf)
-        for k, j in zip(rows.tolist(), columns.tolist()):
-            violations.setdefault(k, []).append({"joint": j, "value": joints[k][j], "lower": lower[j],
-                                                 "upper": upper[j]})
+    violations = violations_to_wire(answer.limits, scale, outside, joints)
     targets = table.target.tolist()
     row_violations = [violations.get(k, ()) for k in range(len(targets))] if violations else [()] * len(targets)
     if any(free_of_target) or table.roll is not None:

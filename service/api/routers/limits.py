@@ -5,7 +5,7 @@ from __future__ import annotations
 from fastapi import APIRouter, Depends, Request
 
 from ...kinematics import LIMIT_TOLERANCE, check_limits
-from ..boundary import joints_from_core, joints_to_core, limits_to_core, located, violation_to_wire
+from ..boundary import _unit_scale, joints_from_core, joints_to_core, limits_to_core, located, violations_to_wire
 from ..deps import RobotRef, catalogue_robot, check_batch_size, inline_robot, with_request_frames
 from ..problems import problem_responses
 from ..responses import FastJSONResponse
@@ -24,10 +24,10 @@ def _check(request: Request, ref: RobotRef, body: LimitsRequest) -> FastJSONResp
     with located("body", "limits"):
         limits = limits_to_core(robot, body.limits, body.angle_unit)
     check = check_limits(robot, limits, rows)
+    scale = _unit_scale(robot, body.angle_unit)
+    violations = violations_to_wire(limits, scale, check.outside, (check.q / scale).tolist())
     equivalents = joints_from_core(robot, check.equivalent, body.angle_unit).tolist()
-    results = [{"within_limits": inside,
-                "violations": [] if inside else [violation_to_wire(robot, v, body.angle_unit)
-                                                 for v in check.violations(row)],
+    results = [{"within_limits": inside, "violations": violations.get(row, []),
                 "equivalent": equivalents[row] if fits else None}
                for row, (inside, fits) in enumerate(zip(check.inside.tolist(), check.fits.tolist()))]
     # built to LimitsResponse field by field (a test validates it): validated and serialised through the model again,

@@ -356,20 +356,21 @@ WIRE_NOTES = {
 }
 
 
-def violations_to_wire(limits: Limits, scale: np.ndarray, outside: np.ndarray, values: list[list[float]]
+def violations_to_wire(limits: Limits, scale: np.ndarray, outside: np.ndarray, q: np.ndarray
                        ) -> dict[int, list[dict]]:
-    """The violations of S rows, keyed by row (rows without one are absent): each joint that ``outside`` (S, n)
-    marks, with its value as ``values`` (the rows as lists, in the request's unit) holds it and the bounds it breaks
-    in that unit (``scale`` (n,): the unit's factor to the core's, :func:`_unit_scale`), an open side null. What
-    :func:`violation_to_wire` gives each, with the bounds converted once for all rows."""
+    """The violations of S joint vectors q (S, n, the core's units), keyed by row (rows without one are absent):
+    each joint that ``outside`` (S, n) marks, with its value and the bounds it breaks in the request's unit
+    (``scale`` (n,): its factor to the core's, :func:`_unit_scale`), an open side null. What
+    :func:`violation_to_wire` gives each, with the bounds converted once and only the violating values divided."""
     violations: dict[int, list[dict]] = {}
     rows, columns = np.nonzero(outside)
-    if len(rows):
-        lower, upper = ([None if math.isinf(bound) else bound for bound in (side / scale).tolist()]
-                        for side in (limits.lower, limits.upper))
-        for k, j in zip(rows.tolist(), columns.tolist()):
-            violations.setdefault(k, []).append({"joint": j, "value": values[k][j], "lower": lower[j],
-                                                 "upper": upper[j]})
+    if not len(rows):
+        return violations
+    lower, upper = ([None if math.isinf(bound) else bound for bound in (side / scale).tolist()]
+                    for side in (limits.lower, limits.upper))
+    values = (q[rows, columns] / scale[columns]).tolist()
+    for k, j, value in zip(rows.tolist(), columns.tolist(), values):
+        violations.setdefault(k, []).append({"joint": j, "value": value, "lower": lower[j], "upper": upper[j]})
     return violations
 
 

@@ -55,7 +55,7 @@ def _solution_dicts(table: SolutionTable, outside: np.ndarray, answer: IKAnswer,
     orientation = _listed(table.orientation, np.isnan)
     within = table.within_limits.tolist()
     branches = table.branches()
-    violations = violations_to_wire(answer.limits, scale, outside, joints)
+    violations = violations_to_wire(answer.limits, scale, outside, table.joints)
     targets = table.target.tolist()
     row_violations = [violations.get(k, ()) for k in range(len(targets))] if violations else [()] * len(targets)
     if any(free_of_target) or table.roll is not None:

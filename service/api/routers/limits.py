@@ -24,8 +24,7 @@ def _check(request: Request, ref: RobotRef, body: LimitsRequest) -> FastJSONResp
     with located("body", "limits"):
         limits = limits_to_core(robot, body.limits, body.angle_unit)
     check = check_limits(robot, limits, rows)
-    scale = _unit_scale(robot, body.angle_unit)
-    violations = violations_to_wire(limits, scale, check.outside, (check.q / scale).tolist())
+    violations = violations_to_wire(limits, _unit_scale(robot, body.angle_unit), check.outside, check.q)
     equivalents = joints_from_core(robot, check.equivalent, body.angle_unit).tolist()
     results = [{"within_limits": inside, "violations": violations.get(row, []),
                 "equivalent": equivalents[row] if fits else None}

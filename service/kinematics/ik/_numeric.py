@@ -69,7 +69,7 @@ def initial_guesses(robot: Robot, count: int, rng: np.random.Generator, referenc
         lower = np.where(empty, own_lower, lower)
         upper = np.where(empty, np.minimum(own_lower + width, robot.upper), upper)
     starts = rng.uniform(lower, upper, (count, robot.dof))
-    starts[0] = np.clip(0.0, lower, upper)
+    starts[:1] = np.clip(0.0, lower, upper)  # none when count is 0
     if reference is not None and count > 1:
         starts[1] = reference
     return starts
@@ -113,9 +113,10 @@ def search(robot: Robot, goal: Goal, options: NumericOptions, reference: np.ndar
     for begin in range(0, total, chunk):
         index = np.arange(begin, min(begin + chunk, total))
         rows, slots = np.divmod(index, per_target)
-        starts = common[np.minimum(slots, len(common) - 1)]
+        seeded = slots >= len(common)
+        starts = np.empty((len(index), n))
+        starts[~seeded] = common[slots[~seeded]]
         if own:
-            seeded = slots >= len(common)
             starts[seeded] = seeds[rows[seeded], slots[seeded] - len(common)]  # not finite: never active
         if held:
             starts[:, list(held)] = list(held.values())

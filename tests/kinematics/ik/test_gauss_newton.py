@@ -34,3 +34,25 @@ def test_newton_steps_along_a_near_singular_direction_never_raise_a_rows_error()
     assert (start > 1e-7).all() and (start < 1e-5).all(), start  # the narrow misses of the probe
     assert (reached.error <= start).all(), (start, reached.error)
     assert np.allclose(forward_kinematics(robot, reached.joints), goal.world_T_targets[0], atol=1e-5)
+
+
+def test_the_search_runs_from_each_targets_seeds_with_or_without_common_starts():
+    """search() takes each target's own seeds after the common starts, and from the seeds alone when a library
+    caller asks for no common start (starts=0): each target reaches the configuration its seed lies next to, a
+    seed that is not finite never becomes a candidate, and the rows stay each target's own."""
+    from service.kinematics.ik._numeric import NumericOptions, search
+
+    arm = Robot([Joint(f"q{i}", "revolute", a, alpha, d, 0.0) for i, (a, alpha, d) in enumerate(
+        [(0.0, np.pi / 2, 0.4), (0.5, 0.0, 0.0), (0.1, np.pi / 2, 0.0), (0.0, -np.pi / 2, 0.45),
+         (0.0, np.pi / 2, 0.0), (0.0, 0.0, 0.1)])])
+    truth = np.array([[0.3, -0.4, 0.5, 0.2, -0.6, 0.7], [-1.1, 0.2, -0.3, 1.0, 0.9, -2.0]])
+    goal = PoseGoal(forward_kinematics(arm, truth))
+    seeds = np.full((2, 2, 6), np.nan)
+    seeds[:, 0] = truth + 0.02  # beside each target's own configuration; the second seed of each is empty
+    for starts in (0, 3):
+        found = search(arm, goal, NumericOptions(starts=starts), None, seeds=seeds)
+        assert found.candidates.joints.shape == (2, starts + 2, 6)
+        for target in range(2):
+            valid = found.candidates.valid[target]
+            assert valid[starts] and not valid[starts + 1]
+            np.testing.assert_allclose(found.candidates.joints[target, starts], truth[target], atol=1e-9)

@@ -18,7 +18,7 @@ import numpy as np
 from .._angles import wrap_any_float, wrap_float
 from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, POLISH_RESIDUAL
 from . import _scalar as scalar
-from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, Positioner
+from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, ParallelShoulder, Positioner
 from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, move_point, perpendicular_unit, rotate_about, rotation_about
 from ._structure import target_error
@@ -267,11 +267,17 @@ class DecoupledPlan(Sealed):
             return None
 
     @cached_property
-    def _one_pose(self) -> "_SphericalWristOnePose | None":
+    def _one_pose(self) -> "_SphericalWristOnePose | _ParallelShoulderOnePose | None":
         """The scalar solver when joints 4–6 are a spherical wrist and joints 1–3 an intersecting shoulder with a
         revolute joint 3 (the PUMA type) or with a slide through axis 2 (the Stanford type), or an offset shoulder
-        with joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB, Fanuc), else None."""
+        with joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB, Fanuc); when joints 1–3 are a SCARA shoulder
+        with a roll or nothing after them; else None."""
         positioner = self.positioner
+        if (isinstance(positioner, ParallelShoulder) and positioner.joints == (0, 1, 2) and not positioner.free_joints
+                and (self.wrist is None or isinstance(self.wrist, Roll) and self.wrist.joints == (3,))
+                and [*positioner.joints, *(self.wrist.joints if self.wrist else ()), *sorted(self.fixed)]
+                == list(range(self.dof))):
+            return _ParallelShoulderOnePose(self)
         if not (positioner is not None and isinstance(self.wrist, SphericalWrist) and not self.fixed
                 and not positioner.free_joints
                 and positioner.joints == (0, 1, 2) and self.wrist.joints == (3, 4, 5)):
@@ -578,3 +584,78 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
         rejection = scalar.reject(elbow, line)
         return scalar.side_code(scalar.dot(rejection, self.up), scalar.norm(elbow))
 
+
+
+class _ParallelShoulderOnePose:
+    """:class:`DecoupledPlan` with a :class:`ParallelShoulder` (the SCARA arm: joints 1 and 2 about parallel axes,
+    a slide along them) and a roll after it, or nothing (a pose or a position target of a three-joint SCARA, or a
+    position target with the joints past the third held): the slide from the height, subproblem 3 about axis 2
+    for the distance from axis 1 (the two assembly modes, in the positioner's slot order), 1 about axis 1, then 1
+    for the roll, and the assembly mode's label, as :meth:`ParallelShoulder.solve` and ``label_codes`` work them
+    out."""
+
+    names = ("assembly_mode",)
+    values = ((1, 2),)
+
+    def __init__(self, plan: DecoupledPlan) -> None:
+        positioner = plan.positioner
+        g, (i, j, k) = positioner.geometry, positioner.joints
+        directions = positioner.model.directions
+        self.dof, self.size = plan.dof, g.length_scale
+        home_inverse = plan.home_inverse
+        self.point = scalar.vector_of(positioner.point)
+        self.point_home = None if home_inverse is None else scalar.vector_of(
+            home_inverse[:3, :3] @ positioner.point + home_inverse[:3, 3])
+        u, self.slide = scalar.vector_of(g.direction(i)), scalar.vector_of(g.direction(k))
+        self.u, self.along = u, scalar.dot(u, self.slide)
+        self.axis_1, self.axis_2 = scalar.vector_of(g.point(i)), scalar.vector_of(g.point(j))
+        self.turn_1, self.elbow_turn = scalar.Turn(u), scalar.Turn(scalar.vector_of(g.direction(j)))
+        self.axis_1_from_2 = self.elbow_turn.coordinates(scalar.reject(scalar.sub(self.axis_1, self.axis_2), u))
+        # the joints' rotation (the slide turns nothing) and the label's constants
+        self.first, self.second = scalar.vector_of(directions[i]), scalar.vector_of(directions[j])
+        self.elbow = scalar.sub(self.axis_2, self.axis_1)
+        self.up = scalar.vector_of(g.upward(g.direction(i)))
+        self.fixed = [(index, wrap_float(value) if plan.positioner.model.is_revolute[index] else float(value))
+                      for index, value in sorted(plan.fixed.items())]
+        self.roll = None
+        if plan.wrist is not None:  # subproblem 1 about the roll's axis on a normal of it, seen through R_Gᵀ
+            roll = plan.wrist
+            self.roll = scalar.Turn(scalar.vector_of(roll.axis))
+            self.roll_normal = self.roll.coordinates(scalar.vector_of(roll.normal))
+            self.normal_home = scalar.vector_of(home_inverse[:3, :3] @ roll.normal)
+
+    def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
+        """The two slots for a target (4, 4), or NotGeneric (``reference``: not read, see
+        :meth:`DecoupledPlan.solve_one`)."""
+        top = T[:3].tolist()
+        moved = (top[0][3], top[1][3], top[2][3])
+        R_T = (top[0][:3], top[1][:3], top[2][:3])
+        x = moved if self.point_home is None else scalar.add(scalar.mv(R_T, self.point_home), moved)
+        u = self.u
+        slide = (scalar.dot(u, x) - scalar.dot(u, self.point)) / self.along  # prismatic_to_plane: the height
+        w3 = scalar.add(self.point, (self.slide[0] * slide, self.slide[1] * slide, self.slide[2] * slide))
+        from_1 = scalar.sub(x, self.axis_1)
+        reach = scalar.norm(scalar.reject(from_1, u))
+        from_2 = scalar.sub(w3, self.axis_2)
+        roots = self.elbow_turn.angles_at_distance(self.elbow_turn.coordinates(scalar.reject(from_2, u)),
+                                                   self.axis_1_from_2, reach, out_of_reach=True)
+        if math.isnan(roots[1]):  # clearly out of reach: the array path words why
+            raise scalar.NotGeneric
+        target = self.turn_1.coordinates(from_1)
+        seen = None if self.roll is None else scalar.mv(R_T, self.normal_home)
+        rows, codes = [], []
+        for q2 in roots:
+            w2 = scalar.add(scalar.rotate(self.elbow_turn.k, q2, from_2), self.axis_2)
+            placed = self.turn_1.coordinates(scalar.sub(w2, self.axis_1))
+            q1 = self.turn_1.angle(placed, target, scale=self.size)  # the point clear of axis 1, reached exactly
+            row = [q1, q2, slide]
+            if self.roll is not None:
+                R_G = scalar.mm(scalar.rotation(self.first, q1), scalar.rotation(self.second, q2))
+                row.append(self.roll.angle(self.roll_normal, self.roll.coordinates(scalar.mtv(R_G, seen))))
+            for index, value in self.fixed:
+                row.append(value)  # (joints past the third, in order)
+            elbow = scalar.rotate(self.first, q1, self.elbow)
+            side = scalar.dot(scalar.cross(from_1, elbow), self.up)
+            rows.append(row)
+            codes.append((scalar.side_code(side, scalar.norm(from_1) * scalar.norm(elbow)),))
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)

@@ -235,10 +235,12 @@ class Turn:
         return x, y, z, radius, math.sqrt(radius * radius + z * z)
 
     @staticmethod
-    def angle(p: tuple[float, ...], q: tuple[float, ...], free_below: float = GEOMETRY_TOLERANCE) -> float:
+    def angle(p: tuple[float, ...], q: tuple[float, ...], free_below: float = GEOMETRY_TOLERANCE,
+              scale: float | None = None) -> float:
         """Subproblem 1: θ with R(k, θ) p = q (least squares), p and q as :meth:`coordinates`; non-degenerate
-        only (``free_below`` as :func:`.subproblems.subproblem_1`'s, relative to the vectors' length)."""
-        theta = _rotate_onto_clear(p, q, MARGIN, free_below)
+        only (``free_below`` as :func:`.subproblems.subproblem_1`'s, relative to the vectors' length). With
+        ``scale`` (:func:`.subproblems.subproblem_1`'s), relative to it, and clearly exact only."""
+        theta = _rotate_onto_clear(p, q, MARGIN, free_below, scale)
         if theta is None:
             raise NotGeneric
         return theta

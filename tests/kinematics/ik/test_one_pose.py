@@ -26,12 +26,12 @@ ONE_POSE_ROBOTS = sorted(robot_id for robot_id, (robot, plan) in _PLANS.items() 
 
 
 def test_the_hot_families_are_covered():
-    """The PUMA type, the OPW type (KUKA, ABB, Fanuc: issue 24 asked for it), the UR type and the Stanford type
-    (its slide through axis 2 shares the PUMA's structure name)."""
+    """The PUMA type, the OPW type (KUKA, ABB, Fanuc: issue 24 asked for it), the UR type, the Stanford type (its
+    slide through axis 2 shares the PUMA's structure name) and the SCARA (with its roll, and without)."""
     structures = {cached_plan(_CATALOGUE.get(rid).robot, constrain_orientation=True, reference=None).structure
                   for rid in ONE_POSE_ROBOTS}
     assert structures == {"intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist",
-                          "three_parallel"}
+                          "three_parallel", "parallel_shoulder+roll", "parallel_shoulder"}
     assert "spong_ex3_5_stanford" in ONE_POSE_ROBOTS
 
 

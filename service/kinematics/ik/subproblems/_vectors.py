@@ -139,14 +139,18 @@ def _rotate_onto(
 
 
 def _rotate_onto_clear(p: tuple[float, ...], q: tuple[float, ...], margin: float,
-                       free_below: float = GEOMETRY_TOLERANCE) -> float | None:
+                       free_below: float = GEOMETRY_TOLERANCE, scale: float | None = None) -> float | None:
     """:func:`_rotate_onto` on floats where its answer is clear, for the one-pose paths (numpy's per-call cost
     would exceed the arithmetic): ``p`` and ``q`` as ``(x, y, z, radius, length)`` in the axis frame; theta, or
     None where either lies within ``margin`` times ``free_below`` (relative to the longer one) of the axis
-    (degenerate)."""
-    px, py, _, radius_p, length_p = p
-    qx, qy, _, radius_q, length_q = q
-    tol = free_below * (length_p if length_p > length_q else length_q)
+    (degenerate). With ``scale`` (the length a caller of :func:`_rotate_onto` passes), the band is ``free_below``
+    times it, and an answer that is not clearly exact (its radii or heights apart by more than that band over
+    ``margin``) is None too."""
+    px, py, pz, radius_p, length_p = p
+    qx, qy, qz, radius_q, length_q = q
+    tol = free_below * (scale if scale is not None else length_p if length_p > length_q else length_q)
     if not (radius_p > margin * tol and radius_q > margin * tol):
+        return None
+    if scale is not None and not (margin * abs(radius_p - radius_q) <= tol and margin * abs(pz - qz) <= tol):
         return None
     return wrap_float(math.atan2(px * qy - py * qx, px * qx + py * qy))

@@ -267,44 +267,118 @@ class DecoupledPlan(Sealed):
             return None
 
     @cached_property
-    def _one_pose(self) -> "_SphericalWristOnePose | _ParallelShoulderOnePose | None":
-        """The scalar solver when joints 4–6 are a spherical wrist and joints 1–3 an intersecting shoulder with a
-        revolute joint 3 (the PUMA type) or with a slide through axis 2 (the Stanford type), or an offset shoulder
-        with joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB, Fanuc); when joints 1–3 are a SCARA shoulder
-        with a roll or nothing after them; else None."""
+    def _one_pose(self) -> "_ArmOnePose | None":
+        """The scalar solver when joints 1–3 are an intersecting shoulder with a revolute joint 3 (the PUMA type) or
+        with a slide through axis 2 (the Stanford type, the polar arms), an offset shoulder with joints 2 ∥ 3, all
+        revolute (the OPW type: KUKA, ABB, Fanuc), or a SCARA shoulder, and what follows them is one
+        :class:`_WristStep` (a spherical wrist, a roll, or nothing), else None."""
         positioner = self.positioner
-        if (isinstance(positioner, ParallelShoulder) and positioner.joints == (0, 1, 2) and not positioner.free_joints
-                and (self.wrist is None or isinstance(self.wrist, Roll) and self.wrist.joints == (3,))
-                and [*positioner.joints, *(self.wrist.joints if self.wrist else ()), *sorted(self.fixed)]
-                == list(range(self.dof))):
-            return _ParallelShoulderOnePose(self)
-        if not (positioner is not None and isinstance(self.wrist, SphericalWrist) and not self.fixed
-                and not positioner.free_joints
-                and positioner.joints == (0, 1, 2) and self.wrist.joints == (3, 4, 5)):
+        if positioner is None or positioner.free_joints or positioner.joints != (0, 1, 2):
             return None
-        if isinstance(positioner, IntersectingShoulder) and bool(positioner.model.is_revolute[2]):
-            return _ShoulderWristOnePose(self)
+        step = _wrist_step(self)
+        if step is None:
+            return None
+        revolute = positioner.model.is_revolute
+        if isinstance(positioner, ParallelShoulder):
+            return _ParallelShoulderOnePose(self, step)
+        if isinstance(positioner, IntersectingShoulder) and bool(revolute[2]):
+            return _ShoulderOnePose(self, step)
         if isinstance(positioner, IntersectingShoulder) and positioner.slide_through_axis_2 is not None:
-            return _SlideShoulderWristOnePose(self)
-        if (isinstance(positioner, OffsetShoulderParallelElbow) and bool(positioner.model.is_revolute[:3].all())
+            return _SlideShoulderOnePose(self, step)
+        if (isinstance(positioner, OffsetShoulderParallelElbow) and bool(revolute[:3].all())
                 and positioner.forward is not None):
-            return _OffsetShoulderWristOnePose(self)
+            return _OffsetShoulderOnePose(self, step)
         return None
 
 
-class _SphericalWristOnePose:
-    """What the scalar one-pose paths of :class:`DecoupledPlan` share: the spherical wrist (joints 4–6), step for
-    step, with the plan's constants as floats (built once per plan), and the labels' names."""
+def _wrist_step(plan: DecoupledPlan) -> "_WristStep | None":
+    """What follows the positioner (joints 1–3) on the scalar path: a spherical wrist (joints 4–6), a roll (joint
+    4), or nothing (a pose of a three-joint arm; a position target, any joints past the third held); None for
+    anything else."""
+    wrist, held = plan.wrist, sorted(plan.fixed)
+    if isinstance(wrist, SphericalWrist) and wrist.joints == (3, 4, 5) and plan.dof == 6 and not held:
+        return _SphericalWristStep(plan)
+    if isinstance(wrist, Roll) and wrist.joints == (3,) and plan.dof == 4 and not held:
+        return _RollStep(plan)
+    if wrist is None and held == list(range(3, plan.dof)):
+        return _WristStep(plan)
+    return None
 
-    names = ("shoulder", "elbow", "wrist")
-    values = (("left", "right"), ("up", "down"), ("no_flip", "flip"))
+
+class _WristStep:
+    """What follows the positioner on a scalar path (:class:`_ArmOnePose`), one arm branch at a time: here
+    nothing, the joints past the third (if any) held at the plan's values, one slot per branch; its subclasses
+    solve a roll and a spherical wrist. :meth:`target` reads what the step needs of a target once, :meth:`rows`
+    appends a branch's slots; ``turned`` says whether :meth:`rows` reads the positioner's rotation R_G."""
+
+    names: tuple[str, ...] = ()
+    values: tuple[tuple[str, ...], ...] = ()
+    slots, turned = 1, False
 
     def __init__(self, plan: DecoupledPlan) -> None:
+        home_inverse = plan.home_inverse  # None: a position target, whose position is the point's
+        # the point the positioner places, at home: home⁻¹ applied once here
+        self.point_home = None if home_inverse is None else scalar.vector_of(
+            home_inverse[:3, :3] @ plan.point + home_inverse[:3, 3])
+        revolute = plan.positioner.model.is_revolute
+        self.held = [wrap_float(value) if revolute[index] else float(value)
+                     for index, value in sorted(plan.fixed.items())]
+
+    def target(self, T: np.ndarray) -> tuple[scalar.Vector, tuple]:
+        """The point the positioner places (T · home⁻¹ · point; a position target's own), and what :meth:`rows`
+        reads of the target (4, 4)."""
+        top = T[:3].tolist()
+        moved = (top[0][3], top[1][3], top[2][3])
+        if self.point_home is None:
+            return moved, ()
+        R_T = (top[0][:3], top[1][:3], top[2][:3])
+        return scalar.add(scalar.mv(R_T, self.point_home), moved), self._seen(R_T)
+
+    def _seen(self, R_T: scalar.Matrix) -> tuple:
+        return ()
+
+    def rows(self, R_G: scalar.Matrix | None, seen: tuple, arm: list[float], arm_codes: tuple[int | None, ...],
+             rows: list, codes: list) -> None:
+        """One arm branch's slots (joints ``arm``, turning what follows by R_G)."""
+        rows.append(arm + self.held if self.held else arm)
+        codes.append(arm_codes)
+
+
+class _RollStep(_WristStep):
+    """Joint 4 a roll: subproblem 1 about its axis on a normal of it, as R_Gᵀ · R_target turns that normal
+    (:class:`Roll`)."""
+
+    slots, turned = 1, True
+
+    def __init__(self, plan: DecoupledPlan) -> None:
+        super().__init__(plan)
+        roll = plan.wrist
+        self.turn = scalar.Turn(scalar.vector_of(roll.axis))
+        self.normal = self.turn.coordinates(scalar.vector_of(roll.normal))
+        self.normal_home = scalar.vector_of(plan.home_inverse[:3, :3] @ roll.normal)
+
+    def _seen(self, R_T: scalar.Matrix) -> tuple:
+        return (scalar.mv(R_T, self.normal_home),)
+
+    def rows(self, R_G: scalar.Matrix | None, seen: tuple, arm: list[float], arm_codes: tuple[int | None, ...],
+             rows: list, codes: list) -> None:
+        rows.append([*arm, self.turn.angle(self.normal, self.turn.coordinates(scalar.mtv(R_G, seen[0])))])
+        codes.append(arm_codes)
+
+
+class _SphericalWristStep(_WristStep):
+    """Joints 4–6 a spherical wrist: its two slots per arm branch, and its label."""
+
+    names = ("wrist",)
+    values = (("no_flip", "flip"),)
+    slots, turned = 2, True
+
+    def __init__(self, plan: DecoupledPlan) -> None:
+        super().__init__(plan)
         wrist = plan.wrist
         home_inverse = plan.home_inverse
         a, b, axis_c = (scalar.vector_of(axis) for axis in wrist.axes)
-        # the wrist point, and the wrist's last axis and its normal, at home: home⁻¹ applied once here
-        self.point_home = scalar.vector_of(home_inverse[:3, :3] @ plan.point + home_inverse[:3, 3])
+        # the wrist's last axis and its normal at home
         self.axis_c_home = scalar.vector_of(home_inverse[:3, :3] @ wrist.axes[2])
         self.normal_home = scalar.vector_of(home_inverse[:3, :3] @ wrist.normal)
         # subproblem 2 about the wrist's first two axes, 1 about its last (the normal)
@@ -313,22 +387,16 @@ class _SphericalWristOnePose:
         self.wrist_start = self.wrist.start(axis_c)
         self.last_turn = scalar.Turn(axis_c)
         self.last_normal = self.last_turn.coordinates(scalar.vector_of(wrist.normal))
-        self.dof = plan.dof
-        # the positioner's isolation band (its near_singular): a point this near an axis it reads an angle about
-        self.near_axis = NEAR_SINGULAR * plan.positioner.geometry.length_scale
 
-    def _target(self, T: np.ndarray) -> tuple[scalar.Vector, scalar.Vector, scalar.Vector]:
-        """The wrist point (T · home⁻¹ · point), and the wrist's last axis and normal as the target (4, 4) turns
-        them."""
-        top = T[:3].tolist()
-        R_T = (top[0][:3], top[1][:3], top[2][:3])
-        point_world = scalar.add(scalar.mv(R_T, self.point_home), (top[0][3], top[1][3], top[2][3]))
-        return point_world, scalar.mv(R_T, self.axis_c_home), scalar.mv(R_T, self.normal_home)
+    def _seen(self, R_T: scalar.Matrix) -> tuple:
+        """The wrist's last axis and normal as the target turns them."""
+        return scalar.mv(R_T, self.axis_c_home), scalar.mv(R_T, self.normal_home)
 
-    def _wrist_rows(self, R_G: scalar.Matrix, axis_c: scalar.Vector, normal: scalar.Vector, arm: list[float],
-                    arm_codes: tuple[int | None, int | None], rows: list, codes: list) -> None:
-        """The wrist's two slots for one arm branch (joints ``arm``, turning the wrist by R_G): what is left to
-        the wrist, R_Gᵀ · R_target, applied to its last axis and normal."""
+    def rows(self, R_G: scalar.Matrix | None, seen: tuple, arm: list[float], arm_codes: tuple[int | None, ...],
+             rows: list, codes: list) -> None:
+        """The wrist's two slots for one arm branch: what is left to the wrist, R_Gᵀ · R_target, applied to its
+        last axis and normal."""
+        axis_c, normal = seen
         wanted = scalar.mtv(R_G, normal)
         a, b = self.wrist_axes
         u, w = self.wrist_volume
@@ -344,7 +412,7 @@ class _SphericalWristOnePose:
         for roots in pairs:
             if roots is None:
                 rows.append(None)
-                codes.append((None,) * len(self.names))
+                codes.append((None,) * (len(arm_codes) + 1))
                 continue
             qa, qb = roots
             unwound = scalar.rotate(b, -qb, scalar.rotate(a, -qa, wanted))
@@ -352,17 +420,37 @@ class _SphericalWristOnePose:
             rows.append([*arm, qa, qb, qc])
             codes.append((*arm_codes, scalar.wrist_code(qb)))
 
-    def _empty(self, rows: list, codes: list, count: int) -> None:
-        """``count`` empty slots: an arm branch that does not exist, and its wrist's."""
+
+class _ArmOnePose:
+    """What the scalar one-pose paths of :class:`DecoupledPlan` share: the step after the positioner
+    (:class:`_WristStep`), the labels' names (the positioner's ``arm_names``, then the step's), and the
+    positioner's isolation band, with the plan's constants as floats (built once per plan)."""
+
+    arm_names: tuple[str, ...] = ()
+    arm_values: tuple[tuple, ...] = ()
+
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        self.step, self.dof = step, plan.dof
+        self.names, self.values = self.arm_names + step.names, self.arm_values + step.values
+        # the positioner's isolation band (its near_singular): a point this near an axis it reads an angle about
+        self.near_axis = NEAR_SINGULAR * plan.positioner.geometry.length_scale
+
+    def _empty(self, rows: list, codes: list, branches: int) -> None:
+        """The slots of ``branches`` arm branches that do not exist (and of what follows them)."""
+        count = branches * self.step.slots
         rows += [None] * count
         codes += [(None,) * len(self.names)] * count
 
 
-class _ShoulderWristOnePose(_SphericalWristOnePose):
-    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` (revolute joint 3) and a spherical wrist."""
+class _ShoulderOnePose(_ArmOnePose):
+    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` (revolute joint 3): subproblem 3 about axis 3,
+    2 about axes 1 and 2, in the positioner's slot order, and the shoulder's and the elbow's labels."""
 
-    def __init__(self, plan: DecoupledPlan) -> None:
-        super().__init__(plan)
+    arm_names = ("shoulder", "elbow")
+    arm_values = (("left", "right"), ("up", "down"))
+
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        super().__init__(plan, step)
         positioner, model = plan.positioner, plan.positioner.model
         d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
         p2 = scalar.vector_of(model.points[2])
@@ -387,10 +475,10 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
         self.elbow_length = scalar.norm(self.elbow)
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
-        """The eight slots for a target (4, 4), or NotGeneric (``reference``: not read, see
-        :meth:`DecoupledPlan.solve_one`)."""
-        point_world, axis_c, normal = self._target(T)
-        d, c, shoulder = self.directions, self.centre, self.shoulder
+        """The slots for a target (4, 4) (eight with a spherical wrist), or NotGeneric (``reference``: not read,
+        see :meth:`DecoupledPlan.solve_one`)."""
+        point_world, seen = self.step.target(T)
+        d, c, shoulder, step = self.directions, self.centre, self.shoulder, self.step
         target = scalar.sub(point_world, c)
         goal = shoulder.goal(target)
         error = target_error(self.geometry, scalar.norm(point_world), rounding=0.0)  # as the array path's
@@ -405,12 +493,12 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
                 raise scalar.NotGeneric  # the array path checks that the solutions there are isolated
             for pair in shoulder.angles(start, goal, error):
                 if pair is None:  # no arm branch here: its wrist slots are empty too
-                    self._empty(rows, codes, 2)
+                    self._empty(rows, codes, 1)
                     continue
                 q1, q2 = pair
                 R_1, R_2 = scalar.rotation(d[0], q1), scalar.rotation(d[1], q2)
-                self._wrist_rows(scalar.mm(scalar.mm(R_1, R_2), R_3), axis_c, normal, [q1, q2, q3],
-                                 self._arm_codes(R_2, reach_local, elbow_side), rows, codes)
+                step.rows(scalar.mm(scalar.mm(R_1, R_2), R_3) if step.turned else None, seen, [q1, q2, q3],
+                          self._arm_codes(R_2, reach_local, elbow_side), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
     def _elbow_side(self, reach_local: scalar.Vector) -> scalar.Vector:
@@ -433,7 +521,7 @@ class _ShoulderWristOnePose(_SphericalWristOnePose):
                 scalar.side_code(scalar.dot(scalar.mv(R_2, elbow_side), self.up), self.elbow_length))
 
 
-class _SlideShoulderWristOnePose(_SphericalWristOnePose):
+class _SlideShoulderOnePose(_ArmOnePose):
     """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` whose third joint slides normal to axis 2
     along a line crossing it (the Stanford type) and a spherical wrist: the shoulder and the slide in the slide's
     frame as :meth:`.SlideThroughAxis2.solve` works them out, a reference's values taken where they lie in the
@@ -441,11 +529,11 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
     subproblem 1 for joint 1, in its slot order (the two shoulder solutions ±a, each with the slide's two signs),
     and the shoulder's label (a slide has no elbow label)."""
 
-    names = ("shoulder", "wrist")
-    values = (("left", "right"), ("no_flip", "flip"))
+    arm_names = ("shoulder",)
+    arm_values = (("left", "right"),)
 
-    def __init__(self, plan: DecoupledPlan) -> None:
-        super().__init__(plan)
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        super().__init__(plan, step)
         positioner, model = plan.positioner, plan.positioner.model
         self.frame = positioner.slide_through_axis_2
         self.first, self.second = scalar.vector_of(model.directions[0]), scalar.vector_of(model.directions[1])
@@ -457,8 +545,9 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
         self.exact_within, self.at_centre = GEOMETRY_TOLERANCE * size, 0.5 * ACCEPT_RESIDUAL * size
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
-        """The eight slots for a target (4, 4), or NotGeneric; ``reference`` (n,) as :meth:`DecoupledPlan.solve`."""
-        point_world, axis_c, normal = self._target(T)
+        """The slots for a target (4, 4) (eight with a spherical wrist), or NotGeneric; ``reference`` (n,) as
+        :meth:`DecoupledPlan.solve`."""
+        point_world, seen = self.step.target(T)
         frame, k1, k2, n1, n2 = self.frame, self.first, self.second, self.n1, self.n2
         y = scalar.sub(point_world, self.centre)
         height = scalar.dot(y, k1)
@@ -501,19 +590,22 @@ class _SlideShoulderWristOnePose(_SphericalWristOnePose):
                     raise scalar.NotGeneric
                 q2 = wrap_any_float(turn - frame.psi0)
                 shoulder_code = scalar.side_code(scalar.dot(turned, self.forward), scalar.norm(turned))
-                R_G = scalar.mm(scalar.rotation(k1, q1), scalar.rotation(k2, q2))
-                self._wrist_rows(R_G, axis_c, normal, [q1, q2, frame.foot + slide], (shoulder_code,), rows, codes)
+                R_G = scalar.mm(scalar.rotation(k1, q1), scalar.rotation(k2, q2)) if self.step.turned else None
+                self.step.rows(R_G, seen, [q1, q2, frame.foot + slide], (shoulder_code,), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
 
-class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
+class _OffsetShoulderOnePose(_ArmOnePose):
     """:class:`DecoupledPlan` with an :class:`OffsetShoulderParallelElbow` (joints 1–3 revolute, 2 ∥ 3: the OPW
     arms) and a spherical wrist: subproblem 4 for joint 1 (front and back), 3 for joint 3 (elbow up and down), 1
     for joint 2, in the positioner's slot order, and its labels, all in the frame of the arm before joint 1 turns
     it (joint 1 leaves its axis, and the up direction along it, where they are)."""
 
-    def __init__(self, plan: DecoupledPlan) -> None:
-        super().__init__(plan)
+    arm_names = ("shoulder", "elbow")
+    arm_values = (("left", "right"), ("up", "down"))
+
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        super().__init__(plan, step)
         positioner, model = plan.positioner, plan.positioner.model
         d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
         o, p2, p3 = (scalar.vector_of(model.points[j]) for j in range(3))
@@ -533,10 +625,10 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
         self.elbow_from_2 = scalar.sub(p3, p2)
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
-        """The eight slots for a target (4, 4), or NotGeneric (``reference``: not read, see
-        :meth:`DecoupledPlan.solve_one`)."""
-        point_world, axis_c, normal = self._target(T)
-        d, o, p2, p3 = self.directions, self.origin, self.point_2, self.point_3
+        """The slots for a target (4, 4) (eight with a spherical wrist), or NotGeneric (``reference``: not read,
+        see :meth:`DecoupledPlan.solve_one`)."""
+        point_world, seen = self.step.target(T)
+        d, o, p2, p3, step = self.directions, self.origin, self.point_2, self.point_3, self.step
         from_origin = scalar.sub(point_world, o)
         if scalar.norm(scalar.reject(from_origin, d[0])) <= self.near_axis:  # OffsetShoulderParallelElbow's
             raise scalar.NotGeneric  # near_singular: the array path checks that the solutions there are isolated
@@ -554,7 +646,7 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
             target_2 = self.second_turn.coordinates(y_from_2)
             elbows = self.elbow_turn.angles_at_distance(*self.elbow_coordinates, reach, out_of_reach=True)
             if math.isnan(elbows[1]):  # this side clearly out of reach: the least-squares root is no solution
-                self._empty(rows, codes, 4)
+                self._empty(rows, codes, 2)
                 continue
             for q3 in elbows:
                 point_3 = scalar.add(scalar.sub(p3, p2), scalar.rotate(d[2], q3, self.point_from_3))
@@ -564,8 +656,9 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
                 q2 = self.second_turn.angle(placed, target_2)
                 R_2 = scalar.rotation(d[1], q2)
                 elbow_code = self._elbow_code(R_2, y_from_origin)
-                R_G = scalar.mm(scalar.mm(scalar.rotation(d[0], q1), R_2), scalar.rotation(d[2], q3))
-                self._wrist_rows(R_G, axis_c, normal, [q1, q2, q3], (shoulder_code, elbow_code), rows, codes)
+                R_G = scalar.mm(scalar.mm(scalar.rotation(d[0], q1), R_2), scalar.rotation(d[2], q3)) \
+                    if step.turned else None
+                step.rows(R_G, seen, [q1, q2, q3], (shoulder_code, elbow_code), rows, codes)
         if not any(rows):  # out of reach on both sides: the array path words why
             raise scalar.NotGeneric
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
@@ -586,26 +679,22 @@ class _OffsetShoulderWristOnePose(_SphericalWristOnePose):
 
 
 
-class _ParallelShoulderOnePose:
+class _ParallelShoulderOnePose(_ArmOnePose):
     """:class:`DecoupledPlan` with a :class:`ParallelShoulder` (the SCARA arm: joints 1 and 2 about parallel axes,
-    a slide along them) and a roll after it, or nothing (a pose or a position target of a three-joint SCARA, or a
-    position target with the joints past the third held): the slide from the height, subproblem 3 about axis 2
-    for the distance from axis 1 (the two assembly modes, in the positioner's slot order), 1 about axis 1, then 1
-    for the roll, and the assembly mode's label, as :meth:`ParallelShoulder.solve` and ``label_codes`` work them
-    out."""
+    a slide along them): the slide from the height, subproblem 3 about axis 2 for the distance from axis 1 (the two
+    assembly modes, in the positioner's slot order), 1 about axis 1, and the assembly mode's label, as
+    :meth:`ParallelShoulder.solve` and ``label_codes`` work them out."""
 
-    names = ("assembly_mode",)
-    values = ((1, 2),)
+    arm_names = ("assembly_mode",)
+    arm_values = ((1, 2),)
 
-    def __init__(self, plan: DecoupledPlan) -> None:
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        super().__init__(plan, step)
         positioner = plan.positioner
         g, (i, j, k) = positioner.geometry, positioner.joints
         directions = positioner.model.directions
-        self.dof, self.size = plan.dof, g.length_scale
-        home_inverse = plan.home_inverse
+        self.size = g.length_scale
         self.point = scalar.vector_of(positioner.point)
-        self.point_home = None if home_inverse is None else scalar.vector_of(
-            home_inverse[:3, :3] @ positioner.point + home_inverse[:3, 3])
         u, self.slide = scalar.vector_of(g.direction(i)), scalar.vector_of(g.direction(k))
         self.u, self.along = u, scalar.dot(u, self.slide)
         self.axis_1, self.axis_2 = scalar.vector_of(g.point(i)), scalar.vector_of(g.point(j))
@@ -615,23 +704,12 @@ class _ParallelShoulderOnePose:
         self.first, self.second = scalar.vector_of(directions[i]), scalar.vector_of(directions[j])
         self.elbow = scalar.sub(self.axis_2, self.axis_1)
         self.up = scalar.vector_of(g.upward(g.direction(i)))
-        self.fixed = [(index, wrap_float(value) if plan.positioner.model.is_revolute[index] else float(value))
-                      for index, value in sorted(plan.fixed.items())]
-        self.roll = None
-        if plan.wrist is not None:  # subproblem 1 about the roll's axis on a normal of it, seen through R_Gᵀ
-            roll = plan.wrist
-            self.roll = scalar.Turn(scalar.vector_of(roll.axis))
-            self.roll_normal = self.roll.coordinates(scalar.vector_of(roll.normal))
-            self.normal_home = scalar.vector_of(home_inverse[:3, :3] @ roll.normal)
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
         """The two slots for a target (4, 4), or NotGeneric (``reference``: not read, see
         :meth:`DecoupledPlan.solve_one`)."""
-        top = T[:3].tolist()
-        moved = (top[0][3], top[1][3], top[2][3])
-        R_T = (top[0][:3], top[1][:3], top[2][:3])
-        x = moved if self.point_home is None else scalar.add(scalar.mv(R_T, self.point_home), moved)
-        u = self.u
+        x, seen = self.step.target(T)
+        u, step = self.u, self.step
         slide = (scalar.dot(u, x) - scalar.dot(u, self.point)) / self.along  # prismatic_to_plane: the height
         w3 = scalar.add(self.point, (self.slide[0] * slide, self.slide[1] * slide, self.slide[2] * slide))
         from_1 = scalar.sub(x, self.axis_1)
@@ -642,20 +720,14 @@ class _ParallelShoulderOnePose:
         if math.isnan(roots[1]):  # clearly out of reach: the array path words why
             raise scalar.NotGeneric
         target = self.turn_1.coordinates(from_1)
-        seen = None if self.roll is None else scalar.mv(R_T, self.normal_home)
         rows, codes = [], []
         for q2 in roots:
             w2 = scalar.add(scalar.rotate(self.elbow_turn.k, q2, from_2), self.axis_2)
             placed = self.turn_1.coordinates(scalar.sub(w2, self.axis_1))
             q1 = self.turn_1.angle(placed, target, scale=self.size)  # the point clear of axis 1, reached exactly
-            row = [q1, q2, slide]
-            if self.roll is not None:
-                R_G = scalar.mm(scalar.rotation(self.first, q1), scalar.rotation(self.second, q2))
-                row.append(self.roll.angle(self.roll_normal, self.roll.coordinates(scalar.mtv(R_G, seen))))
-            for index, value in self.fixed:
-                row.append(value)  # (joints past the third, in order)
             elbow = scalar.rotate(self.first, q1, self.elbow)
             side = scalar.dot(scalar.cross(from_1, elbow), self.up)
-            rows.append(row)
-            codes.append((scalar.side_code(side, scalar.norm(from_1) * scalar.norm(elbow)),))
+            R_G = scalar.mm(scalar.rotation(self.first, q1), scalar.rotation(self.second, q2)) if step.turned else None
+            step.rows(R_G, seen, [q1, q2, slide], (scalar.side_code(side, scalar.norm(from_1) * scalar.norm(elbow)),),
+                      rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)

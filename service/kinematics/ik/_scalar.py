@@ -2,10 +2,11 @@
 
 A single-pose call through the array solvers costs hundreds of small numpy
 operations, each with a fixed overhead far larger than its arithmetic. The hot
-6-joint families (:class:`~._decoupled.DecoupledPlan` with a spherical wrist
-and an intersecting shoulder, the PUMA and the Stanford types, or an offset
-one, the OPW type, and :class:`~._three_parallel.ThreeParallelPlan`, the UR5
-type) therefore also
+families (:class:`~._decoupled.DecoupledPlan` with an intersecting shoulder, the
+PUMA and the Stanford types and the polar arms, an offset one, the OPW type,
+or a SCARA shoulder, followed by a spherical wrist, a roll or nothing, which
+covers position targets too; and :class:`~._three_parallel.ThreeParallelPlan`,
+the UR5 type) therefore also
 solve one pose with ``math`` on floats (their ``solve_one``, which also labels
 the slots from the quantities it has: :class:`OnePose`), from these pieces,
 with the plan's fixed vectors reduced once when the plan is built

@@ -162,8 +162,9 @@ def random_scara_arms(seed: int, roll: bool) -> list[Robot]:
 @pytest.mark.parametrize("roll", [True, False])
 def test_random_scara_arms_answer_alike_on_both_paths(roll, monkeypatch):
     """SCARA arms in every convention, pose and position targets from their own FK, some moved out of reach: the
-    scalar path answers most of them and finds the generating vector (a position target's roll held at 0); with it switched off the array path gives the same solutions, labels, residuals
-    and promises (and the same words where a target is out of reach)."""
+    scalar path answers most of them and finds the generating vector (a position target's roll held at 0); with
+    it switched off the array path gives the same solutions, labels, residuals and promises (and the same words
+    where a target is out of reach)."""
     answered = asked = 0
     for seed in range(3):
         for robot in random_scara_arms(seed, roll):

@@ -18,7 +18,8 @@ import numpy as np
 from .._angles import wrap_any_float, wrap_float
 from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, POLISH_RESIDUAL
 from . import _scalar as scalar
-from ._positioning import IntersectingShoulder, OffsetShoulderParallelElbow, ParallelShoulder, Positioner
+from ._positioning import (IntersectingShoulder, OffsetShoulderParallelElbow, OneRevolute, ParallelShoulder,
+                           PlanarTwoLink, Positioner)
 from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, move_point, perpendicular_unit, rotate_about, rotation_about
 from ._structure import target_error
@@ -268,19 +269,26 @@ class DecoupledPlan(Sealed):
 
     @cached_property
     def _one_pose(self) -> "_ArmOnePose | None":
-        """The scalar solver when joints 1–3 are an intersecting shoulder with a revolute joint 3 (the PUMA type) or
-        with a slide through axis 2 (the Stanford type, the polar arms), an offset shoulder with joints 2 ∥ 3, all
-        revolute (the OPW type: KUKA, ABB, Fanuc), or a SCARA shoulder, and what follows them is one
-        :class:`_WristStep` (a spherical wrist, a roll, or nothing), else None."""
+        """The scalar solver when the positioner (joints 1…k) is an intersecting shoulder with a revolute joint 3
+        (the PUMA type) or with a slide through axis 2 (the Stanford type, the polar arms), an offset shoulder with
+        joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB, Fanuc), a SCARA shoulder, a planar two-link arm or
+        one revolute joint, or there is none, and what follows it is one :class:`_WristStep` (a spherical wrist,
+        a roll, or nothing), else None."""
         positioner = self.positioner
-        if positioner is None or positioner.free_joints or positioner.joints != (0, 1, 2):
+        if positioner is None:
+            step = _wrist_step(self, 0)
+            return _WristOnlyOnePose(self, step) if isinstance(step, _SphericalWristStep) else None
+        k = len(positioner.joints)
+        if positioner.free_joints or positioner.joints != tuple(range(k)):
             return None
-        step = _wrist_step(self)
+        step = _wrist_step(self, k)
         if step is None:
             return None
         revolute = positioner.model.is_revolute
-        if isinstance(positioner, ParallelShoulder):
-            return _ParallelShoulderOnePose(self, step)
+        if isinstance(positioner, (ParallelShoulder, PlanarTwoLink)):
+            return _ParallelAxesOnePose(self, step)
+        if isinstance(positioner, OneRevolute):
+            return _OneRevoluteOnePose(self, step)
         if isinstance(positioner, IntersectingShoulder) and bool(revolute[2]):
             return _ShoulderOnePose(self, step)
         if isinstance(positioner, IntersectingShoulder) and positioner.slide_through_axis_2 is not None:
@@ -291,16 +299,16 @@ class DecoupledPlan(Sealed):
         return None
 
 
-def _wrist_step(plan: DecoupledPlan) -> "_WristStep | None":
-    """What follows the positioner (joints 1–3) on the scalar path: a spherical wrist (joints 4–6), a roll (joint
-    4), or nothing (a pose of a three-joint arm; a position target, any joints past the third held); None for
-    anything else."""
+def _wrist_step(plan: DecoupledPlan, k: int) -> "_WristStep | None":
+    """What follows the positioner (joints 1…k) on the scalar path: a spherical wrist (joints k+1…k+3), a roll
+    (joint k+1), or nothing (a pose of an arm of k joints; a position target, any joints past the k-th held);
+    None for anything else."""
     wrist, held = plan.wrist, sorted(plan.fixed)
-    if isinstance(wrist, SphericalWrist) and wrist.joints == (3, 4, 5) and plan.dof == 6 and not held:
+    if isinstance(wrist, SphericalWrist) and wrist.joints == (k, k + 1, k + 2) and plan.dof == k + 3 and not held:
         return _SphericalWristStep(plan)
-    if isinstance(wrist, Roll) and wrist.joints == (3,) and plan.dof == 4 and not held:
+    if isinstance(wrist, Roll) and wrist.joints == (k,) and plan.dof == k + 1 and not held:
         return _RollStep(plan)
-    if wrist is None and held == list(range(3, plan.dof)):
+    if wrist is None and held == list(range(k, plan.dof)):
         return _WristStep(plan)
     return None
 
@@ -320,7 +328,7 @@ class _WristStep:
         # the point the positioner places, at home: home⁻¹ applied once here
         self.point_home = None if home_inverse is None else scalar.vector_of(
             home_inverse[:3, :3] @ plan.point + home_inverse[:3, 3])
-        revolute = plan.positioner.model.is_revolute
+        revolute = plan.positioner.model.is_revolute if plan.fixed else ()
         self.held = [wrap_float(value) if revolute[index] else float(value)
                      for index, value in sorted(plan.fixed.items())]
 
@@ -433,7 +441,7 @@ class _ArmOnePose:
         self.step, self.dof = step, plan.dof
         self.names, self.values = self.arm_names + step.names, self.arm_values + step.values
         # the positioner's isolation band (its near_singular): a point this near an axis it reads an angle about
-        self.near_axis = NEAR_SINGULAR * plan.positioner.geometry.length_scale
+        self.near_axis = 0.0 if plan.positioner is None else NEAR_SINGULAR * plan.positioner.geometry.length_scale
 
     def _empty(self, rows: list, codes: list, branches: int) -> None:
         """The slots of ``branches`` arm branches that do not exist (and of what follows them)."""
@@ -679,28 +687,32 @@ class _OffsetShoulderOnePose(_ArmOnePose):
 
 
 
-class _ParallelShoulderOnePose(_ArmOnePose):
-    """:class:`DecoupledPlan` with a :class:`ParallelShoulder` (the SCARA arm: joints 1 and 2 about parallel axes,
-    a slide along them): the slide from the height, subproblem 3 about axis 2 for the distance from axis 1 (the two
-    assembly modes, in the positioner's slot order), 1 about axis 1, and the assembly mode's label, as
-    :meth:`ParallelShoulder.solve` and ``label_codes`` work them out."""
-
-    arm_names = ("assembly_mode",)
-    arm_values = ((1, 2),)
+class _ParallelAxesOnePose(_ArmOnePose):
+    """:class:`DecoupledPlan` with joints 1 and 2 about parallel axes: a :class:`ParallelShoulder` (the SCARA arm,
+    a slide along them) or a :class:`PlanarTwoLink` (the point in their plane): the slide from the height (or the
+    height checked), subproblem 3 about axis 2 for the distance from axis 1 (the two branches, in the
+    positioner's slot order), 1 about axis 1, and the branch's label (the SCARA's assembly mode, the planar arm's
+    elbow), as the positioner's ``solve`` and ``label_codes`` work them out."""
 
     def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
-        super().__init__(plan, step)
         positioner = plan.positioner
-        g, (i, j, k) = positioner.geometry, positioner.joints
+        g, joints = positioner.geometry, positioner.joints
+        i, j = joints[:2]
+        if isinstance(positioner, ParallelShoulder):
+            self.arm_names, self.arm_values = ("assembly_mode",), ((1, 2),)
+        else:
+            self.arm_names, self.arm_values = ("elbow",), (("up", "down"),)
+        super().__init__(plan, step)
         directions = positioner.model.directions
         self.size = g.length_scale
         self.point = scalar.vector_of(positioner.point)
-        u, self.slide = scalar.vector_of(g.direction(i)), scalar.vector_of(g.direction(k))
-        self.u, self.along = u, scalar.dot(u, self.slide)
+        u = self.u = scalar.vector_of(g.direction(i))
+        self.slide = None if len(joints) == 2 else scalar.vector_of(g.direction(joints[2]))
+        self.along = None if self.slide is None else scalar.dot(u, self.slide)
         self.axis_1, self.axis_2 = scalar.vector_of(g.point(i)), scalar.vector_of(g.point(j))
         self.turn_1, self.elbow_turn = scalar.Turn(u), scalar.Turn(scalar.vector_of(g.direction(j)))
         self.axis_1_from_2 = self.elbow_turn.coordinates(scalar.reject(scalar.sub(self.axis_1, self.axis_2), u))
-        # the joints' rotation (the slide turns nothing) and the label's constants
+        # the joints' rotation (a slide turns nothing) and the label's constants
         self.first, self.second = scalar.vector_of(directions[i]), scalar.vector_of(directions[j])
         self.elbow = scalar.sub(self.axis_2, self.axis_1)
         self.up = scalar.vector_of(g.upward(g.direction(i)))
@@ -710,8 +722,15 @@ class _ParallelShoulderOnePose(_ArmOnePose):
         :meth:`DecoupledPlan.solve_one`)."""
         x, seen = self.step.target(T)
         u, step = self.u, self.step
-        slide = (scalar.dot(u, x) - scalar.dot(u, self.point)) / self.along  # prismatic_to_plane: the height
-        w3 = scalar.add(self.point, (self.slide[0] * slide, self.slide[1] * slide, self.slide[2] * slide))
+        height = scalar.dot(u, x) - scalar.dot(u, self.point)
+        if self.slide is None:  # PlanarTwoLink's in_plane: the height clearly kept (off the plane the arrays word it)
+            if not scalar.MARGIN * abs(height) <= GEOMETRY_TOLERANCE * self.size:
+                raise scalar.NotGeneric
+            arm, w3 = [], self.point
+        else:
+            slide = height / self.along  # prismatic_to_plane
+            arm = [slide]
+            w3 = scalar.add(self.point, (self.slide[0] * slide, self.slide[1] * slide, self.slide[2] * slide))
         from_1 = scalar.sub(x, self.axis_1)
         reach = scalar.norm(scalar.reject(from_1, u))
         from_2 = scalar.sub(w3, self.axis_2)
@@ -728,6 +747,43 @@ class _ParallelShoulderOnePose(_ArmOnePose):
             elbow = scalar.rotate(self.first, q1, self.elbow)
             side = scalar.dot(scalar.cross(from_1, elbow), self.up)
             R_G = scalar.mm(scalar.rotation(self.first, q1), scalar.rotation(self.second, q2)) if step.turned else None
-            step.rows(R_G, seen, [q1, q2, slide], (scalar.side_code(side, scalar.norm(from_1) * scalar.norm(elbow)),),
+            step.rows(R_G, seen, [q1, q2, *arm], (scalar.side_code(side, scalar.norm(from_1) * scalar.norm(elbow)),),
                       rows, codes)
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
+
+
+class _OneRevoluteOnePose(_ArmOnePose):
+    """:class:`DecoupledPlan` with a :class:`OneRevolute` positioner (a two-joint arm whose second joint is a
+    roll, placing a full pose): subproblem 1 about axis 1, clearly exact (the target on the circle the point
+    sweeps) and clear of the axis (where the joint is free); no label."""
+
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        super().__init__(plan, step)
+        positioner = plan.positioner
+        g, (i,) = positioner.geometry, positioner.joints
+        self.size, self.axis = g.length_scale, scalar.vector_of(g.point(i))
+        self.turn = scalar.Turn(scalar.vector_of(g.direction(i)))
+        self.placed = self.turn.coordinates(scalar.sub(scalar.vector_of(positioner.point), self.axis))
+        self.direction = scalar.vector_of(positioner.model.directions[i])
+
+    def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
+        """The one slot for a target (4, 4), or NotGeneric (``reference``: not read)."""
+        x, seen = self.step.target(T)
+        q1 = self.turn.angle(self.placed, self.turn.coordinates(scalar.sub(x, self.axis)), scale=self.size)
+        rows, codes = [], []
+        self.step.rows(scalar.rotation(self.direction, q1) if self.step.turned else None, seen, [q1], (), rows, codes)
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
+
+
+class _WristOnlyOnePose(_ArmOnePose):
+    """:class:`DecoupledPlan` of a spherical wrist alone (a three-joint arm placing an orientation): its two
+    slots, turned by nothing before it."""
+
+    _UNTURNED = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+    def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
+        """The two slots for a target (4, 4), or NotGeneric (``reference``: not read)."""
+        _, seen = self.step.target(T)
+        rows, codes = [], []
+        self.step.rows(self._UNTURNED, seen, [], (), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)

@@ -4,9 +4,10 @@ A single-pose call through the array solvers costs hundreds of small numpy
 operations, each with a fixed overhead far larger than its arithmetic. The hot
 families (:class:`~._decoupled.DecoupledPlan` with an intersecting shoulder, the
 PUMA and the Stanford types and the polar arms, an offset one, the OPW type,
-or a SCARA shoulder, followed by a spherical wrist, a roll or nothing, which
-covers position targets too; and :class:`~._three_parallel.ThreeParallelPlan`,
-the UR5 type) therefore also
+a SCARA shoulder, a planar two-link arm, one revolute joint or no positioner,
+followed by a spherical wrist, a roll or nothing, which covers position
+targets too; and :class:`~._three_parallel.ThreeParallelPlan`, the UR5 type)
+therefore also
 solve one pose with ``math`` on floats (their ``solve_one``, which also labels
 the slots from the quantities it has: :class:`OnePose`), from these pieces,
 with the plan's fixed vectors reduced once when the plan is built

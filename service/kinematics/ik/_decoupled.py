@@ -18,8 +18,8 @@ import numpy as np
 from .._angles import wrap_any_float, wrap_float
 from .._tolerances import ACCEPT_RESIDUAL, GEOMETRY_TOLERANCE, POLISH_RESIDUAL
 from . import _scalar as scalar
-from ._positioning import (IntersectingShoulder, OffsetShoulderParallelElbow, OneRevolute, ParallelShoulder,
-                           PlanarTwoLink, Positioner)
+from ._positioning import (IntersectingShoulder, OffsetShoulderParallelElbow, OneRevolute, OneRevoluteTwoPrismatic,
+                           ParallelShoulder, PlanarTwoLink, Positioner)
 from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, move_point, perpendicular_unit, rotate_about, rotation_about
 from ._structure import target_error
@@ -273,7 +273,7 @@ class DecoupledPlan(Sealed):
         (the PUMA type) or with a slide through axis 2 (the Stanford type, the polar arms), an offset shoulder with
         joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB, Fanuc), a SCARA shoulder, a planar two-link arm or
         one revolute joint, or there is none, and what follows it is one :class:`_WristStep` (a spherical wrist,
-        a roll, or nothing), else None."""
+        a roll, or nothing), or the cylindrical arms' one revolute joint and two slides, else None."""
         positioner = self.positioner
         if positioner is None:
             step = _wrist_step(self, 0)
@@ -289,6 +289,8 @@ class DecoupledPlan(Sealed):
             return _ParallelAxesOnePose(self, step)
         if isinstance(positioner, OneRevolute):
             return _OneRevoluteOnePose(self, step)
+        if isinstance(positioner, OneRevoluteTwoPrismatic):
+            return _CylindricalOnePose(self, step)
         if isinstance(positioner, IntersectingShoulder) and bool(revolute[2]):
             return _ShoulderOnePose(self, step)
         if isinstance(positioner, IntersectingShoulder) and positioner.slide_through_axis_2 is not None:
@@ -774,6 +776,73 @@ class _OneRevoluteOnePose(_ArmOnePose):
         self.step.rows(scalar.rotation(self.direction, q1) if self.step.turned else None, seen, [q1], (), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
+
+
+class _CylindricalOnePose(_ArmOnePose):
+    """:class:`DecoupledPlan` with a :class:`OneRevoluteTwoPrismatic` positioner (the cylindrical RPP and PRP
+    arms): the slides from the height along the revolute axis (linear) and the distance from it (a quadratic),
+    then subproblem 1 for the revolute joint, in the positioner's slot order, as its ``solve`` works them out (it
+    gives no label)."""
+
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        super().__init__(plan, step)
+        positioner = plan.positioner
+        g, r = positioner.geometry, positioner.revolute
+        omega, p = g.direction(r), g.point(r)
+        V = np.stack([g.direction(j) for j in positioner.slides], axis=1)  # (3, 2)
+        before = np.array([j < r for j in positioner.slides])
+        V_pre, V_post = V * before, V * ~before
+        perp = np.eye(3) - np.outer(omega, omega)
+        a = omega @ (V_pre + V_post)
+        self.a, self.a_squared = a.tolist(), float(a @ a)
+        self.nullspace = (np.array([-a[1], a[0]]) / np.linalg.norm(a)).tolist()
+        self.omega, self.axis = scalar.vector_of(omega), scalar.vector_of(p)
+        self.point = scalar.vector_of(positioner.point)
+        self.beta = scalar.vector_of(perp @ (positioner.point - p))
+        self.P, self.Q = scalar.matrix_of(perp @ V_pre), scalar.matrix_of(perp @ V_post)  # rows: x, y, z of (3, 2)
+        self.V_pre, self.V_post = scalar.matrix_of(V_pre), scalar.matrix_of(V_post)
+        self.Pn = tuple(row[0] * self.nullspace[0] + row[1] * self.nullspace[1] for row in self.P)
+        self.Qn = tuple(row[0] * self.nullspace[0] + row[1] * self.nullspace[1] for row in self.Q)
+        self.geometry, self.size, self.revolute = g, g.length_scale, r
+        self.turn = scalar.Turn(self.omega)
+        order = list(positioner.joints)
+        self.columns = (order.index(r), order.index(positioner.slides[0]), order.index(positioner.slides[1]))
+        self.direction = scalar.vector_of(positioner.model.directions[r])
+
+    def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
+        """The two slots for a target (4, 4), or NotGeneric; ``reference`` (n,) as :meth:`DecoupledPlan.solve`."""
+        x, seen = self.step.target(T)
+        omega, (a0, a1), (n0, n1) = self.omega, self.a, self.nullspace
+        b = scalar.dot(scalar.sub(x, self.point), omega)
+        s0 = (b * a0 / self.a_squared, b * a1 / self.a_squared)
+        alpha = scalar.reject(scalar.sub(x, self.axis), omega)
+        lhs = tuple(alpha[i] - (self.P[i][0] * s0[0] + self.P[i][1] * s0[1]) for i in range(3))
+        rhs = tuple(self.beta[i] + (self.Q[i][0] * s0[0] + self.Q[i][1] * s0[1]) for i in range(3))
+        A = scalar.dot(self.Pn, self.Pn) - scalar.dot(self.Qn, self.Qn)
+        B = -2 * scalar.dot(lhs, self.Pn) - 2 * scalar.dot(rhs, self.Qn)
+        C = scalar.dot(lhs, lhs) - scalar.dot(rhs, rhs)
+        band = target_error(self.geometry, scalar.norm(x))  # an azimuth on a radius is known to this / radius
+        rows, codes = [], []
+        for t in scalar.quadratic(A, B, C, self.size):
+            if t != t:  # a linear row's second slot
+                self._empty(rows, codes, 1)
+                continue
+            s = (s0[0] + t * n0, s0[1] + t * n1)
+            body = scalar.add(scalar.sub(self.point, self.axis),
+                              tuple(row[0] * s[0] + row[1] * s[1] for row in self.V_post))
+            world = scalar.sub(scalar.sub(x, self.axis), tuple(row[0] * s[0] + row[1] * s[1] for row in self.V_pre))
+            placed, wanted = self.turn.coordinates(body), self.turn.coordinates(world)
+            if min(placed[3], wanted[3]) <= scalar.MARGIN * band:  # the point near the axis: the joint free there
+                raise scalar.NotGeneric
+            theta = self.turn.angle(placed, wanted, scale=self.size)
+            if reference is not None and scalar.clearly_within(
+                    abs(wrap_any_float(theta - float(reference[self.revolute]))) * wanted[3], band):
+                theta = wrap_any_float(float(reference[self.revolute]))
+            arm = [0.0, 0.0, 0.0]
+            arm[self.columns[0]], arm[self.columns[1]], arm[self.columns[2]] = theta, s[0], s[1]
+            R_G = scalar.rotation(self.direction, theta) if self.step.turned else None
+            self.step.rows(R_G, seen, arm, (), rows, codes)
+        return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
 class _WristOnlyOnePose(_ArmOnePose):
     """:class:`DecoupledPlan` of a spherical wrist alone (a three-joint arm placing an orientation): its two

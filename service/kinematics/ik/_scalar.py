@@ -39,7 +39,7 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._screws import axis_frame
 from ._types import LabelCodes, SingularFlags
 from .subproblems._paden_kahan import _distance_equation, _subproblem_2_chain_clear
-from .subproblems._roots import _harmonic_clear
+from .subproblems._roots import _harmonic_clear, _quadratic_clear
 from .subproblems._vectors import _rotate_onto_clear
 
 #: How far (as a multiple of each tolerance) a quantity must be from the array solver's threshold for the
@@ -259,6 +259,15 @@ class Turn:
         if roots is None:
             raise NotGeneric
         return roots
+
+
+def quadratic(A: float, B: float, C: float, scale: float) -> tuple[float, float]:
+    """The real roots of A t² + B t + C = 0 (:func:`.subproblems.quadratic_roots`), the second NaN for a linear
+    one."""
+    roots = _quadratic_clear(A, B, C, scale, MARGIN)
+    if roots is None:
+        raise NotGeneric
+    return roots
 
 
 class Height:

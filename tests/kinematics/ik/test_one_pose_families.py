@@ -194,3 +194,35 @@ def test_random_scara_arms_answer_alike_on_both_paths(roll, monkeypatch):
                 monkeypatch.undo()
                 assert_same_answers(robot, fast, slow, 1e-9)
     assert answered >= 0.8 * asked  # all but the poses out of reach
+
+
+@pytest.mark.parametrize("kinds", ["RPP", "PRP", "PPR"])
+def test_random_cylindrical_arms_answer_alike_on_both_paths(kinds, monkeypatch):
+    """Arms of one revolute joint and two slides (:class:`OneRevoluteTwoPrismatic`) with random twists, in every
+    convention with a random base and tool, pose and position targets from their own FK, with and without the
+    generating vector as reference: the scalar path answers most of them and finds the generating vector, and
+    both paths give the same solutions, labels, residuals, promises and words."""
+    answered = asked = 0
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        rows = RandomDHRows(rng)
+        for robot in stated_three_ways(rng, [rows.free() for _ in kinds], kinds):
+            for constrain_orientation in (True, False):
+                plan = cached_plan(robot, constrain_orientation=constrain_orientation, reference=None)
+                assert plan.structure == "one_revolute_two_prismatic"
+                q = random_configurations(robot, 24, seed)
+                poses = forward_kinematics(robot, q)
+                references = [None if i % 2 else generating for i, generating in enumerate(q)]
+                answered += sum(plan.solve_one(T, reference) is not None for T, reference in zip(poses, references))
+                asked += len(poses)
+                fast = [solve_ik(robot, T, constrain_orientation=constrain_orientation, reference=reference)
+                        for T, reference in zip(poses, references)]
+                for generating, result in zip(q, fast):
+                    joints = np.array([s.joints for s in result.solutions])
+                    assert np.abs(joint_difference(robot, joints, generating)).max(axis=1).min() <= 1e-7
+                _array_path(monkeypatch, plan)
+                slow = [solve_ik(robot, T, constrain_orientation=constrain_orientation, reference=reference)
+                        for T, reference in zip(poses, references)]
+                monkeypatch.undo()
+                assert_same_answers(robot, fast, slow, 1e-9)
+    assert answered >= 0.9 * asked

@@ -116,6 +116,22 @@ def quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale: 
     return roots, valid, merged
 
 
+
+def _quadratic_clear(A: float, B: float, C: float, scale: float, margin: float) -> tuple[float, float] | None:
+    """:func:`quadratic_roots` on floats where its answer is clear, for the one-pose paths: the two roots in its
+    slot order, or one and NaN (a linear row), or None where a quantity is within ``margin`` times its band of one
+    of its thresholds (linear or not, a double root) or the roots are not real (the array path words that)."""
+    if abs(A) * margin <= 1e-12:
+        return (-C / B, math.nan) if abs(B) > margin * 1e-12 else None
+    if not abs(A) > margin * 1e-12:
+        return None
+    discriminant = B * B - 4 * A * C
+    tolerance = ROUNDING_TOLERANCE * (B * B + abs(4 * A * C) + scale * scale * 1e-12)
+    if not discriminant > margin * tolerance:
+        return None
+    root = math.sqrt(discriminant)
+    return (-B + root) / (2 * A), (-B - root) / (2 * A)
+
 # A root z of a trigonometric quartic (:func:`_trig_quartic_roots`) counts as a real angle when | |z| - 1 | is at
 # most this. Real roots lie on the unit circle and the others come in pairs (z, 1 / conj(z)); a double root (a
 # tangent case) that rounding splits lies about sqrt(eps) ~ 1.5e-8 off it, some 600 times inside. A root accepted

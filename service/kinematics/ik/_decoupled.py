@@ -788,21 +788,14 @@ class _CylindricalOnePose(_ArmOnePose):
         super().__init__(plan, step)
         positioner = plan.positioner
         g, r = positioner.geometry, positioner.revolute
-        omega, p = g.direction(r), g.point(r)
-        V = np.stack([g.direction(j) for j in positioner.slides], axis=1)  # (3, 2)
-        before = np.array([j < r for j in positioner.slides])
-        V_pre, V_post = V * before, V * ~before
-        perp = np.eye(3) - np.outer(omega, omega)
-        a = omega @ (V_pre + V_post)
-        self.a, self.a_squared = a.tolist(), float(a @ a)
-        self.nullspace = (np.array([-a[1], a[0]]) / np.linalg.norm(a)).tolist()
+        omega, p, V_pre, V_post, perp, a, nullspace, P, Q, Pn, Qn = positioner.equations
+        self.a, self.a_squared, self.nullspace = a.tolist(), float(a @ a), nullspace.tolist()
         self.omega, self.axis = scalar.vector_of(omega), scalar.vector_of(p)
         self.point = scalar.vector_of(positioner.point)
         self.beta = scalar.vector_of(perp @ (positioner.point - p))
-        self.P, self.Q = scalar.matrix_of(perp @ V_pre), scalar.matrix_of(perp @ V_post)  # rows: x, y, z of (3, 2)
-        self.V_pre, self.V_post = scalar.matrix_of(V_pre), scalar.matrix_of(V_post)
-        self.Pn = tuple(row[0] * self.nullspace[0] + row[1] * self.nullspace[1] for row in self.P)
-        self.Qn = tuple(row[0] * self.nullspace[0] + row[1] * self.nullspace[1] for row in self.Q)
+        # the (3, 2) matrices by rows, and the null direction's images
+        self.P, self.Q, self.V_pre, self.V_post = (scalar.matrix_of(M) for M in (P, Q, V_pre, V_post))
+        self.Pn, self.Qn = scalar.vector_of(Pn), scalar.vector_of(Qn)
         self.geometry, self.size, self.revolute = g, g.length_scale, r
         self.turn = scalar.Turn(self.omega)
         order = list(positioner.joints)

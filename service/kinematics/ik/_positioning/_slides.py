@@ -4,6 +4,8 @@ with a slide (:class:`SkewAxesWithSlide`)."""
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from ..._angles import wrap_angle
@@ -78,6 +80,39 @@ class ParallelShoulder(Positioner):
 
 
 
+class SlideEquations(NamedTuple):
+    """The fixed parts of :class:`OneRevoluteTwoPrismatic`'s equations: the revolute axis (direction ``omega``
+    through ``p``), the slides' directions as columns (3, 2) split into those before the revolute joint
+    (``V_pre``) and after it (``V_post``, zero columns elsewhere), the projector ``perp`` normal to the axis, the
+    height equation's ``a`` = ω·(V_pre + V_post) (2,) and its null direction ``nullspace`` (2,), the projected
+    columns ``P``, ``Q`` (3, 2) and their images ``Pn``, ``Qn`` (3,) of the null direction. Built once per
+    positioner; its scalar path (``_decoupled``) reads them too."""
+
+    omega: np.ndarray
+    p: np.ndarray
+    V_pre: np.ndarray
+    V_post: np.ndarray
+    perp: np.ndarray
+    a: np.ndarray
+    nullspace: np.ndarray
+    P: np.ndarray
+    Q: np.ndarray
+    Pn: np.ndarray
+    Qn: np.ndarray
+
+    @classmethod
+    def of(cls, geometry: Geometry, revolute: int, slides: tuple[int, int], point: np.ndarray) -> "SlideEquations":
+        omega, p = geometry.direction(revolute), geometry.point(revolute)
+        V = np.stack([geometry.direction(s) for s in slides], axis=1)  # (3, 2)
+        before = np.array([s < revolute for s in slides])
+        V_pre, V_post = V * before, V * ~before
+        perp = np.eye(3) - np.outer(omega, omega)
+        a = omega @ (V_pre + V_post)
+        nullspace = np.array([-a[1], a[0]]) / np.linalg.norm(a)
+        P, Q = perp @ V_pre, perp @ V_post
+        return cls(omega, p, V_pre, V_post, perp, a, nullspace, P, Q, P @ nullspace, Q @ nullspace)
+
+
 class OneRevoluteTwoPrismatic(Positioner):
     """One revolute and two prismatic joints in any order (cylindrical RPP, PRP).
 
@@ -96,6 +131,8 @@ class OneRevoluteTwoPrismatic(Positioner):
         super().__init__(geometry, joints, point)
         #: the revolute joint and the two slides (indices into the arm)
         self.revolute, self.slides = revolute, slides
+        #: the equations' fixed parts (:class:`SlideEquations`)
+        self.equations = SlideEquations.of(geometry, revolute, slides, self.point)
 
     @classmethod
     def _fit(cls, geometry: Geometry, joints: tuple[int, ...], point: np.ndarray, centre: np.ndarray | None
@@ -115,22 +152,14 @@ class OneRevoluteTwoPrismatic(Positioner):
 
     def solve(self, targets: np.ndarray, reference: np.ndarray | None) -> PositionerResult:
         g, r = self.geometry, self.revolute
-        omega, p = g.direction(r), g.point(r)
-        V = np.stack([g.direction(s) for s in self.slides], axis=1)  # (3, 2)
-        before = np.array([s < r for s in self.slides])
-        V_pre, V_post = V * before, V * ~before
-        perp = np.eye(3) - np.outer(omega, omega)
+        omega, p, V_pre, V_post, perp, a, nullspace, P, Q, Pn, Qn = self.equations
         # linear: a·s = b   with a = ω·(V_pre + V_post), b = ω·(x − w)
-        a = omega @ (V_pre + V_post)
         b = (targets - self.point) @ omega
         s0 = np.outer(b, a) / (a @ a)  # (N, 2)
-        nullspace = np.array([-a[1], a[0]]) / np.linalg.norm(a)
         alpha = (targets - p) @ perp  # (N, 3)
         beta = (self.point - p) @ perp
-        P, Q = perp @ V_pre, perp @ V_post  # (3, 2)
         lhs = alpha - s0 @ P.T
         rhs = beta + s0 @ Q.T
-        Pn, Qn = P @ nullspace, Q @ nullspace
         A = Pn @ Pn - Qn @ Qn
         B = -2 * (lhs @ Pn) - 2 * (rhs @ Qn)
         C = np.einsum("ni,ni->n", lhs, lhs) - np.einsum("ni,ni->n", rhs, rhs)

@@ -269,11 +269,12 @@ class DecoupledPlan(Sealed):
 
     @cached_property
     def _one_pose(self) -> "_ArmOnePose | None":
-        """The scalar solver when the positioner (joints 1…k) is an intersecting shoulder with a revolute joint 3
-        (the PUMA type) or with a slide through axis 2 (the Stanford type, the polar arms), an offset shoulder with
-        joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB, Fanuc), a SCARA shoulder, a planar two-link arm or
-        one revolute joint, or there is none, and what follows it is one :class:`_WristStep` (a spherical wrist,
-        a roll, or nothing), or the cylindrical arms' one revolute joint and two slides, else None."""
+        """The scalar solver, or None. The positioner (joints 1…k, structurally free joints none) is one of:
+        an intersecting shoulder with a revolute joint 3 (the PUMA type) or a slide through axis 2 (the Stanford
+        type, the polar arms); an offset shoulder with joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB,
+        Fanuc); two parallel axes with a slide along them (the SCARA) or without (a planar arm); one revolute
+        joint; one revolute joint and two slides (the cylindrical arms); or none (a wrist alone). What follows
+        it is one :class:`_WristStep`: a spherical wrist, a roll, or nothing."""
         positioner = self.positioner
         if positioner is None:
             step = _wrist_step(self, 0)
@@ -317,9 +318,10 @@ def _wrist_step(plan: DecoupledPlan, k: int) -> "_WristStep | None":
 
 class _WristStep:
     """What follows the positioner on a scalar path (:class:`_ArmOnePose`), one arm branch at a time: here
-    nothing, the joints past the third (if any) held at the plan's values, one slot per branch; its subclasses
-    solve a roll and a spherical wrist. :meth:`target` reads what the step needs of a target once, :meth:`rows`
-    appends a branch's slots; ``turned`` says whether :meth:`rows` reads the positioner's rotation R_G."""
+    nothing, the joints past the positioner's (if any: a position target's) held at the plan's values, one slot
+    per branch; its subclasses solve a roll and a spherical wrist. :meth:`target` reads what the step needs of a
+    target once, :meth:`rows` appends a branch's slots; ``turned`` says whether :meth:`rows` reads the
+    positioner's rotation R_G."""
 
     names: tuple[str, ...] = ()
     values: tuple[tuple[str, ...], ...] = ()

@@ -226,3 +226,39 @@ def test_random_cylindrical_arms_answer_alike_on_both_paths(kinds, monkeypatch):
                 monkeypatch.undo()
                 assert_same_answers(robot, fast, slow, 1e-9)
     assert answered >= 0.9 * asked
+
+
+@pytest.mark.parametrize("robot_id, constrain_orientation, joint, singular, coupled", [
+    ("spong_ex3_6_scara_rrpr", True, 1, 0.0, []),  # the elbow stretched: the two assembly modes meet
+    ("spong_ex3_6_scara_rrpr", True, 1, np.pi, []),  # folded
+    ("assur001_scara_rrp", True, 1, 0.0, []),
+    ("spong_ex3_1_planar_rr", False, 1, 0.0, []),  # a position: the planar two-link arm's elbow stretched
+    ("spong_ex3_2_cylindrical_rpp", True, 2, 0.0, [0]),  # the radial slide at 0: the point on the revolute axis
+    ("ex004_1_prp", True, 2, 0.0, [1]),
+])
+def test_poses_approaching_the_scara_planar_and_cylindrical_singularities_answer_alike(
+        robot_id, constrain_orientation, joint, singular, coupled, monkeypatch):
+    """A joint at 1e-3 … 1e-12 and 0 from where two branches meet (the SCARA's and the planar arm's elbow
+    stretched or folded) or where the point reaches the revolute axis (the cylindrical arms' radial slide at 0,
+    the revolute joint free there): the scalar path answers the poses far enough from it, and whichever it
+    leaves to the array path, the answers are the same sets with the same labels, and hold the generating vector
+    (within √rounding at a fold; the free joint aside on the axis)."""
+    robot = _CATALOGUE.get(robot_id).robot
+    plan = cached_plan(robot, constrain_orientation=constrain_orientation, reference=None)
+    answered = 0
+    for trial in range(4):
+        q = random_configurations(robot, 1, seed=trial)[0]
+        for epsilon in (1e-3, 1e-6, 1e-9, 1e-12, 0.0):
+            q[joint] = singular + epsilon * (1 if trial % 2 else -1)
+            T = forward_kinematics(robot, q)
+            answered += plan.solve_one(T) is not None
+            fast = solve_ik(robot, T, constrain_orientation=constrain_orientation)
+            _array_path(monkeypatch, plan)
+            slow = solve_ik(robot, T, constrain_orientation=constrain_orientation)
+            monkeypatch.undo()
+            assert fast.status == "ok"
+            assert_same_answers(robot, [fast], [slow], max(1e-9, 1e-15 / max(epsilon, 1e-15) * 1e2))
+            gap = np.abs(joint_difference(robot, np.array([s.joints for s in fast.solutions]), q))
+            determined = [i for i in range(robot.dof) if i not in coupled or epsilon >= 1e-6]
+            assert gap[:, determined].max(axis=1).min() <= 1e-6
+    assert 4 <= answered < 20  # (at 1e-3 at least; not at the singular value itself)

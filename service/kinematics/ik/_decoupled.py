@@ -24,6 +24,7 @@ from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, move_point, perpendicular_unit, rotate_about, rotation_about
 from ._structure import target_error
 from .subproblems import subproblem_1
+from .subproblems._prismatic import _slide_to_distance_clear
 from ._types import LEAN_CHUNK, NEAR_SINGULAR, Candidates, LabelCodes, SingularFlags, Sealed
 from ._wrist import Roll, SphericalWrist, seen_by
 
@@ -270,11 +271,12 @@ class DecoupledPlan(Sealed):
     @cached_property
     def _one_pose(self) -> "_ArmOnePose | None":
         """The scalar solver, or None. The positioner (joints 1…k, structurally free joints none) is one of:
-        an intersecting shoulder with a revolute joint 3 (the PUMA type) or a slide through axis 2 (the Stanford
-        type, the polar arms); an offset shoulder with joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB,
-        Fanuc); two parallel axes with a slide along them (the SCARA) or without (a planar arm); one revolute
-        joint; one revolute joint and two slides (the cylindrical arms); or none (a wrist alone). What follows
-        it is one :class:`_WristStep`: a spherical wrist, a roll, or nothing."""
+        an intersecting shoulder with a revolute joint 3 (the PUMA type), a slide through axis 2 (the Stanford
+        type, the polar arms) or a slide that misses it (a polar arm with an offset); an offset shoulder with
+        joints 2 ∥ 3, all revolute (the OPW type: KUKA, ABB, Fanuc); two parallel axes with a slide along them
+        (the SCARA) or without (a planar arm); one revolute joint; one revolute joint and two slides (the
+        cylindrical arms); or none (a wrist alone). What follows it is one :class:`_WristStep`: a spherical
+        wrist, a roll, or nothing."""
         positioner = self.positioner
         if positioner is None:
             step = _wrist_step(self, 0)
@@ -294,6 +296,8 @@ class DecoupledPlan(Sealed):
             return _CylindricalOnePose(self, step)
         if isinstance(positioner, IntersectingShoulder) and bool(revolute[2]):
             return _ShoulderOnePose(self, step)
+        if isinstance(positioner, IntersectingShoulder) and positioner.slide_through_axis_2 is None:
+            return _SlideElbowShoulderOnePose(self, step)
         if isinstance(positioner, IntersectingShoulder) and positioner.slide_through_axis_2 is not None:
             return _SlideShoulderOnePose(self, step)
         if (isinstance(positioner, OffsetShoulderParallelElbow) and bool(revolute[:3].all())
@@ -495,10 +499,7 @@ class _ShoulderOnePose(_ArmOnePose):
         goal = shoulder.goal(target)
         error = target_error(self.geometry, scalar.norm(point_world), rounding=0.0)  # as the array path's
         rows, codes = [], []
-        for q3 in self.elbow_turn.angles_at_distance(*self.elbow_coordinates, scalar.norm(target)):
-            R_3 = scalar.rotation(d[2], q3)
-            # the wrist point from the centre with joint 3 turned (joints 1 and 2 turn it about the centre)
-            reach_local = scalar.add(scalar.mv(R_3, self.point_from_3), self.centre_to_3)
+        for q3, R_3, reach_local in self._thirds(scalar.norm(target)):
             elbow_side = self._elbow_side(reach_local)
             start = shoulder.start(reach_local)
             if goal[3] <= self.near_axis or start[3] <= self.near_axis:  # IntersectingShoulder's near_singular:
@@ -509,9 +510,20 @@ class _ShoulderOnePose(_ArmOnePose):
                     continue
                 q1, q2 = pair
                 R_1, R_2 = scalar.rotation(d[0], q1), scalar.rotation(d[1], q2)
-                step.rows(scalar.mm(scalar.mm(R_1, R_2), R_3) if step.turned else None, seen, [q1, q2, q3],
-                          self._arm_codes(R_2, reach_local, elbow_side), rows, codes)
+                R_G = None if not step.turned else scalar.mm(R_1, R_2) if R_3 is None else scalar.mm(scalar.mm(R_1,
+                                                                                                         R_2), R_3)
+                step.rows(R_G, seen, [q1, q2, q3], self._arm_codes(R_2, reach_local, elbow_side), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
+
+    def _thirds(self, distance: float) -> list[tuple[float, scalar.Matrix | None, scalar.Vector]]:
+        """Joint 3's two values that put the point at ``distance`` from the centre (subproblem 3), each with its
+        turn R_3 and the point from the centre so placed (joints 1 and 2 turn it about the centre)."""
+        d = self.directions
+        thirds = []
+        for q3 in self.elbow_turn.angles_at_distance(*self.elbow_coordinates, distance):
+            R_3 = scalar.rotation(d[2], q3)
+            thirds.append((q3, R_3, scalar.add(scalar.mv(R_3, self.point_from_3), self.centre_to_3)))
+        return thirds
 
     def _elbow_side(self, reach_local: scalar.Vector) -> scalar.Vector:
         """The elbow's offset from the centre–point line (in the arm's plane when axes 2 ∥ 3), before joints 1
@@ -531,6 +543,37 @@ class _ShoulderOnePose(_ArmOnePose):
             return None, None  # the point near axis 1: the array labeller decides
         return (scalar.side_code(scalar.dot(reach, self.forward), length),
                 scalar.side_code(scalar.dot(scalar.mv(R_2, elbow_side), self.up), self.elbow_length))
+
+
+class _SlideElbowShoulderOnePose(_ShoulderOnePose):
+    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` whose third joint slides along a line that
+    misses axis 2 (a polar arm with an offset): the slide's two values at the target's distance from the centre
+    (:func:`.subproblems.prismatic_to_distance`), then the shoulder as for a revolute joint 3, and the shoulder's
+    label (a slide has no elbow label)."""
+
+    arm_names = ("shoulder",)
+    arm_values = (("left", "right"),)
+
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        super().__init__(plan, step)
+        self.point = scalar.vector_of(plan.positioner.point)
+        self.slide = scalar.vector_of(plan.positioner.geometry.direction(plan.positioner.joints[2]))
+
+    def _thirds(self, distance: float) -> list[tuple[float, scalar.Matrix | None, scalar.Vector]]:
+        roots = _slide_to_distance_clear(self.point, self.slide, self.centre, distance, scalar.MARGIN)
+        if roots is None:
+            raise scalar.NotGeneric
+        p, v, c = self.point, self.slide, self.centre
+        return [(s, None, (p[0] + s * v[0] - c[0], p[1] + s * v[1] - c[1], p[2] + s * v[2] - c[2])) for s in roots]
+
+    def _elbow_side(self, reach_local: scalar.Vector) -> None:
+        return None
+
+    def _arm_codes(self, R_2: scalar.Matrix, reach_local: scalar.Vector, elbow_side: None) -> tuple[int | None]:
+        reach = scalar.mv(R_2, reach_local)
+        if scalar.norm(scalar.reject(reach, self.directions[0])) <= scalar.MARGIN * self.on_axis:
+            return (None,)  # the point near axis 1: the array labeller decides
+        return (scalar.side_code(scalar.dot(reach, self.forward), scalar.norm(reach)),)
 
 
 class _SlideShoulderOnePose(_ArmOnePose):

@@ -32,11 +32,10 @@ POSITION_ROBOTS = sorted(robot_id for robot_id, plan in _POSITION_PLANS.items() 
 def test_the_hot_families_are_covered():
     """The PUMA type, the OPW type (KUKA, ABB, Fanuc: issue 24 asked for it), the UR type, the Stanford type (its
     slide through axis 2 shares the PUMA's structure name), the SCARA (with its roll, and without), the polar
-    arms (a slide through axis 2, with a roll or nothing after it), the planar two-joint arm, the cylindrical
+    arms (a slide through axis 2 or missing it, with a roll or nothing after it), the planar two-joint arm, the cylindrical
     arms and the spherical wrist alone; and position targets (the joints past the third held) of the six-joint
-    arms with those shoulders, and of the planar arm. Of the catalogue's arms of six joints or fewer, the polar
-    arm whose slide misses axis 2, the xArm 6 (general 6R) and the SO-101 (five joints, its parallel axes
-    rounded) run the array program."""
+    arms with those shoulders, and of the planar arm. Of the catalogue's arms of six joints or fewer, only the
+    xArm 6 (general 6R) and the SO-101 (five joints, its parallel axes rounded) run the array program."""
     structures = {cached_plan(_CATALOGUE.get(rid).robot, constrain_orientation=True, reference=None).structure
                   for rid in ONE_POSE_ROBOTS}
     assert structures == {"intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist",
@@ -46,7 +45,7 @@ def test_the_hot_families_are_covered():
     assert {"puma560_standard", "kuka_kr6_r900_2", "spong_ex3_5_stanford", "ur5", "spong_ex3_1_planar_rr"} <= \
         set(POSITION_ROBOTS)
     without = {entry.description.id for entry in _CATALOGUE.entries() if entry.robot.dof <= 6} - set(ONE_POSE_ROBOTS)
-    assert without == {"ex004_4_polar_offset_rrp", "ufactory_xarm6", "so101"}
+    assert without == {"ufactory_xarm6", "so101"}
     assert "spong_ex3_5_stanford" in ONE_POSE_ROBOTS
 
 

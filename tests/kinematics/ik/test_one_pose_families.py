@@ -228,6 +228,35 @@ def test_random_cylindrical_arms_answer_alike_on_both_paths(kinds, monkeypatch):
     assert answered >= 0.9 * asked
 
 
+def test_random_polar_arms_with_an_offset_slide_answer_alike_on_both_paths(monkeypatch):
+    """Arms whose first two axes meet and whose third joint slides along a line that misses axis 2 (random
+    twists and offsets), in every convention with a random base and tool, pose and position targets from their
+    own FK, some moved out of reach: the scalar path answers most and finds the generating vector, and both paths
+    give the same solutions, labels, residuals, promises and words."""
+    answered = asked = 0
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        rows = RandomDHRows(rng)
+        table = [(0.0, rows.twist(), rows.length(), rows.offset()), rows.free(), rows.free()]  # axes 1 and 2 meet
+        for robot in stated_three_ways(rng, table, "RRP"):
+            for constrain_orientation in (True, False):
+                plan = cached_plan(robot, constrain_orientation=constrain_orientation, reference=None)
+                assert plan.structure == "intersecting_shoulder" and plan.positioner.slide_through_axis_2 is None
+                q = random_configurations(robot, 24, seed)
+                poses = forward_kinematics(robot, q)
+                answered += sum(plan.solve_one(T) is not None for T in poses)
+                asked += len(poses)
+                fast = [solve_ik(robot, T, constrain_orientation=constrain_orientation) for T in poses]
+                for generating, result in zip(q, fast):
+                    joints = np.array([s.joints for s in result.solutions])
+                    assert np.abs(joint_difference(robot, joints, generating)).max(axis=1).min() <= 1e-7
+                _array_path(monkeypatch, plan)
+                slow = [solve_ik(robot, T, constrain_orientation=constrain_orientation) for T in poses]
+                monkeypatch.undo()
+                assert_same_answers(robot, fast, slow, 1e-9)
+    assert answered >= 0.8 * asked
+
+
 @pytest.mark.parametrize("robot_id, constrain_orientation, joint, singular, coupled", [
     ("spong_ex3_6_scara_rrpr", True, 1, 0.0, []),  # the elbow stretched: the two assembly modes meet
     ("spong_ex3_6_scara_rrpr", True, 1, np.pi, []),  # folded

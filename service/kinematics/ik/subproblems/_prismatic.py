@@ -8,6 +8,8 @@ quadratic, each finished by Newton steps on the undivided pair.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -90,6 +92,22 @@ def prismatic_to_distance(p: ArrayLike, v: ArrayLike, q: ArrayLike, delta: Array
         degenerate=np.zeros(shape, dtype=bool),
         merged=np.asarray(merged),
     )
+
+
+def _slide_to_distance_clear(p: tuple[float, ...], v: tuple[float, ...], q: tuple[float, ...], delta: float,
+                             margin: float) -> tuple[float, float] | None:
+    """:func:`prismatic_to_distance` on floats (p, v, q three floats each) where its answer is clear, for the
+    one-pose paths: its two roots in its slot order, or None where the roots are within ``margin`` times its band
+    of merging, or the distance is not clearly reached (the array path words that)."""
+    w = (p[0] - q[0], p[1] - q[1], p[2] - q[2])
+    b = v[0] * w[0] + v[1] * w[1] + v[2] * w[2]  # along the line; e: the distance from it
+    e = math.sqrt((w[0] - b * v[0]) ** 2 + (w[1] - b * v[1]) ** 2 + (w[2] - b * v[2]) ** 2)
+    scale = math.hypot(e, b) + delta
+    excess = e - delta
+    if not -excess > margin * max(_MERGE_RESIDUAL, GEOMETRY_TOLERANCE) * scale:
+        return None
+    root = math.sqrt(-excess * (delta + e))
+    return root - b, -b - root
 
 
 def prismatic_to_plane(h: ArrayLike, p: ArrayLike, v: ArrayLike, delta: ArrayLike) -> DisplacementSolutions:

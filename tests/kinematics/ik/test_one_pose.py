@@ -32,10 +32,11 @@ POSITION_ROBOTS = sorted(robot_id for robot_id, plan in _POSITION_PLANS.items() 
 def test_the_hot_families_are_covered():
     """The PUMA type, the OPW type (KUKA, ABB, Fanuc: issue 24 asked for it), the UR type, the Stanford type (its
     slide through axis 2 shares the PUMA's structure name), the SCARA (with its roll, and without), the polar
-    arms (a slide through axis 2 or missing it, with a roll or nothing after it), the planar two-joint arm, the cylindrical
-    arms and the spherical wrist alone; and position targets (the joints past the third held) of the six-joint
-    arms with those shoulders, and of the planar arm. Of the catalogue's arms of six joints or fewer, only the
-    xArm 6 (general 6R) and the SO-101 (five joints, its parallel axes rounded) run the array program."""
+    arms (a slide through axis 2 or missing it, with a roll or nothing after it), the planar two-joint arm, the
+    cylindrical arms and the spherical wrist alone; and position targets (the joints past the third held) of the
+    six-joint arms with those shoulders, and of the planar arm. Of the catalogue's arms of six joints or fewer,
+    only the xArm 6 (general 6R) and the SO-101 (five joints, its parallel axes rounded) run the array
+    program."""
     structures = {cached_plan(_CATALOGUE.get(rid).robot, constrain_orientation=True, reference=None).structure
                   for rid in ONE_POSE_ROBOTS}
     assert structures == {"intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist",

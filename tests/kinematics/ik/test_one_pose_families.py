@@ -12,7 +12,7 @@ from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.robots.catalogue import load_catalogue
 from service.config import Settings
-from tests.arms import RandomDHRows, random_family_arm, random_stanford_type_arm, stated_three_ways
+from tests.arms import RandomDHRows, random_family_arm, random_stanford_type_arm, rounded, stated_three_ways
 from tests.ik_helpers import random_configurations, stretched_elbow
 
 FAMILIES = ("intersecting_shoulder+spherical_wrist", "offset_shoulder_parallel_elbow+spherical_wrist", "three_parallel")
@@ -291,3 +291,36 @@ def test_poses_approaching_the_scara_planar_and_cylindrical_singularities_answer
             determined = [i for i in range(robot.dof) if i not in coupled or epsilon >= 1e-6]
             assert gap[:, determined].max(axis=1).min() <= 1e-6
     assert 4 <= answered < 20  # (at 1e-3 at least; not at the singular value itself)
+
+
+_ROUNDED_FAMILY_ARMS = ["spong_ex3_6_scara_rrpr", "assur001_scara_rrp", "spong_ex3_1_planar_rr", "ex004_2_polar_rrp",
+                        "ex004_3_spherical_rrpr", "ex004_4_polar_offset_rrp", "spong_ex3_2_cylindrical_rpp",
+                        "ex004_1_prp", "spong_ex3_3_spherical_wrist_rrr", "spong_ex3_4_cylindrical_with_wrist"]
+
+
+@pytest.mark.parametrize("arm", [*_ROUNDED_FAMILY_ARMS, "random SCARA", "random SCARA without roll",
+                                 "random cylindrical"])
+def test_the_scalar_paths_families_rounded_as_cad_exports_keep_their_promises(arm):
+    """The families this scalar path covers beyond the six-joint ones, written as a CAD export writes them
+    (:func:`tests.arms.rounded`: angles to 4 decimals, parallel axes 1e-5 rad off, lengths to 0.1 mm, a rounded base
+    and tool): on poses from the rounded arm's own FK no answer is unreachable, and every answer that promises
+    all solutions (``complete``, no singular condition or free joint) holds the generating vector."""
+    if arm in _ROUNDED_FAMILY_ARMS:
+        exact = _CATALOGUE.get(arm).robot
+    elif arm.startswith("random SCARA"):
+        exact = random_scara_arms(4, roll=arm == "random SCARA")[0]
+    else:
+        rng = np.random.default_rng(4)
+        rows = RandomDHRows(rng)
+        exact = stated_three_ways(rng, [rows.free() for _ in "RPP"], "RPP")[1]
+    promised = 0
+    for seed in range(2):
+        robot = rounded(exact, seed)
+        q = random_configurations(robot, 30, seed)
+        for generating, T in zip(q, forward_kinematics(robot, q)):
+            result = solve_ik(robot, T)
+            assert result.status != "unreachable", (seed, generating.tolist(), result.structure, result.detail)
+            if result.complete and not result.singularities and not result.free_joints:
+                promised += 1
+                assert holds_the_generating_vector(robot, result, generating), (seed, generating.tolist())
+    assert promised >= 30

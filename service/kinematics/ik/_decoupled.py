@@ -458,37 +458,22 @@ class _ArmOnePose:
         codes += [(None,) * len(self.names)] * count
 
 
-class _ShoulderOnePose(_ArmOnePose):
-    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` (revolute joint 3): subproblem 3 about axis 3,
-    2 about axes 1 and 2, in the positioner's slot order, and the shoulder's and the elbow's labels."""
-
-    arm_names = ("shoulder", "elbow")
-    arm_values = (("left", "right"), ("up", "down"))
+class _IntersectingShoulderOnePose(_ArmOnePose):
+    """What the scalar paths of an :class:`IntersectingShoulder` whose joint 3 does not slide through axis 2
+    share: joint 3's two values at the target's distance from the centre (:meth:`_thirds`, the subclass's), then
+    subproblem 2 about axes 1 and 2 for each, in the positioner's slot order, and the shoulder's label (with the
+    subclass's elbow label, :meth:`_elbow_codes`)."""
 
     def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
         super().__init__(plan, step)
-        positioner, model = plan.positioner, plan.positioner.model
-        d = self.directions = [scalar.vector_of(direction) for direction in model.directions]
-        p2 = scalar.vector_of(model.points[2])
-        c, w = scalar.vector_of(positioner.centre), scalar.vector_of(plan.point)
-        self.centre, self.geometry = c, positioner.geometry
-        # subproblem 3 about axis 3 (the wrist point's distance from the centre), 2 about axes 1 and 2 (where the
-        # arm turns it)
-        self.elbow_turn = scalar.Turn(d[2])
-        self.point_from_3 = scalar.sub(w, p2)
-        self.elbow_coordinates = (self.elbow_turn.coordinates(self.point_from_3),
-                                  self.elbow_turn.coordinates(scalar.sub(c, p2)))
-        self.centre_to_3 = scalar.sub(p2, c)
-        self.shoulder = scalar.TwoTurns(d[0], d[1])
-        # the labels' constants
+        positioner = plan.positioner
+        d = self.directions = [scalar.vector_of(direction) for direction in positioner.model.directions]
+        self.centre, self.geometry = scalar.vector_of(positioner.centre), positioner.geometry
+        self.shoulder = scalar.TwoTurns(d[0], d[1])  # subproblem 2 about axes 1 and 2 (where the arm turns it)
+        # the shoulder label's constants
         forward, self.in_plane, up = positioner.label_constants
         self.forward, self.up = scalar.vector_of(forward), scalar.vector_of(up)
         self.on_axis = GEOMETRY_TOLERANCE * 10 * positioner.geometry.length_scale
-        # the elbow (point on axis 3) from the centre before joints 1 and 2 turn it, in the arm's plane if the
-        # labels work there (axes 2 ∥ 3), and its length
-        elbow = scalar.sub(p2, c)
-        self.elbow = scalar.reject(elbow, d[1]) if self.in_plane else elbow
-        self.elbow_length = scalar.norm(self.elbow)
 
     def solve(self, T: np.ndarray, reference: np.ndarray | None = None) -> scalar.OnePose:
         """The slots for a target (4, 4) (eight with a spherical wrist), or NotGeneric (``reference``: not read,
@@ -510,10 +495,45 @@ class _ShoulderOnePose(_ArmOnePose):
                     continue
                 q1, q2 = pair
                 R_1, R_2 = scalar.rotation(d[0], q1), scalar.rotation(d[1], q2)
-                R_G = None if not step.turned else scalar.mm(R_1, R_2) if R_3 is None else scalar.mm(scalar.mm(R_1,
-                                                                                                         R_2), R_3)
+                R_G = scalar.mm(R_1, R_2) if step.turned else None  # (a slide turns nothing)
+                if R_G is not None and R_3 is not None:
+                    R_G = scalar.mm(R_G, R_3)
                 step.rows(R_G, seen, [q1, q2, q3], self._arm_codes(R_2, reach_local, elbow_side), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
+
+    def _arm_codes(self, R_2: scalar.Matrix, reach_local: scalar.Vector,
+                   elbow_side: scalar.Vector | None) -> tuple[int | None, ...]:
+        """:meth:`IntersectingShoulder.label_codes` of one arm branch. Joint 1 turns about axis 1, which is the up
+        direction and carries the forward one with it, so only joint 2's turn R_2 matters."""
+        reach = scalar.mv(R_2, reach_local)
+        length = math.sqrt(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2])
+        if scalar.norm(scalar.reject(reach, self.directions[0])) <= scalar.MARGIN * self.on_axis:
+            return (None,) * len(self.arm_names)  # the point near axis 1: the array labeller decides
+        return (scalar.side_code(scalar.dot(reach, self.forward), length), *self._elbow_codes(R_2, elbow_side))
+
+
+class _ShoulderOnePose(_IntersectingShoulderOnePose):
+    """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` whose joint 3 is revolute: subproblem 3 about
+    axis 3, then the shoulder, and the shoulder's and the elbow's labels."""
+
+    arm_names = ("shoulder", "elbow")
+    arm_values = (("left", "right"), ("up", "down"))
+
+    def __init__(self, plan: DecoupledPlan, step: _WristStep) -> None:
+        super().__init__(plan, step)
+        model, d, c = plan.positioner.model, self.directions, self.centre
+        p2, w = scalar.vector_of(model.points[2]), scalar.vector_of(plan.point)
+        # subproblem 3 about axis 3: the wrist point's distance from the centre
+        self.elbow_turn = scalar.Turn(d[2])
+        self.point_from_3 = scalar.sub(w, p2)
+        self.elbow_coordinates = (self.elbow_turn.coordinates(self.point_from_3),
+                                  self.elbow_turn.coordinates(scalar.sub(c, p2)))
+        self.centre_to_3 = scalar.sub(p2, c)
+        # the elbow (point on axis 3) from the centre before joints 1 and 2 turn it, in the arm's plane if the
+        # labels work there (axes 2 ∥ 3), and its length
+        elbow = scalar.sub(p2, c)
+        self.elbow = scalar.reject(elbow, d[1]) if self.in_plane else elbow
+        self.elbow_length = scalar.norm(self.elbow)
 
     def _thirds(self, distance: float) -> list[tuple[float, scalar.Matrix | None, scalar.Vector]]:
         """Joint 3's two values that put the point at ``distance`` from the centre (subproblem 3), each with its
@@ -533,23 +553,16 @@ class _ShoulderOnePose(_ArmOnePose):
         length = scalar.norm(reach_local)
         return scalar.reject(self.elbow, (reach_local[0] / length, reach_local[1] / length, reach_local[2] / length))
 
-    def _arm_codes(self, R_2: scalar.Matrix, reach_local: scalar.Vector,
-                   elbow_side: scalar.Vector) -> tuple[int | None, int | None]:
-        """:meth:`IntersectingShoulder.label_codes` of one arm branch. Joint 1 turns about axis 1, which is the up
-        direction and carries the forward one with it, so only joint 2's turn R_2 matters."""
-        reach = scalar.mv(R_2, reach_local)
-        length = math.sqrt(reach[0] * reach[0] + reach[1] * reach[1] + reach[2] * reach[2])
-        if scalar.norm(scalar.reject(reach, self.directions[0])) <= scalar.MARGIN * self.on_axis:
-            return None, None  # the point near axis 1: the array labeller decides
-        return (scalar.side_code(scalar.dot(reach, self.forward), length),
-                scalar.side_code(scalar.dot(scalar.mv(R_2, elbow_side), self.up), self.elbow_length))
+    def _elbow_codes(self, R_2: scalar.Matrix, elbow_side: scalar.Vector) -> tuple[int | None]:
+        """The elbow's label: the side of the centre–point line its offset lies on, along the up direction."""
+        return (scalar.side_code(scalar.dot(scalar.mv(R_2, elbow_side), self.up), self.elbow_length),)
 
 
-class _SlideElbowShoulderOnePose(_ShoulderOnePose):
+class _SlideElbowShoulderOnePose(_IntersectingShoulderOnePose):
     """:class:`DecoupledPlan` with an :class:`IntersectingShoulder` whose third joint slides along a line that
     misses axis 2 (a polar arm with an offset): the slide's two values at the target's distance from the centre
-    (:func:`.subproblems.prismatic_to_distance`), then the shoulder as for a revolute joint 3, and the shoulder's
-    label (a slide has no elbow label)."""
+    (:func:`.subproblems.prismatic_to_distance`), then the shoulder, and the shoulder's label (a slide has no
+    elbow label)."""
 
     arm_names = ("shoulder",)
     arm_values = (("left", "right"),)
@@ -569,11 +582,8 @@ class _SlideElbowShoulderOnePose(_ShoulderOnePose):
     def _elbow_side(self, reach_local: scalar.Vector) -> None:
         return None
 
-    def _arm_codes(self, R_2: scalar.Matrix, reach_local: scalar.Vector, elbow_side: None) -> tuple[int | None]:
-        reach = scalar.mv(R_2, reach_local)
-        if scalar.norm(scalar.reject(reach, self.directions[0])) <= scalar.MARGIN * self.on_axis:
-            return (None,)  # the point near axis 1: the array labeller decides
-        return (scalar.side_code(scalar.dot(reach, self.forward), scalar.norm(reach)),)
+    def _elbow_codes(self, R_2: scalar.Matrix, elbow_side: None) -> tuple[()]:
+        return ()
 
 
 class _SlideShoulderOnePose(_ArmOnePose):
@@ -733,7 +743,6 @@ class _OffsetShoulderOnePose(_ArmOnePose):
         return scalar.side_code(scalar.dot(rejection, self.up), scalar.norm(elbow))
 
 
-
 class _ParallelAxesOnePose(_ArmOnePose):
     """:class:`DecoupledPlan` with joints 1 and 2 about parallel axes: a :class:`ParallelShoulder` (the SCARA arm,
     a slide along them) or a :class:`PlanarTwoLink` (the point in their plane): the slide from the height (or the
@@ -786,6 +795,7 @@ class _ParallelAxesOnePose(_ArmOnePose):
         if math.isnan(roots[1]):  # clearly out of reach: the array path words why
             raise scalar.NotGeneric
         target = self.turn_1.coordinates(from_1)
+        from_1_length = scalar.norm(from_1)
         rows, codes = [], []
         for q2 in roots:
             w2 = scalar.add(scalar.rotate(self.elbow_turn.k, q2, from_2), self.axis_2)
@@ -794,8 +804,8 @@ class _ParallelAxesOnePose(_ArmOnePose):
             elbow = scalar.rotate(self.first, q1, self.elbow)
             side = scalar.dot(scalar.cross(from_1, elbow), self.up)
             R_G = scalar.mm(scalar.rotation(self.first, q1), scalar.rotation(self.second, q2)) if step.turned else None
-            step.rows(R_G, seen, [q1, q2, *arm], (scalar.side_code(side, scalar.norm(from_1) * scalar.norm(elbow)),),
-                      rows, codes)
+            step.rows(R_G, seen, [q1, q2, *arm], (scalar.side_code(side, from_1_length * scalar.norm(elbow)),), rows,
+                      codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
 
@@ -822,7 +832,6 @@ class _OneRevoluteOnePose(_ArmOnePose):
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
 
 
-
 class _CylindricalOnePose(_ArmOnePose):
     """:class:`DecoupledPlan` with a :class:`OneRevoluteTwoPrismatic` positioner (the cylindrical RPP and PRP
     arms): the slides from the height along the revolute axis (linear) and the distance from it (a quadratic),
@@ -837,6 +846,7 @@ class _CylindricalOnePose(_ArmOnePose):
         self.a, self.a_squared, self.nullspace = a.tolist(), float(a @ a), nullspace.tolist()
         self.omega, self.axis = scalar.vector_of(omega), scalar.vector_of(p)
         self.point = scalar.vector_of(positioner.point)
+        self.point_from_axis = scalar.sub(self.point, self.axis)
         self.beta = scalar.vector_of(perp @ (positioner.point - p))
         # the (3, 2) matrices by rows, and the null direction's images
         self.P, self.Q, self.V_pre, self.V_post = (scalar.matrix_of(M) for M in (P, Q, V_pre, V_post))
@@ -866,8 +876,7 @@ class _CylindricalOnePose(_ArmOnePose):
                 self._empty(rows, codes, 1)
                 continue
             s = (s0[0] + t * n0, s0[1] + t * n1)
-            body = scalar.add(scalar.sub(self.point, self.axis),
-                              tuple(row[0] * s[0] + row[1] * s[1] for row in self.V_post))
+            body = scalar.add(self.point_from_axis, tuple(row[0] * s[0] + row[1] * s[1] for row in self.V_post))
             world = scalar.sub(scalar.sub(x, self.axis), tuple(row[0] * s[0] + row[1] * s[1] for row in self.V_pre))
             placed, wanted = self.turn.coordinates(body), self.turn.coordinates(world)
             if min(placed[3], wanted[3]) <= scalar.MARGIN * band:  # the point near the axis: the joint free there
@@ -881,6 +890,7 @@ class _CylindricalOnePose(_ArmOnePose):
             R_G = scalar.rotation(self.direction, theta) if self.step.turned else None
             self.step.rows(R_G, seen, arm, (), rows, codes)
         return scalar.OnePose(rows, codes, self.names, self.values, self.dof)
+
 
 class _WristOnlyOnePose(_ArmOnePose):
     """:class:`DecoupledPlan` of a spherical wrist alone (a three-joint arm placing an orientation): its two

@@ -32,7 +32,7 @@
 How the work stays bounded: only the rank tuples of :mod:`._equivalents` are enumerated and costed, in chunks
 of whole solutions of at most about :data:`_CHUNK_ROWS` combinations (one target's may span several), with
 ``budget`` checked between chunks; the counts (``available``, ``trimmed``) are products of interval lengths,
-capped at :data:`.._budget.COUNT_CAP`. One target without a reference or a collision filter, of at most
+capped at :data:`.._budget.COUNT_CAP`. One target without a joint-move bound or a collision filter, of at most
 :data:`_ONE_TARGET_COMBINATIONS` combinations, is selected row by row instead (:func:`_one_target`: a single
 pose's answer, where the chunks' fixed costs outweigh the work).
 """
@@ -79,7 +79,7 @@ NOTE_WORDING = {
                "'rejected' with their collisions.",
 }
 
-#: One target's answer without a reference or a collision filter, of up to this many rows, this many
+#: One target's answer without a joint-move bound or a collision filter, of up to this many rows, this many
 #: combinations in all and this many in a row, is selected row by row (:func:`_one_target`), where the array
 #: path's few dozen steps cost more than the arithmetic: a PUMA 560 with its catalogue limits has 8 … 40
 #: combinations per pose, a UR5 with ±2π about 512 (64 a row). A row's combinations in answer order are worked
@@ -254,8 +254,8 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     if reference is not None:
         reference = effective_reference(robot, limits, reference)
     budget.check("selection")
-    if n_targets == 1 and reference is None and excluded is None and len(table) <= _ONE_TARGET_ROWS:
-        chosen = _one_target(robot, limits, table, filter_limits, max_equivalents)
+    if n_targets == 1 and excluded is None and ordering.max_joint_move is None and len(table) <= _ONE_TARGET_ROWS:
+        chosen = _one_target(robot, limits, table, filter_limits, max_equivalents, reference, ordering)
         if chosen is not None:
             return chosen
     n = robot.dof
@@ -514,26 +514,34 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
     return rows[first_few], values[first_few]
 
 
-def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limits: bool,
-                max_equivalents: int) -> Selection | None:
-    """:func:`select` of one target's rows (``table``) without a reference or excluded rows, in a few steps on
-    Python floats and integers: the same selection, field by field. None where its rows have more combinations
-    than :data:`_ONE_TARGET_COMBINATIONS` in all or :data:`_ROW_COMBINATIONS` in one, or a value that is not
-    finite meets a quotient (the array path then selects them).
+def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limits: bool, max_equivalents: int,
+                reference: np.ndarray | None = None, ordering: Ordering = Ordering()) -> Selection | None:
+    """:func:`select` of one target's rows (``table``) without a joint-move bound or excluded rows, in a few steps
+    on Python floats and integers, or on arrays of that target's few combinations: the same selection, field by
+    field. None where its rows have more combinations than :data:`_ONE_TARGET_COMBINATIONS` in all or
+    :data:`_ROW_COMBINATIONS` in one, or a value that is not finite meets a quotient (the array path then selects
+    them).
 
-    Every row that fits (or, with ``filter_limits`` false, every row) may be kept: each has its stream of
-    combinations (one, at its closest equivalent, for a row that does not fit), and the streams take turns
-    (:func:`_in_turn`); a row that does not fit and is filtered is rejected at its closest equivalent. Rows whose
-    every value has the turns [0, 0] alone (the usual answer: limits within a turn) are found in one comparison."""
+    Every row that fits (or, with ``filter_limits`` false, every row) may be kept, with its combinations (one, at
+    its closest equivalent, for a row that does not fit); a row that does not fit and is filtered is rejected at
+    its closest equivalent. Without a reference each row's combinations form a stream and the streams take turns
+    (:func:`_in_turn`); with one (``reference`` effective already, :func:`effective_reference`) every combination
+    is costed and the nearest kept (:func:`_nearest_of_one`). Rows whose every value has the turns [0, 0] alone
+    (the usual answer: limits within a turn) are found in one comparison."""
     bounds = limits.widened(robot)
     q = table.joints
     n_rows, n = q.shape
+    limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
+    capped = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
     at_zero = ((q > bounds.zero_turn_low) & (q < bounds.zero_turn_high)).all(axis=1).tolist()
-    if all(at_zero) and n_rows <= max_equivalents:  # every row kept as it stands, at q + 2π·0 as the arrays list it
+    if all(at_zero) and n_rows <= limit:  # every row kept, at q + 2π·0 as the arrays list it, nearest first
         counts = np.array([n_rows], dtype=np.int64)
-        return _outcome(counts, table.listed_at(q + 0.0, np.ones(n_rows, dtype=bool)), counts,
-                        table.take(slice(0, 0)), counts, counts, counts, np.zeros(1, dtype=np.int64), False,
-                        max_equivalents, False, None, n)
+        order = slice(None) if reference is None else np.argsort(travel(robot, limits, q, reference, ordering),
+                                                                  kind="stable")
+        kept = table.listed_at(q + 0.0, np.ones(n_rows, dtype=bool)) if reference is None else table.take(
+            order, joints=q[order] + 0.0, within_limits=np.ones(n_rows, dtype=bool))
+        return _outcome(counts, kept, counts, table.take(slice(0, 0)), counts, counts, counts,
+                        np.zeros(1, dtype=np.int64), capped, max_equivalents, reference is not None, None, n)
     zero = [0.0] * n
     fits, firsts, lasts, candidates, dropped, dropped_turns, combinations = [], [], [], [], [], [], 0
     for row, (simple, values) in enumerate(zip(at_zero, q.tolist())):
@@ -564,18 +572,49 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
         combinations += 1
         if combinations > _ONE_TARGET_COMBINATIONS:
             return None
-    kept_of, turns = _in_turn(firsts, lasts, max_equivalents, n)
+    if reference is None:
+        kept_of, turns = _in_turn(firsts, lasts, max_equivalents, n)
+    else:
+        kept_of, turns = _nearest_of_one(robot, limits, q.take(candidates, axis=0), firsts, lasts, limit, reference,
+                                         ordering)
     kept_rows = np.array(candidates, dtype=np.int64)[kept_of]
     fits = np.array(fits, dtype=bool)
     # q + 2πk as the arrays list them: 2πk first, then q added (the same sum either way round)
     kept = table.take(kept_rows, joints=turns * _TWO_PI + q.take(kept_rows, axis=0), within_limits=fits[kept_rows])
     dropped = np.array(dropped, dtype=np.int64)
-    rejected = table.take(dropped, joints=np.array(dropped_turns, dtype=float).reshape(len(dropped), n) * _TWO_PI
-                          + q.take(dropped, axis=0), within_limits=fits[dropped])
+    dropped_values = (np.array(dropped_turns, dtype=float).reshape(len(dropped), n) * _TWO_PI
+                      + q.take(dropped, axis=0))
+    if reference is not None and len(dropped) > 1:  # nearest first, as the kept ones
+        order = np.argsort(travel(robot, limits, dropped_values, reference, ordering), kind="stable")
+        dropped, dropped_values = dropped[order], dropped_values[order]
+    rejected = table.take(dropped, joints=dropped_values, within_limits=fits[dropped])
     rows, n_kept, n_candidates, available = (np.array([count], dtype=np.int64) for count in (
         n_rows, len(kept_rows), len(candidates), combinations))
     return _outcome(rows, kept, n_kept, rejected, n_candidates, available, available, np.zeros(1, dtype=np.int64),
-                    False, max_equivalents, False, None, n)
+                    capped, max_equivalents, reference is not None, None, n)
+
+
+def _nearest_of_one(robot: Robot, limits: Limits, q: np.ndarray, firsts: list[list[float]],
+                    lasts: list[list[float]], limit: int, reference: np.ndarray, ordering: Ordering
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_nearest` of one target's candidate rows q (C, n) with a reference: the kept rows (K,) (indices
+    into q) and each one's turns (K, n), nearest first. ``firsts``, ``lasts`` are the rows' usable turns (n whole
+    floats each, ``last ≥ first``), their combinations few (:data:`_ONE_TARGET_COMBINATIONS`): each is costed,
+    in the order :func:`~._equivalents.combination_turns` gives them (rows in order, each one's rank tuples
+    lexicographically), and a stable sort keeps the array path's ties."""
+    n = q.shape[1]
+    first = np.array(firsts, dtype=float).reshape(len(firsts), n)
+    if firsts == lasts:  # one combination each (limits within a turn): the rows themselves
+        owner, turns = np.arange(len(firsts)), first
+    else:
+        last = np.array(lasts, dtype=float).reshape(first.shape)
+        row_limit = np.full(len(first), limit, dtype=np.int64)
+        weights = np.ones(n) if ordering.weights is None else np.asarray(ordering.weights, dtype=float)
+        owner, turns = combination_turns(q, first, last, np.minimum(last - first + 1.0, limit).astype(np.int64),
+                                         row_limit, reference, weights)
+    cost = travel(robot, limits, q.take(owner, axis=0) + _TWO_PI * turns, reference, ordering)
+    pick = np.argsort(cost, kind="stable")[:limit]
+    return owner[pick], turns[pick]
 
 
 def _in_turn(firsts: list[list[float]], lasts: list[list[float]], limit: int, n: int

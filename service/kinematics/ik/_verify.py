@@ -21,7 +21,7 @@ import numpy as np
 from .._cache import memo
 from .._forward import JointTrig
 from .._robot import Robot
-from .._angles import wrap_angle
+from .._angles import wrap_angle, wrap_any_float
 from .._tolerances import ACCEPT_RESIDUAL, DUPLICATE_TOLERANCE, POLISH_RESIDUAL, ROUNDING_TOLERANCE
 from ._gauss_newton import gauss_newton
 from ._goals import Goal, PoseGoal, pose_residuals_of_rows
@@ -63,6 +63,13 @@ def distance_to_reference(robot: Robot, q: np.ndarray, reference: np.ndarray, *,
     if weights is not None:
         difference = difference * weights
     return difference.max(axis=-1) if norm == "linf" else np.linalg.norm(difference, axis=-1)
+
+
+def linf_distances_of_rows(robot: Robot, rows: list[list[float]], reference: list[float]) -> list[float]:
+    """:func:`distance_to_reference` (``linf``, no weights) of a few rows of n floats, on floats, bit for bit."""
+    revolute = robot.is_revolute.tolist()
+    return [max(abs(wrap_any_float(value - at)) if turns else abs(value - at)
+                for value, at, turns in zip(row, reference, revolute)) for row in rows]
 
 
 def residuals(robot: Robot, q: np.ndarray, world_T_target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -405,9 +412,9 @@ def verify_one(robot: Robot, goal: PoseGoal, one_pose, reference: np.ndarray | N
     for row in kept:
         if None in codes[row]:
             return None
-    if reference is not None and len(kept) > 1:
-        distance = distance_to_reference(robot, np.array([rows[row] for row in kept]), reference)
-        kept = [kept[i] for i in np.argsort(distance, kind="stable").tolist()]
+    if reference is not None and len(kept) > 1:  # nearest first (a stable sort, as the array path's)
+        distance = linf_distances_of_rows(robot, [rows[row] for row in kept], reference.tolist())
+        kept = [kept[i] for i in sorted(range(len(kept)), key=distance.__getitem__)]
     nearest = np.array([min(sizes, default=np.inf)])
     complete = promised(one_pose, np.array([len(kept)]), nearest, constrained)
     no_orientation = math.nan  # a position target's orientation residual, as the table holds it

@@ -299,6 +299,22 @@ def test_the_error_size_of_one_pair_of_floats_is_the_arrays():
                 assert on_floats == on_arrays[0] or (np.isnan(on_floats) and np.isnan(on_arrays[0]))
 
 
+@pytest.mark.parametrize("robot_id", ["puma560_standard", "spong_ex3_2_cylindrical_rpp", "spong_ex3_5_stanford"])
+def test_the_distances_of_a_few_rows_on_floats_are_the_arrays(robot_id):
+    """linf_distances_of_rows (verify_one's nearest-first order) is distance_to_reference bit for bit: references
+    within a turn, several turns away, and exactly half a turn from a row (where the wrap decides), on arms with
+    and without slides."""
+    robot = _CATALOGUE.get(robot_id).robot
+    rng = np.random.default_rng(31)
+    for case in range(300):
+        rows = rng.uniform(-np.pi, np.pi, (int(rng.integers(1, 9)), robot.dof))
+        reference = rng.choice([1.0, 4.0, 30.0]) * rng.uniform(-np.pi, np.pi, robot.dof)
+        if case % 3 == 0:
+            reference = rows[0] + rng.choice([-1.0, 1.0], robot.dof) * np.pi
+        on_floats = _verify.linf_distances_of_rows(robot, rows.tolist(), reference.tolist())
+        assert np.array(on_floats).tobytes() == _verify.distance_to_reference(robot, rows, reference).tobytes(), case
+
+
 @pytest.mark.parametrize("robot_id", ONE_POSE_ROBOTS)
 def test_the_float_check_of_one_pose_is_verify(robot_id):
     """verify_one (the FK check, the duplicate scan and the labels of one pose's scalar slots, on floats) gives

@@ -31,8 +31,8 @@ MAX_COMBINATIONS_PER_SOLUTION = 1 << 15
 
 #: Rows (one target's solutions) and rank entries per row (∏ caps × n, bounding the cache's memory) up to which
 #: :func:`_rank_tuples` looks rows up one by one rather than enumerating them all at once; up to these rows and
-#: entries in all, :func:`combination_turns` works out each combination's turns directly rather than tabling
-#: each joint's ranked turns first.
+#: entries in all, :func:`combination_turns` ranks every row, the single ones too, rather than the rows with
+#: several turns alone.
 _FEW_ROWS, _FEW_RANKS = 32, 1 << 13
 
 
@@ -105,9 +105,8 @@ def combination_turns(q: np.ndarray, first: np.ndarray, last: np.ndarray, ranks_
         return np.arange(len(q)), first
     if len(q) <= _FEW_ROWS:  # few rows: all ranked, the single ones keeping their ``first`` turns
         owner, ranks = _rank_tuples(ranks_cap, row_limit)
-        if ranks.size <= _FEW_RANKS:  # and few combinations: each one's turns worked out directly
-            cheapest, direction, ahead, behind = _ranked_turns(q, first, last, reference, weights)
-            turns = cheapest[owner] + _rank_offsets(ranks, direction[owner], ahead[owner], behind[owner])
+        if ranks.size <= _FEW_RANKS:  # and few combinations: tabled at once, the single rows' entries too
+            turns = _tabled_turns(ranks_cap, owner, ranks, *_ranked_turns(q, first, last, reference, weights))
             return owner, np.where(single[owner, None], first[owner], turns)
     multi = (~single).nonzero()[0]
     caps = ranks_cap[multi]

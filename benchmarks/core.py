@@ -204,6 +204,11 @@ ROUNDED_ROBOTS = ["UR5", "KUKA KR6"]
 ANSWER_SINGLE_TASK, ANSWER_BATCH_TASK = "IK answer, {limits}, single pose", "IK answer, {limits}, batch of {batch:,}"
 #: a motion planner's handful of waypoints in one call: the whole answer of that many targets a call, per pose
 ANSWER_FEW_TASK = "IK answer, {limits}, {few} targets a call"
+#: a motion planner's single pose: its solutions nearest first to the joints it holds (each pose's own, moved a
+#: little); EAIK's anchor sorts its solutions by the same distance, as its user has to
+ANSWER_NEAREST_TASK = "IK answer, {limits}, single pose, nearest first to a reference"
+#: how far (radians, standard deviation per joint) a nearest-first row's reference is from the pose's own joints
+REFERENCE_SPREAD = 0.05
 FEW_TARGETS_A_CALL = 4
 WHOLE_ANSWER = "core"  # the row the others are compared with: answer_ik, solve + select
 SOLVE_ONLY_SINGLE = "core, solve only (solve_closed_form: solve + FK check)"
@@ -255,6 +260,7 @@ def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.
     q_batch = sample_configurations(robot, args.batch, seed=6)
     T_single, T_batch = forward_kinematics(robot, q_single), forward_kinematics(robot, q_batch)
     singles = [IKTargets.poses(T[None]) for T in T_single]
+    references = q_single + np.random.default_rng(7).normal(0.0, REFERENCE_SPREAD, q_single.shape)
     few = FEW_TARGETS_A_CALL
     fews = [IKTargets.poses(T_single[start:start + few]) for start in range(0, len(T_single), few)]
     batch_targets = IKTargets.poses(T_batch)
@@ -273,6 +279,9 @@ def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.
         single: dict[str, Callable[[], list]] = {
             WHOLE_ANSWER: lambda o=options: [answer_ik(robot, t, o) for t in singles]}
         a_few: dict[str, Callable[[], list]] = {WHOLE_ANSWER: lambda o=options: [answer_ik(robot, t, o) for t in fews]}
+        nearest_options = [replace(options, reference=reference) for reference in references]
+        nearest: dict[str, Callable[[], list]] = {
+            WHOLE_ANSWER: lambda o=nearest_options: [answer_ik(robot, t, each) for t, each in zip(singles, o)]}
         batch: dict[str, Callable[[], object]] = {
             WHOLE_ANSWER: lambda o=options: answer_ik(robot, batch_targets, o),
             SOLVE_ONLY: lambda: solve_ik_arrays(robot, T_batch)}
@@ -281,6 +290,8 @@ def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.
         if eaik is not None:
             single["EAIK"] = lambda: [eaik.ik_single(T) for T in T_single]
             a_few["EAIK (IK)"] = single["EAIK"]  # its best for a handful: IK per pose, or IK_batched on one thread
+            nearest["EAIK"] = lambda: [nearest_first(eaik.ik_single(T), reference)
+                                       for T, reference in zip(T_single, references)]
             a_few["EAIK (IK_batched)"] = lambda: [solution for start in range(0, len(T_single), few)
                                                   for solution in eaik.ik_batch_threads(T_single[start:start + few], 1)]
             for threads in EAIK_THREADS:
@@ -288,17 +299,20 @@ def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.
         solutions = {  # untimed: warm-up, and the answers for the solution counts and recall
             WHOLE_ANSWER: ([s for a in single[WHOLE_ANSWER]() for s in answer_solutions(a)],
                            [s for a in a_few[WHOLE_ANSWER]() for s in answer_solutions(a)],
-                           answer_solutions(batch[WHOLE_ANSWER]()))}
+                           answer_solutions(batch[WHOLE_ANSWER]()),
+                           [s for a in nearest[WHOLE_ANSWER]() for s in answer_solutions(a)])}
         if eaik is not None:
             solutions["EAIK"] = (single["EAIK"](), a_few["EAIK (IK_batched)"](),
-                                 batch[f"EAIK ({EAIK_THREADS[-1]})"]())
-        for task in (*single.values(), *a_few.values(), *batch.values()):
+                                 batch[f"EAIK ({EAIK_THREADS[-1]})"](), nearest["EAIK"]())
+        for task in (*single.values(), *a_few.values(), *batch.values(), *nearest.values()):
             task()
         single_task = ANSWER_SINGLE_TASK.format(limits=limits_name)
         few_task = ANSWER_FEW_TASK.format(limits=limits_name, few=few)
         batch_task = ANSWER_BATCH_TASK.format(limits=limits_name, batch=args.batch)
+        nearest_task = ANSWER_NEAREST_TASK.format(limits=limits_name)
         for kind, (task, tasks, truth) in enumerate(((single_task, single, q_single), (few_task, a_few, q_single),
-                                                     (batch_task, batch, q_batch))):
+                                                     (batch_task, batch, q_batch),
+                                                     (nearest_task, nearest, q_single))):
             best = best_of(tasks, args.repeats)
             eaik_rows = {name: seconds for name, seconds in best.items() if name.startswith("EAIK (")}
             if eaik_rows:  # EAIK at its best: its fastest call (thread count, or IK against IK_batched)
@@ -315,6 +329,12 @@ def bench_whole_answer(report: Report, label: str, robot: Robot, args: argparse.
                     if limits != "open":
                         found = None
                 report.rows.append(Row(label, task, name, seconds / len(truth), per_pose, found))
+
+
+def nearest_first(solutions: np.ndarray, reference: np.ndarray) -> np.ndarray:
+    """Solutions (m, n) ordered by their largest joint travel from ``reference`` (n,), the nearest first: the
+    answer's own order under the default ``linf`` norm, for an anchor that lists them in its own order."""
+    return solutions[np.argsort(np.abs(solutions - reference).max(axis=1), kind="stable")]
 
 
 def _timed_ik(report: Report, label: str, task: str, robot: Robot, tasks: dict[str, Callable[[], list]],
@@ -394,6 +414,10 @@ def targets(report: Report, batch: int) -> list[str]:
         if few_ratio is not None and single_ratio is not None:
             out.append(f"- whole answer per pose, {FEW_TARGETS_A_CALL} targets a call, {OPEN_LIMITS}, core / EAIK at "
                        f"its best ({robot}): {few_ratio:.2f} (single pose: {single_ratio:.2f}; no target of its own)")
+        nearest_ratio = ratio(robot, ANSWER_NEAREST_TASK.format(limits=OPEN_LIMITS), WHOLE_ANSWER, "EAIK")
+        if nearest_ratio is not None:
+            out.append(f"- single-pose whole answer nearest first to a reference, {OPEN_LIMITS}, core / EAIK IK and "
+                       f"a sort by the same distance ({robot}): {nearest_ratio:.2f} (no target of its own)")
     open_single = ANSWER_SINGLE_TASK.format(limits=OPEN_LIMITS)
     for robot in ROUNDED_ROBOTS:  # no target: what a CAD-rounded description costs against the exact arm
         rounded, exact = report.find(rounded_label(robot), open_single, WHOLE_ANSWER), report.find(

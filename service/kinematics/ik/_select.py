@@ -254,7 +254,7 @@ def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *
     if reference is not None:
         reference = effective_reference(robot, limits, reference)
     budget.check("selection")
-    if n_targets == 1 and excluded is None and ordering.max_joint_move is None and len(table) <= _ONE_TARGET_ROWS:
+    if n_targets == 1 and excluded is None and len(table) <= _ONE_TARGET_ROWS:
         chosen = _one_target(robot, limits, table, filter_limits, max_equivalents, reference, ordering)
         if chosen is not None:
             return chosen
@@ -516,9 +516,8 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
 
 def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limits: bool, max_equivalents: int,
                 reference: np.ndarray | None = None, ordering: Ordering = Ordering()) -> Selection | None:
-    """:func:`select` of one target's rows (``table``) without a joint-move bound or excluded rows, in a few steps
-    on Python floats and integers, or on arrays of that target's few combinations: the same selection, field by
-    field. None where its rows have more combinations than :data:`_ONE_TARGET_COMBINATIONS` in all or
+    """:func:`select` of one target's rows (``table``) without excluded rows, in a few steps on Python floats and
+    integers, or on arrays of that target's few combinations: the same selection, field by field. None where its rows have more combinations than :data:`_ONE_TARGET_COMBINATIONS` in all or
     :data:`_ROW_COMBINATIONS` in one, or a value that is not finite meets a quotient (the array path then selects
     them).
 
@@ -526,15 +525,16 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
     its closest equivalent, for a row that does not fit); a row that does not fit and is filtered is rejected at
     its closest equivalent. Without a reference each row's combinations form a stream and the streams take turns
     (:func:`_in_turn`); with one (``reference`` effective already, :func:`effective_reference`) every combination
-    is costed and the nearest kept (:func:`_nearest_of_one`). Rows whose every value has the turns [0, 0] alone
-    (the usual answer: limits within a turn) are found in one comparison."""
+    is costed and the nearest kept (:func:`_nearest_of_one`, within the joint-move bound if any). Rows whose every
+    value has the turns [0, 0] alone (the usual answer: limits within a turn) are found in one comparison."""
     bounds = limits.widened(robot)
     q = table.joints
     n_rows, n = q.shape
     limit = max_equivalents if ordering.max_solutions is None else min(max_equivalents, ordering.max_solutions)
     capped = ordering.max_solutions is not None and ordering.max_solutions <= max_equivalents
     at_zero = ((q > bounds.zero_turn_low) & (q < bounds.zero_turn_high)).all(axis=1).tolist()
-    if all(at_zero) and n_rows <= limit:  # every row kept, at q + 2π·0 as the arrays list it, nearest first
+    if all(at_zero) and n_rows <= limit and ordering.max_joint_move is None:
+        # every row kept, at q + 2π·0 as the arrays list it (nearest first with a reference)
         counts = np.array([n_rows], dtype=np.int64)
         order = slice(None) if reference is None else np.argsort(travel(robot, limits, q, reference, ordering),
                                                                   kind="stable")
@@ -572,11 +572,12 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
         combinations += 1
         if combinations > _ONE_TARGET_COMBINATIONS:
             return None
+    available = combinations
     if reference is None:
         kept_of, turns = _in_turn(firsts, lasts, max_equivalents, n)
     else:
-        kept_of, turns = _nearest_of_one(robot, limits, q.take(candidates, axis=0), firsts, lasts, limit, reference,
-                                         ordering)
+        kept_of, turns, available = _nearest_of_one(robot, limits, q.take(candidates, axis=0), firsts, lasts, limit,
+                                                    reference, ordering)
     kept_rows = np.array(candidates, dtype=np.int64)[kept_of]
     fits = np.array(fits, dtype=bool)
     # q + 2πk as the arrays list them: 2πk first, then q added (the same sum either way round)
@@ -588,33 +589,44 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
         order = np.argsort(travel(robot, limits, dropped_values, reference, ordering), kind="stable")
         dropped, dropped_values = dropped[order], dropped_values[order]
     rejected = table.take(dropped, joints=dropped_values, within_limits=fits[dropped])
-    rows, n_kept, n_candidates, available = (np.array([count], dtype=np.int64) for count in (
-        n_rows, len(kept_rows), len(candidates), combinations))
-    return _outcome(rows, kept, n_kept, rejected, n_candidates, available, available, np.zeros(1, dtype=np.int64),
-                    capped, max_equivalents, reference is not None, None, n)
+    rows, n_kept, n_candidates, available, with_all_moves = (np.array([count], dtype=np.int64) for count in (
+        n_rows, len(kept_rows), len(candidates), available, combinations))
+    return _outcome(rows, kept, n_kept, rejected, n_candidates, available, with_all_moves,
+                    np.zeros(1, dtype=np.int64), capped, max_equivalents, reference is not None, None, n)
 
 
 def _nearest_of_one(robot: Robot, limits: Limits, q: np.ndarray, firsts: list[list[float]],
                     lasts: list[list[float]], limit: int, reference: np.ndarray, ordering: Ordering
-                    ) -> tuple[np.ndarray, np.ndarray]:
+                    ) -> tuple[np.ndarray, np.ndarray, int]:
     """:func:`_nearest` of one target's candidate rows q (C, n) with a reference: the kept rows (K,) (indices
-    into q) and each one's turns (K, n), nearest first. ``firsts``, ``lasts`` are the rows' usable turns (n whole
-    floats each, ``last ≥ first``), their combinations few (:data:`_ONE_TARGET_COMBINATIONS`): each is costed,
-    in the order :func:`~._equivalents.combination_turns` gives them (rows in order, each one's rank tuples
-    lexicographically), and a stable sort keeps the array path's ties."""
+    into q), each one's turns (K, n), nearest first, and the combinations within the joint-move bound (all of
+    them without one). ``firsts``, ``lasts`` are the rows' usable turns (n whole floats each, ``last ≥ first``),
+    their combinations few (:data:`_ONE_TARGET_COMBINATIONS`): the bound narrows them (:func:`_within_move`), and
+    each combination left is costed, in the order :func:`~._equivalents.combination_turns` gives them (rows in
+    order, each one's rank tuples lexicographically), and a stable sort keeps the array path's ties."""
     n = q.shape[1]
     first = np.array(firsts, dtype=float).reshape(len(firsts), n)
-    if firsts == lasts:  # one combination each (limits within a turn): the rows themselves
-        owner, turns = np.arange(len(firsts)), first
+    if firsts == lasts and ordering.max_joint_move is None:  # one combination each: the rows themselves
+        owner, turns, available = np.arange(len(firsts)), first, len(firsts)
     else:
         last = np.array(lasts, dtype=float).reshape(first.shape)
-        row_limit = np.full(len(first), limit, dtype=np.int64)
-        weights = np.ones(n) if ordering.weights is None else np.asarray(ordering.weights, dtype=float)
-        owner, turns = combination_turns(q, first, last, np.minimum(last - first + 1.0, limit).astype(np.int64),
-                                         row_limit, reference, weights)
+        if ordering.max_joint_move is not None:
+            first, last = _within_move(robot, limits, q, first, last, reference, ordering.max_joint_move)
+        counts = np.maximum(last - first + 1.0, 0.0)  # 0 for a joint no value of which is near enough
+        combinations = np.prod(counts, axis=1)
+        available = int(combinations.sum())  # whole numbers within _ONE_TARGET_COMBINATIONS: exact
+        near = np.flatnonzero(combinations)  # the rows with a combination left (each one's come alone)
+        if (combinations[near] == 1.0).all():
+            owner, turns = near, first[near]
+        else:
+            weights = np.ones(n) if ordering.weights is None else np.asarray(ordering.weights, dtype=float)
+            owner, turns = combination_turns(q[near], first[near], last[near],
+                                             np.minimum(counts[near], limit).astype(np.int64),
+                                             np.full(len(near), limit, dtype=np.int64), reference, weights)
+            owner = near[owner]
     cost = travel(robot, limits, q.take(owner, axis=0) + _TWO_PI * turns, reference, ordering)
     pick = np.argsort(cost, kind="stable")[:limit]
-    return owner[pick], turns[pick]
+    return owner[pick], turns[pick], available
 
 
 def _in_turn(firsts: list[list[float]], lasts: list[list[float]], limit: int, n: int

@@ -68,8 +68,8 @@ def distance_to_reference(robot: Robot, q: np.ndarray, reference: np.ndarray, *,
 def linf_distances_of_rows(robot: Robot, rows: list[list[float]], reference: list[float]) -> list[float]:
     """:func:`distance_to_reference` (``linf``, no weights) of a few rows of n floats, on floats, bit for bit."""
     revolute = robot.is_revolute.tolist()
-    return [max(abs(wrap_any_float(value - at)) if turns else abs(value - at)
-                for value, at, turns in zip(row, reference, revolute)) for row in rows]
+    return [max([abs(wrap_any_float(value - at)) if turns else abs(value - at)
+                 for value, at, turns in zip(row, reference, revolute)]) for row in rows]
 
 
 def residuals(robot: Robot, q: np.ndarray, world_T_target: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -108,7 +108,8 @@ def _select_both(robot, target, options, rng, monkeypatch):
 @pytest.fixture
 def calls(monkeypatch):
     """Counts of the selection's few-rows and general forms, as the cases call them."""
-    counted = {"few rows": 0, "general": 0, "few in turn": 0, "one target": 0, "one target, nearest first": 0}
+    counted = {"few rows": 0, "general": 0, "few in turn": 0, "one target": 0, "one target, nearest first": 0,
+               "one target, within a joint move": 0}
 
     def counting(function, key):
         def wrapper(*args, **kwargs):
@@ -126,6 +127,7 @@ def calls(monkeypatch):
         chosen = selects_one_target(*args, **kwargs)
         counted["one target"] += chosen is not None
         counted["one target, nearest first"] += chosen is not None and args[5] is not None
+        counted["one target, within a joint move"] += chosen is not None and args[6].max_joint_move is not None
         return chosen
     monkeypatch.setattr(_select, "_one_target", one_target)
     return counted
@@ -150,7 +152,8 @@ def test_one_target_selects_as_the_general_path(monkeypatch, calls):
     # the cases exercise the few-rows forms, one target selected on floats (its few combinations put in turn on
     # integers) and the general form, and rank many equivalents
     assert ranked > 50 and calls["general"] > 50 and calls["one target"] > 30 and calls["few in turn"] > 20 \
-        and calls["one target, nearest first"] > 30 and kept_many > 100, (ranked, calls, kept_many)
+        and calls["one target, nearest first"] > 30 and calls["one target, within a joint move"] > 20 \
+        and kept_many > 100, (ranked, calls, kept_many)
 
 
 def test_few_combinations_without_a_reference_come_in_the_general_paths_order(monkeypatch, calls):

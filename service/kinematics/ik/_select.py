@@ -86,9 +86,10 @@ NOTE_WORDING = {
 #: out once per turn ranges and kept (:func:`_stream`, for this many ranges: at most 512 × 256 rows of n floats,
 #: 6 MB for six joints); past these sizes the array path ranks only the combinations it keeps, and wins.
 _ONE_TARGET_ROWS, _ONE_TARGET_COMBINATIONS, _ROW_COMBINATIONS, _KEPT_STREAMS = 64, 1024, 256, 512
-#: Up to this many combinations in all, :func:`_in_turn` takes the rounds on Python lists (numpy's fixed costs
-#: outweigh the work).
-_FEW_IN_TURN = 64
+#: Up to this many combinations in all, :func:`_in_turn` takes the rounds on Python lists, and one target's
+#: combinations nearest a reference are ranked on floats (:func:`_nearest_on_floats`): numpy's fixed costs
+#: outweigh the work.
+_FEW_IN_TURN = _FEW_NEAREST = 64
 
 #: About the most combinations (one value per joint of one solution) costed at once, for the memory of a chunk.
 _CHUNK_ROWS = 1 << 18
@@ -517,9 +518,9 @@ def _nearest(robot: Robot, limits: Limits, target: np.ndarray, q: np.ndarray, fi
 def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limits: bool, max_equivalents: int,
                 reference: np.ndarray | None = None, ordering: Ordering = Ordering()) -> Selection | None:
     """:func:`select` of one target's rows (``table``) without excluded rows, in a few steps on Python floats and
-    integers, or on arrays of that target's few combinations: the same selection, field by field. None where its rows have more combinations than :data:`_ONE_TARGET_COMBINATIONS` in all or
-    :data:`_ROW_COMBINATIONS` in one, or a value that is not finite meets a quotient (the array path then selects
-    them).
+    integers, or on arrays of that target's few combinations: the same selection, field by field. None where its
+    rows have more combinations than :data:`_ONE_TARGET_COMBINATIONS` in all or :data:`_ROW_COMBINATIONS` in one,
+    or a value that is not finite meets a quotient (the array path then selects them).
 
     Every row that fits (or, with ``filter_limits`` false, every row) may be kept, with its combinations (one, at
     its closest equivalent, for a row that does not fit); a row that does not fit and is filtered is rejected at
@@ -618,6 +619,9 @@ def _nearest_of_one(robot: Robot, limits: Limits, q: np.ndarray, firsts: list[li
         near = np.flatnonzero(combinations)  # the rows with a combination left (each one's come alone)
         if (combinations[near] == 1.0).all():
             owner, turns = near, first[near]
+        elif available <= _FEW_NEAREST and (ordering.norm == "linf" or n < 8):  # (numpy sums 8 terms pairwise)
+            return (*_nearest_on_floats(robot, limits, q[near].tolist(), first[near].tolist(), last[near].tolist(),
+                                        near.tolist(), limit, reference, ordering), available)
         else:
             weights = np.ones(n) if ordering.weights is None else np.asarray(ordering.weights, dtype=float)
             owner, turns = combination_turns(q[near], first[near], last[near],
@@ -627,6 +631,74 @@ def _nearest_of_one(robot: Robot, limits: Limits, q: np.ndarray, firsts: list[li
     cost = travel(robot, limits, q.take(owner, axis=0) + _TWO_PI * turns, reference, ordering)
     pick = np.argsort(cost, kind="stable")[:limit]
     return owner[pick], turns[pick], available
+
+
+def _nearest_on_floats(robot: Robot, limits: Limits, q: list[list[float]], firsts: list[list[float]],
+                       lasts: list[list[float]], rows: list[int], limit: int, reference: np.ndarray,
+                       ordering: Ordering) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_nearest_of_one` of a few combinations (:data:`_FEW_NEAREST`) on Python floats: the rows ``rows``
+    (each with q, its usable turns ``firsts`` … ``lasts``, n floats each) give their combinations in the order of
+    :func:`~._equivalents.combination_turns` (rows in order, each one's rank tuples lexicographically, a joint's
+    turns ranked as :func:`~._equivalents._ranked_turns` and :func:`~._equivalents._rank_offsets` rank them), each
+    costed as :func:`travel` costs it, bit for bit, and a stable sort keeps the first ``limit``. Every tuple is
+    costed: those the arrays skip (∏(r_j + 1) > ``limit``) have ``limit`` tuples at most as far before them, so
+    they are never kept. Returns the kept rows (K,) and their turns (K, n)."""
+    at = reference.tolist()
+    n = len(at)
+    weights = [1.0] * n if ordering.weights is None else np.asarray(ordering.weights, dtype=float).tolist()
+    continuous = limits.continuous(robot).tolist()
+    l2 = ordering.norm == "l2"
+    costed = []
+    for row, values, first, last in zip(rows, q, firsts, lasts):
+        ranked = [_ranked_turns_of(*joint, limit) for joint in zip(values, first, last, at, weights)]
+        for turns in itertools.product(*ranked):
+            total = 0.0
+            for value, turn, reference_value, weight, wraps in zip(values, turns, at, weights, continuous):
+                distance = abs(value + _TWO_PI * turn - reference_value)
+                if wraps:
+                    distance = abs(math.pi - (math.pi - distance) % _TWO_PI)
+                if ordering.weights is not None:
+                    distance *= weight
+                total = total + distance * distance if l2 else (distance if distance > total else total)
+            costed.append((math.sqrt(total) if l2 else total, row, turns))
+    costed.sort(key=lambda entry: entry[0])  # stable: ties keep the enumeration's order
+    kept = costed[:limit]
+    return (np.array([row for _, row, _ in kept], dtype=np.int64),
+            np.array([turns for _, _, turns in kept], dtype=float).reshape(len(kept), n))
+
+
+def _ranked_turns_of(value: float, first: float, last: float, reference: float, weight: float, limit: int
+                     ) -> list[float]:
+    """One joint's usable turns (``first`` … ``last``) in rank order, at most ``limit`` of them: cheapest
+    |value + 2kπ − reference|·weight first, then alternately on either side while both have turns left (the lower
+    value first at equal cost), as :func:`~._equivalents._ranked_turns` and :func:`~._equivalents._rank_offsets`
+    rank them on arrays."""
+    if first == last:  # the usual joint: its one turn
+        return [first]
+
+    def cost(turn: float) -> float:
+        return abs(value + _TWO_PI * turn - reference) * weight
+
+    below = float(math.floor((reference - value) / _TWO_PI))
+    above = below + 1.0
+    at_above = cost(above)
+    lower_costs_more = at_above < cost(below)
+    cheapest = above if lower_costs_more else below
+    direction = -1.0 if lower_costs_more or cost(below - 1.0) <= at_above else 1.0
+    if weight == 0:  # every value costs 0: ascending values
+        cheapest, direction = first, 1.0
+    direction = 1.0 if cheapest < first else -1.0 if cheapest > last else direction
+    cheapest = min(max(cheapest, first), last)
+    ahead = last - cheapest if direction > 0 else cheapest - first
+    behind = (last - first) - ahead
+    turns = []
+    for rank in range(min(int(last - first) + 1, limit)):
+        if rank <= 2.0 * min(ahead, behind):
+            offset = direction * (rank + 1.0) / 2.0 if rank % 2 == 1 else -direction * rank / 2.0
+        else:
+            offset = -direction * (rank - ahead) if ahead <= behind else direction * (rank - behind)
+        turns.append(cheapest + offset)
+    return turns
 
 
 def _in_turn(firsts: list[list[float]], lasts: list[list[float]], limit: int, n: int

@@ -109,7 +109,7 @@ def _select_both(robot, target, options, rng, monkeypatch):
 def calls(monkeypatch):
     """Counts of the selection's few-rows and general forms, as the cases call them."""
     counted = {"few rows": 0, "general": 0, "few in turn": 0, "one target": 0, "one target, nearest first": 0,
-               "one target, within a joint move": 0}
+               "one target, within a joint move": 0, "nearest on floats": 0}
 
     def counting(function, key):
         def wrapper(*args, **kwargs):
@@ -120,6 +120,7 @@ def calls(monkeypatch):
     monkeypatch.setattr(_equivalents, "_row_rank_tuples", counting(_equivalents._row_rank_tuples, "few rows"))
     monkeypatch.setattr(_equivalents, "_tabled_turns", counting(_equivalents._tabled_turns, "general"))
     monkeypatch.setattr(_select, "_in_turn", counting(_select._in_turn, "few in turn"))
+    monkeypatch.setattr(_select, "_nearest_on_floats", counting(_select._nearest_on_floats, "nearest on floats"))
 
     selects_one_target = _select._one_target
 
@@ -153,6 +154,7 @@ def test_one_target_selects_as_the_general_path(monkeypatch, calls):
     # integers) and the general form, and rank many equivalents
     assert ranked > 50 and calls["general"] > 50 and calls["one target"] > 30 and calls["few in turn"] > 20 \
         and calls["one target, nearest first"] > 30 and calls["one target, within a joint move"] > 20 \
+        and calls["nearest on floats"] > 30 \
         and kept_many > 100, (ranked, calls, kept_many)
 
 

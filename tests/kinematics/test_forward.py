@@ -377,3 +377,17 @@ def test_a_nan_joint_gives_the_same_residuals_on_floats_and_on_arrays(monkeypatc
         np.testing.assert_array_equal(np.isnan(a), np.isnan(b))
         np.testing.assert_allclose(a[~np.isnan(a)], b[~np.isnan(b)], rtol=0, atol=1e-14)
     assert np.isnan(scalar[1][0, 0]) and np.isfinite(scalar[0][0, 0])
+
+
+@pytest.mark.parametrize("rows", [1, 8, 255, 256, 257, 2000])
+def test_cross_is_numpys_cross_at_every_size(rows):
+    """The core's cross product (its component slices for many vectors, gathered components for a few, floats for
+    two 3-vectors) gives np.cross's values at every size and broadcast, bit for bit."""
+    from service.kinematics._forward import cross
+
+    rng = np.random.default_rng(rows)
+    a, b = rng.normal(size=(rows, 3)), rng.normal(size=(rows, 3))
+    assert cross(a, b).tobytes() == np.cross(a, b).tobytes()
+    assert cross(a[0], b).tobytes() == np.cross(a[0], b).tobytes()  # one vector against many
+    assert cross(a[:, None], b[None, :2]).tobytes() == np.cross(a[:, None], b[None, :2]).tobytes()  # broadcast
+    assert cross(a[0], b[0]).tobytes() == np.cross(a[0], b[0]).tobytes()

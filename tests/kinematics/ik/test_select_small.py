@@ -1,9 +1,10 @@
 """One target's answer (the few-rows forms of the selection) is the general array path's, field by field.
 
-For one target the selection looks rank tuples up row by row, works out each combination's turns directly and
-skips the bookkeeping of many targets (:mod:`service.kinematics.ik._equivalents`); where each solution has at most
-one equivalent within the limits and nothing orders the rows, it keeps them in table order without ranking any
-(``_select._each_once``). The general path is forced by answering the same target inside a batch of other
+For one target the selection looks rank tuples up row by row, tables each joint's ranked turns once and skips
+the bookkeeping of many targets (:mod:`service.kinematics.ik._equivalents`), on Python floats where its
+combinations are few (``_select._one_target``: in turn without a reference, nearest first with one); where each
+solution has at most one equivalent within the limits and nothing orders the rows, it keeps them in table order
+without ranking any (``_select._each_once``). The general path is forced by answering the same target inside a batch of other
 targets, with those forms switched off and an exclusion mask that excludes nothing: the two answers must
 agree bit for bit, over random catalogue arms, limits (±2π and wider, narrow, one-sided, exactly at a
 solution's joints), references (some exactly between two equivalents) and options.
@@ -222,3 +223,77 @@ def test_joint_exactly_at_its_limits_and_reference_between_equivalents(monkeypat
             mine, general = _select_both(robot, target, options, rng, monkeypatch)
             _assert_identical(mine, 0, general, 3)
             assert mine.available[0] >= 7 and mine.truncated[0]
+
+
+def test_nearest_of_one_is_the_general_ranking_of_random_rows():
+    """``_select._nearest_of_one`` (its float ranking of a few combinations, and its arrays past them) against
+    ``_select._nearest`` on random rows of arms of 2 to 9 joints, prismatic and continuous joints among them:
+    usable turns from −3 to +4, references anywhere (some exactly half a turn from a row's value, where two
+    equivalents tie), weights with zeros, both norms, with and without a joint-move bound, any limit: the same
+    rows and values, bit for bit."""
+    from tests.arms import random_dh_robot
+
+    rng = np.random.default_rng(20261206)
+    ways = {"on floats": 0, "on arrays": 0}
+    for case in range(400):
+        n = int(rng.choice([2, 3, 6, 7, 8, 9]))
+        kinds = "".join(rng.choice(["R", "R", "R", "P"], n))
+        robot = random_dh_robot(rng, "standard", kinds)
+        revolute = robot.is_revolute
+        lower = np.where(rng.random(n) < 0.2, -np.inf, -rng.choice([np.pi, 3 * np.pi, 5 * np.pi], n))
+        upper = np.where(np.isinf(lower), np.inf, -lower)
+        limits = Limits(np.where(revolute, lower, -1.0), np.where(revolute, upper, 1.0))
+        multi = limits.multi_valued(robot)
+        rows = int(rng.integers(1, 9))
+        q = rng.uniform(-np.pi, np.pi, (rows, n))
+        first = np.where(multi, rng.integers(-3, 2, (rows, n)), 0).astype(float)
+        last = np.where(multi, first + rng.choice([0, 0, 1, 2], (rows, n)), first)
+        reference = rng.uniform(-6, 6, n)
+        if case % 3 == 0:  # half a turn from the first row's value: its two nearest equivalents tie
+            reference = np.where(revolute, q[0] + np.pi * rng.choice([-1, 1], n), reference)
+        ordering = Ordering(str(rng.choice(["linf", "l2"])),
+                            rng.choice([0.0, 0.5, 1.0, 2.0], n) if rng.random() < 0.4 else None, None,
+                            np.where(rng.random(n) < 0.5, rng.uniform(0, 4, n), np.inf) if rng.random() < 0.3
+                            else None)
+        limit = int(rng.choice([1, 2, 3, 7, 1024]))
+        counts = last - first + 1.0
+        c_first, c_last = first, last
+        if ordering.max_joint_move is not None:
+            c_first, c_last = _select._within_move(robot, limits, q, first, last, reference, ordering.max_joint_move)
+            counts = np.maximum(c_last - c_first + 1.0, 0.0)
+        combinations = counts.prod(axis=1)
+        target = np.zeros(rows, dtype=np.int64)
+        expected = _select._nearest(robot, limits, target, q, c_first, c_last, counts,
+                                    np.full(rows, limit, dtype=np.int64), limit, reference, ordering, UNLIMITED)
+        floats = 1 < combinations.sum() <= _select._FEW_NEAREST and (combinations[combinations > 0] > 1).any()
+        ways["on floats" if floats and (ordering.norm == "linf" or n < 8) else "on arrays"] += 1
+        rows_kept, turns, available = _select._nearest_of_one(robot, limits, q, first.tolist(), last.tolist(), limit,
+                                                              reference, ordering)
+        assert rows_kept.tolist() == expected[0].tolist(), case
+        assert (turns * TWO_PI + q[rows_kept]).tobytes() == expected[1].tobytes(), case
+        assert available == int(combinations.sum()), case
+    assert min(ways.values()) > 60, ways
+
+
+def test_the_l2_travel_of_fewer_than_8_joints_is_summed_in_joint_order():
+    """The float ranking (``_select._nearest_on_floats``) sums an l2 travel's squares in joint order, which is what
+    numpy's reduction does for fewer than 8 terms (8 or more it sums pairwise, and those arms stay on arrays):
+    travel() on arrays equals the sequential sum bit for bit, for 1 to 7 joints, values over many magnitudes."""
+    rng = np.random.default_rng(8)
+    robot = CATALOGUE.get("puma560_standard").robot
+    for n in range(1, 8):
+        distance = rng.uniform(0, 7, (500, n)) * rng.choice([1.0, 1e-8, 1e8], (500, n))
+        in_order = np.sqrt([_squares_in_order(row) for row in distance])
+        assert in_order.tobytes() == np.sqrt(np.sum(distance ** 2, axis=-1)).tobytes(), n
+    q = rng.uniform(-np.pi, np.pi, (50, 6))  # and travel() itself, whose costs the float ranking mirrors
+    reference = rng.uniform(-6, 6, 6)
+    in_order = np.sqrt([_squares_in_order(np.abs(row - reference)) for row in q])
+    assert in_order.tobytes() == _select.travel(robot, Limits.of(robot), q, reference, Ordering("l2")).tobytes()
+
+
+def _squares_in_order(values: np.ndarray) -> float:
+    """Σ v_j² of a row (n,), summed in joint order on Python floats."""
+    total = 0.0
+    for value in values.tolist():
+        total = total + value * value
+    return total

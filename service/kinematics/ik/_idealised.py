@@ -65,13 +65,12 @@ from __future__ import annotations
 import numpy as np
 
 from .._forward import JointTrig, ScrewModel, geometric_jacobian
-from .._robot import Robot
+from .._robot import Robot, ScrewJoint
 from .._tolerances import ACCEPT_RESIDUAL
-from ._screws import chain_motion
 from ._structure import arm_size
 from ._types import Candidates, LabelCodes, Sealed
 from ._gauss_newton import gauss_newton
-from ._goals import PoseGoal, turn_of_chord
+from ._goals import PoseGoal
 from ._verify import POLISH_FROM, first_of_each, residual_arrays, wrap_revolute
 
 #: A rejected candidate whose true-arm residual (fraction of the arm's size, or radians) is within this many times
@@ -144,7 +143,12 @@ class IdealisedPlan(Sealed):
                  constrain_orientation: bool) -> None:
         """``inner`` is the family's plan for the idealised arm, whose screw model is ``model``."""
         self.inner = inner
-        self.inner_model = model
+        #: the idealised arm as a robot of its own (its screws and home pose), whose FK is the core's chain program
+        self.ideal_robot = Robot.from_screws(
+            [ScrewJoint(f"q{index + 1}", "revolute" if turns else "prismatic", tuple(axis.tolist()),
+                        tuple(point.tolist()))
+             for index, (axis, point, turns) in enumerate(zip(model.directions, model.points, model.is_revolute))],
+            model.home)
         self.robot = robot
         self.deviation = deviation
         self.size = size
@@ -372,11 +376,7 @@ class IdealisedPlan(Sealed):
 
     def _ideal_error(self, joints: np.ndarray, world_T_targets: np.ndarray) -> np.ndarray:
         """The idealised arm's residual at joints (N, m, n): position / size, or the larger with the orientation."""
-        model = self.inner_model
-        world_T_tool = chain_motion(model.directions, model.points, model.is_revolute, joints) @ model.home
-        position = np.linalg.norm(world_T_tool[..., :3, 3] - world_T_targets[:, None, :3, 3], axis=-1)
-        chord = world_T_tool[..., :3, :3] - world_T_targets[:, None, :3, :3]
-        return self._size(position, turn_of_chord(np.einsum("...ij,...ij->...", chord, chord)))
+        return self._size(*PoseGoal(world_T_targets).residuals(self.ideal_robot, joints))
 
     def _size(self, position: np.ndarray, orientation: np.ndarray) -> np.ndarray:
         size = position / self.size

@@ -32,9 +32,9 @@
 How the work stays bounded: only the rank tuples of :mod:`._equivalents` are enumerated and costed, in chunks
 of whole solutions of at most about :data:`_CHUNK_ROWS` combinations (one target's may span several), with
 ``budget`` checked between chunks; the counts (``available``, ``trimmed``) are products of interval lengths,
-capped at :data:`.._budget.COUNT_CAP`. One target without a joint-move bound or a collision filter, of at most
+capped at :data:`.._budget.COUNT_CAP`. One target without a collision filter, of at most
 :data:`_ONE_TARGET_COMBINATIONS` combinations, is selected row by row instead (:func:`_one_target`: a single
-pose's answer, where the chunks' fixed costs outweigh the work).
+pose's answer, where the chunks' fixed costs outweigh the work), with or without a reference.
 """
 
 from __future__ import annotations
@@ -79,7 +79,7 @@ NOTE_WORDING = {
                "'rejected' with their collisions.",
 }
 
-#: One target's answer without a joint-move bound or a collision filter, of up to this many rows, this many
+#: One target's answer without a collision filter, of up to this many rows, this many
 #: combinations in all and this many in a row, is selected row by row (:func:`_one_target`), where the array
 #: path's few dozen steps cost more than the arithmetic: a PUMA 560 with its catalogue limits has 8 … 40
 #: combinations per pose, a UR5 with ±2π about 512 (64 a row). A row's combinations in answer order are worked

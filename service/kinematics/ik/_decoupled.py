@@ -24,7 +24,6 @@ from .._forward import JointTrig
 from ._screws import apply, chain_rotation, invert, move_point, perpendicular_unit, rotate_about, rotation_about
 from ._structure import target_error
 from .subproblems import subproblem_1
-from .subproblems._prismatic import _slide_to_distance_clear
 from ._types import LEAN_CHUNK, NEAR_SINGULAR, Candidates, LabelCodes, SingularFlags, Sealed
 from ._wrist import Roll, SphericalWrist, seen_by
 
@@ -573,11 +572,9 @@ class _SlideElbowShoulderOnePose(_IntersectingShoulderOnePose):
         self.slide = scalar.vector_of(plan.positioner.geometry.direction(plan.positioner.joints[2]))
 
     def _thirds(self, distance: float) -> list[tuple[float, scalar.Matrix | None, scalar.Vector]]:
-        roots = _slide_to_distance_clear(self.point, self.slide, self.centre, distance, scalar.MARGIN)
-        if roots is None:
-            raise scalar.NotGeneric
         p, v, c = self.point, self.slide, self.centre
-        return [(s, None, (p[0] + s * v[0] - c[0], p[1] + s * v[1] - c[1], p[2] + s * v[2] - c[2])) for s in roots]
+        return [(s, None, (p[0] + s * v[0] - c[0], p[1] + s * v[1] - c[1], p[2] + s * v[2] - c[2]))
+                for s in scalar.slide_to_distance(p, v, c, distance)]
 
     def _elbow_side(self, reach_local: scalar.Vector) -> None:
         return None

@@ -39,6 +39,7 @@ from .._tolerances import DUPLICATE_TOLERANCE, GEOMETRY_TOLERANCE
 from ._screws import axis_frame
 from ._types import LabelCodes, SingularFlags
 from .subproblems._paden_kahan import _distance_equation, _subproblem_2_chain_clear
+from .subproblems._prismatic import _slide_to_distance_clear
 from .subproblems._roots import _harmonic_clear, _quadratic_clear
 from .subproblems._vectors import _rotate_onto_clear
 
@@ -265,6 +266,14 @@ def quadratic(A: float, B: float, C: float, scale: float) -> tuple[float, float]
     """The real roots of A t² + B t + C = 0 (:func:`.subproblems.quadratic_roots`), the second NaN for a linear
     one."""
     roots = _quadratic_clear(A, B, C, scale, MARGIN)
+    if roots is None:
+        raise NotGeneric
+    return roots
+
+
+def slide_to_distance(p: Vector, v: Vector, q: Vector, delta: float) -> tuple[float, float]:
+    """The two slides s with |p + s v − q| = δ (:func:`.subproblems.prismatic_to_distance`), in its slot order."""
+    roots = _slide_to_distance_clear(p, v, q, delta, MARGIN)
     if roots is None:
         raise NotGeneric
     return roots

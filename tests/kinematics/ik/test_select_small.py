@@ -2,12 +2,12 @@
 
 For one target the selection looks rank tuples up row by row, tables each joint's ranked turns once and skips
 the bookkeeping of many targets (:mod:`service.kinematics.ik._equivalents`), on Python floats where its
-combinations are few (``_select._one_target``: in turn without a reference, nearest first with one); where each
-solution has at most one equivalent within the limits and nothing orders the rows, it keeps them in table order
-without ranking any (``_select._each_once``). The general path is forced by answering the same target inside a batch of other
-targets, with those forms switched off and an exclusion mask that excludes nothing: the two answers must
-agree bit for bit, over random catalogue arms, limits (±2π and wider, narrow, one-sided, exactly at a
-solution's joints), references (some exactly between two equivalents) and options.
+combinations are few (``_select._one_target``: in turn without a reference, nearest first with one); where
+each solution has at most one equivalent within the limits and nothing orders the rows, it keeps them in table
+order without ranking any (``_select._each_once``). The general path is forced by answering the same target
+inside a batch of other targets, with those forms switched off and an exclusion mask that excludes nothing:
+the two answers must agree bit for bit, over random catalogue arms, limits (±2π and wider, narrow, one-sided,
+exactly at a solution's joints), references (some exactly between two equivalents) and options.
 """
 
 from __future__ import annotations

@@ -79,7 +79,6 @@ class ParallelShoulder(Positioner):
         return {"assembly_mode": ((1, 2), side_codes(side, size))}
 
 
-
 class SlideEquations(NamedTuple):
     """The fixed parts of :class:`OneRevoluteTwoPrismatic`'s equations: the revolute axis (direction ``omega``
     through ``p``), the slides' directions as columns (3, 2) split into those before the revolute joint
@@ -192,7 +191,6 @@ class OneRevoluteTwoPrismatic(Positioner):
         return PositionerResult(joints, valid, singular)
 
 
-
 class Cartesian(Positioner):
     """Three prismatic joints with independent directions: one linear solve."""
 
@@ -218,7 +216,6 @@ class Cartesian(Positioner):
         joints = (targets - self.point) @ self.inverse.T
         return PositionerResult(joints[:, None, :], np.ones((len(targets), 1), dtype=bool),
                                 SingularFlags(len(targets)))
-
 
 
 class SkewAxesWithSlide(Positioner):

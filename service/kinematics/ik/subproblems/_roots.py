@@ -84,28 +84,36 @@ def _harmonic_clear(a: float, b: float, c: float, scale: float, margin: float,
     return wrap_float(phi + half), wrap_float(phi - half)
 
 
+#: A quadratic's leading coefficient at most this is linear (one root), and a linear one's B at most this has none;
+#: this times the scale squared floors the discriminant's rounding band. :func:`quadratic_roots` and its float form
+#: :func:`_quadratic_clear` read it.
+_QUADRATIC_NEGLIGIBLE = 1e-12
+
+
 def quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale: float
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Real roots of ``A t² + B t + C = 0`` per row, B and C (N,), A (N,) or a number: (N, 2) roots, their
     validity (N, 2), and merged flags (N,) where the two are one (the midpoint, in the first slot).
 
-    A row with ``|A| <= 1e-12`` is linear: one root. ``scale`` is the length the coefficients are built from
-    (t is a length): it floors the discriminant's rounding band, within which the roots are one.
+    A row with ``|A| <=`` :data:`_QUADRATIC_NEGLIGIBLE` is linear: one root. ``scale`` is the length the
+    coefficients are built from (t is a length): it floors the discriminant's rounding band, within which the
+    roots are one.
     """
     A = np.broadcast_to(np.asarray(A, dtype=float), B.shape)
     roots = np.full(B.shape + (2,), np.nan)
     valid = np.zeros(B.shape + (2,), dtype=bool)
     merged = np.zeros(B.shape, dtype=bool)
-    linear = np.abs(A) <= 1e-12
+    linear = np.abs(A) <= _QUADRATIC_NEGLIGIBLE
     with np.errstate(divide="ignore", invalid="ignore"):
         roots[linear, 0] = -C[linear] / B[linear]
-        valid[linear, 0] = np.abs(B[linear]) > 1e-12
+        valid[linear, 0] = np.abs(B[linear]) > _QUADRATIC_NEGLIGIBLE
         quad = ~linear
         discriminant = B[quad] ** 2 - 4 * A[quad] * C[quad]
         # the discriminant's rounding: a double root only within it. (SINGULARITY_TOLERANCE here merged roots
         # ±1e-10 of the scale apart and kept the + one: the cylindrical arm's radial slide at −1e-10 came back
         # at +1e-10 with joint 1 turned by π.)
-        tolerance = ROUNDING_TOLERANCE * (B[quad] ** 2 + np.abs(4 * A[quad] * C[quad]) + scale ** 2 * 1e-12)
+        tolerance = ROUNDING_TOLERANCE * (B[quad] ** 2 + np.abs(4 * A[quad] * C[quad])
+                                          + scale ** 2 * _QUADRATIC_NEGLIGIBLE)
         touching = np.abs(discriminant) <= tolerance
         root = np.sqrt(np.maximum(discriminant, 0.0)) * ~touching  # a double root: the midpoint
         roots[quad, 0] = (-B[quad] + root) / (2 * A[quad])
@@ -116,21 +124,21 @@ def quadratic_roots(A: np.ndarray | float, B: np.ndarray, C: np.ndarray, scale: 
     return roots, valid, merged
 
 
-
 def _quadratic_clear(A: float, B: float, C: float, scale: float, margin: float) -> tuple[float, float] | None:
     """:func:`quadratic_roots` on floats where its answer is clear, for the one-pose paths: the two roots in its
     slot order, or one and NaN (a linear row), or None where a quantity is within ``margin`` times its band of one
     of its thresholds (linear or not, a double root) or the roots are not real (the array path words that)."""
-    if abs(A) * margin <= 1e-12:
-        return (-C / B, math.nan) if abs(B) > margin * 1e-12 else None
-    if not abs(A) > margin * 1e-12:
+    if abs(A) * margin <= _QUADRATIC_NEGLIGIBLE:
+        return (-C / B, math.nan) if abs(B) > margin * _QUADRATIC_NEGLIGIBLE else None
+    if not abs(A) > margin * _QUADRATIC_NEGLIGIBLE:
         return None
     discriminant = B * B - 4 * A * C
-    tolerance = ROUNDING_TOLERANCE * (B * B + abs(4 * A * C) + scale * scale * 1e-12)
+    tolerance = ROUNDING_TOLERANCE * (B * B + abs(4 * A * C) + scale * scale * _QUADRATIC_NEGLIGIBLE)
     if not discriminant > margin * tolerance:
         return None
     root = math.sqrt(discriminant)
     return (-B + root) / (2 * A), (-B - root) / (2 * A)
+
 
 # A root z of a trigonometric quartic (:func:`_trig_quartic_roots`) counts as a real angle when | |z| - 1 | is at
 # most this. Real roots lie on the unit circle and the others come in pairs (z, 1 / conj(z)); a double root (a

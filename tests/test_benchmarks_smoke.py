@@ -10,7 +10,8 @@ import shutil
 
 import pytest
 
-from benchmarks import anchors, collision, core, http_throughput, request_profile, slide_classes, wrist_classes
+from benchmarks import (anchors, collision, core, http_throughput, request_profile, single_pose_profile, slide_classes,
+                        wrist_classes)
 
 
 def test_core_benchmark_runs_with_tiny_sizes(capsys):
@@ -76,6 +77,42 @@ def test_request_profile_runs_with_tiny_sizes(capsys):
         assert f"| POST {request}, whole request, arguments found by FastAPI's dependency solver |" in out
 
 
+def test_single_pose_profile_runs_with_tiny_sizes(capsys):
+    assert single_pose_profile.main(["--quick", "--robots", "PUMA 560", "UR5"]) == 0
+    out = capsys.readouterr().out
+    for robot in ("PUMA 560", "UR5"):
+        assert f"**{robot}**: " in out
+    for stage in ("scalar solve (plan.solve_one)", "FK check (verify_one)",
+                  "the rest: table, selection, targets, plan look-up, assembly, IKAnswer"):
+        assert out.count(f"|   {stage} |") == 2
+    for stage in ("FK of the solutions (the chain program on floats)", "table (one_pose_table)",
+                  "selection (select), limits ±π, no filter"):
+        assert out.count(f"|     {stage} |") == 2
+    assert out.count("| whole answer (answer_ik), catalogue limits |") == 2
+    assert out.count("- the floor (the scalar solve + the FK of its solutions): ") == 2
+
+
+def test_the_single_pose_profile_leaves_the_core_as_it_found_it():
+    """The in-the-answer rows look stages up from tables while they run: afterwards the plan's solve, the FK check
+    and the chain program are the core's own again, and answer a pose the profile never saw."""
+    import numpy as np
+
+    from service.config import Settings
+    from service.kinematics import forward_kinematics
+    from service.kinematics.ik import IKTargets, answer_ik, cached_plan
+    from service.kinematics.ik import _closed_form, _goals
+    from service.robots.catalogue import load_catalogue
+
+    robot = load_catalogue([Settings().builtin_robots_dir], max_joints=32).get(core.ROBOTS["UR5"]).robot
+    plan = cached_plan(robot, constrain_orientation=True, reference=None)
+    before = (vars(type(plan)).get("solve_one"), _closed_form.verify_one, _goals.tool_columns_scalar_rows)
+    single_pose_profile.profile_robot("UR5", robot, 3, 1)
+    assert (vars(type(plan)).get("solve_one"), _closed_form.verify_one, _goals.tool_columns_scalar_rows) == before
+    q = np.array([0.3, -1.1, 1.4, -0.2, 0.9, 2.5])
+    answer = answer_ik(robot, IKTargets.poses(forward_kinematics(robot, q)[None]))
+    assert np.abs(answer.solutions.joints - q).max(axis=1).min() < 1e-9
+
+
 def test_wrist_classes_benchmark_runs_with_tiny_sizes(capsys):
     assert wrist_classes.main(["--quick"]) == 0
     out = capsys.readouterr().out
@@ -131,6 +168,8 @@ def test_redundant_benchmark_runs_with_tiny_sizes(capsys):
     out = capsys.readouterr().out
     assert "| iiwa 14 | full pose, q7 sampled 32× |" in out
     assert "| SO-101-like | position + direction, roll axis z |" in out
+
+
 def test_general_6r_benchmark_runs_with_tiny_sizes(capsys):
     from benchmarks import general_6r
 

@@ -25,8 +25,9 @@ or beyond the budget, the goal is out of reach of a core in Python and numpy, wh
 Stages timed alone run hot (the same few functions in a loop over the poses); inside the answer they run among
 the others' code and cost more. So each stage of the floor is also timed **in the answer**: the whole answer again
 with that stage's results looked up from a table made beforehand (the scalar solve, keyed by the pose's bytes; the
-FK of the solutions, keyed by their joints; the FK check, keyed by the scalar answer it checks), the difference
-being what the stage costs where it runs. A lookup costs a microsecond or two, so those figures are a little low.
+FK of the solutions, keyed by their rows; the FK check, keyed by the scalar answer it checks), interleaved with
+the other rows in each round, the difference being what the stage costs where it runs. A lookup costs a
+microsecond or so, so those figures are a little low.
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ import argparse
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -114,8 +115,26 @@ def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile
     def whole(option) -> Callable[[], object]:
         return lambda: [answer_ik(robot, t, option) for t in singles]
 
+    # in the answer: the whole answer again, stages looked up from tables (made on the warm-up pass)
+    solve = Lookup(type(plan), "solve_one", lambda self, pose, reference=None: pose.tobytes())
+    check = Lookup(_closed_form, "verify_one", lambda robot, goal, one_pose, reference=None: id(one_pose),
+                   _fresh_verified)
+    # (the solve looked up, each pose's scalar answer is one object, and so is each of its rows)
+    fk = Lookup(_goals, "tool_columns_scalar_rows", lambda robot, rows: tuple(map(id, rows)))
+
+    def whole_with(*lookups: Lookup) -> Callable[[], object]:
+        run = whole(options[open_name])
+
+        def looked_up() -> object:
+            with _looked_up(lookups):
+                return run()
+        return looked_up
+
     tasks: dict[str, Callable[[], object]] = {
         **{f"whole {name}": whole(option) for name, option in options.items()},
+        "whole, solve looked up": whole_with(solve),
+        "whole, solve and FK looked up": whole_with(solve, fk),
+        "whole, solve and check looked up": whole_with(solve, check),
         "scalar solve": lambda: [plan.solve_one(pose, None) for pose in T],
         "FK of the solutions": lambda: [tool_columns_scalar_rows(robot, r) for r in rows],
         "FK check": lambda: [verify_one(robot, goal, one_pose, None) for goal, one_pose in zip(goals, one_poses)],
@@ -125,27 +144,14 @@ def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile
     eaik, eaik_note = _eaik(robot)
     if eaik is not None:
         tasks["EAIK"] = lambda: [eaik(pose) for pose in T]
-    for task in tasks.values():  # warm-up
+    for task in tasks.values():  # warm-up, and the lookups' tables
         task()
     count = max(len(T), 1)
     per_pose = {name: value / count * 1e6 for name, value in best_of(tasks, repeats).items()}
-
-    # in the answer: the whole answer again, stages looked up from tables made on a first, untimed pass
-    def whole_with(*lookups) -> float:
-        with _looked_up(lookups):
-            run = whole(options[open_name])
-            run()
-            return best_of({"whole": run}, repeats)["whole"] / count * 1e6
-
-    solve_lookup = (type(plan), "solve_one", lambda self, pose, reference=None: pose.tobytes(), None)
-    check_lookup = (_closed_form, "verify_one", lambda robot, goal, one_pose, reference=None: id(one_pose),
-                    _fresh_verified)
-    # (the solve looked up, each pose's scalar answer is one object, and so is each of its rows)
-    fk_lookup = (_goals, "tool_columns_scalar_rows", lambda robot, rows: tuple(map(id, rows)), None)
     whole_open = per_pose[f"whole {open_name}"]
-    without_solve = whole_with(solve_lookup)
-    without_solve_and_fk = whole_with(solve_lookup, fk_lookup)
-    without_solve_and_check = whole_with(solve_lookup, check_lookup)
+    without_solve = per_pose["whole, solve looked up"]
+    without_solve_and_fk = per_pose["whole, solve and FK looked up"]
+    without_solve_and_check = per_pose["whole, solve and check looked up"]
     solutions = sum(len(r) for r in rows) / count
     stages = [Stage("scalar solve (plan.solve_one)", per_pose["scalar solve"], whole_open - without_solve),
               Stage("FK check (verify_one)", per_pose["FK check"], without_solve - without_solve_and_check),
@@ -161,31 +167,43 @@ def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile
                    per_pose["FK of the solutions"] / max(solutions, 1e-9), per_pose.get("EAIK"), eaik_note)
 
 
+@dataclass
+class Lookup:
+    """``owner.name`` answered from ``table``, its results by ``key(*arguments)`` (made on the first call with each
+    key), while :func:`_looked_up` holds it; ``fresh`` (or None) makes each answer a new object of the stored one
+    (an object the answer changes, as a lazily built table)."""
+
+    owner: object
+    name: str
+    key: Callable[..., object]
+    fresh: Callable[[object], object] | None = None
+    table: dict = field(default_factory=dict)
+
+    def bound_to(self, original: Callable) -> Callable:
+        def looked_up(*args, **kwargs):
+            found = self.key(*args, **kwargs)
+            if found not in self.table:
+                self.table[found] = original(*args, **kwargs)
+            return self.table[found] if self.fresh is None else self.fresh(self.table[found])
+        return looked_up
+
+
 @contextmanager
-def _looked_up(lookups) -> Iterator[None]:
-    """Within, each ``(owner, name, key, fresh)`` of ``lookups`` has ``owner.name`` answer from a table of its
-    results, made on the first call with each ``key(*arguments)``; ``fresh`` (or None) makes each answer a new
-    object of the stored one (an object the answer changes, as a lazily built table)."""
+def _looked_up(lookups: tuple[Lookup, ...]) -> Iterator[None]:
+    """Within, each of ``lookups`` answers in place of its function; afterwards the functions are as they were."""
     saved = []
-    for owner, name, key, fresh in lookups:
-        original, own = getattr(owner, name), name in vars(owner)
-
-        def looked_up(*args, _original=original, _key=key, _fresh=fresh, _table={}, **kwargs):
-            found = _key(*args, **kwargs)
-            if found not in _table:
-                _table[found] = _original(*args, **kwargs)
-            return _table[found] if _fresh is None else _fresh(_table[found])
-
-        saved.append((owner, name, original, own))
-        setattr(owner, name, looked_up)
+    for lookup in lookups:
+        original, own = getattr(lookup.owner, lookup.name), lookup.name in vars(lookup.owner)
+        saved.append((lookup, original, own))
+        setattr(lookup.owner, lookup.name, lookup.bound_to(original))
     try:
         yield
     finally:
-        for owner, name, original, own in reversed(saved):
+        for lookup, original, own in reversed(saved):
             if own:
-                setattr(owner, name, original)
+                setattr(lookup.owner, lookup.name, original)
             else:
-                delattr(owner, name)
+                delattr(lookup.owner, lookup.name)
 
 
 def _fresh_verified(verified: OnePoseVerified | None) -> OnePoseVerified | None:

@@ -370,6 +370,33 @@ def _outcome(rows: np.ndarray, kept: SolutionTable, n_kept: np.ndarray, rejected
     return Selection(status, truncated, trimmed, available, notes, kept, rejected)
 
 
+def _one_outcome(rows: int, kept: SolutionTable, rejected: SolutionTable, candidates: int, available: int,
+                 with_all_moves: int, capped: bool, max_equivalents: int, has_reference: bool, n: int) -> Selection:
+    """:func:`_outcome` of one target (:func:`_one_target`: no row excluded, no limit lowered) from its counts as
+    Python integers: the same rules and the same columns (arrays (1,) of the same dtypes), without an array
+    operation per rule, each of which costs more than its arithmetic for one target. ``kept`` and ``rejected``
+    are its two tables (their lengths are ``n_kept`` and ``n_rejected`` there)."""
+    n_kept, n_rejected = len(kept), len(rejected)
+    outside = n_kept - np.count_nonzero(kept.within_limits)  # kept but flagged: outside the limits
+    none_kept = candidates == 0 and n_rejected > 0  # (a target with no row at all rejects none either)
+    status = "unreachable" if rows == 0 else "no_solution_within_limits" if none_kept else "ok"
+    truncated = not capped and available > n_kept
+    trimmed = min(with_all_moves - available + (available - n_kept if capped else 0), COUNT_CAP)
+    noted = (none_kept or truncated or outside > 0
+             or (rows > 0 and not none_kept and n_kept == 0 and with_all_moves > 0))
+    status_column = np.empty(1, dtype=object)
+    status_column[0] = status
+    truncated_column = np.array([truncated])
+    available_column = np.array([available], dtype=np.int64)
+    notes = TargetNotes(np.array([0] if noted else [], dtype=np.int64), status_column,
+                        np.array([n_rejected], dtype=np.int64), np.array([outside], dtype=np.int64),
+                        truncated_column, available_column, np.array([n_kept], dtype=np.int64),
+                        np.array([with_all_moves], dtype=np.int64), np.zeros(1, dtype=np.int64), max_equivalents,
+                        has_reference, None, n)
+    return Selection(status_column, truncated_column, np.array([trimmed], dtype=np.int64), available_column, notes,
+                     kept, rejected)
+
+
 def _each_once(robot: Robot, limits: Limits, table: SolutionTable, n_targets: int, first: np.ndarray,
                last: np.ndarray, fits: np.ndarray, filter_limits: bool, max_equivalents: int) -> Selection:
     """:func:`select` where every row that fits the limits does so at exactly one 2π-equivalent (limits within a
@@ -536,13 +563,12 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
     at_zero = ((q > bounds.zero_turn_low) & (q < bounds.zero_turn_high)).all(axis=1).tolist()
     if all(at_zero) and n_rows <= limit and ordering.max_joint_move is None:
         # every row kept, at q + 2π·0 as the arrays list it (nearest first with a reference)
-        counts = np.array([n_rows], dtype=np.int64)
         order = slice(None) if reference is None else np.argsort(travel(robot, limits, q, reference, ordering),
                                                                   kind="stable")
         kept = table.listed_at(q + 0.0, np.ones(n_rows, dtype=bool)) if reference is None else table.take(
             order, joints=q[order] + 0.0, within_limits=np.ones(n_rows, dtype=bool))
-        return _outcome(counts, kept, counts, table.take(slice(0, 0)), counts, counts, counts,
-                        np.zeros(1, dtype=np.int64), capped, max_equivalents, reference is not None, None, n)
+        return _one_outcome(n_rows, kept, table.take(slice(0, 0)), n_rows, n_rows, n_rows, capped, max_equivalents,
+                            reference is not None, n)
     zero = [0.0] * n
     fits, firsts, lasts, candidates, dropped, dropped_turns, combinations = [], [], [], [], [], [], 0
     for row, (simple, values) in enumerate(zip(at_zero, q.tolist())):
@@ -590,10 +616,8 @@ def _one_target(robot: Robot, limits: Limits, table: SolutionTable, filter_limit
         order = np.argsort(travel(robot, limits, dropped_values, reference, ordering), kind="stable")
         dropped, dropped_values = dropped[order], dropped_values[order]
     rejected = table.take(dropped, joints=dropped_values, within_limits=fits[dropped])
-    rows, n_kept, n_candidates, available, with_all_moves = (np.array([count], dtype=np.int64) for count in (
-        n_rows, len(kept_rows), len(candidates), available, combinations))
-    return _outcome(rows, kept, n_kept, rejected, n_candidates, available, with_all_moves,
-                    np.zeros(1, dtype=np.int64), capped, max_equivalents, reference is not None, None, n)
+    return _one_outcome(n_rows, kept, rejected, len(candidates), available, combinations, capped, max_equivalents,
+                        reference is not None, n)
 
 
 def _nearest_of_one(robot: Robot, limits: Limits, q: np.ndarray, firsts: list[list[float]],

@@ -81,7 +81,10 @@ def _assert_identical(mine, index, general, general_index) -> None:
     """Target ``index`` of selection ``mine`` and ``general_index`` of ``general`` agree in every field."""
     for name in ("status", "truncated", "trimmed", "available"):
         assert getattr(mine, name)[index] == getattr(general, name)[general_index], name
+        assert getattr(mine, name).dtype == getattr(general, name).dtype, name  # the encoders list them as they are
     assert mine.notes.get(index, []) == general.notes.get(general_index, [])
+    assert (index in mine.notes) == (general_index in general.notes)  # noted, even where a note has no words
+    assert mine.notes.rows.dtype == general.notes.rows.dtype
     for kind in ("solutions", "rejected"):
         assert _rows(getattr(mine, kind), index) == _rows(getattr(general, kind), general_index), kind
 
@@ -157,6 +160,28 @@ def test_one_target_selects_as_the_general_path(monkeypatch, calls):
         and calls["one target, nearest first"] > 30 and calls["one target, within a joint move"] > 20 \
         and calls["nearest on floats"] > 30 \
         and kept_many > 100, (ranked, calls, kept_many)
+
+
+def test_a_target_without_rows_is_selected_as_the_general_path_selects_it(monkeypatch):
+    """A target the solver found no row for (unreachable) goes through the one-target path too: its status, its
+    counts and its notes (none) as the general path gives them inside a batch, whatever the limits' filter."""
+    rng = np.random.default_rng(20261206)
+    for case in range(20):
+        robot, target, options = _random_case(rng)
+        empty = SolutionTable.empty(robot.dof)
+        others = table_of_arrays(solve_ik_arrays(robot, forward_kinematics(robot, rng.uniform(-np.pi, np.pi,
+                                                                                               (2, robot.dof)))))
+        batch = SolutionTable.concat([others.take(others.target < 1), others.take(others.target >= 1)
+                                      .with_targets(others.take(others.target >= 1).target + 1)], robot.dof)
+        arguments = dict(filter_limits=options.filter_limits, max_equivalents=options.max_equivalents)
+        mine = select(robot, empty, 1, options.limits, **arguments)
+        with monkeypatch.context() as forced:
+            forced.setattr(_equivalents, "_FEW_ROWS", -1)
+            forced.setattr(_equivalents, "_FEW_RANKS", -1)
+            general = select(robot, batch, 3, options.limits, excluded=np.zeros(len(batch), dtype=bool),
+                             **arguments)
+        assert mine.status[0] == general.status[1] == "unreachable", case
+        _assert_identical(mine, 0, general, 1)
 
 
 def test_few_combinations_without_a_reference_come_in_the_general_paths_order(monkeypatch, calls):

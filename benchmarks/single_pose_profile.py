@@ -27,12 +27,15 @@ the others' code and cost more. So each stage of the floor is also timed **in th
 with that stage's results looked up from a table made beforehand (the scalar solve, keyed by the pose's bytes; the
 FK of the solutions, keyed by their rows; the FK check, keyed by the scalar answer it checks), interleaved with
 the other rows in each round, the difference being what the stage costs where it runs. A lookup costs a
-microsecond or so, so those figures are a little low.
+microsecond or so, so those figures are a little low. Every row is timed with the objects the warm-up left (the
+lookups' tables among them) frozen out of the garbage collector's passes (``gc.freeze``, as the service freezes its
+start-up objects): kept alive and tracked, the tables would lengthen each pass of the looked-up rows alone.
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -147,7 +150,11 @@ def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile
     for task in tasks.values():  # warm-up, and the lookups' tables
         task()
     count = max(len(T), 1)
-    per_pose = {name: value / count * 1e6 for name, value in best_of(tasks, repeats).items()}
+    gc.freeze()  # what the warm-up left (the lookups' tables too) out of the collector's passes, as the service's
+    try:         # start-up objects are: tables kept alive would lengthen every pass of the looked-up rows alone
+        per_pose = {name: value / count * 1e6 for name, value in best_of(tasks, repeats).items()}
+    finally:
+        gc.unfreeze()
     whole_open = per_pose[f"whole {open_name}"]
     without_solve = per_pose["whole, solve looked up"]
     without_solve_and_fk = per_pose["whole, solve and FK looked up"]

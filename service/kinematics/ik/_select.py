@@ -382,8 +382,8 @@ def _one_outcome(rows: int, kept: SolutionTable, rejected: SolutionTable, candid
     status = "unreachable" if rows == 0 else "no_solution_within_limits" if none_kept else "ok"
     truncated = not capped and available > n_kept
     trimmed = min(with_all_moves - available + (available - n_kept if capped else 0), COUNT_CAP)
-    noted = (none_kept or truncated or outside > 0
-             or (rows > 0 and not none_kept and n_kept == 0 and with_all_moves > 0))
+    # (no collision excludes a row here, so every target with none kept is noted: _outcome's no_fit is none_kept)
+    noted = none_kept or truncated or outside > 0 or (rows > 0 and n_kept == 0 and with_all_moves > 0)
     status_column = np.empty(1, dtype=object)
     status_column[0] = status
     truncated_column = np.array([truncated])

@@ -184,6 +184,30 @@ def test_a_target_without_rows_is_selected_as_the_general_path_selects_it(monkey
         _assert_identical(mine, 0, general, 1)
 
 
+def test_one_outcome_is_the_outcome_of_one_target():
+    """``_select._one_outcome`` (one target's counts on Python integers) against ``_select._outcome`` (the
+    arrays' rules) on random counts, zeros and caps included: the same status, columns, dtypes and notes."""
+    rng = np.random.default_rng(20261207)
+    for case in range(400):
+        n_rows, n_kept, n_rejected = (int(rng.choice([0, 1, 2, 5])) for _ in range(3))
+        kept = SolutionTable(np.zeros(n_kept, dtype=np.int64), np.zeros((n_kept, 6)), rng.random(n_kept) < 0.7,
+                             np.zeros(n_kept), np.zeros(n_kept), {})
+        rejected = SolutionTable(np.zeros(n_rejected, dtype=np.int64), np.zeros((n_rejected, 6)),
+                                 np.zeros(n_rejected, dtype=bool), np.zeros(n_rejected), np.zeros(n_rejected), {})
+        candidates = int(rng.choice([0, 1, n_kept, n_kept + 2]))
+        available = n_kept + int(rng.choice([0, 0, 1, 7, 2 ** 60]))
+        with_all_moves = available + int(rng.choice([0, 0, 3]))
+        capped, has_reference, cap = bool(rng.random() < 0.3), bool(rng.random() < 0.5), int(rng.choice([1, 3, 64]))
+        mine = _select._one_outcome(n_rows, kept, rejected, candidates, available, with_all_moves, capped, cap,
+                                    has_reference, 6)
+        general = _select._outcome(*(np.array([count], dtype=np.int64) for count in (n_rows,)), kept,
+                                   np.array([n_kept], dtype=np.int64), rejected,
+                                   *(np.array([count], dtype=np.int64) for count in (candidates, available,
+                                                                                      with_all_moves, 0)),
+                                   capped, cap, has_reference, None, 6)
+        _assert_identical(mine, 0, general, 0)
+
+
 def test_few_combinations_without_a_reference_come_in_the_general_paths_order(monkeypatch, calls):
     """Without a reference, one target's few combinations (``_select._FEW_COMBINATIONS``) are put in order on
     Python integers: the same rows, values and counts as the general path, over the random cases without their

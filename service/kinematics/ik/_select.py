@@ -50,7 +50,7 @@ import numpy as np
 
 from .._budget import COUNT_CAP, UNLIMITED, Budget
 from .._errors import InvalidInputError
-from .._limits import Limits, closest_turns, turn_ranges, turns_of_row
+from .._limits import MULTI_VALUED, Limits, closest_turns, turn_ranges, turns_of_row
 from .._robot import Robot
 from ._equivalents import (MAX_COMBINATIONS_PER_SOLUTION, capped_products, capped_sums, combination_turns,
                            down_set_size, enumerable_limit, position_in_group, rounds_needed)
@@ -212,17 +212,23 @@ def effective_reference(robot: Robot, limits: Limits, reference: np.ndarray) -> 
     [-2.2832]
     """
     bounds = limits.widened(robot)
-    lower, upper, multi_valued = bounds.lower, bounds.upper, bounds.multi_valued
-    outside = multi_valued & ((reference < lower) | (reference > upper))
-    if not outside.any():
+    values = reference.tolist()  # one vector of a few joints: on floats, without an array operation a rule
+    # (a value that is not finite stays as it is: no whole turn brings it within)
+    outside = [joint for joint, (value, (kind, lower, upper, *_)) in enumerate(zip(values, bounds.rules))
+               if kind == MULTI_VALUED and (value < lower or value > upper) and math.isfinite(value)]
+    if not outside:
         return reference
     tolerance = limits.tolerance(robot)
-    with np.errstate(invalid="ignore"):  # whole turns towards the nearer bound, the fewest that cross it
-        turns = np.where(reference > limits.upper, -np.ceil((reference - limits.upper - tolerance) / _TWO_PI),
-                         np.ceil((lower - reference) / _TWO_PI))
-    moved = reference + _TWO_PI * np.where(outside, turns, 0.0)
-    fits = (moved >= lower) & (moved <= upper)
-    return np.where(outside & fits, moved, reference)
+    for joint in outside:
+        _, lower, upper, _, _, _, stated_upper = bounds.rules[joint]
+        value = values[joint]
+        # whole turns towards the nearer bound, the fewest that cross it
+        turns = (-math.ceil((value - stated_upper - float(tolerance[joint])) / _TWO_PI) if value > stated_upper
+                 else math.ceil((lower - value) / _TWO_PI))
+        moved = value + _TWO_PI * turns
+        if lower <= moved <= upper:
+            values[joint] = moved
+    return np.array(values)
 
 
 def select(robot: Robot, table: SolutionTable, n_targets: int, limits: Limits, *, filter_limits: bool = True,

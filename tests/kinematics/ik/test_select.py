@@ -386,3 +386,47 @@ def test_a_reference_outside_the_limits_is_met_at_its_equivalent_within_them():
     selection = select(narrow, IKResult("ok", solutions, "analytic", "test", True), Limits.of(narrow),
                        reference=np.array([2.5]))
     assert [entry.solution.joints[0] for entry in selection.solutions] == [0.9, -0.9]
+
+
+def _effective_reference_on_arrays(robot, limits, reference):
+    """The arrays' rule :func:`effective_reference` applied before it went to floats (the same arithmetic, every
+    joint at once): the independent form the float one must equal bit for bit."""
+    bounds = limits.widened(robot)
+    lower, upper, multi_valued = bounds.lower, bounds.upper, bounds.multi_valued
+    outside = multi_valued & ((reference < lower) | (reference > upper))
+    tolerance = limits.tolerance(robot)
+    with np.errstate(invalid="ignore"):
+        turns = np.where(reference > limits.upper, -np.ceil((reference - limits.upper - tolerance) / (2 * np.pi)),
+                         np.ceil((lower - reference) / (2 * np.pi)))
+        moved = reference + 2 * np.pi * np.where(outside, turns, 0.0)
+    fits = (moved >= lower) & (moved <= upper)
+    return np.where(outside & fits, moved, reference)
+
+
+def test_the_effective_reference_is_the_arrays_rule_on_random_references():
+    """``effective_reference`` on floats against the arrays' rule: references inside and outside limits of every
+    kind (within a turn, several turns, one-sided, open, a slide, narrower than the tolerance), values exactly at a
+    bound, a whole turn past it, far away, and not finite (kept as they are)."""
+    from service.kinematics.ik._select import effective_reference
+
+    rng = np.random.default_rng(20261208)
+    moved = 0
+    for case in range(300):
+        n = int(rng.integers(1, 8))
+        kinds = rng.choice(["revolute", "prismatic"], n, p=[0.85, 0.15])
+        robot = Robot([Joint(f"q{j + 1}", str(kind), 0.3, 0.1, 0.2, 0.0) for j, kind in enumerate(kinds)])
+        centre, width = rng.uniform(-4, 4, n), rng.choice([1e-10, 0.3, 2.0, np.pi, 2 * np.pi, 9.0], n)
+        lower, upper = centre - width, centre + width
+        lower = np.where(rng.random(n) < 0.15, -np.inf, lower)
+        upper = np.where(rng.random(n) < 0.15, np.inf, upper)
+        limits = Limits(lower, upper)
+        reference = rng.uniform(-20, 20, n)
+        at = rng.random(n)
+        reference = np.where(at < 0.1, lower, np.where(at < 0.2, upper + 2 * np.pi, reference))
+        reference = np.where(rng.random(n) < 0.03, rng.choice([np.inf, -np.inf, np.nan, 1e300]), reference)
+        got = effective_reference(robot, limits, reference)
+        expected = _effective_reference_on_arrays(robot, limits, reference)
+        assert got.dtype == expected.dtype and got.shape == expected.shape
+        assert got.tobytes() == expected.tobytes(), case  # bit for bit, NaN and the zeros' signs included
+        moved += int(np.sum(got != reference))
+    assert moved > 100, moved

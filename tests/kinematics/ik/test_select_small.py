@@ -140,7 +140,7 @@ def calls(monkeypatch):
 
 def test_one_target_selects_as_the_general_path(monkeypatch, calls):
     rng = np.random.default_rng(20240611)
-    ranked = kept_many = 0
+    ranked = kept_many = rejected_in_order = 0
     for case in range(250):
         robot, target, options = _random_case(rng)
         before = calls["few rows"]
@@ -148,6 +148,7 @@ def test_one_target_selects_as_the_general_path(monkeypatch, calls):
         ranked += calls["few rows"] > before
         _assert_identical(mine, 0, general, 3)
         kept_many += int(np.sum(mine.solutions.target == 0)) > 1
+        rejected_in_order += options.reference is not None and len(mine.rejected) > 1  # (nearest first)
         # and the answer built on it (one part, one target) keeps it as it is
         answer = answer_ik(robot, IKTargets.poses(target[None]), options)
         assert _rows(answer.solutions, 0) == _rows(mine.solutions, 0), case
@@ -159,7 +160,7 @@ def test_one_target_selects_as_the_general_path(monkeypatch, calls):
     assert ranked > 50 and calls["general"] > 50 and calls["one target"] > 30 and calls["few in turn"] > 20 \
         and calls["one target, nearest first"] > 30 and calls["one target, within a joint move"] > 20 \
         and calls["nearest on floats"] > 30 \
-        and kept_many > 100, (ranked, calls, kept_many)
+        and kept_many > 100 and rejected_in_order > 20, (ranked, calls, kept_many, rejected_in_order)
 
 
 def test_a_target_without_rows_is_selected_as_the_general_path_selects_it(monkeypatch):

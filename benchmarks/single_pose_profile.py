@@ -9,7 +9,7 @@ row, and the catalogue's limits) and then each stage alone, on the same poses, i
 them for a closed-form arm:
 
 * scalar solve: the family's one-pose path (``plan.solve_one``), every candidate slot on Python floats;
-* FK of the solutions: the forward kinematics the FK check runs on them (the core's chain program as straight-line
+* FK of the candidates: the forward kinematics the FK check runs on them (the core's chain program as straight-line
   float arithmetic, ``tool_columns_scalar_rows``), alone;
 * FK check (``verify_one``): that forward kinematics, the residuals, the duplicate scan, the labels, the promise;
 * table: the verified rows as a ``SolutionTable`` (``one_pose_table``);
@@ -19,13 +19,13 @@ them for a closed-form arm:
 
 Beside them EAIK's ``IK`` of each pose, its solutions turned into an array (what ``benchmarks.core`` times), and the
 budget the goal sets, 10× that. The **floor** is what no answer can skip: the solve and the forward kinematics of
-every solution it returns (each one is verified by FK before it leaves the service). Where the floor alone is near
-or beyond the budget, the goal is out of reach of a core in Python and numpy, whatever the glue.
+every candidate it proposes (each solution is verified by FK before it leaves the service). Where the floor alone is
+near or beyond the budget, the goal is out of reach of a core in Python and numpy, whatever the glue.
 
 Stages timed alone run hot (the same few functions in a loop over the poses); inside the answer they run among
 the others' code and cost more. So each stage of the floor is also timed **in the answer**: the whole answer again
 with that stage's results looked up from a table made beforehand (the scalar solve, keyed by the pose's bytes; the
-FK of the solutions, keyed by their rows; the FK check, keyed by the scalar answer it checks), interleaved with
+FK of the candidates, keyed by their rows; the FK check, keyed by the scalar answer it checks), interleaved with
 the other rows in each round, the difference being what the stage costs where it runs. A lookup costs a
 microsecond or so, so those figures are a little low. Every row is timed with the objects the warm-up left (the
 lookups' tables among them) frozen out of the garbage collector's passes (``gc.freeze``, as the service freezes its
@@ -76,18 +76,18 @@ class Profile:
     robot: str
     poses: int
     declined: int  # poses the scalar path declined (not clearly generic): answered on arrays, left out here
-    solutions: float  # verified solutions a pose
+    candidates: float  # the scalar path's valid slots a pose: the rows the FK check runs on
     whole: dict[str, float]  # limit setting → µs a pose
     stages: list[Stage]
     selection: dict[str, float]  # limit setting → µs a pose
-    fk_per_solution: float
+    fk_per_candidate: float  # µs
     eaik: float | None  # µs a pose, or None when EAIK is missing or does not take the arm
     eaik_note: str = ""
 
     def floor(self, in_answer: bool) -> float:
-        """The scalar solve and the forward kinematics of its solutions, µs a pose, alone or in the answer."""
+        """The scalar solve and the forward kinematics of its candidates, µs a pose, alone or in the answer."""
         return sum(stage.in_answer if in_answer else stage.alone for stage in self.stages
-                   if stage.name.startswith(("scalar solve", "FK of the solutions")))
+                   if stage.name.startswith(("scalar solve", "FK of the candidates")))
 
 
 def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile:
@@ -139,7 +139,7 @@ def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile
         "whole, solve and FK looked up": whole_with(solve, fk),
         "whole, solve and check looked up": whole_with(solve, check),
         "scalar solve": lambda: [plan.solve_one(pose, None) for pose in T],
-        "FK of the solutions": lambda: [tool_columns_scalar_rows(robot, r) for r in rows],
+        "FK of the candidates": lambda: [tool_columns_scalar_rows(robot, r) for r in rows],
         "FK check": lambda: [verify_one(robot, goal, one_pose, None) for goal, one_pose in zip(goals, one_poses)],
         "table": lambda: [one_pose_table([r], robot.dof) for r in kept_rows],
         **{f"selection {name}": selected(option) for name, option in options.items()},
@@ -159,19 +159,19 @@ def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile
     without_solve = per_pose["whole, solve looked up"]
     without_solve_and_fk = per_pose["whole, solve and FK looked up"]
     without_solve_and_check = per_pose["whole, solve and check looked up"]
-    solutions = sum(len(r) for r in rows) / count
+    candidates = sum(len(r) for r in rows) / count
     stages = [Stage("scalar solve (plan.solve_one)", per_pose["scalar solve"], whole_open - without_solve),
               Stage("FK check (verify_one)", per_pose["FK check"], without_solve - without_solve_and_check),
-              Stage("FK of the solutions (the chain program on floats)", per_pose["FK of the solutions"],
+              Stage("FK of the candidates (the chain program on floats)", per_pose["FK of the candidates"],
                     without_solve - without_solve_and_fk, 2),
               Stage("the rest: table, selection, targets, plan look-up, assembly, IKAnswer",
                     whole_open - per_pose["scalar solve"] - per_pose["FK check"], without_solve_and_check),
               Stage("table (one_pose_table)", per_pose["table"], None, 2),
               Stage(f"selection (select), {open_name}", per_pose[f"selection {open_name}"], None, 2)]
-    return Profile(label, count, poses - len(kept), solutions,
+    return Profile(label, count, poses - len(kept), candidates,
                    {name: per_pose[f"whole {name}"] for name in LIMIT_SETTINGS}, stages,
                    {name: per_pose[f"selection {name}"] for name in LIMIT_SETTINGS},
-                   per_pose["FK of the solutions"] / max(solutions, 1e-9), per_pose.get("EAIK"), eaik_note)
+                   per_pose["FK of the candidates"] / max(candidates, 1e-9), per_pose.get("EAIK"), eaik_note)
 
 
 @dataclass
@@ -245,7 +245,7 @@ def format_profile(profile: Profile) -> str:
         return (f"| {'  ' * indent}{name} | {alone:.1f} | {situ} | {share / whole:.2f} | "
                 f"{ratio(in_answer if in_answer is not None else alone)} |")
 
-    lines = [f"**{profile.robot}**: {profile.poses} poses, {profile.solutions:.2f} solutions a pose"
+    lines = [f"**{profile.robot}**: {profile.poses} poses, {profile.candidates:.2f} candidates a pose checked by FK"
              + (f" ({profile.declined} more declined by the scalar path, left out)" if profile.declined else ""),
              "", "| stage | µs a pose, alone | µs a pose, in the answer | share of the whole answer | × EAIK |",
              "|---|---:|---:|---:|---:|", row(f"whole answer (answer_ik), {open_name}", whole, whole)]
@@ -257,18 +257,18 @@ def format_profile(profile: Profile) -> str:
     if profile.eaik:
         lines.append(row("EAIK IK (its solutions as an array)", profile.eaik, profile.eaik))
     lines.append("")
-    lines.append(f"- FK of one solution on floats, alone: {profile.fk_per_solution:.2f} µs")
+    lines.append(f"- FK of one candidate on floats, alone: {profile.fk_per_candidate:.2f} µs")
     alone, in_answer = profile.floor(False), profile.floor(True)
     floor = f"{alone:.1f} µs alone, {in_answer:.1f} in the answer"
     if profile.eaik:
         budget = GOAL_RATIO * profile.eaik
         lines.append(f"- the goal's budget ({GOAL_RATIO:g}× EAIK): {budget:.1f} µs; the whole answer "
                      f"{whole / profile.eaik:.1f}× EAIK")
-        lines.append(f"- the floor (the scalar solve + the FK of its solutions): {floor}; "
+        lines.append(f"- the floor (the scalar solve + the FK of its candidates): {floor}; "
                      f"{alone / profile.eaik:.1f}× / {in_answer / profile.eaik:.1f}× EAIK, "
                      f"{alone / budget:.2f} / {in_answer / budget:.2f} of the budget")
     else:
-        lines.append(f"- the floor (the scalar solve + the FK of its solutions): {floor} ({profile.eaik_note})")
+        lines.append(f"- the floor (the scalar solve + the FK of its candidates): {floor} ({profile.eaik_note})")
     return "\n".join(lines)
 
 

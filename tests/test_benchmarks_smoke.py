@@ -85,11 +85,11 @@ def test_single_pose_profile_runs_with_tiny_sizes(capsys):
     for stage in ("scalar solve (plan.solve_one)", "FK check (verify_one)",
                   "the rest: table, selection, targets, plan look-up, assembly, IKAnswer"):
         assert out.count(f"|   {stage} |") == 2
-    for stage in ("FK of the solutions (the chain program on floats)", "table (one_pose_table)",
+    for stage in ("FK of the candidates (the chain program on floats)", "table (one_pose_table)",
                   "selection (select), limits ±π, no filter"):
         assert out.count(f"|     {stage} |") == 2
     assert out.count("| whole answer (answer_ik), catalogue limits |") == 2
-    assert out.count("- the floor (the scalar solve + the FK of its solutions): ") == 2
+    assert out.count("- the floor (the scalar solve + the FK of its candidates): ") == 2
 
 
 def test_the_single_pose_profile_leaves_the_core_as_it_found_it():

@@ -5,7 +5,6 @@ filter keeps exactly the solutions at least the margin clear; hostile inputs are
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from tests.collision_check import independent_check

@@ -121,7 +121,6 @@ PUMA = "puma560_modified"
 def test_puma_wrist_singularity(client, theta5, relation, combined):
     """θ5 = 0 (axes 4 and 6 aligned, same sense in Craig's frames): only θ4 + θ6 is determined; θ5 = π: θ4 − θ6.
     One representative with θ4 = the reference value, or 0; the other three arm branches keep both wrists."""
-    robot = catalogue_robot(client, PUMA)
     q = np.array([0.3, -0.6, 0.4, 0.8, theta5, -0.5])
     T = CLOSED_FORMS[PUMA](q)
     for reference, q4 in ((None, 0.0), ([0.0, 0.0, 0.0, 1.1, 0.0, 0.0], 1.1), ([0.3, -0.6, 0.4, -2.9, 0, 0], -2.9)):

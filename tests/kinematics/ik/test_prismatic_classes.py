@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from service.kinematics import Joint, Robot, forward_kinematics
+from service.kinematics import Robot, forward_kinematics
 from service.kinematics.ik import joint_difference, solve_ik, solve_ik_arrays
 from service.kinematics.ik import cached_plan
 from service.kinematics.ik.subproblems import subproblem_5_prismatic

@@ -69,6 +69,7 @@ class Stage:
     alone: float  # µs a pose, timed alone
     in_answer: float | None = None  # µs a pose, what the whole answer saves when the stage is looked up
     indent: int = 1
+    floor: bool = False  # part of what every answer pays (the solve, the FK of its candidates)
 
 
 @dataclass
@@ -86,8 +87,7 @@ class Profile:
 
     def floor(self, in_answer: bool) -> float:
         """The scalar solve and the forward kinematics of its candidates, µs a pose, alone or in the answer."""
-        return sum(stage.in_answer if in_answer else stage.alone for stage in self.stages
-                   if stage.name.startswith(("scalar solve", "FK of the candidates")))
+        return sum(stage.in_answer if in_answer else stage.alone for stage in self.stages if stage.floor)
 
 
 def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile:
@@ -160,10 +160,11 @@ def profile_robot(label: str, robot: Robot, poses: int, repeats: int) -> Profile
     without_solve_and_fk = per_pose["whole, solve and FK looked up"]
     without_solve_and_check = per_pose["whole, solve and check looked up"]
     candidates = sum(len(r) for r in rows) / count
-    stages = [Stage("scalar solve (plan.solve_one)", per_pose["scalar solve"], whole_open - without_solve),
+    stages = [Stage("scalar solve (plan.solve_one)", per_pose["scalar solve"], whole_open - without_solve,
+                    floor=True),
               Stage("FK check (verify_one)", per_pose["FK check"], without_solve - without_solve_and_check),
               Stage("FK of the candidates (the chain program on floats)", per_pose["FK of the candidates"],
-                    without_solve - without_solve_and_fk, 2),
+                    without_solve - without_solve_and_fk, 2, floor=True),
               Stage("the rest: table, selection, targets, plan look-up, assembly, IKAnswer",
                     whole_open - per_pose["scalar solve"] - per_pose["FK check"], without_solve_and_check),
               Stage("table (one_pose_table)", per_pose["table"], None, 2),
@@ -241,9 +242,8 @@ def format_profile(profile: Profile) -> str:
 
     def row(name: str, alone: float, in_answer: float | None = None, indent: int = 0) -> str:
         situ = "" if in_answer is None else f"{in_answer:.1f}"
-        share = in_answer if in_answer is not None else alone
-        return (f"| {'  ' * indent}{name} | {alone:.1f} | {situ} | {share / whole:.2f} | "
-                f"{ratio(in_answer if in_answer is not None else alone)} |")
+        share = in_answer if in_answer is not None else alone  # where it runs, when measured there
+        return f"| {'  ' * indent}{name} | {alone:.1f} | {situ} | {share / whole:.2f} | {ratio(share)} |"
 
     lines = [f"**{profile.robot}**: {profile.poses} poses, {profile.candidates:.2f} candidates a pose checked by FK"
              + (f" ({profile.declined} more declined by the scalar path, left out)" if profile.declined else ""),

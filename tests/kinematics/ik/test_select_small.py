@@ -172,8 +172,9 @@ def test_a_target_without_rows_is_selected_as_the_general_path_selects_it(monkey
         empty = SolutionTable.empty(robot.dof)
         others = table_of_arrays(solve_ik_arrays(robot, forward_kinematics(robot, rng.uniform(-np.pi, np.pi,
                                                                                                (2, robot.dof)))))
-        batch = SolutionTable.concat([others.take(others.target < 1), others.take(others.target >= 1)
-                                      .with_targets(others.take(others.target >= 1).target + 1)], robot.dof)
+        later = others.take(others.target >= 1)  # the empty target between the two others: number 1
+        batch = SolutionTable.concat([others.take(others.target < 1), later.with_targets(later.target + 1)],
+                                     robot.dof)
         arguments = dict(filter_limits=options.filter_limits, max_equivalents=options.max_equivalents)
         mine = select(robot, empty, 1, options.limits, **arguments)
         with monkeypatch.context() as forced:
